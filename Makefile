@@ -1,0 +1,30 @@
+# Two commands do all the set-up on a fresh machine (Python >= 3.11 and make present):
+#   make demo   -> virtual environment + install + default scenario
+#   make test   -> virtual environment + install + test suite
+PYTHON ?= python3
+VENV ?= .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.installed
+DEMO_OUT ?= results/demo
+
+.PHONY: demo test install bench clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e ".[test]"
+	touch $(STAMP)
+
+install: $(STAMP)
+
+demo: $(STAMP)
+	$(PY) -m scenarios.demo --out $(DEMO_OUT)
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+bench: $(STAMP)
+	$(PY) -m scenarios.bench_engine
+
+clean:
+	rm -rf $(VENV) results .pytest_cache .hypothesis

@@ -1,0 +1,25 @@
+"""mbd: a generic planar rigid-body engine.
+
+Static :class:`Model` built by a :class:`ModelBuilder`; mutable :class:`State`; vectorised element
+families (:mod:`mbd.element`); sparse assembly (:class:`System`); HHT-α stepper with step controllers
+and one :func:`simulate` loop; chunked atomic :class:`Recorder`; a scipy ``solve_ivp`` adapter;
+linearization and modal analysis. It knows nothing about gears or bearings.
+"""
+from .assembly import Counters, System
+from .control import Adaptive, FixedStep
+from .element import Element, body_dofs, marker, marker_velocity, point_force
+from .errors import IntegrationError, ModelError
+from .hht import HHT, Tolerance, hht_coefficients
+from .modal import linearize, modal_analysis
+from .model import BodyRef, Frame, FrameState, Model, ModelBuilder, State, to_fixed, to_reference
+from .recorder import BodyMotion, ElementOutput, Recorder
+from .scipy_adapter import FirstOrderSystem, solve_scipy
+from .simulate import Checkpoint, SimResult, load_state, save_state, simulate
+
+__all__ = [
+    "Adaptive", "BodyMotion", "BodyRef", "Checkpoint", "Counters", "Element", "ElementOutput",
+    "FirstOrderSystem", "FixedStep", "Frame", "FrameState", "HHT", "IntegrationError", "Model",
+    "ModelBuilder", "ModelError", "Recorder", "SimResult", "State", "System", "Tolerance",
+    "body_dofs", "hht_coefficients", "linearize", "load_state", "marker", "marker_velocity",
+    "modal_analysis", "point_force", "save_state", "simulate", "solve_scipy", "to_fixed", "to_reference",
+]

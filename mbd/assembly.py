@@ -1,0 +1,187 @@
+"""Assembly: element families → residual forces and a sparse Newton matrix with a fixed pattern.
+
+The integrator sees only this interface (Chrono's ChIntegrable idea):
+    forces(t, q, v, z, jac)            -> F on the free DOFs (and Jacobian values on the pattern)
+    newton_matrix(c_M, c_C, c_K)       -> c_M·M + c_C·C + c_K·K as CSC (C = −∂F/∂v, K = −∂F/∂q)
+The sparsity pattern (every element block, the frame terms, the mass diagonal) is computed once;
+a Jacobian evaluation only refreshes the ``data`` array through a precomputed scatter map.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .element import evaluate
+from .errors import IntegrationError
+from .model import Model
+
+__all__ = ["System", "Counters"]
+
+
+@dataclass
+class Counters:
+    residual: int = 0     # force evaluations without Jacobian
+    jacobian: int = 0     # force + Jacobian evaluations
+    factor: int = 0       # LU factorizations
+    newton: int = 0       # Newton iterations
+    accepted: int = 0
+    rejected: int = 0
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+class System:
+    def __init__(self, model: Model):
+        self.model = model
+        self.ndof = n = model.ndof
+        self.counters = Counters()
+        m = model
+        f2f = m.full_to_free
+        rows, cols, self._blocks = [], [], []
+        # element blocks: entry (i, j) of every instance, kept where both DOFs are free
+        for e in m.elements:
+            fr = f2f[e.dofs]                                   # (n, k)
+            r = np.repeat(fr[:, :, None], e.k, axis=2)         # (n, k, k): row = local i
+            c = np.repeat(fr[:, None, :], e.k, axis=1)         # col = local j
+            keep = ((r >= 0) & (c >= 0)).ravel()
+            self._blocks.append(np.flatnonzero(keep))
+            rows.append(r.ravel()[keep])
+            cols.append(c.ravel()[keep])
+        # frame terms: 2×2 (x, y) block of every free body when R rotates
+        self.rotating = not m.frame.is_inertial
+        free_bodies = np.flatnonzero(~m.fixed)
+        self._free_bodies = free_bodies
+        bx, by = f2f[3 * free_bodies], f2f[3 * free_bodies + 1]
+        if self.rotating:
+            rows.append(np.concatenate([bx, bx, by, by]))
+            cols.append(np.concatenate([bx, by, bx, by]))
+        # mass diagonal
+        diag = np.arange(n)
+        rows.append(diag)
+        cols.append(diag)
+        allr = np.concatenate(rows) if rows else np.zeros(0, int)
+        allc = np.concatenate(cols) if cols else np.zeros(0, int)
+        key = allc.astype(np.int64) * n + allr  # CSC order: by column, then row
+        uniq, inv = np.unique(key, return_inverse=True)
+        self.nnz = uniq.size
+        self._indices = (uniq % n).astype(np.int32)
+        self._indptr = np.searchsorted(uniq // n, np.arange(n + 1)).astype(np.int32)
+        # split the inverse map back per block
+        off = 0
+        self._maps = []
+        for keep, r in zip(self._blocks, rows[: len(m.elements)]):
+            self._maps.append((keep, inv[off: off + r.size]))
+            off += r.size
+        if self.rotating:
+            self._frame_map = inv[off: off + 4 * free_bodies.size]
+            off += 4 * free_bodies.size
+        self._diag_map = inv[off: off + n]
+        self.Jq = np.zeros(self.nnz)   # ∂F/∂q on the pattern
+        self.Jv = np.zeros(self.nnz)   # ∂F/∂v on the pattern
+        self._M = np.zeros(self.nnz)
+        self._M[self._diag_map] = m.mdiag
+        self._mx = m.mass[free_bodies]
+        self._J = m.inertia[free_bodies]
+        self._bx, self._by = bx, by
+        self._bt = f2f[3 * free_bodies + 2]
+        # element dofs flattened, for the force scatter
+        self._dofs_flat = [e.dofs.ravel() for e in m.elements]
+        self.has_gravity = bool(np.any(m.gravity != 0.0))
+
+    # ------------------------------------------------------------------------------------------
+    def init_internal(self) -> dict:
+        z = {}
+        for e in self.model.elements:
+            zi = e.init_internal()
+            if zi is not None:
+                z[e.name] = np.asarray(zi, dtype=float)
+        return z
+
+    def forces(self, t: float, q: np.ndarray, v: np.ndarray, z: dict, jac: bool = False) -> np.ndarray:
+        """Total generalized force on the free DOFs; with ``jac`` also refresh self.Jq / self.Jv."""
+        m = self.model
+        fs = m.frame.at(t)
+        qf, vf = m.full(t, q, v)
+        Ffull = np.zeros(3 * m.n_bodies)
+        if jac:
+            self.counters.jacobian += 1
+            self.Jq[:] = 0.0
+            self.Jv[:] = 0.0
+        else:
+            self.counters.residual += 1
+        for e, flat, (keep, mp) in zip(m.elements, self._dofs_flat, self._maps):
+            F, _, Jq, Jv = evaluate(e, t, fs, qf, vf, z.get(e.name), jac)
+            Ffull += np.bincount(flat, weights=F.ravel(), minlength=Ffull.size)
+            if jac:
+                self.Jq += np.bincount(mp, weights=Jq.ravel()[keep], minlength=self.nnz)
+                self.Jv += np.bincount(mp, weights=Jv.ravel()[keep], minlength=self.nnz)
+        F = Ffull[m.free]
+        self._add_frame_terms(F, fs, q, v, jac)
+        return F
+
+    def _add_frame_terms(self, F, fs, q, v, jac):
+        """Centrifugal, Coriolis, Euler and gravity terms of every free body (MODEL.md §2)."""
+        m = self.model
+        bx, by, bt, mx = self._bx, self._by, self._bt, self._mx
+        if self.has_gravity:
+            c, s = np.cos(fs.phi), np.sin(fs.phi)
+            gx, gy = m.gravity
+            F[bx] += mx * (c * gx + s * gy)
+            F[by] += mx * (-s * gx + c * gy)
+        if not self.rotating:
+            return
+        W, dW = fs.omega, fs.domega
+        x, y, vx, vy = q[bx], q[by], v[bx], v[by]
+        F[bx] += mx * (W * W * x + 2 * W * vy + dW * y)
+        F[by] += mx * (W * W * y - 2 * W * vx - dW * x)
+        F[bt] -= self._J * dW
+        if jac:
+            nb = bx.size
+            # pattern order: (bx,bx), (bx,by), (by,bx), (by,by)
+            jq = np.concatenate([mx * W * W, mx * dW, -mx * dW, mx * W * W])
+            jv = np.concatenate([np.zeros(nb), 2 * W * mx, -2 * W * mx, np.zeros(nb)])
+            self.Jq += np.bincount(self._frame_map, weights=jq, minlength=self.nnz)
+            self.Jv += np.bincount(self._frame_map, weights=jv, minlength=self.nnz)
+
+    def newton_matrix(self, c_M: float, c_C: float, c_K: float) -> sp.csc_matrix:
+        """c_M·M + c_C·C + c_K·K with C = −J_v, K = −J_q (values from the last Jacobian evaluation)."""
+        data = c_M * self._M - c_C * self.Jv - c_K * self.Jq
+        return sp.csc_matrix((data, self._indices, self._indptr), shape=(self.ndof, self.ndof))
+
+    def matrices(self):
+        """(M, C, K) as CSC from the last Jacobian evaluation (for linearization)."""
+        mk = lambda d: sp.csc_matrix((d, self._indices, self._indptr), shape=(self.ndof, self.ndof))
+        return mk(self._M.copy()), mk(-self.Jv), mk(-self.Jq)
+
+    # ------------------------------------------------------------------------------------------
+    def family_forces(self, t, q, v, z) -> dict[str, float]:
+        """Largest generalized-force magnitude of each element family (for diagnostics)."""
+        m = self.model
+        fs = m.frame.at(t)
+        qf, vf = m.full(t, q, v)
+        out = {}
+        for e in m.elements:
+            with np.errstate(all="ignore"):
+                F, _, _, _ = evaluate(e, t, fs, qf, vf, z.get(e.name), False)
+            out[e.name] = float(np.nanmax(np.abs(F))) if F.size and np.isfinite(F).all() else float("nan") if F.size else 0.0
+        return out
+
+    def outputs(self, t, q, v, z) -> dict[str, dict[str, np.ndarray]]:
+        """Every family's outputs at a state."""
+        m = self.model
+        fs = m.frame.at(t)
+        qf, vf = m.full(t, q, v)
+        res = {}
+        for e in m.elements:
+            F, out, _, _ = evaluate(e, t, fs, qf, vf, z.get(e.name), False)
+            res[e.name] = out
+        return res
+
+    def check_finite(self, t, F, q, v, z):
+        if not np.all(np.isfinite(F)):
+            fam = self.family_forces(t, q, v, z)
+            bad = [k for k, x in fam.items() if not np.isfinite(x)]
+            raise IntegrationError(f"non-finite forces at t = {t:.6e} s from element families {bad or 'frame/gravity'}")

@@ -1,0 +1,105 @@
+"""Linear spring-dampers: body–ground supports, body–body bushings between markers, torsional springs."""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import ad
+from ..element import Element, body_dofs, marker, marker_velocity, point_force
+from ..errors import ModelError
+
+
+class GroundSupport(Element):
+    """Spring-damper from each body's centre to an anchor fixed in the inertial frame.
+
+    Translational stiffness ``kx``, ``ky`` (and damping ``cx``, ``cy``) act along the *fixed*
+    frame's axes; ``ky=None`` means isotropic (then the support is the same in R and I). Optional
+    torsional spring ``k_theta``/``c_theta`` to the fixed angle ``theta0``. Damping acts on the
+    velocity relative to ground, so a support in a rotating frame does not drag the body along R.
+    """
+    k = 3
+
+    def __init__(self, name, bodies, kx, cx=0.0, ky=None, cy=None, anchor=(0.0, 0.0),
+                 k_theta=0.0, c_theta=0.0, theta0=0.0):
+        self.name = name
+        self.dofs = body_dofs(bodies)
+        self.kx = self._per_instance("kx", kx, nonneg=True)
+        self.ky = self.kx if ky is None else self._per_instance("ky", ky, nonneg=True)
+        self.cx = self._per_instance("cx", cx, nonneg=True)
+        self.cy = self.cx if cy is None else self._per_instance("cy", cy, nonneg=True)
+        self.isotropic = ky is None and cy is None
+        a = np.asarray(anchor, dtype=float)
+        self.anchor = np.broadcast_to(a, (self.n, 2)).copy()
+        self.k_theta = self._per_instance("k_theta", k_theta, nonneg=True)
+        self.c_theta = self._per_instance("c_theta", c_theta, nonneg=True)
+        self.theta0 = self._per_instance("theta0", theta0)
+
+    def kernel(self, t, fs, q, v, z):
+        c, s = np.cos(fs.phi), np.sin(fs.phi)
+        W = fs.omega
+        ax, ay = self.anchor[:, 0], self.anchor[:, 1]
+        # displacement and ground-relative velocity, expressed in R
+        dx = q[0] - (c * ax + s * ay)
+        dy = q[1] - (-s * ax + c * ay)
+        ux = v[0] - W * q[1]
+        uy = v[1] + W * q[0]
+        if self.isotropic:
+            Fx = -self.kx * dx - self.cx * ux
+            Fy = -self.kx * dy - self.cx * uy
+        else:  # rotate into I, apply the axis-aligned law, rotate back
+            dX, dY = c * dx - s * dy, s * dx + c * dy
+            uX, uY = c * ux - s * uy, s * ux + c * uy
+            FX = -self.kx * dX - self.cx * uX
+            FY = -self.ky * dY - self.cy * uY
+            Fx, Fy = c * FX + s * FY, -s * FX + c * FY
+        T = -self.k_theta * (q[2] + fs.phi - self.theta0) - self.c_theta * (v[2] + W)
+        return [Fx, Fy, T], {"fx": Fx, "fy": Fy, "torque": T}
+
+
+class BodySpring(Element):
+    """Isotropic bushing between a marker on body A and a marker on body B.
+
+    F_B = −k (P_B − P_A) − c (Ṗ_B − Ṗ_A), A gets −F_B; both act at the midpoint of the markers so
+    that forces *and* moments balance exactly. Typical use: a planet on a linear bearing to its pin.
+    """
+    k = 6
+
+    def __init__(self, name, body_a, body_b, k, c=0.0, marker_a=(0.0, 0.0), marker_b=(0.0, 0.0)):
+        self.name = name
+        self.dofs = body_dofs(body_a, body_b)
+        self.stiffness = self._per_instance("k", k, nonneg=True)
+        self.damping = self._per_instance("c", c, nonneg=True)
+        self.marker_a = np.broadcast_to(np.asarray(marker_a, float), (self.n, 2)).copy()
+        self.marker_b = np.broadcast_to(np.asarray(marker_b, float), (self.n, 2)).copy()
+
+    def kernel(self, t, fs, q, v, z):
+        qa, qb, va, vb = q[:3], q[3:], v[:3], v[3:]
+        Pa, ra = marker(qa, self.marker_a)
+        Pb, rb = marker(qb, self.marker_b)
+        Va = marker_velocity(va, ra)
+        Vb = marker_velocity(vb, rb)
+        dx, dy = Pb[0] - Pa[0], Pb[1] - Pa[1]
+        Fx = -self.stiffness * dx - self.damping * (Vb[0] - Va[0])
+        Fy = -self.stiffness * dy - self.damping * (Vb[1] - Va[1])
+        # application point: the midpoint, seen from each body's centre
+        ma = (ra[0] + 0.5 * dx, ra[1] + 0.5 * dy)
+        mb = (rb[0] - 0.5 * dx, rb[1] - 0.5 * dy)
+        fa = point_force(ma, (-Fx, -Fy))
+        fb = point_force(mb, (Fx, Fy))
+        return fa + fb, {"fx": Fx, "fy": Fy, "deflection": ad.hypot(dx, dy)}
+
+
+class TorsionalSpring(Element):
+    """Torsional spring-damper on the relative angle θ_B − θ_A − θ0 of two bodies."""
+    k = 6
+
+    def __init__(self, name, body_a, body_b, k, c=0.0, theta0=0.0):
+        self.name = name
+        self.dofs = body_dofs(body_a, body_b)
+        self.stiffness = self._per_instance("k", k, nonneg=True)
+        self.damping = self._per_instance("c", c, nonneg=True)
+        self.theta0 = self._per_instance("theta0", theta0)
+
+    def kernel(self, t, fs, q, v, z):
+        T = -self.stiffness * (q[5] - q[2] - self.theta0) - self.damping * (v[5] - v[2])
+        zero = 0.0 * q[0]
+        return [zero, zero, -T, zero, zero, T], {"torque": T}

@@ -1,0 +1,190 @@
+"""HHT-α stepper for M a = F(q, v, t), Newton on the accelerations.
+
+Scheme (Hilber–Hughes–Taylor, α ∈ [−1/3, 0]; α = 0 is the trapezoidal rule):
+    q₁ = q₀ + h v₀ + h² ((½ − β) a₀ + β a₁)
+    v₁ = v₀ + h ((1 − γ) a₀ + γ a₁)
+    M a₁ = (1 + α) F(q₁, v₁, t₁) − α F(q₀, v₀, t₀)
+with β = (1 − α)²/4 and γ = ½ − α (derived in :func:`hht_coefficients`, nowhere else).
+Newton matrix: ∂r/∂a₁ = M + (1+α)(γh·C + βh²·K), C = −∂F/∂v, K = −∂F/∂q.
+
+Jacobian/LU reuse policy (modified Newton, after SciPy's Radau): the LU is kept across steps while
+h is unchanged; it is refreshed when Newton contracts too slowly (rate > ``rate_refresh``) or fails,
+and the step is only rejected when Newton fails with a *fresh* Jacobian. Counters record every
+residual evaluation, Jacobian evaluation, factorization and Newton iteration.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from .assembly import System
+from .errors import ModelError
+from .model import State
+
+__all__ = ["HHT", "StepInfo", "hht_coefficients", "Tolerance", "NewtonCache"]
+
+
+def hht_coefficients(alpha: float) -> tuple[float, float]:
+    """(β, γ) of HHT-α; raises for α outside [−1/3, 0]."""
+    if not (-1.0 / 3.0 - 1e-15 <= alpha <= 0.0):
+        raise ModelError(f"HHT alpha must lie in [-1/3, 0], got {alpha!r}")
+    return (1.0 - alpha) ** 2 / 4.0, 0.5 - alpha
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """Error scale per DOF: atol + rtol·|q| (separate absolute tolerances for lengths and angles)."""
+    rtol: float = 1e-4
+    atol_pos: float = 1e-9     # m
+    atol_rot: float = 1e-7     # rad
+
+    def __post_init__(self):
+        for k in ("rtol", "atol_pos", "atol_rot"):
+            val = getattr(self, k)
+            if not (np.isfinite(val) and val > 0):
+                raise ModelError(f"Tolerance.{k} must be > 0, got {val!r}")
+
+    def scale(self, model, q0, q1) -> np.ndarray:
+        rot = (model.free % 3) == 2
+        atol = np.where(rot, self.atol_rot, self.atol_pos)
+        return atol + self.rtol * np.maximum(np.abs(q0), np.abs(q1))
+
+
+@dataclass
+class StepInfo:
+    converged: bool
+    iterations: int
+    rate: float               # last Newton contraction rate
+    error: float = np.nan     # scaled local error estimate (RMS), set by the stepper
+    jacobian_refreshed: bool = False
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class HHT:
+    alpha: float = -0.1
+    newton_tol: float = 1e-3     # Newton stops when ‖Δq‖ (scaled by the Tolerance) is below this
+    max_iter: int = 10
+    rate_refresh: float = 0.5    # contraction rate above which a stale Jacobian is refreshed
+    reuse: bool = True           # False: fresh Jacobian + LU at the start of every step
+    tol: Tolerance = Tolerance()
+
+    def __post_init__(self):
+        hht_coefficients(self.alpha)
+        if self.max_iter < 1 or not (0 < self.newton_tol < 1):
+            raise ModelError("HHT: max_iter must be >= 1 and newton_tol in (0, 1)")
+
+    @property
+    def beta_gamma(self):
+        return hht_coefficients(self.alpha)
+
+    def error_constant(self) -> float:
+        """Local displacement error ≈ (β − 1/6) h² (a₁ − a₀)  (Zienkiewicz & Xie)."""
+        beta, _ = self.beta_gamma
+        return beta - 1.0 / 6.0
+
+    # ------------------------------------------------------------------------------------------
+    def initial_state(self, system: System, t0: float, q0, v0, z=None) -> State:
+        q0 = np.asarray(q0, float)
+        v0 = np.asarray(v0, float)
+        n = system.ndof
+        if q0.shape != (n,) or v0.shape != (n,):
+            raise ModelError(f"initial q and v must have {n} entries (free DOFs), got {q0.shape}, {v0.shape}")
+        if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(v0))):
+            raise ModelError("initial state contains NaN or inf")
+        z = system.init_internal() if z is None else z
+        f = system.forces(t0, q0, v0, z)
+        system.check_finite(t0, f, q0, v0, z)
+        return State(t0, q0.copy(), v0.copy(), f / system.model.mdiag, f, z)
+
+    def step(self, system: System, s: State, h: float, cache: "NewtonCache") -> tuple[State, StepInfo]:
+        """One step of size h from s. Never mutates s. Returns (new state, info)."""
+        beta, gamma = self.beta_gamma
+        M = system.model.mdiag
+        t1 = s.t + h
+        qp = s.q + h * s.v + h * h * (0.5 - beta) * s.a   # predictor parts that do not depend on a₁
+        vp = s.v + h * (1.0 - gamma) * s.a
+        bh2, gh = beta * h * h, gamma * h
+        a1 = s.a.copy()
+        refreshed = False
+        for attempt in range(2):
+            if cache.lu is None or cache.h != h or not self.reuse:
+                self._refresh(system, cache, t1, qp + bh2 * a1, vp + gh * a1, s.z, h, bh2, gh)
+                refreshed = True
+            a1, info = self._newton(system, s, cache, t1, qp, vp, a1, bh2, gh, M, fresh=refreshed)
+            info.jacobian_refreshed = refreshed
+            if info.converged:
+                break
+            if refreshed:      # failed on a fresh Jacobian: give up (the controller shrinks h)
+                break
+            cache.lu = None    # stale Jacobian: refresh and retry once from the predictor
+            a1 = s.a.copy()
+        if not info.converged:
+            cache.lu = None
+            return s, info
+        q1 = qp + bh2 * a1
+        v1 = vp + gh * a1
+        scale = self.tol.scale(system.model, s.q, q1)
+        err = self.error_constant() * h * h * (a1 - s.a) / scale
+        info.error = float(np.sqrt(np.mean(err * err))) if err.size else 0.0
+        z1 = self._update_internal(system, s, t1, q1, v1)
+        # F₁ implied by the converged a₁ (exact for the scheme; equals F(q₁, v₁) to Newton tolerance)
+        f1 = (M * a1 + self.alpha * s.f) / (1.0 + self.alpha)
+        return State(t1, q1, v1, a1, f1, z1), info
+
+    def _refresh(self, system, cache, t1, q1, v1, z, h, bh2, gh):
+        system.forces(t1, q1, v1, z, jac=True)
+        A = system.newton_matrix(1.0, (1.0 + self.alpha) * gh, (1.0 + self.alpha) * bh2)
+        cache.lu = spla.splu(A, permc_spec="COLAMD")
+        cache.h = h
+        system.counters.factor += 1
+
+    def _newton(self, system, s, cache, t1, qp, vp, a1, bh2, gh, M, fresh):
+        a_ = self.alpha
+        cnt = system.counters
+        prev = np.inf
+        rate = 0.0
+        for it in range(1, self.max_iter + 1):
+            q1 = qp + bh2 * a1
+            v1 = vp + gh * a1
+            F1 = system.forces(t1, q1, v1, s.z)
+            cnt.newton += 1
+            if not np.all(np.isfinite(F1)):
+                return a1, StepInfo(False, it, np.inf, reason="non-finite forces")
+            r = M * a1 - (1.0 + a_) * F1 + a_ * s.f
+            da = cache.lu.solve(r)
+            a1 = a1 - da
+            nrm = float(np.max(np.abs(bh2 * da) / self.tol.scale(system.model, s.q, q1)))
+            if it > 1:
+                rate = nrm / prev if prev > 0 else 0.0
+                if rate >= 1.0:
+                    return a1, StepInfo(False, it, rate, reason="Newton diverged")
+            prev = nrm
+            if nrm <= self.newton_tol:
+                return a1, StepInfo(True, it, rate)
+            if it > 1 and rate > self.rate_refresh and not fresh:
+                return a1, StepInfo(False, it, rate, reason="slow contraction on a stale Jacobian")
+        return a1, StepInfo(False, self.max_iter, rate, reason="Newton did not converge in max_iter")
+
+    def _update_internal(self, system, s, t1, q1, v1):
+        if not s.z:
+            return s.z
+        m = system.model
+        fs0, fs1 = m.frame.at(s.t), m.frame.at(t1)
+        q0f, v0f = m.full(s.t, s.q, s.v)
+        q1f, v1f = m.full(t1, q1, v1)
+        z1 = dict(s.z)
+        for e in m.elements:
+            if e.name in s.z:
+                d = e.dofs
+                z1[e.name] = e.update_internal(s.z[e.name], s.t, t1, fs0, fs1, list(q0f[d].T),
+                                               list(v0f[d].T), list(q1f[d].T), list(v1f[d].T))
+        return z1
+
+
+@dataclass
+class NewtonCache:
+    lu: object = None
+    h: float = np.nan

@@ -1,0 +1,259 @@
+"""Static model (built once, frozen) and mutable state — the mjModel/mjData split.
+
+Coordinates: every body b has q_b = (x_b, y_b, θ_b), its centre of mass in the reference frame R and
+its angle relative to R. R rotates about the fixed z axis at a prescribed Ω(t) (Ω = 0: R is inertial).
+The *full* coordinate vector holds 3 entries per body; bodies fixed to ground have prescribed motion
+(constant pose in the inertial frame) and are not degrees of freedom. Elements index the full vector;
+the integrator sees only the free DOFs.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+
+from .errors import ModelError
+
+__all__ = ["Frame", "FrameState", "BodyRef", "ModelBuilder", "Model", "State"]
+
+
+@dataclass(frozen=True)
+class FrameState:
+    """Angle φ = ∫Ω dt of R relative to I, its rate Ω and acceleration Ω̇ at one instant."""
+    phi: float
+    omega: float
+    domega: float
+
+    def rot(self) -> np.ndarray:
+        c, s = np.cos(self.phi), np.sin(self.phi)
+        return np.array([[c, -s], [s, c]])
+
+
+@dataclass(frozen=True)
+class Frame:
+    """Reference frame R rotating about z.
+
+    ``omega`` is a constant rate [rad/s], or ``profile`` a callable t -> (φ, Ω, Ω̇) for a
+    prescribed time-varying rate (φ must be the exact integral of Ω so that fixed-frame outputs match).
+    """
+    omega: float = 0.0
+    profile: Callable[[float], tuple[float, float, float]] | None = None
+
+    @staticmethod
+    def inertial() -> "Frame":
+        return Frame(0.0)
+
+    @staticmethod
+    def rotating(omega: float) -> "Frame":
+        return Frame(float(omega))
+
+    @property
+    def is_inertial(self) -> bool:
+        return self.profile is None and self.omega == 0.0
+
+    def at(self, t: float) -> FrameState:
+        if self.profile is not None:
+            return FrameState(*map(float, self.profile(t)))
+        return FrameState(self.omega * t, self.omega, 0.0)
+
+
+@dataclass(frozen=True)
+class BodyRef:
+    """Handle to a body: its index and the indices of its 3 entries in the full coordinate vector."""
+    index: int
+    name: str
+
+    @property
+    def dofs(self) -> tuple[int, int, int]:
+        i = 3 * self.index
+        return (i, i + 1, i + 2)
+
+
+class ModelBuilder:
+    """Collects bodies and element families, then :meth:`build` freezes them into a :class:`Model`."""
+
+    def __init__(self, frame: Frame | None = None, gravity: Sequence[float] = (0.0, 0.0)):
+        self.frame = frame if frame is not None else Frame.inertial()
+        self.gravity = np.asarray(gravity, dtype=float)
+        if self.gravity.shape != (2,) or not np.all(np.isfinite(self.gravity)):
+            raise ModelError(f"gravity must be a finite 2-vector in the fixed frame [m/s^2], got {gravity!r}")
+        self._names: list[str] = []
+        self._mass: list[float] = []
+        self._inertia: list[float] = []
+        self._fixed: list[bool] = []
+        self._pose: list[np.ndarray] = []
+        self._elements: list = []
+
+    def add_body(self, name: str, mass: float, inertia: float, pose=(0.0, 0.0, 0.0),
+                 fixed: bool = False) -> BodyRef:
+        """Add a rigid body. ``pose`` (x, y, θ) is its nominal pose in the *fixed* frame at t = 0;
+        for a fixed body it is the pose it keeps for ever."""
+        if name in self._names:
+            raise ModelError(f"body name {name!r} is used twice")
+        if not (np.isfinite(mass) and mass > 0):
+            raise ModelError(f"body {name!r}: mass must be > 0 kg, got {mass!r}")
+        if not (np.isfinite(inertia) and inertia > 0):
+            raise ModelError(f"body {name!r}: polar inertia must be > 0 kg*m^2, got {inertia!r}")
+        pose = np.asarray(pose, dtype=float)
+        if pose.shape != (3,) or not np.all(np.isfinite(pose)):
+            raise ModelError(f"body {name!r}: pose must be finite (x [m], y [m], theta [rad]), got {pose!r}")
+        self._names.append(name)
+        self._mass.append(float(mass))
+        self._inertia.append(float(inertia))
+        self._fixed.append(bool(fixed))
+        self._pose.append(pose)
+        return BodyRef(len(self._names) - 1, name)
+
+    def add(self, element):
+        if any(e.name == element.name for e in self._elements):
+            raise ModelError(f"element family name {element.name!r} is used twice")
+        self._elements.append(element)
+        return element
+
+    @property
+    def n_bodies(self) -> int:
+        return len(self._names)
+
+    def build(self) -> "Model":
+        nb = len(self._names)
+        if nb == 0:
+            raise ModelError("a model needs at least one body")
+        nfull = 3 * nb
+        for e in self._elements:
+            d = np.asarray(e.dofs)
+            if d.ndim != 2 or d.shape[1] != e.k or d.dtype.kind not in "iu":
+                raise ModelError(f"element {e.name!r}: dofs must be an integer (n, {e.k}) array, got shape {d.shape}")
+            if d.size and (d.min() < 0 or d.max() >= nfull):
+                raise ModelError(f"element {e.name!r}: dof index out of range [0, {nfull}) — "
+                                 "does it refer to a body of another model?")
+            e.check()
+        fixed = np.array(self._fixed)
+        dof_fixed = np.repeat(fixed, 3)
+        free = np.flatnonzero(~dof_fixed)
+        full_to_free = -np.ones(nfull, dtype=np.int64)
+        full_to_free[free] = np.arange(free.size)
+        mass = np.array(self._mass)
+        inertia = np.array(self._inertia)
+        mdiag_full = np.column_stack([mass, mass, inertia]).ravel()
+        return Model(
+            body_names=tuple(self._names), mass=mass, inertia=inertia, fixed=fixed,
+            pose0=np.array(self._pose), frame=self.frame, gravity=self.gravity,
+            elements=tuple(self._elements), free=free, full_to_free=full_to_free,
+            mdiag=mdiag_full[free],
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    body_names: tuple[str, ...]
+    mass: np.ndarray
+    inertia: np.ndarray
+    fixed: np.ndarray
+    pose0: np.ndarray        # (nb, 3) nominal poses in the fixed frame at t = 0
+    frame: Frame
+    gravity: np.ndarray      # (2,) in the fixed frame
+    elements: tuple
+    free: np.ndarray         # full indices of the free DOFs
+    full_to_free: np.ndarray  # (3 nb,) free index or -1
+    mdiag: np.ndarray        # (ndof,) diagonal mass matrix on the free DOFs
+
+    @property
+    def n_bodies(self) -> int:
+        return len(self.body_names)
+
+    @property
+    def ndof(self) -> int:
+        return self.free.size
+
+    def body(self, name: str) -> BodyRef:
+        try:
+            return BodyRef(self.body_names.index(name), name)
+        except ValueError:
+            raise ModelError(f"no body named {name!r}") from None
+
+    def element(self, name: str):
+        for e in self.elements:
+            if e.name == name:
+                return e
+        raise ModelError(f"no element family named {name!r}; have {[e.name for e in self.elements]}")
+
+    # frames -----------------------------------------------------------------------------------
+    def fixed_body_motion(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Full-vector (q, v) of the fixed bodies in R at time t (zeros elsewhere)."""
+        fs = self.frame.at(t)
+        q = np.zeros(3 * self.n_bodies)
+        v = np.zeros(3 * self.n_bodies)
+        if self.fixed.any():
+            idx = np.flatnonzero(self.fixed)
+            p = self.pose0[idx]
+            qr, vr = to_reference(p, np.zeros_like(p), fs)
+            for j in range(3):
+                q[3 * idx + j] = qr[:, j]
+                v[3 * idx + j] = vr[:, j]
+        return q, v
+
+    def full(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if self.fixed.any():
+            qf, vf = self.fixed_body_motion(t)
+        else:  # two distinct arrays: (np.zeros(n),) * 2 would alias q and v
+            qf, vf = np.zeros(3 * self.n_bodies), np.zeros(3 * self.n_bodies)
+        qf[self.free] = q
+        vf[self.free] = v
+        return qf, vf
+
+    def poses(self, q_full: np.ndarray) -> np.ndarray:
+        return q_full.reshape(-1, 3)
+
+
+def to_reference(pose_I: np.ndarray, vel_I: np.ndarray, fs: FrameState):
+    """Poses/velocities (nb, 3) from the fixed frame I into the rotating frame R."""
+    c, s = np.cos(fs.phi), np.sin(fs.phi)
+    x, y = pose_I[:, 0], pose_I[:, 1]
+    xr, yr = c * x + s * y, -s * x + c * y
+    vx, vy = vel_I[:, 0], vel_I[:, 1]
+    # v_R = Rot(-φ) v_I − Ω k × x_R
+    vxr = c * vx + s * vy + fs.omega * yr
+    vyr = -s * vx + c * vy - fs.omega * xr
+    q = np.column_stack([xr, yr, pose_I[:, 2] - fs.phi])
+    v = np.column_stack([vxr, vyr, vel_I[:, 2] - fs.omega])
+    return q, v
+
+
+def to_fixed(pose_R: np.ndarray, vel_R: np.ndarray, fs: FrameState, acc_R: np.ndarray | None = None):
+    """Poses, velocities (and accelerations) (..., 3) from R into the fixed frame I."""
+    c, s = np.cos(fs.phi), np.sin(fs.phi)
+    x, y = pose_R[..., 0], pose_R[..., 1]
+    vx, vy = vel_R[..., 0], vel_R[..., 1]
+    W, dW = fs.omega, fs.domega
+    q = np.stack([c * x - s * y, s * x + c * y, pose_R[..., 2] + fs.phi], axis=-1)
+    # v_I = Rot(φ) (v_R + Ω k × x_R)
+    ux, uy = vx - W * y, vy + W * x
+    v = np.stack([c * ux - s * uy, s * ux + c * uy, vel_R[..., 2] + W], axis=-1)
+    if acc_R is None:
+        return q, v
+    ax, ay = acc_R[..., 0], acc_R[..., 1]
+    # a_I = Rot(φ) (a_R + 2Ω k × v_R + Ω̇ k × x_R − Ω² x_R)
+    bx = ax - 2 * W * vy - dW * y - W * W * x
+    by = ay + 2 * W * vx + dW * x - W * W * y
+    a = np.stack([c * bx - s * by, s * bx + c * by, acc_R[..., 2] + dW], axis=-1)
+    return q, v, a
+
+
+@dataclass
+class State:
+    """Mutable integration state on the free DOFs.
+
+    ``f`` is the total generalized force F(q, v, t) at this state (HHT needs F_n of the last step),
+    ``z`` holds element internal states (e.g. a PI integrator), keyed by element family name.
+    """
+    t: float
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    f: np.ndarray
+    z: dict = field(default_factory=dict)
+
+    def copy(self) -> "State":
+        return State(self.t, self.q.copy(), self.v.copy(), self.a.copy(), self.f.copy(),
+                     {k: np.array(v, copy=True) for k, v in self.z.items()})

@@ -1,0 +1,260 @@
+"""Recorder: chosen outputs at a fixed sampling rate, streamed to disk, written atomically.
+
+Samples fall at t_start + k·dt. Between two accepted steps the state is interpolated (cubic Hermite
+in q with v, in v with a; linear in a) and element outputs are evaluated there, so the sampling rate
+is independent of the step size. Samples are buffered in memory up to ``chunk`` samples, then written
+to a chunk file (atomic rename), so memory stays bounded on long runs. :meth:`finalize` streams the
+chunks into one netCDF4/HDF5 file (readable with xarray or h5py) through a temporary file and an
+atomic rename: a results file is either complete or absent.
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from .errors import ModelError
+from .model import to_fixed
+
+__all__ = ["BodyMotion", "ElementOutput", "Recorder", "atomic_write_bytes", "atomic_write_text"]
+
+
+def atomic_write_bytes(path, data: bytes) -> None:
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    with open(tmp, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def atomic_write_text(path, text: str) -> None:
+    atomic_write_bytes(path, text.encode())
+
+
+@dataclass(frozen=True)
+class BodyMotion:
+    """Pose, velocity and acceleration of bodies (all when ``bodies`` is None) in the reference frame
+    R (``frame='reference'``) or the fixed frame I (``frame='fixed'``)."""
+    name: str = "motion"
+    bodies: Sequence[str] | None = None
+    frame: str = "reference"
+    quantities: Sequence[str] = ("q", "v", "a")
+
+    def __post_init__(self):
+        if self.frame not in ("reference", "fixed"):
+            raise ModelError(f"BodyMotion.frame must be 'reference' or 'fixed', got {self.frame!r}")
+        bad = set(self.quantities) - {"q", "v", "a"}
+        if bad:
+            raise ModelError(f"BodyMotion.quantities: unknown {sorted(bad)}; use q, v, a")
+
+
+@dataclass(frozen=True)
+class ElementOutput:
+    """Outputs of an element family (all its output keys when ``keys`` is None)."""
+    element: str
+    keys: Sequence[str] | None = None
+
+
+class Recorder:
+    def __init__(self, path, dt: float, probes: Sequence, t_start: float = 0.0, chunk: int = 2000,
+                 attrs: dict | None = None):
+        if not (np.isfinite(dt) and dt > 0):
+            raise ModelError(f"Recorder.dt must be > 0 s, got {dt!r}")
+        self.path = Path(path)
+        self.dt = float(dt)
+        self.t_start = float(t_start)
+        self.probes = list(probes)
+        self.chunk = int(chunk)
+        self.attrs = dict(attrs or {})
+        self.parts = self.path.with_name(self.path.name + ".parts")
+        self.next_index = 0
+        self.n_chunks = 0
+        self._buf: dict[str, list] = {}
+        self._times: list[float] = []
+
+    # binding to a model ------------------------------------------------------------------------
+    def bind(self, model, system, state) -> None:
+        self.model, self.system = model, system
+        self.vars: dict[str, tuple[tuple[str, ...], dict]] = {}   # name -> (dims, coords)
+        self._plan = []
+        for p in self.probes:
+            if isinstance(p, BodyMotion):
+                names = list(p.bodies) if p.bodies is not None else list(model.body_names)
+                idx = np.array([model.body(nm).index for nm in names], dtype=int)
+                for qty in p.quantities:
+                    vname = f"{p.name}.{qty}"
+                    self.vars[vname] = (("time", f"{p.name}.body", "coord"),
+                                        {f"{p.name}.body": names, "coord": ["x", "y", "theta"]})
+                self._plan.append(("body", p, idx))
+            elif isinstance(p, ElementOutput):
+                e = model.element(p.element)
+                probe_out = system.outputs(state.t, state.q, state.v, state.z)[e.name]
+                keys = list(p.keys) if p.keys is not None else list(probe_out)
+                missing = set(keys) - set(probe_out)
+                if missing:
+                    raise ModelError(f"element {e.name!r} has no outputs {sorted(missing)}; it has {sorted(probe_out)}")
+                for k in keys:
+                    self.vars[f"{e.name}.{k}"] = (("time", f"{e.name}.n"), {})
+                self._plan.append(("elem", e, keys))
+            else:
+                raise ModelError(f"unknown probe {p!r}")
+        self._buf = {k: [] for k in self.vars}
+
+    # sampling ----------------------------------------------------------------------------------
+    def sample_times(self, t0: float, t1: float, include_start: bool) -> np.ndarray:
+        """Sample times in (t0, t1] (and t0 itself if include_start)."""
+        k0 = self.next_index
+        ks = []
+        k = k0
+        while True:
+            tk = self.t_start + k * self.dt
+            if tk > t1 + 1e-12 * max(1.0, abs(t1)):
+                break
+            if tk > t0 + 1e-12 * max(1.0, abs(t0)) or (include_start and tk >= t0 - 1e-12 * max(1.0, abs(t0))):
+                ks.append(k)
+            k += 1
+        return np.array(ks, dtype=int)
+
+    def record(self, s0, s1, first: bool = False) -> None:
+        """Record every sample time in (s0.t, s1.t] by interpolation (and s0.t itself if ``first``)."""
+        if first:
+            ks = self.sample_times(s0.t, s0.t, include_start=True)
+            for k in ks:
+                self._sample(self.t_start + k * self.dt, s0.q, s0.v, s0.a, s0.z)
+                self.next_index = k + 1
+            if s1 is None:
+                return
+        ks = self.sample_times(s0.t, s1.t, include_start=False)
+        h = s1.t - s0.t
+        for k in ks:
+            t = self.t_start + k * self.dt
+            th = min(1.0, max(0.0, (t - s0.t) / h))
+            q, v, a = _hermite(s0, s1, th, h)
+            self._sample(t, q, v, a, s0.z)
+            self.next_index = k + 1
+
+    def _sample(self, t, q, v, a, z):
+        m = self.model
+        qf, vf = m.full(t, q, v)
+        af = np.zeros_like(qf)
+        af[m.free] = a
+        fs = m.frame.at(t)
+        outs = None
+        for kind, p, sel in self._plan:
+            if kind == "body":
+                Q, V, A = qf.reshape(-1, 3)[sel], vf.reshape(-1, 3)[sel], af.reshape(-1, 3)[sel]
+                if p.frame == "fixed":
+                    Q, V, A = to_fixed(Q, V, fs, A)
+                for qty, arr in zip("qva", (Q, V, A)):
+                    if qty in p.quantities:
+                        self._buf[f"{p.name}.{qty}"].append(np.array(arr))
+            else:
+                if outs is None:
+                    outs = self.system.outputs(t, q, v, z)
+                o = outs[p.name]
+                for k in sel:
+                    self._buf[f"{p.name}.{k}"].append(np.asarray(o[k], dtype=float).copy())
+        self._times.append(t)
+        if len(self._times) >= self.chunk:
+            self.flush()
+
+    # chunks, checkpoints, final file -----------------------------------------------------------
+    def flush(self) -> None:
+        if not self._times:
+            return
+        self.parts.mkdir(parents=True, exist_ok=True)
+        arrays = {"time": np.array(self._times)}
+        for k, lst in self._buf.items():
+            arrays[k] = np.stack(lst)
+        import io
+        bio = io.BytesIO()
+        np.savez(bio, **{f"v{i}": a for i, a in enumerate(arrays.values())}, names=np.array(list(arrays)))
+        atomic_write_bytes(self.parts / f"chunk_{self.n_chunks:06d}.npz", bio.getvalue())
+        self.n_chunks += 1
+        self._times = []
+        self._buf = {k: [] for k in self._buf}
+
+    def checkpoint_state(self) -> dict:
+        self.flush()
+        return {"next_index": self.next_index, "n_chunks": self.n_chunks}
+
+    def restore(self, st: dict) -> None:
+        self.next_index = int(st["next_index"])
+        self.n_chunks = int(st["n_chunks"])
+        self._times, self._buf = [], {k: [] for k in self._buf}
+        if self.parts.exists():
+            for f in self.parts.glob("chunk_*.npz"):
+                if int(f.stem.split("_")[1]) >= self.n_chunks:
+                    f.unlink()
+
+    def reset(self) -> None:
+        if self.parts.exists():
+            shutil.rmtree(self.parts)
+        self.next_index = 0
+        self.n_chunks = 0
+
+    def _chunks(self):
+        for i in range(self.n_chunks):
+            with np.load(self.parts / f"chunk_{i:06d}.npz") as d:
+                names = list(d["names"])
+                yield {nm: d[f"v{j}"] for j, nm in enumerate(names)}
+
+    def finalize(self, attrs: dict | None = None) -> Path:
+        """Stream all chunks into the results file (netCDF4 via h5netcdf) atomically."""
+        import h5netcdf
+
+        self.flush()
+        total = sum(c["time"].shape[0] for c in self._chunks())
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = self.path.with_name(f".{self.path.name}.tmp{os.getpid()}")
+        allattrs = {**self.attrs, **(attrs or {})}
+        with h5netcdf.File(tmp, "w") as f:
+            f.dimensions["time"] = total
+            for key, val in allattrs.items():
+                f.attrs[key] = val if isinstance(val, (int, float, str)) else json.dumps(val, default=float)
+            tv = f.create_variable("time", ("time",), float)
+            tv.attrs["units"] = "s"
+            created = {}
+            first = next(self._chunks(), None)
+            for name, (dims, coords) in self.vars.items():
+                shape_tail = first[name].shape[1:] if first is not None else (0,) * (len(dims) - 1)
+                for d, size in zip(dims[1:], shape_tail):
+                    if d not in f.dimensions:
+                        f.dimensions[d] = size
+                        if d in coords:
+                            cv = f.create_variable(d, (d,), str)
+                            cv[:] = np.array(coords[d], dtype=object)
+                created[name] = f.create_variable(name, dims, float, chunks=None)
+            i0 = 0
+            for c in self._chunks():
+                n = c["time"].shape[0]
+                tv[i0: i0 + n] = c["time"]
+                for name in self.vars:
+                    created[name][i0: i0 + n, ...] = c[name]
+                i0 += n
+        os.replace(tmp, self.path)
+        shutil.rmtree(self.parts, ignore_errors=True)
+        return self.path
+
+
+def _hermite(s0, s1, th, h):
+    """Cubic Hermite interpolation of (q, v) and linear of a at fraction th of the step."""
+    if th <= 0.0:
+        return s0.q, s0.v, s0.a
+    if th >= 1.0:
+        return s1.q, s1.v, s1.a
+    h00 = 2 * th**3 - 3 * th**2 + 1
+    h10 = th**3 - 2 * th**2 + th
+    h01 = -2 * th**3 + 3 * th**2
+    h11 = th**3 - th**2
+    q = h00 * s0.q + h10 * h * s0.v + h01 * s1.q + h11 * h * s1.v
+    v = h00 * s0.v + h10 * h * s0.a + h01 * s1.v + h11 * h * s1.a
+    a = (1 - th) * s0.a + th * s1.a
+    return q, v, a

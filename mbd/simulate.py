@@ -1,0 +1,205 @@
+"""The one loop: stepper + controller + recorder + checkpoints + progress bar.
+
+Checkpoints every K accepted steps save the state, the controller's h, the counters and the
+recorder's position atomically; a run started again with ``resume=True`` continues from the last
+checkpoint and ends with results identical to an uninterrupted run (a checkpoint also drops the
+cached LU in both, so Newton iterates are the same either way).
+"""
+from __future__ import annotations
+
+import io
+import json
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .assembly import Counters, System
+from .control import Adaptive, FixedStep
+from .errors import IntegrationError, ModelError
+from .hht import HHT, NewtonCache
+from .model import Model, State
+from .recorder import Recorder, atomic_write_bytes
+
+__all__ = ["simulate", "SimResult", "Checkpoint", "save_state", "load_state"]
+
+
+@dataclass(frozen=True)
+class Checkpoint:
+    path: str | os.PathLike
+    every: int = 2000          # accepted steps between checkpoints
+
+    def __post_init__(self):
+        if self.every < 1:
+            raise ModelError(f"Checkpoint.every must be >= 1 step, got {self.every!r}")
+
+
+@dataclass
+class SimResult:
+    state: State
+    counters: dict
+    wall_s: float
+    steps: int
+    error_max: float           # largest scaled local error estimate of an accepted step
+    error_rms: float           # RMS over accepted steps of the scaled local error estimates
+    h_min_used: float
+    h_max_used: float
+    results_path: Path | None = None
+    resumed_from: float | None = None
+
+    def summary(self) -> dict:
+        return {"wall_s": self.wall_s, "steps": self.steps, "error_estimate_max": self.error_max,
+                "error_estimate_rms": self.error_rms, "h_min_s": self.h_min_used,
+                "h_max_s": self.h_max_used, **{f"n_{k}": v for k, v in self.counters.items()}}
+
+
+def save_state(path, s: State, extra: dict | None = None) -> None:
+    bio = io.BytesIO()
+    z = {f"z__{k}": v for k, v in s.z.items()}
+    np.savez(bio, t=s.t, q=s.q, v=s.v, a=s.a, f=s.f, extra=json.dumps(extra or {}), **z)
+    atomic_write_bytes(path, bio.getvalue())
+
+
+def load_state(path) -> tuple[State, dict]:
+    with np.load(path) as d:
+        z = {k[3:]: d[k] for k in d.files if k.startswith("z__")}
+        s = State(float(d["t"]), d["q"].copy(), d["v"].copy(), d["a"].copy(), d["f"].copy(), z)
+        extra = json.loads(str(d["extra"]))
+    return s, extra
+
+
+def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 0.0,
+             stepper: HHT | None = None, controller=None, recorder: Recorder | None = None,
+             checkpoint: Checkpoint | None = None, resume: bool = False, progress: bool | None = None,
+             failed_state_path=None, state: State | None = None, system: System | None = None) -> SimResult:
+    """Integrate from (t0, q0, v0) — or from ``state`` — to t_end.
+
+    ``stepper`` defaults to HHT(α = −0.1); ``controller`` is required (FixedStep or Adaptive), since
+    the step size is the user's accuracy decision. Progress bar: on for runs of more than ~2 s wall
+    unless ``progress=False`` or the environment sets DPGT_PROGRESS=0.
+    """
+    if controller is None:
+        raise ModelError("simulate: pass controller=FixedStep(h) or Adaptive(h0=..., ...)")
+    stepper = stepper or HHT()
+    system = system or System(model)
+    if state is None:
+        if q0 is None or v0 is None:
+            raise ModelError("simulate: give q0 and v0 (free DOFs) or a State")
+        state = stepper.initial_state(system, t0, q0, v0)
+    if not (np.isfinite(t_end) and t_end >= state.t):
+        raise ModelError(f"simulate: t_end must be >= the start time {state.t} s, got {t_end!r}")
+    h = controller.initial()
+    resumed_from = None
+    stats = {"steps": 0, "err_max": 0.0, "err_sq": 0.0, "h_lo": np.inf, "h_hi": 0.0}
+    if recorder is not None:
+        recorder.bind(model, system, state)
+    if checkpoint is not None and resume and Path(checkpoint.path).exists():
+        state, extra = load_state(checkpoint.path)
+        h = extra["h"]
+        stats = extra["stats"]
+        for k, val in extra["counters"].items():
+            setattr(system.counters, k, val)
+        if recorder is not None:
+            recorder.restore(extra["recorder"])
+        resumed_from = state.t
+    elif recorder is not None:
+        recorder.reset()
+        recorder.record(state, None, first=True)
+
+    show = progress if progress is not None else os.environ.get("DPGT_PROGRESS", "1") != "0"
+    bar = _Progress(state.t, t_end, show)
+    cache = NewtonCache()
+    wall0 = time.perf_counter()
+    h_floor = getattr(controller, "h_min", 0.0)
+    span = max(abs(t_end), 1.0)
+    try:
+        while state.t < t_end - 1e-12 * span:
+            h_try = min(h, t_end - state.t)
+            new, info = stepper.step(system, state, h_try, cache)
+            ok, h_next = controller.decide(h_try, info.converged, info.error)
+            if not ok:
+                system.counters.rejected += 1
+                if h_next < h_floor:
+                    _fail(system, state, h_next, info, failed_state_path)
+                h = h_next
+                continue
+            system.counters.accepted += 1
+            if recorder is not None:
+                recorder.record(state, new)
+            state = new
+            stats["steps"] += 1
+            stats["err_max"] = max(stats["err_max"], info.error)
+            stats["err_sq"] += info.error ** 2
+            stats["h_lo"] = min(stats["h_lo"], h_try)
+            stats["h_hi"] = max(stats["h_hi"], h_try)
+            h = h_next
+            bar.update(state.t, system.counters)
+            if checkpoint is not None and stats["steps"] % checkpoint.every == 0:
+                rec = recorder.checkpoint_state() if recorder is not None else {}
+                save_state(checkpoint.path, state, {"h": h, "stats": stats, "counters": system.counters.as_dict(),
+                                                    "recorder": rec})
+                cache.lu = None
+    finally:
+        bar.close()
+    wall = time.perf_counter() - wall0
+    n = max(stats["steps"], 1)
+    res = SimResult(state=state, counters=system.counters.as_dict(), wall_s=wall, steps=stats["steps"],
+                    error_max=float(stats["err_max"]), error_rms=float(np.sqrt(stats["err_sq"] / n)),
+                    h_min_used=float(stats["h_lo"]), h_max_used=float(stats["h_hi"]), resumed_from=resumed_from)
+    if recorder is not None:
+        res.results_path = recorder.finalize(attrs={"run": res.summary()})
+    if checkpoint is not None and Path(checkpoint.path).exists():
+        Path(checkpoint.path).unlink()
+    return res
+
+
+def _fail(system: System, state: State, h: float, info, path) -> None:
+    fam = system.family_forces(state.t, state.q, state.v, state.z)
+    top = max(fam, key=lambda k: (np.nan_to_num(fam[k], nan=np.inf))) if fam else "none"
+    saved = None
+    if path is not None:
+        save_state(path, state, {"reason": info.reason})
+        saved = str(path)
+    raise IntegrationError(
+        f"step size fell below the minimum at t = {state.t:.9e} s (h = {h:.3e} s; Newton: {info.reason or 'error test'}, "
+        f"rate {info.rate:.3g}); the element family with the largest force is {top!r} "
+        f"(|F| = {fam.get(top, float('nan')):.3e}); last good state "
+        + (f"saved to {saved}" if saved else "attached to this exception as .state"),
+        state=state, saved_to=saved)
+
+
+class _Progress:
+    """tqdm bar over simulated time: shows the simulated time, steps per second and time left."""
+
+    def __init__(self, t0, t1, show):
+        self.bar = None
+        self.t_last = t0
+        self.t0 = t0
+        self._last_post = time.perf_counter()
+        self._start = self._last_post
+        self.show = show
+        self.total = t1 - t0
+        self._steps = 0
+
+    def update(self, t, counters):
+        self._steps += 1
+        if not self.show:
+            return
+        now = time.perf_counter()
+        if self.bar is None:
+            if now - self._start < 2.0:   # short runs stay silent
+                return
+            from tqdm.auto import tqdm
+            self.bar = tqdm(total=self.total, unit="s", unit_scale=True, desc="simulating",
+                            bar_format="{desc}: {percentage:3.0f}%|{bar}| t={n:.4g}/{total:.4g} s [{elapsed}<{remaining}{postfix}]")
+        self.bar.update(t - self.t_last)
+        self.t_last = t
+        if now - self._last_post > 0.5:
+            self.bar.set_postfix_str(f"{self._steps / (now - self._start):.0f} steps/s, rej {counters.rejected}")
+            self._last_post = now
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
