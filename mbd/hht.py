@@ -8,9 +8,11 @@ with β = (1 − α)²/4 and γ = ½ − α (derived in :func:`hht_coefficients`
 Newton matrix: ∂r/∂a₁ = M + (1+α)(γh·C + βh²·K), C = −∂F/∂v, K = −∂F/∂q.
 
 Jacobian/LU reuse policy (modified Newton, after SciPy's Radau): the LU is kept across steps while
-h is unchanged; it is refreshed when Newton contracts too slowly (rate > ``rate_refresh``) or fails,
-and the step is only rejected when Newton fails with a *fresh* Jacobian. Counters record every
-residual evaluation, Jacobian evaluation, factorization and Newton iteration.
+h is unchanged; when Newton contracts too slowly (rate > ``rate_refresh``) the Jacobian is
+re-evaluated at the *current iterate* and the iteration continues (contacts that switch within a step
+make an old Jacobian stale); a step fails only when Newton diverges on a fresh Jacobian or runs out of
+iterations, and the controller then shrinks h. Counters record every residual evaluation, Jacobian
+evaluation, factorization and Newton iteration.
 """
 from __future__ import annotations
 
@@ -35,20 +37,28 @@ def hht_coefficients(alpha: float) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class Tolerance:
-    """Error scale per DOF: atol + rtol·|q| (separate absolute tolerances for lengths and angles)."""
-    rtol: float = 1e-4
-    atol_pos: float = 1e-9     # m
-    atol_rot: float = 1e-7     # rad
+    """Error scale per DOF: atol + rtol·|q|, with separate absolute tolerances for lengths and angles.
+
+    The default is absolute only (rtol = 0): a relative tolerance on *positions* would depend on where
+    the origin lies (a roller 85 mm from the axis would get 1000× the tolerance of one at 85 µm), so in
+    a multibody model the meaningful scale is an absolute length (10 nm ≈ 1e-3 of a Hertz deflection)."""
+    rtol: float = 0.0
+    atol_pos: float = 1e-8     # m
+    atol_rot: float = 1e-6     # rad
 
     def __post_init__(self):
-        for k in ("rtol", "atol_pos", "atol_rot"):
+        for k in ("atol_pos", "atol_rot"):
             val = getattr(self, k)
             if not (np.isfinite(val) and val > 0):
                 raise ModelError(f"Tolerance.{k} must be > 0, got {val!r}")
+        if not (np.isfinite(self.rtol) and self.rtol >= 0):
+            raise ModelError(f"Tolerance.rtol must be >= 0, got {self.rtol!r}")
 
     def scale(self, model, q0, q1) -> np.ndarray:
         rot = (model.free % 3) == 2
         atol = np.where(rot, self.atol_rot, self.atol_pos)
+        if self.rtol == 0.0:
+            return atol
         return atol + self.rtol * np.maximum(np.abs(q0), np.abs(q1))
 
 
@@ -65,7 +75,7 @@ class StepInfo:
 @dataclass(frozen=True)
 class HHT:
     alpha: float = -0.1
-    newton_tol: float = 1e-3     # Newton stops when ‖Δq‖ (scaled by the Tolerance) is below this
+    newton_tol: float = 0.03     # Newton stops when η‖Δq‖ (scaled by the Tolerance) is below this
     max_iter: int = 10
     rate_refresh: float = 0.5    # contraction rate above which a stale Jacobian is refreshed
     reuse: bool = True           # False: fresh Jacobian + LU at the start of every step
@@ -92,8 +102,13 @@ class HHT:
         n = system.ndof
         if q0.shape != (n,) or v0.shape != (n,):
             raise ModelError(f"initial q and v must have {n} entries (free DOFs), got {q0.shape}, {v0.shape}")
-        if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(v0))):
-            raise ModelError("initial state contains NaN or inf")
+        for label, x in (("q0", q0), ("v0", v0)):
+            bad = np.flatnonzero(~np.isfinite(x))
+            if bad.size:   # name the parameter and the first offending body coordinate
+                full = system.model.free[bad[0]]
+                body = system.model.body_names[full // 3]
+                raise ModelError(f"initial state: {label} contains NaN or inf at {bad.size} free DOF(s), first "
+                                 f"{label}[{bad[0]}] = {x[bad[0]]} ({'x y theta'.split()[full % 3]} of body {body!r})")
         z = system.init_internal() if z is None else z
         f = system.forces(t0, q0, v0, z)
         system.check_finite(t0, f, q0, v0, z)
@@ -108,19 +123,7 @@ class HHT:
         vp = s.v + h * (1.0 - gamma) * s.a
         bh2, gh = beta * h * h, gamma * h
         a1 = s.a.copy()
-        refreshed = False
-        for attempt in range(2):
-            if cache.lu is None or cache.h != h or not self.reuse:
-                self._refresh(system, cache, t1, qp + bh2 * a1, vp + gh * a1, s.z, h, bh2, gh)
-                refreshed = True
-            a1, info = self._newton(system, s, cache, t1, qp, vp, a1, bh2, gh, M, fresh=refreshed)
-            info.jacobian_refreshed = refreshed
-            if info.converged:
-                break
-            if refreshed:      # failed on a fresh Jacobian: give up (the controller shrinks h)
-                break
-            cache.lu = None    # stale Jacobian: refresh and retry once from the predictor
-            a1 = s.a.copy()
+        a1, info = self._newton(system, s, cache, t1, qp, vp, a1, bh2, gh, h, M)
         if not info.converged:
             cache.lu = None
             return s, info
@@ -137,36 +140,66 @@ class HHT:
     def _refresh(self, system, cache, t1, q1, v1, z, h, bh2, gh):
         system.forces(t1, q1, v1, z, jac=True)
         A = system.newton_matrix(1.0, (1.0 + self.alpha) * gh, (1.0 + self.alpha) * bh2)
-        cache.lu = spla.splu(A, permc_spec="COLAMD")
-        cache.h = h
         system.counters.factor += 1
+        cache.h = h
+        if not np.all(np.isfinite(A.data)):
+            cache.lu = None
+            return False
+        try:
+            cache.lu = spla.splu(A, permc_spec="COLAMD")
+        except RuntimeError:          # exactly singular
+            cache.lu = None
+            return False
+        return True
 
-    def _newton(self, system, s, cache, t1, qp, vp, a1, bh2, gh, M, fresh):
+    def _newton(self, system, s, cache, t1, qp, vp, a1, bh2, gh, h, M):
+        """Newton on a₁. The LU is reused while it contracts well; when the contraction rate exceeds
+        ``rate_refresh`` the Jacobian is re-evaluated *at the current iterate* (contacts that switched
+        within the step make a predictor-time Jacobian stale) and the iteration continues.
+        Convergence (Hairer): η‖Δ‖ ≤ tol with η = θ/(1−θ) from the observed rate θ."""
         a_ = self.alpha
         cnt = system.counters
+        fresh = False
+        if cache.lu is None or cache.h != h or not self.reuse:
+            if not self._refresh(system, cache, t1, qp + bh2 * a1, vp + gh * a1, s.z, h, bh2, gh):
+                return a1, StepInfo(False, 0, np.inf, reason="singular Newton matrix", jacobian_refreshed=True)
+            fresh = True
         prev = np.inf
         rate = 0.0
+        eta = np.inf                          # no rate known before the second iteration
         for it in range(1, self.max_iter + 1):
             q1 = qp + bh2 * a1
             v1 = vp + gh * a1
             F1 = system.forces(t1, q1, v1, s.z)
             cnt.newton += 1
             if not np.all(np.isfinite(F1)):
-                return a1, StepInfo(False, it, np.inf, reason="non-finite forces")
+                return a1, StepInfo(False, it, np.inf, reason="non-finite forces", jacobian_refreshed=fresh)
             r = M * a1 - (1.0 + a_) * F1 + a_ * s.f
             da = cache.lu.solve(r)
             a1 = a1 - da
             nrm = float(np.max(np.abs(bh2 * da) / self.tol.scale(system.model, s.q, q1)))
+            if not np.isfinite(nrm):
+                return a1, StepInfo(False, it, np.inf, reason="non-finite Newton correction", jacobian_refreshed=fresh)
             if it > 1:
                 rate = nrm / prev if prev > 0 else 0.0
-                if rate >= 1.0:
-                    return a1, StepInfo(False, it, rate, reason="Newton diverged")
+                if rate >= 1.0 and fresh:
+                    return a1, StepInfo(False, it, rate, reason="Newton diverged", jacobian_refreshed=fresh)
+                eta = rate / (1.0 - rate) if rate < 1.0 else np.inf
+            # first iteration: accept only a correction far below the tolerance (no rate known yet)
+            if eta * nrm <= self.newton_tol or nrm <= 1e-2 * self.newton_tol:
+                return a1, StepInfo(True, it, rate, jacobian_refreshed=fresh)
+            if it > 1 and rate > self.rate_refresh and it < self.max_iter:
+                q1 = qp + bh2 * a1
+                v1 = vp + gh * a1
+                if not self._refresh(system, cache, t1, q1, v1, s.z, h, bh2, gh):
+                    return a1, StepInfo(False, it, rate, reason="singular Newton matrix", jacobian_refreshed=True)
+                fresh = True
+                prev = np.inf
+                eta = np.inf
+                continue
             prev = nrm
-            if nrm <= self.newton_tol:
-                return a1, StepInfo(True, it, rate)
-            if it > 1 and rate > self.rate_refresh and not fresh:
-                return a1, StepInfo(False, it, rate, reason="slow contraction on a stale Jacobian")
-        return a1, StepInfo(False, self.max_iter, rate, reason="Newton did not converge in max_iter")
+        return a1, StepInfo(False, self.max_iter, rate, reason="Newton did not converge in max_iter",
+                            jacobian_refreshed=fresh)
 
     def _update_internal(self, system, s, t1, q1, v1):
         if not s.z:

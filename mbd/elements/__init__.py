@@ -1,5 +1,12 @@
-"""Element families. Generic ones (supports, springs, drives) and the contact/mesh laws used by components."""
-from .springs import GroundSupport, BodySpring, TorsionalSpring
-from .drives import TorqueSource, SpeedDrive, Ramp
+"""Element families. Generic ones (supports, springs, loads, drives) and the contact/mesh laws used by components."""
+from .contact import GuideContact, LubricantDrag, PocketContact, RaceContact, Traction
+from .drives import Ramp, SpeedDrive, TorqueSource
+from .gear_mesh import GearMesh, StiffnessShape, mesh_damping, mesh_u0
+from .loads import ForceSource
+from .springs import BodySpring, GroundSupport, TorsionalSpring
 
-__all__ = ["GroundSupport", "BodySpring", "TorsionalSpring", "TorqueSource", "SpeedDrive", "Ramp"]
+__all__ = [
+    "BodySpring", "ForceSource", "GearMesh", "GroundSupport", "GuideContact", "LubricantDrag", "PocketContact",
+    "RaceContact", "Ramp", "SpeedDrive", "StiffnessShape", "TorqueSource", "TorsionalSpring", "Traction",
+    "mesh_damping", "mesh_u0",
+]

@@ -1,0 +1,106 @@
+"""The double planetary gear train (DPGT) on the source's rig.
+
+Bodies: sun, ring, carrier, N inner planets a_n, N outer planets b_n, and per planet a bearing (Z
+rollers + cage, or a linear spring). Meshes: sun–a_n, a_n–b_n (external), b_n–ring (internal).
+Rig (MODEL.md §3.7): sun driven by the torque P/|ω_s| along ω_s, carrier held at the reference speed
+by a speed drive, ring fixed through stiff supports. Reverse rotation flips every speed.
+The initial state is the kinematic steady state (MODEL.md §4); the sun torque is ramped in.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from mbd.elements import GroundSupport, Ramp, SpeedDrive, TorqueSource
+
+from .bearing import add_planet_bearing, bearing_si
+from .gears import add_mesh_family
+from .geometry import check_design, layout, loaded_flanks
+from .params import DPGTParams
+from .scene import BuiltScene, Scene, SceneOptions
+
+__all__ = ["RigSettings", "build_dpgt"]
+
+
+@dataclass(frozen=True)
+class RigSettings:
+    """Rig and start-up settings that are not machine data ([assumed], stated in the README)."""
+    drive_freq: float = 30.0      # carrier speed-drive bandwidth [Hz]: holds the speed, filters mesh dynamics
+    drive_zeta: float = 0.7
+    ramp_meshes: float = 20.0     # sun-torque ramp length in mesh periods
+
+
+def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, rig: RigSettings | None = None,
+               strict: bool = True) -> BuiltScene:
+    """Build the DPGT scene. Design errors raise ParameterError; design warnings are issued."""
+    opt = options or SceneOptions()
+    rig = rig or RigSettings()
+    check_design(params, strict=strict)
+    si = params.si()
+    lay = si.layout
+    G, op, sup, ms = si.gears, si.operating, si.support, si.mesh
+    wc = op.carrier_speed
+    W = {"sun": op.sun_speed, "a": op.inner_planet_speed, "b": op.outer_planet_speed}
+    b = bearing_si(si.bearing, si.lubricant)
+    scene = Scene(frame_omega=wc if opt.frame == "rotating" else 0.0,
+                  gravity=si.gravity if opt.gravity else 0.0, options=opt)
+    N = lay.planets
+    ph = lay.phasing
+    scene.body("sun", G.sun.mass, G.sun.inertia, vel=(0, 0, W["sun"]))
+    scene.body("ring", G.ring.mass, G.ring.inertia, pose=(0, 0, ph.gamma_ring))
+    scene.body("carrier", G.carrier_mass, G.carrier_inertia, vel=(0, 0, wc))
+    sup_f = scene.family("support", GroundSupport, ("bodies",))
+    for name, k, m, J in (("sun", sup.sun_stiffness, G.sun.mass, G.sun.inertia),
+                          ("ring", sup.ring_stiffness, G.ring.mass, G.ring.inertia),
+                          ("carrier", sup.carrier_stiffness, G.carrier_mass, G.carrier_inertia)):
+        kt = sup.ring_torsional_stiffness if name == "ring" else 0.0
+        sup_f.add(1, bodies=[name], kx=k, cx=2 * sup.damping_ratio * np.sqrt(k * m), k_theta=kt,
+                  c_theta=2 * sup.damping_ratio * np.sqrt(kt * J), theta0=ph.gamma_ring if name == "ring" else 0.0)
+
+    pairs = []
+    a_names = [f"a{n + 1}" for n in range(N)]
+    b_names = [f"b{n + 1}" for n in range(N)]
+    for n in range(N):
+        pa, pb = lay.centres_a[n], lay.centres_b[n]
+        va, vb = wc * np.array([-pa[1], pa[0]]), wc * np.array([-pb[1], pb[0]])
+        scene.body(a_names[n], G.inner_planet.mass, G.inner_planet.inertia, pose=(*pa, ph.gamma_inner[n]), vel=(*va, W["a"]))
+        scene.body(b_names[n], G.outer_planet.mass, G.outer_planet.inertia, pose=(*pb, ph.gamma_outer[n]), vel=(*vb, W["b"]))
+        pair = {"inner": a_names[n], "outer": b_names[n], "psi_a": float(lay.psi_a[n]), "psi_b": float(lay.psi_b[n])}
+        for key, planet, p, v, w in (("inner", a_names[n], pa, va, W["a"]), ("outer", b_names[n], pb, vb, W["b"])):
+            pair[f"{key}_bearing"] = add_planet_bearing(
+                scene, f"{planet}.pb", pin_body="carrier", pin_local=p, outer_body=planet, b=b,
+                pin_xy=p, pin_vel=v, omega_pin=wc, omega_outer=w)
+        pairs.append(pair)
+
+    # meshes, phased for the flank the torque path loads (reverse rotation loads the other flanks)
+    T_s = op.sun_torque
+    flanks = loaded_flanks(np.sign(T_s) if T_s != 0 else np.sign(W["sun"]))
+    common = dict(time_varying=opt.mesh_stiffness == "time_varying", smoothing=ms.smoothing_width,
+                  ratio=ms.stiffness_ratio, backlash=ms.backlash)
+    M = lay.meshes
+    add_mesh_family(scene, "mesh_sa", M["sun_inner"], gear1=["sun"] * N, gear2=a_names, theta1_0=np.zeros(N),
+                    theta2_0=ph.gamma_inner, flank=flanks["sun_inner"], **common)
+    add_mesh_family(scene, "mesh_ab", M["inner_outer"], gear1=a_names, gear2=b_names, theta1_0=ph.gamma_inner,
+                    theta2_0=ph.gamma_outer, flank=flanks["inner_outer"], **common)
+    add_mesh_family(scene, "mesh_br", M["outer_ring"], gear1=b_names, gear2=["ring"] * N, theta1_0=ph.gamma_outer,
+                    theta2_0=np.full(N, ph.gamma_ring), flank=flanks["outer_ring"], **common)
+
+    # drives: sun torque (driving motor), carrier speed drive (loading motor)
+    f_m = op.mesh_frequency
+    ramp_t = rig.ramp_meshes / f_m if f_m > 0 else 0.0
+    if T_s != 0:
+        scene.add_element(TorqueSource("sun_torque", [scene.index["sun"]], T_s, ramp=Ramp(0.0, ramp_t)))
+    J_eff = G.carrier_inertia + N * (G.inner_planet.mass * lay.r_ca**2 + G.outer_planet.mass * lay.r_cb**2)
+    wd = 2 * np.pi * rig.drive_freq
+    scene.add_element(SpeedDrive("carrier_drive", scene.index["carrier"], wc, k=J_eff * wd**2,
+                                 c=2 * rig.drive_zeta * J_eff * wd, k_i=J_eff * wd**3 / 5))
+    scene.handles.update({"pairs": pairs, "flanks": flanks})
+    scene.meta.update({
+        "speeds_rad_s": {"sun": W["sun"], "inner_planet": W["a"], "outer_planet": W["b"], "carrier": wc},
+        "f_c_hz": abs(op.carrier_frequency), "f_m_hz": f_m, "sun_torque_Nm": T_s, "carrier_torque_Nm": op.carrier_torque,
+        "ramp_s": ramp_t, "ring_mismatch_teeth": [float(x) for x in ph.ring_mismatch], "planets": N,
+        "rollers": b.Z, "direction": op.direction, "frame": opt.frame, "bearing": b,
+    })
+    return scene.build()

@@ -1,0 +1,40 @@
+"""Gear meshes: mesh constants u0 and stiffness phases from the real tooth positions.
+
+Tooth convention (shared with :mod:`components.geometry`): a gear's tooth 0 lies at its body angle
+θ; at assembly each gear is turned to the angle γ at which its teeth mate with the gear it meshes
+with (the sun has γ = 0). The mesh position p = z₁(θ₁ − φ_e)/2π + p0 counts gear 1's teeth passing
+the line of centres; p0 places the stiffness wave's double-contact zone where a new tooth pair enters
+on the *loaded* flank (:meth:`MeshGeometry.wave_p0`), so phases between planets, between mesh types and
+between forward and reverse follow from the geometry, never from hand-set numbers.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from mbd.elements.gear_mesh import GearMesh, StiffnessShape
+
+from .scene import Scene
+
+__all__ = ["add_mesh_family"]
+
+
+def add_mesh_family(scene: Scene, family: str, mg, *, gear1: list[str], gear2: list[str], theta1_0, theta2_0,
+                    flank: int, time_varying: bool, smoothing: float, ratio: float, backlash: float) -> slice:
+    """Add the N meshes of one type (``mg`` a :class:`components.geometry.MeshGeometry`).
+    ``theta*_0`` are the gears' body angles at assembly (tooth 0 at the body angle); u0 makes both
+    flanks' compression zero there."""
+    th1, th2 = np.asarray(theta1_0, float), np.asarray(theta2_0, float)
+    phi = np.asarray(mg.line_angle, float)
+    rb1, rb2 = mg.base_radius1, mg.base_radius2
+    u0 = rb2 * (th2 - phi) - rb1 * (th1 - phi) if mg.internal else rb1 * (th1 - phi) + rb2 * (th2 - phi)
+    if time_varying:
+        shape = StiffnessShape.rectangular(mg.contact_ratio, ratio=ratio, smoothing=smoothing)
+        # geometry's p0 assumes body angle 0 at assembly; here the body angle already holds γ₁
+        p0 = np.mod(mg.wave_p0(flank) - mg.p0, 1.0)
+    else:
+        shape = StiffnessShape.constant()
+        p0 = np.zeros_like(phi)
+    fam = scene.family(family, GearMesh, ("gear1", "gear2"), internal=mg.internal, stiffness=shape)
+    n = phi.size
+    return fam.add(n, gear1=gear1, gear2=gear2, rb1=rb1, rb2=rb2, alpha=mg.pressure_angle, a0=mg.centre_distance,
+                   teeth1=mg.z1, k_mean=mg.k_mean, c_mesh=mg.damping, u0=u0, p0=p0, backlash=backlash, phi_ref=phi)

@@ -1,0 +1,714 @@
+"""Parameter objects of the DPGT: frozen dataclasses of pint quantities, each value with its source.
+
+Design (ARCHITECTURE.md idea 6)
+-------------------------------
+* Every parameter class is a frozen, keyword-only dataclass. Its fields hold pint quantities (or ints,
+  bools, strings for counts, flags, choices; or nested parameter objects). At construction every value
+  may be given as a pint quantity, a string (``"3 mm"``, ``"4200 rpm"``) or, for dimensionless values,
+  a number; ``__post_init__`` converts and checks it (dimension, sign, integrality) and raises
+  :class:`~components.units.ParameterError` naming the dotted parameter, e.g. ``bearing.clearance``.
+* Provenance: wrap a value with :func:`paper`, :func:`derived` or :func:`assumed` (``Sourced``) to tag it;
+  ``obj.source("clearance")`` returns its :class:`Source` (tag ``paper``/``derived``/``assumed``, or
+  ``user`` once a value differs from the tagged one, ``default`` for an untouched field default).
+  Optional values left ``None`` follow a documented rule (e.g. the Palmgren stiffness from the roller
+  length, gear inertias from the pitch radius); their source is that rule's tag, and they follow the
+  values they derive from when those are overridden.
+* Overrides: :func:`with_overrides` ``(params, {"bearing.clearance": "30 um", "gears.planets": 4})``
+  with dotted paths (unknown paths raise ParameterError listing the valid ones); :func:`load_toml`
+  reads the same dotted structure from a TOML file; :func:`to_toml` writes it back (lossless).
+* Conversion to SI happens once: ``obj.si()`` returns an immutable :class:`SIView` of floats (SI base
+  units: m, kg, s, rad, rad/s, N/m, N/m^(10/9) ...), with the rule-based values resolved and the
+  convenient derived values added (gear radii, raceway radii, ...). ``DPGTParams.si()`` also contains
+  ``layout`` (:class:`components.geometry.Layout`: planet positions, meshes, phases) and the nominal
+  kinematics/torques in ``operating``. Builders read only ``si()``; nothing downstream touches pint.
+
+Single values are checked here (positive masses, clearances ≥ 0, N ≥ 1, Z ≥ 3, h = ±1, ...); how
+values fit together (rollers fit, gears assemble, tip circles clear) is checked by
+:func:`components.geometry.check_design`, which a builder should call before building.
+"""
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import json
+import math
+import numbers
+import tomllib
+from dataclasses import MISSING, dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any, ClassVar, Iterator, Mapping
+
+import numpy as np
+
+from . import geometry as geo
+from .units import ParameterError, Quantity, format_quantity, quantity, to_si
+
+__all__ = [
+    "Source", "Sourced", "paper", "derived", "assumed", "SIView", "Params",
+    "GearParams", "GearSetParams", "CageParams", "BearingParams", "LubricantParams", "SupportParams",
+    "MeshParams", "OperatingPoint", "DPGTParams",
+    "with_overrides", "parameter_names", "flatten", "describe", "to_toml", "overrides_from_toml", "load_toml",
+]
+
+
+# ---------------------------------------------------------------------------------------------
+# provenance
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Source:
+    """Where a value comes from: tag ``paper`` | ``derived`` | ``assumed`` | ``user`` | ``default``.
+
+    ``value`` is the value the tag was given to (filled in automatically); a parameter whose current
+    value differs from it is reported as ``user``.
+    """
+
+    tag: str
+    note: str = ""
+    value: Any = field(default=None, compare=False, repr=False)
+
+    def __str__(self) -> str:
+        return f"[{self.tag}]" + (f" {self.note}" if self.note else "")
+
+
+@dataclass(frozen=True)
+class Sourced:
+    """A value with its source, accepted by every parameter field at construction."""
+
+    value: Any
+    source: Source
+
+
+def paper(value, note: str = "") -> Sourced:
+    """A value from the source study's tables or text."""
+    return Sourced(value, Source("paper", note))
+
+
+def derived(value, note: str = "") -> Sourced:
+    """A value computed from paper values."""
+    return Sourced(value, Source("derived", note))
+
+
+def assumed(value, note: str = "") -> Sourced:
+    """An engineering estimate; say its basis in ``note``."""
+    return Sourced(value, Source("assumed", note))
+
+
+_USER = Source("user")
+
+
+# ---------------------------------------------------------------------------------------------
+# SI view
+# ---------------------------------------------------------------------------------------------
+class SIView(Mapping):
+    """Read-only nested mapping of SI floats with attribute access (``si.bearing.clearance``)."""
+
+    __slots__ = ("_d",)
+
+    def __init__(self, data: Mapping):
+        object.__setattr__(self, "_d", dict(data))
+
+    def __getattr__(self, key):
+        try:
+            return self._d[key]
+        except KeyError:
+            raise AttributeError(f"no SI value {key!r}; available: {', '.join(self._d)}") from None
+
+    def __setattr__(self, key, value):
+        raise AttributeError("SIView is read-only")
+
+    def __getitem__(self, key):
+        return self._d[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._d)
+
+    def __len__(self) -> int:
+        return len(self._d)
+
+    def replace(self, **changes) -> "SIView":
+        return SIView({**self._d, **changes})
+
+    def to_dict(self) -> dict:
+        return {k: v.to_dict() if isinstance(v, SIView) else v for k, v in self._d.items()}
+
+    def __repr__(self) -> str:
+        return "SIView(" + ", ".join(f"{k}={v!r}" for k, v in self._d.items()) + ")"
+
+
+# ---------------------------------------------------------------------------------------------
+# field specifications
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class _Spec:
+    kind: str                      # a units kind, or "count" | "sign" | "flag" | "choice" | "nested"
+    lo: float | None = None        # bounds on the SI value
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
+    bound_text: str = ""           # how the bound reads in an error message
+    optional: bool = False         # None allowed: the value then follows ``rule``
+    rule: Source | None = None
+    choices: tuple = ()
+    cls: type | None = None
+    doc: str = ""
+
+
+def _param(kind: str, doc: str = "", *, default=MISSING, **kw):
+    return field(default=default, metadata={"spec": _Spec(kind, doc=doc, **kw)})
+
+
+def _pos(kind, doc="", **kw):
+    return _param(kind, doc, lo=0.0, lo_open=True, bound_text="> 0", **kw)
+
+
+def _nonneg(kind, doc="", **kw):
+    return _param(kind, doc, lo=0.0, bound_text=">= 0", **kw)
+
+
+def _rule(kind, tag, note, doc=""):
+    """An optional positive value that follows a rule when None."""
+    return _param(kind, doc or note, default=None, lo=0.0, lo_open=True, bound_text="> 0", optional=True,
+                  rule=Source(tag, note))
+
+
+def _nested(cls, doc=""):
+    return _param("nested", doc, cls=cls)
+
+
+def _check_bounds(spec: _Spec, name: str, x: float, shown) -> None:
+    bad = (spec.lo is not None and (x < spec.lo or (spec.lo_open and x == spec.lo))) or \
+          (spec.hi is not None and (x > spec.hi or (spec.hi_open and x == spec.hi)))
+    if bad:
+        raise ParameterError.at(name, f"must be {spec.bound_text}, got {shown!r}")
+
+
+def _as_int(name: str, value, what: str) -> int:
+    if isinstance(value, (bool, np.bool_)):
+        raise ParameterError.at(name, f"expected {what}, got {value!r}")
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, numbers.Real) and math.isfinite(value) and float(value).is_integer():
+        return int(value)
+    if isinstance(value, str):
+        try:
+            return int(value.strip())
+        except ValueError:
+            pass
+    raise ParameterError.at(name, f"expected {what}, got {value!r}")
+
+
+def _convert(spec: _Spec, name: str, value):
+    """Check and convert one user value for a field (see the module docstring)."""
+    if value is None:
+        if spec.optional:
+            return None
+        raise ParameterError.at(name, "is required (got None)")
+    k = spec.kind
+    if k == "nested":
+        if isinstance(value, spec.cls):
+            return value
+        if isinstance(value, Mapping):
+            try:
+                return spec.cls(**value)
+            except ParameterError as e:
+                raise e.renamed(spec.cls._prefix, name) from None
+            except TypeError:
+                fs = _param_fields(spec.cls)
+                unknown = sorted(set(value) - {f.name for f in fs})
+                missing = [f.name for f in fs if f.name not in value
+                           and f.default is MISSING and f.default_factory is MISSING]
+                raise ParameterError.at(name, f"a {spec.cls.__name__} table needs all of {missing} "
+                                              f"(unknown: {unknown}); to change single values use dotted "
+                                              f"overrides such as '{name}.{fs[0].name}'") from None
+        raise ParameterError.at(name, f"expected {spec.cls.__name__} or a table, got {type(value).__name__}")
+    if k == "count":
+        v = _as_int(name, value, "an integer")
+        _check_bounds(spec, name, v, value)
+        return v
+    if k == "sign":
+        v = _as_int(name, value, "+1 or -1")
+        if v not in (-1, 1):
+            raise ParameterError.at(name, f"expected +1 or -1, got {value!r}")
+        return v
+    if k == "flag":
+        if not isinstance(value, (bool, np.bool_)):
+            raise ParameterError.at(name, f"expected true or false, got {value!r}")
+        return bool(value)
+    if k == "choice":
+        if value not in spec.choices:
+            raise ParameterError.at(name, f"expected one of {list(spec.choices)}, got {value!r}")
+        return value
+    q = quantity(name, value, k)
+    _check_bounds(spec, name, to_si(q), value if isinstance(value, (str, numbers.Real)) else str(q))
+    return q
+
+
+def _param_fields(cls) -> tuple:
+    return tuple(f for f in dataclasses.fields(cls) if "spec" in f.metadata)
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, Quantity) or isinstance(b, Quantity):
+        if not (isinstance(a, Quantity) and isinstance(b, Quantity)):
+            return False
+        if a.dimensionality != b.dimensionality:
+            return False
+        x, y = to_si(a), to_si(b)
+        return x == y or abs(x - y) <= 1e-12 * max(abs(x), abs(y))
+    return type(a) is type(b) and a == b
+
+
+# ---------------------------------------------------------------------------------------------
+# base class
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True, kw_only=True)
+class Params:
+    """Base of all parameter classes: conversion, provenance, replace, SI view."""
+
+    _prefix: ClassVar[str] = ""
+    sources: Mapping[str, Source] = field(default_factory=dict, compare=False, repr=False)
+
+    def __post_init__(self):
+        names = {f.name for f in _param_fields(type(self))}
+        tags: dict[str, Source] = {}
+        for key, src in dict(self.sources).items():
+            if key not in names:
+                raise ParameterError.at(self._path(key), f"source given for an unknown parameter; valid: {sorted(names)}")
+            tags[key] = src if isinstance(src, Source) else Source(str(src))
+        for f in _param_fields(type(self)):
+            value = getattr(self, f.name)
+            if isinstance(value, Sourced):
+                tags[f.name] = value.source
+                value = value.value
+            value = _convert(f.metadata["spec"], self._path(f.name), value)
+            object.__setattr__(self, f.name, value)
+            src = tags.get(f.name)
+            if src is not None and src.value is None:  # remember what the tag was given to
+                tags[f.name] = dataclasses.replace(src, value=value)
+        object.__setattr__(self, "sources", MappingProxyType(tags))
+
+    @classmethod
+    def _path(cls, name: str) -> str:
+        return f"{cls._prefix}.{name}" if cls._prefix else name
+
+    def source(self, name: str) -> Source:
+        """Provenance of field ``name`` (see :class:`Source`)."""
+        spec = self._spec(name)
+        value = getattr(self, name)
+        src = self.sources.get(name)
+        if src is not None and _same(src.value, value):
+            return src
+        if value is None and spec.rule is not None:
+            return spec.rule
+        f = next(f for f in _param_fields(type(self)) if f.name == name)
+        if f.default is not MISSING and _same(_convert(spec, name, f.default), value):
+            return Source("default", spec.doc)
+        return _USER
+
+    @classmethod
+    def _spec(cls, name: str) -> _Spec:
+        for f in _param_fields(cls):
+            if f.name == name:
+                return f.metadata["spec"]
+        raise ParameterError.at(cls._path(name), f"unknown parameter; valid: {[f.name for f in _param_fields(cls)]}")
+
+    def replace(self, **changes) -> "Params":
+        """A copy with some fields changed (values converted and checked like at construction)."""
+        valid = [f.name for f in _param_fields(type(self))]
+        for key in changes:
+            if key not in valid:
+                raise ParameterError.at(self._path(key), f"unknown parameter; valid: {valid}")
+        return dataclasses.replace(self, **changes)
+
+    def si(self) -> SIView:
+        """All values as SI floats (rule-based values resolved, derived values added)."""
+        d: dict[str, Any] = {}
+        for f in _param_fields(type(self)):
+            v = getattr(self, f.name)
+            if isinstance(v, Params):
+                d[f.name] = v.si()
+            elif isinstance(v, Quantity):
+                d[f.name] = to_si(v)
+            else:
+                d[f.name] = v
+        self._derive(d)
+        return SIView(d)
+
+    def _derive(self, d: dict) -> None:
+        """Resolve rule-based values and add derived ones to the SI dict (subclasses)."""
+
+
+# ---------------------------------------------------------------------------------------------
+# gears
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True, kw_only=True)
+class GearParams(Params):
+    """One standard involute spur gear (no profile shift).
+
+    si() adds pitch_radius, base_radius, tip_radius, root_radius and resolves ``inertia``.
+    """
+
+    _prefix: ClassVar[str] = "gear"
+    teeth: int = _param("count", "number of teeth", lo=3, bound_text=">= 3")
+    module: Quantity = _pos("length", "module m")
+    pressure_angle: Quantity = _param("angle", "pressure angle α", lo=0.0, hi=math.pi / 4, lo_open=True,
+                                      hi_open=True, bound_text="between 0 and 45 deg")
+    face_width: Quantity = _pos("length", "face width")
+    mass: Quantity = _pos("mass", "mass")
+    inertia: Quantity | None = _rule("inertia", "assumed", "solid disc at the pitch radius, m r^2/2 "
+                                                           "(internal gear: thin ring at the pitch radius, m r^2)")
+    internal: bool = _param("flag", "internal gear (teeth inside, the ring)", default=False)
+    addendum_coefficient: Quantity = _nonneg("dimensionless", "addendum h_a/m (standard 1)", default=1.0)
+    dedendum_coefficient: Quantity = _nonneg("dimensionless", "dedendum h_f/m (standard 1.25)", default=1.25)
+
+    def _derive(self, d):
+        g = geo.GearGeometry(teeth=d["teeth"], module=d["module"], pressure_angle=d["pressure_angle"],
+                             internal=d["internal"], addendum_coefficient=d["addendum_coefficient"],
+                             dedendum_coefficient=d["dedendum_coefficient"])
+        if d["inertia"] is None:
+            d["inertia"] = d["mass"] * g.pitch_radius ** 2 * (1.0 if self.internal else 0.5)
+        d.update(pitch_radius=g.pitch_radius, base_radius=g.base_radius, tip_radius=g.tip_radius,
+                 root_radius=g.root_radius)
+
+
+@dataclass(frozen=True, kw_only=True)
+class GearSetParams(Params):
+    """Sun, inner planets, outer planets, ring and carrier of the double planetary set.
+
+    ``handedness`` h: the outer planet stands at ψ_b = ψ_a + h·Δψ (+1: it leads its inner planet in the
+    positive angular direction). ``planet_angle`` ψ_0: angle of pair 0's inner planet at t = 0.
+    """
+
+    _prefix: ClassVar[str] = "gears"
+    sun: GearParams = _nested(GearParams, "sun gear")
+    inner_planet: GearParams = _nested(GearParams, "inner planets (mesh with the sun)")
+    outer_planet: GearParams = _nested(GearParams, "outer planets (mesh with the ring)")
+    ring: GearParams = _nested(GearParams, "ring gear (internal)")
+    carrier_mass: Quantity = _pos("mass", "carrier mass")
+    carrier_inertia: Quantity | None = _rule("inertia", "assumed", "disc of radius 1.2 r_cb, m (1.2 r_cb)^2/2")
+    planets: int = _param("count", "planet pairs N", lo=1, bound_text=">= 1")
+    handedness: int = _param("sign", "planet-pair handedness h = +1 or -1")
+    planet_angle: Quantity = _param("angle", "angle psi_0 of the first inner planet", default="0 deg")
+
+    def _derive(self, d):
+        if d["carrier_inertia"] is None:
+            r_cb = 0.5 * d["sun"].module * (d["ring"].teeth - d["outer_planet"].teeth)
+            d["carrier_inertia"] = 0.5 * d["carrier_mass"] * (1.2 * r_cb) ** 2
+
+
+# ---------------------------------------------------------------------------------------------
+# planet bearing
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True, kw_only=True)
+class CageParams(Params):
+    """Cage of a planet bearing: outer-raceway (planet bore) guided, with Z pockets."""
+
+    _prefix: ClassVar[str] = "bearing.cage"
+    mass: Quantity = _pos("mass", "cage mass")
+    inertia: Quantity | None = _rule("inertia", "assumed", "m (d_m/2)^2: mass on the pitch circle")
+    pocket_clearance: Quantity = _nonneg("length", "circumferential pocket clearance per side C_p")
+    guide_clearance: Quantity = _nonneg("length", "radial guiding clearance C_g")
+    pocket_stiffness: Quantity = _pos("stiffness", "pocket contact stiffness K_p")
+    guide_stiffness: Quantity = _pos("stiffness", "guide-land contact stiffness K_g")
+    restitution: Quantity = _param("dimensionless", "coefficient of restitution of pocket and guide impacts",
+                                   lo=0.0, hi=1.0, lo_open=True, bound_text="in (0, 1]")
+    pocket_friction: Quantity = _nonneg("dimensionless", "pocket wall friction coefficient")
+    guide_friction: Quantity = _nonneg("dimensionless", "guide land friction coefficient")
+
+
+@dataclass(frozen=True, kw_only=True)
+class BearingParams(Params):
+    """Cylindrical roller planet bearing (same for inner and outer planets), with its cage.
+
+    Inner raceway = carrier pin, diameter d_m − D; outer raceway = planet bore, diameter d_m + D + P_d
+    (P_d the diametral clearance). si() adds inner_raceway_radius, outer_raceway_radius and resolves
+    roller_mass, roller_inertia, contact_stiffness and cage.inertia.
+    """
+
+    _prefix: ClassVar[str] = "bearing"
+    pitch_diameter: Quantity = _pos("length", "pitch diameter d_m")
+    roller_diameter: Quantity = _pos("length", "roller diameter D")
+    roller_length: Quantity = _pos("length", "effective roller length l")
+    rollers: int = _param("count", "rollers Z per bearing", lo=3, bound_text=">= 3")
+    clearance: Quantity = _nonneg("length", "diametral clearance P_d")
+    roller_density: Quantity = _pos("density", "roller material density")
+    roller_mass: Quantity | None = _rule("mass", "derived", "solid cylinder: density x pi D^2 l / 4")
+    roller_inertia: Quantity | None = _rule("inertia", "derived", "solid cylinder: m D^2 / 8")
+    contact_stiffness: Quantity | None = _rule("contact_stiffness", "derived",
+                                               "Palmgren line contact: K = 8.06e4 l^(8/9) N/mm^(10/9), l in mm")
+    contact_damping_ratio: Quantity = _nonneg("dimensionless", "roller-raceway contact damping ratio")
+    traction_mu_max: Quantity = _nonneg("dimensionless", "traction curve maximum mu_max (mu = mu_max tanh(v/v0))")
+    traction_v0: Quantity = _pos("velocity", "traction curve slip velocity scale v0")
+    cage: CageParams = _nested(CageParams, "cage")
+
+    def _derive(self, d):
+        dm, dr, ln = d["pitch_diameter"], d["roller_diameter"], d["roller_length"]
+        if d["roller_mass"] is None:
+            d["roller_mass"] = d["roller_density"] * math.pi * dr ** 2 * ln / 4.0
+        if d["roller_inertia"] is None:
+            d["roller_inertia"] = d["roller_mass"] * dr ** 2 / 8.0
+        if d["contact_stiffness"] is None:
+            d["contact_stiffness"] = geo.palmgren_stiffness(ln)
+        if d["cage"].inertia is None:
+            d["cage"] = d["cage"].replace(inertia=d["cage"].mass * (dm / 2.0) ** 2)
+        d["inner_raceway_radius"] = (dm - dr) / 2.0
+        d["outer_raceway_radius"] = (dm + dr + d["clearance"]) / 2.0
+
+
+# ---------------------------------------------------------------------------------------------
+# environment, supports, meshes, operating point
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True, kw_only=True)
+class LubricantParams(Params):
+    """Oil–air mixture for roller drag F = C_d ρ D l (d_m Ω_m)^2 / 8."""
+
+    _prefix: ClassVar[str] = "lubricant"
+    drag_coefficient: Quantity = _nonneg("dimensionless", "drag coefficient C_d")
+    density: Quantity = _nonneg("density", "oil-air mixture density")
+
+
+@dataclass(frozen=True, kw_only=True)
+class SupportParams(Params):
+    """Isotropic translational supports of sun, ring and carrier; torsional support of the ring.
+
+    The ring's torsional support is given as a tangential stiffness k on u = r_r·θ_r (r_r its pitch
+    radius); ``DPGTParams.si().support`` adds ring_torsional_stiffness = k·r_r^2 [N·m/rad].
+    """
+
+    _prefix: ClassVar[str] = "support"
+    sun_stiffness: Quantity = _nonneg("stiffness", "sun translational support stiffness")
+    ring_stiffness: Quantity = _nonneg("stiffness", "ring translational support stiffness")
+    carrier_stiffness: Quantity = _nonneg("stiffness", "carrier translational support stiffness")
+    damping_ratio: Quantity = _nonneg("dimensionless", "support damping ratio")
+    ring_tangential_stiffness: Quantity = _nonneg("stiffness", "ring torsional support as tangential stiffness "
+                                                               "at the ring pitch radius")
+
+
+@dataclass(frozen=True, kw_only=True)
+class MeshParams(Params):
+    """Mesh stiffness and damping, common to the three meshes.
+
+    k_mean of a mesh = ``mean_stiffness`` if given, else c_γα × the mesh's common face width; the
+    time-varying stiffness is a smoothed rectangular wave with k_double/k_single = ``stiffness_ratio``;
+    ``smoothing_width`` is the width of its steps as a fraction of one mesh cycle. Resolved per mesh in
+    ``DPGTParams.si().layout.meshes``.
+    """
+
+    _prefix: ClassVar[str] = "mesh"
+    c_gamma_alpha: Quantity = _pos("stiffness_per_width", "ISO 6336 mean mesh stiffness per face width")
+    mean_stiffness: Quantity | None = _rule("stiffness", "derived", "c_gamma_alpha x common face width of each mesh")
+    stiffness_ratio: Quantity = _param("dimensionless", "k_double / k_single", lo=1.0, bound_text=">= 1")
+    smoothing_width: Quantity = _param("dimensionless", "step width of the stiffness wave, fraction of a mesh cycle",
+                                       lo=0.0, hi=0.5, lo_open=True, bound_text="in (0, 0.5]")
+    damping_ratio: Quantity = _nonneg("dimensionless", "mesh damping ratio zeta_m")
+    backlash: Quantity = _nonneg("length", "backlash b along the line of action")
+
+
+@dataclass(frozen=True, kw_only=True)
+class OperatingPoint(Params):
+    """Ring fixed, sun driven, carrier loaded. ``carrier_speed`` is a magnitude; ``direction`` gives
+    its sense (forward = counter-clockwise seen from the input side = positive).
+
+    si(): carrier_speed signed [rad/s], output_power [W], direction (str) and sign (±1);
+    ``DPGTParams.si().operating`` adds the nominal speeds and torques (:class:`geometry.Kinematics`).
+    """
+
+    _prefix: ClassVar[str] = "operating"
+    carrier_speed: Quantity = _param("angular_velocity", "carrier speed magnitude n_c", lo=0.0,
+                                     bound_text=">= 0 (give the sense with direction)")
+    output_power: Quantity = _nonneg("power", "output power P")
+    direction: str = _param("choice", "sense of rotation", choices=("forward", "reverse"), default="forward")
+
+    def _derive(self, d):
+        d["sign"] = 1 if d["direction"] == "forward" else -1
+        d["carrier_speed"] = d["sign"] * d["carrier_speed"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class DPGTParams(Params):
+    """The whole machine: gears, planet bearing (with cage), lubricant, supports, meshes, operating
+    point and gravity (magnitude, along −Y of the fixed frame).
+
+    si() has one section per field plus ``layout`` (:class:`geometry.Layout`); ``support`` gains
+    ring_torsional_stiffness and ``operating`` the fields of :class:`geometry.Kinematics`. It raises
+    ParameterError if the gears cannot be laid out: run :func:`geometry.check_design` first.
+    """
+
+    _prefix: ClassVar[str] = ""
+    gears: GearSetParams = _nested(GearSetParams, "gear set")
+    bearing: BearingParams = _nested(BearingParams, "planet bearing")
+    lubricant: LubricantParams = _nested(LubricantParams, "lubricant")
+    support: SupportParams = _nested(SupportParams, "supports")
+    mesh: MeshParams = _nested(MeshParams, "meshes")
+    operating: OperatingPoint = _nested(OperatingPoint, "operating point")
+    gravity: Quantity = _nonneg("acceleration", "gravitational acceleration (0 switches gravity off)")
+
+    def _derive(self, d):
+        g = d["gears"]
+        d["support"] = d["support"].replace(
+            ring_torsional_stiffness=d["support"].ring_tangential_stiffness * g.ring.pitch_radius ** 2)
+        d["layout"] = geo.layout(self, gears_si=g, mesh_si=d["mesh"])
+        op = d["operating"]
+        kin = geo.kinematics(g.sun.teeth, g.inner_planet.teeth, g.outer_planet.teeth, g.ring.teeth,
+                             op.carrier_speed, op.output_power)
+        d["operating"] = op.replace(**dataclasses.asdict(kin))
+
+
+# ---------------------------------------------------------------------------------------------
+# dotted paths: overrides, listing, TOML
+# ---------------------------------------------------------------------------------------------
+def flatten(params: Params, prefix: str = "") -> dict[str, Any]:
+    """{dotted path: value} of every leaf parameter (nested objects expanded)."""
+    out: dict[str, Any] = {}
+    for f in _param_fields(type(params)):
+        v = getattr(params, f.name)
+        path = f"{prefix}{f.name}"
+        if isinstance(v, Params):
+            out.update(flatten(v, path + "."))
+        else:
+            out[path] = v
+    return out
+
+
+def parameter_names(params: Params) -> list[str]:
+    """All dotted leaf paths accepted by :func:`with_overrides`."""
+    return list(flatten(params))
+
+
+def _unknown(params: Params, key: str, path: str) -> ParameterError:
+    names = [f"{path}{n}" for n in parameter_names(params)]
+    close = difflib.get_close_matches(f"{path}{key}", names, n=3)
+    hint = f" (did you mean {', '.join(close)}?)" if close else ""
+    return ParameterError.at(f"{path}{key}", f"unknown parameter{hint}; valid keys: {', '.join(names)}")
+
+
+def _override(params: Params, overrides: Mapping[str, Any], path: str) -> Params:
+    nested_fields = {f.name for f in _param_fields(type(params)) if f.metadata["spec"].kind == "nested"}
+    leaf_fields = {f.name for f in _param_fields(type(params))} - nested_fields
+    changes: dict[str, Any] = {}
+    groups: dict[str, dict[str, Any]] = {}
+    for key, value in overrides.items():
+        head, _, rest = key.partition(".")
+        if rest and head in nested_fields:
+            groups.setdefault(head, {})[rest] = value
+        elif not rest and (head in leaf_fields or head in nested_fields):
+            changes[head] = value
+        else:
+            raise _unknown(params, key, path)
+    for head, sub in groups.items():
+        base = changes.pop(head, getattr(params, head))
+        if not isinstance(base, Params):
+            base = _convert(type(params)._spec(head), f"{path}{head}", base)
+        changes[head] = _override(base, sub, f"{path}{head}.")
+    try:
+        return params.replace(**changes)
+    except ParameterError as e:
+        raise e.renamed(type(params)._prefix, path.rstrip(".")) from None
+
+
+def with_overrides(params: Params, overrides: Mapping[str, Any] | None) -> Params:
+    """A copy of ``params`` with dotted-path overrides, e.g. ``{"bearing.clearance": "30 um",
+    "gears.planets": 4, "gears.sun.teeth": 29}``; values are checked like at construction and
+    overridden values are tagged ``user`` (unless given as :class:`Sourced`)."""
+    if not overrides:
+        return params
+    return _override(params, dict(overrides), "")
+
+
+def _describe_value(v) -> str:
+    if isinstance(v, Quantity):
+        return f"{v:~P}"
+    return repr(v) if isinstance(v, str) else str(v)
+
+
+def _si_at(view, path: str):
+    for part in path.split("."):
+        view = view[part]
+    return view
+
+
+def describe(params: Params) -> str:
+    """A table: dotted path, value (rule-based values resolved, in SI), source tag and note."""
+    try:
+        si = params.si()
+    except ParameterError:
+        si = None
+    rows = []
+    for path, v in flatten(params).items():
+        *owner_path, name = path.split(".")
+        owner = params
+        for p in owner_path:
+            owner = getattr(owner, p)
+        if v is None:
+            resolved = _si_at(si, path) if si is not None else None
+            shown = f"{resolved:.6g} (SI)" if resolved is not None else "(rule)"
+        else:
+            shown = _describe_value(v)
+        rows.append((path, shown, str(owner.source(name))))
+    w0 = max(len(r[0]) for r in rows)
+    w1 = max(len(r[1]) for r in rows)
+    return "\n".join(f"{a:<{w0}}  {b:<{w1}}  {c}" for a, b, c in rows)
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, Quantity):
+        if v.dimensionless and str(v.units) == "dimensionless":
+            return repr(float(v.magnitude))
+        return json.dumps(format_quantity(v))
+    return json.dumps(str(v))
+
+
+def to_toml(params: Params) -> str:
+    """The parameters as TOML (dotted tables, values as exact unit strings, sources as comments).
+    Values left None (following their rule) are written as comments: loading keeps the base's value."""
+    lines: list[str] = []
+
+    def emit(obj: Params, path: str):
+        subs = []
+        for f in _param_fields(type(obj)):
+            v = getattr(obj, f.name)
+            if isinstance(v, Params):
+                subs.append((f.name, v))
+            elif v is None:
+                lines.append(f"# {f.name}: {obj.source(f.name)}")
+            else:
+                lines.append(f"{f.name} = {_toml_value(v)}  # {obj.source(f.name)}")
+        for name, sub in subs:
+            lines.append("")
+            lines.append(f"[{path}{name}]")
+            emit(sub, f"{path}{name}.")
+
+    emit(params, "")
+    return "\n".join(lines) + "\n"
+
+
+def overrides_from_toml(text: str) -> dict[str, Any]:
+    """Parse TOML text into {dotted path: value} (nested tables flattened)."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise ParameterError(f"invalid TOML: {e}") from None
+    out: dict[str, Any] = {}
+
+    def walk(d: Mapping, prefix: str):
+        for k, v in d.items():
+            if isinstance(v, Mapping):
+                walk(v, f"{prefix}{k}.")
+            else:
+                out[f"{prefix}{k}"] = v
+
+    walk(data, "")
+    return out
+
+
+def load_toml(path, base: DPGTParams | None = None) -> DPGTParams:
+    """``base`` (default: the reference machine) with the overrides in the TOML file ``path``."""
+    if base is None:
+        from .presets import reference_dpgt  # presets imports this module
+        base = reference_dpgt()
+    return with_overrides(base, overrides_from_toml(Path(path).read_text(encoding="utf-8")))

@@ -1,0 +1,116 @@
+"""The reference machine of the source study (PARAMETERS.md), with the source of every value.
+
+``reference_dpgt(condition=3, direction="forward")`` → :class:`DPGTParams`; change anything with
+:func:`components.params.with_overrides`. Values from the study's tables are tagged [paper], values
+computed from them [derived] (left None in the parameter objects so that they follow overrides: roller
+mass, Palmgren stiffness, mean mesh stiffness), engineering estimates [assumed] with their basis.
+"""
+from __future__ import annotations
+
+from types import MappingProxyType
+
+from .params import (BearingParams, CageParams, DPGTParams, GearParams, GearSetParams, LubricantParams,
+                     MeshParams, OperatingPoint, SupportParams, assumed, paper)
+from .units import Q_, ParameterError
+
+__all__ = ["CONDITIONS", "DIRECTIONS", "operating_point", "reference_gears", "reference_bearing",
+           "reference_dpgt"]
+
+# the study's four operating conditions: carrier speed n_c and output power P (ring fixed)
+CONDITIONS = MappingProxyType({
+    1: (Q_(1000, "rpm"), Q_(200, "kW")),
+    2: (Q_(2000, "rpm"), Q_(200, "kW")),
+    3: (Q_(4200, "rpm"), Q_(200, "kW")),
+    4: (Q_(4200, "rpm"), Q_(0, "kW")),
+})
+DIRECTIONS = ("forward", "reverse")
+
+
+def operating_point(condition: int = 3, direction: str = "forward") -> OperatingPoint:
+    """Operating condition 1..4 of the study, forward (n_c > 0) or reverse (n_c < 0)."""
+    if condition not in CONDITIONS:
+        raise ParameterError.at("operating.condition", f"expected one of {sorted(CONDITIONS)}, got {condition!r}")
+    if direction not in DIRECTIONS:
+        raise ParameterError.at("operating.direction", f"expected one of {list(DIRECTIONS)}, got {direction!r}")
+    speed, power = CONDITIONS[condition]
+    return OperatingPoint(carrier_speed=paper(speed, f"condition {condition}"),
+                          output_power=paper(power, f"condition {condition}"),
+                          direction=paper(direction, "the study runs both senses"))
+
+
+def _gear(teeth, face_width, mass, internal=False) -> GearParams:
+    profile = "standard full-depth involute teeth, no profile shift"
+    return GearParams(teeth=paper(teeth), module=paper("3 mm"), pressure_angle=paper("20 deg"),
+                      face_width=paper(face_width), mass=paper(mass),
+                      internal=paper(internal, "internal gear" if internal else "external gear"),
+                      addendum_coefficient=assumed(1.0, profile), dedendum_coefficient=assumed(1.25, profile))
+
+
+def reference_gears() -> GearSetParams:
+    """Table-1 gears; inertias follow the assumed rules (solid disc / thin ring / carrier disc)."""
+    return GearSetParams(
+        sun=_gear(31, "35.5 mm", "1.088 kg"),
+        inner_planet=_gear(24, "32 mm", "0.557 kg"),
+        outer_planet=_gear(24, "32 mm", "0.557 kg"),
+        ring=_gear(82, "33 mm", "6.07 kg", internal=True),
+        carrier_mass=paper("7.751 kg"),
+        planets=paper(3, "default planet count of the study"),
+        handedness=assumed(-1, "outer planet trails its inner planet by delta_psi in the forward "
+                               "(counter-clockwise) carrier direction"),
+        planet_angle=assumed("0 deg", "pair 0 on the +x axis at t = 0"),
+    )
+
+
+def reference_bearing() -> BearingParams:
+    """The planet bearing (same for inner and outer planets) and its cage."""
+    cage = CageParams(
+        mass=assumed("0.04 kg", "machined brass cage with side rings"),
+        pocket_clearance=assumed("0.10 mm", "circumferential, per side"),
+        guide_clearance=assumed("0.15 mm", "radial, outer-raceway guided"),
+        pocket_stiffness=assumed("2e7 N/m"),
+        guide_stiffness=assumed("2e7 N/m"),
+        restitution=assumed(0.8, "Hunt-Crossley, pocket and guide impacts"),
+        pocket_friction=assumed(0.1, "not stated by the source"),
+        guide_friction=assumed(0.1, "not stated by the source"),
+    )
+    return BearingParams(
+        pitch_diameter=paper("39 mm"),
+        roller_diameter=paper("7.5 mm"),
+        roller_length=paper("9 mm"),
+        rollers=paper(12),
+        clearance=assumed("20 um", "diametral"),
+        roller_density=assumed("7850 kg/m^3", "bearing steel"),
+        contact_damping_ratio=assumed(0.05, "of critical, gated to compression"),
+        traction_mu_max=assumed(0.08, "mu = 0.08 tanh(v_s / 0.3 m/s)"),
+        traction_v0=assumed("0.3 m/s"),
+        cage=cage,
+    )
+
+
+def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams:
+    """The reference DPGT exactly per PARAMETERS.md, at operating ``condition`` (1..4) and ``direction``."""
+    return DPGTParams(
+        gears=reference_gears(),
+        bearing=reference_bearing(),
+        lubricant=LubricantParams(
+            drag_coefficient=assumed(1.0),
+            density=assumed("45 kg/m^3", "oil-air mixture: 5 % oil of 870 kg/m^3"),
+        ),
+        support=SupportParams(
+            sun_stiffness=assumed("1e8 N/m"),
+            ring_stiffness=assumed("1e8 N/m"),
+            carrier_stiffness=assumed("1e8 N/m"),
+            damping_ratio=assumed(0.02),
+            ring_tangential_stiffness=assumed("1e9 N/m", "ring fixed: k_theta = 1e9 N/m x r_r^2"),
+        ),
+        mesh=MeshParams(
+            c_gamma_alpha=assumed("20 N/(mm*um)", "ISO 6336 typical c_gamma_alpha"),
+            stiffness_ratio=assumed(1.5, "k_double / k_single"),
+            smoothing_width=assumed(0.05, "not in PARAMETERS.md: 5 % of a mesh cycle per step, "
+                                          "smooth enough for Newton, sharp enough to keep the wave"),
+            damping_ratio=assumed(0.07),
+            backlash=assumed("0 um", "a parameter; 0 by default"),
+        ),
+        operating=operating_point(condition, direction),
+        gravity=assumed("9.81 m/s^2", "standard gravity along -Y of the fixed frame"),
+    )

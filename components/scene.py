@@ -1,0 +1,156 @@
+"""Scene composition: components add bodies and element *instances*; one family per element kind.
+
+Components never create one element object per roller: they append instances to a
+:class:`FamilyCollector` (body indices + per-instance parameters), and :meth:`Scene.build` turns each
+collector into a single vectorised element family. Initial poses and velocities are given in the
+fixed frame I (the kinematic steady state) and converted once into the reference frame R.
+A scene contains only what its components added: nothing unused is built or evaluated.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+import mbd
+from mbd.model import to_reference
+
+__all__ = ["Scene", "BuiltScene", "FamilyCollector", "SceneOptions"]
+
+
+@dataclass(frozen=True)
+class SceneOptions:
+    """Physics switches of a scene (PyBaMM-style validated options). Unknown keys fail loudly."""
+    bearings: str = "rollers"          # "rollers": full roller/cage model; "linear": radial spring
+    cage: bool = True                  # cage body + pocket and guide contacts (rollers only)
+    drag: bool = True                  # lubricant drag on rollers
+    gravity: bool = True
+    mesh_stiffness: str = "time_varying"   # "time_varying" | "constant"
+    frame: str = "rotating"            # "rotating" (R turns with the nominal carrier speed) | "fixed"
+
+    _CHOICES = {"bearings": ("rollers", "linear"), "mesh_stiffness": ("time_varying", "constant"),
+                "frame": ("rotating", "fixed")}
+
+    def __post_init__(self):
+        for key, allowed in self._CHOICES.items():
+            if getattr(self, key) not in allowed:
+                raise mbd.ModelError(f"scene option {key!r} must be one of {allowed}, got {getattr(self, key)!r}")
+        for key in ("cage", "drag", "gravity"):
+            if not isinstance(getattr(self, key), bool):
+                raise mbd.ModelError(f"scene option {key!r} must be true or false, got {getattr(self, key)!r}")
+
+    @classmethod
+    def from_dict(cls, d: dict | None) -> "SceneOptions":
+        d = dict(d or {})
+        valid = [f for f in cls.__dataclass_fields__ if not f.startswith("_")]
+        unknown = set(d) - set(valid)
+        if unknown:
+            raise mbd.ModelError(f"unknown scene option(s) {sorted(unknown)}; valid options: {valid}")
+        return cls(**d)
+
+
+class FamilyCollector:
+    """Instances of one element family, accumulated by components, created once at build."""
+
+    def __init__(self, cls, name: str, body_args: tuple[str, ...], **common):
+        self.cls, self.name, self.body_args, self.common = cls, name, body_args, common
+        self.rows: list[dict[str, np.ndarray]] = []
+
+    def add(self, n: int, **kw) -> slice:
+        """Append n instances. Each value is a scalar (same for all n) or an array whose first
+        dimension is n (e.g. (n, 2) marker offsets). Returns the instances' slice in the family."""
+        row = {}
+        for k, v in kw.items():
+            a = np.asarray(v)
+            if a.ndim == 0:
+                a = np.full(n, v, dtype=a.dtype if a.dtype != object else object)
+            elif a.shape[0] != n:
+                raise mbd.ModelError(f"family {self.name!r}: argument {k!r} needs {n} rows, got shape {a.shape}")
+            row[k] = a
+        start = self.n
+        row["__n"] = n
+        self.rows.append(row)
+        return slice(start, start + n)
+
+    @property
+    def n(self) -> int:
+        return sum(r["__n"] for r in self.rows)
+
+    def make(self, body_index):
+        keys = [k for k in self.rows[0] if k != "__n"]
+        cat = {k: np.concatenate([r[k] for r in self.rows]) for k in keys}
+        for b in self.body_args:
+            cat[b] = np.array([body_index[x] if isinstance(x, str) else int(x) for x in cat[b]], dtype=np.int64)
+        return self.cls(self.name, **{b: cat.pop(b) for b in self.body_args}, **cat, **self.common)
+
+
+@dataclass
+class BuiltScene:
+    """A built model with its initial state (free DOFs, in R) and handles for outputs."""
+    model: mbd.Model
+    q0: np.ndarray
+    v0: np.ndarray
+    handles: dict = field(default_factory=dict)
+    meta: dict = field(default_factory=dict)
+    probes: list = field(default_factory=list)
+
+    def body_index(self, name: str) -> int:
+        return self.model.body(name).index
+
+
+class Scene:
+    def __init__(self, frame_omega: float = 0.0, gravity: float = 0.0, options: SceneOptions | None = None):
+        self.options = options or SceneOptions()
+        frame = mbd.Frame.rotating(frame_omega) if frame_omega != 0.0 else mbd.Frame.inertial()
+        self.mb = mbd.ModelBuilder(frame=frame, gravity=(0.0, -gravity))
+        self.frame_omega = frame_omega
+        self._pose: list[np.ndarray] = []
+        self._vel: list[np.ndarray] = []
+        self.index: dict[str, int] = {}
+        self.families: dict[str, FamilyCollector] = {}
+        self.handles: dict[str, Any] = {}
+        self.meta: dict[str, Any] = {}
+        self.probes: list = []
+        self._direct: list = []
+
+    def body(self, name, mass, inertia, pose=(0.0, 0.0, 0.0), vel=(0.0, 0.0, 0.0), fixed=False) -> int:
+        """Add a body with its initial pose and velocity in the fixed frame; returns its index."""
+        ref = self.mb.add_body(name, mass, inertia, pose=pose, fixed=fixed)
+        self.index[name] = ref.index
+        self._pose.append(np.asarray(pose, float))
+        self._vel.append(np.zeros(3) if fixed else np.asarray(vel, float))
+        return ref.index
+
+    def pose(self, name: str) -> np.ndarray:
+        return self._pose[self.index[name]].copy()
+
+    def set_pose(self, name: str, pose) -> None:
+        """Change a body's initial pose in the fixed frame before the scene is built (e.g. a ring
+        turned to mate with its planets). Its nominal pose in the model follows."""
+        i = self.index[name]
+        self._pose[i] = np.asarray(pose, float)
+        self.mb._pose[i] = self._pose[i].copy()
+
+    def family(self, key: str, cls, body_args: tuple[str, ...], **common) -> FamilyCollector:
+        """The collector for family ``key`` (created on first use)."""
+        if key not in self.families:
+            self.families[key] = FamilyCollector(cls, key, body_args, **common)
+        return self.families[key]
+
+    def add_element(self, element) -> None:
+        """A ready-made element family (e.g. one drive)."""
+        self._direct.append(element)
+
+    def build(self) -> BuiltScene:
+        for fam in self.families.values():
+            if fam.n:
+                self.mb.add(fam.make(self.index))
+        for e in self._direct:
+            self.mb.add(e)
+        model = self.mb.build()
+        fs = model.frame.at(0.0)
+        q, v = to_reference(np.array(self._pose), np.array(self._vel), fs)
+        qf, vf = q.ravel(), v.ravel()
+        return BuiltScene(model, qf[model.free].copy(), vf[model.free].copy(), dict(self.handles),
+                          dict(self.meta), list(self.probes))

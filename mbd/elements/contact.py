@@ -1,0 +1,351 @@
+"""Planet-bearing contacts (MODEL.md §3.3–3.6): roller–raceway Hertz line contact with traction,
+roller–cage pocket impact, cage–guide-land impact and lubricant drag on the rollers.
+
+Every family covers all rollers (or cages) of all bearings at once; each instance couples two bodies
+(k = 6: first body x, y, θ, then second body x, y, θ). Forces that act at a contact point are applied
+at the *same* world point on both bodies, equal and opposite, so forces and moments balance exactly
+about any point. Kernels are written with :mod:`mbd.ad` so the assembler gets exact Jacobians.
+
+Regularisations (all smooth, documented where they are made):
+- centre distances use a safe norm sqrt(x² + y² + η²), η = 1e-12 m: bitwise identical to |x| at any
+  real bearing distance, finite derivatives when two centres coincide (a centred cage at t = 0);
+- friction laws are tanh-regularised Coulomb laws (no stick state in a stateless element);
+- the EHL traction curve uses a regularised slide-to-roll ratio (see :class:`Traction`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import ad
+from ..element import Element, body_dofs, marker, marker_velocity, point_force
+from ..errors import ModelError
+
+__all__ = ["Traction", "RaceContact", "PocketContact", "GuideContact", "LubricantDrag"]
+
+_ETA2 = 1e-24  # (1e-12 m)²: below round-off of any physical distance squared, keeps norms nonzero
+
+
+def _norm(x, y):
+    """Safe Euclidean norm (see module docstring)."""
+    return ad.sqrt(x * x + y * y + _ETA2)
+
+
+def _markers(elem: Element, name: str, value) -> np.ndarray:
+    """(n, 2) body-fixed offsets from a (2,) or (n, 2) value, checked finite."""
+    a = np.asarray(value, dtype=float)
+    if a.shape not in ((2,), (elem.n, 2)):
+        raise ModelError(f"{elem.name}: parameter {name!r} must have shape (2,) or ({elem.n}, 2) [m], got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ModelError(f"{elem.name}: parameter {name!r} must be finite, got {value!r}")
+    return np.broadcast_to(a, (elem.n, 2)).copy()
+
+
+def _fraction(elem: Element, name: str, value) -> np.ndarray:
+    a = elem._per_instance(name, value, nonneg=True)
+    if np.any(a > 1.0):
+        raise ModelError(f"{elem.name}: parameter {name!r} must lie in [0, 1], got {value!r}")
+    return a
+
+
+def _hunt_crossley(k, pen, pen_dot, restitution, v_ref):
+    """k·pen·(1 + 1.5(1 − e)·ṗen/v_ref) for pen > 0, clipped at ≥ 0 (never pulling), else 0.
+
+    The true Hunt–Crossley law scales damping with the impact velocity, which a stateless element
+    cannot know; a fixed reference impact velocity v_ref stands in for it (an assumption)."""
+    F = k * pen * (1.0 + 1.5 * (1.0 - restitution) * pen_dot / v_ref)
+    active = (ad.value(pen) > 0.0) & (ad.value(F) > 0.0)
+    return ad.where(active, F, 0.0)
+
+
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Traction:
+    """Roller–raceway traction curve μ: smooth, odd and bounded (MODEL.md §3.3).
+
+    ``kind="tanh"``: μ = mu_max·tanh(v_s / v0) of the sliding velocity v_s [m/s].
+
+    ``kind="ehl"``: μ(s) = (A + B·s)·e^(−C·s) + D of the slide-to-roll ratio s ≥ 0, extended as an odd
+    function. The ratio is regularised so that it stays finite when the rolling speed vanishes:
+        s = v_s / sqrt(u_r² + u_reg²),   u_r = mean rolling (entrainment) speed of the two surfaces
+    relative to the moving contact point. The odd extension is sign(s)·μ(|s|) with |s| smoothed to
+    a = sqrt(s² + s_eps²): μ = (s/a)·[(A + B a)e^(−C a) + D], which is C^∞ and, when A + D = 0 (zero
+    traction at pure rolling), follows the curve to O(s_eps²) with slope ≈ B − A·C at s = 0.
+    Default EHL coefficients [assumed]: peak μ ≈ 0.073 at s ≈ 0.033, tending to D = 0.04 at large slip;
+    u_reg = 0.1 m/s (far below the bearing's rolling speeds of metres per second, it only matters when
+    the bearing is nearly at rest), s_eps = 1e-4.
+    """
+    kind: str = "tanh"
+    mu_max: float = 0.08
+    v0: float = 0.3
+    A: float = -0.04
+    B: float = 5.0
+    C: float = 40.0
+    D: float = 0.04
+    u_reg: float = 0.1
+    s_eps: float = 1e-4
+
+    def __post_init__(self):
+        if self.kind not in ("tanh", "ehl"):
+            raise ModelError(f"Traction: kind must be 'tanh' or 'ehl', got {self.kind!r}")
+        for name in ("mu_max", "v0", "A", "B", "C", "D", "u_reg", "s_eps"):
+            if not np.isfinite(getattr(self, name)):
+                raise ModelError(f"Traction: {name} must be finite, got {getattr(self, name)!r}")
+        for name in ("v0", "u_reg", "s_eps"):
+            if getattr(self, name) <= 0:
+                raise ModelError(f"Traction: {name} must be > 0, got {getattr(self, name)!r}")
+        if self.mu_max < 0 or self.C < 0:
+            raise ModelError(f"Traction: mu_max and C must be >= 0, got {self.mu_max!r}, {self.C!r}")
+
+    @property
+    def needs_rolling_speed(self) -> bool:
+        return self.kind == "ehl"
+
+    def coefficient(self, v_s, u_roll=None):
+        """μ for sliding velocity v_s [m/s] (and rolling speed u_roll [m/s] for the EHL curve)."""
+        if self.kind == "tanh":
+            return self.mu_max * ad.tanh(v_s * (1.0 / self.v0))
+        s = v_s / ad.sqrt(u_roll * u_roll + self.u_reg ** 2)
+        a = ad.sqrt(s * s + self.s_eps ** 2)
+        return (s / a) * ((self.A + self.B * a) * ad.exp(a * (-self.C)) + self.D)
+
+
+# --------------------------------------------------------------------------------------------
+class RaceContact(Element):
+    """Roller–raceway Hertz line contact (Palmgren) with damping and traction.
+
+    Instances couple a roller (first 3 coordinates) with the body carrying the raceway (last 3): the
+    carrier for an inner raceway (``race_marker`` = pin centre in carrier axes), the planet for an outer
+    one (``race_marker`` = (0, 0), the bore centre). With c the raceway centre, ρ = |p − c|, e = (p − c)/ρ:
+        inner: δ = R + D/2 − ρ (roller pushed along +e),  outer: δ = ρ + D/2 − R (pushed along −e).
+    Normal load Q = K δ^p + c(δ) δ̇ for δ > 0, clipped at ≥ 0, with c(δ) = 2ζ sqrt(m_roller · dQ/dδ) and
+    dQ/dδ = p K δ^(p−1): a damping ratio ζ of the local contact oscillator, vanishing at first touch.
+    Traction: v_s = (roller surface point − raceway surface point velocity)·t, t = k × e, at the contact
+    point P = c + R e (line of centres, raceway surface); force −μ·Q along t on the roller. The normal
+    and traction forces act at P on both bodies, equal and opposite.
+
+    Outputs: "load" Q ≥ 0 [N]; "deflection" δ [m] (negative: a gap); "traction" tangential force on the
+    roller along t [N] (opposes v_s); "slip_velocity" v_s [m/s]; "angle" the roller centre's angle about
+    the raceway centre measured in the race body's axes [rad] (wrapped to (−π, π]).
+    """
+    k = 6
+
+    def __init__(self, name, roller, race_body, *, kind, race_marker, R_race, D, K, exponent=10.0 / 9.0,
+                 zeta=0.05, m_roller, traction: Traction = Traction()):
+        self.name = name
+        self.dofs = body_dofs(roller, race_body)
+        if kind not in ("inner", "outer"):
+            raise ModelError(f"{name}: kind must be 'inner' or 'outer', got {kind!r}")
+        if not isinstance(traction, Traction):
+            raise ModelError(f"{name}: traction must be a Traction, got {type(traction).__name__}")
+        self.kind = kind
+        self.kappa = 1.0 if kind == "inner" else -1.0  # δ = D/2 − κ(ρ − R), normal on roller κ·e
+        self.race_marker = _markers(self, "race_marker", race_marker)
+        self.R_race = self._per_instance("R_race", R_race, positive=True)
+        self.D = self._per_instance("D", D, positive=True)
+        self.K = self._per_instance("K", K, positive=True)
+        self.exponent = float(exponent)
+        if not (np.isfinite(self.exponent) and self.exponent >= 1.0):
+            # p < 1 would make dQ/dδ infinite at first touch
+            raise ModelError(f"{name}: parameter 'exponent' must be >= 1, got {exponent!r}")
+        self.zeta = self._per_instance("zeta", zeta, nonneg=True)
+        self.m_roller = self._per_instance("m_roller", m_roller, positive=True)
+        self.traction = traction
+        self._c0 = 2.0 * self.zeta * np.sqrt(self.m_roller * self.exponent * self.K)
+
+    def kernel(self, t, fs, q, v, z):
+        qr, qb, vr, vb = q[:3], q[3:], v[:3], v[3:]
+        R, kap, p = self.R_race, self.kappa, self.exponent
+        (cx, cy), rc = marker(qb, self.race_marker)
+        dx, dy = qr[0] - cx, qr[1] - cy
+        rho = _norm(dx, dy)
+        ex, ey = dx / rho, dy / rho
+        tx, ty = -1.0 * ey, ex
+        delta = 0.5 * self.D - kap * (rho - R)
+        Vc = marker_velocity(vb, rc)
+        wx, wy = vr[0] - Vc[0], vr[1] - Vc[1]            # roller centre relative to raceway centre
+        delta_dot = -kap * (ex * wx + ey * wy)
+        # normal load; powers are taken of a safe positive δ and selected afterwards (no 0^negative)
+        touch = ad.value(delta) > 0.0
+        ds = ad.where(touch, delta, 1.0)
+        Q_raw = self.K * ad.power(ds, p) + self._c0 * ad.power(ds, 0.5 * (p - 1.0)) * delta_dot
+        Q = ad.where(touch & (ad.value(Q_raw) > 0.0), Q_raw, 0.0)
+        # contact point P = c + R e, seen from the roller centre and from the race body's centre
+        r_roll = ((R - rho) * ex, (R - rho) * ey)
+        r_race = (rc[0] + R * ex, rc[1] + R * ey)
+        Vr = marker_velocity(vr, r_roll)
+        Vb = marker_velocity(vb, r_race)
+        ur = Vr[0] * tx + Vr[1] * ty
+        ub = Vb[0] * tx + Vb[1] * ty
+        v_s = ur - ub
+        if self.traction.needs_rolling_speed:
+            # velocity of the geometric contact point P along t: ċ·t + R (ṗ − ċ)·t / ρ
+            vP = Vc[0] * tx + Vc[1] * ty + R * (wx * tx + wy * ty) / rho
+            mu = self.traction.coefficient(v_s, 0.5 * (ur + ub) - vP)
+        else:
+            mu = self.traction.coefficient(v_s)
+        Ft = -1.0 * mu * Q
+        Fx = kap * Q * ex + Ft * tx
+        Fy = kap * Q * ey + Ft * ty
+        forces = point_force(r_roll, (Fx, Fy)) + point_force(r_race, (-1.0 * Fx, -1.0 * Fy))
+        angle = ad.wrap_angle(ad.arctan2(dy, dx) - qb[2])
+        return forces, {"load": Q, "deflection": delta, "traction": Ft, "slip_velocity": v_s, "angle": angle,
+                        "fx": Fx, "fy": Fy}   # fx, fy: total force on the roller, in R
+
+
+# --------------------------------------------------------------------------------------------
+class PocketContact(Element):
+    """Roller–cage pocket impact with wall friction (MODEL.md §3.4).
+
+    Instances couple a roller (first 3 coordinates) with its cage (last 3). Circumferential offset of
+    the roller in pocket j: s = (d_m/2)·wrap(β − θ_g − ψ_j), β the angle of (p − c_g) in R. Penetration
+    d = |s| − C_p; for d > 0 the contact force is F = K_p d (1 + 1.5(1 − e) ḋ / v_ref) ≥ 0 (Hunt–Crossley
+    with a fixed reference impact velocity v_ref: an assumption, a stateless element cannot know the
+    real impact velocity). It is applied in potential form, generalized force −F·∂d/∂q, which balances
+    forces and moments exactly: the roller is pushed back along the pitch circle towards the pocket
+    centre, the cage gets the opposite force and the moment F·sign(s)·d_m/2.
+    Wall friction: the roller touches the wall at P_w = p + sign(s)·(D/2)·t (t = k × e_r, e_r radial
+    from the cage centre); μ·tanh(v/v_mu)·F along ∓e_r opposes the radial sliding v of the roller surface
+    on the wall (the wall taken along the roller's radial line), applied at P_w on both bodies.
+
+    Outputs: "force" signed tangential force F·sign(s) [N] (+ when the roller pushes the cage forward);
+    "offset" s [m]; "penetration" max(d, 0) [m].
+    """
+    k = 6
+
+    def __init__(self, name, roller, cage, *, pocket_angle, pitch_radius, clearance, K_p, restitution=0.8,
+                 v_ref=0.1, mu=0.1, v_mu=0.05, D):
+        self.name = name
+        self.dofs = body_dofs(roller, cage)
+        self.pocket_angle = self._per_instance("pocket_angle", pocket_angle)
+        self.pitch_radius = self._per_instance("pitch_radius", pitch_radius, positive=True)
+        self.clearance = self._per_instance("clearance", clearance, nonneg=True)
+        self.K_p = self._per_instance("K_p", K_p, positive=True)
+        self.restitution = _fraction(self, "restitution", restitution)
+        self.v_ref = self._per_instance("v_ref", v_ref, positive=True)
+        self.mu = self._per_instance("mu", mu, nonneg=True)
+        self.v_mu = self._per_instance("v_mu", v_mu, positive=True)
+        self.D = self._per_instance("D", D, positive=True)
+
+    def kernel(self, t, fs, q, v, z):
+        qr, qg, vr, vg = q[:3], q[3:], v[:3], v[3:]
+        rm = self.pitch_radius
+        dx, dy = qr[0] - qg[0], qr[1] - qg[1]
+        rho2 = dx * dx + dy * dy + _ETA2
+        s = rm * ad.wrap_angle(ad.arctan2(dy, dx) - qg[2] - self.pocket_angle)
+        sg = ad.sign(s)
+        pen = ad.abs_(s) - self.clearance
+        wx, wy = vr[0] - vg[0], vr[1] - vg[1]
+        s_dot = rm * ((dx * wy - dy * wx) / rho2 - vg[2])
+        F = _hunt_crossley(self.K_p, pen, sg * s_dot, self.restitution, self.v_ref)
+        Fs = F * sg
+        # −Fs ∂s/∂q: ∂s/∂p = rm (−dy, dx)/ρ², ∂s/∂c_g = −∂s/∂p, ∂s/∂θ_g = −rm
+        gx, gy = rm * (-1.0 * dy) / rho2, rm * dx / rho2
+        fnx, fny = -1.0 * Fs * gx, -1.0 * Fs * gy
+        # wall friction at the roller's contact point with the wall
+        rho = ad.sqrt(rho2)
+        ex, ey = dx / rho, dy / rho
+        half = 0.5 * self.D * sg
+        r_w = (-1.0 * half * ey, half * ex)                 # sign(s)·(D/2)·t from the roller centre
+        r_wg = (dx + r_w[0], dy + r_w[1])                   # the same point from the cage centre
+        Vr = marker_velocity(vr, r_w)
+        Vg = marker_velocity(vg, r_wg)
+        v_rad = (Vr[0] - Vg[0]) * ex + (Vr[1] - Vg[1]) * ey
+        f = -1.0 * self.mu * ad.tanh(v_rad / self.v_mu) * F
+        fr = point_force(r_w, (f * ex, f * ey))
+        fg = point_force(r_wg, (-1.0 * f * ex, -1.0 * f * ey))
+        forces = [fnx + fr[0], fny + fr[1], fr[2],
+                  -1.0 * fnx + fg[0], -1.0 * fny + fg[1], Fs * rm + fg[2]]
+        return forces, {"force": Fs, "offset": s, "penetration": ad.pos(pen)}
+
+
+# --------------------------------------------------------------------------------------------
+class GuideContact(Element):
+    """Cage–guide-land impact for an outer-raceway-guided cage (MODEL.md §3.5).
+
+    Instances couple a cage (first 3 coordinates) with its planet (last 3; the planet's centre is the
+    bore centre). e = c_g − c_o, ε = |e|, n = e/ε. For ε > C_g the normal force
+    F_n = K_g (ε − C_g)(1 + 1.5(1 − e_r) ε̇ / v_ref) ≥ 0 pushes the cage along −n (back to the bore centre)
+    and the planet along +n. Both act at the land contact point P = c_g + land_radius·n. Land friction
+    μ·tanh(v_t/v_mu)·F_n opposes the relative surface speed v_t = (V_cage(P) − V_planet(P))·t, t = k × n.
+    The centred cage (ε = 0) is regular: the safe norm keeps n finite and the forces are zero there.
+
+    Outputs: "force" F_n ≥ 0 [N]; "eccentricity" ε [m]; "friction" tangential force on the cage along t [N].
+    """
+    k = 6
+
+    def __init__(self, name, cage, planet, *, clearance, K_g, restitution=0.8, v_ref=0.1, mu=0.1, v_mu=0.05,
+                 land_radius):
+        self.name = name
+        self.dofs = body_dofs(cage, planet)
+        self.clearance = self._per_instance("clearance", clearance, nonneg=True)
+        self.K_g = self._per_instance("K_g", K_g, positive=True)
+        self.restitution = _fraction(self, "restitution", restitution)
+        self.v_ref = self._per_instance("v_ref", v_ref, positive=True)
+        self.mu = self._per_instance("mu", mu, nonneg=True)
+        self.v_mu = self._per_instance("v_mu", v_mu, positive=True)
+        self.land_radius = self._per_instance("land_radius", land_radius, positive=True)
+
+    def kernel(self, t, fs, q, v, z):
+        qg, qo, vg, vo = q[:3], q[3:], v[:3], v[3:]
+        ex, ey = qg[0] - qo[0], qg[1] - qo[1]
+        eps = _norm(ex, ey)
+        nx, ny = ex / eps, ey / eps
+        tx, ty = -1.0 * ny, nx
+        eps_dot = nx * (vg[0] - vo[0]) + ny * (vg[1] - vo[1])
+        F = _hunt_crossley(self.K_g, eps - self.clearance, eps_dot, self.restitution, self.v_ref)
+        rL = self.land_radius
+        r_g = (rL * nx, rL * ny)
+        r_o = (ex + r_g[0], ey + r_g[1])
+        Vg = marker_velocity(vg, r_g)
+        Vo = marker_velocity(vo, r_o)
+        v_t = (Vg[0] - Vo[0]) * tx + (Vg[1] - Vo[1]) * ty
+        fr = -1.0 * self.mu * ad.tanh(v_t / self.v_mu) * F
+        Fx = -1.0 * F * nx + fr * tx
+        Fy = -1.0 * F * ny + fr * ty
+        forces = point_force(r_g, (Fx, Fy)) + point_force(r_o, (-1.0 * Fx, -1.0 * Fy))
+        ecc = np.hypot(ad.value(ex), ad.value(ey))  # the plain norm for the record
+        return forces, {"force": F, "eccentricity": ecc, "friction": fr, "fx": Fx, "fy": Fy}  # fx, fy on the cage, in R
+
+
+# --------------------------------------------------------------------------------------------
+class LubricantDrag(Element):
+    """Lubricant (oil–air mixture) drag on the rollers' orbital motion (MODEL.md §3.6).
+
+    Instances couple a roller (first 3 coordinates) with the body carrying the inner raceway (last 3:
+    the carrier, ``race_marker`` = pin centre in its axes). Ω_m = orbital angular speed of the roller
+    centre about the pin centre minus the race body's angular speed;
+        F_d = (1/8) C_d ρ D l d_m² Ω_m |Ω_m|   (signed, smooth),
+    applied at the roller centre along −t (t = k × e, e from pin centre to roller): it opposes the
+    orbital motion relative to the race body. The race body gets the reaction at the same point.
+
+    Output: "force" signed F_d [N] (the drag on the roller is −force·t).
+    """
+    k = 6
+
+    def __init__(self, name, roller, race_body, *, race_marker, C_d, rho, D, l, d_m):
+        self.name = name
+        self.dofs = body_dofs(roller, race_body)
+        self.race_marker = _markers(self, "race_marker", race_marker)
+        C_d = self._per_instance("C_d", C_d, nonneg=True)
+        rho = self._per_instance("rho", rho, nonneg=True)
+        D = self._per_instance("D", D, positive=True)
+        l = self._per_instance("l", l, positive=True)
+        d_m = self._per_instance("d_m", d_m, positive=True)
+        self.coef = 0.125 * C_d * rho * D * l * d_m * d_m
+
+    def kernel(self, t, fs, q, v, z):
+        qr, qb, vr, vb = q[:3], q[3:], v[:3], v[3:]
+        (cx, cy), rc = marker(qb, self.race_marker)
+        dx, dy = qr[0] - cx, qr[1] - cy
+        rho2 = dx * dx + dy * dy + _ETA2
+        rho = ad.sqrt(rho2)
+        Vc = marker_velocity(vb, rc)
+        wx, wy = vr[0] - Vc[0], vr[1] - Vc[1]
+        om = (dx * wy - dy * wx) / rho2 - vb[2]
+        Fd = self.coef * om * ad.abs_(om)
+        Fx, Fy = Fd * dy / rho, -1.0 * Fd * dx / rho   # −Fd·t, t = (−dy, dx)/ρ
+        zero = 0.0 * qr[0]
+        forces = [Fx, Fy, zero] + point_force((rc[0] + dx, rc[1] + dy), (-1.0 * Fx, -1.0 * Fy))
+        return forces, {"force": Fd}

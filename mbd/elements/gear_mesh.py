@@ -1,0 +1,296 @@
+"""Spur gear mesh: two flanks, optional backlash, time-varying stiffness (MODEL.md §3.2).
+
+One :class:`GearMesh` family holds n meshes of one kind (all external or all internal). Local
+coordinates are (x1, y1, θ1, x2, y2, θ2): gear 1 then gear 2. For the internal mesh gear 1 is the
+planet and gear 2 the ring.
+
+Compression of flank f = ±1 (exact for large motions, the same in every frame):
+
+    external  δ_f = f·[r_b1(θ1 − φ_e) + r_b2(θ2 − φ_e) − u0] − (a − a0)·sin α − b/2,  e: c1 → c2
+    internal  δ_f = f·[r_b2(θ2 − φ_e) − r_b1(θ1 − φ_e) − u0] + (a − a0)·sin α − b/2,  e: c2 → c1
+
+with a = |c2 − c1| and φ_e the angle of e. The bracket (the transmission error s) is taken modulo
+the base pitch p_b = 2π r_b1/z1, i.e. wrapped into (−p_b/2, p_b/2]: tooth pairs are identical, and
+this removes the 2π jumps of φ_e = arctan2(...) when the line of centres turns through ±π (a
+planet orbiting in the fixed frame) — such a jump shifts s by (z1 ± z2)·p_b, whole pitches.
+
+Generalized forces are Q = −F_f ∇δ_f, with ∇δ_f written out analytically. Writing d for the centre
+vector along e (external d = c2 − c1, internal d = c1 − c2), t = k × e, and κ = (r_b1 ± r_b2)/a:
+
+    ∂δ_f/∂d = −f κ t − σ sin α e          (σ = +1 external, −1 internal)
+    ∂δ_f/∂θ1 = σ f r_b1,   ∂δ_f/∂θ2 = f r_b2
+
+At a = a0, κ = cos α and −∂δ_f/∂d is the spec's line of action n_f on the body at the head of d
+(gear 2 external, the planet internal). δ is invariant under a rigid motion of both gears, so the
+forces sum to zero and the moments balance about any point, exactly, in any state.
+
+Flank force F_f = max(k(p) δ_f + c_m δ̇_f, 0) while δ_f > 0, else 0, with δ̇_f = ∇δ_f · q̇ (the same in
+R and in I, because δ is frame-invariant). The mesh position p = z1 (θ1 − φ_e)/2π + p0 (mod 1) is
+gear 1's angle relative to the line of centres, measured from the direction e that points from gear 1's
+centre to its contact zone in both kinds (external: towards gear 2; internal: from the ring centre out
+through the planet to where it touches the ring). It is computed from the states, never from time.
+
+Mesh-cycle convention of :class:`StiffnessShape` ("rectangular"): double-tooth contact is centred
+on p = (ε_α − 1)/2, i.e. it spans p ∈ [0, ε_α − 1) (a new tooth pair enters at p = 0) and single
+contact spans [ε_α − 1, 1). Components choose p0 from the real tooth positions accordingly.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import ad
+from ..element import Element, body_dofs
+from ..errors import ModelError
+
+__all__ = ["StiffnessShape", "GearMesh", "mesh_damping", "mesh_u0", "contact_ratio_to_fraction"]
+
+_TWO_PI = 2.0 * np.pi
+
+
+def contact_ratio_to_fraction(contact_ratio) -> float:
+    """Fraction of a mesh cycle with two tooth pairs in contact, ε_α − 1 (needs 1 ≤ ε_α ≤ 2)."""
+    eps = float(contact_ratio)
+    if not (np.isfinite(eps) and 1.0 <= eps <= 2.0):
+        raise ModelError(f"contact_ratio must be in [1, 2] for a spur mesh with single/double contact, got {contact_ratio!r}")
+    return eps - 1.0
+
+
+@dataclass(frozen=True)
+class StiffnessShape:
+    """Shape of the mesh stiffness over one mesh cycle: k(p) = k_mean · factor(p), mean(factor) = 1.
+
+    kind "constant": factor 1.
+    kind "rectangular": smoothed rectangular wave between k_single and k_double = ratio·k_single;
+        double contact over the fraction ε_α − 1 of each cycle (p ∈ [0, ε_α − 1) with the ramps centred
+        on the edges); each edge is a quintic smoothstep (C², exactly periodic) of full width
+        ``smoothing`` cycles, which must not exceed min(ε_α − 1, 2 − ε_α).
+    kind "fourier": factor = 1 + Σ_j a_j cos(2πjp) + b_j sin(2πjp), j = 1, 2, ...; must stay > 0.
+
+    Use the constructors :meth:`constant`, :meth:`rectangular`, :meth:`fourier`.
+    """
+    kind: str = "constant"
+    contact_ratio: float = 1.0
+    ratio: float = 1.0
+    smoothing: float = 0.05
+    a: tuple = ()
+    b: tuple = ()
+
+    def __post_init__(self):
+        if self.kind not in ("constant", "rectangular", "fourier"):
+            raise ModelError(f"StiffnessShape: kind must be 'constant', 'rectangular' or 'fourier', got {self.kind!r}")
+        if self.kind == "rectangular":
+            frac = contact_ratio_to_fraction(self.contact_ratio)
+            if not (np.isfinite(self.ratio) and self.ratio > 0):
+                raise ModelError(f"StiffnessShape: ratio k_double/k_single must be > 0, got {self.ratio!r}")
+            s_max = min(frac, 1.0 - frac)
+            if not (np.isfinite(self.smoothing) and 0 < self.smoothing <= s_max):
+                raise ModelError(
+                    f"StiffnessShape: smoothing (ramp width, fraction of a mesh cycle) must be in (0, {s_max:.4g}] "
+                    f"for contact_ratio {self.contact_ratio!r} (ramps may not overlap), got {self.smoothing!r}")
+        if self.kind == "fourier":
+            a = np.asarray(self.a, float).ravel()
+            b = np.asarray(self.b, float).ravel()
+            if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+                raise ModelError(f"StiffnessShape: Fourier coefficients a, b must be finite, got a={self.a!r}, b={self.b!r}")
+            object.__setattr__(self, "a", tuple(a.tolist()))
+            object.__setattr__(self, "b", tuple(b.tolist()))
+            nh = max(len(self.a), len(self.b), 1)
+            p = np.linspace(0.0, 1.0, 64 * nh, endpoint=False)
+            if np.min(self.factor(p)) <= 0.0:
+                raise ModelError("StiffnessShape: Fourier stiffness 1 + Σ a_j cos + b_j sin must stay > 0 over the cycle, "
+                                 f"got a={self.a!r}, b={self.b!r}")
+
+    @classmethod
+    def constant(cls) -> "StiffnessShape":
+        return cls("constant")
+
+    @classmethod
+    def rectangular(cls, contact_ratio: float, ratio: float = 1.5, smoothing: float = 0.05) -> "StiffnessShape":
+        return cls("rectangular", contact_ratio=float(contact_ratio), ratio=float(ratio), smoothing=float(smoothing))
+
+    @classmethod
+    def fourier(cls, a=(), b=()) -> "StiffnessShape":
+        return cls("fourier", a=tuple(np.atleast_1d(np.asarray(a, float))), b=tuple(np.atleast_1d(np.asarray(b, float))))
+
+    # rectangular wave levels relative to k_mean
+    @property
+    def single(self) -> float:
+        """k_single / k_mean (1 for the other kinds)."""
+        if self.kind != "rectangular":
+            return 1.0
+        return 1.0 / (1.0 + (self.ratio - 1.0) * (self.contact_ratio - 1.0))
+
+    @property
+    def double(self) -> float:
+        """k_double / k_mean (1 for the other kinds)."""
+        return self.ratio * self.single if self.kind == "rectangular" else 1.0
+
+    def factor(self, p):
+        """k(p)/k_mean for mesh position p (any real; periodic with period 1); Dual-capable."""
+        if self.kind == "constant":
+            return 1.0
+        if self.kind == "fourier":
+            out = 1.0
+            for j, aj in enumerate(self.a, start=1):
+                out = out + aj * ad.cos(_TWO_PI * j * p)
+            for j, bj in enumerate(self.b, start=1):
+                out = out + bj * ad.sin(_TWO_PI * j * p)
+            return out
+        h = 0.5 * (self.contact_ratio - 1.0)      # half width of the double-contact window
+        s = self.smoothing
+        u = ad.wrap_angle(_TWO_PI * (p - h)) * (1.0 / _TWO_PI)   # position from the window centre, in [-1/2, 1/2]
+        x = (h + 0.5 * s - ad.abs_(u)) * (1.0 / s)             # 1 inside, 0 outside, linear across an edge
+        x = ad.where(x > 1.0, 1.0, ad.where(x < 0.0, 0.0, x))
+        w = x * x * x * (10.0 + x * (-15.0 + 6.0 * x))       # quintic smoothstep: C², symmetric ramp
+        return self.single * (1.0 + (self.ratio - 1.0) * w)
+
+
+def mesh_damping(zeta, k_mean, J1, J2, rb1, rb2):
+    """Mesh damping c_m = 2 ζ sqrt(k_mean m_eq), m_eq = J1 J2 / (J1 r_b2² + J2 r_b1²) [N·s/m]."""
+    zeta, k_mean, J1, J2, rb1, rb2 = (np.asarray(x, float) for x in (zeta, k_mean, J1, J2, rb1, rb2))
+    for name, x in (("zeta", zeta), ("k_mean", k_mean), ("J1", J1), ("J2", J2), ("rb1", rb1), ("rb2", rb2)):
+        if not np.all(np.isfinite(x)) or np.any(x < 0 if name == "zeta" else x <= 0):
+            raise ModelError(f"mesh_damping: {name} must be finite and {'>= 0' if name == 'zeta' else '> 0'}, got {x!r}")
+    m_eq = J1 * J2 / (J1 * rb2 ** 2 + J2 * rb1 ** 2)
+    return 2.0 * zeta * np.sqrt(k_mean * m_eq)
+
+
+def mesh_u0(internal: bool, rb1, rb2, pose1, pose2):
+    """The u0 that makes the transmission error zero with the gears at poses (x, y, θ) (any one frame).
+
+    Pass the nominal poses ((n, 3) or (3,)); with it both flanks sit at δ = −b/2."""
+    p1 = np.atleast_2d(np.asarray(pose1, float))
+    p2 = np.atleast_2d(np.asarray(pose2, float))
+    d = (p1 - p2) if internal else (p2 - p1)
+    phi = np.arctan2(d[:, 1], d[:, 0])
+    rb1 = np.asarray(rb1, float)
+    rb2 = np.asarray(rb2, float)
+    if internal:
+        return rb2 * (p2[:, 2] - phi) - rb1 * (p1[:, 2] - phi)
+    return rb1 * (p1[:, 2] - phi) + rb2 * (p2[:, 2] - phi)
+
+
+class GearMesh(Element):
+    """n spur meshes of one kind between gear 1 and gear 2 (see the module docstring for the law).
+
+    Parameters (scalars or (n,) arrays, SI): ``rb1``, ``rb2`` base radii [m]; ``alpha`` operating
+    pressure angle [rad]; ``a0`` nominal centre distance [m] (involute geometry requires
+    r_b1 ± r_b2 = a0 cos α, checked); ``teeth1`` tooth count of gear 1 (r_b2/r_b1 must be a tooth-count
+    ratio); ``k_mean`` mean mesh stiffness [N/m]; ``c_mesh`` mesh damping [N·s/m]; ``u0`` [m] from
+    :func:`mesh_u0`; ``p0`` mesh phase [cycles]; ``backlash`` b ≥ 0 [m] (b = 0: both flanks touch at
+    the nominal state with zero force); ``stiffness`` a :class:`StiffnessShape` shared by the family;
+    ``phi_ref`` [rad] the nominal angle of e: φ_e is taken in (phi_ref − π, phi_ref + π], so a u0
+    computed with an unwrapped nominal angle matches exactly (any 2π offset costs whole base pitches,
+    which the pitch wrap removes anyway).
+
+    Outputs: ``force`` = F_drive − F_coast [N] (signed: > 0 when flank f = +1 carries the load);
+    ``force_drive``, ``force_coast`` ≥ 0 (flanks f = +1, −1); ``deflection`` δ_+ and
+    ``deflection_coast`` δ_− [m]; ``deflection_rate``, ``deflection_rate_coast`` δ̇_± [m/s]; ``stiffness`` k(p) [N/m];
+    ``position`` p in [0, 1); ``fx``, ``fy`` the mesh force on gear 2 in R [N] (gear 1 gets minus it).
+    """
+    k = 6
+
+    def __init__(self, name, gear1, gear2, *, internal: bool, rb1, rb2, alpha, a0, teeth1, k_mean,
+                 c_mesh=0.0, u0=0.0, p0=0.0, backlash=0.0, stiffness: StiffnessShape | None = None,
+                 phi_ref=0.0):
+        self.name = name
+        self.dofs = body_dofs(gear1, gear2)
+        self.internal = bool(internal)
+        self.rb1 = self._per_instance("rb1", rb1, positive=True)
+        self.rb2 = self._per_instance("rb2", rb2, positive=True)
+        self.alpha = self._per_instance("alpha", alpha, positive=True)
+        self.a0 = self._per_instance("a0", a0, positive=True)
+        self.teeth1 = self._per_instance("teeth1", teeth1, positive=True)
+        self.k_mean = self._per_instance("k_mean", k_mean, positive=True)
+        self.c_mesh = self._per_instance("c_mesh", c_mesh, nonneg=True)
+        self.u0 = self._per_instance("u0", u0)
+        self.p0 = self._per_instance("p0", p0)
+        self.backlash = self._per_instance("backlash", backlash, nonneg=True)
+        self.phi_ref = self._per_instance("phi_ref", phi_ref)
+        self.stiffness = StiffnessShape.constant() if stiffness is None else stiffness
+        if not isinstance(self.stiffness, StiffnessShape):
+            raise ModelError(f"{name}: parameter 'stiffness' must be a StiffnessShape, got {stiffness!r}")
+        if np.any(self.alpha >= 0.5 * np.pi):
+            raise ModelError(f"{name}: parameter 'alpha' must be a pressure angle in (0, pi/2) rad, got {alpha!r}")
+        if np.any(self.teeth1 != np.round(self.teeth1)):
+            raise ModelError(f"{name}: parameter 'teeth1' must be whole tooth counts, got {teeth1!r}")
+        if self.internal and np.any(self.rb2 <= self.rb1):
+            raise ModelError(f"{name}: internal mesh needs the ring's base radius rb2 > the planet's rb1, got rb1={rb1!r}, rb2={rb2!r}")
+        # involute geometry: the line of action is tangent to both base circles
+        rsum = self.rb2 - self.rb1 if self.internal else self.rb1 + self.rb2
+        if not np.allclose(rsum, self.a0 * np.cos(self.alpha), rtol=1e-6, atol=0.0):
+            raise ModelError(f"{name}: parameters 'a0', 'alpha' must satisfy rb1 {'−' if self.internal else '+'} rb2"
+                             f"{' (ring − planet)' if self.internal else ''} = a0·cos(alpha); got "
+                             f"{rsum!r} vs {self.a0 * np.cos(self.alpha)!r}")
+        # the transmission error is wrapped modulo the base pitch: rb2 must be a whole number of pitches
+        z2 = self.rb2 / self.rb1 * self.teeth1
+        if not np.allclose(z2, np.round(z2), rtol=0.0, atol=1e-6):
+            raise ModelError(f"{name}: parameter 'rb2' must equal rb1·z2/teeth1 for a whole tooth count z2 "
+                             f"(same base pitch), got z2 = {z2!r}")
+        self.pitch = _TWO_PI * self.rb1 / self.teeth1      # base pitch p_b [m]
+        self.kappa0 = rsum                                  # κ·a
+        self.sigma = -1.0 if self.internal else 1.0
+        self.sin_alpha = np.sin(self.alpha)
+
+    def kernel(self, t, fs, q, v, z):
+        x1, y1, th1, x2, y2, th2 = q
+        vx1, vy1, w1, vx2, vy2, w2 = v
+        sig = self.sigma
+        # centre vector d along e (external c1 → c2, internal ring → planet) and its rate
+        if self.internal:
+            dx, dy, ddx, ddy = x1 - x2, y1 - y2, vx1 - vx2, vy1 - vy2
+        else:
+            dx, dy, ddx, ddy = x2 - x1, y2 - y1, vx2 - vx1, vy2 - vy1
+        a = ad.hypot(dx, dy)
+        inv_a = 1.0 / a
+        ex, ey = dx * inv_a, dy * inv_a
+        tx, ty = -ey, ex
+        # φ_e on the branch (phi_ref − π, phi_ref + π]: continuous near the nominal line of centres
+        phi_e = self.phi_ref + ad.wrap_angle(ad.arctan2(dy, dx) - self.phi_ref)
+        if self.internal:
+            raw = self.rb2 * (th2 - phi_e) - self.rb1 * (th1 - phi_e) - self.u0
+            roll = self.rb2 * w2 - self.rb1 * w1
+        else:
+            raw = self.rb1 * (th1 - phi_e) + self.rb2 * (th2 - phi_e) - self.u0
+            roll = self.rb1 * w1 + self.rb2 * w2
+        pb = self.pitch
+        s = ad.wrap_angle(raw * (_TWO_PI / pb)) * (pb / _TWO_PI)   # transmission error mod base pitch
+        kappa = self.kappa0 * inv_a
+        radial = sig * self.sin_alpha * (a - self.a0)
+        half_b = 0.5 * self.backlash
+        # rates: ṡ = roll − κ t·ḋ, ȧ = e·ḋ
+        t_dd = tx * ddx + ty * ddy
+        e_dd = ex * ddx + ey * ddy
+        s_dot = roll - kappa * t_dd
+        radial_dot = sig * self.sin_alpha * e_dd
+        d_plus = s - radial - half_b
+        d_minus = -1.0 * s - radial - half_b
+        r_plus = s_dot - radial_dot
+        r_minus = -1.0 * s_dot - radial_dot
+        p = self.teeth1 * (th1 - phi_e) * (1.0 / _TWO_PI) + self.p0
+        kp = self.k_mean * self.stiffness.factor(p)
+        c = self.c_mesh
+        F_plus = ad.where(d_plus > 0.0, ad.pos(kp * d_plus + c * r_plus), 0.0)
+        F_minus = ad.where(d_minus > 0.0, ad.pos(kp * d_minus + c * r_minus), 0.0)
+        # Q = −Σ F_f ∇δ_f; on the body at the head of d: (F+ − F−) κ t + σ (F+ + F−) sin α e
+        F_net = F_plus - F_minus
+        F_sum = F_plus + F_minus
+        Fx_head = F_net * kappa * tx + sig * self.sin_alpha * F_sum * ex
+        Fy_head = F_net * kappa * ty + sig * self.sin_alpha * F_sum * ey
+        T1 = -sig * self.rb1 * F_net
+        T2 = -1.0 * self.rb2 * F_net
+        if self.internal:   # head = planet = gear 1
+            f1x, f1y, f2x, f2y = Fx_head, Fy_head, -1.0 * Fx_head, -1.0 * Fy_head
+        else:               # head = gear 2
+            f1x, f1y, f2x, f2y = -1.0 * Fx_head, -1.0 * Fy_head, Fx_head, Fy_head
+        outputs = {
+            "force": F_net, "force_drive": F_plus, "force_coast": F_minus,
+            "deflection": d_plus, "deflection_coast": d_minus,
+            "deflection_rate": r_plus, "deflection_rate_coast": r_minus,
+            "stiffness": np.broadcast_to(ad.value(kp), (self.n,)).astype(float),
+            "position": np.mod(ad.value(p), 1.0),
+            "fx": f2x, "fy": f2y,
+        }
+        return [f1x, f1y, T1, f2x, f2y, T2], outputs

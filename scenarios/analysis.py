@@ -1,0 +1,71 @@
+"""Post-processing shared by the scenarios: window statistics, ISO 281 relative life, spectra."""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["rms", "window", "relative_life", "amplitude_spectrum", "peak_table", "bearing_equivalent_load"]
+
+
+def window(t: np.ndarray, t0: float, t1: float) -> np.ndarray:
+    """Boolean mask of the samples in [t0, t1]."""
+    return (t >= t0 - 1e-12) & (t <= t1 + 1e-12)
+
+
+def rms(x: np.ndarray, axis=0) -> np.ndarray:
+    x = np.asarray(x, float)
+    return np.sqrt(np.mean(x * x, axis=axis))
+
+
+def bearing_equivalent_load(load_history: np.ndarray) -> float:
+    """Cubic-mean-type equivalent of a time-varying radial load for life (ISO 281: P = (mean P^p)^(1/p)
+    with p = 10/3 for roller bearings)."""
+    p = 10.0 / 3.0
+    x = np.abs(np.asarray(load_history, float))
+    return float(np.mean(x**p) ** (1.0 / p))
+
+
+def relative_life(P: float, P_ref: float) -> float:
+    """ISO 281 basic rating life ratio L10/L10_ref = (P_ref/P)^(10/3) for roller bearings."""
+    if P <= 0:
+        return float("inf")
+    return float((P_ref / P) ** (10.0 / 3.0))
+
+
+def amplitude_spectrum(t: np.ndarray, x: np.ndarray, detrend: bool = True):
+    """One-sided amplitude spectrum with a Hann window (amplitude-corrected: a sine of amplitude A
+    reads A at its bin). Samples must be equally spaced. Returns (frequency_hz, amplitude, df)."""
+    t = np.asarray(t, float)
+    x = np.asarray(x, float)
+    dt = np.median(np.diff(t))
+    if not np.allclose(np.diff(t), dt, rtol=1e-6, atol=1e-12):
+        raise ValueError("amplitude_spectrum needs equally spaced samples")
+    if detrend:
+        x = x - x.mean()
+    n = x.size
+    w = np.hanning(n)
+    X = np.fft.rfft(x * w)
+    amp = 2.0 * np.abs(X) / w.sum()
+    amp[0] /= 2.0
+    f = np.fft.rfftfreq(n, dt)
+    return f, amp, 1.0 / (n * dt)
+
+
+def peak_table(f: np.ndarray, amp: np.ndarray, centre: float, span: float, expected: dict[str, float], n: int = 8):
+    """The n strongest local maxima within centre ± span, each with the nearest expected frequency
+    (label, its frequency, distance in Hz and in bins)."""
+    df = f[1] - f[0]
+    sel = np.flatnonzero((f >= centre - span) & (f <= centre + span))
+    if sel.size < 3:
+        return []
+    a = amp[sel]
+    is_peak = np.r_[False, (a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:]), False]
+    idx = sel[is_peak]
+    idx = idx[np.argsort(amp[idx])[::-1][:n]]
+    rows = []
+    for i in idx:
+        lab = min(expected, key=lambda k: abs(expected[k] - f[i])) if expected else ""
+        fe = expected.get(lab, np.nan)
+        rows.append({"frequency_hz": float(f[i]), "amplitude": float(amp[i]), "nearest": lab,
+                     "expected_hz": float(fe), "distance_hz": float(f[i] - fe),
+                     "distance_bins": float((f[i] - fe) / df)})
+    return rows

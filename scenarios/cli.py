@@ -1,0 +1,52 @@
+"""`dpgt` console command: list the scenarios and run one by name.
+
+    dpgt                      # list scenarios
+    dpgt NAME [options...]    # same as python -m scenarios.NAME [options...]
+    dpgt animate RESULTS --out FILE
+"""
+from __future__ import annotations
+
+import importlib
+import sys
+
+SCENARIOS = {
+    "demo": "the default job: forward vs reverse study at condition 3 (what `make demo` runs)",
+    "paper_study": "forward/reverse study over operating conditions, comparison tables and plots",
+    "spectrum": "fixed-frame carrier-housing acceleration spectrum (the source's test rig)",
+    "bearing_rig": "one planet bearing on a rig: roller load distribution, load zone, Q_max",
+    "modal": "natural frequencies and mode shapes (single planetary set, DPGT with linear bearings)",
+    "work_precision": "error against run time for every integrator",
+    "stability": "stiff and extreme cases: what completes, what breaks and why",
+    "benchmark": "speed target of the full DPGT",
+    "bench_engine": "engine benchmark: networks of stiff bodies, HHT vs solve_ivp(Radau)",
+    "animate": "animate saved results (cage orbits, whole train)",
+}
+
+
+def available() -> dict[str, str]:
+    out = {}
+    for name, doc in SCENARIOS.items():
+        mod = "viz.cli" if name == "animate" else f"scenarios.{name}"
+        if importlib.util.find_spec(mod) is not None:
+            out[name] = doc
+    return out
+
+
+def main(argv=None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    have = available()
+    if not argv or argv[0] in ("-h", "--help", "list"):
+        print("usage: dpgt SCENARIO [options]   (dpgt SCENARIO --help for its options)\n\nscenarios:")
+        for name, doc in have.items():
+            print(f"  {name:<15} {doc}")
+        return 0
+    name, rest = argv[0], argv[1:]
+    if name not in have:
+        print(f"dpgt: unknown scenario {name!r}; available: {', '.join(have)}", file=sys.stderr)
+        return 2
+    mod = importlib.import_module("viz.cli" if name == "animate" else f"scenarios.{name}")
+    return int(mod.main(rest) or 0)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,628 @@
+"""Planet-bearing contact families (MODEL.md §3.3–3.6): exact Jacobians, Newton's third law, Palmgren's
+law, no adhesion, traction/friction directions, pocket and guide geometry, lubricant drag.
+
+Geometry from PARAMETERS.md: d_m = 39 mm, D = 7.5 mm, l = 9 mm, K = 1.22e9 N/m^(10/9), P_d = 20 µm.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+from mbd.element import evaluate
+from mbd.errors import ModelError
+from mbd.model import FrameState
+from mbd.elements.contact import GuideContact, LubricantDrag, PocketContact, RaceContact, Traction
+
+DM, DR, LR = 39e-3, 7.5e-3, 9e-3
+K_HZ = 1.22e9
+PD = 20e-6
+R_IN = (DM - DR) / 2
+R_OUT = (DM + DR) / 2 + PD / 2
+M_ROLLER = 7850.0 * np.pi * (DR / 2) ** 2 * LR
+RCA = 82.5e-3                      # pin radius on the carrier
+Z = 12
+C_P, C_G, K_P, K_G = 1e-4, 1.5e-4, 2e7, 2e7
+R_LAND = R_OUT - C_G
+FS = FrameState(0.3, 40.0, 0.0)    # kernels must not depend on the frame: any state will do
+LEVER = 0.02                       # [m] to compare angle columns / torque rows with lengths / forces
+
+SETTINGS = settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+# ---------------------------------------------------------------------------------------------
+# helpers
+def rot(a):
+    return np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+
+
+def kcross(w, r):
+    """ω k × r for a planar vector r."""
+    return w * np.array([-r[1], r[0]])
+
+
+def local_forces(elem, ql, vl):
+    f, _ = elem.kernel(0.0, FS, list(ql.T), list(vl.T), None)
+    return np.column_stack([np.broadcast_to(np.asarray(fi, float), (elem.n,)) for fi in f])
+
+
+# power-of-two steps: x ± h and x ± 2h are exact in floating point for the magnitudes used here
+STEP_Q = (2.0 ** -30, 2.0 ** -30, 2.0 ** -26)   # m, m, rad
+STEP_V = (2.0 ** -20, 2.0 ** -20, 2.0 ** -14)   # m/s, m/s, rad/s
+
+
+def fd_jacobians(elem, qf, vf):
+    """Fourth-order central differences of the local forces w.r.t. local q and v."""
+    ql, vl = qf[elem.dofs], vf[elem.dofs]
+    out = []
+    for wrt_v, steps in ((False, STEP_Q), (True, STEP_V)):
+        J = np.empty((elem.n, elem.k, elem.k))
+        for j in range(elem.k):
+            h = steps[j % 3]
+
+            def f(m):
+                x = (vl if wrt_v else ql).copy()
+                x[:, j] += m * h
+                return local_forces(elem, ql, x) if wrt_v else local_forces(elem, x, vl)
+
+            J[:, :, j] = (8.0 * (f(1) - f(-1)) - (f(2) - f(-2))) / (12.0 * h)
+        out.append(J)
+    return out
+
+
+# round-off scales of the outputs that are not forces (SI); forces are compared relative to the largest
+OUT_ATOL = {"deflection": 1e-15, "offset": 1e-15, "penetration": 1e-15, "eccentricity": 1e-15,
+            "slip_velocity": 1e-11, "angle": 1e-12}
+
+
+def assert_jacobians(elem, qf, vf, rtol=1e-6):
+    F, out, Jq, Jv = evaluate(elem, 0.0, FS, qf, vf, None, True)
+    F0, out0, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+    # Dual and plain paths agree to round-off (Dual division multiplies by the reciprocal)
+    np.testing.assert_allclose(F, F0, rtol=1e-12, atol=1e-12 * np.abs(F0).max())
+    for key in out0:
+        np.testing.assert_allclose(out[key], out0[key], rtol=1e-12, atol=OUT_ATOL.get(key, 1e-12 * np.abs(F0).max()))
+    assert np.all(np.isfinite(Jq)) and np.all(np.isfinite(Jv))
+    Nq, Nv = fd_jacobians(elem, qf, vf)
+    k = elem.k
+    S = np.ones((k, k))
+    S[2::3, :] /= LEVER      # torque rows
+    S[:, 2::3] *= LEVER      # angle columns
+    for name, Ja, Jn in (("dF/dq", Jq, Nq), ("dF/dv", Jv, Nv)):
+        for i in range(elem.n):
+            a, b = Ja[i] * S, Jn[i] * S
+            scale = np.abs(a).max()
+            err = np.abs(a - b)
+            ok = err <= rtol * (np.abs(a) + scale)
+            assert ok.all(), f"{elem.name} {name} instance {i}: max err {err.max():.3e}, scale {scale:.3e}\n{a}\n{b}"
+    return F, out
+
+
+def assert_balanced(elem, qf, vf):
+    """Forces sum to zero and moments about the origin balance (Newton's third law)."""
+    F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+    x = qf[elem.dofs]
+    fx = F[:, 0] + F[:, 3]
+    fy = F[:, 1] + F[:, 4]
+    mz = F[:, 2] + F[:, 5] + x[:, 0] * F[:, 1] - x[:, 1] * F[:, 0] + x[:, 3] * F[:, 4] - x[:, 4] * F[:, 3]
+    scale = np.abs(F).max() + 1e-300
+    assert np.all(np.abs(fx) <= 1e-13 * scale) and np.all(np.abs(fy) <= 1e-13 * scale)
+    assert np.all(np.abs(mz) <= 1e-13 * scale * (np.abs(x[:, [0, 1, 3, 4]]).max() + LEVER))
+    return F, out
+
+
+def assert_objective(elem, qf, vf, alpha, w, u):
+    """Rotating the whole configuration by alpha and superposing a rigid motion (angular speed w about
+    the origin, translation u) rotates the forces and leaves torques and outputs unchanged."""
+    F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+    nb = qf.size // 3
+    q2, v2 = qf.reshape(nb, 3).copy(), vf.reshape(nb, 3).copy()
+    Rm = rot(alpha)
+    q2[:, :2] = q2[:, :2] @ Rm.T
+    q2[:, 2] += alpha
+    v2[:, :2] = v2[:, :2] @ Rm.T + np.asarray(u) + w * np.column_stack([-q2[:, 1], q2[:, 0]])
+    v2[:, 2] += w
+    F2, out2, _, _ = evaluate(elem, 0.0, FS, q2.ravel(), v2.ravel(), None, False)
+    scale = np.abs(F).max() + 1e-300
+    for b in (0, 3):
+        np.testing.assert_allclose(F2[:, b:b + 2], F[:, b:b + 2] @ Rm.T, rtol=0, atol=1e-8 * scale)
+        np.testing.assert_allclose(F2[:, b + 2], F[:, b + 2], rtol=0, atol=1e-8 * scale * LEVER)
+    for key in out:
+        if key not in ("angle", "fx", "fy"):
+            np.testing.assert_allclose(out2[key], out[key], rtol=1e-7, atol=OUT_ATOL.get(key, 1e-8 * scale))
+    if "fx" in out:   # force-vector outputs rotate with the configuration
+        f1 = np.column_stack([out["fx"], out["fy"]]) @ Rm.T
+        np.testing.assert_allclose(np.column_stack([out2["fx"], out2["fy"]]), f1, rtol=0, atol=1e-8 * scale)
+
+
+def power_of(F, vf, elem):
+    """Mechanical power of the element's generalized forces, per instance."""
+    return np.sum(F * vf[elem.dofs], axis=1)
+
+
+# ---------------------------------------------------------------------------------------------
+# roller–raceway scenes: body 0 is the race body (carrier with a pin, or planet), bodies 1..n rollers
+def race_scene(kind, pose, vel, psi, angles, deltas, v_normal, v_orbit, slips):
+    """Rollers pressed δ_j into the raceway at angles_j (in race-body axes), with normal and
+    tangential centre velocities relative to the raceway centre, and the spin that gives slip v_s."""
+    n = len(angles)
+    mk = np.array([RCA * np.cos(psi), RCA * np.sin(psi)]) if kind == "inner" else np.zeros(2)
+    R = R_IN if kind == "inner" else R_OUT
+    qf, vf = np.zeros(3 * (n + 1)), np.zeros(3 * (n + 1))
+    qf[:3], vf[:3] = pose, vel
+    cb, th, vb, wb = np.asarray(pose[:2]), pose[2], np.asarray(vel[:2]), vel[2]
+    rc = rot(th) @ mk
+    c, vc = cb + rc, vb + kcross(wb, rc)
+    for j in range(n):
+        a = th + angles[j]
+        e = np.array([np.cos(a), np.sin(a)])
+        t = np.array([-e[1], e[0]])
+        rho = R + DR / 2 - deltas[j] if kind == "inner" else R - DR / 2 + deltas[j]
+        p = c + rho * e
+        pdot = vc + v_normal[j] * e + v_orbit[j] * t
+        P = c + R * e                                      # contact point on the raceway surface
+        race_speed = (vb + kcross(wb, P - cb)) @ t
+        b = R - rho                                        # P − p = b e, so roller surface speed = ṗ·t + θ̇ b
+        spin = (slips[j] + race_speed - pdot @ t) / b
+        qf[3 * (j + 1):3 * (j + 2)] = (p[0], p[1], 0.7 * j)
+        vf[3 * (j + 1):3 * (j + 2)] = (pdot[0], pdot[1], spin)
+    return qf, vf, mk, R
+
+
+def race_element(kind, n, mk, R, traction=Traction(), zeta=0.05):
+    return RaceContact("race", np.arange(1, n + 1), 0, kind=kind, race_marker=mk, R_race=R, D=DR, K=K_HZ,
+                       zeta=zeta, m_roller=M_ROLLER, traction=traction)
+
+
+N = 4
+floats = st.floats
+
+
+@st.composite
+def race_states(draw, kind):
+    pose = (draw(floats(-2e-3, 2e-3)), draw(floats(-2e-3, 2e-3)), draw(floats(-np.pi, np.pi)))
+    if kind == "outer":   # the planet stands on the pin circle
+        pose = (pose[0] + RCA * np.cos(pose[2]), pose[1] + RCA * np.sin(pose[2]), pose[2])
+    vel = (draw(floats(-2.0, 2.0)), draw(floats(-2.0, 2.0)), draw(floats(-500.0, 500.0)))
+    psi = draw(floats(-np.pi, np.pi))
+    lst = lambda s: draw(st.lists(s, min_size=N, max_size=N))  # noqa: E731
+    angles = lst(floats(-np.pi, np.pi))
+    touching = lst(st.booleans())
+    depth = lst(floats(2e-6, 3e-5))
+    gap = lst(floats(2e-6, 1e-4))
+    deltas = [d if c else -g for c, d, g in zip(touching, depth, gap)]
+    v_normal = lst(floats(-0.3, 0.3))
+    v_orbit = lst(floats(-5.0, 5.0))
+    slips = lst(floats(-2.0, 2.0))
+    return pose, vel, psi, angles, deltas, v_normal, v_orbit, slips
+
+
+TRACTIONS = {"tanh": Traction(), "ehl": Traction(kind="ehl")}
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+@pytest.mark.parametrize("law", ["tanh", "ehl"])
+@SETTINGS
+@given(data=st.data())
+def test_race_jacobian_balance_and_kinematics(kind, law, data):
+    state = data.draw(race_states(kind))
+    qf, vf, mk, R = race_scene(kind, *state)
+    elem = race_element(kind, N, mk, R, TRACTIONS[law])
+    assert_jacobians(elem, qf, vf)
+    F, out = assert_balanced(elem, qf, vf)
+    deltas, slips = np.array(state[4]), np.array(state[7])
+    # the element's kinematics agree with the scene's construction
+    np.testing.assert_allclose(out["deflection"], deltas, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(out["slip_velocity"], slips, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(np.cos(out["angle"] - np.array(state[3])), 1.0, atol=1e-12)
+    touch = deltas > 0
+    assert np.all(out["load"][touch] > 0) and np.all(out["load"][~touch] == 0) and np.all(out["load"] >= 0)
+    assert np.all(F[~touch] == 0)
+    # traction opposes sliding (and vanishes out of contact)
+    assert np.all(out["traction"] * out["slip_velocity"] <= 0)
+    assert np.all(out["traction"][~touch] == 0)
+    if law == "tanh":
+        assert np.all(np.abs(out["traction"]) <= 0.08 * out["load"] * (1 + 1e-12))
+
+
+@pytest.mark.parametrize("elem_kind", ["race_inner", "race_outer", "pocket", "guide", "drag"])
+@settings(max_examples=15, deadline=None)
+@given(data=st.data(), alpha=floats(-np.pi, np.pi), w=floats(-300.0, 300.0),
+       u=st.tuples(floats(-5.0, 5.0), floats(-5.0, 5.0)))
+def test_objectivity(elem_kind, data, alpha, w, u):
+    """Same physics in any rotating/translating frame: forces only depend on relative motion."""
+    if elem_kind.startswith("race"):
+        kind = elem_kind[5:]
+        qf, vf, mk, R = race_scene(kind, *data.draw(race_states(kind)))
+        elem = race_element(kind, N, mk, R, Traction(kind="ehl"))
+    elif elem_kind == "pocket":
+        qf, vf, elem, _ = pocket_scene(*data.draw(pocket_states()))
+    elif elem_kind == "guide":
+        qf, vf, elem = guide_scene(*data.draw(guide_states()))
+    else:
+        qf, vf, elem, _ = drag_scene(*data.draw(drag_states()))
+    assert_objective(elem, qf, vf, alpha, w, u)
+
+
+# ---------------------------------------------------------------------------------------------
+def test_palmgren_constant_for_the_bearing():
+    """K = 8.06e4·l^(8/9) N/mm^(10/9) with l = 9 mm is 1.22e9 N/m^(10/9) (PARAMETERS.md), and it is the
+    inverse of Palmgren's δ[mm] = 3.84e-5 Q^0.9 / l^0.8."""
+    l_mm = LR * 1e3
+    K_mm = 8.06e4 * l_mm ** (8 / 9)                 # Q[N] = K_mm · δ[mm]^(10/9)
+    K_si = K_mm * (1e3) ** (10 / 9)                 # δ[mm] = 1e3 δ[m]
+    assert round(K_si / 1e9, 2) == 1.22
+    Q = 1500.0
+    d_mm = 3.84e-5 * Q ** 0.9 / l_mm ** 0.8
+    assert K_mm * d_mm ** (10 / 9) == pytest.approx(Q, rel=1e-3)
+    # the element with this K reproduces Palmgren's deflection law
+    for kind in ("inner", "outer"):
+        qf, vf, mk, R = race_scene(kind, (0, 0, 0.3), (0, 0, 0), 0.2, [1.0], [d_mm * 1e-3], [0], [0], [0])
+        elem = RaceContact("r", [1], 0, kind=kind, race_marker=mk, R_race=R, D=DR, K=K_si, m_roller=M_ROLLER)
+        F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+        assert out["load"][0] == pytest.approx(Q, rel=1e-3)
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+def test_race_static_load_is_hertz_palmgren(kind):
+    deltas = [1e-7, 1e-6, 5e-6, 2e-5]
+    qf, vf, mk, R = race_scene(kind, (1e-4, -2e-4, 0.8), (0, 0, 0), -0.4, [0.1, 1.2, 2.5, -2.0], deltas,
+                               [0] * 4, [0] * 4, [0] * 4)
+    elem = race_element(kind, 4, mk, R)
+    F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+    np.testing.assert_allclose(out["load"], K_HZ * np.array(deltas) ** (10 / 9), rtol=1e-9)
+    # the roller is pushed out of the raceway: outward from the pin, inward from the bore
+    ang = 0.8 + np.array([0.1, 1.2, 2.5, -2.0])
+    radial = F[:, 0] * np.cos(ang) + F[:, 1] * np.sin(ang)
+    np.testing.assert_allclose(radial, (1 if kind == "inner" else -1) * out["load"], rtol=1e-12)
+    np.testing.assert_allclose(out["traction"], 0.0, atol=0)
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+def test_race_damping_never_pulls(kind):
+    deltas = [1e-5, 1e-5, 1e-5, -1e-5]
+    sep = [-0.01, 0.01, -50.0, -50.0]   # δ̇: v_normal is ρ̇, and δ̇ = −ρ̇ (inner), +ρ̇ (outer)
+    vn = sep if kind == "outer" else [-s for s in sep]
+    qf, vf, mk, R = race_scene(kind, (0, 0, 0), (0, 0, 0), 0.0, [0.3, 0.3, 0.3, 0.3], deltas, vn, [0] * 4,
+                               [0.5] * 4)
+    elem = race_element(kind, 4, mk, R)
+    F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+    # the first two rollers: Q = Kδ^p + c(δ)δ̇ with c(δ) = 2ζ sqrt(m dQ/dδ)
+    p = 10 / 9
+    c = 2 * 0.05 * np.sqrt(M_ROLLER * p * K_HZ * 1e-5 ** (p - 1))
+    np.testing.assert_allclose(out["load"][:2], K_HZ * 1e-5 ** p + c * np.array(sep[:2]), rtol=1e-9)
+    assert out["load"][0] < K_HZ * 1e-5 ** p < out["load"][1]
+    # fast separation: the damper would pull — the load is clipped to zero, so is the traction
+    assert out["load"][2] == 0 and out["traction"][2] == 0 and np.all(F[2] == 0)
+    # out of contact: nothing, whatever the velocity
+    assert out["load"][3] == 0 and np.all(F[3] == 0)
+
+
+@pytest.mark.parametrize("law", ["tanh", "ehl"])
+@SETTINGS
+@given(w_carrier=floats(-500, 500), w_cage=floats(-500, 500), w_planet=floats(-1500, 1500),
+       vel=st.tuples(floats(-40, 40), floats(-40, 40)), theta=floats(-np.pi, np.pi),
+       orbit=floats(-np.pi, np.pi), delta=floats(1e-6, 2e-5), dspin=floats(1.0, 200.0))
+def test_traction_vanishes_for_pure_rolling(law, w_carrier, w_cage, w_planet, vel, theta, orbit, delta, dspin):
+    """Epicyclic rolling kinematics (pin on a moving carrier, roller orbiting at the cage speed):
+    the roller spin from the rolling condition gives zero slip and zero traction on both raceways;
+    any extra spin gives a traction that opposes the slip and dissipates power."""
+    a = DR / 2 - delta                                   # roller centre to contact point
+    for kind, w_race, R in (("inner", w_carrier, R_IN), ("outer", w_planet, R_OUT)):
+        mk = np.array([RCA, 0.0]) if kind == "inner" else np.zeros(2)
+        pose = np.array([vel[0] * 1e-4, vel[1] * 1e-4, theta])
+        vb = np.array([vel[0], vel[1], w_race])
+        rc = rot(theta) @ mk
+        c, vc = pose[:2] + rc, vb[:2] + kcross(w_race, rc)
+        e = np.array([np.cos(orbit), np.sin(orbit)])
+        rho = R + DR / 2 - delta if kind == "inner" else R - DR / 2 + delta
+        p, pdot = c + rho * e, vc + kcross(w_cage, rho * e)
+        if kind == "inner":
+            w_roll = w_cage - (w_race - w_cage) * R / a
+        else:
+            w_roll = w_cage + (w_race - w_cage) * R / a
+        qf = np.concatenate([pose, [p[0], p[1], 0.0], [p[0], p[1], 0.0]])
+        vf = np.concatenate([vb, [pdot[0], pdot[1], w_roll], [pdot[0], pdot[1], w_roll + dspin]])
+        elem = race_element(kind, 2, mk, R, TRACTIONS[law])
+        F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+        assert out["load"][0] == pytest.approx(K_HZ * delta ** (10 / 9), rel=1e-9)
+        speed_scale = abs(w_race) * R + abs(w_cage) * R + np.hypot(*vel) + abs(w_roll) * a
+        assert abs(out["slip_velocity"][0]) <= 1e-12 * speed_scale
+        assert abs(out["traction"][0]) <= 1e-9 * out["load"][0]
+        # extra spin: slip = ±a·Δω, traction opposes it, and the element only dissipates (δ̇ = 0 here)
+        assert out["slip_velocity"][1] == pytest.approx((-a if kind == "inner" else a) * dspin, rel=1e-6)
+        assert out["traction"][1] * out["slip_velocity"][1] < 0
+        P = power_of(F, vf, elem)
+        np.testing.assert_allclose(P, out["traction"] * out["slip_velocity"], rtol=1e-6,
+                                   atol=1e-9 * out["load"][0] * speed_scale)
+
+
+def test_ehl_curve_shape():
+    tr = Traction(kind="ehl")
+    s = np.array([-2.0, -0.1, -0.033, -1e-3, 0.0, 1e-3, 0.033, 0.1, 2.0])
+    u = np.full(s.size, 10.0)
+    v_s = s * np.sqrt(u ** 2 + tr.u_reg ** 2)
+    mu = tr.coefficient(v_s, u)
+    np.testing.assert_allclose(mu, -mu[::-1], atol=1e-15)                       # odd
+    f = lambda x: (tr.A + tr.B * x) * np.exp(-tr.C * x) + tr.D                   # noqa: E731
+    big = np.abs(s) >= 0.03
+    np.testing.assert_allclose(mu[big], np.sign(s[big]) * f(np.abs(s[big])), rtol=1e-4)  # the curve
+    # near rolling the regularised |s| deviates by O((s_eps/s)²): 0.5 % at s = 1e-3
+    np.testing.assert_allclose(mu[[3, 5]], np.array([-1, 1]) * f(1e-3), rtol=1e-2)
+    assert mu[4] == 0.0 and 0.07 < mu.max() < 0.075                              # peak ≈ 0.073
+    # slope at pure rolling: B − A·C (the regularised sign changes it by O(C·s_eps)), exact Jacobian
+    from mbd import ad
+    x = ad.Dual(np.array([0.0]), np.array([[1.0]]))
+    slope = tr.coefficient(x, np.array([10.0])).der[0, 0] * np.sqrt(100.0 + tr.u_reg ** 2)
+    assert slope == pytest.approx(f(tr.s_eps) / tr.s_eps, rel=1e-9)           # d/ds (s/a)f(a) at 0
+    assert slope == pytest.approx(tr.B - tr.A * tr.C, rel=tr.C * tr.s_eps)   # ≈ f'(0), to O(C s_eps)
+    with pytest.raises(ModelError, match="kind"):
+        Traction(kind="coulomb")
+    with pytest.raises(ModelError, match="v0"):
+        Traction(v0=0.0)
+
+
+# ---------------------------------------------------------------------------------------------
+# pocket: body 0 cage, bodies 1..n rollers
+def pocket_scene(pose, vel, pockets, offsets, radial, v_circ, v_rad, spins, mu=0.1):
+    n = len(pockets)
+    qf, vf = np.zeros(3 * (n + 1)), np.zeros(3 * (n + 1))
+    qf[:3], vf[:3] = pose, vel
+    cg, th = np.asarray(pose[:2]), pose[2]
+    psi = 2 * np.pi * np.asarray(pockets) / Z
+    for j in range(n):
+        beta = th + psi[j] + offsets[j] / (DM / 2)
+        e = np.array([np.cos(beta), np.sin(beta)])
+        t = np.array([-e[1], e[0]])
+        p = cg + (DM / 2 + radial[j]) * e
+        pdot = np.asarray(vel[:2]) + kcross(vel[2], p - cg) + v_circ[j] * t + v_rad[j] * e
+        qf[3 * (j + 1):3 * (j + 2)] = (p[0], p[1], -0.3 * j)
+        vf[3 * (j + 1):3 * (j + 2)] = (pdot[0], pdot[1], spins[j])
+    elem = PocketContact("pocket", np.arange(1, n + 1), 0, pocket_angle=psi, pitch_radius=DM / 2, clearance=C_P,
+                         K_p=K_P, restitution=0.8, v_ref=0.1, mu=mu, v_mu=0.05, D=DR)
+    return qf, vf, elem, psi
+
+
+@st.composite
+def pocket_states(draw):
+    lst = lambda s: draw(st.lists(s, min_size=N, max_size=N))  # noqa: E731
+    pose = (0.08 + draw(floats(-2e-4, 2e-4)), 0.02 + draw(floats(-2e-4, 2e-4)), draw(floats(-np.pi, np.pi)))
+    vel = (draw(floats(-20, 20)), draw(floats(-20, 20)), draw(floats(-300, 300)))
+    pockets = lst(st.integers(0, Z - 1))
+    inside = lst(st.booleans())
+    sgn = lst(st.sampled_from([-1.0, 1.0]))
+    a_in = lst(floats(0.0, C_P - 1e-6))
+    a_out = lst(floats(C_P + 1e-6, C_P + 5e-5))
+    offsets = [s * (i_ if c else o) for s, c, i_, o in zip(sgn, inside, a_in, a_out)]
+    radial = lst(floats(-2e-4, 2e-4))
+    v_circ = lst(floats(-0.05, 0.05))
+    v_rad = lst(floats(-0.5, 0.5))
+    spins = lst(floats(-3000, 3000))
+    return pose, vel, pockets, offsets, radial, v_circ, v_rad, spins
+
+
+@SETTINGS
+@given(state=pocket_states())
+def test_pocket_jacobian_and_balance(state):
+    qf, vf, elem, _ = pocket_scene(*state)
+    assert_jacobians(elem, qf, vf)
+    F, out = assert_balanced(elem, qf, vf)
+    offsets = np.array(state[3])
+    np.testing.assert_allclose(out["offset"], offsets, rtol=0, atol=1e-12)
+    inside = np.abs(offsets) < C_P
+    assert np.all(F[inside] == 0) and np.all(out["force"][inside] == 0)
+    assert np.all(out["force"][~inside] * offsets[~inside] > 0)      # + when pushing the cage forward
+    np.testing.assert_allclose(out["penetration"], np.maximum(np.abs(offsets) - C_P, 0), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_pocket_pushes_roller_back_and_cage_moment(side):
+    depth = 3e-5
+    # no relative velocity: the force is K_p·d; mu = 0: the cage moment is exactly force × d_m/2
+    qf, vf, elem, psi = pocket_scene((0.05, -0.01, 0.4), (0.3, -0.2, 50.0), [0, 5], [side * (C_P + depth)] * 2,
+                                     [0.0, 1e-4], [0.0, 0.0], [0.0, 0.0], [800.0, -800.0], mu=0.0)
+    F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+    np.testing.assert_allclose(out["force"], side * K_P * depth, rtol=1e-6)
+    np.testing.assert_allclose(F[:, 5], out["force"] * DM / 2, rtol=1e-12)
+    beta = 0.4 + psi + side * (C_P + depth) / (DM / 2)
+    t = np.column_stack([-np.sin(beta), np.cos(beta)])
+    e = np.column_stack([np.cos(beta), np.sin(beta)])
+    tang = np.sum(F[:, :2] * t, axis=1)
+    assert np.all(np.sign(tang) == -side)                               # back towards the pocket centre
+    np.testing.assert_allclose(np.sum(F[:, :2] * e, axis=1), 0.0, atol=1e-9 * abs(tang).max())
+    np.testing.assert_allclose(np.abs(tang[0]), K_P * depth, rtol=1e-6)   # on the pitch circle: F itself
+    assert np.all(F[:, 2] == 0)                                         # no spin torque without friction
+    # with wall friction: it opposes the radial sliding of the roller surface on the wall
+    qf, vf, elem, psi = pocket_scene((0.05, -0.01, 0.4), (0.3, -0.2, 50.0), [0, 5], [side * (C_P + depth)] * 2,
+                                     [0.0, 1e-4], [0.0, 0.0], [0.0, 0.0], [800.0, -800.0], mu=0.1)
+    F2, out2, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+    friction_e = np.sum((F2[:, :2] - F[:, :2]) * e, axis=1)             # radial part added by friction
+    # radial sliding of the roller surface point p + sign(s)(D/2)t on the cage wall: sign(s)(D/2)(θ̇_g − spin)
+    spins = np.array([800.0, -800.0])
+    v_slide = side * (DR / 2) * (50.0 - spins)
+    assert np.all(friction_e * v_slide < 0)
+    np.testing.assert_allclose(np.abs(friction_e), 0.1 * np.tanh(np.abs(v_slide) / 0.05) * K_P * depth, rtol=1e-6)
+    assert np.all(F2[:, 2] * (spins - 50.0) < 0)                         # and brakes the relative spin
+    assert_balanced(elem, qf, vf)
+
+
+def test_pocket_hunt_crossley_damping():
+    d = 2e-5
+    # relative circumferential velocity into the wall (s > 0 growing) stiffens, out of it softens, clipped at 0
+    qf, vf, elem, _ = pocket_scene((0, 0, 0), (0, 0, 0), [1, 1, 1], [C_P + d] * 3, [0] * 3,
+                                   [0.05, -0.05, -1.0], [0] * 3, [0] * 3, mu=0.0)
+    F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+    expect = K_P * d * (1 + 1.5 * 0.2 * np.array([0.05, -0.05]) / 0.1)
+    np.testing.assert_allclose(out["force"][:2], expect, rtol=1e-9)
+    assert out["force"][2] == 0 and np.all(F[2] == 0)
+
+
+# ---------------------------------------------------------------------------------------------
+# guide: body 0 planet, bodies 1..n cages (one per instance)
+def guide_scene(pose, vel, ecc, angles, v_rad, v_tan, cage_spin, mu=0.1):
+    n = len(ecc)
+    qf, vf = np.zeros(3 * (n + 1)), np.zeros(3 * (n + 1))
+    qf[:3], vf[:3] = pose, vel
+    co = np.asarray(pose[:2])
+    for j in range(n):
+        nvec = np.array([np.cos(angles[j]), np.sin(angles[j])])
+        tvec = np.array([-nvec[1], nvec[0]])
+        cg = co + ecc[j] * nvec
+        vg = np.asarray(vel[:2]) + v_rad[j] * nvec + v_tan[j] * tvec
+        qf[3 * (j + 1):3 * (j + 2)] = (cg[0], cg[1], 0.2 * j)
+        vf[3 * (j + 1):3 * (j + 2)] = (vg[0], vg[1], cage_spin[j])
+    elem = GuideContact("guide", np.arange(1, n + 1), 0, clearance=C_G, K_g=K_G, restitution=0.8, v_ref=0.1,
+                        mu=mu, v_mu=0.05, land_radius=R_LAND)
+    return qf, vf, elem
+
+
+@st.composite
+def guide_states(draw):
+    lst = lambda s: draw(st.lists(s, min_size=N, max_size=N))  # noqa: E731
+    pose = (0.07 + draw(floats(-1e-3, 1e-3)), -0.04 + draw(floats(-1e-3, 1e-3)), draw(floats(-np.pi, np.pi)))
+    vel = (draw(floats(-20, 20)), draw(floats(-20, 20)), draw(floats(-1500, 1500)))
+    which = lst(st.sampled_from(["zero", "inside", "contact"]))
+    a_in = lst(floats(1e-7, C_G - 1e-6))
+    a_out = lst(floats(C_G + 1e-6, C_G + 5e-5))
+    ecc = [0.0 if w == "zero" else (i_ if w == "inside" else o) for w, i_, o in zip(which, a_in, a_out)]
+    angles = lst(floats(-np.pi, np.pi))
+    v_rad = lst(floats(-0.05, 0.05))
+    v_tan = lst(floats(-1.0, 1.0))
+    spin = lst(floats(-500, 500))
+    return pose, vel, ecc, angles, v_rad, v_tan, spin
+
+
+@SETTINGS
+@given(state=guide_states())
+def test_guide_jacobian_and_balance(state):
+    qf, vf, elem = guide_scene(*state)
+    F, out = assert_jacobians(elem, qf, vf)
+    assert_balanced(elem, qf, vf)
+    ecc = np.array(state[2])
+    np.testing.assert_allclose(out["eccentricity"], ecc, rtol=0, atol=1e-15)
+    free = ecc < C_G
+    assert np.all(F[free] == 0) and np.all(out["force"][free] == 0) and np.all(out["force"] >= 0)
+    assert np.all(out["force"][~free] > 0)
+
+
+def test_guide_centred_cage_is_regular():
+    qf, vf, elem = guide_scene((0.07, -0.04, 0.0), (1.0, 2.0, 300.0), [0.0, 0.0], [0.0, 1.0], [0.0, 0.1],
+                               [0.0, 0.5], [0.0, -200.0])
+    F, out, Jq, Jv = evaluate(elem, 0.0, FS, qf, vf, None, True)
+    assert np.all(F == 0) and np.all(Jq == 0) and np.all(Jv == 0)
+    assert np.all(out["eccentricity"] == 0) and np.all(np.isfinite(Jq))
+
+
+def test_guide_restoring_and_land_friction():
+    d = 4e-5
+    ang = np.array([0.3, 2.0])
+    w_planet, spins = 400.0, [100.0, 700.0]
+    qf, vf, elem = guide_scene((0.07, -0.04, 0.5), (0.0, 0.0, w_planet), [C_G + d] * 2, ang, [0.0] * 2,
+                               [0.0] * 2, spins)
+    F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+    n = np.column_stack([np.cos(ang), np.sin(ang)])
+    t = np.column_stack([-n[:, 1], n[:, 0]])
+    np.testing.assert_allclose(out["force"], K_G * d, rtol=1e-9)
+    np.testing.assert_allclose(np.sum(F[:, :2] * n, axis=1), -K_G * d, rtol=1e-9)     # cage back to the centre
+    np.testing.assert_allclose(np.sum(F[:, 3:5] * n, axis=1), K_G * d, rtol=1e-9)     # planet the other way
+    # land surface speed of the cage relative to the bore at the contact: (θ̇_g − θ̇_o)·r_L (centres at rest
+    # apart from the bore's rotation carrying the point e + r_L n)
+    v_rel = (np.array(spins) - w_planet) * R_LAND - w_planet * (C_G + d)
+    fric = np.sum(F[:, :2] * t, axis=1)
+    assert np.all(fric * v_rel < 0)
+    np.testing.assert_allclose(out["friction"], fric, rtol=1e-12)
+    np.testing.assert_allclose(np.abs(fric), 0.1 * np.tanh(np.abs(v_rel) / 0.05) * K_G * d, rtol=1e-9)
+    # the friction torque brakes the relative spin of the cage
+    assert np.all(F[:, 2] * (np.array(spins) - w_planet) < 0)
+    assert np.all(power_of(F, vf, elem) < 0)
+
+
+# ---------------------------------------------------------------------------------------------
+# drag: body 0 carrier (pin at a marker), bodies 1..n rollers
+C_D, RHO_OIL = 1.0, 45.0
+DRAG_COEF = C_D * RHO_OIL * DR * LR * DM ** 2 / 8
+
+
+def drag_scene(pose, vel, psi, angles, radial, orbit, v_rad, spins):
+    n = len(angles)
+    mk = np.array([RCA * np.cos(psi), RCA * np.sin(psi)])
+    qf, vf = np.zeros(3 * (n + 1)), np.zeros(3 * (n + 1))
+    qf[:3], vf[:3] = pose, vel
+    rc = rot(pose[2]) @ mk
+    c, vc = np.asarray(pose[:2]) + rc, np.asarray(vel[:2]) + kcross(vel[2], rc)
+    for j in range(n):
+        e = np.array([np.cos(angles[j]), np.sin(angles[j])])
+        p = c + (DM / 2 + radial[j]) * e
+        pdot = vc + kcross(orbit[j], p - c) + v_rad[j] * e
+        qf[3 * (j + 1):3 * (j + 2)] = (p[0], p[1], 0.0)
+        vf[3 * (j + 1):3 * (j + 2)] = (pdot[0], pdot[1], spins[j])
+    elem = LubricantDrag("drag", np.arange(1, n + 1), 0, race_marker=mk, C_d=C_D, rho=RHO_OIL, D=DR, l=LR, d_m=DM)
+    omega_m = np.asarray(orbit) - vel[2]
+    return qf, vf, elem, omega_m
+
+
+@st.composite
+def drag_states(draw):
+    lst = lambda s: draw(st.lists(s, min_size=N, max_size=N))  # noqa: E731
+    pose = (draw(floats(-1e-3, 1e-3)), draw(floats(-1e-3, 1e-3)), draw(floats(-np.pi, np.pi)))
+    vel = (draw(floats(-2, 2)), draw(floats(-2, 2)), draw(floats(-500, 500)))
+    # orbital speed relative to the carrier kept away from 0, where Ω|Ω| is only C¹ (finite differences
+    # are O(h) wrong there; the exact zero Jacobian at Ω_m = 0 is checked separately)
+    rel = [s * m for s, m in zip(lst(st.sampled_from([-1.0, 1.0])), lst(floats(1.0, 800.0)))]
+    orbit = [vel[2] + r for r in rel]
+    return (pose, vel, draw(floats(-np.pi, np.pi)), lst(floats(-np.pi, np.pi)), lst(floats(-5e-5, 5e-5)),
+            orbit, lst(floats(-0.1, 0.1)), lst(floats(-3000, 3000)))
+
+
+@SETTINGS
+@given(state=drag_states())
+def test_drag_jacobian_balance_magnitude_direction(state):
+    qf, vf, elem, omega_m = drag_scene(*state)
+    F, out = assert_jacobians(elem, qf, vf)
+    assert_balanced(elem, qf, vf)
+    np.testing.assert_allclose(out["force"], DRAG_COEF * omega_m * np.abs(omega_m), rtol=1e-9,
+                               atol=1e-9 * DRAG_COEF * np.max(omega_m ** 2))
+    # the drag on the roller is tangential, of magnitude (1/8) C_d ρ D l (d_m Ω_m)², against the orbit
+    # relative to the carrier: it removes power from the relative orbital motion
+    fr = F[:, :2]
+    np.testing.assert_allclose(np.hypot(fr[:, 0], fr[:, 1]), C_D * RHO_OIL * DR * LR * (DM * omega_m) ** 2 / 8,
+                               rtol=1e-9, atol=1e-12)
+    assert np.all(F[:, 2] == 0)
+    assert np.all(power_of(F, vf, elem) <= 1e-12 * DRAG_COEF * np.max(np.abs(omega_m)) ** 3 * DM)
+
+
+def test_drag_zero_relative_orbit():
+    # the roller orbits exactly with the carrier: no drag, and ∂(Ω|Ω|)/∂Ω = 2|Ω| = 0 exactly
+    qf, vf, elem, omega_m = drag_scene((0, 0, 0.2), (1.0, -2.0, 440.0), 0.3, [0.5, 2.0], [0, 1e-5],
+                                       [440.0, 440.0], [0.0, 0.05], [100.0, 0.0])
+    F, out, Jq, Jv = evaluate(elem, 0.0, FS, qf, vf, None, True)
+    assert np.all(np.abs(F) <= 1e-20) and np.all(np.abs(Jq) <= 1e-12) and np.all(np.abs(Jv) <= 1e-12)
+
+
+def test_drag_opposes_orbit():
+    qf, vf, elem, omega_m = drag_scene((0, 0, 0.0), (0, 0, 440.0), 0.0, [0.0, np.pi / 2], [0, 0],
+                                       [600.0, 300.0], [0, 0], [0, 0])
+    F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+    # roller 0 at angle 0 from the pin orbits faster than the carrier turns: drag along −y
+    assert F[0, 1] < 0 and abs(F[0, 0]) < 1e-12 * abs(F[0, 1])
+    # roller 1 at angle π/2 (t = (−1, 0)) orbits slower than the carrier: Ω_m < 0, drag −F·t along −x
+    assert out["force"][1] < 0 and F[1, 0] < 0 and abs(F[1, 1]) < 1e-12 * abs(F[1, 0])
+    np.testing.assert_allclose(out["force"], DRAG_COEF * omega_m * np.abs(omega_m), rtol=1e-12)
+
+
+# ---------------------------------------------------------------------------------------------
+def test_parameter_errors_name_the_parameter():
+    with pytest.raises(ModelError, match="kind"):
+        RaceContact("r", [1], 0, kind="middle", race_marker=(0, 0), R_race=R_IN, D=DR, K=K_HZ, m_roller=M_ROLLER)
+    with pytest.raises(ModelError, match="race_marker"):
+        RaceContact("r", [1, 2], 0, kind="inner", race_marker=np.zeros((3, 2)), R_race=R_IN, D=DR, K=K_HZ,
+                    m_roller=M_ROLLER)
+    with pytest.raises(ModelError, match="'K'"):
+        RaceContact("r", [1], 0, kind="inner", race_marker=(0, 0), R_race=R_IN, D=DR, K=-1.0, m_roller=M_ROLLER)
+    with pytest.raises(ModelError, match="restitution"):
+        PocketContact("p", [1], 0, pocket_angle=0.0, pitch_radius=DM / 2, clearance=C_P, K_p=K_P, restitution=1.5,
+                      D=DR)
+    with pytest.raises(ModelError, match="clearance"):
+        GuideContact("g", [1], 0, clearance=-1e-4, K_g=K_G, land_radius=R_LAND)
+    with pytest.raises(ModelError, match="d_m"):
+        LubricantDrag("d", [1], 0, race_marker=(0, 0), C_d=1.0, rho=45.0, D=DR, l=LR, d_m=0.0)

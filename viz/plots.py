@@ -1,0 +1,290 @@
+"""Shared matplotlib plots for the scenario reports.
+
+Every function takes plain numpy arrays plus an output path (PNG), writes the figure and returns the
+path as a :class:`pathlib.Path`.  Figures are made with ``matplotlib.figure.Figure`` and the Agg canvas
+directly, so nothing here touches pyplot's global state or needs a display.
+
+Conventions shared by all plots: forward rotation is a solid blue line, reverse a dashed orange line;
+every axis carries a unit in square brackets ("[–]" for dimensionless quantities).
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import matplotlib as mpl
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter
+
+__all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution",
+           "mode_shapes", "FWD", "REV", "STYLE"]
+
+# One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
+STYLE = {
+    "font.size": 9,
+    "axes.titlesize": 10,
+    "axes.labelsize": 9,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "grid.linewidth": 0.6,
+    "legend.fontsize": 8,
+    "legend.framealpha": 0.85,
+    "lines.linewidth": 1.2,
+    "savefig.dpi": 150,
+    "figure.dpi": 100,
+}
+FWD = {"color": "#1f5fa8", "linestyle": "-", "label": "forward"}
+REV = {"color": "#e07b00", "linestyle": "--", "label": "reverse"}
+_MARK_COLOR = "#7a1f7a"
+
+
+def _axis_label(name: str, unit: str | None) -> str:
+    return f"{name} [{unit if unit else '–'}]"
+
+
+def _save(fig: Figure, path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    FigureCanvasAgg(fig)
+    fig.savefig(path, format="png")
+    return path
+
+
+def _time_scale(t: np.ndarray) -> tuple[float, str]:
+    """Show short runs in ms: mesh periods are fractions of a millisecond."""
+    span = float(np.nanmax(np.abs(t))) if t.size else 0.0
+    return (1e3, "ms") if span < 2.0 else (1.0, "s")
+
+
+def time_histories(t, series: Mapping[str, tuple], units: Mapping[str, str], path, *,
+                   t_rev=None, title: str | None = None) -> Path:
+    """Forward vs reverse overlays, one stacked subplot per series.
+
+    t: (n,) times in s.  series: label -> (fwd, rev), each an (n,) array or None.  units: label -> unit
+    string.  t_rev: times of the reverse run when it was sampled differently from the forward run.
+    """
+    t = np.asarray(t, float)
+    tr = t if t_rev is None else np.asarray(t_rev, float)
+    scale, tunit = _time_scale(np.concatenate([t, tr]))
+    n = len(series)
+    if n == 0:
+        raise ValueError("series is empty")
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(7.0, 1.0 + 1.7 * n), layout="constrained")
+        axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
+        for ax, (label, pair) in zip(axes, series.items()):
+            fwd, rev = pair
+            if fwd is not None:
+                ax.plot(t * scale, np.asarray(fwd, float), **FWD)
+            if rev is not None:
+                ax.plot(tr * scale, np.asarray(rev, float), **REV)
+            ax.set_ylabel(_axis_label(label, units.get(label)))
+            ax.legend(loc="upper right")
+        axes[-1].set_xlabel(_axis_label("time", tunit))
+        if title:
+            fig.suptitle(title)
+        return _save(fig, path)
+
+
+def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]],
+              units: Mapping[str, str], path, *, title: str | None = None) -> Path:
+    """Grouped bars: one subplot per quantity (units differ), a forward/reverse pair per condition.
+
+    table: quantity -> {condition: (fwd, rev)}; a missing condition or a None value leaves a gap.
+    """
+    conditions = list(conditions)
+    if not table:
+        raise ValueError("table is empty")
+    x = np.arange(len(conditions))
+    w = 0.38
+    n = len(table)
+    ncols = min(n, 3)
+    nrows = -(-n // ncols)
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(3.2 * ncols + 0.6, 2.8 * nrows + 0.4), layout="constrained")
+        axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
+        for ax, (quantity, by_cond) in zip(axes, table.items()):
+            vals = np.full((len(conditions), 2), np.nan)
+            for i, c in enumerate(conditions):
+                pair = by_cond.get(c)
+                if pair is not None:
+                    vals[i] = [np.nan if v is None else float(v) for v in pair]
+            ax.bar(x - w / 2, vals[:, 0], w, color=FWD["color"], label="forward")
+            ax.bar(x + w / 2, vals[:, 1], w, color=REV["color"], label="reverse", hatch="//",
+                   edgecolor="white", linewidth=0)
+            ax.set_xticks(x, conditions, rotation=20 if len(conditions) > 3 else 0)
+            ax.set_ylabel(_axis_label(quantity, units.get(quantity)))
+            ax.set_xlabel(_axis_label("condition", "–"))
+            ax.set_title(quantity)
+            ax.grid(axis="x", visible=False)
+        for ax in axes[n:]:
+            ax.set_visible(False)
+        axes[0].legend(loc="best")
+        if title:
+            fig.suptitle(title)
+        return _save(fig, path)
+
+
+def spectrum(freq_hz, amplitude, marks: Mapping[str, float], path, fmax: float | None = None, *,
+             quantity: str = "amplitude", unit: str = "a.u.", logy: bool = False,
+             title: str | None = None) -> Path:
+    """Amplitude spectrum with characteristic frequencies marked (e.g. f_m, f_m ± k f_c).
+
+    amplitude: (n,) array, or label -> (n,) array for overlays (forward/reverse).  marks: label ->
+    frequency in Hz; marks above fmax are left out; labels are staggered so neighbours stay legible.
+    """
+    f = np.asarray(freq_hz, float)
+    curves = dict(amplitude) if isinstance(amplitude, Mapping) else {None: amplitude}
+    fmax = float(np.nanmax(f)) if fmax is None else float(fmax)
+    keep = f <= fmax
+    styles = [FWD, REV]
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(7.5, 3.6), layout="constrained")
+        ax = fig.add_subplot()
+        for i, (label, a) in enumerate(curves.items()):
+            st = dict(styles[i % 2]) if label is not None else dict(FWD)
+            st["linestyle"] = "-"
+            st["label"] = label
+            if i >= 2:
+                st.pop("color")
+            ax.plot(f[keep], np.asarray(a, float)[keep], **st)
+        if logy:
+            ax.set_yscale("log")
+        ax.set_xlim(max(0.0, float(np.nanmin(f))), fmax)
+        ax.set_xlabel(_axis_label("frequency", "Hz"))
+        ax.set_ylabel(_axis_label(quantity, unit))
+        if any(k is not None for k in curves):
+            ax.legend(loc="center right")
+        if title:
+            ax.set_title(title)
+        _mark_frequencies(fig, ax, marks, fmax)
+        return _save(fig, path)
+
+
+def _mark_frequencies(fig: Figure, ax, marks: Mapping[str, float], fmax: float) -> None:
+    """Dotted vertical lines with labels stacked in rows so that close marks (side bands) stay legible.
+
+    Label widths are measured on a drawn canvas, then each label goes to the first row where it does
+    not overlap the previous label of that row.
+    """
+    inside = sorted((float(v), str(k)) for k, v in marks.items() if 0 <= float(v) <= fmax)
+    if not inside:
+        return
+    trans = ax.get_xaxis_transform()  # x in data, y in axes fraction
+    texts = []
+    for fv, label in inside:
+        ax.axvline(fv, color=_MARK_COLOR, lw=0.8, ls=":", alpha=0.9)
+        texts.append(ax.text(fv, 0.98, label, transform=trans, ha="center", va="top", fontsize=7,
+                             color=_MARK_COLOR,
+                             bbox={"boxstyle": "square,pad=0.15", "fc": "white", "ec": "none",
+                                   "alpha": 0.8}))
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    row_h = 1.15 * max(tx.get_window_extent(renderer).height for tx in texts) / ax.bbox.height
+    row_end: list[float] = []  # right edge (pixels) of the last label in each row
+    for tx in texts:
+        ext = tx.get_window_extent(renderer)
+        pad = 2.0
+        row = next((r for r, end in enumerate(row_end) if ext.x0 > end + pad), len(row_end))
+        if row == len(row_end):
+            row_end.append(ext.x1)
+        else:
+            row_end[row] = ext.x1
+        tx.set_y(0.98 - row * row_h)
+
+
+def work_precision(rows: Sequence[tuple], path, *, error_label: str = "error",
+                   error_unit: str = "–", title: str | None = None) -> Path:
+    """Log–log work-precision diagram: one line per method through its (wall time, error) points."""
+    by_method: dict[str, list[tuple[float, float]]] = {}
+    for method, wall, err in rows:
+        by_method.setdefault(str(method), []).append((float(wall), float(err)))
+    if not by_method:
+        raise ValueError("rows is empty")
+    markers = "osD^v<>p*h"
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(5.5, 4.2), layout="constrained")
+        ax = fig.add_subplot()
+        for i, (method, pts) in enumerate(by_method.items()):
+            pts = np.array(sorted(pts))
+            ax.loglog(pts[:, 0], pts[:, 1], marker=markers[i % len(markers)], label=method)
+        ax.set_xlabel(_axis_label("wall time", "s"))
+        ax.set_ylabel(_axis_label(error_label, error_unit))
+        ax.grid(True, which="both", alpha=0.25)
+        ax.legend(loc="best")
+        if title:
+            ax.set_title(title)
+        return _save(fig, path)
+
+
+def load_distribution(angles_rad, loads_N, path, *, title: str | None = None) -> Path:
+    """Polar plot of roller loads at their angular positions.
+
+    loads_N: (Z,) array, or label -> (Z,) array (e.g. forward/reverse) sharing angles_rad.
+    Each roller is a stem from the centre plus a marker; the envelope is closed around the bearing.
+    """
+    ang = np.asarray(angles_rad, float)
+    curves = dict(loads_N) if isinstance(loads_N, Mapping) else {None: loads_N}
+    order = np.argsort(np.mod(ang, 2 * np.pi))
+    styles = [FWD, REV]
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(4.8, 4.8), layout="constrained")
+        ax = fig.add_subplot(projection="polar")
+        for i, (label, load) in enumerate(curves.items()):
+            st = styles[i % 2]
+            a = np.mod(ang, 2 * np.pi)[order]
+            q = np.asarray(load, float)[order]
+            ax.vlines(a, 0.0, q, color=st["color"], lw=2.0, alpha=0.6)
+            ax.plot(np.append(a, a[0]), np.append(q, q[0]), color=st["color"], ls=st["linestyle"],
+                    marker="o", ms=3.5, label=label)
+        ax.set_rlabel_position(100)
+        # A polar axis has no radial axis label of its own: the unit goes on every radial tick.
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g} N"))
+        ax.set_xlabel(_axis_label("roller angle", "°") + "   radial: roller load [N]")
+        if any(k is not None for k in curves):
+            ax.legend(loc="lower right", bbox_to_anchor=(1.12, -0.08))
+        if title:
+            ax.set_title(title)
+        return _save(fig, path)
+
+
+def mode_shapes(freqs_hz, shapes, labels: Sequence[str], path, *, max_modes: int = 12,
+                title: str | None = None) -> Path:
+    """Bar chart of each mode shape (rows of `shapes`, one entry per coordinate in `labels`).
+
+    Each shape is scaled to unit maximum magnitude, so the bars read as relative participation;
+    pass comparable coordinates (e.g. rotations times a base radius) for that to be meaningful.
+    """
+    freqs = np.asarray(freqs_hz, float)
+    shp = np.atleast_2d(np.asarray(shapes, float))
+    if shp.shape != (freqs.size, len(labels)):
+        raise ValueError(f"shapes must be (n_modes, n_coords) = ({freqs.size}, {len(labels)}), "
+                         f"got {shp.shape}")
+    n = min(freqs.size, max_modes)
+    ncols = 1 if n < 3 else 2
+    nrows = -(-n // ncols)
+    x = np.arange(len(labels))
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(max(5.0, 0.28 * len(labels) + 1.5) * ncols, 1.9 * nrows + 0.6),
+                     layout="constrained")
+        axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
+        for i in range(n):
+            ax = axes[i]
+            s = shp[i]
+            s = s / max(np.max(np.abs(s)), np.finfo(float).tiny)
+            ax.bar(x, s, color=FWD["color"])
+            ax.axhline(0.0, color="k", lw=0.6)
+            ax.set_ylim(-1.1, 1.1)
+            ax.set_title(f"mode {i + 1}: f = {freqs[i]:.4g} Hz")
+            ax.set_xticks(x, labels, rotation=90, fontsize=7)
+            ax.set_ylabel(_axis_label("amplitude", "–"))
+            ax.set_xlabel(_axis_label("coordinate", "–"))
+            ax.grid(axis="x", visible=False)
+        for ax in axes[n:]:
+            ax.set_visible(False)
+        if title:
+            fig.suptitle(title)
+        return _save(fig, path)
