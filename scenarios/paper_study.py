@@ -1,0 +1,291 @@
+"""Forward vs reverse carrier rotation: planet-bearing loads, cage collisions and vibration, bearing life.
+
+    python -m scenarios.paper_study --conditions 3 --out results/study
+    python -m scenarios.paper_study --conditions 1,2,3,4 --directions forward,reverse --workers 2 \\
+        --set bearing.clearance="30 um" --out results/study
+
+Writes DIR/c{condition}_{direction}/{results.nc, summary.json}, DIR/comparison.csv, DIR/comparison.md,
+DIR/c{condition}_time_histories.png, DIR/bars.png, and (with --animate) DIR/c{condition}_cage_orbits.gif.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from mbd.recorder import atomic_write_text
+
+from .runner import Integration, RunConfig
+from .sweep import Case, build_params, run_sweep
+
+QUANTITIES = [
+    ("roller_cage_rms_N", "N"), ("roller_cage_max_N", "N"), ("cage_guide_rms_N", "N"), ("cage_guide_max_N", "N"),
+    ("roller_inner_race_rms_N", "N"), ("roller_inner_race_max_N", "N"), ("roller_outer_race_rms_N", "N"),
+    ("roller_outer_race_max_N", "N"), ("cage_acc_x_rms", "m/s^2"), ("cage_acc_y_rms", "m/s^2"),
+    ("bearing_load_mean_N", "N"), ("life_L10_relative", "-"),
+]
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(prog="python -m scenarios.paper_study", description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--conditions", default="3", help="comma list of operating conditions 1-4 (default 3)")
+    p.add_argument("--directions", default="forward,reverse", help="comma list: forward, reverse")
+    p.add_argument("--planets", type=int, default=None, help="planet pairs N (default 3, the reference machine)")
+    p.add_argument("--settle", type=float, default=0.03, help="seconds discarded after the start (default 0.03)")
+    p.add_argument("--window", type=float, default=0.02, help="seconds recorded and analysed (default 0.02)")
+    p.add_argument("--sample-rate", type=float, default=25000.0, help="recording rate [Hz]")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help='override a parameter, e.g. --set bearing.clearance="30 um" (repeatable)')
+    p.add_argument("--params", default=None, help="TOML file of parameter overrides")
+    p.add_argument("--method", default="hht-adaptive", choices=["hht-adaptive", "hht-fixed"])
+    p.add_argument("--h", type=float, default=5e-6, help="fixed step / initial step [s]")
+    p.add_argument("--alpha", type=float, default=-0.3, help="HHT alpha in [-1/3, 0]")
+    p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                   help="scene switch, e.g. --option drag=false --option bearings=linear")
+    p.add_argument("--workers", type=int, default=None, help="Dask local workers (default: one per core)")
+    p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
+    p.add_argument("--animate", action="store_true", help="write a cage-orbit animation per condition")
+    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--out", default="results/study", help="output directory")
+    return p.parse_args(argv)
+
+
+def _bool(v: str):
+    lv = v.strip().lower()
+    if lv in ("true", "yes", "on", "1"):
+        return True
+    if lv in ("false", "no", "off", "0"):
+        return False
+    return v
+
+
+def parse_sets(items: list[str]) -> dict:
+    out = {}
+    for it in items:
+        if "=" not in it:
+            raise SystemExit(f"error: --set expects KEY=VALUE (e.g. bearing.clearance=\"30 um\"), got {it!r}")
+        k, v = it.split("=", 1)
+        out[k.strip()] = v.strip().strip('"').strip("'")
+    return out
+
+
+def build_config(a) -> RunConfig:
+    from components.scene import SceneOptions
+
+    opts = {k: _bool(v) for k, v in parse_sets(a.option).items()}
+    return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate,
+                     integration=Integration(method=a.method, h=a.h, alpha=a.alpha),
+                     options=SceneOptions.from_dict(opts), progress=not a.no_progress)
+
+
+def make_cases(a, out: Path) -> list[Case]:
+    conds = [int(c) for c in str(a.conditions).split(",") if c.strip()]
+    dirs = [d.strip() for d in str(a.directions).split(",") if d.strip()]
+    for d in dirs:
+        if d not in ("forward", "reverse"):
+            raise SystemExit(f"error: --directions takes forward and/or reverse, got {d!r}")
+    overrides = parse_sets(a.set)
+    if a.planets is not None:
+        overrides["gears.planets"] = a.planets
+    cases = [Case(c, d, str(out / f"c{c}_{d}"), overrides, a.params) for c in conds for d in dirs]
+    return cases
+
+
+def relative_life(results: dict) -> None:
+    """Fill life_L10_relative = (P_fwd / P)^(10/3) per condition and bearing kind (forward = 1)."""
+    for label, s in results.items():
+        if "error" in s:
+            continue
+        fwd = results.get(f"c{s['condition']}_forward")
+        for kind in ("inner", "outer"):
+            if fwd is None or "error" in fwd:
+                s[kind]["life_L10_relative"] = None
+                continue
+            P, Pf = s[kind]["equivalent_load_N"], fwd[kind]["equivalent_load_N"]
+            s[kind]["life_L10_relative"] = float((Pf / P) ** (10.0 / 3.0)) if P > 0 else None
+
+
+def comparison_rows(results: dict) -> list[dict]:
+    rows = []
+    conds = sorted({s["condition"] for s in results.values() if "error" not in s})
+    for c in conds:
+        f, r = results.get(f"c{c}_forward", {}), results.get(f"c{c}_reverse", {})
+        for kind in ("inner", "outer"):
+            for q, unit in QUANTITIES:
+                fv = f.get(kind, {}).get(q) if "error" not in f else None
+                rv = r.get(kind, {}).get(q) if "error" not in r else None
+                diff = (rv - fv) / fv * 100.0 if (fv not in (None, 0) and rv is not None) else None
+                rows.append({"condition": c, "bearing": kind, "quantity": q, "unit": unit,
+                             "forward": fv, "reverse": rv, "difference_pct": diff})
+    return rows
+
+
+def _fmt(x, nd=4):
+    return "–" if x is None else f"{x:.{nd}g}"
+
+
+def write_tables(rows: list[dict], out: Path) -> tuple[Path, Path, str]:
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=list(rows[0]) if rows else ["condition"])
+    w.writeheader()
+    w.writerows(rows)
+    atomic_write_text(out / "comparison.csv", buf.getvalue())
+    md = []
+    for c in sorted({r["condition"] for r in rows}):
+        md.append(f"\n### Condition {c}\n\n| bearing | quantity | forward | reverse | difference % |\n|---|---|---|---|---|")
+        for r in rows:
+            if r["condition"] == c:
+                md.append(f"| {r['bearing']} | {r['quantity']} [{r['unit']}] | {_fmt(r['forward'])} | "
+                          f"{_fmt(r['reverse'])} | {_fmt(r['difference_pct'], 3)} |")
+    text = "\n".join(md).strip() + "\n"
+    atomic_write_text(out / "comparison.md", text)
+    return out / "comparison.csv", out / "comparison.md", text
+
+
+def plots(results: dict, out: Path) -> list[Path]:
+    import xarray as xr
+
+    from viz import plots as vp
+
+    paths = []
+    conds = sorted({s["condition"] for s in results.values() if "error" not in s})
+    for c in conds:
+        series, units = {}, {}
+        runs = {}
+        for d in ("forward", "reverse"):
+            p = out / f"c{c}_{d}" / "results.nc"
+            if p.exists() and "error" not in results.get(f"c{c}_{d}", {"error": 1}):
+                runs[d] = p
+        if not runs:
+            continue
+        data = {}
+        for d, p in runs.items():
+            with xr.open_dataset(p, engine="h5netcdf") as ds:
+                bmap = json.loads(ds.attrs["bearings"])
+                t = ds["time"].values
+                bodies = list(ds["motion.body"].values)
+                cols = {}
+                for kind in ("inner", "outer"):
+                    b = next(x for x in bmap if x["kind"] == kind)
+                    if b["type"] != "rollers":
+                        continue
+                    cols[f"{kind}: roller–inner race"] = ds["race_inner.load"].values[:, b["race_inner"][0]]
+                    if "pocket" in b:
+                        cols[f"{kind}: roller–cage"] = ds["pocket.force"].values[:, b["pocket"][0]]
+                    if "guide" in b:
+                        cols[f"{kind}: cage–guide"] = ds["guide.force"].values[:, b["guide"]]
+                        a = ds["motion.a"].values
+                        ic, ip = bodies.index(b["cage"]), bodies.index(b["planet"])
+                        cols[f"{kind}: cage acc x"] = a[:, ic, 0] - a[:, ip, 0]
+                data[d] = (t, cols)
+        labels = list(next(iter(data.values()))[1])
+        t = next(iter(data.values()))[0]
+        for lab in labels:
+            fw = data.get("forward", (None, {}))[1].get(lab)
+            rv = data.get("reverse", (None, {}))[1].get(lab)
+            n = min(x.size for x in (fw, rv) if x is not None)
+            series[lab] = (fw[:n] if fw is not None else None, rv[:n] if rv is not None else None)
+            units[lab] = "m/s^2" if "acc" in lab else "N"
+        t = t[:n]
+        if series:
+            paths.append(vp.time_histories(t, series, units, out / f"c{c}_time_histories.png",
+                                           title=f"Condition {c}: forward vs reverse (reference roller, pair 1)"))
+    table = {}
+    bar_units = {}
+    for q, unit in QUANTITIES[:10]:
+        for kind in ("inner", "outer"):
+            key = f"{kind} {q}"
+            table[key] = {}
+            bar_units[key] = unit
+            for c in conds:
+                f, r = results.get(f"c{c}_forward", {}), results.get(f"c{c}_reverse", {})
+                fv = f.get(kind, {}).get(q) if "error" not in f else None
+                rv = r.get(kind, {}).get(q) if "error" not in r else None
+                table[key][c] = (fv, rv)
+    sel = {k: v for k, v in table.items() if "rms" in k}
+    if conds and sel:
+        paths.append(vp.bar_chart(conds, sel, {k: bar_units[k] for k in sel}, out / "bars.png",
+                                  title="RMS across conditions: forward vs reverse"))
+    return paths
+
+
+def animate(results: dict, out: Path) -> list[Path]:
+    paths = []
+    try:
+        from viz.results import study_cage_animation
+    except ImportError as exc:   # pragma: no cover - viz integration missing
+        print(f"animation skipped: {exc}")
+        return paths
+    from viz.render_check import check_offscreen
+
+    ok, msg = check_offscreen()
+    if not ok:
+        print(f"animation skipped: {msg}")
+        return paths
+    for c in sorted({s["condition"] for s in results.values() if "error" not in s}):
+        f, r = out / f"c{c}_forward" / "results.nc", out / f"c{c}_reverse" / "results.nc"
+        if f.exists() and r.exists():
+            paths.append(Path(study_cage_animation(f, r, out / f"c{c}_cage_orbits.gif")))
+    return paths
+
+
+def run(a) -> dict:
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    cfg = build_config(a)
+    cases = make_cases(a, out)
+    # validate every case's parameters here, before any run starts (clear errors, design warnings once)
+    from components.units import ParameterError
+
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            for c in cases:
+                build_params(c)
+                from components.geometry import check_design
+                check_design(build_params(c))
+        for msg in sorted({str(w.message) for w in caught}):
+            print(f"design warning: {msg}")
+    except ParameterError as exc:
+        raise SystemExit(f"error: {exc}") from None
+    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress)
+    relative_life(results)
+    for label, s in results.items():   # store the relative life in each run's summary (atomic rewrite)
+        if "error" not in s:
+            s.pop("skipped", None)
+            atomic_write_text(out / label / "summary.json", json.dumps(s, indent=2, default=str))
+    rows = comparison_rows(results)
+    csv_p, md_p, text = write_tables(rows, out)
+    figs = plots(results, out)
+    anims = animate(results, out) if a.animate else []
+    print("\n" + text)
+    failed = {k: v["error"] for k, v in results.items() if "error" in v}
+    for k, v in failed.items():
+        print(f"FAILED {k}: {v}  (details in {out / k / 'error.json'})")
+    print("run time and accuracy per run:")
+    for k, s in sorted(results.items()):
+        if "error" not in s:
+            e = s["error_estimate"]
+            print(f"  {k}: {s['wall_s']:.1f} s wall, {s['steps']} steps, local error estimate rms {e['rms']:.2f} / "
+                  f"max {e['max']:.2f} × {e['atol_m']:.0e} m")
+    print("\nwritten:")
+    for p in [csv_p, md_p, *figs, *anims]:
+        print(f"  {p}")
+    return {"results": results, "rows": rows, "failed": failed, "figures": figs, "animations": anims}
+
+
+def main(argv=None) -> int:
+    a = parse_args(sys.argv[1:] if argv is None else argv)
+    r = run(a)
+    return 1 if r["failed"] else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,110 @@
+"""Sweeps of many runs on Dask: a local cluster by default, or an existing one (``scheduler``).
+
+Each case is plain data (condition, direction, parameter overrides as strings, run config), so it
+travels to any worker; the worker rebuilds the pint parameters itself. A case whose summary.json
+exists is skipped (a restarted sweep resumes); a failing case writes error.json with its traceback
+and does not stop the others; every file is written atomically.
+"""
+from __future__ import annotations
+
+import json
+import os
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from mbd.recorder import atomic_write_text
+
+__all__ = ["Case", "run_sweep", "execute_case"]
+
+
+@dataclass(frozen=True)
+class Case:
+    condition: int
+    direction: str
+    out_dir: str
+    overrides: dict = field(default_factory=dict)   # dotted parameter path -> value string
+    params_file: str | None = None
+
+    @property
+    def label(self) -> str:
+        return f"c{self.condition}_{self.direction}"
+
+
+def build_params(case: Case):
+    from components.params import load_toml, with_overrides
+    from components.presets import reference_dpgt
+
+    base = reference_dpgt(case.condition, case.direction)
+    if case.params_file:
+        base = load_toml(case.params_file, base=base)
+    return with_overrides(base, case.overrides)
+
+
+def execute_case(case: Case, cfg) -> dict:
+    """Run one case (on whichever process). Returns its summary, or {"error": ...}; never raises."""
+    from .runner import run_case
+
+    out = Path(case.out_dir)
+    done = out / "summary.json"
+    if done.exists():
+        return {**json.loads(done.read_text()), "skipped": True}
+    try:
+        params = build_params(case)
+        s = run_case(params, cfg, out, label={"condition": case.condition, "direction": case.direction})
+        err = out / "error.json"
+        if err.exists():
+            err.unlink()
+        return s
+    except Exception as exc:  # reported, never hidden; the sweep goes on
+        out.mkdir(parents=True, exist_ok=True)
+        info = {"case": case.label, "error": f"{type(exc).__name__}: {exc}", "traceback": traceback.format_exc()}
+        atomic_write_text(out / "error.json", json.dumps(info, indent=2))
+        return info
+
+
+def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | None = None,
+              progress: bool = True) -> dict[str, dict]:
+    """Run every case; returns {label: summary or error}. One case runs in-process (no cluster)."""
+    from tqdm.auto import tqdm
+
+    todo = [c for c in cases if not (Path(c.out_dir) / "summary.json").exists()]
+    results = {c.label: execute_case(c, cfg) for c in cases if c not in todo}   # finished: just load
+    if not todo:
+        return results
+    n_workers = workers or min(len(todo), os.cpu_count() or 1)
+    if scheduler is None and n_workers <= 1:
+        for c in tqdm(todo, desc="runs", disable=not progress or len(todo) == 1):
+            results[c.label] = execute_case(c, cfg)
+        return results
+    from dataclasses import replace
+
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    wcfg = replace(cfg, progress=False)   # per-run bars would interleave; the sweep bar shows progress
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=40)
+        client = Client(cluster)
+    else:
+        client = Client(scheduler)
+    try:
+        futs = {client.submit(execute_case, c, wcfg, pure=False, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
+        bar = tqdm(total=len(futs), desc="runs", disable=not progress)
+        for fut in as_completed(futs):
+            c = futs[fut]
+            try:
+                results[c.label] = fut.result()
+            except Exception as exc:   # worker died: report, keep going
+                results[c.label] = {"case": c.label, "error": f"worker failure: {exc}"}
+            bar.update(1)
+            if "error" in results[c.label]:
+                bar.write(f"run {c.label} failed: {results[c.label]['error']}")
+        bar.close()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return results
