@@ -1,0 +1,123 @@
+"""Scenarios end to end in reduced form (short windows, few rollers): documented outputs, sane values."""
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from scenarios import paper_study, spectrum
+
+SUMMARY_KEYS = {"condition", "direction", "carrier_rpm", "sun_rpm", "power_W", "planets", "rollers", "window_s",
+                "wall_s", "steps", "error_estimate", "inner", "outer"}
+BEARING_KEYS = {"roller_cage_rms_N", "roller_cage_max_N", "cage_guide_rms_N", "cage_guide_max_N",
+                "roller_inner_race_rms_N", "roller_inner_race_max_N", "roller_outer_race_rms_N",
+                "roller_outer_race_max_N", "cage_acc_x_rms", "cage_acc_y_rms", "bearing_load_mean_N",
+                "life_L10_relative", "all_rollers"}
+
+REDUCED = ["--settle", "0.002", "--window", "0.001", "--set", "bearing.rollers=8", "--no-progress",
+           "--workers", "1"]
+
+
+@pytest.fixture(scope="module")
+def zero_power_study(tmp_path_factory):
+    out = tmp_path_factory.mktemp("study")
+    r = paper_study.run(paper_study.parse_args(["--conditions", "4", "--out", str(out)] + REDUCED))
+    return out, r
+
+
+def test_study_writes_documented_outputs(zero_power_study):
+    out, r = zero_power_study
+    assert not r["failed"]
+    for d in ("forward", "reverse"):
+        s = json.loads((out / f"c4_{d}" / "summary.json").read_text())
+        assert SUMMARY_KEYS <= set(s)
+        assert s["condition"] == 4 and s["direction"] == d and s["rollers"] == 8 and s["planets"] == 3
+        assert s["power_W"] == 0.0 and abs(abs(s["carrier_rpm"]) - 4200) < 1e-9
+        assert s["window_s"] == pytest.approx([0.002, 0.003])
+        for kind in ("inner", "outer"):
+            assert BEARING_KEYS <= set(s[kind])
+            for k, v in s[kind].items():
+                if isinstance(v, float):
+                    assert np.isfinite(v) and v >= 0, (kind, k, v)
+        assert s["inner"]["life_L10_relative"] > 0
+        assert (out / f"c4_{d}" / "results.nc").exists()
+    rows = list(csv.DictReader((out / "comparison.csv").open()))
+    assert {r["quantity"] for r in rows} >= {"bearing_load_mean_N", "roller_cage_rms_N", "life_L10_relative"}
+    assert "| bearing | quantity | forward | reverse | difference % |" in (out / "comparison.md").read_text()
+    assert (out / "c4_time_histories.png").stat().st_size > 10_000
+    assert (out / "bars.png").stat().st_size > 10_000
+
+
+def test_zero_power_forward_and_reverse_agree(zero_power_study):
+    """With no transmitted power the bearing load is centrifugal (+ gravity): the direction of rotation
+    must not change the mean bearing load by more than 2 % (MODEL.md §6.6 in spirit)."""
+    out, _ = zero_power_study
+    f = json.loads((out / "c4_forward" / "summary.json").read_text())
+    r = json.loads((out / "c4_reverse" / "summary.json").read_text())
+    for kind in ("inner", "outer"):
+        a, b = f[kind]["bearing_load_mean_N"], r[kind]["bearing_load_mean_N"]
+        assert abs(b - a) / a < 0.02, (kind, a, b)
+        assert f[kind]["life_L10_relative"] == 1.0
+
+
+def test_sweep_resume_skips_finished_runs(zero_power_study, capsys):
+    out, _ = zero_power_study
+    before = {d: (out / f"c4_{d}" / "summary.json").stat().st_mtime_ns for d in ("forward", "reverse")}
+    results_before = (out / "c4_forward" / "results.nc").stat().st_mtime_ns
+    r = paper_study.run(paper_study.parse_args(["--conditions", "4", "--out", str(out)] + REDUCED))
+    assert not r["failed"]
+    # results were not recomputed (summaries are rewritten only to refresh the relative life)
+    assert (out / "c4_forward" / "results.nc").stat().st_mtime_ns == results_before
+    assert r["results"]["c4_forward"]["steps"] > 0
+
+
+def test_failing_run_is_reported_and_others_finish(tmp_path):
+    from scenarios.runner import Integration, RunConfig
+    from scenarios.sweep import Case, run_sweep
+
+    cfg = RunConfig(settle=0.0005, window=0.0005, progress=False)
+    good = Case(4, "forward", str(tmp_path / "good"), {"bearing.rollers": 8})
+    bad = Case(4, "reverse", str(tmp_path / "bad"), {"bearing.rollers": 8, "gears.planets": 0})
+    res = run_sweep([good, bad], cfg, workers=1, progress=False)
+    assert "error" in res["c4_reverse"] and "gears.planets" in res["c4_reverse"]["error"]
+    assert (tmp_path / "bad" / "error.json").exists() and not (tmp_path / "bad" / "summary.json").exists()
+    assert "error" not in res["c4_forward"] and (tmp_path / "good" / "summary.json").exists()
+
+
+def test_bad_set_gives_clear_error(tmp_path):
+    with pytest.raises(SystemExit) as e:
+        paper_study.run(paper_study.parse_args(["--out", str(tmp_path), "--set", "bearing.clearance=3 kg"]))
+    assert "bearing.clearance" in str(e.value) and "length" in str(e.value)
+    with pytest.raises(SystemExit) as e:
+        paper_study.run(paper_study.parse_args(["--out", str(tmp_path), "--set", "bearing.clearence=30 um"]))
+    assert "clearence" in str(e.value)
+    with pytest.raises(SystemExit) as e:
+        paper_study.run(paper_study.parse_args(["--out", str(tmp_path), "--set", "novalue"]))
+    assert "KEY=VALUE" in str(e.value)
+
+
+@pytest.mark.slow
+def test_spectrum_peaks_sit_on_mesh_sidebands(tmp_path):
+    """The strongest peaks near f_m lie on f_m + k f_c (k small integers) within one frequency bin.
+    Which k dominate is physics to report, not to tune. Linear bearings keep the run short."""
+    s = spectrum.run(spectrum.parse_args(["--out", str(tmp_path), "--settle", "0.06", "--window", "0.09",
+                                          "--option", "bearings=linear", "--no-progress"]))
+    assert s["f_c_hz"] == pytest.approx(2000 / 60) and s["f_m_hz"] == pytest.approx(82 * 2000 / 60)
+    assert s["resolution_hz"] == pytest.approx(1 / 0.09, rel=0.01)
+    top = s["peaks"][:3]
+    assert top, "no peaks found near f_m"
+    for p in top:
+        k = (p["frequency_hz"] - s["f_m_hz"]) / s["f_c_hz"]
+        assert abs(k - round(k)) * s["f_c_hz"] <= s["resolution_hz"], p
+        assert abs(round(k)) <= 6
+    rows = list(csv.DictReader((tmp_path / "spectrum.csv").open()))
+    assert set(rows[0]) >= {"frequency_hz", "amplitude"}
+    assert (tmp_path / "spectrum.png").exists()
+
+
+def test_spectrum_rejects_inconsistent_sun_speed(tmp_path):
+    with pytest.raises(SystemExit) as e:
+        spectrum.run(spectrum.parse_args(["--out", str(tmp_path), "--carrier-rpm", "2000", "--sun-rpm", "3000"]))
+    assert "3290" in str(e.value)
