@@ -90,7 +90,9 @@ def evaluate(elem: Element, t, fs, q_full, v_full, z, jac: bool):
     k = elem.k
     if not jac:
         f, out = elem.kernel(t, fs, list(ql.T), list(vl.T), z)
-        F = np.column_stack([np.broadcast_to(np.asarray(fi, dtype=float), (elem.n,)) for fi in f])
+        F = np.empty((elem.n, k))
+        for i, fi in enumerate(f):      # column assignment broadcasts scalars (hot path: no temporaries)
+            F[:, i] = fi
         return F, out, None, None
     m = 2 * k
     f, out = elem.kernel(t, fs, ad.seed(ql, 0, m), ad.seed(vl, k, m), z)

@@ -146,6 +146,8 @@ class Recorder:
         af = np.zeros_like(qf)
         af[m.free] = a
         fs = m.frame.at(t)
+        if m.fixed.any() and not m.frame.is_inertial:
+            _fixed_body_acceleration(m, fs, qf, vf, af)
         outs = None
         for kind, p, sel in self._plan:
             if kind == "body":
@@ -183,7 +185,7 @@ class Recorder:
 
     def checkpoint_state(self) -> dict:
         self.flush()
-        return {"next_index": self.next_index, "n_chunks": self.n_chunks}
+        return {"next_index": int(self.next_index), "n_chunks": int(self.n_chunks)}   # JSON-safe ints
 
     def restore(self, st: dict) -> None:
         self.next_index = int(st["next_index"])
@@ -209,6 +211,7 @@ class Recorder:
     def finalize(self, attrs: dict | None = None) -> Path:
         """Stream all chunks into the results file (netCDF4 via h5netcdf) atomically."""
         import h5netcdf
+        import h5py
 
         self.flush()
         total = sum(c["time"].shape[0] for c in self._chunks())
@@ -222,14 +225,17 @@ class Recorder:
             tv = f.create_variable("time", ("time",), float)
             tv.attrs["units"] = "s"
             created = {}
-            first = next(self._chunks(), None)
+            chunks = self._chunks()
+            first = next(chunks, None)
+            chunks.close()          # release the first chunk's file now, not at garbage collection
             for name, (dims, coords) in self.vars.items():
                 shape_tail = first[name].shape[1:] if first is not None else (0,) * (len(dims) - 1)
                 for d, size in zip(dims[1:], shape_tail):
                     if d not in f.dimensions:
                         f.dimensions[d] = size
                         if d in coords:
-                            cv = f.create_variable(d, (d,), str)
+                            # h5py has no conversion for numpy '<U' strings: variable-length UTF-8
+                            cv = f.create_variable(d, (d,), h5py.string_dtype())
                             cv[:] = np.array(coords[d], dtype=object)
                 created[name] = f.create_variable(name, dims, float, chunks=None)
             i0 = 0
@@ -242,6 +248,17 @@ class Recorder:
         os.replace(tmp, self.path)
         shutil.rmtree(self.parts, ignore_errors=True)
         return self.path
+
+
+def _fixed_body_acceleration(m, fs, qf, vf, af) -> None:
+    """Acceleration in R of the bodies at rest in I (the frame terms with F = 0, MODEL.md §2):
+    a fixed body seen from a rotating R accelerates, and to_fixed must map it back to zero."""
+    idx = np.flatnonzero(m.fixed)
+    x, y, vx, vy = qf[3 * idx], qf[3 * idx + 1], vf[3 * idx], vf[3 * idx + 1]
+    W, dW = fs.omega, fs.domega
+    af[3 * idx] = W * W * x + 2 * W * vy + dW * y
+    af[3 * idx + 1] = W * W * y - 2 * W * vx - dW * x
+    af[3 * idx + 2] = -dW
 
 
 def _hermite(s0, s1, th, h):

@@ -50,11 +50,15 @@ class FirstOrderSystem:
         return sp.vstack([top, bot], format="csc")
 
     def sparsity(self):
-        """Structural pattern of the Jacobian (for LSODA/BDF finite-difference grouping)."""
-        y = np.zeros(2 * self.n)
-        J = self.jac(0.0, y)
-        J.data[:] = 1.0
-        return J
+        """Structural pattern of the Jacobian (for finite-difference grouping, ``jac_sparsity``).
+
+        Built from the assembler's fixed pattern, not from Jacobian values: entries that happen to
+        be zero at one state (sparse products drop them) are still structurally nonzero."""
+        s, n = self.system, self.n
+        ones = sp.csc_matrix((np.ones(s.nnz), s._indices, s._indptr), shape=(n, n))
+        P = sp.vstack([sp.hstack([sp.csr_matrix((n, n)), self._I]), sp.hstack([ones, ones])], format="csc")
+        P.data[:] = 1.0
+        return P
 
 
 @dataclass
@@ -82,7 +86,9 @@ def solve_scipy(model: Model, q0, v0, t_span, method="Radau", rtol=1e-6, atol=1e
                 raise TimeoutError(f"{method} exceeded {max_wall_s:.0f} s wall time at t = {t:.6e} s")
             return fo.fun(t, y)
     opts = dict(method=method, rtol=rtol, atol=atol, t_eval=t_eval, **kw)
-    if method in IMPLICIT:
+    if method == "LSODA":   # LSODA's Fortran core takes only a dense (or banded) Jacobian
+        opts["jac"] = lambda t, y: fo.jac(t, y).toarray()
+    elif method in IMPLICIT:
         opts["jac"] = fo.jac
     try:
         sol = solve_ivp(fun, t_span, y0, **opts)

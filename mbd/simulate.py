@@ -58,7 +58,9 @@ class SimResult:
 def save_state(path, s: State, extra: dict | None = None) -> None:
     bio = io.BytesIO()
     z = {f"z__{k}": v for k, v in s.z.items()}
-    np.savez(bio, t=s.t, q=s.q, v=s.v, a=s.a, f=s.f, extra=json.dumps(extra or {}), **z)
+    # numpy scalars (np.int64 counters, indices) are not JSON types: store them as Python numbers
+    extra_json = json.dumps(extra or {}, default=lambda o: o.item() if isinstance(o, np.generic) else str(o))
+    np.savez(bio, t=s.t, q=s.q, v=s.v, a=s.a, f=s.f, extra=extra_json, **z)
     atomic_write_bytes(path, bio.getvalue())
 
 

@@ -39,7 +39,8 @@ def parse_args(argv):
     p.add_argument("--directions", default="forward,reverse", help="comma list: forward, reverse")
     p.add_argument("--planets", type=int, default=None, help="planet pairs N (default 3, the reference machine)")
     p.add_argument("--settle", type=float, default=0.03, help="seconds discarded after the start (default 0.03)")
-    p.add_argument("--window", type=float, default=0.02, help="seconds recorded and analysed (default 0.02)")
+    p.add_argument("--window", type=float, default=None,
+                   help="seconds recorded and analysed (default: max(0.02 s, one carrier revolution))")
     p.add_argument("--sample-rate", type=float, default=25000.0, help="recording rate [Hz]")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help='override a parameter, e.g. --set bearing.clearance="30 um" (repeatable)')
@@ -80,7 +81,7 @@ def build_config(a) -> RunConfig:
     from components.scene import SceneOptions
 
     opts = {k: _bool(v) for k, v in parse_sets(a.option).items()}
-    return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate,
+    return RunConfig(settle=a.settle, window=a.window or 0.02, sample_rate=a.sample_rate,
                      integration=Integration(method=a.method, h=a.h, alpha=a.alpha),
                      options=SceneOptions.from_dict(opts), progress=not a.no_progress)
 
@@ -94,8 +95,20 @@ def make_cases(a, out: Path) -> list[Case]:
     overrides = parse_sets(a.set)
     if a.planets is not None:
         overrides["gears.planets"] = a.planets
-    cases = [Case(c, d, str(out / f"c{c}_{d}"), overrides, a.params) for c in conds for d in dirs]
-    return cases
+    from components.presets import CONDITIONS
+    from components.units import to_si
+
+    def window(c):
+        if a.window is not None:
+            return a.window
+        speed = overrides.get("operating.carrier_speed")
+        w_c = to_si(CONDITIONS[c][0]) if speed is None else None
+        return max(0.02, 2 * np.pi / abs(w_c)) if w_c else 0.02
+
+    for c in conds:
+        if c not in (1, 2, 3, 4):
+            raise SystemExit(f"error: --conditions takes 1, 2, 3 and/or 4 (PARAMETERS.md), got {c}")
+    return [Case(c, d, str(out / f"c{c}_{d}"), overrides, a.params, window(c)) for c in conds for d in dirs]
 
 
 def relative_life(results: dict) -> None:

@@ -26,6 +26,7 @@ class Case:
     out_dir: str
     overrides: dict = field(default_factory=dict)   # dotted parameter path -> value string
     params_file: str | None = None
+    window: float | None = None                     # per-case recorded window [s] (None: the config's)
 
     @property
     def label(self) -> str:
@@ -52,6 +53,9 @@ def execute_case(case: Case, cfg) -> dict:
         return {**json.loads(done.read_text()), "skipped": True}
     try:
         params = build_params(case)
+        if case.window is not None:
+            from dataclasses import replace as _replace
+            cfg = _replace(cfg, window=case.window)
         s = run_case(params, cfg, out, label={"condition": case.condition, "direction": case.direction})
         err = out / "error.json"
         if err.exists():

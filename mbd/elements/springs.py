@@ -8,6 +8,16 @@ from ..element import Element, body_dofs, marker, marker_velocity, point_force
 from ..errors import ModelError
 
 
+def _offsets(elem: Element, name: str, value) -> np.ndarray:
+    """(n, 2) point/offset parameter from a (2,) or (n, 2) value; errors name the parameter."""
+    a = np.asarray(value, dtype=float)
+    if a.shape not in ((2,), (elem.n, 2)):
+        raise ModelError(f"{elem.name}: parameter {name!r} must have shape (2,) or ({elem.n}, 2) [m], got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ModelError(f"{elem.name}: parameter {name!r} must be finite, got {value!r}")
+    return np.broadcast_to(a, (elem.n, 2)).copy()
+
+
 class GroundSupport(Element):
     """Spring-damper from each body's centre to an anchor fixed in the inertial frame.
 
@@ -27,8 +37,7 @@ class GroundSupport(Element):
         self.cx = self._per_instance("cx", cx, nonneg=True)
         self.cy = self.cx if cy is None else self._per_instance("cy", cy, nonneg=True)
         self.isotropic = ky is None and cy is None
-        a = np.asarray(anchor, dtype=float)
-        self.anchor = np.broadcast_to(a, (self.n, 2)).copy()
+        self.anchor = _offsets(self, "anchor", anchor)
         self.k_theta = self._per_instance("k_theta", k_theta, nonneg=True)
         self.c_theta = self._per_instance("c_theta", c_theta, nonneg=True)
         self.theta0 = self._per_instance("theta0", theta0)
@@ -58,8 +67,12 @@ class GroundSupport(Element):
 class BodySpring(Element):
     """Isotropic bushing between a marker on body A and a marker on body B.
 
-    F_B = −k (P_B − P_A) − c (Ṗ_B − Ṗ_A), A gets −F_B; both act at the midpoint of the markers so
-    that forces *and* moments balance exactly. Typical use: a planet on a linear bearing to its pin.
+    F_B = −k d − c ḋ_A with d = P_B − P_A and ḋ_A = (Ṗ_B − Ṗ_A) − θ̇_A k × d, the rate of the
+    deflection seen from body A. F_B acts on B at its marker P_B and −F_B on A at the same point, so
+    forces and moments balance exactly, the spring is conservative, the damper only dissipates (its
+    power is −c|ḋ_A|²) and neither a rigid motion of the pair nor the choice of reference frame
+    produces a damping force (the R-frame rate Ṗ_B − Ṗ_A alone would make the damper depend on Ω).
+    Typical use: a planet (B, marker at its centre) on a linear bearing to its pin (A, the carrier).
     """
     k = 6
 
@@ -68,8 +81,8 @@ class BodySpring(Element):
         self.dofs = body_dofs(body_a, body_b)
         self.stiffness = self._per_instance("k", k, nonneg=True)
         self.damping = self._per_instance("c", c, nonneg=True)
-        self.marker_a = np.broadcast_to(np.asarray(marker_a, float), (self.n, 2)).copy()
-        self.marker_b = np.broadcast_to(np.asarray(marker_b, float), (self.n, 2)).copy()
+        self.marker_a = _offsets(self, "marker_a", marker_a)
+        self.marker_b = _offsets(self, "marker_b", marker_b)
 
     def kernel(self, t, fs, q, v, z):
         qa, qb, va, vb = q[:3], q[3:], v[:3], v[3:]
@@ -78,13 +91,12 @@ class BodySpring(Element):
         Va = marker_velocity(va, ra)
         Vb = marker_velocity(vb, rb)
         dx, dy = Pb[0] - Pa[0], Pb[1] - Pa[1]
-        Fx = -self.stiffness * dx - self.damping * (Vb[0] - Va[0])
-        Fy = -self.stiffness * dy - self.damping * (Vb[1] - Va[1])
-        # application point: the midpoint, seen from each body's centre
-        ma = (ra[0] + 0.5 * dx, ra[1] + 0.5 * dy)
-        mb = (rb[0] - 0.5 * dx, rb[1] - 0.5 * dy)
-        fa = point_force(ma, (-Fx, -Fy))
-        fb = point_force(mb, (Fx, Fy))
+        ux = Vb[0] - Va[0] + va[2] * dy        # ḋ_A = Ṗ_B − Ṗ_A − θ̇_A k × d: the velocity of P_B
+        uy = Vb[1] - Va[1] - va[2] * dx        # relative to the point of A under it
+        Fx = -self.stiffness * dx - self.damping * ux
+        Fy = -self.stiffness * dy - self.damping * uy
+        fa = point_force((ra[0] + dx, ra[1] + dy), (-Fx, -Fy))   # both at P_B
+        fb = point_force(rb, (Fx, Fy))
         return fa + fb, {"fx": Fx, "fy": Fy, "deflection": ad.hypot(dx, dy)}
 
 

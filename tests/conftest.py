@@ -1,0 +1,24 @@
+"""Shared pytest configuration.
+
+Hypothesis profiles: ``default`` (fast, used in CI and ``make test``) and ``thorough`` (many more
+examples; select with HYPOTHESIS_PROFILE=thorough). No deadline: the first example of a test pays
+for numpy/scipy warm-up and would trip hypothesis' timing check on a loaded 2-core machine.
+"""
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+from hypothesis import HealthCheck, settings
+
+# make ``import strategies`` work whatever pytest's import mode or the working directory
+_here = str(Path(__file__).resolve().parent)
+if _here not in sys.path:
+    sys.path.insert(0, _here)
+
+settings.register_profile("default", max_examples=20, deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile("thorough", max_examples=300, deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
