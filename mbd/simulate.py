@@ -75,12 +75,14 @@ def load_state(path) -> tuple[State, dict]:
 def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 0.0,
              stepper: HHT | None = None, controller=None, recorder: Recorder | None = None,
              checkpoint: Checkpoint | None = None, resume: bool = False, progress: bool | None = None,
-             failed_state_path=None, state: State | None = None, system: System | None = None) -> SimResult:
+             failed_state_path=None, state: State | None = None, system: System | None = None,
+             on_progress=None) -> SimResult:
     """Integrate from (t0, q0, v0) — or from ``state`` — to t_end.
 
     ``stepper`` defaults to HHT(α = −0.1); ``controller`` is required (FixedStep or Adaptive), since
     the step size is the user's accuracy decision. Progress bar: on for runs of more than ~2 s wall
-    unless ``progress=False`` or the environment sets DPGT_PROGRESS=0.
+    unless ``progress=False`` or the environment sets DPGT_PROGRESS=0. ``on_progress(t, t_end, counters)``
+    is called at most twice a second (e.g. to report progress from a worker process).
     """
     if controller is None:
         raise ModelError("simulate: pass controller=FixedStep(h) or Adaptive(h0=..., ...)")
@@ -111,7 +113,7 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
         recorder.record(state, None, first=True)
 
     show = progress if progress is not None else os.environ.get("DPGT_PROGRESS", "1") != "0"
-    bar = _Progress(state.t, t_end, show)
+    bar = _Progress(state.t, t_end, show, on_progress)
     cache = NewtonCache()
     wall0 = time.perf_counter()
     h_floor = getattr(controller, "h_min", 0.0)
@@ -175,7 +177,10 @@ def _fail(system: System, state: State, h: float, info, path) -> None:
 class _Progress:
     """tqdm bar over simulated time: shows the simulated time, steps per second and time left."""
 
-    def __init__(self, t0, t1, show):
+    def __init__(self, t0, t1, show, callback=None):
+        self.callback = callback
+        self.t_end = t1
+        self._last_cb = 0.0
         self.bar = None
         self.t_last = t0
         self.t0 = t0
@@ -187,9 +192,12 @@ class _Progress:
 
     def update(self, t, counters):
         self._steps += 1
+        now = time.perf_counter()
+        if self.callback is not None and now - self._last_cb > 0.5:
+            self._last_cb = now
+            self.callback(t, self.t_end, counters)
         if not self.show:
             return
-        now = time.perf_counter()
         if self.bar is None:
             if now - self._start < 2.0:   # short runs stay silent
                 return

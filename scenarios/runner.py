@@ -124,9 +124,16 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
     integ = cfg.integration
     t_end = cfg.settle + cfg.window
     wall0 = time.perf_counter()
+
+    def report(t, t_end, counters):   # read by a sweep's progress display (another process)
+        atomic_write_text(out_dir / "progress.json", json.dumps(
+            {"t": t, "t_end": t_end, "wall_s": time.perf_counter() - wall0, "steps": counters.accepted}))
+
     res = mbd.simulate(scene.model, scene.q0, scene.v0, t_end, stepper=integ.stepper(), controller=integ.controller(),
                        recorder=rec, checkpoint=mbd.Checkpoint(out_dir / "checkpoint.npz", cfg.checkpoint_every),
-                       resume=True, progress=cfg.progress, failed_state_path=out_dir / "failed_state.npz")
+                       resume=True, progress=cfg.progress, failed_state_path=out_dir / "failed_state.npz",
+                       on_progress=report)
+    (out_dir / "progress.json").unlink(missing_ok=True)
     wall = time.perf_counter() - wall0
     summary = summarize(out_dir / "results.nc", params, scene, cfg)
     summary.update(label or {})

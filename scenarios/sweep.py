@@ -68,6 +68,42 @@ def execute_case(case: Case, cfg) -> dict:
         return info
 
 
+class _RunBars:
+    """One bar per running case, fed from the progress.json each worker writes (simulated time)."""
+
+    def __init__(self, cases, show):
+        from tqdm.auto import tqdm
+
+        self.show = show
+        self.bars = {}
+        if show:
+            for i, c in enumerate(cases):
+                self.bars[c.label] = (c, tqdm(total=1.0, desc=c.label, position=i + 1, leave=False, unit="",
+                                              bar_format="{desc}: {percentage:3.0f}%|{bar}| {postfix}"))
+
+    def poll(self):
+        for label, (c, b) in self.bars.items():
+            p = Path(c.out_dir) / "progress.json"
+            try:
+                d = json.loads(p.read_text())
+            except (OSError, ValueError):
+                continue
+            b.n = min(1.0, d["t"] / d["t_end"]) if d["t_end"] else 0.0
+            rate = d["steps"] / max(d["wall_s"], 1e-9)
+            left = (d["t_end"] - d["t"]) / max(d["t"], 1e-12) * d["wall_s"]
+            b.set_postfix_str(f"t={d['t']:.4f}/{d['t_end']:.4f} s, {rate:.0f} steps/s, ~{left:.0f} s left")
+
+    def finish(self, c):
+        if c.label in self.bars:
+            b = self.bars[c.label][1]
+            b.n = 1.0
+            b.refresh()
+
+    def close(self):
+        for _, b in self.bars.values():
+            b.close()
+
+
 def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | None = None,
               progress: bool = True) -> dict[str, dict]:
     """Run every case; returns {label: summary or error}. One case runs in-process (no cluster)."""
@@ -84,7 +120,7 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
         return results
     from dataclasses import replace
 
-    from dask.distributed import Client, LocalCluster, as_completed
+    from dask.distributed import Client, LocalCluster
 
     wcfg = replace(cfg, progress=False)   # per-run bars would interleave; the sweep bar shows progress
     cluster = None
@@ -96,16 +132,27 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
         client = Client(scheduler)
     try:
         futs = {client.submit(execute_case, c, wcfg, pure=False, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
-        bar = tqdm(total=len(futs), desc="runs", disable=not progress)
-        for fut in as_completed(futs):
+        bar = tqdm(total=len(futs), desc="runs", disable=not progress, position=0)
+        runs = _RunBars(todo, progress)
+        while True:
+            done = [f for f in futs if f.done() and futs[f].label not in results]
+            if not done:
+                if all(futs[f].label in results for f in futs):
+                    break
+                runs.poll()
+                time.sleep(0.5)
+                continue
+            fut = done[0]
             c = futs[fut]
             try:
                 results[c.label] = fut.result()
             except Exception as exc:   # worker died: report, keep going
                 results[c.label] = {"case": c.label, "error": f"worker failure: {exc}"}
             bar.update(1)
+            runs.finish(c)
             if "error" in results[c.label]:
                 bar.write(f"run {c.label} failed: {results[c.label]['error']}")
+        runs.close()
         bar.close()
     finally:
         client.close()
