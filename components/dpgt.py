@@ -27,7 +27,7 @@ __all__ = ["RigSettings", "build_dpgt"]
 @dataclass(frozen=True)
 class RigSettings:
     """Rig and start-up settings that are not machine data ([assumed], stated in the README)."""
-    drive_freq: float = 30.0      # carrier speed-drive bandwidth [Hz]: holds the speed, filters mesh dynamics
+    drive_freq: float = 80.0      # carrier speed-drive bandwidth [Hz]: speed error < 0.1 rad/s by 30 ms (measured), far below f_m
     drive_zeta: float = 0.7
     ramp_meshes: float = 20.0     # sun-torque ramp length in mesh periods
 

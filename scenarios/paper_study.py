@@ -245,7 +245,7 @@ def animate(results: dict, out: Path) -> list[Path]:
     for c in sorted({s["condition"] for s in results.values() if "error" not in s}):
         f, r = out / f"c{c}_forward" / "results.nc", out / f"c{c}_reverse" / "results.nc"
         if f.exists() and r.exists():
-            paths.append(Path(study_cage_animation(f, r, out / f"c{c}_cage_orbits.gif")))
+            paths.append(Path(study_cage_animation(f, r, out / f"c{c}_cage_orbits.gif", max_frames=150)))
     return paths
 
 

@@ -119,8 +119,11 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
         scene = build_dpgt(params, cfg.options, cfg.rig)
     bmap = bearing_map(scene)
     meta = {k: v for k, v in scene.meta.items() if k != "bearing"}
+    from viz.results import geometry_from_params   # drawing geometry travels with the results
+
     rec = Recorder(out_dir / "results.nc", dt=1.0 / cfg.sample_rate, probes=_probes(scene), t_start=cfg.settle,
-                   attrs={"bearings": bmap, "meta": meta, "label": label or {}})
+                   attrs={"bearings": bmap, "meta": meta, "label": label or {},
+                          "geometry": geometry_from_params(params)})
     integ = cfg.integration
     t_end = cfg.settle + cfg.window
     wall0 = time.perf_counter()

@@ -41,6 +41,8 @@ def frame_indices(n_t: int, max_frames: int | None) -> np.ndarray:
         return np.arange(n_t)
     if max_frames < 1:
         raise ValueError("max_frames must be >= 1")
+    if max_frames == 1:   # a single frame shows the final state (the whole orbit trace)
+        return np.array([n_t - 1])
     return np.unique(np.round(np.linspace(0, n_t - 1, int(max_frames))).astype(int))
 
 
@@ -547,7 +549,9 @@ def train_animation(path, t, bodies: Sequence[Mapping], magnify: float = 1.0, fp
             p.add_mesh(g["mesh"], color=_KIND_COLOR[g["kind"]], line_width=width, lighting=False)
 
         if title:
-            ta = view.text(title, (0.02, 0.96), fs, bold=True)
+            # shrink a long title to fit the width rather than let it run off the frame
+            ta = view.text(title, (0.02, 0.96), min(fs, _font(H, 0.028, title, int(0.96 * W))),
+                           bold=True)
             ta.prop.justification_vertical = "top"
         view.scale_bar(fx0=0.04, fy0=0.04, frac=0.22, size=fs)
         time_actor = view.text(tfmt(t[idx[0]]), (band_x1, 0.02), fs, justify="right")

@@ -1,0 +1,329 @@
+"""viz.results and `dpgt animate`: saved DPGT results → cage orbits, train bodies, animations.
+
+One short forward and one short reverse DPGT run (1 ms simulated, 13 samples each) are made once per
+session with scenarios.runner.run_case; everything else reads their results files.  The derived
+quantities are checked against independent outputs the engine recorded in the same file (guide
+eccentricity and force, pocket offset, inner-race deflection, fixed-frame poses).  Animations are tiny
+and skip, with the probe's reason, where this machine cannot render offscreen.
+"""
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import imageio.v3 as iio
+import numpy as np
+import pytest
+import xarray as xr
+
+from viz import render_check
+from viz import results as vr
+from viz.cli import main as animate_main
+
+N_FRAMES = 5
+
+
+# ----------------------------------------------------------------------------------- fixtures
+def _short_run(out_dir: Path, direction: str) -> Path:
+    from components.presets import reference_dpgt
+    from components.scene import SceneOptions
+    from scenarios.runner import RunConfig, run_case
+
+    run_case(reference_dpgt(3, direction),
+             RunConfig(settle=0.0005, window=0.0005, progress=False, options=SceneOptions()), out_dir)
+    return out_dir / "results.nc"
+
+
+@pytest.fixture(scope="session")
+def runs(tmp_path_factory) -> dict[str, Path]:
+    root = tmp_path_factory.mktemp("dpgt_runs")
+    return {d: _short_run(root / d, d) for d in ("forward", "reverse")}
+
+
+@pytest.fixture(scope="session")
+def fwd(runs) -> vr.Run:
+    return vr.load_run(runs["forward"])
+
+
+@pytest.fixture(scope="module")
+def offscreen():
+    ok, msg = render_check.check_offscreen()
+    if not ok:
+        pytest.skip(msg)
+    return msg
+
+
+def _frames(path: Path) -> np.ndarray:
+    return np.asarray(iio.imread(path, index=None))[..., :3]
+
+
+def _assert_animation(path: Path, n_frames: int, size: tuple[int, int]) -> None:
+    assert path.is_file() and path.stat().st_size > 0
+    frames = _frames(path)
+    assert frames.shape[:3] == (n_frames, size[1], size[0])
+    for f in frames.astype(float):
+        assert f.std() > 8.0, "blank frame"
+        assert np.mean(f.min(axis=-1) < 200) > 0.005, "frame has almost no ink"
+    diffs = [np.abs(frames[k + 1].astype(float) - frames[k]).mean() for k in range(n_frames - 1)]
+    assert min(diffs) > 0.05, f"consecutive frames (nearly) identical: {diffs}"
+
+
+def _pocket_axes(off: np.ndarray):
+    """(radial, tangential) components of roller offsets given in cage axes (pocket j at 2πj/Z)."""
+    Z = off.shape[1]
+    psi = 2 * np.pi * np.arange(Z) / Z
+    c, s = np.cos(psi), np.sin(psi)
+    return off[..., 0] * c + off[..., 1] * s, -off[..., 0] * s + off[..., 1] * c
+
+
+# ----------------------------------------------------------------------------------- loader
+def test_load_run_layout(runs, fwd):
+    with xr.open_dataset(runs["forward"], engine="h5netcdf") as ds:
+        t_file = ds["time"].values
+        q_file = ds["motion.q"].values
+    np.testing.assert_array_equal(fwd.t, t_file)
+    np.testing.assert_array_equal(fwd.q, q_file)
+    assert fwd.n_t == 13 and np.all(np.diff(fwd.t) > 0)
+    N, Z = fwd.meta["planets"], fwd.meta["rollers"]
+    assert (N, Z) == (3, 12)
+    assert fwd.q.shape == fwd.v.shape == fwd.a.shape == (fwd.n_t, len(fwd.bodies), 3)
+    expected = {"sun", "ring", "carrier", *(f"{p}{n}" for p in "ab" for n in range(1, N + 1))}
+    assert expected <= set(fwd.bodies)
+    assert len(fwd.bodies) == 3 + 2 * N * (1 + Z + 1)
+    assert [b["kind"] for b in fwd.bearings] == ["inner", "outer"] * N
+    assert fwd.bearing("outer", 2)["planet"] == "b3" and fwd.bearing("a2.pb")["pair"] == 1
+    assert fwd.direction == "forward" and fwd.frame == "rotating"
+    assert fwd.output("race_inner.load").shape == (fwd.n_t, 2 * N * Z)
+    # R turns at Ω: the angle read from the carrier's pose in both frames is Ω t
+    np.testing.assert_allclose(fwd.frame_angle, fwd.carrier_speed * fwd.t, rtol=0, atol=1e-9)
+    # a run directory works as well as the file
+    assert vr.load_run(runs["forward"].parent).bodies == fwd.bodies
+
+
+def test_geometry_falls_back_to_preset_then_prefers_the_file(runs, fwd, tmp_path):
+    from components.presets import reference_dpgt
+    g = fwd.geometry
+    assert g["source"] == "preset"
+    si = reference_dpgt().si()
+    assert g["bearing"]["d_m"] == pytest.approx(si.bearing.pitch_diameter)
+    assert g["bearing"]["guide_clearance"] == pytest.approx(0.15e-3)
+    assert g["teeth"] == {"sun": 31, "inner_planet": 24, "outer_planet": 24, "ring": 82}
+    # geometry stored in the file wins; what it lacks still comes from the preset
+    path = tmp_path / "results.nc"
+    shutil.copy(runs["forward"], path)
+    with h5py.File(path, "r+") as f:
+        f.attrs["geometry"] = json.dumps({"bearing": {"guide_clearance": 0.2e-3}})
+    g2 = vr.load_run(path).geometry
+    assert g2["source"] == "file+preset"
+    assert g2["bearing"]["guide_clearance"] == 0.2e-3 and g2["bearing"]["d_m"] == g["bearing"]["d_m"]
+
+
+def test_geometry_mismatch_warns(runs, tmp_path):
+    path = tmp_path / "results.nc"
+    shutil.copy(runs["forward"], path)
+    with h5py.File(path, "r+") as f:
+        f.attrs["geometry"] = json.dumps({"bearing": {"d_m": 0.05}})
+    with pytest.warns(vr.GeometryWarning, match="d_m/2"):
+        run = vr.load_run(path)
+    assert run.geometry["source"] == "file+preset"  # partly from the preset: checked against the motion
+
+
+# ----------------------------------------------------------------------------------- orbits
+def test_cage_orbits_match_the_guide_contact(fwd):
+    orb = vr.cage_orbits(fwd)
+    assert set(orb) == {"inner", "outer"}
+    eps = fwd.output("guide.eccentricity")
+    F = fwd.output("guide.force")
+    C_g = fwd.geometry["bearing"]["guide_clearance"]
+    for kind, e in orb.items():
+        assert e.shape == (fwd.n_t, 2)
+        g = fwd.bearing(kind)["guide"]
+        np.testing.assert_allclose(np.hypot(e[:, 0], e[:, 1]), eps[:, g], rtol=1e-12, atol=1e-15)
+        # the land pushes only outside the clearance circle: the geometry's C_g is the run's
+        ecc = eps[:, g]
+        assert np.all((F[:, g] > 0) == (ecc > C_g))
+    every = vr.cage_orbits(fwd, pair=None)
+    assert list(every) == [b["name"] for b in fwd.bearings]
+    np.testing.assert_array_equal(every["b1.pb"], orb["outer"])
+    # the fixed-frame view is the same vector turned by φ_R
+    fixed = vr.cage_orbits(fwd, frame="fixed")["inner"]
+    np.testing.assert_allclose(np.hypot(*fixed.T), np.hypot(*orb["inner"].T), rtol=1e-12)
+
+
+def test_roller_offsets_match_pocket_and_race_outputs(fwd):
+    for kind in ("inner", "outer"):
+        b = fwd.bearing(kind)
+        off = vr.roller_offsets(fwd, kind)
+        assert off.shape == (fwd.n_t, 12, 2)
+        radial, tangential = _pocket_axes(off)
+        # tangential: the pocket contact's offset s_j; radial: −(inner-race deflection)
+        np.testing.assert_allclose(tangential, fwd.output("pocket.offset")[:, slice(*b["pocket"])],
+                                   rtol=0, atol=1e-12)
+        np.testing.assert_allclose(radial, -fwd.output("race_inner.deflection")[:, slice(*b["race_inner"])],
+                                   rtol=0, atol=1e-12)
+
+
+def test_no_cage_is_a_clear_error(fwd):
+    b = dict(fwd.bearing("inner"), cage=None, type="linear")
+    with pytest.raises(vr.ResultsError, match="no cage"):
+        vr.roller_offsets(fwd, b)
+
+
+# ----------------------------------------------------------------------------------- train
+def test_train_bodies(fwd):
+    bodies = vr.train_bodies(fwd, frame="carrier")
+    kinds = [b["kind"] for b in bodies]
+    assert kinds.count("roller") == 72 and kinds.count("cage") == 6 and kinds.count("ring") == 1
+    assert kinds.count("gear") == 1 + 6 and kinds.count("carrier") == 1 + 6  # plate + pins
+    by = {b["name"]: b for b in bodies}
+    # seen from the carrier, a rotating-frame run is drawn in R as recorded
+    np.testing.assert_allclose(by["a1"]["xy"], fwd.pose("a1")[:, :2], rtol=0, atol=1e-15)
+    assert by["sun"]["teeth"] == 31 and by["b2"]["teeth"] == 24
+    assert by["ring"]["radius"] == pytest.approx(0.123)
+    b = fwd.bearing("outer", 1)
+    np.testing.assert_array_equal(by[b["rollers"][3]]["force"],
+                                  fwd.output("race_inner.load")[:, b["race_inner"][0] + 3])
+    # seen from the housing: sun, carrier, ring coincide with the fixed-frame poses the engine wrote
+    fixed = {b["name"]: b for b in vr.train_bodies(fwd, frame="fixed")}
+    for name in ("sun", "carrier", "ring"):
+        fq = fwd.fixed_q[:, fwd.fixed_bodies.index(name)]
+        np.testing.assert_allclose(fixed[name]["xy"], fq[:, :2], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(fixed[name]["theta"], fq[:, 2], rtol=0, atol=1e-12)
+    # magnify scales the displacement from the nominal centre and nothing else
+    mag = {b["name"]: b for b in vr.train_bodies(fwd, frame="carrier", magnify=50.0)}
+    for name in ("sun", "a1", "b1.pb.cage", b["rollers"][3]):
+        np.testing.assert_allclose(mag[name]["xy"] - mag[name]["ref"],
+                                   50.0 * (by[name]["xy"] - by[name]["ref"]), rtol=1e-9, atol=1e-15)
+        np.testing.assert_array_equal(mag[name]["theta"], by[name]["theta"])
+    with pytest.raises(ValueError, match="frame"):
+        vr.train_bodies(fwd, frame="planet")
+
+
+def test_fixed_frame_run_seen_from_the_carrier(runs, fwd, tmp_path):
+    """The same motion stored as a fixed-frame run (R = I) gives the same carrier view and orbits."""
+    with xr.open_dataset(runs["forward"], engine="h5netcdf") as ds:
+        ds = ds.load()
+    phi = fwd.frame_angle[:, None]
+    q = ds["motion.q"].values.copy()
+    x, y = q[..., 0].copy(), q[..., 1].copy()
+    q[..., 0] = np.cos(phi) * x - np.sin(phi) * y
+    q[..., 1] = np.sin(phi) * x + np.cos(phi) * y
+    q[..., 2] += phi
+    ds["motion.q"].values = q
+    ds = ds.drop_vars(["fixed.q", "fixed.v", "fixed.a"])  # R from the metadata alone
+    meta = dict(fwd.meta, frame="fixed")
+    ds.attrs["meta"] = json.dumps(meta)
+    ds.to_netcdf(tmp_path / "results.nc", engine="h5netcdf")
+    other = vr.load_run(tmp_path / "results.nc")
+    assert other.frame == "fixed" and np.all(other.frame_angle == 0.0)
+    a = {b["name"]: b for b in vr.train_bodies(fwd, "carrier")}
+    b = {b["name"]: b for b in vr.train_bodies(other, "carrier")}
+    for name in ("sun", "a2", "b3.pb.cage", "b3.pb.roller7"):
+        np.testing.assert_allclose(b[name]["xy"], a[name]["xy"], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(b[name]["theta"], a[name]["theta"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(vr.cage_orbits(other)["outer"], vr.cage_orbits(fwd)["outer"],
+                               rtol=0, atol=1e-12)
+
+
+# ----------------------------------------------------------------------------------- bad inputs
+def test_bad_inputs_give_clear_errors(tmp_path, capsys, runs):
+    missing = tmp_path / "nope.nc"
+    with pytest.raises(vr.ResultsError, match="no such results file"):
+        vr.load_run(missing)
+    text = tmp_path / "notes.nc"
+    text.write_text("not a results file\n")
+    with pytest.raises(vr.ResultsError, match="not a netCDF4/HDF5"):
+        vr.load_run(text)
+    foreign = tmp_path / "other.nc"
+    xr.Dataset({"x": ("time", np.arange(3.0))}, coords={"time": np.arange(3.0)}).to_netcdf(
+        foreign, engine="h5netcdf")
+    with pytest.raises(vr.ResultsError, match="not a DPGT results file.*motion.q"):
+        vr.load_run(foreign)
+    with pytest.raises(vr.ResultsError, match="without a results.nc"):
+        vr.load_run(tmp_path)
+
+    out = tmp_path / "a.gif"
+    cases = [([str(missing), "--out", str(out)], 1, "no such results file"),
+             ([str(text), "--out", str(out)], 1, "not a netCDF4/HDF5"),
+             ([str(foreign), "--out", str(out)], 1, "not a DPGT results file"),
+             ([str(runs["forward"]), "--out", str(tmp_path / "a.png")], 2, ".gif or .mp4"),
+             ([str(runs["forward"]), "--out", str(out), "--size", "big"], 2, "WxH"),
+             ([str(runs["forward"]), "--out", str(out), "--fps", "0"], 2, "positive"),
+             ([str(runs["forward"]), "--out", str(out), "--kind", "train", "--compare",
+               str(runs["reverse"])], 2, "--compare applies to --kind cage"),
+             ([str(runs["forward"]), "--out", str(out), "--compare", str(missing)], 1,
+              "no such results file")]
+    for argv, code, message in cases:
+        assert animate_main(argv) == code, argv
+        err = capsys.readouterr().err
+        assert message in err, (argv, err)
+        assert "Traceback" not in err
+    assert not out.exists()
+    with pytest.raises(vr.ResultsError, match="expected 'forward'"):
+        vr.study_cage_animation(runs["reverse"], runs["forward"], tmp_path / "s.gif")
+
+
+def test_no_offscreen_rendering_is_a_message(runs, tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(render_check, "check_offscreen",
+                        lambda timeout=60.0: (False, "no offscreen OpenGL library found"))
+    out = tmp_path / "a.gif"
+    assert animate_main([str(runs["forward"]), "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "cannot render offscreen: no offscreen OpenGL library found" in err
+    assert not out.exists()
+
+
+def test_dpgt_routes_animate(tmp_path, capsys):
+    from scenarios.cli import main as dpgt_main
+    assert dpgt_main(["animate", str(tmp_path / "x.nc"), "--out", str(tmp_path / "x.gif")]) == 1
+    assert "no such results file" in capsys.readouterr().err
+
+
+def test_viz_reads_results_without_the_engine(runs):
+    """viz must not import mbd (integrators): load, derive and build panels in a fresh process."""
+    code = (
+        "import sys; import viz.results as vr, viz.cli\n"
+        f"r = vr.load_run({str(runs['forward'])!r}); vr.train_bodies(r, 'fixed'); "
+        f"vr.cage_panels([r, {str(runs['reverse'])!r}])\n"
+        "bad = sorted(m for m in sys.modules if m == 'mbd' or m.startswith('mbd.'))\n"
+        "assert not bad, bad\n")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+
+
+# ----------------------------------------------------------------------------------- animations
+def test_cli_cage_animation(offscreen, runs, tmp_path, capsys):
+    out = tmp_path / "cage.gif"
+    size = (320, 180)
+    rc = animate_main([str(runs["forward"]), "--out", str(out), "--max-frames", str(N_FRAMES),
+                       "--size", f"{size[0]}x{size[1]}", "--fps", "10"])
+    assert rc == 0, capsys.readouterr().err
+    assert f"({N_FRAMES} frames" in capsys.readouterr().out
+    _assert_animation(out, N_FRAMES, size)
+
+
+def test_cli_compare_and_train(offscreen, runs, tmp_path, capsys):
+    out = tmp_path / "compare.gif"
+    size = (480, 160)
+    assert animate_main([str(runs["forward"]), "--out", str(out), "--max-frames", str(N_FRAMES),
+                         "--size", "480x160", "--compare", str(runs["reverse"])]) == 0
+    _assert_animation(out, N_FRAMES, size)
+    out = tmp_path / "train.gif"
+    assert animate_main([str(runs["forward"]), "--out", str(out), "--kind", "train", "--frame", "fixed",
+                         "--max-frames", "4", "--size", "200x200"]) == 0, capsys.readouterr().err
+    _assert_animation(out, 4, (200, 200))
+
+
+def test_study_cage_animation(offscreen, runs, tmp_path):
+    out = vr.study_cage_animation(runs["forward"], runs["reverse"], tmp_path / "study.gif",
+                                  size=(480, 170), max_frames=3)
+    _assert_animation(out, 3, (480, 170))
+    # four panels side by side: each quarter of the last frame carries its own drawing
+    last = _frames(out)[-1].astype(float)
+    for k in range(4):
+        quarter = last[:, k * 120:(k + 1) * 120]
+        assert np.mean(quarter.min(axis=-1) < 200) > 0.01, f"panel {k} is empty"
