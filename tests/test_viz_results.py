@@ -106,8 +106,14 @@ def test_load_run_layout(runs, fwd):
 
 def test_geometry_falls_back_to_preset_then_prefers_the_file(runs, fwd, tmp_path):
     from components.presets import reference_dpgt
-    g = fwd.geometry
+    assert fwd.geometry["source"] == "file"          # the runner stores the drawing geometry
+    bare = tmp_path / "bare.nc"                       # a file without it falls back to the preset
+    shutil.copy(runs["forward"], bare)
+    with h5py.File(bare, "r+") as f:
+        del f.attrs["geometry"]
+    g = vr.load_run(bare).geometry
     assert g["source"] == "preset"
+    assert g == {**fwd.geometry, "source": "preset"}
     si = reference_dpgt().si()
     assert g["bearing"]["d_m"] == pytest.approx(si.bearing.pitch_diameter)
     assert g["bearing"]["guide_clearance"] == pytest.approx(0.15e-3)
