@@ -73,7 +73,8 @@ def parse_sets(items: list[str]) -> dict:
         if "=" not in it:
             raise SystemExit(f"error: --set expects KEY=VALUE (e.g. bearing.clearance=\"30 um\"), got {it!r}")
         k, v = it.split("=", 1)
-        out[k.strip()] = v.strip().strip('"').strip("'")
+        v = v.strip().strip('"').strip("'")
+        out[k.strip()] = int(v) if v.lstrip("+-").isdigit() else v   # counts (planets, rollers) are integers
     return out
 
 

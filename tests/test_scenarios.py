@@ -121,3 +121,37 @@ def test_spectrum_rejects_inconsistent_sun_speed(tmp_path):
     with pytest.raises(SystemExit) as e:
         spectrum.run(spectrum.parse_args(["--out", str(tmp_path), "--carrier-rpm", "2000", "--sun-rpm", "3000"]))
     assert "3290" in str(e.value)
+
+
+def test_bearing_rig_scenario(tmp_path):
+    from scenarios import bearing_rig
+
+    s = bearing_rig.run(bearing_rig.parse_args(["--radial-load", "5 kN", "--clearance", "20 um", "--out", str(tmp_path)]))
+    for k in ("radial_load_N", "clearance_m", "roller_angle_deg", "roller_load_N", "q_max_N", "load_zone_deg",
+              "ring_deflection_m"):
+        assert k in s
+    assert s["radial_load_N"] == pytest.approx(5000.0) and s["clearance_m"] == pytest.approx(20e-6)
+    assert len(s["roller_angle_deg"]) == len(s["roller_load_N"]) == 12
+    # the rollers carry the load: their vector sum balances F_r, and the peak agrees with the
+    # quasi-static discrete-roller solution
+    assert s["load_balance_error"] < 0.01
+    assert s["q_max_N"] == pytest.approx(s["discrete_theory"]["q_max_N"], rel=0.02)
+    assert 0 < s["load_zone_deg"] < 180 and s["ring_deflection_m"] > 0
+    assert (tmp_path / "load_distribution.png").exists()
+    with pytest.raises(SystemExit, match="radial_load"):
+        bearing_rig.run(bearing_rig.parse_args(["--radial-load", "5 m", "--out", str(tmp_path)]))
+
+
+def test_modal_scenario_single_planetary(tmp_path):
+    from scenarios import modal
+
+    s = modal.run(modal.parse_args(["--out", str(tmp_path)]))
+    f = np.array(s["frequencies_hz"])
+    assert f.size == s["dof"] == 3 * (3 + 3) and len(s["mode_class"]) == f.size
+    assert np.all(np.diff(f) >= 0) and f[0] == 0.0          # ascending, the free rotation as 0
+    # Lin & Parker: N = 3 → translational modes come in pairs, no planet modes
+    assert all(m == 2 for m, k in zip(s["multiplicity"], s["mode_class"]) if k == "translational")
+    assert "planet" not in s["mode_class"]
+    s4 = modal.run(modal.parse_args(["--out", str(tmp_path / "n4"), "--set", "planets=4"]))
+    assert s4["mode_class"].count("planet") == 3 * (4 - 3)   # one planet-mode family of multiplicity N−3
+    assert (tmp_path / "mode_shapes.png").exists() and (tmp_path / "modes.csv").exists()
