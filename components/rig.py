@@ -1,0 +1,420 @@
+"""A planet bearing alone on a test rig (MODEL.md §6 check 4), and its quasi-static post-processing.
+
+Scene: a pin fixed to ground (the inner raceway), an outer ring (the "planet": the outer raceway),
+Z rollers and a cage between them (:func:`components.bearing.add_planet_bearing`). A radial load F_r,
+fixed in the inertial frame, pulls the outer ring (ramped in smoothly); a speed drive holds the ring's
+spin at ``outer_speed`` (0: a held ring). Everything is in the inertial frame.
+
+Where the load goes: the ring is pulled along u = (cos a, sin a) (a = ``load_angle``), so it closes
+the radial gap on the *opposite* side of the pin: the loaded rollers sit around the direction −u seen
+from the pin centre (the *load-zone centre*), and they press the pin along u. Roller angles below are
+measured from that load-zone centre. ``discrete_load_distribution`` gives the classical (Stribeck /
+Sjövall) answer for the same discrete roller set: Q_max·Z/F_r ≈ 4.08 at zero clearance for a line
+contact (4.083 for Z = 12 with a roller on the load line), larger with clearance.
+
+``run_sampled`` integrates a model and returns the states at given times (used here and by tests).
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import optimize
+
+import mbd
+from mbd.elements import ForceSource, GroundSupport, Ramp, SpeedDrive
+
+from .bearing import BearingSI, add_planet_bearing, bearing_si
+from .scene import BuiltScene, Scene, SceneOptions
+from .units import ParameterError
+
+__all__ = ["RING_MASS", "RING_INERTIA", "build_bearing_rig", "run_sampled", "run_averaged", "rig_loads", "RigSolution",
+           "rig_static_solution", "discrete_load_distribution", "DiscreteDistribution"]
+
+RING_MASS = 0.557                         # [assumed] a planet-like outer ring: the reference planet's mass, kg
+RING_INERTIA = 0.5 * RING_MASS * 0.036**2  # [assumed] solid disc at the planet's pitch radius (36 mm), kg m^2
+_EXP = 10.0 / 9.0                          # Palmgren line-contact exponent
+
+
+# ----------------------------------------------------------------------------------------------
+# classical reference
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class DiscreteDistribution:
+    """Quasi-static load distribution of a rigid-ring bearing with discrete rollers (no centrifugal
+    force, no traction): ring displacement ``deflection`` along the load [m] (and ``sideways``,
+    perpendicular to it, non-zero only for a roller set that is not symmetric about the load line),
+    roller loads ``loads`` [N] at ``angles`` [rad, from the load-zone centre]."""
+    deflection: float
+    sideways: float
+    angles: np.ndarray
+    loads: np.ndarray
+    radial_load: float
+    clearance: float
+
+    @property
+    def q_max(self) -> float:
+        return float(self.loads.max())
+
+    @property
+    def stribeck(self) -> float:
+        """Q_max·Z/F_r."""
+        return self.q_max * self.loads.size / self.radial_load
+
+    @property
+    def zone_angle(self) -> float:
+        """Full angle of the continuous load zone for this deflection and clearance [rad]."""
+        return _zone_angle(self.deflection, self.clearance)
+
+
+def _zone_angle(deflection: float, clearance: float) -> float:
+    """Full angle 2ψ_l of the continuous load zone: roller compression δ_r cos ψ − P_d/2 > 0."""
+    if deflection <= 0.5 * clearance:
+        return 0.0
+    return 2.0 * float(np.arccos(0.5 * clearance / deflection))
+
+
+def discrete_load_distribution(b: BearingSI, radial_load: float, angles=None) -> DiscreteDistribution:
+    """Classical reference: rigid rings, the rollers at ``angles`` [rad] from the load-zone centre
+    (default: one roller on the load line, Z equally spaced), Palmgren contacts Q = K δ^(10/9) at both
+    raceways in series (equal loads: Q = K (δ/2)^(10/9) for a total compression δ), diametral clearance
+    P_d. Solves the ring's equilibrium F_r = Σ Q_j cos ψ_j (and Σ Q_j sin ψ_j = 0 with a sideways shift)."""
+    F = float(radial_load)
+    if not (np.isfinite(F) and F > 0):
+        raise ParameterError.at("radial_load", f"must be > 0 N for a load distribution, got {radial_load!r}")
+    psi = 2 * np.pi * np.arange(b.Z) / b.Z if angles is None else np.asarray(angles, float)
+    c, s = np.cos(psi), np.sin(psi)
+    K2 = b.K * 2.0 ** (-_EXP)
+    half = 0.5 * b.clearance
+
+    def loads(d):   # d = (along the load, sideways): compression δ_r cos ψ + d_s sin ψ − P_d/2
+        comp = d[0] * c + d[1] * s - half
+        return K2 * np.where(comp > 0, np.abs(comp), 0.0) ** _EXP
+
+    # 1-D solve (symmetric set) as the start, then the 2-D equilibrium
+    f1 = lambda x: np.sum(loads((x, 0.0)) * c) - F
+    hi = half + 1e-6
+    while f1(hi) < 0:
+        hi *= 2.0
+    d0 = optimize.brentq(f1, half, hi, xtol=1e-16, rtol=1e-14)
+    # scaled unknowns (d / d0) and residuals (/ F): hybr's default tolerances then mean what they say
+    sol = optimize.root(lambda x: [np.sum(loads(x * d0) * c) / F - 1.0, np.sum(loads(x * d0) * s) / F],
+                        [1.0, 0.0], method="hybr", options={"xtol": 1e-13})
+    if not sol.success:
+        raise RuntimeError(f"discrete_load_distribution: no equilibrium found ({sol.message})")
+    d = sol.x * d0
+    return DiscreteDistribution(float(d[0]), float(d[1]), psi, loads(d), F, float(b.clearance))
+
+
+# ----------------------------------------------------------------------------------------------
+# the scene
+# ----------------------------------------------------------------------------------------------
+def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 * np.pi, outer_speed: float = 0.0,
+                      cage: str = "free", gravity: bool = False, options: SceneOptions | None = None,
+                      lubricant=None, ring_mass: float = RING_MASS, ring_inertia: float = RING_INERTIA,
+                      ramp_time: float | None = None, settle_damping_ratio: float = 0.2,
+                      drive_freq: float = 100.0, drive_zeta: float = 0.7) -> BuiltScene:
+    """A bearing between a fixed pin and a loaded outer ring (SI arguments).
+
+    ``bearing``: :class:`~components.params.BearingParams` (then ``lubricant`` a LubricantParams, or None
+    for no lubricant drag) or a :class:`~components.bearing.BearingSI`. ``radial_load`` F_r ≥ 0 [N] on the
+    outer ring along ``load_angle`` [rad, fixed frame; default downwards]. ``outer_speed`` [rad/s] the
+    ring's spin, held by a speed drive (``drive_freq`` [Hz], ``drive_zeta``). ``cage``: "free" (guided by
+    the outer ring), "held" (a fixed body: the rollers cannot orbit) or "none". ``options``: the scene's
+    switches (``drag``; ``bearings`` must be "rollers"); the rig is always inertial and ``gravity`` (a
+    bool, 9.81 m/s² along −y) overrides options.gravity.
+
+    Rig aids [assumed], neither changes the static solution: the load is ramped over ``ramp_time``
+    (default 20 periods of the ring's radial mode on the loaded bearing), and a dashpot from the ring
+    to ground with ``settle_damping_ratio`` of that mode's critical damping lets it settle (the Hertz
+    contacts alone damp the ring very little).
+
+    meta: radial_load, load_angle, zone_angle (direction of the load-zone centre), ramp_s, t_settle_s
+    (a suggested start of the averaging window), period_s (the ring mode), bearing (BearingSI).
+    handles: "bearing" (from add_planet_bearing), "ring", "pin".
+    """
+    b = _bearing_si(bearing, lubricant)
+    _check_bearing(b)
+    F = _finite("radial_load", radial_load, nonneg=True)
+    a = _finite("load_angle", load_angle)
+    w = _finite("outer_speed", outer_speed)
+    if cage not in ("free", "held", "none"):
+        raise ParameterError.at("cage", f"expected 'free', 'held' or 'none', got {cage!r}")
+    _finite("ring_mass", ring_mass, positive=True)
+    _finite("ring_inertia", ring_inertia, positive=True)
+    _finite("settle_damping_ratio", settle_damping_ratio, nonneg=True)
+    _finite("drive_freq", drive_freq, positive=True)
+    opt = options or SceneOptions()
+    if opt.bearings != "rollers":
+        raise ParameterError.at("options.bearings", f"the bearing rig needs the roller model ('rollers'), got {opt.bearings!r}")
+    has_lubricant = isinstance(bearing, BearingSI) or lubricant is not None   # else: no drag family at all
+    opt = dataclasses.replace(opt, cage=cage != "none", gravity=bool(gravity), frame="fixed",
+                              drag=opt.drag and has_lubricant)
+    scene = Scene(frame_omega=0.0, gravity=9.81 if gravity else 0.0, options=opt)
+    scene.body("pin", 1.0, 1.0, fixed=True)
+    scene.body("ring", ring_mass, ring_inertia, vel=(0.0, 0.0, w))
+    h = add_planet_bearing(scene, "pb", pin_body="pin", pin_local=(0.0, 0.0), outer_body="ring", b=b,
+                           pin_xy=(0.0, 0.0), pin_vel=(0.0, 0.0), omega_pin=0.0, omega_outer=w,
+                           cage_held=cage == "held")
+    # radial mode of the ring on the loaded bearing (stiffness dF/dδ_r of the classical solution)
+    if F > 0:
+        ref = discrete_load_distribution(b, F, _roller_angles_from_zone(b.Z, a))
+        k_r = _radial_stiffness(b, F, a)
+        period = 2 * np.pi * np.sqrt(ring_mass / k_r)
+    else:
+        ref, k_r, period = None, 0.0, 1e-3
+    ramp = 20.0 * period if ramp_time is None else _finite("ramp_time", ramp_time, nonneg=True)
+    u = np.array([np.cos(a), np.sin(a)])
+    scene.add_element(ForceSource("radial_load", [scene.index["ring"]], F * u, ramp=Ramp(0.0, ramp)))
+    wd = 2 * np.pi * drive_freq
+    scene.add_element(SpeedDrive("ring_drive", scene.index["ring"], w, k=ring_inertia * wd**2,
+                                 c=2 * drive_zeta * ring_inertia * wd))
+    c_settle = 2.0 * settle_damping_ratio * np.sqrt(k_r * ring_mass)
+    if c_settle > 0:
+        scene.add_element(GroundSupport("ring_damper", [scene.index["ring"]], kx=0.0, cx=c_settle))
+    scene.handles.update({"bearing": h, "ring": "ring", "pin": "pin"})
+    scene.meta.update({"radial_load": F, "load_angle": a, "zone_angle": a + np.pi, "outer_speed": w,
+                       "ramp_s": ramp, "period_s": period, "t_settle_s": ramp + 10.0 * period,
+                       "radial_stiffness": k_r, "cage": cage, "bearing": b, "reference": ref})
+    return scene.build()
+
+
+def _bearing_si(bearing, lubricant) -> BearingSI:
+    if isinstance(bearing, BearingSI):
+        return bearing
+    from .params import BearingParams, LubricantParams
+    if not isinstance(bearing, BearingParams):
+        raise ParameterError.at("bearing", f"expected BearingParams or BearingSI, got {type(bearing).__name__}")
+    if lubricant is None:
+        lub = LubricantParams(drag_coefficient=0.0, density="0 kg/m^3").si()
+    elif isinstance(lubricant, LubricantParams):
+        lub = lubricant.si()
+    else:
+        raise ParameterError.at("lubricant", f"expected LubricantParams or None, got {type(lubricant).__name__}")
+    return bearing_si(bearing.si(), lub)
+
+
+def _check_bearing(b: BearingSI) -> None:
+    """The fit checks of :func:`components.geometry.design_findings` that concern the bearing alone."""
+    if b.Z < 3:
+        raise ParameterError.at("bearing.rollers", f"must be >= 3, got {b.Z}")
+    if not b.D < b.d_m:
+        raise ParameterError.at("bearing.roller_diameter", f"{b.D * 1e3:g} mm leaves no pin inside the pitch "
+                                                           f"diameter {b.d_m * 1e3:g} mm")
+    chord = b.d_m * np.sin(np.pi / b.Z)
+    if chord <= b.D:
+        raise ParameterError.at("bearing.rollers", f"{b.Z} rollers of {b.D * 1e3:g} mm do not fit on the "
+                                                   f"{b.d_m * 1e3:g} mm pitch circle (centre spacing {chord * 1e3:.3f} mm)")
+    if b.clearance < 0:
+        raise ParameterError.at("bearing.clearance", f"must be >= 0, got {b.clearance!r} m")
+
+
+def _finite(name, value, positive=False, nonneg=False) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError.at(name, f"expected a finite number (SI units), got {value!r}") from None
+    if not np.isfinite(x) or (positive and x <= 0) or (nonneg and x < 0):
+        cond = "> 0" if positive else ">= 0" if nonneg else "finite"
+        raise ParameterError.at(name, f"must be {cond}, got {value!r}")
+    return x
+
+
+def _roller_angles_from_zone(Z: int, load_angle: float) -> np.ndarray:
+    """Initial roller angles (roller j at 2πj/Z from +x) measured from the load-zone centre."""
+    return _wrap(2 * np.pi * np.arange(Z) / Z - (load_angle + np.pi))
+
+
+def _radial_stiffness(b: BearingSI, F: float, a: float) -> float:
+    """dF_r/dδ_r of the classical solution (central difference)."""
+    ang = _roller_angles_from_zone(b.Z, a)
+    d1 = discrete_load_distribution(b, 0.99 * F, ang).deflection
+    d2 = discrete_load_distribution(b, 1.01 * F, ang).deflection
+    return 0.02 * F / (d2 - d1)
+
+
+def _wrap(x):
+    return (np.asarray(x) + np.pi) % (2 * np.pi) - np.pi
+
+
+# ----------------------------------------------------------------------------------------------
+# running and post-processing
+# ----------------------------------------------------------------------------------------------
+def run_sampled(model: mbd.Model, q0, v0, times, *, controller, stepper: mbd.HHT | None = None,
+                system: mbd.System | None = None, t0: float = 0.0, state: mbd.State | None = None) -> list[mbd.State]:
+    """Integrate from (t0, q0, v0) (or ``state``) and return copies of the states at ``times`` (ascending).
+
+    The run is split at the sample times (steps end exactly on them, no interpolation); an
+    :class:`mbd.Adaptive` controller continues each piece from the largest step of the previous one."""
+    system = system or mbd.System(model)
+    stepper = stepper or mbd.HHT(alpha=-0.3)
+    if state is None:
+        state = stepper.initial_state(system, t0, q0, v0)
+    out = []
+    for t in np.asarray(times, float):
+        if t > state.t:
+            res = mbd.simulate(model, t_end=float(t), state=state, stepper=stepper, controller=controller,
+                               system=system, progress=False)
+            state = res.state
+            if isinstance(controller, mbd.Adaptive) and res.steps:
+                controller = dataclasses.replace(controller, h0=float(np.clip(res.h_max_used, controller.h_min,
+                                                                                 controller.h_max)))
+        out.append(state.copy())
+    return out
+
+
+def run_averaged(model: mbd.Model, fn, t0: float, t1: float, *, controller, q0=None, v0=None,
+                 state: mbd.State | None = None, stepper: mbd.HHT | None = None,
+                 system: mbd.System | None = None) -> tuple[np.ndarray, mbd.State, int]:
+    """Time mean of ``fn(system, state)`` (an array) over [t0, t1], by the trapezoidal rule on the
+    integrator's own accepted steps (every contact event the integrator resolves is in the mean; a
+    mean of samples at a fixed rate would alias roller impacts and mesh harmonics).
+
+    Integrates from (0, q0, v0) — or from ``state`` — to t0 first. Returns (mean, state at t1, steps)."""
+    from mbd.hht import NewtonCache
+    system = system or mbd.System(model)
+    stepper = stepper or mbd.HHT(alpha=-0.3)
+    if not t1 > t0:
+        raise mbd.ModelError(f"run_averaged: need t1 > t0, got t0={t0!r}, t1={t1!r}")
+    state = run_sampled(model, q0, v0, [t0], controller=controller, stepper=stepper, system=system,
+                        state=state)[-1]
+    cache = NewtonCache()
+    h = controller.initial()
+    h_floor = getattr(controller, "h_min", 0.0)
+    f_prev = np.asarray(fn(system, state), float)
+    acc = np.zeros_like(f_prev)
+    steps = 0
+    while state.t < t1 - 1e-12 * max(1.0, abs(t1)):
+        h_try = min(h, t1 - state.t)
+        new, info = stepper.step(system, state, h_try, cache)
+        ok, h_next = controller.decide(h_try, info.converged, info.error)
+        if not ok:
+            system.counters.rejected += 1
+            if h_next < h_floor:
+                raise mbd.IntegrationError(f"run_averaged: step size fell below the minimum at t = {state.t:.9e} s "
+                                           f"({info.reason or 'error test'})", state=state)
+            h = h_next
+            continue
+        system.counters.accepted += 1
+        f_new = np.asarray(fn(system, new), float)
+        acc += 0.5 * (new.t - state.t) * (f_prev + f_new)
+        f_prev, state, h = f_new, new, h_next
+        steps += 1
+    return acc / (state.t - t0), state, steps
+
+
+def rig_loads(built: BuiltScene, system: mbd.System, s: mbd.State) -> dict:
+    """Instantaneous roller loads of the rig at state ``s``: inner- and outer-raceway loads (Z,) [N],
+    roller angles from the load-zone centre (Z,) [rad], the ring centre (2,) [m], and the vector sums
+    (2,) [N, fixed frame] of the inner normal loads pressing the pin, Σ Q_j·(−e_j), and of the whole
+    contact forces (normal + traction) the rollers exert on the pin and on the ring."""
+    m = built.model
+    out = system.outputs(s.t, s.q, s.v, s.z)
+    h = built.handles["bearing"]
+    si, so = h["race_inner"], h["race_outer"]
+    inner, outer = out["race_inner"], out["race_outer"]
+    ang = inner["angle"][si]                            # about the pin (fixed, θ = 0): fixed-frame angle
+    e = np.column_stack([np.cos(ang), np.sin(ang)])
+    qf, _ = m.full(s.t, s.q, s.v)
+    ring = qf[3 * m.body("ring").index: 3 * m.body("ring").index + 2]
+    Qi, Qo = inner["load"][si], outer["load"][so]
+    return {
+        "t": s.t, "angle": _wrap(ang - built.meta["zone_angle"]), "load_inner": Qi, "load_outer": Qo,
+        "ring": ring.copy(),
+        "load_sum": -(Qi[:, None] * e).sum(axis=0),
+        "pin_force": -np.array([inner["fx"][si].sum(), inner["fy"][si].sum()]),
+        "ring_force": np.array([outer["fx"][so].sum(), outer["fy"][so].sum()]),   # −(force on ring)
+    }
+
+
+@dataclass(frozen=True)
+class RigSolution:
+    """Time means over the window [t0, t1] of a bearing rig run.
+
+    ``angles`` (Z,) roller angles from the load-zone centre [rad] (mean angle of the rollers found in
+    each of Z equal bins centred on the load-zone centre + 2πk/Z: orbiting rollers are binned by where
+    they are, rollers at rest are their own bins), ``loads`` (Z,) mean inner-raceway load in each bin
+    [N], ``loads_outer`` the same at the outer raceway; ``q_max`` the largest; ``stribeck`` = Q_max·Z/F_r;
+    ``zone_angle`` full angular extent of the loaded bins (from the first to the last bin whose mean load
+    exceeds ``zone_tol``·Q_max) [rad]; ``zone_angle_continuous`` = 2 arccos(P_d/(2 δ_r)), the load zone of
+    the continuous theory for the measured deflection; ``deflection`` δ_r mean ring-centre displacement
+    along the load [m], ``sideways`` perpendicular to it; ``load_sum`` (2,) mean Σ Q_j(−e_j) on the pin;
+    ``pin_force``, ``ring_force`` (2,) mean total contact forces (normal + traction) of the rollers on the
+    pin and (negated) on the ring; ``radial_load`` F_r [N] and ``load_vector`` (2,) the applied load."""
+    t0: float
+    t1: float
+    samples: int
+    angles: np.ndarray
+    loads: np.ndarray
+    loads_outer: np.ndarray
+    q_max: float
+    stribeck: float
+    zone_angle: float
+    zone_angle_continuous: float
+    deflection: float
+    sideways: float
+    load_sum: np.ndarray
+    pin_force: np.ndarray
+    ring_force: np.ndarray
+    radial_load: float
+    load_vector: np.ndarray
+    wall_s: float
+    zone_tol: float = 1e-3
+
+    def summary(self) -> dict:
+        return {"radial_load_N": self.radial_load, "q_max_N": self.q_max, "stribeck": self.stribeck,
+                "zone_angle_deg": np.degrees(self.zone_angle),
+                "zone_angle_continuous_deg": np.degrees(self.zone_angle_continuous),
+                "deflection_um": self.deflection * 1e6, "load_sum_N": self.load_sum.tolist(), "wall_s": self.wall_s}
+
+
+def rig_static_solution(built: BuiltScene, *, t_settle: float | None = None, window: float | None = None,
+                        samples: int = 40, controller=None, stepper: mbd.HHT | None = None,
+                        zone_tol: float = 1e-3) -> RigSolution:
+    """Run the rig built by :func:`build_bearing_rig` past the load ramp and average over a window.
+
+    Defaults: t_settle = meta["t_settle_s"], window = 10 periods of the ring's radial mode, ``samples``
+    equally spaced samples in it; ``controller`` Adaptive (h0 = 1 µs, h_max = period/20)."""
+    import time
+    meta = built.meta
+    F, a, Z = meta["radial_load"], meta["load_angle"], meta["bearing"].Z
+    t_settle = meta["t_settle_s"] if t_settle is None else float(t_settle)
+    window = 10.0 * meta["period_s"] if window is None else float(window)
+    if controller is None:
+        controller = mbd.Adaptive(h0=1e-6, h_max=meta["period_s"] / 20.0)
+    times = t_settle + window * np.arange(samples) / max(samples - 1, 1)
+    system = mbd.System(built.model)
+    w0 = time.perf_counter()
+    states = run_sampled(built.model, built.q0, built.v0, times, controller=controller, stepper=stepper, system=system)
+    wall = time.perf_counter() - w0
+    recs = [rig_loads(built, system, s) for s in states]
+    # bin by angle from the load-zone centre (bin k centred on 2πk/Z)
+    ang = np.array([r["angle"] for r in recs])                       # (samples, Z)
+    k = np.mod(np.round(ang * Z / (2 * np.pi)).astype(int), Z)
+    Qi = np.array([r["load_inner"] for r in recs])
+    Qo = np.array([r["load_outer"] for r in recs])
+    n = len(recs)
+    loads = np.bincount(k.ravel(), weights=Qi.ravel(), minlength=Z) / n
+    loads_o = np.bincount(k.ravel(), weights=Qo.ravel(), minlength=Z) / n
+    # mean angle of each bin's occupants, relative to the bin centre (no wrap problems)
+    centre = 2 * np.pi * np.arange(Z) / Z
+    rel = _wrap(ang - centre[k])
+    cnt = np.bincount(k.ravel(), minlength=Z)
+    angles = _wrap(centre + np.bincount(k.ravel(), weights=rel.ravel(), minlength=Z) / np.maximum(cnt, 1))
+    order = np.argsort(angles)
+    angles, loads, loads_o = angles[order], loads[order], loads_o[order]
+    q_max = float(loads.max())
+    loaded = angles[loads > zone_tol * q_max] if q_max > 0 else np.array([])
+    zone = float(loaded.max() - loaded.min()) if loaded.size else 0.0
+    u = np.array([np.cos(a), np.sin(a)])
+    ring = np.array([r["ring"] for r in recs]).mean(axis=0)
+    defl = float(ring @ u)
+    side = float(ring @ np.array([-u[1], u[0]]))
+    mean = lambda key: np.array([r[key] for r in recs]).mean(axis=0)
+    return RigSolution(t0=float(times[0]), t1=float(times[-1]), samples=n, angles=angles, loads=loads,
+                       loads_outer=loads_o, q_max=q_max, stribeck=q_max * Z / F if F > 0 else float("nan"),
+                       zone_angle=zone, zone_angle_continuous=_zone_angle(defl, meta["bearing"].clearance),
+                       deflection=defl, sideways=side, load_sum=mean("load_sum"), pin_force=mean("pin_force"),
+                       ring_force=mean("ring_force"), radial_load=F, load_vector=F * u, wall_s=wall,
+                       zone_tol=zone_tol)
