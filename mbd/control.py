@@ -13,9 +13,13 @@ __all__ = ["FixedStep", "Adaptive"]
 @dataclass(frozen=True)
 class FixedStep:
     """Constant h. A step whose Newton iteration fails is retried with h/2 (up to ``max_halvings``
-    times) and the controller returns to h afterwards; the error estimate is only reported."""
+    times) and the controller returns to h afterwards; the error estimate is only reported — except
+    that a step whose scaled error estimate exceeds ``reject_error`` (default 1e6: 1 cm at the default
+    10 nm tolerance) is treated as failed: Newton can "converge" onto a blown-up state (forces of
+    1e50 N were seen at h = 20 µs on the DPGT), and such a step must never be accepted."""
     h: float
     max_halvings: int = 6
+    reject_error: float = 1e6
 
     def __post_init__(self):
         if not (np.isfinite(self.h) and self.h > 0):
@@ -29,7 +33,7 @@ class FixedStep:
         return self.h / 2 ** self.max_halvings
 
     def decide(self, h: float, converged: bool, error: float) -> tuple[bool, float]:
-        if converged:
+        if converged and error <= self.reject_error:
             return True, self.h
         return False, h / 2
 
