@@ -93,6 +93,11 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
 
     Z = int(b.Z)
     wm, wr = bearing_kinematics(b, omega_pin, omega_outer)
+    if cage_held and opt.cage:
+        # a held cage stops the orbit, so the rollers slide on both races; start them at the spin where
+        # the two tractions balance for equal loads (equal slips): ω_R = (ω_o R_o − ω_i R_i)/D
+        wm = 0.0
+        wr = (omega_outer * 0.5 * (b.d_m + b.D) - omega_pin * b.R_i) / b.D
     psi = 2 * np.pi * np.arange(Z) / Z
     rho = 0.5 * b.d_m + 0.25 * b.clearance          # centred in the radial gap
     pin_xy = np.asarray(pin_xy, float)

@@ -1,0 +1,381 @@
+"""Shared machinery of the numerics scenarios (work-precision, stability, benchmark).
+
+- :func:`dpgt_problem` / :func:`rig_problem`: the two test problems, each a :class:`Problem` (built
+  scene, which bearing is the "reference bearing", its roller/cage/planet, how to settle it).
+- :func:`settled_state`: integrate the problem past its start-up transient with a robust setting once
+  and cache the state (``mbd.save_state``) so every contender starts from exactly the same state.
+- :class:`StateSampler`: a duck-typed recorder for :func:`mbd.simulate` that keeps (q, v) on a fixed
+  time grid by the same cubic Hermite interpolation as :class:`mbd.Recorder`, at negligible cost (no
+  element evaluation inside the timed loop); observables are computed afterwards, identically for
+  every integrator (:func:`observables`).
+- :func:`run_hht` and :func:`run_scipy`: one contender run, returning the sampled states and its costs.
+  ``run_scipy`` calls ``solve_ivp`` with :class:`mbd.FirstOrderSystem` (the sparse analytic Jacobian)
+  itself, rather than :func:`mbd.solve_scipy`, because the work-precision table needs the number of
+  steps and the time reached when the wall-time cap stops a run.
+- :func:`error_metrics`: (a) max-norm error of the reference bearing's pin-reaction magnitude on the
+  common grid (absolute [N] and relative to the reference's max), (b) relative errors of the RMS of
+  the reference roller's inner-race load, the cage–guide force and the cage acceleration.
+"""
+from __future__ import annotations
+
+import dataclasses
+import statistics
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+import mbd
+from components.params import with_overrides
+from components.presets import reference_dpgt
+
+__all__ = ["Problem", "dpgt_problem", "rig_problem", "settled_state", "StateSampler", "RunResult",
+           "run_hht", "run_scipy", "FrozenInternalHHT", "observables", "error_metrics", "scipy_atol", "peak_rss_mb",
+           "eval_costs", "machine_note"]
+
+
+@dataclass
+class Problem:
+    name: str
+    built: object                 # components.scene.BuiltScene
+    race_inner: slice             # instances of the reference bearing in the race_inner family
+    roller: int                   # reference roller (race_inner instance index)
+    guide: int | None             # guide-family instance of the reference cage
+    cage: str | None              # reference cage body name
+    planet: str                   # outer-raceway body of the reference bearing
+    settle: float                 # s: end of the settling run
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def model(self) -> mbd.Model:
+        return self.built.model
+
+
+def dpgt_problem(condition: int = 3, direction: str = "forward", overrides: dict | None = None,
+                 options=None, settle: float = 0.03) -> Problem:
+    """Full DPGT (reference_dpgt(condition, direction) with ``overrides``); reference bearing = the
+    first inner planet's bearing, reference roller = its roller 0."""
+    from components.dpgt import build_dpgt
+    params = with_overrides(reference_dpgt(condition, direction), overrides or {})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")      # design warnings (tip overlap, N not assemblable) are known
+        sc = build_dpgt(params, options)
+    h = sc.handles["pairs"][0]["inner_bearing"]
+    if h["kind"] != "rollers":
+        raise mbd.ModelError("the numerics scenarios need the roller bearing model")
+    return Problem("dpgt", sc, h["race_inner"], h["race_inner"].start, h.get("guide").start if "guide" in h else None,
+                   h.get("cage"), sc.handles["pairs"][0]["inner"], settle, {"params": params})
+
+
+def rig_problem(radial_load: float = 5000.0, overrides: dict | None = None, outer_speed: float | None = None) -> Problem:
+    """One planet bearing on the rig: the reference bearing under ``radial_load`` [N] with the outer
+    ring turning at the inner planet's speed relative to the carrier at condition 3 (the bearing's own
+    operating point in the DPGT), lubricant drag on, cage free."""
+    from components.rig import build_bearing_rig
+    params = with_overrides(reference_dpgt(3, "forward"), overrides or {})
+    if outer_speed is None:
+        op = params.si().operating
+        outer_speed = op.inner_planet_speed - op.carrier_speed
+    sc = build_bearing_rig(params.bearing, radial_load=radial_load, outer_speed=outer_speed,
+                           lubricant=params.lubricant)
+    h = sc.handles["bearing"]
+    return Problem("rig", sc, h["race_inner"], h["race_inner"].start, h["guide"].start, h["cage"], "ring",
+                   float(sc.meta["t_settle_s"]), {"params": params, "outer_speed": outer_speed})
+
+
+# ----------------------------------------------------------------------------------------------
+def settled_state(prob: Problem, cache: Path | None = None, h: float = 5e-6) -> tuple[mbd.State, dict]:
+    """State at t = prob.settle from a robust setting (HHT α = −0.3, adaptive, atol 10 nm, h ≤ h);
+    loaded from ``cache`` when it exists (and was made for the same settle time and DOF count)."""
+    fp = model_fingerprint(prob.model)
+    if cache is not None and Path(cache).exists():
+        s, extra = mbd.load_state(cache)
+        if abs(s.t - prob.settle) < 1e-12 and s.q.size == prob.model.ndof and extra.get("fingerprint") == fp:
+            return s, extra
+    stepper = mbd.HHT(alpha=-0.3)
+    res = mbd.simulate(prob.model, prob.built.q0, prob.built.v0, prob.settle, stepper=stepper,
+                       controller=mbd.Adaptive(h0=min(h, 1e-6), h_max=h, h_min=1e-10), progress=False)
+    extra = {"fingerprint": fp, "settle_wall_s": res.wall_s, "settle_steps": res.steps, "setting": "HHT alpha=-0.3 adaptive atol 1e-8 m"}
+    if cache is not None:
+        Path(cache).parent.mkdir(parents=True, exist_ok=True)
+        mbd.save_state(cache, res.state, extra)
+    return res.state, extra
+
+
+def model_fingerprint(model: mbd.Model) -> str:
+    """Hash of the bodies and every element family's numeric parameters (a cached settled state is
+    reused only for the same model: the builders change while the project evolves)."""
+    import hashlib
+    h = hashlib.sha1()
+    for a in (model.mass, model.inertia, model.pose0, model.mdiag, np.asarray(model.gravity)):
+        h.update(np.ascontiguousarray(a, float).tobytes())
+    h.update(repr(model.frame.omega).encode())
+    for e in model.elements:
+        h.update(f"{type(e).__name__}:{e.name}".encode())
+        for k in sorted(vars(e)):
+            val = vars(e)[k]
+            if isinstance(val, np.ndarray) and val.dtype.kind in "fiub":
+                h.update(k.encode() + np.ascontiguousarray(val).tobytes())
+            elif isinstance(val, (int, float, str, bool)):
+                h.update(f"{k}={val!r}".encode())
+            elif hasattr(val, "__dataclass_fields__"):
+                h.update(f"{k}={val!r}".encode())
+    return h.hexdigest()
+
+
+class FrozenInternalHHT(mbd.HHT):
+    """HHT that holds element internal states (a PI drive's integral) at their initial value — the
+    model :class:`mbd.FirstOrderSystem` integrates — so scipy runs can be scored against a reference of
+    the same equations."""
+
+    def _update_internal(self, system, s, t1, q1, v1):
+        return s.z
+
+
+class StateSampler:
+    """Recorder stand-in: (q, v, z) at the grid times, cubic Hermite between accepted steps (q with v,
+    v with a — the interpolation :class:`mbd.Recorder` uses). No element evaluation while timing."""
+
+    def __init__(self, grid):
+        self.grid = np.asarray(grid, float)
+        self.reset()
+
+    def bind(self, model, system, state):
+        pass
+
+    def reset(self):
+        self.i = 0
+        self.q, self.v, self.z = [], [], []
+
+    def _take(self, t, q, v, z):
+        self.q.append(q)
+        self.v.append(v)
+        self.z.append(z)
+        self.i += 1
+
+    def record(self, s0, s1, first=False):
+        tol = 1e-12 * max(1.0, abs(s0.t))
+        if first:
+            while self.i < self.grid.size and self.grid[self.i] <= s0.t + tol:
+                self._take(self.grid[self.i], s0.q.copy(), s0.v.copy(), s0.z)
+            if s1 is None:
+                return
+        h = s1.t - s0.t
+        while self.i < self.grid.size and self.grid[self.i] <= s1.t + tol:
+            th = min(1.0, max(0.0, (self.grid[self.i] - s0.t) / h))
+            h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
+            h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2
+            q = h00 * s0.q + h10 * h * s0.v + h01 * s1.q + h11 * h * s1.v
+            v = h00 * s0.v + h10 * h * s0.a + h01 * s1.v + h11 * h * s1.a
+            self._take(self.grid[self.i], q, v, s0.z)
+
+    def finalize(self, attrs=None):
+        return None
+
+    def checkpoint_state(self):
+        return {}
+
+    @property
+    def complete(self) -> bool:
+        return self.i == self.grid.size
+
+
+@dataclass
+class RunResult:
+    method: str
+    setting: str
+    completed: bool
+    message: str
+    wall_s: float
+    walls: list
+    steps: int
+    residual: int
+    jacobian: int
+    factor: int
+    newton: int = 0
+    rejected: int = 0
+    t_reached: float = np.nan
+    q: np.ndarray | None = None
+    v: np.ndarray | None = None
+    z: list | None = None
+
+    def costs(self) -> dict:
+        return {"method": self.method, "setting": self.setting, "completed": self.completed,
+                "message": self.message, "wall_s": self.wall_s, "steps": self.steps,
+                "residual_evals": self.residual, "jacobian_evals": self.jacobian, "factorizations": self.factor,
+                "newton_iterations": self.newton, "rejected": self.rejected, "t_reached": self.t_reached,
+                "wall_repeats": self.walls}
+
+
+def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float, h: float | None = None,
+            atol_pos: float | None = None, repeats: int = 1, h_max: float = 2e-5, label: str = "") -> RunResult:
+    """HHT fixed step (``h``) or adaptive (``atol_pos``; atol_rot = 100·atol_pos) from ``state``."""
+    if (h is None) == (atol_pos is None):
+        raise ValueError("give exactly one of h (fixed step) or atol_pos (adaptive)")
+    tol = mbd.Tolerance() if atol_pos is None else mbd.Tolerance(atol_pos=atol_pos, atol_rot=100 * atol_pos)
+    stepper = mbd.HHT(alpha=alpha, tol=tol)
+    walls, res, sampler, err = [], None, None, ""
+    for r in range(max(1, repeats)):
+        ctrl = mbd.FixedStep(h) if h is not None else mbd.Adaptive(h0=min(5e-6, h_max), h_max=h_max, h_min=1e-10)
+        smp = StateSampler(grid) if r == 0 else None
+        system = mbd.System(prob.model)
+        w0 = time.perf_counter()
+        try:
+            res = mbd.simulate(prob.model, t_end=t_end, state=state.copy(), stepper=stepper, controller=ctrl,
+                               recorder=smp, progress=False, system=system)
+        except mbd.IntegrationError as exc:
+            c = system.counters
+            return RunResult("HHT", label, False, str(exc), time.perf_counter() - w0, [time.perf_counter() - w0],
+                             c.accepted, c.residual, c.jacobian, c.factor, c.newton, c.rejected,
+                             t_reached=float(exc.state.t) if getattr(exc, "state", None) is not None else np.nan)
+        walls.append(time.perf_counter() - w0)
+        if r == 0:
+            sampler = smp
+    c = res.counters
+    return RunResult("HHT", label, True, "", statistics.median(walls), walls, res.steps, c["residual"], c["jacobian"],
+                     c["factor"], c["newton"], c["rejected"], t_reached=res.state.t,
+                     q=np.array(sampler.q), v=np.array(sampler.v), z=sampler.z)
+
+
+def scipy_atol(model: mbd.Model, tol: float) -> np.ndarray:
+    """Absolute tolerances for y = (q, v) at a scipy setting ``tol`` (= rtol): positions 1e-2·tol m
+    (tol = 1e-6 → 10 nm, HHT's default length scale), angles tol rad, velocities 1e3× those per s."""
+    rot = (model.free % 3) == 2
+    aq = np.where(rot, tol, 1e-2 * tol)
+    return np.concatenate([aq, 1e3 * aq])
+
+
+class _WallCap(Exception):
+    pass
+
+
+def run_scipy(prob: Problem, state: mbd.State, t_end: float, grid, *, method: str, tol: float,
+              max_wall_s: float, repeats: int = 1) -> RunResult:
+    """solve_ivp from ``state`` with the sparse analytic Jacobian (implicit methods; LSODA gets it
+    dense, as its Fortran core needs). Stops with completed=False at ``max_wall_s``."""
+    walls, out = [], None
+    for r in range(max(1, repeats)):
+        fo = mbd.FirstOrderSystem(prob.model, z={k: np.array(v) for k, v in state.z.items()})
+        y0 = np.concatenate([state.q, state.v])
+        t_last = [state.t]
+        start = time.perf_counter()
+
+        def fun(t, y):
+            if time.perf_counter() - start > max_wall_s:
+                raise _WallCap(t)
+            t_last[0] = max(t_last[0], t)
+            return fo.fun(t, y)
+
+        opts = {}
+        if method == "LSODA":
+            opts["jac"] = lambda t, y: fo.jac(t, y).toarray()
+        elif method in ("Radau", "BDF"):
+            opts["jac"] = fo.jac
+        ok, msg, sol = False, "", None
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                sol = solve_ivp(fun, (state.t, t_end), y0, method=method, rtol=tol, atol=scipy_atol(prob.model, tol),
+                                dense_output=True, **opts)
+            ok, msg = bool(sol.success), str(sol.message)
+        except _WallCap:
+            msg = f"stopped by the wall-time cap of {max_wall_s:.0f} s at t = {t_last[0]:.6e} s " \
+                  f"({(t_last[0] - state.t) / (t_end - state.t):.0%} of the window)"
+        wall = time.perf_counter() - start
+        walls.append(wall)
+        nlu = int(getattr(sol, "nlu", 0) or 0) if sol is not None else 0
+        res = RunResult(method, f"rtol={tol:g}", ok, msg, wall, walls, len(sol.t) - 1 if sol is not None else -1,
+                        fo.nfev, fo.njev, nlu, t_reached=float(sol.t[-1]) if sol is not None else t_last[0])
+        if r == 0:
+            out = res
+            if ok:
+                Y = sol.sol(np.asarray(grid, float))
+                n = prob.model.ndof
+                out.q, out.v = Y[:n].T.copy(), Y[n:].T.copy()
+                out.z = [fo.z] * len(grid)
+        if not ok:
+            break
+    out.walls = walls
+    out.wall_s = statistics.median(walls)
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+def observables(prob: Problem, grid, q, v, z) -> dict[str, np.ndarray]:
+    """Time series on the grid: the reference bearing's pin-reaction magnitude [N], the reference
+    roller's inner-race load [N], the reference cage's guide force [N] and its acceleration relative
+    to its planet (x, y in R) [m/s²] (a = M⁻¹F at the sampled state, the same for every integrator)."""
+    system = mbd.System(prob.model)
+    m = prob.model
+    f2f = m.full_to_free
+    ic = m.body(prob.cage).index if prob.cage else None
+    ip = m.body(prob.planet).index
+    sl = prob.race_inner
+    out = {k: [] for k in ("pin_load", "inner_load", "guide_force", "cage_acc_x", "cage_acc_y")}
+    for t, qi, vi, zi in zip(grid, q, v, z):
+        o = system.outputs(t, qi, vi, zi)
+        ri = o["race_inner"]
+        out["pin_load"].append(np.hypot(ri["fx"][sl].sum(), ri["fy"][sl].sum()))
+        out["inner_load"].append(ri["load"][prob.roller])
+        out["guide_force"].append(o["guide"]["force"][prob.guide] if prob.guide is not None else 0.0)
+        if ic is not None:
+            a = system.forces(t, qi, vi, zi) / m.mdiag
+            acc = [a[f2f[3 * ic + j]] - (a[f2f[3 * ip + j]] if f2f[3 * ip + j] >= 0 else 0.0) for j in (0, 1)]
+        else:
+            acc = [0.0, 0.0]
+        out["cage_acc_x"].append(acc[0])
+        out["cage_acc_y"].append(acc[1])
+    return {k: np.asarray(x, float) for k, x in out.items()}
+
+
+def _rms(x):
+    return float(np.sqrt(np.mean(np.square(x))))
+
+
+def summary_stats(obs: dict) -> dict:
+    return {"rms_inner_load_N": _rms(obs["inner_load"]), "rms_guide_N": _rms(obs["guide_force"]),
+            "rms_cage_acc": _rms(np.hypot(obs["cage_acc_x"], obs["cage_acc_y"])),
+            "max_pin_load_N": float(np.max(obs["pin_load"]))}
+
+
+def error_metrics(obs: dict, ref: dict) -> dict:
+    """(a) pin-load max-norm error [N] and relative to max|reference|; (b) relative RMS errors."""
+    e = float(np.max(np.abs(obs["pin_load"] - ref["pin_load"])))
+    s, r = summary_stats(obs), summary_stats(ref)
+    rel = lambda k: abs(s[k] - r[k]) / r[k] if r[k] > 0 else float("nan")
+    return {"err_pin_max_N": e, "err_pin_rel": e / max(np.max(np.abs(ref["pin_load"])), 1e-30),
+            "err_rms_inner": rel("rms_inner_load_N"), "err_rms_guide": rel("rms_guide_N"),
+            "err_rms_cage_acc": rel("rms_cage_acc"), **s}
+
+
+def eval_costs(model: mbd.Model, state: mbd.State, n: int = 200) -> dict:
+    """Median wall time [s] of one residual and of one residual+Jacobian evaluation (batches of 20)."""
+    system = mbd.System(model)
+    out = {}
+    for jac in (False, True):
+        for _ in range(5):
+            system.forces(state.t, state.q, state.v, state.z, jac=jac)
+        batches = []
+        for _ in range(max(1, n // 20)):
+            t0 = time.perf_counter()
+            for _ in range(20):
+                system.forces(state.t, state.q, state.v, state.z, jac=jac)
+            batches.append((time.perf_counter() - t0) / 20)
+        out["jacobian_s" if jac else "residual_s"] = statistics.median(batches)
+    return out
+
+
+def peak_rss_mb() -> float:
+    import resource
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0   # Linux: kB
+
+
+def machine_note() -> str:
+    import os
+    import platform
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    return (f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+            f"numpy {np.__version__}; 1-min load average at start {load:.2f} (machine shared with other jobs)")

@@ -1,0 +1,83 @@
+"""Reduced-form smoke tests of the numerics scenarios: they run, write their documented outputs, and
+the numbers in them are sane (errors finite and ordered, failures reported with a cause)."""
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from scenarios import benchmark, stability, work_precision
+from scenarios.numerics_common import StateSampler
+
+
+def test_state_sampler_hermite_is_exact_for_cubics():
+    # q(t) = t³ with v, a consistent: cubic Hermite in q with v reproduces it exactly
+    import mbd
+
+    s0 = mbd.State(1.0, np.array([1.0]), np.array([3.0]), np.array([6.0]), np.zeros(1))
+    s1 = mbd.State(2.0, np.array([8.0]), np.array([12.0]), np.array([12.0]), np.zeros(1))
+    smp = StateSampler([1.0, 1.25, 1.5, 2.0])
+    smp.record(s0, None, first=True)
+    smp.record(s0, s1)
+    assert smp.complete
+    assert np.allclose(np.ravel(smp.q), [1.0, 1.25**3, 1.5**3, 8.0], rtol=1e-14)
+    assert np.allclose(np.ravel(smp.v), [3.0, 3 * 1.25**2, 3 * 1.5**2, 12.0], rtol=1e-14)
+
+
+def test_work_precision_rig_quick(tmp_path):
+    assert work_precision.main(["--problems", "rig", "--quick", "--window", "1e-4", "--cap", "3",
+                                "--out", str(tmp_path), "--figures", str(tmp_path / "fig")]) == 0
+    for f in ("work_precision_rig.csv", "work_precision_rig.png", "work_precision_rig_rms.png",
+              "work_precision.json", "work_precision.md", "fig/work_precision_rig.png"):
+        assert (tmp_path / f).stat().st_size > 0, f
+    rows = list(csv.DictReader(open(tmp_path / "work_precision_rig.csv")))
+    assert set(work_precision.FIELDS) == set(rows[0])
+    methods = {r["method"] for r in rows}
+    assert {"HHT", "HHT-adaptive", "Radau", "BDF", "LSODA", "RK45", "DOP853"} <= methods
+    done = [r for r in rows if r["completed"] == "True"]
+    assert done, "no contender finished"
+    for r in done:
+        assert np.isfinite(float(r["err_pin_rel"])) and float(r["wall_s"]) > 0
+    for r in rows:
+        if r["completed"] != "True":
+            assert r["message"], "an unfinished run must say why"
+    summ = json.loads((tmp_path / "work_precision.json").read_text())["problems"]["rig"]
+    chk = summ["reference"]["check_vs_reference"]["err_pin_rel"]
+    # the reference check (2 h_ref) lies below the coarsest HHT setting's error
+    hht = [float(r["err_pin_rel"]) for r in done if r["method"] == "HHT"]
+    assert chk < max(hht)
+    # HHT with a 5× smaller step is more accurate (same alpha)
+    e = {(r["alpha"], float(r["h_s"])): float(r["err_pin_rel"]) for r in done if r["method"] == "HHT"}
+    assert e[("0.0", 2e-6)] < e[("0.0", 1e-5)]
+
+
+def test_stability_reports_success_and_refusal(tmp_path):
+    assert stability.main(["--cases", "nominal,Z24", "--window", "2e-4", "--cap", "3", "--out", str(tmp_path)]) == 0
+    rows = list(csv.DictReader(open(tmp_path / "stability.csv")))
+    assert set(stability.FIELDS) == set(rows[0])
+    by = {(r["case"], r["integrator"]): r for r in rows}
+    nom = by[("nominal", "HHT α=-0.3 adaptive")]
+    assert nom["completed"] == "True" and int(nom["steps"]) > 0 and float(nom["newton_per_step"]) >= 1
+    assert float(nom["rms_pin_load_N"]) > 0
+    assert ("nominal", "Radau rtol=1e-5") in by
+    z24 = by[("Z24", "build")]
+    assert z24["completed"] == "False" and "rollers" in z24["message"]      # refused with its cause
+    md = (tmp_path / "stability.md").read_text()
+    assert "| nominal |" in md and "Z24" in md
+
+
+def test_benchmark_json_last_line(tmp_path, capsys):
+    assert benchmark.main(["--json", "--settle", "2e-4", "--window", "2e-4", "--ref-window", "1e-4",
+                           "--h", "1e-5", "--scipy-cap", "3", "--out", str(tmp_path)]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    d = json.loads(last)
+    for k in ("wall_s", "simulated_s", "steps", "rel_error_rms_inner_race", "scipy_best_method", "scipy_best_wall_s",
+              "scipy_rel_error", "per_step_over_eval"):
+        assert k in d, k
+    # fixed step: a step whose Newton fails is retried with h/2, so at least window/h steps
+    assert d["steps"] >= 20 and d["simulated_s"] == pytest.approx(2e-4)
+    assert d["per_step_over_eval"] > 0 and d["wall_s"] > 0
+    assert d["scipy_best_method"] in ("Radau", "BDF", "LSODA")
+    assert (tmp_path / "benchmark.json").exists()
