@@ -33,16 +33,35 @@ class Counters:
         return dict(self.__dict__)
 
 
+def _fused_families(elements, fuse: bool):
+    """[(element to evaluate, [(family name, instance slice)])]: families with equal fuse keys are
+    concatenated into one (fewer Python-level kernel calls; identical results)."""
+    groups: dict = {}
+    for e in elements:
+        key = e.fuse_key() if fuse and e.init_internal() is None else None
+        groups.setdefault(key if key is not None else ("solo", id(e)), []).append(e)
+    out = []
+    for members in groups.values():
+        e = members[0] if len(members) == 1 else type(members[0]).fuse(members)
+        parts, start = [], 0
+        for mem in members:
+            parts.append((mem.name, slice(start, start + mem.n)))
+            start += mem.n
+        out.append((e, parts))
+    return out
+
+
 class System:
-    def __init__(self, model: Model):
+    def __init__(self, model: Model, fuse: bool = True):
         self.model = model
         self.ndof = n = model.ndof
         self.counters = Counters()
         m = model
         f2f = m.full_to_free
+        self._evals = _fused_families(m.elements, fuse)
         rows, cols, self._blocks = [], [], []
         # element blocks: entry (i, j) of every instance, kept where both DOFs are free
-        for e in m.elements:
+        for e, _ in self._evals:
             fr = f2f[e.dofs]                                   # (n, k)
             r = np.repeat(fr[:, :, None], e.k, axis=2)         # (n, k, k): row = local i
             c = np.repeat(fr[:, None, :], e.k, axis=1)         # col = local j
@@ -72,7 +91,7 @@ class System:
         # split the inverse map back per block
         off = 0
         self._maps = []
-        for keep, r in zip(self._blocks, rows[: len(m.elements)]):
+        for keep, r in zip(self._blocks, rows[: len(self._evals)]):
             self._maps.append((keep, inv[off: off + r.size]))
             off += r.size
         if self.rotating:
@@ -88,7 +107,7 @@ class System:
         self._bx, self._by = bx, by
         self._bt = f2f[3 * free_bodies + 2]
         # element dofs flattened, for the force scatter
-        self._dofs_flat = [e.dofs.ravel() for e in m.elements]
+        self._dofs_flat = [e.dofs.ravel() for e, _ in self._evals]
         self.has_gravity = bool(np.any(m.gravity != 0.0))
 
     # ------------------------------------------------------------------------------------------
@@ -112,8 +131,8 @@ class System:
             self.Jv[:] = 0.0
         else:
             self.counters.residual += 1
-        for e, flat, (keep, mp) in zip(m.elements, self._dofs_flat, self._maps):
-            F, _, Jq, Jv = evaluate(e, t, fs, qf, vf, z.get(e.name), jac)
+        for (e, parts), flat, (keep, mp) in zip(self._evals, self._dofs_flat, self._maps):
+            F, _, Jq, Jv = evaluate(e, t, fs, qf, vf, z.get(parts[0][0]) if len(parts) == 1 else None, jac)
             Ffull += np.bincount(flat, weights=F.ravel(), minlength=Ffull.size)
             if jac:
                 self.Jq += np.bincount(mp, weights=Jq.ravel()[keep], minlength=self.nnz)
@@ -175,9 +194,10 @@ class System:
         fs = m.frame.at(t)
         qf, vf = m.full(t, q, v)
         res = {}
-        for e in m.elements:
-            F, out, _, _ = evaluate(e, t, fs, qf, vf, z.get(e.name), False)
-            res[e.name] = out
+        for e, parts in self._evals:
+            F, out, _, _ = evaluate(e, t, fs, qf, vf, z.get(parts[0][0]) if len(parts) == 1 else None, False)
+            for name, sl in parts:
+                res[name] = out if len(parts) == 1 else {k: np.asarray(v)[sl] for k, v in out.items()}
         return res
 
     def check_finite(self, t, F, q, v, z):

@@ -71,6 +71,15 @@ class Element:
             raise ModelError(f"{self.name}: parameter {name!r} must be >= 0, got {value!r}")
         return a
 
+    # fusion: families whose keys are equal (and not None) may be evaluated as one concatenated family
+    # by the assembler (same results, fewer Python-level calls); outputs still go to each family's name
+    def fuse_key(self):
+        return None
+
+    @classmethod
+    def fuse(cls, parts):  # pragma: no cover - only called for classes that define fuse_key
+        raise NotImplementedError
+
     # internal state (e.g. the integral of a PI drive); None when the family has none
     def init_internal(self):
         return None

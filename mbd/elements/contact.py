@@ -153,6 +153,22 @@ class RaceContact(Element):
         self.m_roller = self._per_instance("m_roller", m_roller, positive=True)
         self.traction = traction
         self._c0 = 2.0 * self.zeta * np.sqrt(self.m_roller * self.exponent * self.K)
+        self.kappa = np.full(self.n, self.kappa)   # per instance: inner and outer families can be fused
+
+    _FUSED = ("dofs", "race_marker", "R_race", "D", "K", "zeta", "m_roller", "_c0", "kappa")
+
+    def fuse_key(self):
+        return ("RaceContact", self.exponent, self.traction)
+
+    @classmethod
+    def fuse(cls, parts):
+        """One family holding the instances of several (inner and outer raceways alike)."""
+        f = cls.__new__(cls)
+        f.name = "+".join(p.name for p in parts)
+        for a in cls._FUSED:
+            setattr(f, a, np.concatenate([getattr(p, a) for p in parts]))
+        f.kind, f.exponent, f.traction = None, parts[0].exponent, parts[0].traction
+        return f
 
     def kernel(self, t, fs, q, v, z):
         qr, qb, vr, vb = q[:3], q[3:], v[:3], v[3:]

@@ -138,13 +138,17 @@ class StiffnessShape:
             for j, bj in enumerate(self.b, start=1):
                 out = out + bj * ad.sin(_TWO_PI * j * p)
             return out
-        h = 0.5 * (self.contact_ratio - 1.0)      # half width of the double-contact window
-        s = self.smoothing
-        u = ad.wrap_angle(_TWO_PI * (p - h)) * (1.0 / _TWO_PI)   # position from the window centre, in [-1/2, 1/2]
-        x = (h + 0.5 * s - ad.abs_(u)) * (1.0 / s)             # 1 inside, 0 outside, linear across an edge
-        x = ad.where(x > 1.0, 1.0, ad.where(x < 0.0, 0.0, x))
-        w = x * x * x * (10.0 + x * (-15.0 + 6.0 * x))       # quintic smoothstep: C², symmetric ramp
-        return self.single * (1.0 + (self.ratio - 1.0) * w)
+        return _rect_factor(p, 0.5 * (self.contact_ratio - 1.0), self.smoothing, self.single, self.ratio)
+
+
+def _rect_factor(p, h, s, single, ratio):
+    """Smoothed rectangular wave k/k_mean: double-contact window of half width h centred at p = h
+    (period 1), quintic-smoothstep edges of width s. Parameters may be per-instance (n,) arrays."""
+    u = ad.wrap_angle(_TWO_PI * (p - h)) * (1.0 / _TWO_PI)   # position from the window centre, in [-1/2, 1/2]
+    x = (h + 0.5 * s - ad.abs_(u)) * (1.0 / s)             # 1 inside, 0 outside, linear across an edge
+    x = ad.where(x > 1.0, 1.0, ad.where(x < 0.0, 0.0, x))
+    w = x * x * x * (10.0 + x * (-15.0 + 6.0 * x))       # quintic smoothstep: C², symmetric ramp
+    return single * (1.0 + (ratio - 1.0) * w)
 
 
 def mesh_damping(zeta, k_mean, J1, J2, rb1, rb2):
@@ -231,30 +235,53 @@ class GearMesh(Element):
                              f"(same base pitch), got z2 = {z2!r}")
         self.pitch = _TWO_PI * self.rb1 / self.teeth1      # base pitch p_b [m]
         self.kappa0 = rsum                                  # κ·a
-        self.sigma = -1.0 if self.internal else 1.0
+        # per instance, so that families of different kinds can be evaluated as one (System fusion)
+        self.sigma = np.full(self.n, -1.0 if self.internal else 1.0)
         self.sin_alpha = np.sin(self.alpha)
+        sh = self.stiffness
+        if sh.kind == "rectangular":
+            self._wave = tuple(np.full(self.n, x) for x in
+                               (0.5 * (sh.contact_ratio - 1.0), sh.smoothing, sh.single, sh.ratio))
+
+    _FUSED = ("dofs", "rb1", "rb2", "alpha", "a0", "teeth1", "k_mean", "c_mesh", "u0", "p0", "backlash",
+              "phi_ref", "pitch", "kappa0", "sigma", "sin_alpha")
+
+    def fuse_key(self):
+        sh = self.stiffness
+        return ("GearMesh", sh.kind, sh.a, sh.b) if sh.kind != "rectangular" else ("GearMesh", "rectangular")
+
+    @classmethod
+    def fuse(cls, parts):
+        """One family holding the instances of several (external and internal alike)."""
+        f = cls.__new__(cls)
+        f.name = "+".join(p.name for p in parts)
+        for a in cls._FUSED:
+            setattr(f, a, np.concatenate([getattr(p, a) for p in parts]))
+        f.internal = None
+        f.stiffness = parts[0].stiffness
+        if f.stiffness.kind == "rectangular":
+            f._wave = tuple(np.concatenate([p._wave[i] for p in parts]) for i in range(4))
+        return f
+
+    def _factor(self, p):
+        if self.stiffness.kind == "rectangular":
+            return _rect_factor(p, *self._wave)
+        return self.stiffness.factor(p)
 
     def kernel(self, t, fs, q, v, z):
         x1, y1, th1, x2, y2, th2 = q
         vx1, vy1, w1, vx2, vy2, w2 = v
-        sig = self.sigma
+        sig = self.sigma      # +1 external, −1 internal (per instance)
         # centre vector d along e (external c1 → c2, internal ring → planet) and its rate
-        if self.internal:
-            dx, dy, ddx, ddy = x1 - x2, y1 - y2, vx1 - vx2, vy1 - vy2
-        else:
-            dx, dy, ddx, ddy = x2 - x1, y2 - y1, vx2 - vx1, vy2 - vy1
+        dx, dy, ddx, ddy = sig * (x2 - x1), sig * (y2 - y1), sig * (vx2 - vx1), sig * (vy2 - vy1)
         a = ad.hypot(dx, dy)
         inv_a = 1.0 / a
         ex, ey = dx * inv_a, dy * inv_a
         tx, ty = -ey, ex
         # φ_e on the branch (phi_ref − π, phi_ref + π]: continuous near the nominal line of centres
         phi_e = self.phi_ref + ad.wrap_angle(ad.arctan2(dy, dx) - self.phi_ref)
-        if self.internal:
-            raw = self.rb2 * (th2 - phi_e) - self.rb1 * (th1 - phi_e) - self.u0
-            roll = self.rb2 * w2 - self.rb1 * w1
-        else:
-            raw = self.rb1 * (th1 - phi_e) + self.rb2 * (th2 - phi_e) - self.u0
-            roll = self.rb1 * w1 + self.rb2 * w2
+        raw = sig * self.rb1 * (th1 - phi_e) + self.rb2 * (th2 - phi_e) - self.u0
+        roll = sig * self.rb1 * w1 + self.rb2 * w2
         pb = self.pitch
         s = ad.wrap_angle(raw * (_TWO_PI / pb)) * (pb / _TWO_PI)   # transmission error mod base pitch
         kappa = self.kappa0 * inv_a
@@ -270,7 +297,7 @@ class GearMesh(Element):
         r_plus = s_dot - radial_dot
         r_minus = -1.0 * s_dot - radial_dot
         p = self.teeth1 * (th1 - phi_e) * (1.0 / _TWO_PI) + self.p0
-        kp = self.k_mean * self.stiffness.factor(p)
+        kp = self.k_mean * self._factor(p)
         c = self.c_mesh
         F_plus = ad.where(d_plus > 0.0, ad.pos(kp * d_plus + c * r_plus), 0.0)
         F_minus = ad.where(d_minus > 0.0, ad.pos(kp * d_minus + c * r_minus), 0.0)
@@ -281,10 +308,8 @@ class GearMesh(Element):
         Fy_head = F_net * kappa * ty + sig * self.sin_alpha * F_sum * ey
         T1 = -sig * self.rb1 * F_net
         T2 = -1.0 * self.rb2 * F_net
-        if self.internal:   # head = planet = gear 1
-            f1x, f1y, f2x, f2y = Fx_head, Fy_head, -1.0 * Fx_head, -1.0 * Fy_head
-        else:               # head = gear 2
-            f1x, f1y, f2x, f2y = -1.0 * Fx_head, -1.0 * Fy_head, Fx_head, Fy_head
+        # the head of d is gear 2 (external) or gear 1, the planet (internal)
+        f1x, f1y, f2x, f2y = -sig * Fx_head, -sig * Fy_head, sig * Fx_head, sig * Fy_head
         outputs = {
             "force": F_net, "force_drive": F_plus, "force_coast": F_minus,
             "deflection": d_plus, "deflection_coast": d_minus,
