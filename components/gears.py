@@ -14,6 +14,7 @@ import numpy as np
 from mbd.elements.gear_mesh import GearMesh, StiffnessShape
 
 from .scene import Scene
+from .units import ParameterError
 
 __all__ = ["add_mesh_family"]
 
@@ -28,6 +29,16 @@ def add_mesh_family(scene: Scene, family: str, mg, *, gear1: list[str], gear2: l
     rb1, rb2 = mg.base_radius1, mg.base_radius2
     u0 = rb2 * (th2 - phi) - rb1 * (th1 - phi) if mg.internal else rb1 * (th1 - phi) + rb2 * (th2 - phi)
     if time_varying:
+        # the single/double-contact wave needs 1 <= ε < 2 and non-overlapping ramps: refuse with the
+        # parameter's name here (StiffnessShape would raise a bare ModelError from inside the build)
+        eps = mg.contact_ratio
+        if eps >= 2.0:
+            raise ParameterError.at(f"gears.{mg.gear1}", f"{mg.name} contact ratio {eps:.4f} >= 2: the single/double "
+                                                         "tooth stiffness wave is undefined (use mesh_stiffness='constant')")
+        s_max = min(eps - 1.0, 2.0 - eps)
+        if smoothing > s_max:
+            raise ParameterError.at("mesh.smoothing_width", f"{smoothing:g} is too wide for the {mg.name} mesh: its contact "
+                                                            f"ratio {eps:.4f} allows at most {s_max:.4g} (ramps may not overlap)")
         shape = StiffnessShape.rectangular(mg.contact_ratio, ratio=ratio, smoothing=smoothing)
         # geometry's p0 assumes body angle 0 at assembly; here the body angle already holds γ₁
         p0 = np.mod(mg.wave_p0(flank) - mg.p0, 1.0)

@@ -65,7 +65,7 @@ __all__ = ["EXAMPLE_PLANETARY", "MemberSpec", "PlanetarySpec", "planetary_spec",
 CENTRAL = ("sun", "ring", "carrier")
 
 # the example of the format (values [assumed]: a generic, equally spaced set)
-EXAMPLE_PLANETARY = MappingProxyType({
+EXAMPLE_PLANETARY = MappingProxyType({k: MappingProxyType(v) if isinstance(v, dict) else v for k, v in {
     "kind": "single_planetary", "planets": 3, "module": "3 mm", "pressure_angle": "20 deg",
     "teeth": {"sun": 30, "planet": 30, "ring": 90},
     "mesh_stiffness": {"sun_planet": "5e8 N/m", "ring_planet": "5e8 N/m"},
@@ -73,7 +73,7 @@ EXAMPLE_PLANETARY = MappingProxyType({
     "ring": {"mass": "4 kg", "inertia": "3e-2 kg*m^2", "support_stiffness": "1e8 N/m", "torsional_stiffness": "1e8 N*m/rad"},
     "carrier": {"mass": "3 kg", "inertia": "1.5e-2 kg*m^2", "support_stiffness": "1e8 N/m", "torsional_stiffness": "0 N*m/rad"},
     "planet": {"mass": "0.5 kg", "inertia": "3e-4 kg*m^2", "bearing_stiffness": "1e8 N/m"},
-})
+}.items()})
 
 _MEMBER_KEYS = {"mass": "mass", "inertia": "inertia", "support_stiffness": "stiffness",
                 "torsional_stiffness": "torsional_stiffness"}

@@ -145,6 +145,7 @@ def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 *
     _finite("ring_inertia", ring_inertia, positive=True)
     _finite("settle_damping_ratio", settle_damping_ratio, nonneg=True)
     _finite("drive_freq", drive_freq, positive=True)
+    _finite("drive_zeta", drive_zeta, nonneg=True)
     opt = options or SceneOptions()
     if opt.bearings != "rollers":
         raise ParameterError.at("options.bearings", f"the bearing rig needs the roller model ('rollers'), got {opt.bearings!r}")

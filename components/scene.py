@@ -132,6 +132,12 @@ class Scene:
         self._pose[i] = np.asarray(pose, float)
         self.mb._pose[i] = self._pose[i].copy()
 
+    def kinetic_energy(self) -> float:
+        """Kinetic energy [J] of the initial (fixed-frame) velocities of all bodies added so far."""
+        m, J = np.array(self.mb._mass), np.array(self.mb._inertia)
+        v = np.array(self._vel)
+        return float(0.5 * np.sum(m * (v[:, 0] ** 2 + v[:, 1] ** 2) + J * v[:, 2] ** 2))
+
     def family(self, key: str, cls, body_args: tuple[str, ...], **common) -> FamilyCollector:
         """The collector for family ``key`` (created on first use)."""
         if key not in self.families:

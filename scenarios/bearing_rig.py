@@ -2,7 +2,10 @@
 
     python -m scenarios.bearing_rig --radial-load "10 kN" --clearance "20 um" --out results/rig
 
-Writes DIR/summary.json (radial_load_N, clearance_m, roller_angle_deg measured from the load direction,
+Roller angles are measured from the centre of the load zone: the line along which the loaded outer ring
+presses the rollers onto the pin (the ring is pulled along the load, so that centre lies opposite the
+pull, on the pin's far side).
+Writes DIR/summary.json (radial_load_N, clearance_m, roller_angle_deg from the load-zone centre,
 roller_load_N time-mean per roller, q_max_N, stribeck_ratio = Q_max·Z/F_r, load_zone_deg, ring_deflection_m,
 and the classical discrete-roller solution for comparison) and DIR/load_distribution.png.
 """
@@ -64,7 +67,8 @@ def run(a) -> dict:
     order = np.argsort(sol.angles)
     summary = {
         "radial_load_N": F, "clearance_m": b.clearance, "rollers": b.Z, "outer_speed_rad_s": w, "cage": a.cage,
-        "roller_angle_deg": np.degrees(sol.angles[order]).tolist(),
+        "roller_angle_deg": np.degrees(sol.angles[order]).tolist(),   # from the load-zone centre
+        "angle_reference": "centre of the load zone (opposite the pull on the outer ring)",
         "roller_load_N": sol.loads[order].tolist(),
         "q_max_N": sol.q_max, "stribeck_ratio": sol.stribeck,
         "load_zone_deg": float(np.degrees(sol.zone_angle)),
