@@ -71,6 +71,15 @@ class Element:
             raise ModelError(f"{self.name}: parameter {name!r} must be >= 0, got {value!r}")
         return a
 
+    def _per_instance_xy(self, name: str, value) -> np.ndarray:
+        """(n, 2) body-fixed offsets/points from a (2,) or (n, 2) value [m]; errors name the parameter."""
+        a = np.asarray(value, dtype=float)
+        if a.shape not in ((2,), (self.n, 2)):
+            raise ModelError(f"{self.name}: parameter {name!r} must have shape (2,) or ({self.n}, 2) [m], got {a.shape}")
+        if not np.all(np.isfinite(a)):
+            raise ModelError(f"{self.name}: parameter {name!r} must be finite, got {value!r}")
+        return np.broadcast_to(a, (self.n, 2)).copy()
+
     # fusion: families whose keys are equal (and not None) may be evaluated as one concatenated family
     # by the assembler (same results, fewer Python-level calls); outputs still go to each family's name
     def fuse_key(self):

@@ -32,16 +32,6 @@ def _norm(x, y):
     return ad.sqrt(x * x + y * y + _ETA2)
 
 
-def _markers(elem: Element, name: str, value) -> np.ndarray:
-    """(n, 2) body-fixed offsets from a (2,) or (n, 2) value, checked finite."""
-    a = np.asarray(value, dtype=float)
-    if a.shape not in ((2,), (elem.n, 2)):
-        raise ModelError(f"{elem.name}: parameter {name!r} must have shape (2,) or ({elem.n}, 2) [m], got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ModelError(f"{elem.name}: parameter {name!r} must be finite, got {value!r}")
-    return np.broadcast_to(a, (elem.n, 2)).copy()
-
-
 def _fraction(elem: Element, name: str, value) -> np.ndarray:
     a = elem._per_instance(name, value, nonneg=True)
     if np.any(a > 1.0):
@@ -141,7 +131,7 @@ class RaceContact(Element):
             raise ModelError(f"{name}: traction must be a Traction, got {type(traction).__name__}")
         self.kind = kind
         self.kappa = 1.0 if kind == "inner" else -1.0  # δ = D/2 − κ(ρ − R), normal on roller κ·e
-        self.race_marker = _markers(self, "race_marker", race_marker)
+        self.race_marker = self._per_instance_xy("race_marker", race_marker)
         self.R_race = self._per_instance("R_race", R_race, positive=True)
         self.D = self._per_instance("D", D, positive=True)
         self.K = self._per_instance("K", K, positive=True)
@@ -343,7 +333,7 @@ class LubricantDrag(Element):
     def __init__(self, name, roller, race_body, *, race_marker, C_d, rho, D, l, d_m):
         self.name = name
         self.dofs = body_dofs(roller, race_body)
-        self.race_marker = _markers(self, "race_marker", race_marker)
+        self.race_marker = self._per_instance_xy("race_marker", race_marker)
         C_d = self._per_instance("C_d", C_d, nonneg=True)
         rho = self._per_instance("rho", rho, nonneg=True)
         D = self._per_instance("D", D, positive=True)

@@ -8,16 +8,6 @@ from ..element import Element, body_dofs, marker, marker_velocity, point_force
 from ..errors import ModelError
 
 
-def _offsets(elem: Element, name: str, value) -> np.ndarray:
-    """(n, 2) point/offset parameter from a (2,) or (n, 2) value; errors name the parameter."""
-    a = np.asarray(value, dtype=float)
-    if a.shape not in ((2,), (elem.n, 2)):
-        raise ModelError(f"{elem.name}: parameter {name!r} must have shape (2,) or ({elem.n}, 2) [m], got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ModelError(f"{elem.name}: parameter {name!r} must be finite, got {value!r}")
-    return np.broadcast_to(a, (elem.n, 2)).copy()
-
-
 class GroundSupport(Element):
     """Spring-damper from each body's centre to an anchor fixed in the inertial frame.
 
@@ -37,7 +27,7 @@ class GroundSupport(Element):
         self.cx = self._per_instance("cx", cx, nonneg=True)
         self.cy = self.cx if cy is None else self._per_instance("cy", cy, nonneg=True)
         self.isotropic = ky is None and cy is None
-        self.anchor = _offsets(self, "anchor", anchor)
+        self.anchor = self._per_instance_xy("anchor", anchor)
         self.k_theta = self._per_instance("k_theta", k_theta, nonneg=True)
         self.c_theta = self._per_instance("c_theta", c_theta, nonneg=True)
         self.theta0 = self._per_instance("theta0", theta0)
@@ -81,8 +71,8 @@ class BodySpring(Element):
         self.dofs = body_dofs(body_a, body_b)
         self.stiffness = self._per_instance("k", k, nonneg=True)
         self.damping = self._per_instance("c", c, nonneg=True)
-        self.marker_a = _offsets(self, "marker_a", marker_a)
-        self.marker_b = _offsets(self, "marker_b", marker_b)
+        self.marker_a = self._per_instance_xy("marker_a", marker_a)
+        self.marker_b = self._per_instance_xy("marker_b", marker_b)
 
     def kernel(self, t, fs, q, v, z):
         qa, qb, va, vb = q[:3], q[3:], v[:3], v[3:]
