@@ -191,6 +191,7 @@ def plots(results: dict, out: Path) -> list[Path]:
                     if b["type"] != "rollers":
                         continue
                     cols[f"{kind}: roller–inner race"] = ds["race_inner.load"].values[:, b["race_inner"][0]]
+                    cols[f"{kind}: roller–outer race"] = ds["race_outer.load"].values[:, b["race_outer"][0]]
                     if "pocket" in b:
                         cols[f"{kind}: roller–cage"] = ds["pocket.force"].values[:, b["pocket"][0]]
                     if "guide" in b:
@@ -198,6 +199,7 @@ def plots(results: dict, out: Path) -> list[Path]:
                         a = ds["motion.a"].values
                         ic, ip = bodies.index(b["cage"]), bodies.index(b["planet"])
                         cols[f"{kind}: cage acc x"] = a[:, ic, 0] - a[:, ip, 0]
+                        cols[f"{kind}: cage acc y"] = a[:, ic, 1] - a[:, ip, 1]
                 data[d] = (t, cols)
         labels = list(next(iter(data.values()))[1])
         t = next(iter(data.values()))[0]
