@@ -34,7 +34,8 @@ from components.presets import reference_dpgt
 
 __all__ = ["Problem", "dpgt_problem", "rig_problem", "settled_state", "StateSampler", "RunResult",
            "run_hht", "run_scipy", "FrozenInternalHHT", "observables", "error_metrics", "scipy_atol", "peak_rss_mb",
-           "eval_costs", "machine_note"]
+           "eval_costs", "machine_note", "wait_quiet", "load1",
+           "design_verdict"]
 
 
 @dataclass
@@ -55,14 +56,16 @@ class Problem:
 
 
 def dpgt_problem(condition: int = 3, direction: str = "forward", overrides: dict | None = None,
-                 options=None, settle: float = 0.03) -> Problem:
+                 options=None, settle: float = 0.03, strict: bool = True, rig=None) -> Problem:
     """Full DPGT (reference_dpgt(condition, direction) with ``overrides``); reference bearing = the
-    first inner planet's bearing, reference roller = its roller 0."""
+    first inner planet's bearing, reference roller = its roller 0. ``strict=False`` builds a machine the
+    design check refuses (e.g. overlapping planets: no planet–planet contact is modelled, so such a
+    machine is non-physical, but its equations can still be integrated for cost and stability numbers)."""
     from components.dpgt import build_dpgt
     params = with_overrides(reference_dpgt(condition, direction), overrides or {})
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # design warnings (tip overlap, N not assemblable) are known
-        sc = build_dpgt(params, options)
+        sc = build_dpgt(params, options, rig, strict=strict)
     h = sc.handles["pairs"][0]["inner_bearing"]
     if h["kind"] != "rollers":
         raise mbd.ModelError("the numerics scenarios need the roller bearing model")
@@ -211,12 +214,14 @@ class RunResult:
 
 
 def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float, h: float | None = None,
-            atol_pos: float | None = None, repeats: int = 1, h_max: float = 2e-5, label: str = "") -> RunResult:
-    """HHT fixed step (``h``) or adaptive (``atol_pos``; atol_rot = 100·atol_pos) from ``state``."""
+            atol_pos: float | None = None, repeats: int = 1, h_max: float = 2e-5, label: str = "",
+            newton_tol: float | None = None) -> RunResult:
+    """HHT fixed step (``h``) or adaptive (``atol_pos``; atol_rot = 100·atol_pos) from ``state``;
+    ``newton_tol`` overrides the HHT default (for the error-floor study)."""
     if (h is None) == (atol_pos is None):
         raise ValueError("give exactly one of h (fixed step) or atol_pos (adaptive)")
     tol = mbd.Tolerance() if atol_pos is None else mbd.Tolerance(atol_pos=atol_pos, atol_rot=100 * atol_pos)
-    stepper = mbd.HHT(alpha=alpha, tol=tol)
+    stepper = mbd.HHT(alpha=alpha, tol=tol) if newton_tol is None else mbd.HHT(alpha=alpha, tol=tol, newton_tol=newton_tol)
     walls, res, sampler, err = [], None, None, ""
     for r in range(max(1, repeats)):
         ctrl = mbd.FixedStep(h) if h is not None else mbd.Adaptive(h0=min(5e-6, h_max), h_max=h_max, h_min=1e-10)
@@ -379,3 +384,39 @@ def machine_note() -> str:
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     return (f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
             f"numpy {np.__version__}; 1-min load average at start {load:.2f} (machine shared with other jobs)")
+
+
+def load1() -> float:
+    """1-min load average (nan where the OS has none)."""
+    import os
+    return os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+
+
+def wait_quiet(threshold: float = 1.2, max_wait_s: float = 600.0, poll_s: float = 15.0, log=print) -> dict:
+    """Wait until the 1-min load average is below ``threshold`` (other jobs share the machine and
+    inflate wall times), at most ``max_wait_s``; returns what happened, for the report."""
+    t0 = time.monotonic()
+    first = load1()
+    while load1() >= threshold and time.monotonic() - t0 < max_wait_s:
+        log(f"waiting for a quiet machine: 1-min load {load1():.2f} >= {threshold:g} "
+            f"({time.monotonic() - t0:.0f} s of at most {max_wait_s:.0f} s)")
+        time.sleep(poll_s)
+    now = load1()
+    return {"threshold": threshold, "load_at_call": first, "load_at_start": now,
+            "waited_s": round(time.monotonic() - t0, 1), "quiet": bool(now < threshold)}
+
+
+def design_verdict(overrides: dict | None = None, condition: int = 3, direction: str = "forward") -> dict:
+    """The design check's findings for reference_dpgt with ``overrides``, summarised: ``refused`` (an
+    error: build_dpgt raises unless strict=False), ``collides`` (a warning that gears' pitch circles
+    overlap — the check only warns, but such a machine cannot exist: no planet–planet contact is
+    modelled, so its simulation is non-physical), ``assembly`` (a warning that equally spaced pairs
+    do not assemble), and the messages."""
+    from components.geometry import design_findings
+    params = with_overrides(reference_dpgt(condition, direction), overrides or {})
+    found = design_findings(params)
+    msgs = [f"{f.severity}: {' '.join(str(f).split())}" for f in found]
+    return {"refused": any(f.severity == "error" for f in found),
+            "collides": any("collide" in str(f) for f in found),
+            "assembly": any("do not assemble" in str(f) for f in found),
+            "messages": msgs}

@@ -1,7 +1,7 @@
 """Work-precision study: error against wall time for every integrator on two problems.
 
     python -m scenarios.work_precision [--problems rig,dpgt] [--quick] [--out DIR] [--repeats R]
-                                       [--figures DIR] [--cap S] [--window S]
+                                       [--figures DIR] [--cap S] [--window S] [--floor-check]
 
 Problems: ``rig`` — one planet bearing on the rig (stiff Hertz contacts, traction, cage impacts, the
 outer ring turning at the inner planet's relative speed of condition 3, 5 kN radial load); ``dpgt`` —
@@ -25,7 +25,9 @@ the cage–guide force and of the cage acceleration (relative to its planet).
 
 Outputs in OUT: work_precision_<problem>.csv, work_precision_<problem>.png (error (a) against wall time)
 and work_precision_<problem>_rms.png (error (b), inner race), work_precision.json (reference check,
-fitted HHT orders, evaluation costs) and work_precision.md (tables for docs/numerics.md).
+fitted HHT orders, evaluation costs, the reference's pin-load range, and with --floor-check the HHT
+α = 0 errors at the three smallest h for Newton tolerances 0.03, 1e-3 and 1e-5) and work_precision.md
+(tables for docs/numerics.md).
 """
 from __future__ import annotations
 
@@ -74,7 +76,8 @@ def _log(msg):
     print(msg, flush=True)
 
 
-def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None, window: float | None) -> dict:
+def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None, window: float | None,
+          floor_check: bool = False) -> dict:
     P = plan(quick)
     if cap is not None:
         P["cap"] = cap
@@ -155,6 +158,23 @@ def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None,
             h_, e_ = np.log(np.array(pts, float)).T
             orders[str(alpha)] = {"order": float(np.polyfit(h_, e_, 1)[0]), "points": len(pts),
                                   "h_range_s": [float(np.exp(h_.min())), float(np.exp(h_.max()))]}
+    # error-floor check (what limits the error at small h): the same HHT runs with the old (0.03) and a
+    # 100x tighter (1e-5) Newton tolerance; the grid points are step points for every h that divides
+    # dt, so the sampling adds no interpolation error there
+    floor = []
+    if floor_check:
+        for nt in (0.03, 1e-3, 1e-5):
+            for h in P["fixed_h"][:3]:
+                r = run_hht(prob, s0, t1, grid, alpha=0.0, h=h, newton_tol=nt, label=f"newton_tol={nt:g}")
+                m = error_metrics(obs_of(r), ref_obs) if r.completed else {}
+                floor.append({"newton_tol": nt, "h_s": h, "alpha": 0.0, "completed": r.completed,
+                              "err_pin_rel": m.get("err_pin_rel"), "err_pin_max_N": m.get("err_pin_max_N"),
+                              "err_rms_inner": m.get("err_rms_inner"), "newton_per_step": r.newton / max(r.steps, 1)})
+                _log(f"[{problem}] floor check newton_tol={nt:g} h={h:.0e}: "
+                     + (f"pin {m['err_pin_rel']:.2e} ({m['err_pin_max_N']:.3f} N)" if m else r.message))
+    pin = ref_obs["pin_load"]
+    ripple = {"max_N": float(pin.max()), "min_N": float(pin.min()), "pk_pk_N": float(pin.max() - pin.min()),
+              "pk_pk_rel": float((pin.max() - pin.min()) / pin.max())}
     costs = eval_costs(prob.model, s0)
     _write(out, problem, rows)
     _plots(out, problem, rows, ref_check)
@@ -163,7 +183,7 @@ def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None,
                           "steps": ref.steps, "check_h_s": 2 * P["h_ref"], "check_vs_reference": ref_check,
                           "frozen_internal_state_vs_reference": frozen_diff},
             "reference_roller": prob.roller - prob.race_inner.start, "hht_order": orders, "eval_costs_s": costs, "cap_s": P["cap"], "repeats": repeats,
-            "settle": extra, "rows": rows}
+            "settle": extra, "floor_check": floor, "pin_load_reference": ripple, "rows": rows}
 
 
 def _hht_tight(prob, s0, t1, grid, h, frozen_z=False):
@@ -247,6 +267,17 @@ def markdown(res: dict) -> str:
         lines += ["", "Observed order of HHT (slope of log error (a) against log h): "
                   + ", ".join(f"α = {a}: {o['order']:.2f} ({o['points']} points, h {o['h_range_s'][0] * 1e6:g}–"
                               f"{o['h_range_s'][1] * 1e6:g} µs)" for a, o in res["hht_order"].items())]
+    rp = res.get("pin_load_reference")
+    if rp:
+        lines += ["", f"Reference pin load: {rp['min_N']:.1f}–{rp['max_N']:.1f} N over the window (peak-to-peak "
+                  f"{rp['pk_pk_N']:.1f} N = {rp['pk_pk_rel']:.1e} of its maximum: errors (a) are relative to the maximum)."]
+    if res.get("floor_check"):
+        lines += ["", "Newton-tolerance check (HHT α = 0; pin-load history error, relative):", "",
+                  "| newton_tol | " + " | ".join(f"h = {h * 1e6:g} µs" for h in sorted({f['h_s'] for f in res['floor_check']})) + " |",
+                  "|---|" + "---:|" * len({f['h_s'] for f in res['floor_check']})]
+        for nt in sorted({f["newton_tol"] for f in res["floor_check"]}, reverse=True):
+            fs = sorted((f for f in res["floor_check"] if f["newton_tol"] == nt), key=lambda f: f["h_s"])
+            lines.append(f"| {nt:g} | " + " | ".join(_fmt(f["err_pin_rel"]) + f" ({f['newton_per_step']:.2f} it/step)" for f in fs) + " |")
     c = res["eval_costs_s"]
     lines += ["", f"One residual evaluation {c['residual_s'] * 1e3:.2f} ms, residual + Jacobian {c['jacobian_s'] * 1e3:.2f} ms."]
     return "\n".join(lines) + "\n"
@@ -260,6 +291,8 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=1, help="timing repeats per contender (median reported)")
     ap.add_argument("--cap", type=float, default=None, help="wall-time cap per scipy run [s]")
     ap.add_argument("--window", type=float, default=None, help="integration window after settling [s]")
+    ap.add_argument("--floor-check", action="store_true",
+                    help="also rerun HHT alpha=0 at the three smallest h with Newton tolerances 0.03, 1e-3, 1e-5")
     ap.add_argument("--figures", default=None, help="also copy the PNGs into this directory (e.g. docs/numerics)")
     a = ap.parse_args(argv)
     probs = [p.strip() for p in a.problems.split(",") if p.strip()]
@@ -271,7 +304,7 @@ def main(argv=None) -> int:
     _log(machine_note())
     results = {}
     for p in probs:
-        results[p] = study(p, out, a.quick, a.repeats, a.cap, a.window)
+        results[p] = study(p, out, a.quick, a.repeats, a.cap, a.window, floor_check=a.floor_check)
     summary = {"machine": machine_note(), "peak_rss_mb": peak_rss_mb(),
                "problems": {p: {k: v for k, v in r.items() if k != "rows"} for p, r in results.items()}}
     (out / "work_precision.json").write_text(json.dumps(summary, indent=2, default=str))

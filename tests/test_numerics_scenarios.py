@@ -54,8 +54,13 @@ def test_work_precision_rig_quick(tmp_path):
 
 
 def test_stability_reports_success_and_refusal(tmp_path):
-    assert stability.main(["--cases", "nominal,Z24", "--window", "2e-4", "--cap", "3", "--out", str(tmp_path)]) == 0
+    assert stability.main(["--cases", "nominal,Z24", "--window", "2e-4", "--cap", "3", "--out", str(tmp_path / "a")]) == 0
+    assert stability.main(["--cases", "N4", "--window", "2e-4", "--cap", "3", "--no-radau", "--out", str(tmp_path / "b")]) == 0
+    # partial runs (e.g. in parallel) merge into one table in CASES order
+    assert stability.main(["--merge", f"{tmp_path / 'b'},{tmp_path / 'a'}", "--out", str(tmp_path)]) == 0
     rows = list(csv.DictReader(open(tmp_path / "stability.csv")))
+    cases = [r["case"] for r in rows]
+    assert cases[0] == "nominal" and cases[-1] == "Z24" and "N4" in cases      # CASES order, not argument order
     assert set(stability.FIELDS) == set(rows[0])
     by = {(r["case"], r["integrator"]): r for r in rows}
     nom = by[("nominal", "HHT α=-0.3 adaptive")]
@@ -64,13 +69,24 @@ def test_stability_reports_success_and_refusal(tmp_path):
     assert ("nominal", "Radau rtol=1e-5") in by
     z24 = by[("Z24", "build")]
     assert z24["completed"] == "False" and "rollers" in z24["message"]      # refused with its cause
+    # N = 4 pairs collide on the reference gears: the check only warns; the case is run and labelled
+    n4 = by[("N4", "design check")]
+    assert n4["completed"] == "warning" and "collide" in n4["message"]
+    n4run = by[("N4", "HHT α=-0.3 adaptive")]
+    assert "NON-PHYSICAL" in n4run["description"] and n4run["completed"] == "True"
     md = (tmp_path / "stability.md").read_text()
-    assert "| nominal |" in md and "Z24" in md
+    assert "| nominal |" in md and "Z24" in md and "N4 (non-physical)" in md
+
+
+def test_wait_quiet_returns_at_once_when_quiet_enough():
+    from scenarios.numerics_common import wait_quiet
+    r = wait_quiet(threshold=1e9, max_wait_s=0.0)
+    assert r["quiet"] and r["waited_s"] < 1.0
 
 
 def test_benchmark_json_last_line(tmp_path, capsys):
     assert benchmark.main(["--json", "--settle", "2e-4", "--window", "2e-4", "--ref-window", "1e-4",
-                           "--h", "1e-5", "--scipy-cap", "3", "--out", str(tmp_path)]) == 0
+                           "--h", "1e-5", "--scipy-cap", "3", "--quiet", "0", "--out", str(tmp_path)]) == 0
     last = capsys.readouterr().out.strip().splitlines()[-1]
     d = json.loads(last)
     for k in ("wall_s", "simulated_s", "steps", "rel_error_rms_inner_race", "scipy_best_method", "scipy_best_wall_s",
@@ -79,5 +95,5 @@ def test_benchmark_json_last_line(tmp_path, capsys):
     # fixed step: a step whose Newton fails is retried with h/2, so at least window/h steps
     assert d["steps"] >= 20 and d["simulated_s"] == pytest.approx(2e-4)
     assert d["per_step_over_eval"] > 0 and d["wall_s"] > 0
-    assert d["scipy_best_method"] in ("Radau", "BDF", "LSODA")
+    assert d["scipy_best_method"] in ("Radau", "BDF", "LSODA", "RK45")
     assert (tmp_path / "benchmark.json").exists()
