@@ -85,9 +85,17 @@ class Element:
     def fuse_key(self):
         return None
 
+    _FUSED: tuple = ()   # per-instance attributes a fused family concatenates (dofs among them)
+
     @classmethod
-    def fuse(cls, parts):  # pragma: no cover - only called for classes that define fuse_key
-        raise NotImplementedError
+    def fuse(cls, parts):
+        """One family holding the instances of ``parts`` (equal fuse keys): the per-instance attributes
+        named in ``_FUSED`` are concatenated; subclasses add their family-level attributes."""
+        f = cls.__new__(cls)
+        f.name = "+".join(p.name for p in parts)
+        for a in cls._FUSED:
+            setattr(f, a, np.concatenate([getattr(p, a) for p in parts]))
+        return f
 
     # internal state (e.g. the integral of a PI drive); None when the family has none
     def init_internal(self):
@@ -98,7 +106,7 @@ class Element:
         return z
 
     def kernel(self, t, fs, q, v, z):  # pragma: no cover - abstract
-        raise NotImplementedError
+        raise TypeError(f"{type(self).__name__} must define kernel(t, fs, q, v, z) -> (forces, outputs)")
 
 
 def evaluate(elem: Element, t, fs, q_full, v_full, z, jac: bool):

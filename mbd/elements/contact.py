@@ -153,10 +153,7 @@ class RaceContact(Element):
     @classmethod
     def fuse(cls, parts):
         """One family holding the instances of several (inner and outer raceways alike)."""
-        f = cls.__new__(cls)
-        f.name = "+".join(p.name for p in parts)
-        for a in cls._FUSED:
-            setattr(f, a, np.concatenate([getattr(p, a) for p in parts]))
+        f = super().fuse(parts)
         f.kind, f.exponent, f.traction = None, parts[0].exponent, parts[0].traction
         return f
 

@@ -253,10 +253,7 @@ class GearMesh(Element):
     @classmethod
     def fuse(cls, parts):
         """One family holding the instances of several (external and internal alike)."""
-        f = cls.__new__(cls)
-        f.name = "+".join(p.name for p in parts)
-        for a in cls._FUSED:
-            setattr(f, a, np.concatenate([getattr(p, a) for p in parts]))
+        f = super().fuse(parts)
         f.internal = None
         f.stiffness = parts[0].stiffness
         if f.stiffness.kind == "rectangular":
