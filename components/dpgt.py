@@ -93,8 +93,12 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, rig: Rig
     if T_s != 0:
         scene.add_element(TorqueSource("sun_torque", [scene.index["sun"]], T_s, ramp=Ramp(0.0, ramp_t)))
     # inertia the drive sees: every speed of the kinematic state scales with ω_c (ring fixed), so
-    # J_eff = 2T/ω_c² over all bodies (carrier, sun reflected, planets orbiting and spinning, rollers, cages)
-    J_eff = 2.0 * scene.kinetic_energy() / wc**2
+    # J_eff = 2T/ω_c² over all bodies (carrier, sun reflected, planets orbiting and spinning, rollers, cages);
+    # a carrier at rest has no kinematic scaling: then the carrier plus the planets' orbital inertia
+    if wc != 0.0:
+        J_eff = scene.kinematic_inertia(wc)
+    else:
+        J_eff = G.carrier_inertia + N * (G.inner_planet.mass * lay.r_ca**2 + G.outer_planet.mass * lay.r_cb**2)
     wd = 2 * np.pi * rig.drive_freq
     scene.add_element(SpeedDrive("carrier_drive", scene.index["carrier"], wc, k=J_eff * wd**2,
                                  c=2 * rig.drive_zeta * J_eff * wd, k_i=J_eff * wd**3 / 5))

@@ -132,11 +132,13 @@ class Scene:
         self._pose[i] = np.asarray(pose, float)
         self.mb._pose[i] = self._pose[i].copy()
 
-    def kinetic_energy(self) -> float:
-        """Kinetic energy [J] of the initial (fixed-frame) velocities of all bodies added so far."""
+    def kinematic_inertia(self, speed: float) -> float:
+        """2T/speed² [kg·m²] for initial velocities that all scale with ``speed`` (e.g. the carrier's in
+        a ring-fixed train): the inertia a drive of that member sees. Velocities are divided by the speed
+        before squaring, so tiny speeds do not underflow."""
         m, J = np.array(self.mb._mass), np.array(self.mb._inertia)
-        v = np.array(self._vel)
-        return float(0.5 * np.sum(m * (v[:, 0] ** 2 + v[:, 1] ** 2) + J * v[:, 2] ** 2))
+        u = np.array(self._vel) / speed
+        return float(np.sum(m * (u[:, 0] ** 2 + u[:, 1] ** 2) + J * u[:, 2] ** 2))
 
     def family(self, key: str, cls, body_args: tuple[str, ...], **common) -> FamilyCollector:
         """The collector for family ``key`` (created on first use)."""
