@@ -29,7 +29,8 @@ class RigSettings:
     """Rig and start-up settings that are not machine data ([assumed], stated in the README)."""
     drive_freq: float = 80.0      # carrier speed-drive bandwidth [Hz]: speed error < 0.1 rad/s by 30 ms (measured), far below f_m
     drive_zeta: float = 0.7
-    ramp_meshes: float = 20.0     # sun-torque ramp length in mesh periods
+    ramp_meshes: float = 20.0     # sun-torque ramp length in mesh periods ...
+    ramp_max: float = 0.05        # ... but at most this long [s] (near-zero speeds have no mesh period)
 
 
 def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, rig: RigSettings | None = None,
@@ -89,7 +90,7 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, rig: Rig
 
     # drives: sun torque (driving motor), carrier speed drive (loading motor)
     f_m = op.mesh_frequency
-    ramp_t = rig.ramp_meshes / f_m if f_m > 0 else 0.0
+    ramp_t = min(rig.ramp_meshes / f_m, rig.ramp_max) if f_m > 0 else 0.0
     if T_s != 0:
         scene.add_element(TorqueSource("sun_torque", [scene.index["sun"]], T_s, ramp=Ramp(0.0, ramp_t)))
     # inertia the drive sees: every speed of the kinematic state scales with ω_c (ring fixed), so

@@ -458,6 +458,9 @@ def kinematics(z_s: int, z_a: int, z_b: int, z_r: int, carrier_speed: float, out
                                                     "so no power can be driven in")
     t_s = math.copysign(output_power / abs(w_s), w_s) if output_power > 0 else 0.0
     t_c = -output_power / w_c if output_power > 0 else 0.0
+    if not (math.isfinite(t_s) and math.isfinite(t_c)):
+        raise ParameterError.at("operating.carrier_speed", f"{abs(w_c):.3g} rad/s is too slow to transmit "
+                                                           f"{output_power:g} W: the torques P/omega overflow")
     f_c = abs(w_c) / TWO_PI
     return Kinematics(carrier_speed=w_c, sun_speed=w_s, inner_planet_speed=ra * w_c, outer_planet_speed=rb * w_c,
                       carrier_frequency=f_c, mesh_frequency=mesh_frequency(z_r, f_c), output_power=output_power,
