@@ -386,15 +386,17 @@ def _frame_differences(res):
 
 @pytest.mark.slow
 def test_frame_invariance_full_roller_model():
-    """Full model (rollers, cages, drag), 1.5 ms, fixed steps: R and I agree to ≈ 20–50 nm and
-    ≈ 0.7 µrad on the gears, ≈ 0.5–1 µm for rollers relative to their pins (a tenth of the 10 µm gap)
-    and 0.1–0.2 % on bearing loads. Measured at h = 2, 1 and 0.5 µs (carrier drive tuned with the train's
-    full kinetic inertia): this floor does *not* shrink with h — the floating rollers' contact switching
-    amplifies any difference between the two discretizations — so convergence with h is checked on the
-    smooth model (linear bearings, above), and here the bounds must hold at every step size."""
-    for h in (2e-6, 1e-6):
-        d = _frame_differences(_compare_frames("rollers", 1.5e-3, h))
-        assert np.all(d < [1e-7, 2e-6, 1e-6, 5e-3]), (h, d)
+    """Full model (rollers, cages, drag), 1.5 ms from the kinematic start, fixed steps: R and I differ
+    by discretization error, which falls with h. Measured (h = 2 / 1 / 0.5 µs): gears 790 / 145 / 21 nm
+    and 41 / 2.9 / 0.7 µrad, bearing loads 5.4 / 0.61 / 0.12 %; rollers relative to their pins
+    6.4 / 0.85 / 0.98 µm (floating rollers in the unloaded zone, a tenth of the 10 µm gap, do not
+    converge pointwise: contact switching amplifies any difference). An earlier "floor" of 20–50 nm that
+    did not shrink with h came from a Newton defect (iterates accepted unconverged after a Jacobian
+    refresh; see tests/test_newton.py)."""
+    d = {h: _frame_differences(_compare_frames("rollers", 1.5e-3, h)) for h in (2e-6, 1e-6)}
+    assert np.all(d[1e-6] < [3e-7, 6e-6, 2e-6, 1.2e-2]), d[1e-6]
+    ratio = d[2e-6] / d[1e-6]
+    assert np.all(ratio[[0, 1, 3]] > 3.0), ratio        # gears and loads converge (second order or better)
 
 
 # ================================================================= 6. mirror symmetry
