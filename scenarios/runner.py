@@ -7,9 +7,12 @@ Results layout of a run directory:
                    and the bearing map (which family instances belong to which bearing)
     summary.json   the statistics users read (see :func:`summarize`)
     checkpoint.npz while running; a run started again resumes from it
+    fingerprint    what the run was made from (see :func:`run_fingerprint`): a checkpoint or a finished
+                   summary from other parameters, settings or engine code is never reused
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import time
 import warnings
@@ -26,7 +29,31 @@ from mbd.recorder import BodyMotion, ElementOutput, Recorder, atomic_write_text
 
 from .analysis import bearing_equivalent_load, rms, window
 
-__all__ = ["Integration", "RunConfig", "run_case", "summarize", "bearing_map"]
+__all__ = ["Integration", "RunConfig", "run_case", "summarize", "bearing_map", "run_fingerprint"]
+
+_ROOT = Path(__file__).resolve().parent.parent
+_CODE_DIGEST = None
+
+
+def _code_digest() -> str:
+    """Digest of the code that makes a run's numbers (engine, components, this runner and its analysis)."""
+    global _CODE_DIGEST
+    if _CODE_DIGEST is None:
+        h = hashlib.sha256()
+        files = sorted([*(_ROOT / "mbd").rglob("*.py"), *(_ROOT / "components").rglob("*.py"),
+                        _ROOT / "scenarios" / "runner.py", _ROOT / "scenarios" / "analysis.py"])
+        for f in files:
+            h.update(str(f.relative_to(_ROOT)).encode())
+            h.update(f.read_bytes())
+        _CODE_DIGEST = h.hexdigest()
+    return _CODE_DIGEST
+
+
+def run_fingerprint(params: DPGTParams, cfg: "RunConfig") -> str:
+    """Identifies a run: parameters, run settings (the progress display excluded) and code."""
+    settings = asdict(replace(cfg, progress=False))
+    blob = json.dumps({"params": repr(params), "cfg": settings, "code": _code_digest()}, sort_keys=True, default=repr)
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
 @dataclass(frozen=True)
@@ -126,6 +153,14 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
                           "geometry": geometry_from_params(params)})
     integ = cfg.integration
     t_end = cfg.settle + cfg.window
+    fp = run_fingerprint(params, cfg)
+    fp_file = out_dir / "fingerprint"
+    ckpt = out_dir / "checkpoint.npz"
+    if ckpt.exists() and (not fp_file.exists() or fp_file.read_text().strip() != fp):
+        # a checkpoint of another run (other parameters, settings or code): start afresh, say so
+        print(f"{out_dir}: the checkpoint there is from a different run (parameters, settings or code); starting afresh")
+        ckpt.unlink()
+    atomic_write_text(fp_file, fp)
     wall0 = time.perf_counter()
 
     def report(t, t_end, counters):   # read by a sweep's progress display (another process)
@@ -151,6 +186,7 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
             "max_local_displacement_error_m": res.error_max * integ.atol_pos,
         },
         "integration": asdict(integ),
+        "fingerprint": fp,
     })
     atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2, default=_json_default))
     return summary

@@ -2,8 +2,9 @@
 
 Each case is plain data (condition, direction, parameter overrides as strings, run config), so it
 travels to any worker; the worker rebuilds the pint parameters itself. A case whose summary.json
-exists is skipped (a restarted sweep resumes); a failing case writes error.json with its traceback
-and does not stop the others; every file is written atomically.
+was made from the same parameters, settings and code (its fingerprint, :func:`runner.run_fingerprint`)
+is skipped, so a restarted sweep resumes; a stale one is recomputed. A failing case writes error.json
+with its traceback and does not stop the others; every file is written atomically.
 """
 from __future__ import annotations
 
@@ -43,19 +44,41 @@ def build_params(case: Case):
     return with_overrides(base, case.overrides)
 
 
+def _case_cfg(case: Case, cfg):
+    from dataclasses import replace as _replace
+    return cfg if case.window is None else _replace(cfg, window=case.window)
+
+
+def _finished(case: Case, params, cfg) -> dict | None:
+    """The case's summary if it was finished from the same parameters, settings and code, else None
+    (a stale summary is then recomputed, not reused)."""
+    from .runner import run_fingerprint
+
+    done = Path(case.out_dir) / "summary.json"
+    if not done.exists():
+        return None
+    s = json.loads(done.read_text())
+    return s if s.get("fingerprint") == run_fingerprint(params, cfg) else None
+
+
+def _is_finished(case: Case, cfg) -> bool:
+    try:
+        return _finished(case, build_params(case), _case_cfg(case, cfg)) is not None
+    except Exception:     # bad parameters: execute_case reports them
+        return False
+
+
 def execute_case(case: Case, cfg) -> dict:
     """Run one case (on whichever process). Returns its summary, or {"error": ...}; never raises."""
     from .runner import run_case
 
     out = Path(case.out_dir)
-    done = out / "summary.json"
-    if done.exists():
-        return {**json.loads(done.read_text()), "skipped": True}
     try:
         params = build_params(case)
-        if case.window is not None:
-            from dataclasses import replace as _replace
-            cfg = _replace(cfg, window=case.window)
+        cfg = _case_cfg(case, cfg)
+        done = _finished(case, params, cfg)
+        if done is not None:
+            return {**done, "skipped": True}
         s = run_case(params, cfg, out, label={"condition": case.condition, "direction": case.direction})
         err = out / "error.json"
         if err.exists():
@@ -109,7 +132,7 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
     """Run every case; returns {label: summary or error}. One case runs in-process (no cluster)."""
     from tqdm.auto import tqdm
 
-    todo = [c for c in cases if not (Path(c.out_dir) / "summary.json").exists()]
+    todo = [c for c in cases if not _is_finished(c, cfg)]
     results = {c.label: execute_case(c, cfg) for c in cases if c not in todo}   # finished: just load
     if not todo:
         return results

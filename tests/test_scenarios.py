@@ -162,3 +162,34 @@ def test_modal_scenario_single_planetary(tmp_path):
     s4 = modal.run(modal.parse_args(["--out", str(tmp_path / "n4"), "--set", "planets=4"]))
     assert s4["mode_class"].count("planet") == 3 * (4 - 3)   # one planet-mode family of multiplicity N−3
     assert (tmp_path / "mode_shapes.png").exists() and (tmp_path / "modes.csv").exists()
+
+
+def test_stale_results_are_recomputed_not_reused(zero_power_study, tmp_path):
+    """A finished case is reused only when its parameters, settings and code are the same: the
+    fingerprint in summary.json decides (changing a parameter into the same folder recomputes)."""
+    from dataclasses import replace
+
+    from scenarios.runner import run_fingerprint
+    from scenarios.sweep import _case_cfg, _finished, build_params
+
+    import shutil
+
+    out = tmp_path / "study"
+    shutil.copytree(zero_power_study[0], out)       # this test changes the folder
+    a = paper_study.parse_args(["--conditions", "4", "--out", str(out)] + REDUCED)
+    case = paper_study.make_cases(a, out)[0]
+    cfg = _case_cfg(case, paper_study.build_config(a))
+    params = build_params(case)
+    s = json.loads((out / "c4_forward" / "summary.json").read_text())
+    assert s["fingerprint"] == run_fingerprint(params, cfg)
+    assert _finished(case, params, cfg) is not None
+    assert _finished(case, params, replace(cfg, window=2 * cfg.window)) is None
+    other = replace(case, overrides={**case.overrides, "bearing.rollers": "10"})
+    assert _finished(other, build_params(other), cfg) is None
+    # a checkpoint left by another run is not resumed: run_case starts afresh (and says so)
+    a2 = paper_study.parse_args(["--conditions", "4", "--directions", "forward", "--out", str(out), "--settle", "0.002",
+                                 "--window", "0.001", "--set", "bearing.rollers=10", "--no-progress", "--workers", "1"])
+    (out / "c4_forward" / "checkpoint.npz").write_bytes(b"not this run's checkpoint")
+    r = paper_study.run(a2)
+    assert not r["failed"]
+    assert json.loads((out / "c4_forward" / "summary.json").read_text())["rollers"] == 10
