@@ -15,8 +15,9 @@ class FixedStep:
     """Constant h. A step whose Newton iteration fails is retried with h/2 (up to ``max_halvings``
     times) and the controller returns to h afterwards; the error estimate is only reported — except
     that a step whose scaled error estimate exceeds ``reject_error`` (default 1e6: 1 cm at the default
-    10 nm tolerance) is treated as failed: Newton can "converge" onto a blown-up state (forces of
-    1e50 N were seen at h = 20 µs on the DPGT), and such a step must never be accepted."""
+    10 nm tolerance) is treated as failed: a blown-up state must never be accepted (forces of 1e50 N
+    were seen at h = 20 µs on the DPGT while a Newton defect, since fixed, accepted unconverged steps;
+    the guard stays as a second line of defence)."""
     h: float
     max_halvings: int = 6
     reject_error: float = 1e6
