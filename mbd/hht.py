@@ -147,19 +147,21 @@ class HHT:
         return State(t1, q1, v1, a1, f1, z1), info
 
     def _refresh(self, system, cache, t1, q1, v1, z, h, bh2, gh):
-        system.forces(t1, q1, v1, z, jac=True)
+        """New Jacobian + LU at (q1, v1). Returns the forces there (the next Newton iteration is at this
+        very point and reuses them), or None when the Newton matrix is not usable."""
+        F = system.forces(t1, q1, v1, z, jac=True)
         A = system.newton_matrix(1.0, (1.0 + self.alpha) * gh, (1.0 + self.alpha) * bh2)
         system.counters.factor += 1
         cache.h = h
         if not np.all(np.isfinite(A.data)):
             cache.lu = None
-            return False
+            return None
         try:
             cache.lu = spla.splu(A, permc_spec="COLAMD")
         except RuntimeError:          # exactly singular
             cache.lu = None
-            return False
-        return True
+            return None
+        return F
 
     def _newton(self, system, s, cache, t1, qp, vp, a1, bh2, gh, h, M):
         """Newton on a₁. The LU is reused while it contracts well; when the contraction rate exceeds
@@ -172,8 +174,10 @@ class HHT:
         cnt = system.counters
         fresh = False
         refreshes = 0
+        F_here = None                         # forces at the current iterate, when a refresh computed them
         if cache.lu is None or cache.h != h or not self.reuse:
-            if not self._refresh(system, cache, t1, qp + bh2 * a1, vp + gh * a1, s.z, h, bh2, gh):
+            F_here = self._refresh(system, cache, t1, qp + bh2 * a1, vp + gh * a1, s.z, h, bh2, gh)
+            if F_here is None:
                 return a1, StepInfo(False, 0, np.inf, reason="singular Newton matrix", jacobian_refreshed=True)
             fresh = True
         prev = None                           # correction of the previous iteration with the same matrix
@@ -182,7 +186,8 @@ class HHT:
         for it in range(1, self.max_iter + 1):
             q1 = qp + bh2 * a1
             v1 = vp + gh * a1
-            F1 = system.forces(t1, q1, v1, s.z)
+            F1 = system.forces(t1, q1, v1, s.z) if F_here is None else F_here
+            F_here = None
             cnt.newton += 1
             if not np.all(np.isfinite(F1)):
                 return a1, StepInfo(False, it, np.inf, reason="non-finite forces", jacobian_refreshed=fresh)
@@ -205,7 +210,8 @@ class HHT:
                         a1 = a1 + da          # this correction made it worse: linearize at the previous iterate
                     q1 = qp + bh2 * a1
                     v1 = vp + gh * a1
-                    if not self._refresh(system, cache, t1, q1, v1, s.z, h, bh2, gh):
+                    F_here = self._refresh(system, cache, t1, q1, v1, s.z, h, bh2, gh)
+                    if F_here is None:
                         return a1, StepInfo(False, it, rate, reason="singular Newton matrix", jacobian_refreshed=True)
                     fresh = True
                     refreshes += 1
