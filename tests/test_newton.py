@@ -41,3 +41,29 @@ def test_accepted_steps_are_converged_on_the_bearing_rig(h):
     # η‖Δ‖ ≤ newton_tol stops the iteration; the true remaining correction is of that order (10× margin
     # for the estimate η, which is only a model of the contraction)
     assert max(remaining) < 10 * st.newton_tol, f"worst remaining correction {max(remaining):.3g} (scaled)"
+
+
+def test_factorization_falls_back_to_partial_pivoting(monkeypatch):
+    """The Newton matrix is factorized with diagonal pivots; where that meets a zero pivot (SuperLU
+    raises), partial pivoting takes over and the step still converges to the same solution."""
+    import mbd.hht as hht
+
+    prob = rig_problem()
+    system = mbd.System(prob.model)
+    st = mbd.HHT(alpha=-0.3)
+    s = st.initial_state(system, 0.0, prob.built.q0, prob.built.v0)
+    ref, info_ref = st.step(system, s, 5e-6, NewtonCache())
+    real, calls = hht.spla.splu, []
+
+    def no_diagonal_pivots(A, **kw):
+        calls.append(kw.get("permc_spec"))
+        if kw.get("diag_pivot_thresh") == 0.0:
+            raise RuntimeError("Factor is exactly singular")
+        return real(A, **kw)
+
+    monkeypatch.setattr(hht.spla, "splu", no_diagonal_pivots)
+    new, info = st.step(system, s, 5e-6, NewtonCache())
+    assert info.converged and info_ref.converged
+    assert "COLAMD" in calls
+    scale = st.tol.scale(prob.model, s.q, new.q)
+    assert np.max(np.abs(new.q - ref.q) / scale) < 10 * st.newton_tol
