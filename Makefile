@@ -20,8 +20,9 @@ install: $(STAMP)
 demo: $(STAMP)
 	$(PY) -m scenarios.demo --out $(DEMO_OUT)
 
+# one pytest worker per core (pytest-xdist); a test file stays on one worker, so its module fixtures run once
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n auto --dist loadfile
 
 bench: $(STAMP)
 	$(PY) -m scenarios.bench_engine
