@@ -23,7 +23,7 @@ from .hht import HHT, NewtonCache
 from .model import Model, State
 from .recorder import Recorder, atomic_write_bytes
 
-__all__ = ["simulate", "SimResult", "Checkpoint", "save_state", "load_state"]
+__all__ = ["simulate", "SimResult", "Checkpoint", "Observer", "save_state", "load_state"]
 
 
 @dataclass(frozen=True)
@@ -55,34 +55,60 @@ class SimResult:
                 "h_max_s": self.h_max_used, **{f"n_{k}": v for k, v in self.counters.items()}}
 
 
-def save_state(path, s: State, extra: dict | None = None) -> None:
+def save_state(path, s: State, extra: dict | None = None, arrays: dict | None = None) -> None:
+    """State (with element internal states), JSON ``extra`` and named ``arrays`` in one atomic .npz."""
     bio = io.BytesIO()
     z = {f"z__{k}": v for k, v in s.z.items()}
+    arr = {f"x__{k}": np.asarray(v) for k, v in (arrays or {}).items()}
     # numpy scalars (np.int64 counters, indices) are not JSON types: store them as Python numbers
     extra_json = json.dumps(extra or {}, default=lambda o: o.item() if isinstance(o, np.generic) else str(o))
-    np.savez(bio, t=s.t, q=s.q, v=s.v, a=s.a, f=s.f, extra=extra_json, **z)
+    np.savez(bio, t=s.t, q=s.q, v=s.v, a=s.a, f=s.f, extra=extra_json, **z, **arr)
     atomic_write_bytes(path, bio.getvalue())
 
 
-def load_state(path) -> tuple[State, dict]:
+def load_state(path, with_arrays: bool = False):
+    """(state, extra) — and the named arrays with ``with_arrays``."""
     with np.load(path) as d:
         z = {k[3:]: d[k] for k in d.files if k.startswith("z__")}
         s = State(float(d["t"]), d["q"].copy(), d["v"].copy(), d["a"].copy(), d["f"].copy(), z)
         extra = json.loads(str(d["extra"]))
-    return s, extra
+        arrays = {k[3:]: d[k].copy() for k in d.files if k.startswith("x__")}
+    return (s, extra, arrays) if with_arrays else (s, extra)
+
+
+class Observer:
+    """Something the loop calls on every accepted step (statistics, averages, monitors).
+
+    ``bind`` is called once before the first step (also on resume, before ``load_state_dict``),
+    ``step(s0, s1)`` after every accepted step from s0 to s1, ``state_dict``/``load_state_dict`` carry
+    its running state through checkpoints (a dict of numpy arrays), so a resumed run ends identical.
+    """
+
+    def bind(self, model: Model, system: System, state: State) -> None:
+        pass
+
+    def step(self, s0: State, s1: State) -> None:
+        raise TypeError(f"{type(self).__name__} must define step(s0, s1)")
+
+    def state_dict(self) -> dict:
+        return {}
+
+    def load_state_dict(self, d: dict) -> None:
+        pass
 
 
 def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 0.0,
              stepper: HHT | None = None, controller=None, recorder: Recorder | None = None,
              checkpoint: Checkpoint | None = None, resume: bool = False, progress: bool | None = None,
              failed_state_path=None, state: State | None = None, system: System | None = None,
-             on_progress=None) -> SimResult:
+             on_progress=None, observers=()) -> SimResult:
     """Integrate from (t0, q0, v0) — or from ``state`` — to t_end.
 
     ``stepper`` defaults to HHT(α = −0.1); ``controller`` is required (FixedStep or Adaptive), since
     the step size is the user's accuracy decision. Progress bar: on for runs of more than ~2 s wall
     unless ``progress=False`` or the environment sets DPGT_PROGRESS=0. ``on_progress(t, t_end, counters)``
-    is called at most twice a second (e.g. to report progress from a worker process).
+    is called at most twice a second (e.g. to report progress from a worker process). ``observers``
+    (:class:`Observer`) see every accepted step, whatever the recorder's sample rate.
     """
     if controller is None:
         raise ModelError("simulate: pass controller=FixedStep(h) or Adaptive(h0=..., ...)")
@@ -97,16 +123,22 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
     h = controller.initial()
     resumed_from = None
     stats = {"steps": 0, "err_max": 0.0, "err_sq": 0.0, "h_lo": np.inf, "h_hi": 0.0}
+    observers = list(observers)
     if recorder is not None:
         recorder.bind(model, system, state)
+    for ob in observers:
+        ob.bind(model, system, state)
     if checkpoint is not None and resume and Path(checkpoint.path).exists():
-        state, extra = load_state(checkpoint.path)
+        state, extra, arrays = load_state(checkpoint.path, with_arrays=True)
         h = extra["h"]
         stats = extra["stats"]
         for k, val in extra["counters"].items():
             setattr(system.counters, k, val)
         if recorder is not None:
             recorder.restore(extra["recorder"])
+        for i, ob in enumerate(observers):
+            pre = f"obs{i}__"
+            ob.load_state_dict({k[len(pre):]: v for k, v in arrays.items() if k.startswith(pre)})
         resumed_from = state.t
     elif recorder is not None:
         recorder.reset()
@@ -132,6 +164,8 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
             system.counters.accepted += 1
             if recorder is not None:
                 recorder.record(state, new)
+            for ob in observers:
+                ob.step(state, new)
             state = new
             stats["steps"] += 1
             stats["err_max"] = max(stats["err_max"], info.error)
@@ -142,8 +176,9 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
             bar.update(state.t, system.counters)
             if checkpoint is not None and stats["steps"] % checkpoint.every == 0:
                 rec = recorder.checkpoint_state() if recorder is not None else {}
+                obs = {f"obs{i}__{k}": v for i, ob in enumerate(observers) for k, v in ob.state_dict().items()}
                 save_state(checkpoint.path, state, {"h": h, "stats": stats, "counters": system.counters.as_dict(),
-                                                    "recorder": rec})
+                                                    "recorder": rec}, arrays=obs)
                 cache.lu = None
     finally:
         bar.close()

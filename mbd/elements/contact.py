@@ -11,6 +11,9 @@ Regularisations (all smooth, documented where they are made):
   real bearing distance, finite derivatives when two centres coincide (a centred cage at t = 0);
 - friction laws are tanh-regularised Coulomb laws (no stick state in a stateless element);
 - the EHL traction curve uses a regularised slide-to-roll ratio (see :class:`Traction`).
+
+The pocket and guide-land impacts carry internal state (the approach speed of the current impact, for
+Hunt–Crossley damping that gives the set restitution at any speed), so those families are never fused.
 """
 from __future__ import annotations
 
@@ -22,7 +25,7 @@ from .. import ad
 from ..element import Element, body_dofs, marker, marker_velocity, point_force
 from ..errors import ModelError
 
-__all__ = ["Traction", "RaceContact", "PocketContact", "GuideContact", "LubricantDrag"]
+__all__ = ["Traction", "RaceContact", "PocketContact", "GuideContact", "LubricantDrag", "restitution_lambda"]
 
 _ETA2 = 1e-24  # (1e-12 m)²: below round-off of any physical distance squared, keeps norms nonzero
 
@@ -32,21 +35,105 @@ def _norm(x, y):
     return ad.sqrt(x * x + y * y + _ETA2)
 
 
-def _fraction(elem: Element, name: str, value) -> np.ndarray:
-    a = elem._per_instance(name, value, nonneg=True)
-    if np.any(a > 1.0):
-        raise ModelError(f"{elem.name}: parameter {name!r} must lie in [0, 1], got {value!r}")
+def _multiplicity(elem: Element, value) -> np.ndarray:
+    """(n,) positive integer-valued multiplicity: identical parallel contacts acting as one instance."""
+    a = elem._per_instance("multiplicity", value, positive=True)
+    if np.any(a != np.round(a)):
+        raise ModelError(f"{elem.name}: parameter 'multiplicity' must be a positive integer (number of identical "
+                         f"parallel contacts), got {value!r}")
     return a
 
 
-def _hunt_crossley(k, pen, pen_dot, restitution, v_ref):
-    """k·pen·(1 + 1.5(1 − e)·ṗen/v_ref) for pen > 0, clipped at ≥ 0 (never pulling), else 0.
+def _scaled(forces, mult, scale: bool):
+    """Generalized forces of one physical contact times its multiplicity (skipped when all are 1)."""
+    return [f * mult for f in forces] if scale else forces
 
-    The true Hunt–Crossley law scales damping with the impact velocity, which a stateless element
-    cannot know; a fixed reference impact velocity v_ref stands in for it (an assumption)."""
-    F = k * pen * (1.0 + 1.5 * (1.0 - restitution) * pen_dot / v_ref)
-    active = (ad.value(pen) > 0.0) & (ad.value(F) > 0.0)
-    return ad.where(active, F, 0.0)
+
+def _restitution_lambda_one(e: float) -> float:
+    """λ > 0 with ln((1 + λ)/(1 − λe)) = λ(1 + e), for 0 < e < 1.
+
+    Root of h(λ) = g(λ)/λ², g the residual: h(0) = (e² − 1)/2 < 0 and h → +∞ as λ → 1/e. Near λ = 0
+    h is summed from its series Σ_{k≥2} λ^(k−2)(e^k − (−1)^k)/k (no cancellation as e → 1); the unknown is
+    y = −ln(1 − λe) ∈ (0, ∞), which keeps λ → 1/e resolvable for small e."""
+    from scipy.optimize import brentq
+
+    k = np.arange(2, 40)
+    ck = np.where(k % 2 == 0, np.expm1(k * np.log(e)), e ** k + 1.0) / k
+
+    def h(y):
+        lam = -np.expm1(-y) / e
+        if lam < 0.25:                       # series: terms fall by ≥ 4× each, 38 terms reach round-off
+            return float(np.sum(ck * lam ** (k - 2)))
+        return (np.log1p(lam) + y - lam * (1.0 + e)) / (lam * lam)
+
+    y_hi = (1.0 + e) / e + 1.0              # g(y_hi) > y_hi − (1 + e)/e = 1 > 0
+    y = brentq(h, 0.0, y_hi, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
+    return float(-np.expm1(-y) / e)
+
+
+def restitution_lambda(e) -> np.ndarray:
+    """Dimensionless Hunt–Crossley damping λ(e) = c·v₀ that gives the coefficient of restitution e exactly.
+
+    For m ẍ = −K xⁿ (1 + c ẋ), v dv/(1 + c v) = −(K/m) xⁿ dx; integrated over the impact (x: 0 → 0, ẋ: v₀ →
+    −e v₀) the potential term cancels:  ln((1 + λ)/(1 − λe)) = λ(1 + e),  λ = c v₀,  for any n, K, m.
+    λ(1) = 0; λ ≈ 3(1 − e)/2 as e → 1 (Hunt–Crossley); λ → 1/e as e → 0. ``e`` in (0, 1], scalar or array."""
+    e = np.asarray(e, dtype=float)
+    u, inv = np.unique(e, return_inverse=True)
+    lam = np.array([0.0 if x >= 1.0 else _restitution_lambda_one(float(x)) for x in u])
+    return lam[inv].reshape(e.shape)
+
+
+class _Impact(Element):
+    """Hunt–Crossley impact with the real approach speed (MODEL.md §3.4), shared by the pocket and
+    guide-land contacts. Subclasses define ``_gap(q, v) -> (x, ẋ)`` (penetration and its rate).
+
+    F = K x (1 + c ẋ) for x > 0, clipped at ≥ 0 (never pulling), else 0;  c = λ(e)/v₀ with λ(e) from
+    :func:`restitution_lambda` and v₀ the approach speed ẋ at this impact's onset (internal state).
+    Internal state z, (n, 4): [v₀ (0 = not in contact), x, ẋ, valid] — x, ẋ at the last accepted state
+    (valid = 1 once set). After each accepted step: open at the end → v₀ = 0; closed and v₀ was 0 (a new
+    impact) → v₀ = ẋ at the sign change of x, linearly interpolated between the step's ends (the end rate
+    if the step started in contact); closed and v₀ > 0 → kept; always v₀ = max(v₀, v_min). Within the
+    Newton iterations of the step where contact begins (stored v₀ = 0) the iterate's max(ẋ, v_min) is
+    used, so the kernel is stateless within a step and differentiable."""
+
+    def _impact_params(self, restitution, v_min):
+        e = self._per_instance("restitution", restitution)
+        if np.any(e <= 0.0) or np.any(e > 1.0):
+            raise ModelError(f"{self.name}: parameter 'restitution' must lie in (0, 1] (0, perfectly plastic, "
+                             f"would need infinite damping), got {restitution!r}")
+        self.restitution = e
+        self.v_min = self._per_instance("v_min", v_min, positive=True)
+        self.lam = restitution_lambda(e)
+
+    def init_internal(self):
+        return np.zeros((self.n, 4))
+
+    def update_internal(self, z, t0, t1, fs0, fs1, q0, v0, q1, v1):
+        x1, xd1 = self._gap(q1, v1)
+        x0, xd0 = z[:, 1], z[:, 2]
+        valid = z[:, 3] > 0
+        if not np.all(valid):                              # first step: the start state is not cached
+            xs, xds = self._gap(q0, v0)
+            x0, xd0 = np.where(valid, x0, xs), np.where(valid, xd0, xds)
+        closed = x1 > 0.0
+        opened = x0 <= 0.0                                 # start out of contact: interpolate the onset
+        den = np.where(opened & closed, x0 - x1, -1.0)
+        theta = x0 / den
+        onset = np.where(opened, xd0 + theta * (xd1 - xd0), xd1)
+        v_app = np.where(z[:, 0] > 0.0, z[:, 0], onset)
+        v_app = np.where(closed, np.maximum(v_app, self.v_min), 0.0)
+        return np.column_stack([v_app, x1, xd1, np.ones(self.n)])
+
+    def _impact_force(self, K, x, xd, z):
+        """(F, v₀ in use): F = K x (1 + λ ẋ/v₀) ≥ 0 for x > 0, else 0."""
+        v_min = self.v_min
+        v_app = ad.where(ad.value(xd) > v_min, xd, v_min)  # contact beginning in this step
+        if z is not None:
+            v_app = ad.where(z[:, 0] > 0.0, z[:, 0], v_app)
+        F = K * x * (1.0 + self.lam * xd / v_app)
+        touch = ad.value(x) > 0.0
+        active = touch & (ad.value(F) > 0.0)
+        return ad.where(active, F, 0.0), np.where(touch, ad.value(v_app), 0.0)
 
 
 # --------------------------------------------------------------------------------------------
@@ -115,14 +202,19 @@ class RaceContact(Element):
     point P = c + R e (line of centres, raceway surface); force −μ·Q along t on the roller. The normal
     and traction forces act at P on both bodies, equal and opposite.
 
-    Outputs: "load" Q ≥ 0 [N]; "deflection" δ [m] (negative: a gap); "traction" tangential force on the
-    roller along t [N] (opposes v_s); "slip_velocity" v_s [m/s]; "angle" the roller centre's angle about
-    the raceway centre measured in the race body's axes [rad] (wrapped to (−π, π]).
+    ``multiplicity`` (default 1, a positive integer): the instance stands for that many identical parallel
+    contacts (a double-row bearing modelled as one row): the law above is one physical contact's (K, and
+    m_roller the mass of one physical roller), and the generalized forces are multiplied by it.
+
+    Outputs, all per physical contact: "load" Q ≥ 0 [N]; "deflection" δ [m] (negative: a gap); "traction"
+    tangential force on the roller along t [N] (opposes v_s); "slip_velocity" v_s [m/s]; "angle" the roller
+    centre's angle about the raceway centre measured in the race body's axes [rad] (wrapped to (−π, π]);
+    "fx", "fy" the contact force on one physical roller, in R [N].
     """
     k = 6
 
     def __init__(self, name, roller, race_body, *, kind, race_marker, R_race, D, K, exponent=10.0 / 9.0,
-                 zeta=0.05, m_roller, traction: Traction = Traction()):
+                 zeta=0.05, m_roller, traction: Traction = Traction(), multiplicity=1):
         self.name = name
         self.dofs = body_dofs(roller, race_body)
         if kind not in ("inner", "outer"):
@@ -144,8 +236,10 @@ class RaceContact(Element):
         self.traction = traction
         self._c0 = 2.0 * self.zeta * np.sqrt(self.m_roller * self.exponent * self.K)
         self.kappa = np.full(self.n, self.kappa)   # per instance: inner and outer families can be fused
+        self.multiplicity = _multiplicity(self, multiplicity)
+        self._multi = bool(np.any(self.multiplicity != 1.0))
 
-    _FUSED = ("dofs", "race_marker", "R_race", "D", "K", "zeta", "m_roller", "_c0", "kappa")
+    _FUSED = ("dofs", "race_marker", "R_race", "D", "K", "zeta", "m_roller", "_c0", "kappa", "multiplicity")
 
     def fuse_key(self):
         return ("RaceContact", self.exponent, self.traction)
@@ -155,6 +249,7 @@ class RaceContact(Element):
         """One family holding the instances of several (inner and outer raceways alike)."""
         f = super().fuse(parts)
         f.kind, f.exponent, f.traction = None, parts[0].exponent, parts[0].traction
+        f._multi = bool(np.any(f.multiplicity != 1.0))
         return f
 
     def kernel(self, t, fs, q, v, z):
@@ -192,56 +287,74 @@ class RaceContact(Element):
         Fx = kap * Q * ex + Ft * tx
         Fy = kap * Q * ey + Ft * ty
         forces = point_force(r_roll, (Fx, Fy)) + point_force(r_race, (-1.0 * Fx, -1.0 * Fy))
+        forces = _scaled(forces, self.multiplicity, self._multi)
         angle = ad.wrap_angle(ad.arctan2(dy, dx) - qb[2])
         return forces, {"load": Q, "deflection": delta, "traction": Ft, "slip_velocity": v_s, "angle": angle,
-                        "fx": Fx, "fy": Fy}   # fx, fy: total force on the roller, in R
+                        "fx": Fx, "fy": Fy}   # fx, fy: force on one physical roller, in R
 
 
 # --------------------------------------------------------------------------------------------
-class PocketContact(Element):
+class PocketContact(_Impact):
     """Roller–cage pocket impact with wall friction (MODEL.md §3.4).
 
     Instances couple a roller (first 3 coordinates) with its cage (last 3). Circumferential offset of
     the roller in pocket j: s = (d_m/2)·wrap(β − θ_g − ψ_j), β the angle of (p − c_g) in R. Penetration
-    d = |s| − C_p; for d > 0 the contact force is F = K_p d (1 + 1.5(1 − e) ḋ / v_ref) ≥ 0 (Hunt–Crossley
-    with a fixed reference impact velocity v_ref: an assumption, a stateless element cannot know the
-    real impact velocity). It is applied in potential form, generalized force −F·∂d/∂q, which balances
-    forces and moments exactly: the roller is pushed back along the pitch circle towards the pocket
-    centre, the cage gets the opposite force and the moment F·sign(s)·d_m/2.
+    d = |s| − C_p, rate ḋ = sign(s)·ṡ; for d > 0 the contact force is Hunt–Crossley with the real approach
+    speed (see :class:`_Impact`): F = K_p d (1 + λ(e) ḋ/v₀) ≥ 0, v₀ = ḋ at this impact's onset. It is
+    applied in potential form, generalized force −F·∂d/∂q, which balances forces and moments exactly: the
+    roller is pushed back along the pitch circle towards the pocket centre, the cage gets the opposite
+    force and the moment F·sign(s)·d_m/2.
     Wall friction: the roller touches the wall at P_w = p + sign(s)·(D/2)·t (t = k × e_r, e_r radial
     from the cage centre); μ·tanh(v/v_mu)·F along ∓e_r opposes the radial sliding v of the roller surface
     on the wall (the wall taken along the roller's radial line), applied at P_w on both bodies.
+    ``multiplicity`` (default 1): identical parallel pockets per instance; the law is one physical contact's,
+    the generalized forces are multiplied by it.
 
-    Outputs: "force" signed tangential force F·sign(s) [N] (+ when the roller pushes the cage forward);
-    "offset" s [m]; "penetration" max(d, 0) [m].
+    Internal state ``z`` (n, 4): column 0 is v₀ [m/s], the approach speed of the current impact (0 = not
+    in contact; it becomes > 0 in the first accepted step that ends in contact, so an onset is a 0 → > 0
+    change of column 0); columns 1, 2, 3 are d [m], ḋ [m/s] at the last accepted state and a valid flag.
+
+    Outputs, per physical contact: "force" signed tangential force F·sign(s) [N] (+ when the roller pushes
+    the cage forward); "offset" s [m]; "penetration" max(d, 0) [m]; "penetration_rate" ḋ [m/s] (+ when
+    closing); "approach_speed" v₀ in use [m/s] (0 out of contact).
     """
     k = 6
 
-    def __init__(self, name, roller, cage, *, pocket_angle, pitch_radius, clearance, K_p, restitution=0.8,
-                 v_ref=0.1, mu=0.1, v_mu=0.05, D):
+    def __init__(self, name, roller, cage, *, pocket_angle, pitch_radius, clearance, K_p, restitution,
+                 v_min, mu, v_mu, D, multiplicity=1):
         self.name = name
         self.dofs = body_dofs(roller, cage)
         self.pocket_angle = self._per_instance("pocket_angle", pocket_angle)
         self.pitch_radius = self._per_instance("pitch_radius", pitch_radius, positive=True)
         self.clearance = self._per_instance("clearance", clearance, nonneg=True)
         self.K_p = self._per_instance("K_p", K_p, positive=True)
-        self.restitution = _fraction(self, "restitution", restitution)
-        self.v_ref = self._per_instance("v_ref", v_ref, positive=True)
+        self._impact_params(restitution, v_min)
         self.mu = self._per_instance("mu", mu, nonneg=True)
         self.v_mu = self._per_instance("v_mu", v_mu, positive=True)
         self.D = self._per_instance("D", D, positive=True)
+        self.multiplicity = _multiplicity(self, multiplicity)
+        self._multi = bool(np.any(self.multiplicity != 1.0))
 
-    def kernel(self, t, fs, q, v, z):
+    def _geometry(self, q, v):
         qr, qg, vr, vg = q[:3], q[3:], v[:3], v[3:]
         rm = self.pitch_radius
         dx, dy = qr[0] - qg[0], qr[1] - qg[1]
         rho2 = dx * dx + dy * dy + _ETA2
         s = rm * ad.wrap_angle(ad.arctan2(dy, dx) - qg[2] - self.pocket_angle)
         sg = ad.sign(s)
-        pen = ad.abs_(s) - self.clearance
         wx, wy = vr[0] - vg[0], vr[1] - vg[1]
         s_dot = rm * ((dx * wy - dy * wx) / rho2 - vg[2])
-        F = _hunt_crossley(self.K_p, pen, sg * s_dot, self.restitution, self.v_ref)
+        return dx, dy, rho2, s, sg, ad.abs_(s) - self.clearance, sg * s_dot
+
+    def _gap(self, q, v):
+        g = self._geometry(q, v)
+        return g[5], g[6]
+
+    def kernel(self, t, fs, q, v, z):
+        vr, vg = v[:3], v[3:]
+        rm = self.pitch_radius
+        dx, dy, rho2, s, sg, pen, pen_dot = self._geometry(q, v)
+        F, v_app = self._impact_force(self.K_p, pen, pen_dot, z)
         Fs = F * sg
         # −Fs ∂s/∂q: ∂s/∂p = rm (−dy, dx)/ρ², ∂s/∂c_g = −∂s/∂p, ∂s/∂θ_g = −rm
         gx, gy = rm * (-1.0 * dy) / rho2, rm * dx / rho2
@@ -260,44 +373,60 @@ class PocketContact(Element):
         fg = point_force(r_wg, (-1.0 * f * ex, -1.0 * f * ey))
         forces = [fnx + fr[0], fny + fr[1], fr[2],
                   -1.0 * fnx + fg[0], -1.0 * fny + fg[1], Fs * rm + fg[2]]
-        return forces, {"force": Fs, "offset": s, "penetration": ad.pos(pen)}
+        forces = _scaled(forces, self.multiplicity, self._multi)
+        return forces, {"force": Fs, "offset": s, "penetration": ad.pos(pen), "penetration_rate": pen_dot,
+                        "approach_speed": v_app}
 
 
 # --------------------------------------------------------------------------------------------
-class GuideContact(Element):
+class GuideContact(_Impact):
     """Cage–guide-land impact for an outer-raceway-guided cage (MODEL.md §3.5).
 
     Instances couple a cage (first 3 coordinates) with its planet (last 3; the planet's centre is the
-    bore centre). e = c_g − c_o, ε = |e|, n = e/ε. For ε > C_g the normal force
-    F_n = K_g (ε − C_g)(1 + 1.5(1 − e_r) ε̇ / v_ref) ≥ 0 pushes the cage along −n (back to the bore centre)
-    and the planet along +n. Both act at the land contact point P = c_g + land_radius·n. Land friction
-    μ·tanh(v_t/v_mu)·F_n opposes the relative surface speed v_t = (V_cage(P) − V_planet(P))·t, t = k × n.
-    The centred cage (ε = 0) is regular: the safe norm keeps n finite and the forces are zero there.
+    bore centre). e = c_g − c_o, ε = |e|, n = e/ε, penetration x = ε − C_g, rate ẋ = ε̇. For x > 0 the
+    normal force is Hunt–Crossley with the real approach speed (see :class:`_Impact`):
+    F_n = K_g x (1 + λ(e_r) ε̇/v₀) ≥ 0, v₀ = ε̇ at this impact's onset; it pushes the cage along −n (back to
+    the bore centre) and the planet along +n. Both act at the land contact point P = c_g + land_radius·n.
+    Land friction μ·tanh(v_t/v_mu)·F_n opposes the relative surface speed v_t = (V_cage(P) − V_planet(P))·t,
+    t = k × n. The centred cage (ε = 0) is regular: the safe norm keeps n finite and the forces are zero.
 
-    Outputs: "force" F_n ≥ 0 [N]; "eccentricity" ε [m]; "friction" tangential force on the cage along t [N].
+    Internal state ``z`` (n, 4): column 0 is v₀ [m/s], the approach speed of the current impact (0 = not
+    in contact; an onset is a 0 → > 0 change of column 0 after an accepted step); columns 1, 2, 3 are x [m],
+    ẋ [m/s] at the last accepted state and a valid flag.
+
+    Outputs: "force" F_n ≥ 0 [N]; "eccentricity" ε [m]; "friction" tangential force on the cage along t [N];
+    "fx", "fy" force on the cage, in R [N]; "penetration_rate" ε̇ [m/s]; "approach_speed" v₀ in use [m/s]
+    (0 out of contact).
     """
     k = 6
 
-    def __init__(self, name, cage, planet, *, clearance, K_g, restitution=0.8, v_ref=0.1, mu=0.1, v_mu=0.05,
-                 land_radius):
+    def __init__(self, name, cage, planet, *, clearance, K_g, restitution, v_min, mu, v_mu, land_radius):
         self.name = name
         self.dofs = body_dofs(cage, planet)
         self.clearance = self._per_instance("clearance", clearance, nonneg=True)
         self.K_g = self._per_instance("K_g", K_g, positive=True)
-        self.restitution = _fraction(self, "restitution", restitution)
-        self.v_ref = self._per_instance("v_ref", v_ref, positive=True)
+        self._impact_params(restitution, v_min)
         self.mu = self._per_instance("mu", mu, nonneg=True)
         self.v_mu = self._per_instance("v_mu", v_mu, positive=True)
         self.land_radius = self._per_instance("land_radius", land_radius, positive=True)
 
-    def kernel(self, t, fs, q, v, z):
+    def _geometry(self, q, v):
         qg, qo, vg, vo = q[:3], q[3:], v[:3], v[3:]
         ex, ey = qg[0] - qo[0], qg[1] - qo[1]
         eps = _norm(ex, ey)
         nx, ny = ex / eps, ey / eps
-        tx, ty = -1.0 * ny, nx
         eps_dot = nx * (vg[0] - vo[0]) + ny * (vg[1] - vo[1])
-        F = _hunt_crossley(self.K_g, eps - self.clearance, eps_dot, self.restitution, self.v_ref)
+        return ex, ey, nx, ny, eps - self.clearance, eps_dot
+
+    def _gap(self, q, v):
+        g = self._geometry(q, v)
+        return g[4], g[5]
+
+    def kernel(self, t, fs, q, v, z):
+        vg, vo = v[:3], v[3:]
+        ex, ey, nx, ny, pen, eps_dot = self._geometry(q, v)
+        tx, ty = -1.0 * ny, nx
+        F, v_app = self._impact_force(self.K_g, pen, eps_dot, z)
         rL = self.land_radius
         r_g = (rL * nx, rL * ny)
         r_o = (ex + r_g[0], ey + r_g[1])
@@ -309,7 +438,8 @@ class GuideContact(Element):
         Fy = -1.0 * F * ny + fr * ty
         forces = point_force(r_g, (Fx, Fy)) + point_force(r_o, (-1.0 * Fx, -1.0 * Fy))
         ecc = np.hypot(ad.value(ex), ad.value(ey))  # the plain norm for the record
-        return forces, {"force": F, "eccentricity": ecc, "friction": fr, "fx": Fx, "fy": Fy}  # fx, fy on the cage, in R
+        return forces, {"force": F, "eccentricity": ecc, "friction": fr, "fx": Fx, "fy": Fy,  # fx, fy on the cage, in R
+                        "penetration_rate": eps_dot, "approach_speed": v_app}
 
 
 # --------------------------------------------------------------------------------------------
@@ -323,11 +453,14 @@ class LubricantDrag(Element):
     applied at the roller centre along −t (t = k × e, e from pin centre to roller): it opposes the
     orbital motion relative to the race body. The race body gets the reaction at the same point.
 
-    Output: "force" signed F_d [N] (the drag on the roller is −force·t).
+    ``multiplicity`` (default 1): identical parallel rollers per instance; C_d, D, l are one roller's and
+    the generalized forces are multiplied by it.
+
+    Output: "force" signed F_d [N] on one physical roller (the drag on it is −force·t).
     """
     k = 6
 
-    def __init__(self, name, roller, race_body, *, race_marker, C_d, rho, D, l, d_m):
+    def __init__(self, name, roller, race_body, *, race_marker, C_d, rho, D, l, d_m, multiplicity=1):
         self.name = name
         self.dofs = body_dofs(roller, race_body)
         self.race_marker = self._per_instance_xy("race_marker", race_marker)
@@ -337,6 +470,8 @@ class LubricantDrag(Element):
         l = self._per_instance("l", l, positive=True)
         d_m = self._per_instance("d_m", d_m, positive=True)
         self.coef = 0.125 * C_d * rho * D * l * d_m * d_m
+        self.multiplicity = _multiplicity(self, multiplicity)
+        self._multi = bool(np.any(self.multiplicity != 1.0))
 
     def kernel(self, t, fs, q, v, z):
         qr, qb, vr, vb = q[:3], q[3:], v[:3], v[3:]
@@ -351,4 +486,4 @@ class LubricantDrag(Element):
         Fx, Fy = Fd * dy / rho, -1.0 * Fd * dx / rho   # −Fd·t, t = (−dy, dx)/ρ
         zero = 0.0 * qr[0]
         forces = [Fx, Fy, zero] + point_force((rc[0] + dx, rc[1] + dy), (-1.0 * Fx, -1.0 * Fy))
-        return forces, {"force": Fd}
+        return _scaled(forces, self.multiplicity, self._multi), {"force": Fd}
