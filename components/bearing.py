@@ -13,6 +13,7 @@ import numpy as np
 from mbd.elements import BodySpring
 from mbd.elements.contact import GuideContact, LubricantDrag, PocketContact, RaceContact, Traction
 
+from .outputs import FAMILY
 from .scene import Scene
 
 __all__ = ["BearingSI", "add_planet_bearing", "bearing_kinematics", "bearing_si"]
@@ -25,8 +26,9 @@ class BearingSI:
     D: float
     l: float
     Z: int
+    rows: int                   # identical rows, moving as one (every per-roller force is per physical roller)
     clearance: float            # diametral P_d
-    roller_mass: float
+    roller_mass: float          # one physical roller
     roller_inertia: float
     K: float                    # roller–raceway line contact stiffness [N/m^(10/9)]
     zeta: float                 # roller–raceway contact damping ratio
@@ -43,8 +45,8 @@ class BearingSI:
     mu_guide: float
     C_d: float
     rho: float
-    v_ref: float = 0.1          # Hunt–Crossley reference impact speed [assumed]
-    v_mu: float = 0.01          # friction regularisation speed at pocket walls/land [assumed]
+    v_min: float                # smallest approach speed of the impact damping
+    v_mu: float                 # friction regularisation speed at pocket walls and land
     linear_stiffness: float = 5e8   # radial stiffness when bearings are linear springs [N/m]
     linear_damping: float = 2e3     # [N·s/m]
 
@@ -61,12 +63,12 @@ def bearing_si(bs, lub) -> BearingSI:
     """BearingSI from the SI views of BearingParams (``params.si().bearing``) and LubricantParams."""
     c = bs.cage
     return BearingSI(d_m=bs.pitch_diameter, D=bs.roller_diameter, l=bs.roller_length, Z=int(bs.rollers),
-                     clearance=bs.clearance, roller_mass=bs.roller_mass, roller_inertia=bs.roller_inertia,
+                     rows=int(bs.rows), clearance=bs.clearance, roller_mass=bs.roller_mass, roller_inertia=bs.roller_inertia,
                      K=bs.contact_stiffness, zeta=bs.contact_damping_ratio, mu_max=bs.traction_mu_max,
                      v0=bs.traction_v0, cage_mass=c.mass, cage_inertia=c.inertia, C_p=c.pocket_clearance,
                      C_g=c.guide_clearance, K_p=c.pocket_stiffness, K_g=c.guide_stiffness,
                      restitution=c.restitution, mu_pocket=c.pocket_friction, mu_guide=c.guide_friction,
-                     C_d=lub.drag_coefficient, rho=lub.density)
+                     C_d=lub.drag_coefficient, rho=lub.density, v_min=c.impact_speed_floor, v_mu=c.friction_speed)
 
 
 def bearing_kinematics(b: BearingSI, omega_inner: float, omega_outer: float) -> tuple[float, float]:
@@ -86,7 +88,7 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
     opt = scene.options
     pin_local = np.asarray(pin_local, float)
     if opt.bearings == "linear":
-        fam = scene.family("bearing_linear", BodySpring, ("body_a", "body_b"))
+        fam = scene.family(FAMILY["linear"], BodySpring, ("body_a", "body_b"))
         sl = fam.add(1, body_a=[pin_body], body_b=[outer_body], k=b.linear_stiffness, c=b.linear_damping,
                      marker_a=pin_local[None, :], marker_b=np.zeros((1, 2)))
         return {"kind": "linear", "spring": sl}
@@ -106,34 +108,34 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
     for j in range(Z):
         off = rho * np.array([np.cos(psi[j]), np.sin(psi[j])])
         vel = pin_vel + wm * np.array([-off[1], off[0]])
-        rollers.append(scene.body(f"{tag}.roller{j}", b.roller_mass, b.roller_inertia,
+        rollers.append(scene.body(f"{tag}.roller{j}", b.rows * b.roller_mass, b.rows * b.roller_inertia,
                                   pose=(*(pin_xy + off), 0.0), vel=(*vel, wr)))
     names = [f"{tag}.roller{j}" for j in range(Z)]
     marker = np.tile(pin_local, (Z, 1))
     traction = Traction(kind="tanh", mu_max=b.mu_max, v0=b.v0)
-    common = dict(D=b.D, K=b.K, zeta=b.zeta, m_roller=b.roller_mass)
-    inner = scene.family("race_inner", RaceContact, ("roller", "race_body"), kind="inner", traction=traction)
+    common = dict(D=b.D, K=b.K, zeta=b.zeta, m_roller=b.roller_mass, multiplicity=b.rows)
+    inner = scene.family(FAMILY["race_inner"], RaceContact, ("roller", "race_body"), kind="inner", traction=traction)
     s_in = inner.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker, R_race=b.R_i, **common)
-    outer = scene.family("race_outer", RaceContact, ("roller", "race_body"), kind="outer", traction=traction)
+    outer = scene.family(FAMILY["race_outer"], RaceContact, ("roller", "race_body"), kind="outer", traction=traction)
     s_out = outer.add(Z, roller=names, race_body=[outer_body] * Z, race_marker=np.zeros((Z, 2)), R_race=b.R_o,
                       **common)
     h = {"kind": "rollers", "rollers": names, "race_inner": s_in, "race_outer": s_out,
          "omega_cage": wm, "omega_roller": wr}
     if opt.drag:
-        drag = scene.family("drag", LubricantDrag, ("roller", "race_body"))
+        drag = scene.family(FAMILY["drag"], LubricantDrag, ("roller", "race_body"))
         h["drag"] = drag.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker, C_d=b.C_d,
-                             rho=b.rho, D=b.D, l=b.l, d_m=b.d_m)
+                             rho=b.rho, D=b.D, l=b.l, d_m=b.d_m, multiplicity=b.rows)
     if opt.cage:
         cage = f"{tag}.cage"
         scene.body(cage, b.cage_mass, b.cage_inertia, pose=(*pin_xy, 0.0), vel=(*pin_vel, wm), fixed=cage_held)
-        pocket = scene.family("pocket", PocketContact, ("roller", "cage"))
+        pocket = scene.family(FAMILY["pocket"], PocketContact, ("roller", "cage"))
         h["pocket"] = pocket.add(Z, roller=names, cage=[cage] * Z, pocket_angle=psi, pitch_radius=0.5 * b.d_m,
-                                 clearance=b.C_p, K_p=b.K_p, restitution=b.restitution, v_ref=b.v_ref,
-                                 mu=b.mu_pocket, v_mu=b.v_mu, D=b.D)
+                                 clearance=b.C_p, K_p=b.K_p, restitution=b.restitution, v_min=b.v_min,
+                                 mu=b.mu_pocket, v_mu=b.v_mu, D=b.D, multiplicity=b.rows)
         if not cage_held:
-            guide = scene.family("guide", GuideContact, ("cage", "planet"))
+            guide = scene.family(FAMILY["guide"], GuideContact, ("cage", "planet"))
             h["guide"] = guide.add(1, cage=[cage], planet=[outer_body], clearance=b.C_g, K_g=b.K_g,
-                                   restitution=b.restitution, v_ref=b.v_ref, mu=b.mu_guide,
+                                   restitution=b.restitution, v_min=b.v_min, mu=b.mu_guide, v_mu=b.v_mu,
                                    land_radius=0.5 * (b.d_m + b.D))
         h["cage"] = cage
     return h

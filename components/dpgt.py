@@ -18,6 +18,7 @@ from mbd.elements import GroundSupport, Ramp, SpeedDrive, TorqueSource
 from .bearing import add_planet_bearing, bearing_si
 from .gears import add_mesh_family
 from .geometry import check_design, layout, loaded_flanks
+from .outputs import MESH_FAMILY
 from .params import DPGTParams
 from .scene import BuiltScene, Scene, SceneOptions
 
@@ -79,13 +80,13 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, rig: Rig
     T_s = op.sun_torque
     flanks = loaded_flanks(np.sign(T_s) if T_s != 0 else np.sign(W["sun"]))
     common = dict(time_varying=opt.mesh_stiffness == "time_varying", smoothing=ms.smoothing_width,
-                  ratio=ms.stiffness_ratio, backlash=ms.backlash)
+                  ratio=ms.stiffness_ratio)
     M = lay.meshes
-    add_mesh_family(scene, "mesh_sa", M["sun_inner"], gear1=["sun"] * N, gear2=a_names, theta1_0=np.zeros(N),
+    add_mesh_family(scene, MESH_FAMILY["sun_inner"], M["sun_inner"], gear1=["sun"] * N, gear2=a_names, theta1_0=np.zeros(N),
                     theta2_0=ph.gamma_inner, flank=flanks["sun_inner"], **common)
-    add_mesh_family(scene, "mesh_ab", M["inner_outer"], gear1=a_names, gear2=b_names, theta1_0=ph.gamma_inner,
+    add_mesh_family(scene, MESH_FAMILY["inner_outer"], M["inner_outer"], gear1=a_names, gear2=b_names, theta1_0=ph.gamma_inner,
                     theta2_0=ph.gamma_outer, flank=flanks["inner_outer"], **common)
-    add_mesh_family(scene, "mesh_br", M["outer_ring"], gear1=b_names, gear2=["ring"] * N, theta1_0=ph.gamma_outer,
+    add_mesh_family(scene, MESH_FAMILY["outer_ring"], M["outer_ring"], gear1=b_names, gear2=["ring"] * N, theta1_0=ph.gamma_outer,
                     theta2_0=np.full(N, ph.gamma_ring), flank=flanks["outer_ring"], **common)
 
     # drives: sun torque (driving motor), carrier speed drive (loading motor)
@@ -108,6 +109,6 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, rig: Rig
         "speeds_rad_s": {"sun": W["sun"], "inner_planet": W["a"], "outer_planet": W["b"], "carrier": wc},
         "f_c_hz": abs(op.carrier_frequency), "f_m_hz": f_m, "sun_torque_Nm": T_s, "carrier_torque_Nm": op.carrier_torque,
         "ramp_s": ramp_t, "ring_mismatch_teeth": [float(x) for x in ph.ring_mismatch], "planets": N,
-        "rollers": b.Z, "direction": op.direction, "frame": opt.frame, "bearing": b,
+        "rollers": b.Z, "direction": op.direction, "frame": opt.frame, "bearings": opt.bearings, "bearing": b,
     })
     return scene.build()

@@ -57,7 +57,7 @@ if TYPE_CHECKING:  # geometry works on floats; params is only needed for the who
 __all__ = [
     "STANDARD_ADDENDUM", "STANDARD_DEDENDUM", "GearGeometry", "MeshGeometry", "Phasing", "Layout",
     "Kinematics", "Finding", "DesignWarning",
-    "centre_distances", "pair_angle", "planet_angles", "speed_ratio", "planet_speed_ratios",
+    "centre_distances", "pair_angle", "planet_angles", "speed_ratio", "planet_speed_ratios", "iso_minimum_backlash",
     "mesh_frequency", "contact_path", "contact_ratio", "assembly_number", "mesh_phases",
     "mesh_stiffness_levels", "mesh_damping", "palmgren_stiffness", "kinematics", "layout", "loaded_flanks",
     "design_findings", "check_design",
@@ -145,6 +145,13 @@ def mesh_damping(zeta: float, k_mean: float, j1: float, j2: float, rb1: float, r
     """(c_m, m_eq): c_m = 2ζ·sqrt(k_mean·m_eq), m_eq = J1·J2/(J1·r_b2² + J2·r_b1²) (MODEL.md §3.2)."""
     m_eq = j1 * j2 / (j1 * rb2 ** 2 + j2 * rb1 ** 2)
     return 2.0 * zeta * math.sqrt(k_mean * m_eq), m_eq
+
+
+def iso_minimum_backlash(centre_distance: float, module: float) -> float:
+    """Minimum normal backlash of ISO/TR 10064-2 for steel gears in a steel housing [m]:
+    j_bn,min = (2/3)(0.06 + 0.0005 a + 0.03 m_n) mm with a and m_n in mm (PARAMETERS.md)."""
+    a_mm, m_mm = 1e3 * centre_distance, 1e3 * module
+    return (2.0 / 3.0) * (0.06 + 0.0005 * a_mm + 0.03 * m_mm) * 1e-3
 
 
 def palmgren_stiffness(length: float) -> float:
@@ -299,6 +306,7 @@ class MeshGeometry:
     k_double: float
     m_eq: float
     damping: float
+    backlash: float                # normal backlash j_bn along the line of action
     line_angle: np.ndarray = field(repr=False)   # φ_e at assembly, per pair
     p0: np.ndarray = field(repr=False)           # phase in p = z_1(θ_1 − φ_e)/2π + p0, per pair
     p_assembly: np.ndarray = field(repr=False)   # p at assembly (θ = 0), per pair
@@ -393,11 +401,13 @@ def layout(params: "DPGTParams", gears_si=None, mesh_si=None) -> Layout:
         k1, k2 = mesh_stiffness_levels(k_mean, ms.stiffness_ratio, eps)
         c, m_eq = mesh_damping(ms.damping_ratio, k_mean, gs[n1].inertia, gs[n2].inertia,
                                g1.base_radius, g2.base_radius)
+        b_n = ms[f"backlash_{name}"]
+        b_n = iso_minimum_backlash(a, g1.module) if b_n is None else b_n
         return MeshGeometry(name=name, gear1=n1, gear2=n2, internal=internal, z1=g1.teeth, z2=g2.teeth,
                             base_radius1=g1.base_radius, base_radius2=g2.base_radius, centre_distance=a,
                             pressure_angle=alpha_w, base_pitch=g1.base_pitch, path1=gp1, path2=gp2,
                             contact_ratio=eps, face_width=b, k_mean=k_mean, k_single=k1, k_double=k2,
-                            m_eq=m_eq, damping=c, line_angle=np.asarray(line, dtype=float), p0=p0,
+                            m_eq=m_eq, damping=c, backlash=b_n, line_angle=np.asarray(line, dtype=float), p0=p0,
                             p_assembly=p_asm)
 
     meshes = {

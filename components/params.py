@@ -172,6 +172,14 @@ def _rule(kind, tag, note, doc=""):
                   rule=Source(tag, note))
 
 
+def _backlash(which: str):
+    """Normal backlash of one mesh type: >= 0, or None for the ISO/TR 10064-2 minimum (see geometry)."""
+    return _param("length", f"normal backlash j_bn of the {which} (0: both flanks touch, not a real gear)",
+                  default=None, lo=0.0, bound_text=">= 0", optional=True,
+                  rule=Source("derived", "ISO/TR 10064-2 minimum for steel gears in a steel housing: "
+                                         "j_bn,min = (2/3)(0.06 + 0.0005 a + 0.03 m_n) mm, a and m_n in mm"))
+
+
 def _nested(cls, doc=""):
     return _param("nested", doc, cls=cls)
 
@@ -356,7 +364,8 @@ class GearParams(Params):
                                       hi_open=True, bound_text="between 0 and 45 deg")
     face_width: Quantity = _pos("length", "face width")
     mass: Quantity = _pos("mass", "mass")
-    inertia: Quantity | None = _rule("inertia", "assumed", "solid disc at the pitch radius, m r^2/2 "
+    inertia: Quantity | None = _rule("inertia", "assumed", "solid disc at the pitch radius, m r^2/2; a planet of a "
+                                                           "DPGT: annulus m (r^2 + r_bore^2)/2 with its bearing bore "
                                                            "(internal gear: thin ring at the pitch radius, m r^2)")
     internal: bool = _param("flag", "internal gear (teeth inside, the ring)", default=False)
     addendum_coefficient: Quantity = _nonneg("dimensionless", "addendum h_a/m (standard 1)", default=1.0)
@@ -415,6 +424,10 @@ class CageParams(Params):
                                    lo=0.0, hi=1.0, lo_open=True, bound_text="in (0, 1]")
     pocket_friction: Quantity = _nonneg("dimensionless", "pocket wall friction coefficient")
     guide_friction: Quantity = _nonneg("dimensionless", "guide land friction coefficient")
+    friction_speed: Quantity = _pos("velocity", "sliding speed v_mu over which pocket and land friction "
+                                                "rise to mu (tanh regularisation)")
+    impact_speed_floor: Quantity = _pos("velocity", "smallest approach speed v0 in the impact damping "
+                                                    "c = lambda(e)/v0 (slower contacts count as this speed)")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -431,6 +444,8 @@ class BearingParams(Params):
     roller_diameter: Quantity = _pos("length", "roller diameter D")
     roller_length: Quantity = _pos("length", "effective roller length l")
     rollers: int = _param("count", "rollers Z per bearing", lo=3, bound_text=">= 3")
+    rows: int = _param("count", "roller rows (identical rows move as one in the planar model)", lo=1,
+                       bound_text=">= 1")
     clearance: Quantity = _nonneg("length", "diametral clearance P_d")
     roller_density: Quantity = _pos("density", "roller material density")
     roller_mass: Quantity | None = _rule("mass", "derived", "solid cylinder: density x pi D^2 l / 4")
@@ -502,7 +517,9 @@ class MeshParams(Params):
     smoothing_width: Quantity = _param("dimensionless", "step width of the stiffness wave, fraction of a mesh cycle",
                                        lo=0.0, hi=0.5, lo_open=True, bound_text="in (0, 0.5]")
     damping_ratio: Quantity = _nonneg("dimensionless", "mesh damping ratio zeta_m")
-    backlash: Quantity = _nonneg("length", "backlash b along the line of action")
+    backlash_sun_inner: Quantity | None = _backlash("sun-inner planet meshes")
+    backlash_inner_outer: Quantity | None = _backlash("inner-outer planet meshes")
+    backlash_outer_ring: Quantity | None = _backlash("outer planet-ring meshes")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -546,9 +563,16 @@ class DPGTParams(Params):
 
     def _derive(self, d):
         g = d["gears"]
+        bore = d["bearing"].outer_raceway_radius
+        for name in ("inner_planet", "outer_planet"):   # the planet's bore is the bearing's outer raceway
+            if getattr(self.gears, name).inertia is None:
+                gp = g[name]
+                g = g.replace(**{name: gp.replace(inertia=0.5 * gp.mass * (gp.pitch_radius ** 2 + bore ** 2))})
+        d["gears"] = g
         d["support"] = d["support"].replace(
             ring_torsional_stiffness=d["support"].ring_tangential_stiffness * g.ring.pitch_radius ** 2)
         d["layout"] = geo.layout(self, gears_si=g, mesh_si=d["mesh"])
+        d["mesh"] = d["mesh"].replace(**{f"backlash_{k}": m.backlash for k, m in d["layout"].meshes.items()})
         op = d["operating"]
         kin = geo.kinematics(g.sun.teeth, g.inner_planet.teeth, g.outer_planet.teeth, g.ring.teeth,
                              op.carrier_speed, op.output_power)

@@ -72,12 +72,16 @@ def reference_bearing() -> BearingParams:
         restitution=assumed(0.8, "Hunt-Crossley, pocket and guide impacts"),
         pocket_friction=assumed(0.1, "not stated by the source"),
         guide_friction=assumed(0.1, "not stated by the source"),
+        friction_speed=assumed("0.01 m/s", "tanh-regularised Coulomb friction: full mu above ~2 cm/s of sliding"),
+        impact_speed_floor=assumed("0.01 m/s", "bounds the Hunt-Crossley damping of slow, quasi-static pocket "
+                                               "and land contacts; a roller at 1 cm/s carries ~1e-7 J"),
     )
     return BearingParams(
         pitch_diameter=paper("39 mm"),
         roller_diameter=paper("7.5 mm"),
         roller_length=paper("9 mm"),
         rollers=paper(12),
+        rows=paper(1, "one row in the source's table"),
         clearance=assumed("20 um", "diametral"),
         roller_density=assumed("7850 kg/m^3", "bearing steel"),
         contact_damping_ratio=assumed(0.05, "of critical, gated to compression"),
@@ -109,7 +113,6 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
             smoothing_width=assumed(0.05, "not in PARAMETERS.md: 5 % of a mesh cycle per step, "
                                           "smooth enough for Newton, sharp enough to keep the wave"),
             damping_ratio=assumed(0.07),
-            backlash=assumed("0 um", "a parameter; 0 by default"),
         ),
         operating=operating_point(condition, direction),
         gravity=assumed("9.81 m/s^2", "standard gravity along -Y of the fixed frame"),

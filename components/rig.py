@@ -52,6 +52,7 @@ class DiscreteDistribution:
     loads: np.ndarray
     radial_load: float
     clearance: float
+    rows: int = 1
 
     @property
     def q_max(self) -> float:
@@ -79,10 +80,12 @@ def discrete_load_distribution(b: BearingSI, radial_load: float, angles=None) ->
     """Classical reference: rigid rings, the rollers at ``angles`` [rad] from the load-zone centre
     (default: one roller on the load line, Z equally spaced), Palmgren contacts Q = K δ^(10/9) at both
     raceways in series (equal loads: Q = K (δ/2)^(10/9) for a total compression δ), diametral clearance
-    P_d. Solves the ring's equilibrium F_r = Σ Q_j cos ψ_j (and Σ Q_j sin ψ_j = 0 with a sideways shift)."""
+    P_d. Solves the ring's equilibrium F_r = rows·Σ Q_j cos ψ_j (and Σ Q_j sin ψ_j = 0 with a sideways
+    shift): ``loads`` are per physical roller, each of the ``b.rows`` identical rows carrying F_r/rows."""
     F = float(radial_load)
     if not (np.isfinite(F) and F > 0):
         raise ParameterError.at("radial_load", f"must be > 0 N for a load distribution, got {radial_load!r}")
+    F_total, F = F, F / b.rows
     psi = 2 * np.pi * np.arange(b.Z) / b.Z if angles is None else np.asarray(angles, float)
     c, s = np.cos(psi), np.sin(psi)
     K2 = b.K * 2.0 ** (-_EXP)
@@ -104,7 +107,7 @@ def discrete_load_distribution(b: BearingSI, radial_load: float, angles=None) ->
     if not sol.success:
         raise RuntimeError(f"discrete_load_distribution: no equilibrium found ({sol.message})")
     d = sol.x * d0
-    return DiscreteDistribution(float(d[0]), float(d[1]), psi, loads(d), F, float(b.clearance))
+    return DiscreteDistribution(float(d[0]), float(d[1]), psi, loads(d), F_total, float(b.clearance), b.rows)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -309,7 +312,8 @@ def rig_loads(built: BuiltScene, system: mbd.System, s: mbd.State) -> dict:
     """Instantaneous roller loads of the rig at state ``s``: inner- and outer-raceway loads (Z,) [N],
     roller angles from the load-zone centre (Z,) [rad], the ring centre (2,) [m], and the vector sums
     (2,) [N, fixed frame] of the inner normal loads pressing the pin, Σ Q_j·(−e_j), and of the whole
-    contact forces (normal + traction) the rollers exert on the pin and on the ring."""
+    contact forces (normal + traction) the rollers exert on the pin and on the ring. Loads are per physical
+    roller; the sums count every row."""
     m = built.model
     out = system.outputs(s.t, s.q, s.v, s.z)
     h = built.handles["bearing"]
@@ -320,12 +324,13 @@ def rig_loads(built: BuiltScene, system: mbd.System, s: mbd.State) -> dict:
     qf, _ = m.full(s.t, s.q, s.v)
     ring = qf[3 * m.body("ring").index: 3 * m.body("ring").index + 2]
     Qi, Qo = inner["load"][si], outer["load"][so]
+    rows = built.meta["bearing"].rows
     return {
         "t": s.t, "angle": _wrap(ang - built.meta["zone_angle"]), "load_inner": Qi, "load_outer": Qo,
         "ring": ring.copy(),
-        "load_sum": -(Qi[:, None] * e).sum(axis=0),
-        "pin_force": -np.array([inner["fx"][si].sum(), inner["fy"][si].sum()]),
-        "ring_force": np.array([outer["fx"][so].sum(), outer["fy"][so].sum()]),   # −(force on ring)
+        "load_sum": -rows * (Qi[:, None] * e).sum(axis=0),
+        "pin_force": -rows * np.array([inner["fx"][si].sum(), inner["fy"][si].sum()]),
+        "ring_force": rows * np.array([outer["fx"][so].sum(), outer["fy"][so].sum()]),   # −(force on ring)
     }
 
 
@@ -414,7 +419,8 @@ def rig_static_solution(built: BuiltScene, *, t_settle: float | None = None, win
     side = float(ring @ np.array([-u[1], u[0]]))
     mean = lambda key: np.array([r[key] for r in recs]).mean(axis=0)
     return RigSolution(t0=float(times[0]), t1=float(times[-1]), samples=n, angles=angles, loads=loads,
-                       loads_outer=loads_o, q_max=q_max, stribeck=q_max * Z / F if F > 0 else float("nan"),
+                       loads_outer=loads_o, q_max=q_max,
+                       stribeck=q_max * Z * meta["bearing"].rows / F if F > 0 else float("nan"),
                        zone_angle=zone, zone_angle_continuous=_zone_angle(defl, meta["bearing"].clearance),
                        deflection=defl, sideways=side, load_sum=mean("load_sum"), pin_force=mean("pin_force"),
                        ring_force=mean("ring_force"), radial_load=F, load_vector=F * u, wall_s=wall,

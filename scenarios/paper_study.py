@@ -27,9 +27,13 @@ from .sweep import Case, build_params, run_sweep
 QUANTITIES = [
     ("roller_cage_rms_N", "N"), ("roller_cage_max_N", "N"), ("cage_guide_rms_N", "N"), ("cage_guide_max_N", "N"),
     ("roller_inner_race_rms_N", "N"), ("roller_inner_race_max_N", "N"), ("roller_outer_race_rms_N", "N"),
-    ("roller_outer_race_max_N", "N"), ("cage_acc_x_rms", "m/s^2"), ("cage_acc_y_rms", "m/s^2"),
+    ("roller_outer_race_max_N", "N"), ("cage_acc_radial_rms", "m/s^2"), ("cage_acc_tangential_rms", "m/s^2"),
+    ("cage_acc_rel_radial_rms", "m/s^2"), ("cage_acc_rel_tangential_rms", "m/s^2"), ("cage_slip_pct", "%"),
+    ("pocket_impacts_per_rev", "-"), ("pocket_impact_speed_max", "m/s"), ("pocket_impact_peak_max_N", "N"),
     ("bearing_load_mean_N", "N"), ("life_L10_relative", "-"),
 ]
+# bar chart: RMS values comparable between inner and outer planets (radial/tangential, not x/y)
+BAR_QUANTITIES = [q for q, _ in QUANTITIES if q.endswith("_rms")]
 
 
 def parse_args(argv):
@@ -40,7 +44,8 @@ def parse_args(argv):
     p.add_argument("--planets", type=int, default=None, help="planet pairs N (default 3, the reference machine)")
     p.add_argument("--settle", type=float, default=0.03, help="seconds discarded after the start (default 0.03)")
     p.add_argument("--window", type=float, default=None,
-                   help="seconds recorded and analysed (default: max(0.02 s, one carrier revolution))")
+                   help="seconds recorded and analysed (default: max(0.02 s, one carrier revolution), rounded up "
+                        "to whole revolutions of the slowest cage relative to the carrier)")
     p.add_argument("--sample-rate", type=float, default=25000.0, help="recording rate [Hz]")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help='override a parameter, e.g. --set bearing.clearance="30 um" (repeatable)')
@@ -82,7 +87,7 @@ def build_config(a) -> RunConfig:
     from components.scene import SceneOptions
 
     opts = {k: _bool(v) for k, v in parse_sets(a.option).items()}
-    return RunConfig(settle=a.settle, window=a.window or 0.02, sample_rate=a.sample_rate,
+    return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate,
                      integration=Integration(method=a.method, h=a.h, alpha=a.alpha),
                      options=SceneOptions.from_dict(opts), progress=not a.no_progress)
 
@@ -96,20 +101,10 @@ def make_cases(a, out: Path) -> list[Case]:
     overrides = parse_sets(a.set)
     if a.planets is not None:
         overrides["gears.planets"] = a.planets
-    from components.presets import CONDITIONS
-    from components.units import to_si
-
-    def window(c):
-        if a.window is not None:
-            return a.window
-        speed = overrides.get("operating.carrier_speed")
-        w_c = to_si(CONDITIONS[c][0]) if speed is None else None
-        return max(0.02, 2 * np.pi / abs(w_c)) if w_c else 0.02
-
     for c in conds:
         if c not in (1, 2, 3, 4):
             raise SystemExit(f"error: --conditions takes 1, 2, 3 and/or 4 (PARAMETERS.md), got {c}")
-    return [Case(c, d, str(out / f"c{c}_{d}"), overrides, a.params, window(c)) for c in conds for d in dirs]
+    return [Case(c, d, str(out / f"c{c}_{d}"), overrides, a.params) for c in conds for d in dirs]
 
 
 def relative_life(results: dict) -> None:
@@ -166,6 +161,7 @@ def write_tables(rows: list[dict], out: Path) -> tuple[Path, Path, str]:
 def plots(results: dict, out: Path) -> list[Path]:
     import xarray as xr
 
+    from components.outputs import radial_tangential
     from viz import plots as vp
 
     paths = []
@@ -196,10 +192,11 @@ def plots(results: dict, out: Path) -> list[Path]:
                         cols[f"{kind}: roller–cage"] = ds["pocket.force"].values[:, b["pocket"][0]]
                     if "guide" in b:
                         cols[f"{kind}: cage–guide"] = ds["guide.force"].values[:, b["guide"]]
-                        a = ds["motion.a"].values
-                        ic, ip = bodies.index(b["cage"]), bodies.index(b["planet"])
-                        cols[f"{kind}: cage acc x"] = a[:, ic, 0] - a[:, ip, 0]
-                        cols[f"{kind}: cage acc y"] = a[:, ic, 1] - a[:, ip, 1]
+                        a, q = ds["motion.a"].values, ds["motion.q"].values
+                        ic, ip, ik = (bodies.index(x) for x in (b["cage"], b["planet"], "carrier"))
+                        rad, tan = radial_tangential(a[:, ic, :2] - a[:, ip, :2], q[:, ip, :2], q[:, ik, :2])
+                        cols[f"{kind}: cage acc. rel. radial"] = rad
+                        cols[f"{kind}: cage acc. rel. tangential"] = tan
                 data[d] = (t, cols)
         labels = list(next(iter(data.values()))[1])
         t = next(iter(data.values()))[0]
@@ -215,7 +212,9 @@ def plots(results: dict, out: Path) -> list[Path]:
                                            title=f"Condition {c}: forward vs reverse (reference roller, pair 1)"))
     table = {}
     bar_units = {}
-    for q, unit in QUANTITIES[:10]:
+    for q, unit in QUANTITIES:
+        if q not in BAR_QUANTITIES:
+            continue
         for kind in ("inner", "outer"):
             key = f"{kind} {q}"
             table[key] = {}

@@ -5,7 +5,8 @@ Results layout of a run directory:
                    fixed frame ("fixed.q/v/a"), and element outputs "<family>.<key>" (e.g.
                    race_inner.load, pocket.force, guide.force, mesh_sa.force); attrs hold the run summary
                    and the bearing map (which family instances belong to which bearing)
-    summary.json   the statistics users read (see :func:`summarize`)
+    summary.json   the statistics users read, taken on every accepted step over the window
+                   (:class:`components.outputs.WindowStatistics`; the recording is for plots only)
     checkpoint.npz while running; a run started again resumes from it
     fingerprint    what the run was made from (see :func:`run_fingerprint`): a checkpoint or a finished
                    summary from other parameters, settings or engine code is never reused
@@ -27,9 +28,9 @@ from components.params import DPGTParams
 from components.scene import SceneOptions
 from mbd.recorder import BodyMotion, ElementOutput, Recorder, atomic_write_text
 
-from .analysis import bearing_equivalent_load, rms, window
+from components.outputs import FAMILY, MESH_FAMILY, WindowStatistics, bearing_map, cage_period, default_window
 
-__all__ = ["Integration", "RunConfig", "run_case", "summarize", "bearing_map", "run_fingerprint"]
+__all__ = ["Integration", "RunConfig", "run_case", "run_fingerprint", "statistics_window"]
 
 _ROOT = Path(__file__).resolve().parent.parent
 _CODE_DIGEST = None
@@ -41,7 +42,7 @@ def _code_digest() -> str:
     if _CODE_DIGEST is None:
         h = hashlib.sha256()
         files = sorted([*(_ROOT / "mbd").rglob("*.py"), *(_ROOT / "components").rglob("*.py"),
-                        _ROOT / "scenarios" / "runner.py", _ROOT / "scenarios" / "analysis.py"])
+                        _ROOT / "scenarios" / "runner.py"])
         for f in files:
             h.update(str(f.relative_to(_ROOT)).encode())
             h.update(f.read_bytes())
@@ -82,7 +83,7 @@ class Integration:
 @dataclass(frozen=True)
 class RunConfig:
     settle: float = 0.03          # s discarded after the start (load ramp, drive and cage transients)
-    window: float = 0.02          # s recorded and analysed
+    window: float | None = None   # s recorded and analysed (None: :func:`statistics_window`)
     sample_rate: float = 25000.0  # Hz (> 4 f_m at condition 3)
     integration: Integration = field(default_factory=Integration)
     options: SceneOptions = field(default_factory=SceneOptions)
@@ -92,46 +93,35 @@ class RunConfig:
 
     def __post_init__(self):
         for k in ("settle", "window"):
-            if not (np.isfinite(getattr(self, k)) and getattr(self, k) >= 0):
+            if getattr(self, k) is not None and not (np.isfinite(getattr(self, k)) and getattr(self, k) >= 0):
                 raise mbd.ModelError(f"{k} must be >= 0 s, got {getattr(self, k)!r}")
-        if self.window <= 0:
+        if self.window is not None and not self.window > 0:
             raise mbd.ModelError(f"window must be > 0 s, got {self.window!r}")
         if not self.sample_rate > 0:
             raise mbd.ModelError(f"sample_rate must be > 0 Hz, got {self.sample_rate!r}")
 
 
-def bearing_map(scene) -> list[dict]:
-    """Per bearing: name, kind (inner/outer), pair index, planet, cage, and the instance slices of the
-    roller families (all rollers of all bearings share one family each, in bearing order)."""
-    out = []
-    for n, pair in enumerate(scene.handles["pairs"]):
-        for kind in ("inner", "outer"):
-            h = pair[f"{kind}_bearing"]
-            rec = {"name": f"{pair[kind]}.pb", "kind": kind, "pair": n, "planet": pair[kind],
-                   "type": h["kind"]}
-            if h["kind"] == "rollers":
-                rec.update({"rollers": h["rollers"], "race_inner": [h["race_inner"].start, h["race_inner"].stop],
-                            "race_outer": [h["race_outer"].start, h["race_outer"].stop]})
-                if "pocket" in h:
-                    rec["pocket"] = [h["pocket"].start, h["pocket"].stop]
-                if "guide" in h:
-                    rec["guide"] = h["guide"].start
-                    rec["cage"] = h["cage"]
-            else:
-                rec["spring"] = h["spring"].start
-            out.append(rec)
-    return out
+def statistics_window(scene, base: float = 0.02) -> float:
+    """Default window [s]: at least ``base`` and one carrier revolution, rounded up to whole revolutions
+    of the slowest cage relative to the carrier (MODEL.md §5)."""
+    sp, b = scene.meta["speeds_rad_s"], scene.meta["bearing"]
+    wc = sp["carrier"]
+    if wc != 0.0:
+        base = max(base, 2 * np.pi / abs(wc))
+    if scene.meta.get("bearings", "rollers") != "rollers":
+        return base
+    return default_window(base, [cage_period(b, wc, sp[k]) for k in ("inner_planet", "outer_planet")])
 
 
 def _probes(scene) -> list:
     fams = {e.name for e in scene.model.elements}
     probes = [BodyMotion("motion", frame="reference"),
               BodyMotion("fixed", bodies=["sun", "carrier", "ring"], frame="fixed")]
-    wanted = {"race_inner": ["load", "fx", "fy", "angle", "deflection"], "race_outer": ["load", "fx", "fy"],
-              "pocket": ["force", "offset"], "guide": ["force", "fx", "fy", "eccentricity"],
-              "bearing_linear": ["fx", "fy"], "mesh_sa": ["force", "deflection", "fx", "fy"],
-              "mesh_ab": ["force", "deflection", "fx", "fy"], "mesh_br": ["force", "deflection", "fx", "fy"],
-              "carrier_drive": ["torque"]}
+    mesh = ["force", "force_drive", "force_coast", "deflection", "deflection_coast", "fx", "fy"]
+    wanted = {FAMILY["race_inner"]: ["load", "fx", "fy", "angle", "deflection"],
+              FAMILY["race_outer"]: ["load", "fx", "fy"], FAMILY["pocket"]: ["force", "offset"],
+              FAMILY["guide"]: ["force", "fx", "fy", "eccentricity"], FAMILY["linear"]: ["fx", "fy"],
+              **{f: mesh for f in MESH_FAMILY.values()}, "carrier_drive": ["torque"]}
     probes += [ElementOutput(f, keys) for f, keys in wanted.items() if f in fams]
     return probes
 
@@ -146,13 +136,15 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
         scene = build_dpgt(params, cfg.options, cfg.rig)
     bmap = bearing_map(scene)
     meta = {k: v for k, v in scene.meta.items() if k != "bearing"}
+    window = cfg.window if cfg.window is not None else statistics_window(scene)
+    stats = WindowStatistics(scene, cfg.settle, cfg.settle + window)
     from viz.results import geometry_from_params   # drawing geometry travels with the results
 
     rec = Recorder(out_dir / "results.nc", dt=1.0 / cfg.sample_rate, probes=_probes(scene), t_start=cfg.settle,
                    attrs={"bearings": bmap, "meta": meta, "label": label or {},
                           "geometry": geometry_from_params(params)})
     integ = cfg.integration
-    t_end = cfg.settle + cfg.window
+    t_end = stats.t_end          # the window plus a margin for slipping cages (WindowStatistics)
     fp = run_fingerprint(params, cfg)
     fp_file = out_dir / "fingerprint"
     ckpt = out_dir / "checkpoint.npz"
@@ -170,10 +162,12 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
     res = mbd.simulate(scene.model, scene.q0, scene.v0, t_end, stepper=integ.stepper(), controller=integ.controller(),
                        recorder=rec, checkpoint=mbd.Checkpoint(out_dir / "checkpoint.npz", cfg.checkpoint_every),
                        resume=True, progress=cfg.progress, failed_state_path=out_dir / "failed_state.npz",
-                       on_progress=report)
+                       on_progress=report, observers=[stats])
     (out_dir / "progress.json").unlink(missing_ok=True)
     wall = time.perf_counter() - wall0
-    summary = summarize(out_dir / "results.nc", params, scene, cfg)
+    summary = _run_info(params, scene, stats)
+    summary.update(stats.summary())
+    summary["samples"] = int(rec.next_index)      # recorded (for plots); the statistics use every step
     summary.update(label or {})
     summary.update({
         "wall_s": wall, "steps": res.steps, "rejected_steps": res.counters["rejected"],
@@ -200,79 +194,16 @@ def _json_default(o):
     return str(o)
 
 
-def summarize(path, params: DPGTParams, scene, cfg: RunConfig) -> dict:
-    """Statistics of the recorded window (MODEL.md §5). RMS/max of the reference roller (roller 1 of
-    planet pair 1) and the mean over all rollers of that bearing kind; cage acceleration relative to its
-    planet in R; bearing load = magnitude of the time-mean pin reaction; equivalent load for ISO 281."""
-    import xarray as xr
-
+def _run_info(params: DPGTParams, scene, stats: WindowStatistics) -> dict:
+    """What was run: operating point, machine size, window, characteristic frequencies."""
     si = params.si()
     op = si.operating
-    bmap = bearing_map(scene)
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
-        t = ds["time"].values
-        m = window(t, cfg.settle, cfg.settle + cfg.window)
-        bodies = list(ds["motion.body"].values)
-        acc = ds["motion.a"].values[m]
-        get = lambda k: ds[k].values[m] if k in ds else None
-        inner_fx, inner_fy, inner_Q = get("race_inner.fx"), get("race_inner.fy"), get("race_inner.load")
-        outer_Q = get("race_outer.load")
-        pocket = get("pocket.force")
-        guide = get("guide.force")
-        lin_fx, lin_fy = get("bearing_linear.fx"), get("bearing_linear.fy")
-    out = {
+    return {
         "condition": None, "direction": op.direction, "carrier_rpm": op.carrier_speed * 30 / np.pi,
-        "sun_rpm": op.sun_speed * 30 / np.pi, "power_W": float(si.operating.output_power),
-        "planets": int(si.gears.planets), "rollers": int(si.bearing.rollers),
-        "window_s": [cfg.settle, cfg.settle + cfg.window], "samples": int(m.sum()),
+        "sun_rpm": op.sun_speed * 30 / np.pi, "power_W": float(op.output_power),
+        "planets": int(si.gears.planets), "rollers": int(si.bearing.rollers), "rows": int(si.bearing.rows),
+        "backlash_m": {k: m.backlash for k, m in si.layout.meshes.items()},
         "f_m_hz": scene.meta["f_m_hz"], "f_c_hz": scene.meta["f_c_hz"],
+        "statistics": "time-weighted over every accepted step in the window (trapezoid); max over the steps; "
+                      "radial/tangential in the carrier frame (radial: carrier axis -> planet centre)",
     }
-    for kind in ("inner", "outer"):
-        group = [b for b in bmap if b["kind"] == kind]
-        ref = group[0]
-        d: dict = {}
-        loads = []
-        for b in group:
-            if b["type"] == "rollers":
-                sl = slice(*b["race_inner"])
-                F = np.stack([-inner_fx[:, sl].sum(axis=1), -inner_fy[:, sl].sum(axis=1)], axis=1)
-            else:
-                F = np.stack([lin_fx[:, b["spring"]], lin_fy[:, b["spring"]]], axis=1)   # force on the planet
-            loads.append(F)
-        Fref = loads[0]
-        d["bearing_load_mean_N"] = float(np.hypot(*Fref.mean(axis=0)))
-        d["bearing_load_mean_all_N"] = float(np.mean([np.hypot(*F.mean(axis=0)) for F in loads]))
-        d["equivalent_load_N"] = bearing_equivalent_load(np.hypot(Fref[:, 0], Fref[:, 1]))
-        if ref["type"] == "rollers":
-            r0 = ref["race_inner"][0]
-            sl_all = np.concatenate([np.arange(*b["race_inner"]) for b in group])
-            so_all = np.concatenate([np.arange(*b["race_outer"]) for b in group])
-            ro0 = ref["race_outer"][0]
-            d["roller_inner_race_rms_N"] = float(rms(inner_Q[:, r0]))
-            d["roller_inner_race_max_N"] = float(inner_Q[:, r0].max())
-            d["roller_outer_race_rms_N"] = float(rms(outer_Q[:, ro0]))
-            d["roller_outer_race_max_N"] = float(outer_Q[:, ro0].max())
-            d["all_rollers"] = {"roller_inner_race_rms_N": float(rms(inner_Q[:, sl_all]).mean()),
-                                "roller_inner_race_max_N": float(inner_Q[:, sl_all].max(axis=0).mean()),
-                                "roller_outer_race_rms_N": float(rms(outer_Q[:, so_all]).mean()),
-                                "roller_outer_race_max_N": float(outer_Q[:, so_all].max(axis=0).mean())}
-            if pocket is not None and "pocket" in ref:
-                p0 = ref["pocket"][0]
-                sp_all = np.concatenate([np.arange(*b["pocket"]) for b in group])
-                d["roller_cage_rms_N"] = float(rms(pocket[:, p0]))
-                d["roller_cage_max_N"] = float(np.abs(pocket[:, p0]).max())
-                d["all_rollers"]["roller_cage_rms_N"] = float(rms(pocket[:, sp_all]).mean())
-                d["all_rollers"]["roller_cage_max_N"] = float(np.abs(pocket[:, sp_all]).max(axis=0).mean())
-            if guide is not None and "guide" in ref:
-                g0 = ref["guide"]
-                gi = [b["guide"] for b in group]
-                d["cage_guide_rms_N"] = float(rms(guide[:, g0]))
-                d["cage_guide_max_N"] = float(guide[:, g0].max())
-                d["all_rollers"]["cage_guide_rms_N"] = float(rms(guide[:, gi]).mean())
-                ic, ip = bodies.index(ref["cage"]), bodies.index(ref["planet"])
-                rel = acc[:, ic, :2] - acc[:, ip, :2]
-                d["cage_acc_x_rms"] = float(rms(rel[:, 0]))
-                d["cage_acc_y_rms"] = float(rms(rel[:, 1]))
-        d["life_L10_relative"] = None     # filled by the study relative to the forward run
-        out[kind] = d
-    return out

@@ -107,7 +107,7 @@ def run(a) -> dict:
     fig = vp.spectrum(f, {"x": ax, "y": ay}, marks, out / "spectrum.png", fmax=min(f[-1], 2.5 * f_m),
                       quantity="carrier acceleration (fixed frame)", unit="m/s^2", logy=True,
                       title=f"Carrier housing acceleration, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min")
-    print(f"f_c = {f_c:.2f} Hz, f_m = {f_m:.1f} Hz, resolution {df:.2f} Hz over {a.window} s")
+    print(f"f_c = {f_c:.2f} Hz, f_m = {f_m:.1f} Hz, resolution {df:.2f} Hz over {t[-1] - t[0]:.4g} s")
     print("strongest peaks near f_m:")
     for r in peaks:
         print(f"  {r['frequency_hz']:9.1f} Hz  amp {r['amplitude']:.3g} m/s^2   nearest {r['nearest']:>8} "

@@ -150,7 +150,8 @@ def test_direct_construction_checks_values():
         GearParams(teeth=2, module="3 mm", pressure_angle="20 deg", face_width="30 mm", mass="1 kg")
     with pytest.raises(ParameterError, match=r"^bearing\.cage\.mass: is required"):
         CageParams(mass=None, pocket_clearance="0.1 mm", guide_clearance="0.1 mm", pocket_stiffness="1e7 N/m",
-                   guide_stiffness="1e7 N/m", restitution=0.8, pocket_friction=0.1, guide_friction=0.1)
+                   guide_stiffness="1e7 N/m", restitution=0.8, pocket_friction=0.1, guide_friction=0.1,
+                   friction_speed="0.01 m/s", impact_speed_floor="0.01 m/s")
     with pytest.raises(TypeError):  # a forgotten field is a programming error, caught by the dataclass
         BearingParams(pitch_diameter="39 mm")
 

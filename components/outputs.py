@@ -1,0 +1,544 @@
+"""What the model outputs (MODEL.md §5), defined once.
+
+Every derived quantity a user reads — a planet bearing's load (pin reaction), roller and cage forces,
+each mesh flank's force and deflection, cage accelerations in the carrier frame (own, relative to the
+planet, radial/tangential), cage slip, pocket impacts — is computed here, and every statistic of them is
+taken here, by :class:`WindowStatistics`, an observer of the one simulation loop (:func:`mbd.simulate`):
+
+* on **every accepted integrator step**, never on recorded samples: means and RMS values are
+  time-weighted (trapezoid over the steps), maxima are maxima over the steps, so neither depends on a
+  recorder's sample rate;
+* over a **window** that the runner sizes with :func:`default_window` (whole revolutions of the slowest
+  cage relative to the carrier: every roller passes the load zone equally often);
+* the **carrier frame** C turns at the nominal carrier speed (the pin and the load zone are fixed on the
+  carrier); *radial* is from the carrier axis through the planet's centre, *tangential* 90° ahead.
+  Both are independent of where the planet sits and of the frame the model is integrated in.
+
+Element family names used by the scene builders live here too (:data:`FAMILY`, :data:`MESH_FAMILY`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+import mbd
+
+__all__ = ["FAMILY", "MESH_FAMILY", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
+           "WindowStatistics", "carrier_frame_motion", "radial_tangential"]
+
+# element families of the planet-bearing and train scenes (one family per contact kind)
+FAMILY = {"race_inner": "race_inner", "race_outer": "race_outer", "pocket": "pocket", "guide": "guide",
+          "drag": "drag", "linear": "bearing_linear"}
+MESH_FAMILY = {"sun_inner": "mesh_sa", "inner_outer": "mesh_ab", "outer_ring": "mesh_br"}
+LIFE_EXPONENT = 10.0 / 3.0     # ISO 281, roller bearings: L10 ∝ P^(−10/3)
+
+
+# ----------------------------------------------------------------------------------------------
+# which instances belong to which bearing
+# ----------------------------------------------------------------------------------------------
+def bearing_map(scene) -> list[dict]:
+    """Per bearing: name, kind (inner/outer), pair index, planet, cage, and the instance ranges of the
+    roller families (all rollers of all bearings share one family each, in bearing order)."""
+    out = []
+    for n, pair in enumerate(scene.handles["pairs"]):
+        for kind in ("inner", "outer"):
+            h = pair[f"{kind}_bearing"]
+            rec = {"name": f"{pair[kind]}.pb", "kind": kind, "pair": n, "planet": pair[kind], "type": h["kind"]}
+            if h["kind"] == "rollers":
+                rec.update({"rollers": h["rollers"], "race_inner": [h["race_inner"].start, h["race_inner"].stop],
+                            "race_outer": [h["race_outer"].start, h["race_outer"].stop]})
+                if "pocket" in h:
+                    rec["pocket"] = [h["pocket"].start, h["pocket"].stop]
+                if "guide" in h:
+                    rec["guide"] = h["guide"].start
+                if "cage" in h:
+                    rec["cage"] = h["cage"]
+            else:
+                rec["spring"] = h["spring"].start
+            out.append(rec)
+    return out
+
+
+def cage_period(b, omega_pin: float, omega_planet: float) -> float:
+    """Time of one cage revolution relative to the pin [s] in pure rolling (inf when it does not turn)."""
+    from .bearing import bearing_kinematics   # bearing imports the family names from here
+    w_cage, _ = bearing_kinematics(b, omega_pin, omega_planet)
+    rel = abs(w_cage - omega_pin)
+    return 2.0 * math.pi / rel if rel > 0 else math.inf
+
+
+def default_window(base: float, periods) -> float:
+    """``base`` [s] rounded up to whole revolutions of the slowest cage (the longest of ``periods``)."""
+    T = max((p for p in periods if np.isfinite(p)), default=0.0)
+    if T <= 0.0:
+        return base
+    return math.ceil(base / T - 1e-9) * T
+
+
+# ----------------------------------------------------------------------------------------------
+# kinematics in the carrier frame
+# ----------------------------------------------------------------------------------------------
+def carrier_frame_motion(model, t, q, v, a, omega_c: float):
+    """(x, v, a) of every body, (nb, 3) each, in the frame turning at the nominal carrier speed
+    ``omega_c`` (its orientation at t is immaterial: only lengths and projections are read)."""
+    qf, vf = model.full(t, q, v)
+    af = np.zeros_like(qf)
+    af[model.free] = a
+    X, V, A = qf.reshape(-1, 3), vf.reshape(-1, 3), af.reshape(-1, 3)
+    fr = model.frame
+    if fr.profile is None and fr.omega == omega_c:
+        return X, V, A
+    Xi, Vi, Ai = mbd.to_fixed(X, V, model.frame.at(t), A)
+    c, s = math.cos(omega_c * t), math.sin(omega_c * t)
+    rot = lambda x, y: (c * x + s * y, -s * x + c * y)          # Rot(−φ)
+    W = omega_c
+    x, y = rot(Xi[:, 0], Xi[:, 1])
+    vx, vy = rot(Vi[:, 0], Vi[:, 1])
+    vx, vy = vx + W * y, vy - W * x                               # v_C = Rot(−φ) v_I − Ω k × x_C
+    ax, ay = rot(Ai[:, 0], Ai[:, 1])
+    ax, ay = ax + 2 * W * vy + W * W * x, ay - 2 * W * vx + W * W * y   # a_C = Rot(−φ) a_I − 2Ω k × v_C + Ω² x_C
+    return (np.column_stack([x, y, Xi[:, 2] - W * t]), np.column_stack([vx, vy, Vi[:, 2] - W]),
+            np.column_stack([ax, ay, Ai[:, 2]]))
+
+
+def radial_tangential(vec, planet_xy, carrier_xy):
+    """(radial, tangential) components of vectors (..., 2): radial from the carrier axis through the
+    planet centre, tangential 90° ahead of it (all arrays in one frame, broadcasting over samples)."""
+    er = np.asarray(planet_xy, float) - np.asarray(carrier_xy, float)
+    er = er / np.linalg.norm(er, axis=-1, keepdims=True)
+    vec = np.asarray(vec, float)
+    return (vec[..., 0] * er[..., 0] + vec[..., 1] * er[..., 1],
+            -vec[..., 0] * er[..., 1] + vec[..., 1] * er[..., 0])
+
+
+# ----------------------------------------------------------------------------------------------
+# the observer
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class _Plan:
+    """Index arrays of the bearings (built once at bind): everything a snapshot needs, vectorised."""
+    kinds: np.ndarray            # (nb,) "inner" / "outer"
+    rollers: bool
+    planet: np.ndarray           # body index per bearing
+    cage: np.ndarray | None      # body index per bearing (rollers with a cage)
+    carrier: int
+    roller_bearing: np.ndarray | None   # bearing index of every race_inner instance
+    roller_body: np.ndarray | None      # body index of every roller (race_inner order)
+    pocket_bearing: np.ndarray | None
+    guide: np.ndarray | None     # guide instance per bearing
+    spring: np.ndarray | None    # bearing_linear instance per bearing
+    rows: int
+    pitch_ratio: float           # R_o/(R_i + R_o): epicyclic cage speed / planet speed, relative to the pin
+
+
+class WindowStatistics(mbd.Observer):
+    """Statistics of a DPGT-like scene from ``t0`` on, on every accepted step (module docstring).
+
+    Window: the mesh quantities cover [t0, t1]. A bearing's quantities (its load, rollers, pockets, cage)
+    cover whole revolutions of its cage relative to the carrier, as many as fit in the nominal window,
+    ``round((t1 − t0)/T_cage)`` — so they end when that cage has turned that far, not at t1: the cage
+    slips (≈ 0.7 % at condition 3) and a nominal window would cut every roller's orbit at a different
+    point of the load zone. Run the simulation to :attr:`t_end` (t1 plus a margin for the slip); a cage
+    that slips more than the margin ends at the run's end and is reported with whole_revolutions false.
+
+    ``scene``: a built scene with handles["pairs"] (see :func:`bearing_map`), meta["speeds_rad_s"]
+    ["carrier"] (the carrier frame's speed), meta["bearing"] (BearingSI) and handles["flanks"]
+    (the loaded flank of each mesh type). After the run, :meth:`summary` gives the numbers.
+    """
+
+    MARGIN = 0.05      # extra run time for slipping cages, as a fraction of the window
+
+    def __init__(self, scene, t0: float, t1: float, whole_revolutions: bool = True):
+        if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
+            raise mbd.ModelError(f"statistics window must satisfy t1 > t0 [s], got [{t0!r}, {t1!r}]")
+        self.t0, self.t1 = float(t0), float(t1)
+        self.scene = scene
+        self.bmap = bearing_map(scene)
+        sp = scene.meta["speeds_rad_s"]
+        self.omega_c = float(sp["carrier"])
+        self.flanks = dict(scene.handles.get("flanks", {}))
+        rollers = self.bmap[0]["type"] == "rollers" and "cage" in self.bmap[0]
+        self.target = None
+        if whole_revolutions and rollers:
+            b = scene.meta["bearing"]
+            T = {k: cage_period(b, self.omega_c, sp[f"{k}_planet"]) for k in ("inner", "outer")}
+            revs = np.array([(self.t1 - self.t0) / T[x["kind"]] for x in self.bmap])
+            if np.all(np.isfinite(revs)) and np.all(revs >= 0.5):
+                self.target = np.maximum(np.round(revs), 1.0)
+        self.t_end = self.t1 + (self.MARGIN * (self.t1 - self.t0) if self.target is not None else 0.0)
+
+    # setup -------------------------------------------------------------------------------------
+    def bind(self, model, system, state) -> None:
+        self.model, self.system = model, system
+        fams = {e.name for e in model.elements}
+        bm = self.bmap
+        idx = lambda name: model.body(name).index
+        rollers = bm[0]["type"] == "rollers"
+        b = self.scene.meta["bearing"]
+        Ri, Ro = 0.5 * (b.d_m - b.D), 0.5 * (b.d_m + b.D)
+        cage = np.array([idx(x["cage"]) for x in bm]) if rollers and "cage" in bm[0] else None
+        rb = np.concatenate([np.full(x["race_inner"][1] - x["race_inner"][0], i) for i, x in enumerate(bm)]) \
+            if rollers else None
+        rbody = np.array([idx(r) for x in bm for r in x["rollers"]]) if rollers else None
+        pb = np.concatenate([np.full(x["pocket"][1] - x["pocket"][0], i) for i, x in enumerate(bm)]) \
+            if rollers and FAMILY["pocket"] in fams else None
+        self.plan = _Plan(
+            kinds=np.array([x["kind"] for x in bm]), rollers=rollers, planet=np.array([idx(x["planet"]) for x in bm]),
+            cage=cage, carrier=idx("carrier"), roller_bearing=rb, roller_body=rbody, pocket_bearing=pb,
+            guide=np.array([x["guide"] for x in bm]) if rollers and "guide" in bm[0] else None,
+            spring=np.array([x["spring"] for x in bm]) if not rollers else None,
+            rows=int(getattr(b, "rows", 1)), pitch_ratio=Ro / (Ri + Ro))
+        self.meshes = {k: f for k, f in MESH_FAMILY.items() if f in fams}
+        self.reset()
+
+    def reset(self) -> None:
+        nb = self.plan.planet.size
+        self._acc = {}
+        self._T = {"global": 0.0, "bearing": np.zeros(nb)}     # time covered by each window
+        self._angle = np.zeros(nb)                              # cage angle relative to the carrier since t0
+        self._open = np.ones(nb, bool)                          # bearing windows still open
+        self._t_close = np.full(nb, np.nan)
+        self._prev = None
+        self.ref_roller = None       # (inner, outer) race_inner instance of the reference rollers
+        self._impact = None
+
+    def _owner(self, key: str):
+        """Bearing index of each instance of a snapshot quantity, or None for the global window."""
+        p = self.plan
+        if key.startswith("roller_"):
+            return p.roller_bearing
+        if key == "pocket_force":
+            return p.pocket_bearing
+        if key.startswith(("load_", "cage_", "guide_", "planet_")):
+            return np.arange(p.planet.size)
+        return None
+
+    # one state -> derived quantities -------------------------------------------------------------
+    def snapshot(self, s) -> dict[str, np.ndarray]:
+        """Every derived quantity at state ``s`` (arrays per bearing / roller / mesh)."""
+        p, m = self.plan, self.model
+        out = self.system.outputs(s.t, s.q, s.v, s.z)
+        X, V, A = carrier_frame_motion(m, s.t, s.q, s.v, s.a, self.omega_c)
+        radial = lambda vec: radial_tangential(vec, X[p.planet, :2], X[p.carrier, :2])
+        nb = p.planet.size
+        snap: dict[str, np.ndarray] = {}
+        if p.rollers:
+            ri = out[FAMILY["race_inner"]]
+            # force on the pin = minus the inner raceway's force on the rollers, each element per physical roller
+            pin = -p.rows * np.column_stack([np.bincount(p.roller_bearing, ri["fx"], nb),
+                                             np.bincount(p.roller_bearing, ri["fy"], nb)])
+            snap["roller_inner_load"] = np.asarray(ri["load"], float)
+            snap["roller_outer_load"] = np.asarray(out[FAMILY["race_outer"]]["load"], float)
+            if p.pocket_bearing is not None:
+                snap["pocket_force"] = np.asarray(out[FAMILY["pocket"]]["force"], float)
+        else:
+            lin = out[FAMILY["linear"]]
+            pin = -np.column_stack([lin["fx"][p.spring], lin["fy"][p.spring]])   # fx, fy act on the planet
+        pin = self._to_carrier(pin, s.t)
+        snap["load_radial"], snap["load_tangential"] = radial(pin)
+        snap["load_magnitude"] = np.hypot(pin[:, 0], pin[:, 1])
+        snap["load_life"] = snap["load_magnitude"] ** LIFE_EXPONENT
+        snap["load_x"], snap["load_y"] = pin[:, 0], pin[:, 1]
+        if p.cage is not None:
+            a_own = A[p.cage, :2]
+            a_rel = a_own - A[p.planet, :2]
+            snap["cage_acc_radial"], snap["cage_acc_tangential"] = radial(a_own)
+            snap["cage_acc_magnitude"] = np.hypot(a_own[:, 0], a_own[:, 1])
+            snap["cage_acc_rel_radial"], snap["cage_acc_rel_tangential"] = radial(a_rel)
+            snap["cage_acc_rel_magnitude"] = np.hypot(a_rel[:, 0], a_rel[:, 1])
+            snap["cage_acc_x"], snap["cage_acc_y"] = a_rel[:, 0], a_rel[:, 1]
+            snap["cage_speed_rel"] = V[p.cage, 2] - V[p.carrier, 2]
+            snap["planet_speed_rel"] = V[p.planet, 2] - V[p.carrier, 2]
+            if p.guide is not None:
+                snap["guide_force"] = np.asarray(out[FAMILY["guide"]]["force"], float)[p.guide]
+        for key, fam in self.meshes.items():
+            o, f = out[fam], self.flanks.get(key, 1)
+            drive, coast = ("", "_coast") if f > 0 else ("_coast", "")
+            snap[f"{key}_drive_force"] = np.asarray(o["force" + (drive or "_drive")], float)
+            snap[f"{key}_coast_force"] = np.asarray(o["force" + (coast or "_drive")], float)
+            snap[f"{key}_drive_deflection"] = np.asarray(o["deflection" + drive], float)
+            snap[f"{key}_coast_deflection"] = np.asarray(o["deflection" + coast], float)
+        if p.rollers:
+            snap["_roller_angle"] = self._roller_angles(X)
+        return snap
+
+    def _to_carrier(self, vec, t):
+        """A vector given in the model's frame R, in the carrier frame C."""
+        fr = self.model.frame
+        if fr.profile is None and fr.omega == self.omega_c:
+            return vec
+        d = self.model.frame.at(t).phi - self.omega_c * t
+        c, s = math.cos(d), math.sin(d)
+        return np.column_stack([c * vec[:, 0] - s * vec[:, 1], s * vec[:, 0] + c * vec[:, 1]])
+
+    def _roller_angles(self, X):
+        p = self.plan
+        d = X[p.roller_body, :2] - X[p.planet[p.roller_bearing], :2]
+        return np.arctan2(d[:, 1], d[:, 0])
+
+    # accumulation --------------------------------------------------------------------------------
+    def step(self, s0, s1) -> None:
+        if s1.t <= self.t0 or (s0.t >= self.t1 and not self._open.any()):
+            return
+        x0 = self._prev if self._prev is not None else self.snapshot(s0)
+        x1 = self.snapshot(s1)
+        h = s1.t - s0.t
+        ta = max(s0.t, self.t0)
+        wa = (ta - s0.t) / h                                  # linear interpolation inside a straddling step
+        wg = (min(s1.t, self.t1) - s0.t) / h                  # end of the global window in this step
+        wb = self._bearing_ends(x0, x1, wa, s0.t, h)          # end of each bearing's window in this step
+        if self.ref_roller is None and self.plan.rollers:
+            self._choose_reference(x0, x1, wa)
+        for k, v1 in x1.items():
+            if k.startswith("_"):
+                continue
+            own = self._owner(k)
+            w1 = wb[own] if own is not None else wg
+            v0 = x0[k]
+            va, vb = v0 + wa * (v1 - v0), v0 + w1 * (v1 - v0)
+            dt = np.maximum(w1 - wa, 0.0) * h
+            acc = self._acc.get(k)
+            if acc is None:
+                acc = self._acc[k] = np.stack([np.zeros_like(va), np.zeros_like(va), np.full_like(va, -np.inf),
+                                               np.full_like(va, np.inf)])
+            inside = dt > 0
+            acc[0] += 0.5 * (va + vb) * dt
+            acc[1] += 0.5 * (va * va + vb * vb) * dt
+            acc[2] = np.where(inside, np.maximum(acc[2], np.maximum(va, vb)), acc[2])
+            acc[3] = np.where(inside, np.minimum(acc[3], np.minimum(va, vb)), acc[3])
+        self._T["global"] += max(wg - wa, 0.0) * h
+        self._T["bearing"] += np.maximum(wb - wa, 0.0) * h
+        self._impacts(s0, s1, x1, s0.t + wb * h)
+        self._prev = x1
+
+    def _bearing_ends(self, x0, x1, wa, t_start, h) -> np.ndarray:
+        """Fraction of this step at which each bearing's window ends (1: still open after it; wa: closed
+        before it). A bearing closes when its cage has turned its whole number of revolutions."""
+        open_ = self._open
+        nb = open_.size
+        if self.target is None:            # no cages (or disabled): the nominal window for every bearing
+            w = min(1.0, (self.t1 - t_start) / h)
+            if w < 1.0:
+                self._open[:] = False
+            return np.where(open_, max(w, wa), wa)
+        w0, w1 = x0["cage_speed_rel"], x1["cage_speed_rel"]
+        wa_speed = w0 + wa * (w1 - w0)
+        new = self._angle + 0.5 * (wa_speed + w1) * (1.0 - wa) * h
+        phi_a, phi_b = np.abs(self._angle), np.abs(new)
+        goal = 2.0 * math.pi * self.target
+        closing = open_ & (phi_b >= goal)
+        frac = np.where(closing, (goal - phi_a) / np.where(phi_b > phi_a, phi_b - phi_a, 1.0), 1.0)
+        end = np.where(open_, wa + np.clip(frac, 0.0, 1.0) * (1.0 - wa), wa)
+        self._angle = np.where(open_, np.where(closing, np.sign(new) * goal, new), self._angle)
+        self._t_close = np.where(closing, t_start + end * h, self._t_close)
+        self._open = open_ & ~closing
+        return end
+
+    def _choose_reference(self, x0, x1, w):
+        """Reference roller of each bearing kind: the roller of pair 0's bearing nearest its load-zone
+        centre (opposite the pin force: the loaded rollers press the pin away from them) at the window
+        start."""
+        p = self.plan
+        ang = x0["_roller_angle"] + w * (x1["_roller_angle"] - x0["_roller_angle"])
+        ref = []
+        for kind in ("inner", "outer"):
+            i = int(np.flatnonzero(p.kinds == kind)[0])
+            Fx = x0["load_x"][i] + w * (x1["load_x"][i] - x0["load_x"][i])
+            Fy = x0["load_y"][i] + w * (x1["load_y"][i] - x0["load_y"][i])
+            zone = math.atan2(-Fy, -Fx)
+            mine = np.flatnonzero(p.roller_bearing == i)
+            off = np.angle(np.exp(1j * (ang[mine] - zone)))
+            ref.append(int(mine[np.argmin(np.abs(off))]))
+        self.ref_roller = tuple(ref)
+
+    def _impacts(self, s0, s1, x1, t_end_bearing) -> None:
+        """Pocket impacts: contact onsets (the pocket element stores the approach speed v0 > 0 in column 0
+        of its internal state from the step in which contact begins), their speeds and peak forces."""
+        fam = FAMILY["pocket"]
+        pb = self.plan.pocket_bearing
+        if pb is None or fam not in s1.z:
+            return
+        z0 = np.asarray(s0.z[fam])[:, 0] if fam in s0.z else np.zeros(pb.size)
+        z1 = np.asarray(s1.z[fam])[:, 0]
+        n = z1.size
+        if self._impact is None:
+            self._impact = {k: np.zeros(n) for k in ("count", "speed_sum", "speed_max", "peak_sum", "peak_max",
+                                                     "peak_now", "active")}
+        im = self._impact
+        in_window = (s1.t > self.t0) & (s1.t <= t_end_bearing[pb])      # onset within this bearing's window
+        onset = (z0 <= 0.0) & (z1 > 0.0) & in_window
+        ended = (im["active"] > 0) & ((z1 <= 0.0) | ~in_window)
+        force = np.abs(x1["pocket_force"])
+        np.maximum(im["peak_now"], np.where(im["active"] > 0, force, 0.0), out=im["peak_now"])
+        im["peak_sum"] += np.where(ended, im["peak_now"], 0.0)
+        np.maximum(im["peak_max"], np.where(ended, im["peak_now"], 0.0), out=im["peak_max"])
+        im["active"][ended] = 0.0
+        im["peak_now"][ended] = 0.0
+        im["count"] += onset
+        im["speed_sum"] += np.where(onset, z1, 0.0)
+        np.maximum(im["speed_max"], np.where(onset, z1, 0.0), out=im["speed_max"])
+        im["active"][onset] = 1.0
+        im["peak_now"][onset] = force[onset]
+
+    def _close_impacts(self) -> None:
+        """Impacts still in progress when their window ended count with the peak they reached."""
+        im = self._impact
+        if im is None:
+            return
+        act = im["active"] > 0
+        im["peak_sum"] += np.where(act, im["peak_now"], 0.0)
+        np.maximum(im["peak_max"], np.where(act, im["peak_now"], 0.0), out=im["peak_max"])
+        im["active"][act] = 0.0
+        im["peak_now"][act] = 0.0
+
+    # checkpoints ---------------------------------------------------------------------------------
+    def state_dict(self) -> dict:
+        d = {f"acc__{k}": v for k, v in self._acc.items()}
+        d.update({f"imp__{k}": v for k, v in (self._impact or {}).items()})
+        d.update({f"prev__{k}": v for k, v in (self._prev or {}).items()})
+        d.update({"T_global": np.array(self._T["global"]), "T_bearing": self._T["bearing"], "angle": self._angle,
+                  "open": self._open, "t_close": self._t_close,
+                  "ref": np.array(self.ref_roller if self.ref_roller is not None else (-1, -1))})
+        return d
+
+    def load_state_dict(self, d: dict) -> None:
+        self._acc = {k[5:]: v.copy() for k, v in d.items() if k.startswith("acc__")}
+        self._impact = {k[5:]: v.copy() for k, v in d.items() if k.startswith("imp__")} or None
+        self._prev = {k[6:]: v.copy() for k, v in d.items() if k.startswith("prev__")} or None
+        if "T_global" in d:
+            self._T = {"global": float(d["T_global"]), "bearing": d["T_bearing"].copy()}
+            self._angle, self._open, self._t_close = d["angle"].copy(), d["open"].astype(bool), d["t_close"].copy()
+        ref = tuple(int(x) for x in d.get("ref", (-1, -1)))
+        self.ref_roller = None if ref[0] < 0 else ref
+
+    # results -------------------------------------------------------------------------------------
+    def stats(self, key: str) -> dict[str, np.ndarray]:
+        """mean, rms, max, min of a snapshot quantity over its window (arrays per instance)."""
+        acc = self._acc[key]
+        own = self._owner(key)
+        T = self._T["bearing"][own] if own is not None else self._T["global"]
+        T = np.where(np.asarray(T) > 0, T, np.nan)
+        return {"mean": acc[0] / T, "rms": np.sqrt(np.maximum(acc[1], 0.0) / T), "max": acc[2], "min": acc[3]}
+
+    def aggregate_rms(self, key: str, bearings) -> float:
+        """RMS of a quantity over every instance that belongs to ``bearings`` (time-weighted, all windows)."""
+        own = self._owner(key)
+        mine = np.isin(own, bearings)
+        T = self._T["bearing"][own[mine]]
+        return float(np.sqrt(self._acc[key][1][mine].sum() / T.sum()))
+
+    @property
+    def duration(self) -> float:
+        """Length of the global (mesh) window covered so far [s]."""
+        return self._T["global"]
+
+    def summary(self) -> dict:
+        """The statistics users read, per bearing kind (see README: summary.json)."""
+        if self.duration <= 0.0:
+            raise mbd.ModelError(f"no accepted step fell into the statistics window [{self.t0}, {self.t1}] s")
+        self._close_impacts()
+        p = self.plan
+        out: dict = {"window_s": [self.t0, self.t1], "window_duration_s": self.duration}
+        for kind in ("inner", "outer"):
+            sel = np.flatnonzero(p.kinds == kind)
+            ref = int(sel[0])
+            d: dict = {"window_s": [self.t0, float(self.t0 + self._T["bearing"][ref])]}
+            if self.target is not None:
+                d["whole_revolutions"] = bool(not self._open[sel].any())
+            lr, lt, lm = self.stats("load_radial"), self.stats("load_tangential"), self.stats("load_magnitude")
+            mean_vec = np.hypot(lr["mean"], lt["mean"])
+            d["bearing_load_mean_N"] = float(mean_vec[ref])
+            d["bearing_load_mean_all_N"] = float(mean_vec[sel].mean())
+            d["bearing_load_radial_mean_N"] = float(lr["mean"][ref])
+            d["bearing_load_tangential_mean_N"] = float(lt["mean"][ref])
+            d["bearing_load_max_N"] = float(lm["max"][ref])
+            d["equivalent_load_N"] = float(self.stats("load_life")["mean"][ref] ** (1.0 / LIFE_EXPONENT))
+            if p.rollers:
+                self._roller_summary(d, kind, sel)
+            if p.cage is not None:
+                self._cage_summary(d, ref, sel)
+            d["life_L10_relative"] = None     # filled by a study relative to its forward run
+            out[kind] = d
+        out["meshes"] = self._mesh_summary()
+        return out
+
+    def _roller_summary(self, d, kind, sel):
+        p = self.plan
+        r = self.ref_roller[0 if kind == "inner" else 1]
+        mine = np.isin(p.roller_bearing, sel)
+        al = {}
+        for name, key in (("inner_race", "roller_inner_load"), ("outer_race", "roller_outer_load")):
+            st = self.stats(key)
+            d[f"roller_{name}_rms_N"] = float(st["rms"][r])
+            d[f"roller_{name}_max_N"] = float(st["max"][r])
+            d[f"roller_{name}_mean_N"] = float(st["mean"][r])
+            al[f"roller_{name}_rms_N"] = self.aggregate_rms(key, sel)
+            al[f"roller_{name}_max_N"] = float(st["max"][mine].max())
+        mean_loads = self.stats("roller_inner_load")["mean"][p.roller_bearing == p.roller_bearing[r]]
+        d["roller_inner_race_mean_spread"] = float((mean_loads.max() - mean_loads.min()) / mean_loads.mean())
+        if p.pocket_bearing is not None:
+            st = self.stats("pocket_force")
+            pk = np.isin(p.pocket_bearing, sel)
+            # pocket instances follow the rollers one to one
+            d["roller_cage_rms_N"] = float(st["rms"][r])
+            d["roller_cage_max_N"] = float(max(st["max"][r], -st["min"][r]))
+            al["roller_cage_rms_N"] = self.aggregate_rms("pocket_force", sel)
+            al["roller_cage_max_N"] = float(max(st["max"][pk].max(), -st["min"][pk].min()))
+            if self._impact is not None:
+                im = self._impact
+                count = im["count"][pk].sum()
+                revs = self._cage_revolutions(sel)
+                d["pocket_impacts"] = int(count)
+                d["pocket_impacts_per_rev"] = float(count / revs) if revs > 0 else None
+                d["pocket_impact_speed_max"] = float(im["speed_max"][pk].max())
+                d["pocket_impact_speed_mean"] = float(im["speed_sum"][pk].sum() / count) if count else 0.0
+                d["pocket_impact_peak_max_N"] = float(im["peak_max"][pk].max())
+                d["pocket_impact_peak_mean_N"] = float(im["peak_sum"][pk].sum() / count) if count else 0.0
+        d["all_rollers"] = al
+
+    def _cage_revolutions(self, sel) -> float:
+        """Cage revolutions relative to the carrier in the windows of the bearings ``sel``, summed."""
+        return float(np.abs(self._angle[sel]).sum() / (2 * math.pi))
+
+    def _cage_summary(self, d, ref, sel):
+        p = self.plan
+        for view in ("", "rel_"):
+            for comp in ("radial", "tangential", "magnitude"):
+                st = self.stats(f"cage_acc_{view}{comp}")
+                d[f"cage_acc_{view}{comp}_rms"] = float(st["rms"][ref])
+                d[f"cage_acc_{view}{comp}_max"] = float(max(st["max"][ref], -st["min"][ref]))
+        for comp in ("x", "y"):
+            d[f"cage_acc_{comp}_rms"] = float(self.stats(f"cage_acc_{comp}")["rms"][ref])
+        # every cage of this bearing type: RMS over all their windows (steadier than one cage's)
+        d["all_cages"] = {f"cage_acc_{view}{comp}_rms": self.aggregate_rms(f"cage_acc_{view}{comp}", sel)
+                          for view in ("", "rel_") for comp in ("radial", "tangential", "magnitude")}
+        w_cage = self.stats("cage_speed_rel")["mean"]
+        w_epi = p.pitch_ratio * self.stats("planet_speed_rel")["mean"]
+        slip = 100.0 * (1.0 - w_cage / w_epi)
+        d["cage_slip_pct"] = float(slip[ref])
+        d["cage_slip_pct_all"] = float(slip[sel].mean())
+        d["cage_revolutions"] = float(abs(self._angle[ref]) / (2 * math.pi))
+        if p.guide is not None:
+            st = self.stats("guide_force")
+            d["cage_guide_rms_N"] = float(st["rms"][ref])
+            d["cage_guide_max_N"] = float(st["max"][ref])
+            d["cage_guide_mean_N"] = float(st["mean"][ref])
+            d.setdefault("all_rollers", {})["cage_guide_rms_N"] = self.aggregate_rms("guide_force", sel)
+            d["all_cages"]["cage_guide_rms_N"] = d["all_rollers"]["cage_guide_rms_N"]
+
+    def _mesh_summary(self) -> dict:
+        """Per mesh type, over all planet pairs: mean (average of the pairs) and max of each flank."""
+        out = {}
+        for key in self.meshes:
+            d = {"drive_flank": int(self.flanks.get(key, 1))}
+            for flank in ("drive", "coast"):
+                f, x = self.stats(f"{key}_{flank}_force"), self.stats(f"{key}_{flank}_deflection")
+                d[f"{flank}_force_mean_N"] = float(f["mean"].mean())
+                d[f"{flank}_force_max_N"] = float(f["max"].max())
+                d[f"{flank}_deflection_mean_m"] = float(x["mean"].mean())
+                d[f"{flank}_deflection_max_m"] = float(x["max"].max())
+                d[f"{flank}_force_mean_per_pair_N"] = [float(y) for y in f["mean"]]
+            out[key] = d
+        return out
