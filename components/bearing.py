@@ -13,7 +13,7 @@ import numpy as np
 from mbd.elements import BodySpring
 from mbd.elements.contact import GuideContact, LubricantDrag, PocketContact, RaceContact, Traction
 
-from .outputs import FAMILY
+from .families import FAMILY
 from .scene import Scene
 
 __all__ = ["BearingSI", "add_planet_bearing", "bearing_kinematics", "bearing_si"]

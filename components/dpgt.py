@@ -18,7 +18,7 @@ from mbd.elements import GroundSupport, Ramp, SpeedDrive, TorqueSource
 from .bearing import add_planet_bearing, bearing_si
 from .gears import add_mesh_family
 from .geometry import check_design, layout, loaded_flanks
-from .outputs import MESH_FAMILY
+from .families import MESH_FAMILY
 from .params import DPGTParams
 from .scene import BuiltScene, Scene, SceneOptions
 

@@ -14,7 +14,7 @@ taken here, by :class:`WindowStatistics`, an observer of the one simulation loop
   carrier); *radial* is from the carrier axis through the planet's centre, *tangential* 90° ahead.
   Both are independent of where the planet sits and of the frame the model is integrated in.
 
-Element family names used by the scene builders live here too (:data:`FAMILY`, :data:`MESH_FAMILY`).
+Element family names come from :mod:`components.families` (re-exported here).
 """
 from __future__ import annotations
 
@@ -25,13 +25,12 @@ import numpy as np
 
 import mbd
 
+from .bearing import bearing_kinematics
+from .families import FAMILY, MESH_FAMILY
+
 __all__ = ["FAMILY", "MESH_FAMILY", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
            "WindowStatistics", "carrier_frame_motion", "radial_tangential"]
 
-# element families of the planet-bearing and train scenes (one family per contact kind)
-FAMILY = {"race_inner": "race_inner", "race_outer": "race_outer", "pocket": "pocket", "guide": "guide",
-          "drag": "drag", "linear": "bearing_linear"}
-MESH_FAMILY = {"sun_inner": "mesh_sa", "inner_outer": "mesh_ab", "outer_ring": "mesh_br"}
 LIFE_EXPONENT = 10.0 / 3.0     # ISO 281, roller bearings: L10 ∝ P^(−10/3)
 
 
@@ -63,7 +62,6 @@ def bearing_map(scene) -> list[dict]:
 
 def cage_period(b, omega_pin: float, omega_planet: float) -> float:
     """Time of one cage revolution relative to the pin [s] in pure rolling (inf when it does not turn)."""
-    from .bearing import bearing_kinematics   # bearing imports the family names from here
     w_cage, _ = bearing_kinematics(b, omega_pin, omega_planet)
     rel = abs(w_cage - omega_pin)
     return 2.0 * math.pi / rel if rel > 0 else math.inf
@@ -191,6 +189,8 @@ class WindowStatistics(mbd.Observer):
             spring=np.array([x["spring"] for x in bm]) if not rollers else None,
             rows=int(getattr(b, "rows", 1)), pitch_ratio=Ro / (Ri + Ro))
         self.meshes = {k: f for k, f in MESH_FAMILY.items() if f in fams}
+        if pb is not None:      # approach-speed floor of the impact law: slower onsets are touches
+            self._v_floor = model.element(FAMILY["pocket"]).v_min * (1.0 + 1e-9)
         self.reset()
 
     def reset(self) -> None:
@@ -317,12 +317,17 @@ class WindowStatistics(mbd.Observer):
         """Fraction of this step at which each bearing's window ends (1: still open after it; wa: closed
         before it). A bearing closes when its cage has turned its whole number of revolutions."""
         open_ = self._open
-        nb = open_.size
-        if self.target is None:            # no cages (or disabled): the nominal window for every bearing
+        if self.target is None:            # no whole revolutions asked: the nominal window for every bearing
             w = min(1.0, (self.t1 - t_start) / h)
+            end = np.where(open_, max(w, wa), wa)
+            if "cage_speed_rel" in x1:     # still count the cage's revolutions (impacts per revolution)
+                w0, w1 = x0["cage_speed_rel"], x1["cage_speed_rel"]
+                wa_s = w0 + wa * (w1 - w0)
+                wb_s = w0 + end * (w1 - w0)
+                self._angle = self._angle + 0.5 * (wa_s + wb_s) * (end - wa) * h
             if w < 1.0:
                 self._open[:] = False
-            return np.where(open_, max(w, wa), wa)
+            return end
         w0, w1 = x0["cage_speed_rel"], x1["cage_speed_rel"]
         wa_speed = w0 + wa * (w1 - w0)
         new = self._angle + 0.5 * (wa_speed + w1) * (1.0 - wa) * h
@@ -354,8 +359,9 @@ class WindowStatistics(mbd.Observer):
         self.ref_roller = tuple(ref)
 
     def _impacts(self, s0, s1, x1, t_end_bearing) -> None:
-        """Pocket impacts: contact onsets (the pocket element stores the approach speed v0 > 0 in column 0
-        of its internal state from the step in which contact begins), their speeds and peak forces."""
+        """Pocket impacts: contact onsets faster than the element's approach-speed floor (the pocket element
+        stores the approach speed v0 > 0 in column 0 of its internal state from the step in which contact
+        begins), their speeds and peak forces; onsets at the floor count as touches."""
         fam = FAMILY["pocket"]
         pb = self.plan.pocket_bearing
         if pb is None or fam not in s1.z:
@@ -364,11 +370,16 @@ class WindowStatistics(mbd.Observer):
         z1 = np.asarray(s1.z[fam])[:, 0]
         n = z1.size
         if self._impact is None:
-            self._impact = {k: np.zeros(n) for k in ("count", "speed_sum", "speed_max", "peak_sum", "peak_max",
-                                                     "peak_now", "active")}
+            self._impact = {k: np.zeros(n) for k in ("count", "touches", "speed_sum", "speed_max", "peak_sum",
+                                                     "peak_max", "peak_now", "active")}
         im = self._impact
         in_window = (s1.t > self.t0) & (s1.t <= t_end_bearing[pb])      # onset within this bearing's window
-        onset = (z0 <= 0.0) & (z1 > 0.0) & in_window
+        contact = (z0 <= 0.0) & (z1 > 0.0) & in_window
+        # an approach at the element's speed floor is a quasi-static touch (a roller settling against a
+        # wall, the last bounces of a rattle), not a collision: counted apart
+        touch = contact & (z1 <= self._v_floor)
+        onset = contact & ~touch
+        im["touches"] += touch
         ended = (im["active"] > 0) & ((z1 <= 0.0) | ~in_window)
         force = np.abs(x1["pocket_force"])
         np.maximum(im["peak_now"], np.where(im["active"] > 0, force, 0.0), out=im["peak_now"])
@@ -492,6 +503,7 @@ class WindowStatistics(mbd.Observer):
                 revs = self._cage_revolutions(sel)
                 d["pocket_impacts"] = int(count)
                 d["pocket_impacts_per_rev"] = float(count / revs) if revs > 0 else None
+                d["pocket_touches_per_rev"] = float(im["touches"][pk].sum() / revs) if revs > 0 else None
                 d["pocket_impact_speed_max"] = float(im["speed_max"][pk].max())
                 d["pocket_impact_speed_mean"] = float(im["speed_sum"][pk].sum() / count) if count else 0.0
                 d["pocket_impact_peak_max_N"] = float(im["peak_max"][pk].max())

@@ -26,10 +26,11 @@ import mbd
 from mbd.elements import ForceSource, GroundSupport, Ramp, SpeedDrive
 
 from .bearing import BearingSI, add_planet_bearing, bearing_si
+from .families import FAMILY
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError
 
-__all__ = ["RING_MASS", "RING_INERTIA", "build_bearing_rig", "run_sampled", "run_averaged", "rig_loads", "RigSolution",
+__all__ = ["RING_MASS", "RING_INERTIA", "build_bearing_rig", "run_sampled", "rig_loads", "RigSolution",
            "rig_static_solution", "discrete_load_distribution", "DiscreteDistribution"]
 
 RING_MASS = 0.557                         # [assumed] a planet-like outer ring: the reference planet's mass, kg
@@ -268,46 +269,6 @@ def run_sampled(model: mbd.Model, q0, v0, times, *, controller, stepper: mbd.HHT
     return out
 
 
-def run_averaged(model: mbd.Model, fn, t0: float, t1: float, *, controller, q0=None, v0=None,
-                 state: mbd.State | None = None, stepper: mbd.HHT | None = None,
-                 system: mbd.System | None = None) -> tuple[np.ndarray, mbd.State, int]:
-    """Time mean of ``fn(system, state)`` (an array) over [t0, t1], by the trapezoidal rule on the
-    integrator's own accepted steps (every contact event the integrator resolves is in the mean; a
-    mean of samples at a fixed rate would alias roller impacts and mesh harmonics).
-
-    Integrates from (0, q0, v0) — or from ``state`` — to t0 first. Returns (mean, state at t1, steps)."""
-    from mbd.hht import NewtonCache
-    system = system or mbd.System(model)
-    stepper = stepper or mbd.HHT(alpha=-0.3)
-    if not t1 > t0:
-        raise mbd.ModelError(f"run_averaged: need t1 > t0, got t0={t0!r}, t1={t1!r}")
-    state = run_sampled(model, q0, v0, [t0], controller=controller, stepper=stepper, system=system,
-                        state=state)[-1]
-    cache = NewtonCache()
-    h = controller.initial()
-    h_floor = getattr(controller, "h_min", 0.0)
-    f_prev = np.asarray(fn(system, state), float)
-    acc = np.zeros_like(f_prev)
-    steps = 0
-    while state.t < t1 - 1e-12 * max(1.0, abs(t1)):
-        h_try = min(h, t1 - state.t)
-        new, info = stepper.step(system, state, h_try, cache)
-        ok, h_next = controller.decide(h_try, info.converged, info.error)
-        if not ok:
-            system.counters.rejected += 1
-            if h_next < h_floor:
-                raise mbd.IntegrationError(f"run_averaged: step size fell below the minimum at t = {state.t:.9e} s "
-                                           f"({info.reason or 'error test'})", state=state)
-            h = h_next
-            continue
-        system.counters.accepted += 1
-        f_new = np.asarray(fn(system, new), float)
-        acc += 0.5 * (new.t - state.t) * (f_prev + f_new)
-        f_prev, state, h = f_new, new, h_next
-        steps += 1
-    return acc / (state.t - t0), state, steps
-
-
 def rig_loads(built: BuiltScene, system: mbd.System, s: mbd.State) -> dict:
     """Instantaneous roller loads of the rig at state ``s``: inner- and outer-raceway loads (Z,) [N],
     roller angles from the load-zone centre (Z,) [rad], the ring centre (2,) [m], and the vector sums
@@ -318,7 +279,7 @@ def rig_loads(built: BuiltScene, system: mbd.System, s: mbd.State) -> dict:
     out = system.outputs(s.t, s.q, s.v, s.z)
     h = built.handles["bearing"]
     si, so = h["race_inner"], h["race_outer"]
-    inner, outer = out["race_inner"], out["race_outer"]
+    inner, outer = out[FAMILY["race_inner"]], out[FAMILY["race_outer"]]
     ang = inner["angle"][si]                            # about the pin (fixed, θ = 0): fixed-frame angle
     e = np.column_stack([np.cos(ang), np.sin(ang)])
     qf, _ = m.full(s.t, s.q, s.v)

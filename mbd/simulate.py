@@ -23,7 +23,7 @@ from .hht import HHT, NewtonCache
 from .model import Model, State
 from .recorder import Recorder, atomic_write_bytes
 
-__all__ = ["simulate", "SimResult", "Checkpoint", "Observer", "save_state", "load_state"]
+__all__ = ["simulate", "SimResult", "Checkpoint", "Observer", "TimeMean", "save_state", "load_state"]
 
 
 @dataclass(frozen=True)
@@ -95,6 +95,43 @@ class Observer:
 
     def load_state_dict(self, d: dict) -> None:
         pass
+
+
+class TimeMean(Observer):
+    """Time mean of ``fn(system, state)`` (an array) over [t0, t1], by the trapezoidal rule on the
+    accepted steps that end inside it (every contact event the integrator resolves is in the mean; a mean
+    of samples at a fixed rate would alias impacts). Steps straddling t0 or t1 count from their ends."""
+
+    def __init__(self, fn, t0: float, t1: float):
+        if not t1 > t0:
+            raise ModelError(f"TimeMean: need t1 > t0 [s], got t0={t0!r}, t1={t1!r}")
+        self.fn, self.t0, self.t1 = fn, float(t0), float(t1)
+        self._acc, self._T, self._prev = 0.0, 0.0, None
+
+    def bind(self, model, system, state) -> None:
+        self.system = system
+
+    def step(self, s0: State, s1: State) -> None:
+        if s1.t <= self.t0 or s0.t >= self.t1:
+            return
+        f0 = self._prev if self._prev is not None else np.asarray(self.fn(self.system, s0), float)
+        f1 = np.asarray(self.fn(self.system, s1), float)
+        self._acc = self._acc + 0.5 * (f0 + f1) * (s1.t - s0.t)
+        self._T += s1.t - s0.t
+        self._prev = f1
+
+    def state_dict(self) -> dict:
+        return {"acc": np.asarray(self._acc), "T": np.asarray(self._T),
+                **({"prev": self._prev} if self._prev is not None else {})}
+
+    def load_state_dict(self, d: dict) -> None:
+        self._acc, self._T, self._prev = d["acc"], float(d["T"]), d.get("prev")
+
+    @property
+    def mean(self) -> np.ndarray:
+        if self._T <= 0:
+            raise ModelError(f"TimeMean: no accepted step ended in [{self.t0}, {self.t1}] s")
+        return self._acc / self._T
 
 
 def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 0.0,

@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.outputs import FAMILY
 
 from .numerics_common import (StateSampler, design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note,
                               observables, peak_rss_mb, run_scipy, settled_state, wait_quiet)
@@ -60,7 +61,7 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
               newton_tol: float | None = None) -> dict:
     prob = dpgt_problem(settle=settle)
     s0, extra = settled_state(prob, out / "dpgt_settled.npz")
-    ri = mbd.System(prob.model).outputs(s0.t, s0.q, s0.v, s0.z)["race_inner"]["load"][prob.race_inner]
+    ri = mbd.System(prob.model).outputs(s0.t, s0.q, s0.v, s0.z)[FAMILY["race_inner"]]["load"][prob.race_inner]
     prob.roller = prob.race_inner.start + int(np.argmax(ri))
     t0, t1 = s0.t, s0.t + window
     ref_window = min(ref_window, window)

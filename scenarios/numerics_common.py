@@ -29,6 +29,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import mbd
+from components.outputs import FAMILY
 from components.params import with_overrides
 from components.presets import reference_dpgt
 
@@ -322,10 +323,10 @@ def observables(prob: Problem, grid, q, v, z) -> dict[str, np.ndarray]:
     out = {k: [] for k in ("pin_load", "inner_load", "guide_force", "cage_acc_x", "cage_acc_y")}
     for t, qi, vi, zi in zip(grid, q, v, z):
         o = system.outputs(t, qi, vi, zi)
-        ri = o["race_inner"]
+        ri = o[FAMILY["race_inner"]]
         out["pin_load"].append(np.hypot(ri["fx"][sl].sum(), ri["fy"][sl].sum()))
         out["inner_load"].append(ri["load"][prob.roller])
-        out["guide_force"].append(o["guide"]["force"][prob.guide] if prob.guide is not None else 0.0)
+        out["guide_force"].append(o[FAMILY["guide"]]["force"][prob.guide] if prob.guide is not None else 0.0)
         if ic is not None:
             a = system.forces(t, qi, vi, zi) / m.mdiag
             acc = [a[f2f[3 * ic + j]] - (a[f2f[3 * ip + j]] if f2f[3 * ip + j] >= 0 else 0.0) for j in (0, 1)]

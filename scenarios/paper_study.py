@@ -32,8 +32,10 @@ QUANTITIES = [
     ("pocket_impacts_per_rev", "-"), ("pocket_impact_speed_max", "m/s"), ("pocket_impact_peak_max_N", "N"),
     ("bearing_load_mean_N", "N"), ("life_L10_relative", "-"),
 ]
-# bar chart: RMS values comparable between inner and outer planets (radial/tangential, not x/y)
-BAR_QUANTITIES = [q for q, _ in QUANTITIES if q.endswith("_rms")]
+# bar chart: RMS values, cage accelerations relative to the planet, radial/tangential (comparable between
+# inner and outer planets, unlike x/y)
+BAR_QUANTITIES = ["roller_cage_rms_N", "cage_guide_rms_N", "roller_inner_race_rms_N", "roller_outer_race_rms_N",
+                  "cage_acc_rel_radial_rms", "cage_acc_rel_tangential_rms"]
 
 
 def parse_args(argv):
@@ -161,7 +163,7 @@ def write_tables(rows: list[dict], out: Path) -> tuple[Path, Path, str]:
 def plots(results: dict, out: Path) -> list[Path]:
     import xarray as xr
 
-    from components.outputs import radial_tangential
+    from components.outputs import FAMILY, radial_tangential
     from viz import plots as vp
 
     paths = []
@@ -186,12 +188,12 @@ def plots(results: dict, out: Path) -> list[Path]:
                     b = next(x for x in bmap if x["kind"] == kind)
                     if b["type"] != "rollers":
                         continue
-                    cols[f"{kind}: roller–inner race"] = ds["race_inner.load"].values[:, b["race_inner"][0]]
-                    cols[f"{kind}: roller–outer race"] = ds["race_outer.load"].values[:, b["race_outer"][0]]
+                    cols[f"{kind}: roller–inner race"] = ds[f"{FAMILY['race_inner']}.load"].values[:, b["race_inner"][0]]
+                    cols[f"{kind}: roller–outer race"] = ds[f"{FAMILY['race_outer']}.load"].values[:, b["race_outer"][0]]
                     if "pocket" in b:
-                        cols[f"{kind}: roller–cage"] = ds["pocket.force"].values[:, b["pocket"][0]]
+                        cols[f"{kind}: roller–cage"] = ds[f"{FAMILY['pocket']}.force"].values[:, b["pocket"][0]]
                     if "guide" in b:
-                        cols[f"{kind}: cage–guide"] = ds["guide.force"].values[:, b["guide"]]
+                        cols[f"{kind}: cage–guide"] = ds[f"{FAMILY['guide']}.force"].values[:, b["guide"]]
                         a, q = ds["motion.a"].values, ds["motion.q"].values
                         ic, ip, ik = (bodies.index(x) for x in (b["cage"], b["planet"], "carrier"))
                         rad, tan = radial_tangential(a[:, ic, :2] - a[:, ip, :2], q[:, ip, :2], q[:, ik, :2])

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.outputs import FAMILY
 from components.units import Q_
 
 from .numerics_common import Problem, StateSampler, design_verdict, dpgt_problem, machine_note, run_scipy
@@ -92,7 +93,7 @@ def _build(name: str, strict: bool = True) -> Problem:
 
 
 def _pin_and_roller(prob: Problem, system, t, q, v, z):
-    o = system.outputs(t, q, v, z)["race_inner"]
+    o = system.outputs(t, q, v, z)[FAMILY["race_inner"]]
     sl = prob.race_inner
     return float(np.hypot(o["fx"][sl].sum(), o["fy"][sl].sum())), float(o["load"][sl].max())
 

@@ -38,6 +38,7 @@ import shutil
 import sys
 import time
 from pathlib import Path
+from components.outputs import FAMILY
 
 import numpy as np
 
@@ -91,7 +92,7 @@ def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None,
     # reference roller: the most loaded roller of the reference bearing at the start of the window (a
     # roller outside the load zone for the whole short window would have RMS 0 and no relative error)
     import mbd
-    ri = mbd.System(prob.model).outputs(s0.t, s0.q, s0.v, s0.z)["race_inner"]["load"][prob.race_inner]
+    ri = mbd.System(prob.model).outputs(s0.t, s0.q, s0.v, s0.z)[FAMILY["race_inner"]]["load"][prob.race_inner]
     prob.roller = prob.race_inner.start + int(np.argmax(ri))
     t0, t1 = s0.t, s0.t + P["window"]
     grid = t0 + P["dt"] * np.arange(int(round(P["window"] / P["dt"])) + 1)

@@ -22,30 +22,6 @@ SETTLE = 8e-3
 CONTROLLER = mbd.Adaptive(h0=1e-6, h_max=1e-5, h_min=1e-9)
 
 
-class TimeMean(mbd.Observer):
-    """Time mean of fn(system, state) over [t0, t1] by the trapezoid rule on the accepted steps."""
-
-    def __init__(self, fn, t0, t1):
-        self.fn, self.t0, self.t1 = fn, t0, t1
-        self.acc, self.T, self.prev = 0.0, 0.0, None
-
-    def bind(self, model, system, state):
-        self.system = system
-
-    def step(self, s0, s1):
-        if s1.t <= self.t0 or s0.t >= self.t1:
-            return
-        f0 = self.prev if self.prev is not None else np.asarray(self.fn(self.system, s0), float)
-        f1 = np.asarray(self.fn(self.system, s1), float)
-        self.acc = self.acc + 0.5 * (f0 + f1) * (s1.t - s0.t)
-        self.T += s1.t - s0.t
-        self.prev = f1
-
-    @property
-    def mean(self):
-        return self.acc / self.T
-
-
 def cage_revolution(params) -> float:
     """One cage revolution relative to the carrier [s] (inner and outer cages turn alike here)."""
     from components.bearing import bearing_si

@@ -209,3 +209,30 @@ def test_recorder_rejects_bad_probes(tmp_path):
     rec = mbd.Recorder(tmp_path / "x.nc", dt=1e-3, probes=[mbd.ElementOutput("nope")])
     with pytest.raises(mbd.ModelError, match="nope"):
         mbd.simulate(model, *q0v0(model), 0.001, controller=mbd.FixedStep(1e-3), recorder=rec, progress=False)
+
+
+class _Seen(mbd.Observer):
+    def __init__(self):
+        self.steps = []
+
+    def bind(self, model, system, state):
+        self.t_start = state.t
+
+    def step(self, s0, s1):
+        self.steps.append((s0.t, s1.t))
+
+
+def test_observers_see_every_accepted_step_and_time_means_are_trapezoids(tmp_path):
+    """Every accepted step reaches every observer once, in order, whatever the recorder; TimeMean of a
+    function linear in time is exact (the trapezoid rule), here over the steps that end in [t0, t1]."""
+    seen = _Seen()
+    mean = mbd.TimeMean(lambda system, s: np.array([s.t, 2.0]), 0.01, 0.03)
+    res = run(scene(), tmp_path / "r.nc", t_end=0.04, controller=mbd.Adaptive(h0=1e-4, h_min=1e-9),
+              observers=[seen, mean])
+    assert len(seen.steps) == res.steps == res.counters["accepted"] and res.counters["rejected"] >= 0
+    ends = np.array(seen.steps)
+    assert ends[0, 0] == seen.t_start and ends[-1, 1] == pytest.approx(0.04)
+    np.testing.assert_array_equal(ends[1:, 0], ends[:-1, 1])          # contiguous: no step skipped
+    covered = ends[(ends[:, 1] > 0.01) & (ends[:, 0] < 0.03)]
+    assert mean.mean[0] == pytest.approx(0.5 * (covered[0, 0] + covered[-1, 1]), rel=1e-12)
+    assert mean.mean[1] == pytest.approx(2.0, rel=1e-12)

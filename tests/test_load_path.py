@@ -136,17 +136,18 @@ def test_no_load_reverse_is_the_mirror_image_of_forward(runs):
 
 @pytest.mark.slow
 def test_no_load_forward_and_reverse_of_one_machine(runs):
-    """The same machine at no load, forward vs reverse: the mesh forces are not zero — the planet
-    bearings' traction and drag losses (≈ 40 N on the inner–outer, ≈ 80 N on the ring mesh, measured)
-    go through the meshes, whose geometry the handedness sets — so the directions are not exact mirror
-    images. Bearing loads and roller loads still agree within 2 %; the outer cages' acceleration RMS does
-    not (≈ 11 % apart over one cage revolution, in all three outer bearings alike, gravity on or off):
-    the cage motion amplifies the 0.6 % load difference (printed, not asserted)."""
+    """The same machine at no load, forward vs reverse. The mesh forces are not zero — the planet
+    bearings' traction and drag losses (≈ 40 N on the inner–outer, ≈ 80 N on the ring mesh's flanks,
+    measured) go through the meshes, whose geometry the handedness sets — so the two directions are mirror
+    images only approximately. Forces agree within 2 % (measured ≤ 0.7 %). The cage accelerations' RMS
+    is printed, not asserted: over one cage revolution after this short settling the outer cages differ by
+    ≈ 11 % (all three alike: they share one carrier and sun), over the study's 3 revolutions after 30 ms by
+    1–6 % with the opposite sign: variability of the cage motion between runs, no consistent direction effect."""
     f, r = runs[4, "forward"][1].summary(), runs[4, "reverse"][1].summary()
     for kind in ("inner", "outer"):
         for k in ("roller_inner_race_rms_N", "roller_outer_race_rms_N", "cage_guide_rms_N", "bearing_load_mean_N"):
             assert r[kind][k] == pytest.approx(f[kind][k], rel=0.02), (kind, k)
-        for k in ("roller_inner_race_rms_N", "roller_outer_race_rms_N"):
+        for k in ("roller_inner_race_rms_N", "roller_outer_race_rms_N", "roller_cage_rms_N"):
             assert r[kind]["all_rollers"][k] == pytest.approx(f[kind]["all_rollers"][k], rel=0.02), (kind, k)
         a, b = f[kind]["cage_acc_magnitude_rms"], r[kind]["cage_acc_magnitude_rms"]
         print(f"no load, {kind} cage acceleration RMS: forward {a:.0f}, reverse {b:.0f} m/s^2 ({(b / a - 1) * 100:+.1f} %)")

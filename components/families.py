@@ -1,0 +1,9 @@
+"""Element family names of the planet-bearing and gear-train scenes: one family per contact kind, so
+builders, the outputs module, the runner and the numerics scripts all name them from here."""
+from types import MappingProxyType
+
+__all__ = ["FAMILY", "MESH_FAMILY"]
+
+FAMILY = MappingProxyType({"race_inner": "race_inner", "race_outer": "race_outer", "pocket": "pocket",
+                           "guide": "guide", "drag": "drag", "linear": "bearing_linear"})
+MESH_FAMILY = MappingProxyType({"sun_inner": "mesh_sa", "inner_outer": "mesh_ab", "outer_ring": "mesh_br"})
