@@ -343,3 +343,40 @@ def test_random_bearings_checks_never_crash_and_si_is_consistent(values):
                 geo.check_design(p)
         else:
             geo.check_design(p)
+
+
+def test_backlash_defaults_to_the_iso_minimum_per_mesh_and_zero_is_allowed():
+    """PARAMETERS.md: j_bn,min = (2/3)(0.06 + 0.0005 a + 0.03 m_n) mm, a per mesh type, tagged [derived]."""
+    p = reference_dpgt()
+    si = p.si()
+    for key, a_mm, b_mm in (("sun_inner", 82.5, 0.1275), ("inner_outer", 72.0, 0.124), ("outer_ring", 87.0, 0.129)):
+        m = si.layout.meshes[key]
+        assert m.centre_distance == pytest.approx(a_mm * 1e-3)
+        assert m.backlash == pytest.approx(b_mm * 1e-3, rel=1e-12) == si.mesh[f"backlash_{key}"]
+        assert p.mesh.source(f"backlash_{key}").tag == "derived"
+    zero = with_overrides(p, {"mesh.backlash_outer_ring": "0 um"}).si().layout.meshes
+    assert zero["outer_ring"].backlash == 0.0 and zero["sun_inner"].backlash == pytest.approx(1.275e-4)
+    with pytest.raises(ParameterError, match=r"^mesh\.backlash_sun_inner: must be >= 0"):
+        with_overrides(p, {"mesh.backlash_sun_inner": "-1 um"})
+
+
+def test_planet_inertia_is_an_annulus_with_the_bearing_bore_unless_given():
+    p = reference_dpgt()
+    si = p.si()
+    bore = si.bearing.outer_raceway_radius
+    for g in ("inner_planet", "outer_planet"):
+        gp = si.gears[g]
+        assert gp.inertia == pytest.approx(0.5 * gp.mass * (gp.pitch_radius ** 2 + bore ** 2), rel=1e-12)
+    assert si.gears.sun.inertia == pytest.approx(0.5 * si.gears.sun.mass * si.gears.sun.pitch_radius ** 2)
+    given = with_overrides(p, {"gears.outer_planet.inertia": "4e-4 kg*m^2"}).si().gears
+    assert given.outer_planet.inertia == pytest.approx(4e-4) and given.inner_planet.inertia == si.gears.inner_planet.inertia
+    # the bore follows the bearing: a larger clearance, a (slightly) larger annulus
+    wider = with_overrides(p, {"bearing.clearance": "100 um"}).si().gears.inner_planet.inertia
+    assert wider > si.gears.inner_planet.inertia
+
+
+def test_bearing_rows_is_a_count_of_at_least_one():
+    assert reference_dpgt().bearing.rows == 1 and reference_dpgt().bearing.source("rows").tag == "paper"
+    assert with_overrides(reference_dpgt(), {"bearing.rows": 2}).si().bearing.rows == 2
+    with pytest.raises(ParameterError, match=r"^bearing\.rows"):
+        with_overrides(reference_dpgt(), {"bearing.rows": 0})
