@@ -189,13 +189,15 @@ class WindowStatistics(mbd.Observer):
             spring=np.array([x["spring"] for x in bm]) if not rollers else None,
             rows=int(getattr(b, "rows", 1)), pitch_ratio=Ro / (Ri + Ro))
         self.meshes = {k: f for k, f in MESH_FAMILY.items() if f in fams}
+        self._families = {FAMILY[k] for k in ("race_inner", "race_outer", "pocket", "guide", "linear")} \
+            | set(self.meshes.values())
         if pb is not None:      # approach-speed floor of the impact law: slower onsets are touches
             self._v_floor = model.element(FAMILY["pocket"]).v_min * (1.0 + 1e-9)
         self.reset()
 
     def reset(self) -> None:
         nb = self.plan.planet.size
-        self._acc = {}
+        self._acc, self._flat = {}, None
         self._T = {"global": 0.0, "bearing": np.zeros(nb)}     # time covered by each window
         self._angle = np.zeros(nb)                              # cage angle relative to the carrier since t0
         self._open = np.ones(nb, bool)                          # bearing windows still open
@@ -219,7 +221,7 @@ class WindowStatistics(mbd.Observer):
     def snapshot(self, s) -> dict[str, np.ndarray]:
         """Every derived quantity at state ``s`` (arrays per bearing / roller / mesh)."""
         p, m = self.plan, self.model
-        out = self.system.outputs(s.t, s.q, s.v, s.z)
+        out = self.system.outputs(s.t, s.q, s.v, s.z, families=self._families)
         X, V, A = carrier_frame_motion(m, s.t, s.q, s.v, s.a, self.omega_c)
         radial = lambda vec: radial_tangential(vec, X[p.planet, :2], X[p.carrier, :2])
         nb = p.planet.size
@@ -291,27 +293,39 @@ class WindowStatistics(mbd.Observer):
         wb = self._bearing_ends(x0, x1, wa, s0.t, h)          # end of each bearing's window in this step
         if self.ref_roller is None and self.plan.rollers:
             self._choose_reference(x0, x1, wa)
-        for k, v1 in x1.items():
-            if k.startswith("_"):
-                continue
-            own = self._owner(k)
-            w1 = wb[own] if own is not None else wg
-            v0 = x0[k]
-            va, vb = v0 + wa * (v1 - v0), v0 + w1 * (v1 - v0)
-            dt = np.maximum(w1 - wa, 0.0) * h
-            acc = self._acc.get(k)
-            if acc is None:
-                acc = self._acc[k] = np.stack([np.zeros_like(va), np.zeros_like(va), np.full_like(va, -np.inf),
-                                               np.full_like(va, np.inf)])
-            inside = dt > 0
-            acc[0] += 0.5 * (va + vb) * dt
-            acc[1] += 0.5 * (va * va + vb * vb) * dt
-            acc[2] = np.where(inside, np.maximum(acc[2], np.maximum(va, vb)), acc[2])
-            acc[3] = np.where(inside, np.minimum(acc[3], np.minimum(va, vb)), acc[3])
+        if self._flat is None:
+            self._layout(x1)
+        v0, v1 = self._flatten(x0), self._flatten(x1)
+        own = self._own_flat
+        w1 = np.where(own >= 0, wb[np.maximum(own, 0)], wg)       # window end of every quantity in this step
+        va, vb = v0 + wa * (v1 - v0), v0 + w1 * (v1 - v0)
+        dt = np.maximum(w1 - wa, 0.0) * h
+        acc, inside = self._flat, dt > 0
+        acc[0] += 0.5 * (va + vb) * dt
+        acc[1] += 0.5 * (va * va + vb * vb) * dt
+        np.copyto(acc[2], np.maximum(acc[2], np.maximum(va, vb)), where=inside)
+        np.copyto(acc[3], np.minimum(acc[3], np.minimum(va, vb)), where=inside)
         self._T["global"] += max(wg - wa, 0.0) * h
         self._T["bearing"] += np.maximum(wb - wa, 0.0) * h
         self._impacts(s0, s1, x1, s0.t + wb * h)
         self._prev = x1
+
+    def _layout(self, x) -> None:
+        """One flat accumulator (sum, sum of squares, max, min) for every quantity of a snapshot, each
+        instance tagged with its bearing (or −1: the global window); ``_acc[key]`` are views into it."""
+        keys = [k for k in x if not k.startswith("_")]
+        sizes = [np.size(x[k]) for k in keys]
+        edges = np.concatenate([[0], np.cumsum(sizes)])
+        self._keys = keys
+        self._own_flat = np.concatenate([self._owner(k) if self._owner(k) is not None else np.full(n, -1)
+                                         for k, n in zip(keys, sizes)]).astype(int)
+        if self._flat is None:
+            n = int(edges[-1])
+            self._flat = np.stack([np.zeros(n), np.zeros(n), np.full(n, -np.inf), np.full(n, np.inf)])
+        self._acc = {k: self._flat[:, a:b] for k, a, b in zip(keys, edges[:-1], edges[1:])}
+
+    def _flatten(self, x) -> np.ndarray:
+        return np.concatenate([np.asarray(x[k], float).ravel() for k in self._keys])
 
     def _bearing_ends(self, x0, x1, wa, t_start, h) -> np.ndarray:
         """Fraction of this step at which each bearing's window ends (1: still open after it; wa: closed
@@ -406,7 +420,7 @@ class WindowStatistics(mbd.Observer):
 
     # checkpoints ---------------------------------------------------------------------------------
     def state_dict(self) -> dict:
-        d = {f"acc__{k}": v for k, v in self._acc.items()}
+        d = {"acc": self._flat} if self._flat is not None else {}
         d.update({f"imp__{k}": v for k, v in (self._impact or {}).items()})
         d.update({f"prev__{k}": v for k, v in (self._prev or {}).items()})
         d.update({"T_global": np.array(self._T["global"]), "T_bearing": self._T["bearing"], "angle": self._angle,
@@ -415,9 +429,11 @@ class WindowStatistics(mbd.Observer):
         return d
 
     def load_state_dict(self, d: dict) -> None:
-        self._acc = {k[5:]: v.copy() for k, v in d.items() if k.startswith("acc__")}
+        self._acc, self._flat = {}, (d["acc"].copy() if "acc" in d else None)
         self._impact = {k[5:]: v.copy() for k, v in d.items() if k.startswith("imp__")} or None
         self._prev = {k[6:]: v.copy() for k, v in d.items() if k.startswith("prev__")} or None
+        if self._flat is not None and self._prev is not None:
+            self._layout(self._prev)
         if "T_global" in d:
             self._T = {"global": float(d["T_global"]), "bearing": d["T_bearing"].copy()}
             self._angle, self._open, self._t_close = d["angle"].copy(), d["open"].astype(bool), d["t_close"].copy()

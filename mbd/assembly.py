@@ -188,13 +188,15 @@ class System:
             out[e.name] = float(np.nanmax(np.abs(F))) if F.size and np.isfinite(F).all() else float("nan") if F.size else 0.0
         return out
 
-    def outputs(self, t, q, v, z) -> dict[str, dict[str, np.ndarray]]:
-        """Every family's outputs at a state."""
+    def outputs(self, t, q, v, z, families=None) -> dict[str, dict[str, np.ndarray]]:
+        """Every family's outputs at a state (only those named in ``families``, when given)."""
         m = self.model
         fs = m.frame.at(t)
         qf, vf = m.full(t, q, v)
         res = {}
         for e, parts in self._evals:
+            if families is not None and not any(name in families for name, _ in parts):
+                continue
             F, out, _, _ = evaluate(e, t, fs, qf, vf, z.get(parts[0][0]) if len(parts) == 1 else None, False)
             for name, sl in parts:
                 res[name] = out if len(parts) == 1 else {k: np.asarray(v)[sl] for k, v in out.items()}
