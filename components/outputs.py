@@ -29,7 +29,7 @@ from .bearing import bearing_kinematics
 from .families import FAMILY, MESH_FAMILY
 
 __all__ = ["FAMILY", "MESH_FAMILY", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
-           "WindowStatistics", "carrier_frame_motion", "radial_tangential"]
+           "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions"]
 
 LIFE_EXPONENT = 10.0 / 3.0     # ISO 281, roller bearings: L10 ∝ P^(−10/3)
 
@@ -99,6 +99,16 @@ def carrier_frame_motion(model, t, q, v, a, omega_c: float):
     ax, ay = ax + 2 * W * vy + W * W * x, ay - 2 * W * vx + W * W * y   # a_C = Rot(−φ) a_I − 2Ω k × v_C + Ω² x_C
     return (np.column_stack([x, y, Xi[:, 2] - W * t]), np.column_stack([vx, vy, Vi[:, 2] - W]),
             np.column_stack([ax, ay, Ai[:, 2]]))
+
+
+def pin_reactions(race_inner: dict, rollers, bearing_of_roller, n_bearings: int, rows: int = 1) -> np.ndarray:
+    """(n_bearings, 2) force each bearing's rollers exert on its pin, in the model's frame: minus the sum
+    of the inner-raceway contact forces on the rollers ``rollers`` (instance indices of the race_inner
+    family; its ``fx``, ``fy`` are per physical roller, so × ``rows``), grouped by ``bearing_of_roller``."""
+    fx = np.asarray(race_inner["fx"], float)[rollers]
+    fy = np.asarray(race_inner["fy"], float)[rollers]
+    return -rows * np.column_stack([np.bincount(bearing_of_roller, fx, n_bearings),
+                                    np.bincount(bearing_of_roller, fy, n_bearings)])
 
 
 def radial_tangential(vec, planet_xy, carrier_xy):
@@ -228,9 +238,7 @@ class WindowStatistics(mbd.Observer):
         snap: dict[str, np.ndarray] = {}
         if p.rollers:
             ri = out[FAMILY["race_inner"]]
-            # force on the pin = minus the inner raceway's force on the rollers, each element per physical roller
-            pin = -p.rows * np.column_stack([np.bincount(p.roller_bearing, ri["fx"], nb),
-                                             np.bincount(p.roller_bearing, ri["fy"], nb)])
+            pin = pin_reactions(ri, slice(None), p.roller_bearing, nb, p.rows)
             snap["roller_inner_load"] = np.asarray(ri["load"], float)
             snap["roller_outer_load"] = np.asarray(out[FAMILY["race_outer"]]["load"], float)
             if p.pocket_bearing is not None:

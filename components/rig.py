@@ -27,6 +27,7 @@ from mbd.elements import ForceSource, GroundSupport, Ramp, SpeedDrive
 
 from .bearing import BearingSI, add_planet_bearing, bearing_si
 from .families import FAMILY
+from .outputs import pin_reactions
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError
 
@@ -290,7 +291,7 @@ def rig_loads(built: BuiltScene, system: mbd.System, s: mbd.State) -> dict:
         "t": s.t, "angle": _wrap(ang - built.meta["zone_angle"]), "load_inner": Qi, "load_outer": Qo,
         "ring": ring.copy(),
         "load_sum": -rows * (Qi[:, None] * e).sum(axis=0),
-        "pin_force": -rows * np.array([inner["fx"][si].sum(), inner["fy"][si].sum()]),
+        "pin_force": pin_reactions(inner, si, np.zeros(si.stop - si.start, int), 1, rows)[0],
         "ring_force": rows * np.array([outer["fx"][so].sum(), outer["fy"][so].sum()]),   # −(force on ring)
     }
 

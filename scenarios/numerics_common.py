@@ -29,7 +29,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import mbd
-from components.outputs import FAMILY
+from components.outputs import FAMILY, pin_reactions
 from components.params import with_overrides
 from components.presets import reference_dpgt
 
@@ -320,11 +320,12 @@ def observables(prob: Problem, grid, q, v, z) -> dict[str, np.ndarray]:
     ic = m.body(prob.cage).index if prob.cage else None
     ip = m.body(prob.planet).index
     sl = prob.race_inner
+    rows = prob.built.meta["bearing"].rows
     out = {k: [] for k in ("pin_load", "inner_load", "guide_force", "cage_acc_x", "cage_acc_y")}
     for t, qi, vi, zi in zip(grid, q, v, z):
         o = system.outputs(t, qi, vi, zi)
         ri = o[FAMILY["race_inner"]]
-        out["pin_load"].append(np.hypot(ri["fx"][sl].sum(), ri["fy"][sl].sum()))
+        out["pin_load"].append(np.hypot(*pin_reactions(ri, sl, np.zeros(sl.stop - sl.start, int), 1, rows)[0]))
         out["inner_load"].append(ri["load"][prob.roller])
         out["guide_force"].append(o[FAMILY["guide"]]["force"][prob.guide] if prob.guide is not None else 0.0)
         if ic is not None:
