@@ -11,7 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from mbd.elements import BodySpring
-from mbd.elements.contact import GuideContact, LubricantDrag, PocketContact, RaceContact, Traction
+from mbd.elements.contact import (TRACTION_LAWS, GuideContact, LubricantDrag, PocketContact, RaceContact,
+                                  SlideRollTraction, TanhTraction, Traction)
 
 from .families import FAMILY
 from .scene import Scene
@@ -31,9 +32,9 @@ class BearingSI:
     roller_mass: float          # one physical roller
     roller_inertia: float
     K: float                    # roller–raceway line contact stiffness [N/m^(10/9)]
+    exponent: float             # load-deflection exponent (10/9)
     zeta: float                 # roller–raceway contact damping ratio
-    mu_max: float
-    v0: float
+    traction: Traction          # roller–raceway traction law
     cage_mass: float
     cage_inertia: float
     C_p: float                  # circumferential pocket clearance per side
@@ -47,8 +48,8 @@ class BearingSI:
     rho: float
     v_min: float                # smallest approach speed of the impact damping
     v_mu: float                 # friction regularisation speed at pocket walls and land
-    linear_stiffness: float = 5e8   # radial stiffness when bearings are linear springs [N/m]
-    linear_damping: float = 2e3     # [N·s/m]
+    linear_stiffness: float     # radial stiffness when bearings are linear springs [N/m]
+    linear_damping: float       # [N·s/m]
 
     @property
     def R_i(self) -> float:
@@ -59,16 +60,28 @@ class BearingSI:
         return 0.5 * (self.d_m + self.D + self.clearance)
 
 
+# each traction law from the bearing's SI parameters (a parameter, bearing.traction_law, names one)
+_TRACTION_FROM = {
+    "tanh": lambda bs: TanhTraction(mu_max=bs.traction_mu_max, v0=bs.traction_v0),
+    "slide_roll": lambda bs: SlideRollTraction(
+        A=bs.slide_roll_traction.A, B=bs.slide_roll_traction.B, C=bs.slide_roll_traction.C,
+        D=bs.slide_roll_traction.D, u_reg=bs.slide_roll_traction.rolling_speed_reg,
+        s_eps=bs.slide_roll_traction.ratio_reg),
+}
+assert set(_TRACTION_FROM) == set(TRACTION_LAWS)
+
+
 def bearing_si(bs, lub) -> BearingSI:
     """BearingSI from the SI views of BearingParams (``params.si().bearing``) and LubricantParams."""
     c = bs.cage
     return BearingSI(d_m=bs.pitch_diameter, D=bs.roller_diameter, l=bs.roller_length, Z=int(bs.rollers),
                      rows=int(bs.rows), clearance=bs.clearance, roller_mass=bs.roller_mass, roller_inertia=bs.roller_inertia,
-                     K=bs.contact_stiffness, zeta=bs.contact_damping_ratio, mu_max=bs.traction_mu_max,
-                     v0=bs.traction_v0, cage_mass=c.mass, cage_inertia=c.inertia, C_p=c.pocket_clearance,
+                     K=bs.contact_stiffness, exponent=bs.contact_exponent, zeta=bs.contact_damping_ratio,
+                     traction=_TRACTION_FROM[bs.traction_law](bs), cage_mass=c.mass, cage_inertia=c.inertia, C_p=c.pocket_clearance,
                      C_g=c.guide_clearance, K_p=c.pocket_stiffness, K_g=c.guide_stiffness,
                      restitution=c.restitution, mu_pocket=c.pocket_friction, mu_guide=c.guide_friction,
-                     C_d=lub.drag_coefficient, rho=lub.density, v_min=c.impact_speed_floor, v_mu=c.friction_speed)
+                     C_d=lub.drag_coefficient, rho=lub.density, v_min=c.impact_speed_floor, v_mu=c.friction_speed,
+                     linear_stiffness=bs.linear_stiffness, linear_damping=bs.linear_damping)
 
 
 def bearing_kinematics(b: BearingSI, omega_inner: float, omega_outer: float) -> tuple[float, float]:
@@ -112,11 +125,12 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
                                   pose=(*(pin_xy + off), 0.0), vel=(*vel, wr)))
     names = [f"{tag}.roller{j}" for j in range(Z)]
     marker = np.tile(pin_local, (Z, 1))
-    traction = Traction(kind="tanh", mu_max=b.mu_max, v0=b.v0)
+    traction = b.traction
     common = dict(D=b.D, K=b.K, zeta=b.zeta, m_roller=b.roller_mass, multiplicity=b.rows)
-    inner = scene.family(FAMILY["race_inner"], RaceContact, ("roller", "race_body"), kind="inner", traction=traction)
+    law = dict(traction=traction, exponent=b.exponent)     # family-wide laws
+    inner = scene.family(FAMILY["race_inner"], RaceContact, ("roller", "race_body"), kind="inner", **law)
     s_in = inner.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker, R_race=b.R_i, **common)
-    outer = scene.family(FAMILY["race_outer"], RaceContact, ("roller", "race_body"), kind="outer", traction=traction)
+    outer = scene.family(FAMILY["race_outer"], RaceContact, ("roller", "race_body"), kind="outer", **law)
     s_out = outer.add(Z, roller=names, race_body=[outer_body] * Z, race_marker=np.zeros((Z, 2)), R_race=b.R_o,
                       **common)
     h = {"kind": "rollers", "rollers": names, "race_inner": s_in, "race_outer": s_out,

@@ -14,7 +14,7 @@ Design (ARCHITECTURE.md idea 6)
   length, gear inertias from the pitch radius); their source is that rule's tag, and they follow the
   values they derive from when those are overridden.
 * Overrides: :func:`with_overrides` ``(params, {"bearing.clearance": "30 um", "gears.planets": 4})``
-  with dotted paths (unknown paths raise ParameterError listing the valid ones); :func:`load_toml`
+  with dotted paths (unknown paths raise ParameterError listing the valid ones); :func:`components.presets.load_toml`
   reads the same dotted structure from a TOML file; :func:`to_toml` writes it back (lossless).
 * Conversion to SI happens once: ``obj.si()`` returns an immutable :class:`SIView` of floats (SI base
   units: m, kg, s, rad, rad/s, N/m, N/m^(10/9) ...), with the rule-based values resolved and the
@@ -46,9 +46,9 @@ from .units import ParameterError, Quantity, format_quantity, quantity, to_si
 
 __all__ = [
     "Source", "Sourced", "paper", "derived", "assumed", "SIView", "Params",
-    "GearParams", "GearSetParams", "CageParams", "BearingParams", "LubricantParams", "SupportParams",
+    "GearParams", "GearSetParams", "CageParams", "SlideRollTractionParams", "BearingParams", "LubricantParams", "SupportParams",
     "MeshParams", "OperatingPoint", "DPGTParams",
-    "with_overrides", "parameter_names", "flatten", "describe", "to_toml", "overrides_from_toml", "load_toml",
+    "with_overrides", "parameter_names", "flatten", "describe", "to_toml", "overrides_from_toml",
 ]
 
 
@@ -431,6 +431,20 @@ class CageParams(Params):
 
 
 @dataclass(frozen=True, kw_only=True)
+class SlideRollTractionParams(Params):
+    """Coefficients of the slide-to-roll traction curve μ(s) = (A + B s) e^(−C s) + D
+    (:class:`mbd.elements.SlideRollTraction`), used when ``bearing.traction_law = "slide_roll"``."""
+
+    _prefix: ClassVar[str] = "bearing.slide_roll_traction"
+    A: Quantity = _param("dimensionless", "curve coefficient A (A + D = 0: no traction in pure rolling)")
+    B: Quantity = _param("dimensionless", "curve coefficient B")
+    C: Quantity = _nonneg("dimensionless", "curve decay C")
+    D: Quantity = _param("dimensionless", "traction at large slide-to-roll ratio D")
+    rolling_speed_reg: Quantity = _pos("velocity", "rolling speed below which the slide-to-roll ratio is regularised")
+    ratio_reg: Quantity = _pos("dimensionless", "slide-to-roll ratio smoothing at s = 0")
+
+
+@dataclass(frozen=True, kw_only=True)
 class BearingParams(Params):
     """Cylindrical roller planet bearing (same for inner and outer planets), with its cage.
 
@@ -452,9 +466,16 @@ class BearingParams(Params):
     roller_inertia: Quantity | None = _rule("inertia", "derived", "solid cylinder: m D^2 / 8")
     contact_stiffness: Quantity | None = _rule("contact_stiffness", "derived",
                                                "Palmgren line contact: K = 8.06e4 l^(8/9) N/mm^(10/9), l in mm")
+    contact_exponent: Quantity = _param("dimensionless", "load-deflection exponent p of Q = K delta^p", lo=1.0,
+                                        bound_text=">= 1")
     contact_damping_ratio: Quantity = _nonneg("dimensionless", "roller-raceway contact damping ratio")
+    traction_law: str = _param("choice", "roller-raceway traction law", choices=("tanh", "slide_roll"))
     traction_mu_max: Quantity = _nonneg("dimensionless", "traction curve maximum mu_max (mu = mu_max tanh(v/v0))")
     traction_v0: Quantity = _pos("velocity", "traction curve slip velocity scale v0")
+    slide_roll_traction: SlideRollTractionParams = _nested(SlideRollTractionParams, "slide-to-roll traction curve")
+    linear_stiffness: Quantity = _pos("stiffness", "radial stiffness of a bearing modelled as a linear spring "
+                                                   "(scene option bearings=linear)")
+    linear_damping: Quantity = _nonneg("damping", "radial damping of a bearing modelled as a linear spring")
     cage: CageParams = _nested(CageParams, "cage")
 
     def _derive(self, d):
@@ -728,11 +749,3 @@ def overrides_from_toml(text: str) -> dict[str, Any]:
 
     walk(data, "")
     return out
-
-
-def load_toml(path, base: DPGTParams | None = None) -> DPGTParams:
-    """``base`` (default: the reference machine) with the overrides in the TOML file ``path``."""
-    if base is None:
-        from .presets import reference_dpgt  # presets imports this module
-        base = reference_dpgt()
-    return with_overrides(base, overrides_from_toml(Path(path).read_text(encoding="utf-8")))

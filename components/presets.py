@@ -9,12 +9,15 @@ from __future__ import annotations
 
 from types import MappingProxyType
 
+from pathlib import Path
+
 from .params import (BearingParams, CageParams, DPGTParams, GearParams, GearSetParams, LubricantParams,
-                     MeshParams, OperatingPoint, SupportParams, assumed, paper)
+                     MeshParams, OperatingPoint, SlideRollTractionParams, SupportParams, assumed, derived,
+                     overrides_from_toml, paper, with_overrides)
 from .units import Q_, ParameterError
 
 __all__ = ["CONDITIONS", "DIRECTIONS", "operating_point", "reference_gears", "reference_bearing",
-           "reference_dpgt"]
+           "reference_dpgt", "load_toml"]
 
 # the study's four operating conditions: carrier speed n_c and output power P (ring fixed)
 CONDITIONS = MappingProxyType({
@@ -84,9 +87,18 @@ def reference_bearing() -> BearingParams:
         rows=paper(1, "one row in the source's table"),
         clearance=assumed("20 um", "diametral"),
         roller_density=assumed("7850 kg/m^3", "bearing steel"),
+        contact_exponent=derived(10.0 / 9.0, "Palmgren line contact Q = K delta^(10/9) (MODEL.md 3.3)"),
         contact_damping_ratio=assumed(0.05, "of critical, gated to compression"),
+        traction_law=assumed("tanh", "PARAMETERS.md; slide_roll: an EHL-type curve of the slide-to-roll ratio"),
         traction_mu_max=assumed(0.08, "mu = 0.08 tanh(v_s / 0.3 m/s)"),
         traction_v0=assumed("0.3 m/s"),
+        slide_roll_traction=SlideRollTractionParams(
+            A=assumed(-0.04, "A + D = 0: no traction in pure rolling"), B=assumed(5.0),
+            C=assumed(40.0, "peak mu ~ 0.073 at s ~ 0.033"), D=assumed(0.04, "mu at large slip"),
+            rolling_speed_reg=assumed("0.1 m/s", "far below the rolling speeds of m/s: matters only near rest"),
+            ratio_reg=assumed(1e-4)),
+        linear_stiffness=assumed("5e8 N/m", "a planet bearing's radial stiffness near its loaded state"),
+        linear_damping=assumed("2000 N*s/m"),
         cage=cage,
     )
 
@@ -117,3 +129,9 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
         operating=operating_point(condition, direction),
         gravity=assumed("9.81 m/s^2", "standard gravity along -Y of the fixed frame"),
     )
+
+
+def load_toml(path, base: DPGTParams | None = None) -> DPGTParams:
+    """``base`` (default: the reference machine) with the overrides in the TOML file ``path``."""
+    base = reference_dpgt() if base is None else base
+    return with_overrides(base, overrides_from_toml(Path(path).read_text(encoding="utf-8")))

@@ -35,7 +35,8 @@ class Case:
 
 
 def build_params(case: Case):
-    from components.params import load_toml, with_overrides
+    from components.params import with_overrides
+    from components.presets import load_toml
     from components.presets import reference_dpgt
 
     base = reference_dpgt(case.condition, case.direction)

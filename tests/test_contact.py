@@ -15,7 +15,8 @@ import mbd
 from mbd.element import evaluate
 from mbd.errors import ModelError
 from mbd.model import FrameState
-from mbd.elements.contact import (GuideContact, LubricantDrag, PocketContact, RaceContact, Traction,
+from mbd.elements.contact import (TRACTION_LAWS, GuideContact, LubricantDrag, PocketContact, RaceContact,
+                                  SlideRollTraction, TanhTraction,
                                   restitution_lambda)
 
 DM, DR, LR = 39e-3, 7.5e-3, 9e-3
@@ -183,9 +184,16 @@ def race_scene(kind, pose, vel, psi, angles, deltas, v_normal, v_orbit, slips):
     return qf, vf, mk, R
 
 
-def race_element(kind, n, mk, R, traction=Traction(), zeta=0.05, multiplicity=1):
+# the test laws (the preset's values, PARAMETERS.md): elements have no defaults for them
+TANH = TanhTraction(mu_max=0.08, v0=0.3)
+EHL = SlideRollTraction(A=-0.04, B=5.0, C=40.0, D=0.04, u_reg=0.1, s_eps=1e-4)
+LAW = dict(exponent=10.0 / 9.0, zeta=0.05, traction=TANH)
+
+
+def race_element(kind, n, mk, R, traction=TANH, zeta=0.05, multiplicity=1):
     return RaceContact("race", np.arange(1, n + 1), 0, kind=kind, race_marker=mk, R_race=R, D=DR, K=K_HZ,
-                       zeta=zeta, m_roller=M_ROLLER, traction=traction, multiplicity=multiplicity)
+                       exponent=10.0 / 9.0, zeta=zeta, m_roller=M_ROLLER, traction=traction,
+                       multiplicity=multiplicity)
 
 
 N = 4
@@ -211,7 +219,7 @@ def race_states(draw, kind):
     return pose, vel, psi, angles, deltas, v_normal, v_orbit, slips
 
 
-TRACTIONS = {"tanh": Traction(), "ehl": Traction(kind="ehl")}
+TRACTIONS = {"tanh": TANH, "ehl": EHL}
 
 
 @pytest.mark.parametrize("kind", ["inner", "outer"])
@@ -248,7 +256,7 @@ def test_objectivity(elem_kind, data, alpha, w, u):
     if elem_kind.startswith("race"):
         kind = elem_kind[5:]
         qf, vf, mk, R = race_scene(kind, *data.draw(race_states(kind)))
-        elem = race_element(kind, N, mk, R, Traction(kind="ehl"))
+        elem = race_element(kind, N, mk, R, EHL)
     elif elem_kind == "pocket":
         qf, vf, elem, _ = pocket_scene(*data.draw(pocket_states()))
     elif elem_kind == "guide":
@@ -273,7 +281,7 @@ def test_palmgren_constant_for_the_bearing():
     # the element with this K reproduces Palmgren's deflection law
     for kind in ("inner", "outer"):
         qf, vf, mk, R = race_scene(kind, (0, 0, 0.3), (0, 0, 0), 0.2, [1.0], [d_mm * 1e-3], [0], [0], [0])
-        elem = RaceContact("r", [1], 0, kind=kind, race_marker=mk, R_race=R, D=DR, K=K_si, m_roller=M_ROLLER)
+        elem = RaceContact("r", [1], 0, kind=kind, race_marker=mk, R_race=R, D=DR, K=K_si, m_roller=M_ROLLER, **LAW)
         F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
         assert out["load"][0] == pytest.approx(Q, rel=1e-3)
 
@@ -353,7 +361,7 @@ def test_traction_vanishes_for_pure_rolling(law, w_carrier, w_cage, w_planet, ve
 
 
 def test_ehl_curve_shape():
-    tr = Traction(kind="ehl")
+    tr = EHL
     s = np.array([-2.0, -0.1, -0.033, -1e-3, 0.0, 1e-3, 0.033, 0.1, 2.0])
     u = np.full(s.size, 10.0)
     v_s = s * np.sqrt(u ** 2 + tr.u_reg ** 2)
@@ -371,10 +379,11 @@ def test_ehl_curve_shape():
     slope = tr.coefficient(x, np.array([10.0])).der[0, 0] * np.sqrt(100.0 + tr.u_reg ** 2)
     assert slope == pytest.approx(f(tr.s_eps) / tr.s_eps, rel=1e-9)           # d/ds (s/a)f(a) at 0
     assert slope == pytest.approx(tr.B - tr.A * tr.C, rel=tr.C * tr.s_eps)   # ≈ f'(0), to O(C s_eps)
-    with pytest.raises(ModelError, match="kind"):
-        Traction(kind="coulomb")
+    assert TRACTION_LAWS == {"tanh": TanhTraction, "slide_roll": SlideRollTraction}
     with pytest.raises(ModelError, match="v0"):
-        Traction(v0=0.0)
+        TanhTraction(mu_max=0.08, v0=0.0)
+    with pytest.raises(TypeError):          # no defaults: every coefficient comes from the parameters
+        SlideRollTraction(A=-0.04, B=5.0, C=40.0, D=0.04)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -683,12 +692,12 @@ def test_drag_opposes_orbit():
 # ---------------------------------------------------------------------------------------------
 def test_parameter_errors_name_the_parameter():
     with pytest.raises(ModelError, match="kind"):
-        RaceContact("r", [1], 0, kind="middle", race_marker=(0, 0), R_race=R_IN, D=DR, K=K_HZ, m_roller=M_ROLLER)
+        RaceContact("r", [1], 0, kind="middle", race_marker=(0, 0), R_race=R_IN, D=DR, K=K_HZ, m_roller=M_ROLLER, **LAW)
     with pytest.raises(ModelError, match="race_marker"):
         RaceContact("r", [1, 2], 0, kind="inner", race_marker=np.zeros((3, 2)), R_race=R_IN, D=DR, K=K_HZ,
-                    m_roller=M_ROLLER)
+                    m_roller=M_ROLLER, **LAW)
     with pytest.raises(ModelError, match="'K'"):
-        RaceContact("r", [1], 0, kind="inner", race_marker=(0, 0), R_race=R_IN, D=DR, K=-1.0, m_roller=M_ROLLER)
+        RaceContact("r", [1], 0, kind="inner", race_marker=(0, 0), R_race=R_IN, D=DR, K=-1.0, m_roller=M_ROLLER, **LAW)
     pocket = dict(pocket_angle=0.0, pitch_radius=DM / 2, clearance=C_P, K_p=K_P, restitution=0.8, v_min=V_MIN,
                   mu=0.1, v_mu=0.05, D=DR)
     guide = dict(clearance=C_G, K_g=K_G, restitution=0.8, v_min=V_MIN, mu=0.1, v_mu=0.05, land_radius=R_LAND)
@@ -716,7 +725,7 @@ def test_parameter_errors_name_the_parameter():
     for m in (0, 1.5, -2, [1, 0.5]):
         with pytest.raises(ModelError, match="multiplicity"):
             RaceContact("r", [1, 2], 0, kind="inner", race_marker=(0, 0), R_race=R_IN, D=DR, K=K_HZ,
-                        m_roller=M_ROLLER, multiplicity=m)
+                        m_roller=M_ROLLER, **LAW, multiplicity=m)
         with pytest.raises(ModelError, match="multiplicity"):
             PocketContact("p", [1, 2], 0, **pocket, multiplicity=m)
         with pytest.raises(ModelError, match="multiplicity"):
@@ -909,9 +918,9 @@ def test_race_multiplicity_survives_fusion():
                                [1e-6, 5e-6, -1e-6, 2e-5], [0.01, -0.02, 0, 0.1], [1, 2, 3, 4], [0.1, -0.2, 0.3, 0])
     a = race_element("inner", N, mk, R, multiplicity=[2, 1, 3, 2])
     b = RaceContact("race_o", np.arange(1, N + 1), 0, kind="outer", race_marker=(0, 0), R_race=R_OUT, D=DR, K=K_HZ,
-                    m_roller=M_ROLLER, multiplicity=2)
+                    m_roller=M_ROLLER, **LAW, multiplicity=2)
     b1 = RaceContact("race_o1", np.arange(1, N + 1), 0, kind="outer", race_marker=(0, 0), R_race=R_OUT, D=DR,
-                     K=K_HZ, m_roller=M_ROLLER)
+                     K=K_HZ, m_roller=M_ROLLER, **LAW)
     assert a.fuse_key() == b.fuse_key()
     f = RaceContact.fuse([a, b])
     np.testing.assert_array_equal(f.multiplicity, [2, 1, 3, 2, 2, 2, 2, 2])

@@ -675,9 +675,9 @@ def test_parameter_validation_names_the_parameter():
         with pytest.raises(ModelError, match=msg):
             GearMesh("bad", 0, 1, **bad_kw)
     with pytest.raises(ModelError, match="smoothing"):
-        StiffnessShape.rectangular(1.96, smoothing=0.05)
+        StiffnessShape.rectangular(1.96, ratio=1.5, smoothing=0.05)
     with pytest.raises(ModelError, match="contact_ratio"):
-        StiffnessShape.rectangular(2.3)
+        StiffnessShape.rectangular(2.3, ratio=1.5, smoothing=0.05)
     with pytest.raises(ModelError, match="kind"):
         StiffnessShape("sharp")
     with pytest.raises(ModelError, match="J2"):

@@ -140,7 +140,7 @@ def test_rig_held_cage_with_turning_ring_starts_consistently():
     # the two tractions push each loaded roller forwards (ω > 0) against its pocket wall: it sits within
     # the pocket clearance plus the wall's deflection under the traction force 2 μ Q
     offset = (sol.angles - np.sort(start)) * 0.5 * b.d_m      # sol.angles are sorted
-    bound = b.C_p + 2 * b.mu_max * sol.q_max / b.K_p
+    bound = b.C_p + 2 * b.traction.mu_max * sol.q_max / b.K_p
     assert np.all(np.abs(offset) <= bound)
     assert np.all(offset[sol.loads > 0.1 * sol.q_max] > 0.5 * b.C_p)
 
@@ -341,3 +341,26 @@ def test_planetary_missing_table_and_assembly_warning():
     assert built.model.ndof == 21
     with pytest.warns(DesignWarning, match="overlap"):
         build_single_planetary(overrides={"planets": 6})
+
+
+def test_traction_law_is_chosen_by_a_parameter():
+    """bearing.traction_law selects the law from the registry; its coefficients come from the parameters."""
+    import warnings
+
+    from components.dpgt import build_dpgt
+    from components.params import with_overrides
+    from components.presets import reference_dpgt
+    from components.scene import SceneOptions
+    from mbd.elements import SlideRollTraction, TanhTraction
+
+    for law, cls in (("tanh", TanhTraction), ("slide_roll", SlideRollTraction)):
+        p = with_overrides(reference_dpgt(3), {"bearing.traction_law": law, "bearing.slide_roll_traction.C": 35.0})
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            bs = build_dpgt(p, SceneOptions(gravity=False))
+        tr = bs.model.element("race_inner").traction
+        assert type(tr) is cls and tr == bs.model.element("race_outer").traction
+        if law == "slide_roll":
+            assert tr.C == 35.0 and tr.needs_rolling_speed
+        else:
+            assert tr.mu_max == pytest.approx(0.08) and tr.v0 == pytest.approx(0.3)

@@ -9,9 +9,9 @@ from hypothesis import given, settings, strategies as st
 
 from components import geometry as geo
 from components.params import (BearingParams, CageParams, GearParams, SIView, Source, assumed,
-                               describe, flatten, load_toml, overrides_from_toml, parameter_names, to_toml,
+                               describe, flatten, overrides_from_toml, parameter_names, to_toml,
                                with_overrides)
-from components.presets import CONDITIONS, operating_point, reference_bearing, reference_dpgt
+from components.presets import CONDITIONS, load_toml, operating_point, reference_bearing, reference_dpgt
 from components.units import Q_, ParameterError, format_quantity, quantity, to_si, ureg
 
 RPM = 2 * math.pi / 60
@@ -271,6 +271,8 @@ def test_si_view_is_plain_floats_and_read_only():
         for k, v in s[sect].to_dict().items():
             if isinstance(v, dict):
                 assert all(isinstance(x, (int, float, bool)) or x is None for x in v.values()), (sect, k)
+            elif k.endswith("_law"):                   # a choice among law names stays a name
+                assert isinstance(v, str), (sect, k)
             else:
                 assert isinstance(v, (int, float, bool)) or v is None, (sect, k)
     with pytest.raises(AttributeError):

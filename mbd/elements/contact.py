@@ -10,14 +10,16 @@ Regularisations (all smooth, documented where they are made):
 - centre distances use a safe norm sqrt(x² + y² + η²), η = 1e-12 m: bitwise identical to |x| at any
   real bearing distance, finite derivatives when two centres coincide (a centred cage at t = 0);
 - friction laws are tanh-regularised Coulomb laws (no stick state in a stateless element);
-- the EHL traction curve uses a regularised slide-to-roll ratio (see :class:`Traction`).
+- the slide-to-roll traction curve uses a regularised slide-to-roll ratio (see :class:`SlideRollTraction`).
 
 The pocket and guide-land impacts carry internal state (the approach speed of the current impact, for
 Hunt–Crossley damping that gives the set restitution at any speed), so those families are never fused.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 
@@ -25,7 +27,7 @@ from .. import ad
 from ..element import Element, body_dofs, marker, marker_velocity, point_force
 from ..errors import ModelError
 
-__all__ = ["Traction", "RaceContact", "PocketContact", "GuideContact", "LubricantDrag", "restitution_lambda"]
+__all__ = ["Traction", "TanhTraction", "SlideRollTraction", "TRACTION_LAWS", "RaceContact", "PocketContact", "GuideContact", "LubricantDrag", "restitution_lambda"]
 
 _ETA2 = 1e-24  # (1e-12 m)²: below round-off of any physical distance squared, keeps norms nonzero
 
@@ -137,55 +139,68 @@ class _Impact(Element):
 
 
 # --------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
 class Traction:
-    """Roller–raceway traction curve μ: smooth, odd and bounded (MODEL.md §3.3).
+    """Base of the roller–raceway traction laws μ: smooth, odd and bounded (MODEL.md §3.3). A law is a
+    small frozen dataclass registered in :data:`TRACTION_LAWS` by name; its fields have no defaults
+    (every value comes from the parameters)."""
+    needs_rolling_speed = False
 
-    ``kind="tanh"``: μ = mu_max·tanh(v_s / v0) of the sliding velocity v_s [m/s].
+    def _check(self, positive=(), nonneg=()):
+        name = type(self).__name__
+        for f in dataclasses.fields(self):
+            if not np.isfinite(getattr(self, f.name)):
+                raise ModelError(f"{name}: {f.name} must be finite, got {getattr(self, f.name)!r}")
+        for f in positive:
+            if getattr(self, f) <= 0:
+                raise ModelError(f"{name}: {f} must be > 0, got {getattr(self, f)!r}")
+        for f in nonneg:
+            if getattr(self, f) < 0:
+                raise ModelError(f"{name}: {f} must be >= 0, got {getattr(self, f)!r}")
 
-    ``kind="ehl"``: μ(s) = (A + B·s)·e^(−C·s) + D of the slide-to-roll ratio s ≥ 0, extended as an odd
-    function. The ratio is regularised so that it stays finite when the rolling speed vanishes:
+    def coefficient(self, v_s, u_roll=None):  # pragma: no cover - abstract
+        raise TypeError(f"{type(self).__name__} must define coefficient(v_s, u_roll)")
+
+
+@dataclass(frozen=True)
+class TanhTraction(Traction):
+    """μ = mu_max·tanh(v_s / v0) of the sliding velocity v_s [m/s]."""
+    mu_max: float
+    v0: float
+
+    def __post_init__(self):
+        self._check(positive=("v0",), nonneg=("mu_max",))
+
+    def coefficient(self, v_s, u_roll=None):
+        return self.mu_max * ad.tanh(v_s * (1.0 / self.v0))
+
+
+@dataclass(frozen=True)
+class SlideRollTraction(Traction):
+    """An EHL-type traction curve μ(s) = (A + B·s)·e^(−C·s) + D of the slide-to-roll ratio s ≥ 0, extended
+    as an odd function. The ratio is regularised so that it stays finite when the rolling speed vanishes:
         s = v_s / sqrt(u_r² + u_reg²),   u_r = mean rolling (entrainment) speed of the two surfaces
     relative to the moving contact point. The odd extension is sign(s)·μ(|s|) with |s| smoothed to
     a = sqrt(s² + s_eps²): μ = (s/a)·[(A + B a)e^(−C a) + D], which is C^∞ and, when A + D = 0 (zero
-    traction at pure rolling), follows the curve to O(s_eps²) with slope ≈ B − A·C at s = 0.
-    Default EHL coefficients [assumed]: peak μ ≈ 0.073 at s ≈ 0.033, tending to D = 0.04 at large slip;
-    u_reg = 0.1 m/s (far below the bearing's rolling speeds of metres per second, it only matters when
-    the bearing is nearly at rest), s_eps = 1e-4.
-    """
-    kind: str = "tanh"
-    mu_max: float = 0.08
-    v0: float = 0.3
-    A: float = -0.04
-    B: float = 5.0
-    C: float = 40.0
-    D: float = 0.04
-    u_reg: float = 0.1
-    s_eps: float = 1e-4
+    traction at pure rolling), follows the curve to O(s_eps²) with slope ≈ B − A·C at s = 0."""
+    A: float
+    B: float
+    C: float
+    D: float
+    u_reg: float
+    s_eps: float
+    needs_rolling_speed = True
 
     def __post_init__(self):
-        if self.kind not in ("tanh", "ehl"):
-            raise ModelError(f"Traction: kind must be 'tanh' or 'ehl', got {self.kind!r}")
-        for name in ("mu_max", "v0", "A", "B", "C", "D", "u_reg", "s_eps"):
-            if not np.isfinite(getattr(self, name)):
-                raise ModelError(f"Traction: {name} must be finite, got {getattr(self, name)!r}")
-        for name in ("v0", "u_reg", "s_eps"):
-            if getattr(self, name) <= 0:
-                raise ModelError(f"Traction: {name} must be > 0, got {getattr(self, name)!r}")
-        if self.mu_max < 0 or self.C < 0:
-            raise ModelError(f"Traction: mu_max and C must be >= 0, got {self.mu_max!r}, {self.C!r}")
-
-    @property
-    def needs_rolling_speed(self) -> bool:
-        return self.kind == "ehl"
+        self._check(positive=("u_reg", "s_eps"), nonneg=("C",))
 
     def coefficient(self, v_s, u_roll=None):
-        """μ for sliding velocity v_s [m/s] (and rolling speed u_roll [m/s] for the EHL curve)."""
-        if self.kind == "tanh":
-            return self.mu_max * ad.tanh(v_s * (1.0 / self.v0))
         s = v_s / ad.sqrt(u_roll * u_roll + self.u_reg ** 2)
         a = ad.sqrt(s * s + self.s_eps ** 2)
         return (s / a) * ((self.A + self.B * a) * ad.exp(a * (-self.C)) + self.D)
+
+
+# the traction laws by name (a parameter chooses one)
+TRACTION_LAWS = MappingProxyType({"tanh": TanhTraction, "slide_roll": SlideRollTraction})
 
 
 # --------------------------------------------------------------------------------------------
@@ -213,8 +228,8 @@ class RaceContact(Element):
     """
     k = 6
 
-    def __init__(self, name, roller, race_body, *, kind, race_marker, R_race, D, K, exponent=10.0 / 9.0,
-                 zeta=0.05, m_roller, traction: Traction = Traction(), multiplicity=1):
+    def __init__(self, name, roller, race_body, *, kind, race_marker, R_race, D, K, exponent, zeta, m_roller,
+                 traction: Traction, multiplicity=1):
         self.name = name
         self.dofs = body_dofs(roller, race_body)
         if kind not in ("inner", "outer"):

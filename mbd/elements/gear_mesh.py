@@ -71,9 +71,9 @@ class StiffnessShape:
     Use the constructors :meth:`constant`, :meth:`rectangular`, :meth:`fourier`.
     """
     kind: str = "constant"
-    contact_ratio: float = 1.0
+    contact_ratio: float = 1.0      # the neutral values of the constant shape; rectangular() needs all three
     ratio: float = 1.0
-    smoothing: float = 0.05
+    smoothing: float = 0.0
     a: tuple = ()
     b: tuple = ()
 
@@ -107,7 +107,7 @@ class StiffnessShape:
         return cls("constant")
 
     @classmethod
-    def rectangular(cls, contact_ratio: float, ratio: float = 1.5, smoothing: float = 0.05) -> "StiffnessShape":
+    def rectangular(cls, contact_ratio: float, ratio: float, smoothing: float) -> "StiffnessShape":
         return cls("rectangular", contact_ratio=float(contact_ratio), ratio=float(ratio), smoothing=float(smoothing))
 
     @classmethod

@@ -1,0 +1,121 @@
+"""Architecture rules that keep the code honest (ARCHITECTURE.md): no import cycles between modules,
+the engine never imports the domain, and no physics value hides in an element constructor's default."""
+from __future__ import annotations
+
+import ast
+import dataclasses
+import inspect
+from pathlib import Path
+
+import mbd.elements as elements
+from mbd.element import Element
+from mbd.elements.contact import TRACTION_LAWS
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGES = ("mbd", "components", "scenarios", "viz")
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def import_graph() -> dict[str, set[str]]:
+    """module -> project modules it imports (anywhere in the file, relative imports resolved)."""
+    files = {_module_name(p): p for pkg in PACKAGES for p in (ROOT / pkg).rglob("*.py")}
+    graph = {}
+    for mod, path in files.items():
+        package = mod if path.name == "__init__.py" else mod.rpartition(".")[0]
+        deps = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    up = package.split(".")[: len(package.split(".")) - node.level + 1]
+                    base = ".".join([*up, base] if base else up)
+                names = [base] + [f"{base}.{a.name}" for a in node.names]
+            else:
+                continue
+            deps |= {n for n in names if n in files and n != mod}
+        graph[mod] = deps
+    return graph
+
+
+def find_cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Import cycles between modules (depth-first search); a package's __init__ re-exporting its own
+    modules is not counted."""
+    state, cycles = {}, []
+
+    def visit(m, stack):
+        state[m] = 1
+        for d in sorted(graph[m]):
+            if state.get(d) == 1:
+                cycles.append(stack[stack.index(d):] + [d])
+            elif d not in state:
+                visit(d, stack + [d])
+        state[m] = 2
+
+    for m in sorted(graph):
+        if m not in state:
+            visit(m, [m])
+    return [c for c in cycles if not any(a.startswith(b + ".") or b.startswith(a + ".") for a, b in zip(c, c[1:]))]
+
+
+def test_no_import_cycles():
+    assert find_cycles({"p.a": {"p.b"}, "p.b": {"p.c"}, "p.c": {"p.a"}}) == [["p.a", "p.b", "p.c", "p.a"]]
+    cycles = find_cycles(import_graph())
+    assert not cycles, f"import cycles: {cycles}"
+
+
+def test_the_engine_knows_nothing_of_the_domain():
+    graph = import_graph()
+    for mod, deps in graph.items():
+        if mod.startswith("mbd"):
+            assert not [d for d in deps if not d.startswith("mbd")], (mod, deps)
+
+
+# element constructor arguments that may have a default: structure, not physics
+STRUCTURAL = {"multiplicity": 1, "ramp": None, "anchor": (0.0, 0.0), "marker_a": (0.0, 0.0),
+              "marker_b": (0.0, 0.0), "theta0": 0.0, "u0": 0.0, "p0": 0.0, "phi_ref": 0.0}
+
+
+def _element_classes():
+    seen = set()
+    for name in dir(elements):
+        obj = getattr(elements, name)
+        if inspect.isclass(obj) and issubclass(obj, Element) and obj is not Element and obj not in seen:
+            seen.add(obj)
+            yield obj
+
+
+def test_no_physics_value_hides_in_an_element_constructor_default():
+    """Every physical coefficient (friction, reference speeds, restitution, exponents, damping ratios,
+    traction laws) comes from the parameter objects with its source tag. Defaults may only switch a term
+    off (None or 0) or give structure (STRUCTURAL)."""
+    classes = list(_element_classes())
+    assert len(classes) >= 10
+    bad = []
+    for cls in classes:
+        for p in inspect.signature(cls.__init__).parameters.values():
+            d = p.default
+            if d is inspect.Parameter.empty or d is None or p.name in ("self", "name"):
+                continue
+            if p.name in STRUCTURAL and d == STRUCTURAL[p.name]:
+                continue
+            if isinstance(d, (int, float)) and not isinstance(d, bool) and d == 0:
+                continue          # a term switched off
+            if isinstance(d, bool):
+                continue
+            bad.append(f"{cls.__name__}.{p.name}={d!r}")
+    assert not bad, f"physics values as constructor defaults: {bad}"
+
+
+def test_law_variants_have_no_default_coefficients():
+    for name, law in TRACTION_LAWS.items():
+        fields = dataclasses.fields(law)
+        assert fields and all(f.default is dataclasses.MISSING for f in fields), name
+    from mbd.elements.gear_mesh import StiffnessShape
+    sig = inspect.signature(StiffnessShape.rectangular).parameters
+    assert all(sig[k].default is inspect.Parameter.empty for k in ("contact_ratio", "ratio", "smoothing"))
