@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mbd.elements.gear_mesh import GearMesh, StiffnessShape
+from mbd.elements.gear_mesh import GearMesh, StiffnessShape, mesh_offset
 
 from .scene import Scene
 from .units import ParameterError
@@ -27,7 +27,7 @@ def add_mesh_family(scene: Scene, family: str, mg, *, gear1: list[str], gear2: l
     th1, th2 = np.asarray(theta1_0, float), np.asarray(theta2_0, float)
     phi = np.asarray(mg.line_angle, float)
     rb1, rb2 = mg.base_radius1, mg.base_radius2
-    u0 = rb2 * (th2 - phi) - rb1 * (th1 - phi) if mg.internal else rb1 * (th1 - phi) + rb2 * (th2 - phi)
+    u0 = mesh_offset(mg.internal, rb1, rb2, th1, th2, phi)
     if time_varying:
         # the single/double-contact wave needs 1 <= ε < 2 and non-overlapping ramps: refuse with the
         # parameter's name here (StiffnessShape would raise a bare ModelError from inside the build)

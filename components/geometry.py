@@ -45,6 +45,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field
+
 import numpy as np
 
 from .units import ParameterError
@@ -55,7 +56,7 @@ __all__ = [
     "Kinematics", "Finding", "DesignWarning",
     "centre_distances", "pair_angle", "planet_angles", "speed_ratio", "planet_speed_ratios", "iso_minimum_backlash",
     "mesh_frequency", "contact_path", "contact_ratio", "assembly_number", "mesh_phases",
-    "mesh_stiffness_levels", "mesh_damping", "palmgren_stiffness", "kinematics", "layout", "loaded_flanks",
+    "mesh_stiffness_levels", "mesh_damping", "mesh_equivalent_mass", "palmgren_stiffness", "kinematics", "layout", "loaded_flanks",
     "design_findings", "check_design",
 ]
 
@@ -137,10 +138,18 @@ def mesh_stiffness_levels(k_mean: float, ratio: float, eps: float) -> tuple[floa
     return k_single, ratio * k_single
 
 
-def mesh_damping(zeta: float, k_mean: float, j1: float, j2: float, rb1: float, rb2: float) -> tuple[float, float]:
-    """(c_m, m_eq): c_m = 2ζ·sqrt(k_mean·m_eq), m_eq = J1·J2/(J1·r_b2² + J2·r_b1²) (MODEL.md §3.2)."""
-    m_eq = j1 * j2 / (j1 * rb2 ** 2 + j2 * rb1 ** 2)
-    return 2.0 * zeta * math.sqrt(k_mean * m_eq), m_eq
+def mesh_equivalent_mass(J1, J2, rb1, rb2):
+    """m_eq = J1 J2 / (J1 r_b2² + J2 r_b1²) [kg]: the mass of the mesh's torsional mode on its line of action."""
+    return J1 * J2 / (J1 * rb2 ** 2 + J2 * rb1 ** 2)
+
+
+def mesh_damping(zeta, k_mean, J1, J2, rb1, rb2):
+    """Mesh damping c_m = 2 ζ sqrt(k_mean m_eq) [N·s/m] (MODEL.md §3.2), m_eq from :func:`mesh_equivalent_mass`."""
+    zeta, k_mean, J1, J2, rb1, rb2 = (np.asarray(x, float) for x in (zeta, k_mean, J1, J2, rb1, rb2))
+    for name, x in (("zeta", zeta), ("k_mean", k_mean), ("J1", J1), ("J2", J2), ("rb1", rb1), ("rb2", rb2)):
+        if not np.all(np.isfinite(x)) or np.any(x < 0 if name == "zeta" else x <= 0):
+            raise ParameterError(f"mesh_damping: {name} must be finite and {'>= 0' if name == 'zeta' else '> 0'}, got {x!r}")
+    return 2.0 * zeta * np.sqrt(k_mean * mesh_equivalent_mass(J1, J2, rb1, rb2))
 
 
 def iso_minimum_backlash(centre_distance: float, module: float) -> float:
@@ -395,8 +404,8 @@ def layout(params: "components.params.DPGTParams", gears_si=None, mesh_si=None) 
         b = min(gs[n1].face_width, gs[n2].face_width)
         k_mean = ms.mean_stiffness if ms.mean_stiffness is not None else ms.c_gamma_alpha * b
         k1, k2 = mesh_stiffness_levels(k_mean, ms.stiffness_ratio, eps)
-        c, m_eq = mesh_damping(ms.damping_ratio, k_mean, gs[n1].inertia, gs[n2].inertia,
-                               g1.base_radius, g2.base_radius)
+        args = (gs[n1].inertia, gs[n2].inertia, g1.base_radius, g2.base_radius)
+        c, m_eq = float(mesh_damping(ms.damping_ratio, k_mean, *args)), float(mesh_equivalent_mass(*args))
         b_n = ms[f"backlash_{name}"]
         b_n = iso_minimum_backlash(a, g1.module) if b_n is None else b_n
         return MeshGeometry(name=name, gear1=n1, gear2=n2, internal=internal, z1=g1.teeth, z2=g2.teeth,

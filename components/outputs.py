@@ -24,12 +24,13 @@ from dataclasses import dataclass
 import numpy as np
 
 import mbd
+from mbd.ad import wrap_angle
 
 from .bearing import bearing_kinematics
 from .families import FAMILY, MESH_FAMILY
 
 __all__ = ["FAMILY", "MESH_FAMILY", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
-           "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions"]
+           "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life"]
 
 LIFE_EXPONENT = 10.0 / 3.0     # ISO 281, roller bearings: L10 ∝ P^(−10/3)
 
@@ -109,6 +110,11 @@ def pin_reactions(race_inner: dict, rollers, bearing_of_roller, n_bearings: int,
     fy = np.asarray(race_inner["fy"], float)[rollers]
     return -rows * np.column_stack([np.bincount(bearing_of_roller, fx, n_bearings),
                                     np.bincount(bearing_of_roller, fy, n_bearings)])
+
+
+def relative_life(P: float, P_ref: float) -> float | None:
+    """ISO 281 basic rating life ratio L10/L10_ref = (P_ref/P)^(10/3) for roller bearings (None for P ≤ 0)."""
+    return float((P_ref / P) ** LIFE_EXPONENT) if P > 0 else None
 
 
 def radial_tangential(vec, planet_xy, carrier_xy):
@@ -376,7 +382,7 @@ class WindowStatistics(mbd.Observer):
             Fy = x0["load_y"][i] + w * (x1["load_y"][i] - x0["load_y"][i])
             zone = math.atan2(-Fy, -Fx)
             mine = np.flatnonzero(p.roller_bearing == i)
-            off = np.angle(np.exp(1j * (ang[mine] - zone)))
+            off = wrap_angle(ang[mine] - zone)
             ref.append(int(mine[np.argmin(np.abs(off))]))
         self.ref_roller = tuple(ref)
 

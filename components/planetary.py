@@ -52,9 +52,9 @@ import numpy as np
 
 import mbd
 from mbd.elements import BodySpring, GearMesh, GroundSupport
-from mbd.elements.gear_mesh import mesh_damping, mesh_u0
+from mbd.elements.gear_mesh import mesh_u0
 
-from .geometry import DesignWarning
+from .geometry import DesignWarning, mesh_damping
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError, quantity, to_si
 

@@ -23,6 +23,7 @@ import numpy as np
 from scipy import optimize
 
 import mbd
+from mbd.ad import wrap_angle
 from mbd.elements import ForceSource, GroundSupport, Ramp, SpeedDrive
 
 from .bearing import BearingSI, add_planet_bearing, bearing_si
@@ -229,7 +230,7 @@ def _finite(name, value, positive=False, nonneg=False) -> float:
 
 def _roller_angles_from_zone(Z: int, load_angle: float) -> np.ndarray:
     """Initial roller angles (roller j at 2πj/Z from +x) measured from the load-zone centre."""
-    return _wrap(2 * np.pi * np.arange(Z) / Z - (load_angle + np.pi))
+    return wrap_angle(2 * np.pi * np.arange(Z) / Z - (load_angle + np.pi))
 
 
 def _radial_stiffness(b: BearingSI, F: float, a: float) -> float:
@@ -238,10 +239,6 @@ def _radial_stiffness(b: BearingSI, F: float, a: float) -> float:
     d1 = discrete_load_distribution(b, 0.99 * F, ang).deflection
     d2 = discrete_load_distribution(b, 1.01 * F, ang).deflection
     return 0.02 * F / (d2 - d1)
-
-
-def _wrap(x):
-    return (np.asarray(x) + np.pi) % (2 * np.pi) - np.pi
 
 
 # ----------------------------------------------------------------------------------------------
@@ -254,7 +251,7 @@ def run_sampled(model: mbd.Model, q0, v0, times, *, controller, stepper: mbd.HHT
     The run is split at the sample times (steps end exactly on them, no interpolation); an
     :class:`mbd.Adaptive` controller continues each piece from the largest step of the previous one."""
     system = system or mbd.System(model)
-    stepper = stepper or mbd.HHT(alpha=-0.3)
+    stepper = stepper or mbd.PRODUCTION.stepper()
     if state is None:
         state = stepper.initial_state(system, t0, q0, v0)
     out = []
@@ -288,7 +285,7 @@ def rig_loads(built: BuiltScene, system: mbd.System, s: mbd.State) -> dict:
     Qi, Qo = inner["load"][si], outer["load"][so]
     rows = built.meta["bearing"].rows
     return {
-        "t": s.t, "angle": _wrap(ang - built.meta["zone_angle"]), "load_inner": Qi, "load_outer": Qo,
+        "t": s.t, "angle": wrap_angle(ang - built.meta["zone_angle"]), "load_inner": Qi, "load_outer": Qo,
         "ring": ring.copy(),
         "load_sum": -rows * (Qi[:, None] * e).sum(axis=0),
         "pin_force": pin_reactions(inner, si, np.zeros(si.stop - si.start, int), 1, rows)[0],
@@ -367,9 +364,9 @@ def rig_static_solution(built: BuiltScene, *, t_settle: float | None = None, win
     loads_o = np.bincount(k.ravel(), weights=Qo.ravel(), minlength=Z) / n
     # mean angle of each bin's occupants, relative to the bin centre (no wrap problems)
     centre = 2 * np.pi * np.arange(Z) / Z
-    rel = _wrap(ang - centre[k])
+    rel = wrap_angle(ang - centre[k])
     cnt = np.bincount(k.ravel(), minlength=Z)
-    angles = _wrap(centre + np.bincount(k.ravel(), weights=rel.ravel(), minlength=Z) / np.maximum(cnt, 1))
+    angles = wrap_angle(centre + np.bincount(k.ravel(), weights=rel.ravel(), minlength=Z) / np.maximum(cnt, 1))
     order = np.argsort(angles)
     angles, loads, loads_o = angles[order], loads[order], loads_o[order]
     q_max = float(loads.max())

@@ -14,11 +14,12 @@ from .modal import linearize, modal_analysis
 from .model import BodyRef, Frame, FrameState, Model, ModelBuilder, State, to_fixed, to_reference
 from .recorder import BodyMotion, ElementOutput, Recorder
 from .scipy_adapter import FirstOrderSystem, solve_scipy
+from .settings import PRODUCTION, IntegratorSettings
 from .simulate import Checkpoint, Observer, SimResult, TimeMean, load_state, save_state, simulate
 
 __all__ = [
     "Adaptive", "BodyMotion", "BodyRef", "Checkpoint", "Counters", "Element", "ElementOutput",
-    "FirstOrderSystem", "FixedStep", "Frame", "FrameState", "HHT", "IntegrationError", "Model",
+    "FirstOrderSystem", "FixedStep", "Frame", "FrameState", "HHT", "IntegratorSettings", "PRODUCTION", "IntegrationError", "Model",
     "ModelBuilder", "ModelError", "Observer", "Recorder", "SimResult", "State", "System", "TimeMean", "Tolerance",
     "body_dofs", "hht_coefficients", "linearize", "load_state", "marker", "marker_velocity",
     "modal_analysis", "point_force", "save_state", "simulate", "solve_scipy", "to_fixed", "to_reference",

@@ -52,8 +52,12 @@ def _fused_families(elements, fuse: bool):
 
 
 class System:
-    def __init__(self, model: Model, fuse: bool = True):
+    """``freeze_internal``: hold every element internal state at its value (as the first-order form of
+    :mod:`mbd.scipy_adapter` does), so an HHT run and a scipy run integrate the same equations."""
+
+    def __init__(self, model: Model, fuse: bool = True, freeze_internal: bool = False):
         self.model = model
+        self.freeze_internal = bool(freeze_internal)
         self.ndof = n = model.ndof
         self.counters = Counters()
         m = model

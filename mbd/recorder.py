@@ -6,6 +6,18 @@ is independent of the step size. Samples are buffered in memory up to ``chunk`` 
 to a chunk file (atomic rename), so memory stays bounded on long runs. :meth:`finalize` streams the
 chunks into one netCDF4/HDF5 file (readable with xarray or h5py) through a temporary file and an
 atomic rename: a results file is either complete or absent.
+
+Layout of the file (every variable and coordinate carries CF-style ``units`` and ``long_name``):
+
+* ``time`` (time) [s];
+* per :class:`BodyMotion` probe ``<name>``: coordinates ``<name>.body`` (body names) and ``axis``
+  (x, y); ``<name>.position`` (time, <name>.body, axis) [m], ``<name>.angle`` (time, <name>.body) [rad],
+  ``<name>.velocity`` [m/s], ``<name>.angular_velocity`` [rad/s], ``<name>.acceleration`` [m/s^2],
+  ``<name>.angular_acceleration`` [rad/s^2] (lengths and angles are never in one variable);
+* per :class:`ElementOutput` of family ``<f>``: ``<f>.<key>`` (time, <f>.instance) with the units and
+  long name given in ``ElementOutput.meta``; the dimension ``<f>.instance`` has a coordinate of the same
+  name (instance names from ``ElementOutput.instances``, else the index 0..n-1) and any further
+  per-instance coordinates ``<f>.<coord>`` given there (listed in each variable's ``coordinates``).
 """
 from __future__ import annotations
 
@@ -14,14 +26,14 @@ import os
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 
 from .errors import ModelError
 from .model import to_fixed
 
-__all__ = ["BodyMotion", "ElementOutput", "Recorder", "atomic_write_bytes", "atomic_write_text"]
+__all__ = ["BodyMotion", "ElementOutput", "Recorder", "atomic_write_bytes", "atomic_write_text", "hermite"]
 
 
 def atomic_write_bytes(path, data: bytes) -> None:
@@ -55,11 +67,27 @@ class BodyMotion:
             raise ModelError(f"BodyMotion.quantities: unknown {sorted(bad)}; use q, v, a")
 
 
+# BodyMotion quantity -> (name, units, words) of its translational (x, y) and its rotational part
+BODY_QUANTITIES = {
+    "q": (("position", "m", "position"), ("angle", "rad", "angle")),
+    "v": (("velocity", "m/s", "velocity"), ("angular_velocity", "rad/s", "angular velocity")),
+    "a": (("acceleration", "m/s^2", "acceleration"), ("angular_acceleration", "rad/s^2", "angular acceleration")),
+}
+_FRAME_WORDS = {"reference": "in the reference frame R", "fixed": "in the fixed frame I"}
+
+
 @dataclass(frozen=True)
 class ElementOutput:
-    """Outputs of an element family (all its output keys when ``keys`` is None)."""
+    """Outputs of an element family (all its output keys when ``keys`` is None).
+
+    ``meta`` maps an output key to (units, long_name) for the file's attributes (CF units: "N", "m",
+    "rad", "1" for dimensionless). ``instances`` maps a coordinate name to (long_name, one value per
+    instance): the entry "instance" names the instances (the dimension's own coordinate, e.g. roller
+    names), others (e.g. "planet", "pair") become extra coordinates ``<family>.<name>`` along it."""
     element: str
     keys: Sequence[str] | None = None
+    meta: Mapping[str, tuple[str, str]] | None = None
+    instances: Mapping[str, tuple[str, Sequence]] | None = None
 
 
 class Recorder:
@@ -82,16 +110,23 @@ class Recorder:
     # binding to a model ------------------------------------------------------------------------
     def bind(self, model, system, state) -> None:
         self.model, self.system = model, system
-        self.vars: dict[str, tuple[tuple[str, ...], dict]] = {}   # name -> (dims, coords)
+        self.vars: dict[str, tuple[tuple[str, ...], dict]] = {}     # name -> (dims, attrs)
+        self.coords: dict[str, tuple[str, list, dict]] = {}         # name -> (dim, values, attrs)
+        self.dims: dict[str, int] = {}
         self._plan = []
         for p in self.probes:
             if isinstance(p, BodyMotion):
                 names = list(p.bodies) if p.bodies is not None else list(model.body_names)
                 idx = np.array([model.body(nm).index for nm in names], dtype=int)
+                bdim = f"{p.name}.body"
+                self._coord(bdim, bdim, names, "1", "body name")
+                self._coord("axis", "axis", ["x", "y"], "1", "Cartesian axis of the frame")
+                where = _FRAME_WORDS[p.frame]
                 for qty in p.quantities:
-                    vname = f"{p.name}.{qty}"
-                    self.vars[vname] = (("time", f"{p.name}.body", "coord"),
-                                        {f"{p.name}.body": names, "coord": ["x", "y", "theta"]})
+                    (lin, lu, lw), (ang, au, aw) = BODY_QUANTITIES[qty]
+                    self.vars[f"{p.name}.{lin}"] = (("time", bdim, "axis"),
+                                                   {"units": lu, "long_name": f"body {lw} {where}"})
+                    self.vars[f"{p.name}.{ang}"] = (("time", bdim), {"units": au, "long_name": f"body {aw} {where}"})
                 self._plan.append(("body", p, idx))
             elif isinstance(p, ElementOutput):
                 e = model.element(p.element)
@@ -100,12 +135,33 @@ class Recorder:
                 missing = set(keys) - set(probe_out)
                 if missing:
                     raise ModelError(f"element {e.name!r} has no outputs {sorted(missing)}; it has {sorted(probe_out)}")
+                dim = f"{e.name}.instance"
+                n = int(np.size(probe_out[keys[0]])) if keys else 0
+                self.dims[dim] = n
+                inst = dict(p.instances or {})
+                long_name, values = inst.pop("instance", (f"instance index of element family {e.name}", range(n)))
+                self._coord(dim, dim, values, "1", long_name)
+                for c, (lname, vals) in inst.items():
+                    self._coord(f"{e.name}.{c}", dim, vals, "1", lname)
+                meta = dict(p.meta or {})
                 for k in keys:
-                    self.vars[f"{e.name}.{k}"] = (("time", f"{e.name}.n"), {})
+                    attrs = {"long_name": f"output {k!r} of element family {e.name}"}
+                    if k in meta:
+                        attrs = {"units": meta[k][0], "long_name": meta[k][1]}
+                    if inst:
+                        attrs["coordinates"] = " ".join(f"{e.name}.{c}" for c in inst)
+                    self.vars[f"{e.name}.{k}"] = (("time", dim), attrs)
                 self._plan.append(("elem", e, keys))
             else:
                 raise ModelError(f"unknown probe {p!r}")
         self._buf = {k: [] for k in self.vars}
+
+    def _coord(self, name: str, dim: str, values, units: str, long_name: str) -> None:
+        values = list(values)
+        if self.dims.setdefault(dim, len(values)) != len(values):
+            raise ModelError(f"coordinate {name!r}: {len(values)} values for dimension {dim!r} of size "
+                             f"{self.dims[dim]}")
+        self.coords[name] = (dim, values, {"units": units, "long_name": long_name})
 
     # sampling ----------------------------------------------------------------------------------
     def sample_times(self, t0: float, t1: float, include_start: bool) -> np.ndarray:
@@ -136,7 +192,7 @@ class Recorder:
         for k in ks:
             t = self.t_start + k * self.dt
             th = min(1.0, max(0.0, (t - s0.t) / h))
-            q, v, a = _hermite(s0, s1, th, h)
+            q, v, a = hermite(s0, s1, th, h)
             self._sample(t, q, v, a, s0.z)
             self.next_index = k + 1
 
@@ -156,7 +212,9 @@ class Recorder:
                     Q, V, A = to_fixed(Q, V, fs, A)
                 for qty, arr in zip("qva", (Q, V, A)):
                     if qty in p.quantities:
-                        self._buf[f"{p.name}.{qty}"].append(np.array(arr))
+                        (lin, _, _), (ang, _, _) = BODY_QUANTITIES[qty]
+                        self._buf[f"{p.name}.{lin}"].append(np.array(arr[:, :2]))
+                        self._buf[f"{p.name}.{ang}"].append(np.array(arr[:, 2]))
             else:
                 if outs is None:
                     outs = self.system.outputs(t, q, v, z)
@@ -223,21 +281,23 @@ class Recorder:
             for key, val in allattrs.items():
                 f.attrs[key] = val if isinstance(val, (int, float, str)) else json.dumps(val, default=float)
             tv = f.create_variable("time", ("time",), float)
-            tv.attrs["units"] = "s"
+            tv.attrs.update({"units": "s", "long_name": "time", "standard_name": "time"})
+            for d, size in self.dims.items():
+                f.dimensions[d] = size
+            for name, (d, values, cattrs) in self.coords.items():
+                if all(isinstance(x, str) for x in values):
+                    # h5py has no conversion for numpy '<U' strings: variable-length UTF-8
+                    cv = f.create_variable(name, (d,), h5py.string_dtype())
+                    cv[:] = np.array(values, dtype=object)
+                else:
+                    arr = np.asarray(values)
+                    cv = f.create_variable(name, (d,), arr.dtype)
+                    cv[:] = arr
+                cv.attrs.update(cattrs)
             created = {}
-            chunks = self._chunks()
-            first = next(chunks, None)
-            chunks.close()          # release the first chunk's file now, not at garbage collection
-            for name, (dims, coords) in self.vars.items():
-                shape_tail = first[name].shape[1:] if first is not None else (0,) * (len(dims) - 1)
-                for d, size in zip(dims[1:], shape_tail):
-                    if d not in f.dimensions:
-                        f.dimensions[d] = size
-                        if d in coords:
-                            # h5py has no conversion for numpy '<U' strings: variable-length UTF-8
-                            cv = f.create_variable(d, (d,), h5py.string_dtype())
-                            cv[:] = np.array(coords[d], dtype=object)
+            for name, (dims, vattrs) in self.vars.items():
                 created[name] = f.create_variable(name, dims, float, chunks=None)
+                created[name].attrs.update(vattrs)
             i0 = 0
             for c in self._chunks():
                 n = c["time"].shape[0]
@@ -261,7 +321,7 @@ def _fixed_body_acceleration(m, fs, qf, vf, af) -> None:
     af[3 * idx + 2] = -dW
 
 
-def _hermite(s0, s1, th, h):
+def hermite(s0, s1, th, h):
     """Cubic Hermite interpolation of (q, v) and linear of a at fraction th of the step."""
     if th <= 0.0:
         return s0.q, s0.v, s0.a

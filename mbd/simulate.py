@@ -141,7 +141,7 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
              on_progress=None, observers=()) -> SimResult:
     """Integrate from (t0, q0, v0) — or from ``state`` — to t_end.
 
-    ``stepper`` defaults to HHT(α = −0.1); ``controller`` is required (FixedStep or Adaptive), since
+    ``stepper`` defaults to ``mbd.PRODUCTION.stepper()``; ``controller`` is required (FixedStep or Adaptive), since
     the step size is the user's accuracy decision. Progress bar: on for runs of more than ~2 s wall
     unless ``progress=False`` or the environment sets DPGT_PROGRESS=0. ``on_progress(t, t_end, counters)``
     is called at most twice a second (e.g. to report progress from a worker process). ``observers``
@@ -149,7 +149,9 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
     """
     if controller is None:
         raise ModelError("simulate: pass controller=FixedStep(h) or Adaptive(h0=..., ...)")
-    stepper = stepper or HHT()
+    if stepper is None:
+        from .settings import PRODUCTION
+        stepper = PRODUCTION.stepper()
     system = system or System(model)
     if state is None:
         if q0 is None or v0 is None:

@@ -1,34 +1,9 @@
-"""Post-processing shared by the scenarios: window statistics, ISO 281 relative life, spectra."""
+"""Spectra for the scenarios (the statistics of a run live in components.outputs)."""
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["rms", "window", "relative_life", "amplitude_spectrum", "peak_table", "bearing_equivalent_load"]
-
-
-def window(t: np.ndarray, t0: float, t1: float) -> np.ndarray:
-    """Boolean mask of the samples in [t0, t1]."""
-    return (t >= t0 - 1e-12) & (t <= t1 + 1e-12)
-
-
-def rms(x: np.ndarray, axis=0) -> np.ndarray:
-    x = np.asarray(x, float)
-    return np.sqrt(np.mean(x * x, axis=axis))
-
-
-def bearing_equivalent_load(load_history: np.ndarray) -> float:
-    """Cubic-mean-type equivalent of a time-varying radial load for life (ISO 281: P = (mean P^p)^(1/p)
-    with p = 10/3 for roller bearings)."""
-    p = 10.0 / 3.0
-    x = np.abs(np.asarray(load_history, float))
-    return float(np.mean(x**p) ** (1.0 / p))
-
-
-def relative_life(P: float, P_ref: float) -> float:
-    """ISO 281 basic rating life ratio L10/L10_ref = (P_ref/P)^(10/3) for roller bearings."""
-    if P <= 0:
-        return float("inf")
-    return float((P_ref / P) ** (10.0 / 3.0))
+__all__ = ["amplitude_spectrum", "peak_table"]
 
 
 def amplitude_spectrum(t: np.ndarray, x: np.ndarray, detrend: bool = True):

@@ -8,6 +8,7 @@ Prints one JSON object: wall_plain_s, wall_stats_s, overhead (relative), steps.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import statistics
 import time
@@ -30,7 +31,8 @@ def main(argv=None) -> int:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         bs = build_dpgt(reference_dpgt(a.condition, "forward"))
-    kw = dict(stepper=mbd.HHT(alpha=-0.3), controller=mbd.FixedStep(a.h), progress=False)
+    setting = dataclasses.replace(mbd.PRODUCTION, method="hht-fixed", h=a.h)
+    kw = dict(stepper=setting.stepper(), controller=setting.controller(), progress=False)
     s0 = mbd.simulate(bs.model, bs.q0, bs.v0, a.settle, **kw).state
     walls = {"plain": [], "stats": []}
     for _ in range(a.repeats):

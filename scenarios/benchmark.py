@@ -43,8 +43,8 @@ import numpy as np
 import mbd
 from components.outputs import FAMILY
 
-from .numerics_common import (StateSampler, design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note,
-                              observables, peak_rss_mb, run_scipy, settled_state, wait_quiet)
+from .numerics_common import (design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note,
+                              observables, peak_rss_mb, run_hht, run_scipy, settled_state, wait_quiet)
 
 __all__ = ["main", "benchmark", "scaling", "profile_window"]
 
@@ -71,20 +71,18 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
     log(f"load before timing: {qw}")
     costs = eval_costs(prob.model, s0)
     log(f"one residual {costs['residual_s'] * 1e3:.2f} ms, residual+Jacobian {costs['jacobian_s'] * 1e3:.2f} ms")
-    # the timed run (recording only q, v on the sub-window grid: no element evaluation in the loop)
-    smp = StateSampler(sub)
-    system = mbd.System(prob.model)
-    w0 = time.perf_counter()
-    stepper = mbd.HHT(alpha=alpha) if newton_tol is None else mbd.HHT(alpha=alpha, newton_tol=newton_tol)
-    res = mbd.simulate(prob.model, t_end=t1, state=s0.copy(), stepper=stepper, system=system,
-                       controller=mbd.FixedStep(h), recorder=smp, progress=False)
-    wall = time.perf_counter() - w0
+    # the timed run (sampling only q, v on the sub-window grid: no element evaluation in the loop)
+    run = run_hht(prob, s0, t1, sub, alpha=alpha, h=h, newton_tol=newton_tol, label=f"fixed h={h:.1e}")
+    if not run.completed:
+        raise mbd.IntegrationError(f"benchmark run failed: {run.message}")
+    wall = run.wall_s
     load_after = load1()
     rss_hht = peak_rss_mb()       # before scipy (LSODA's dense Jacobian) and the scaling runs inflate it
-    c = res.counters
-    log(f"HHT α={alpha:g} h={h:.1e}: {window:g} s simulated in {wall:.1f} s, {res.steps} steps, "
-        f"{c['newton'] / res.steps:.2f} Newton/step, {c['factor']} LU, {c['jacobian']} Jacobians, {c['rejected']} rejected")
-    obs = observables(prob, sub, np.array(smp.q), np.array(smp.v), smp.z)
+    c = {"newton": run.newton, "factor": run.factor, "jacobian": run.jacobian, "rejected": run.rejected,
+         "residual": run.residual}
+    log(f"HHT α={alpha:g} h={h:.1e}: {window:g} s simulated in {wall:.1f} s, {run.steps} steps, "
+        f"{c['newton'] / run.steps:.2f} Newton/step, {c['factor']} LU, {c['jacobian']} Jacobians, {c['rejected']} rejected")
+    obs = observables(prob, sub, run.q, run.v, run.z)
     # the reference gets the 100x tighter Newton tolerance of the work-precision reference
     from .work_precision import _hht_tight
     ref = _hht_tight(prob, s0, t0 + ref_window, sub, h / 8)
@@ -115,8 +113,9 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
     best = min(good, key=lambda s: s["wall_s"]) if good else max(sc, key=lambda s: s["simulated_s"])
     hht_per_sim = wall / window
     return {
-        "wall_s": wall, "simulated_s": window, "steps": res.steps, "h_s": h, "alpha": alpha, "newton_tol": stepper.newton_tol,
-        "newton_per_step": c["newton"] / res.steps, "factorizations": c["factor"], "jacobian_evals": c["jacobian"],
+        "wall_s": wall, "simulated_s": window, "steps": run.steps, "h_s": h, "alpha": alpha,
+        "newton_tol": newton_tol if newton_tol is not None else mbd.HHT(alpha=alpha).newton_tol,
+        "newton_per_step": c["newton"] / run.steps, "factorizations": c["factor"], "jacobian_evals": c["jacobian"],
         "residual_evals": c["residual"], "rejected": c["rejected"],
         "rel_error_rms_inner_race": err["err_rms_inner"], "rel_error_pin_history": err["err_pin_rel"],
         "error_reference": f"HHT alpha=-0.1 h={h / 8:.2e} s over the first {ref_window:g} s of the window",
@@ -125,8 +124,8 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
         "scipy_best_completed": best["completed"], "scipy_rel_error": best["rel_error_rms_inner_race"],
         "scipy_reached_1pct": bool(good), "scipy_tols": list(scipy_tols), "scipy_cap_s": scipy_cap,
         "speedup_vs_scipy": best["wall_per_simulated_s"] / hht_per_sim, "scipy": sc,
-        "per_step_s": wall / res.steps, "eval_residual_s": costs["residual_s"], "eval_jacobian_s": costs["jacobian_s"],
-        "per_step_over_eval": (wall / res.steps) / costs["jacobian_s"],
+        "per_step_s": wall / run.steps, "eval_residual_s": costs["residual_s"], "eval_jacobian_s": costs["jacobian_s"],
+        "per_step_over_eval": (wall / run.steps) / costs["jacobian_s"],
         "peak_rss_after_hht_mb": rss_hht, "peak_rss_mb": peak_rss_mb(), "machine": machine_note(), "settle": extra,
         "load": {**qw, "after_timed_run": load_after, "after_scipy": load1()},
     }
@@ -167,9 +166,9 @@ def scaling(configs=SCALING, steps: int = 200, h: float = 5e-6, log=print) -> li
             continue
         prob = dpgt_problem(overrides=ov, strict=not dv["refused"])
         system = mbd.System(prob.model)
-        st = mbd.HHT(alpha=-0.3).initial_state(system, 0.0, prob.built.q0, prob.built.v0)
+        st = mbd.PRODUCTION.stepper().initial_state(system, 0.0, prob.built.q0, prob.built.v0)
         costs = eval_costs(prob.model, st, n=60)
-        res = mbd.simulate(prob.model, t_end=steps * h, state=st, stepper=mbd.HHT(alpha=-0.3), system=system,
+        res = mbd.simulate(prob.model, t_end=steps * h, state=st, stepper=mbd.PRODUCTION.stepper(), system=system,
                            controller=mbd.FixedStep(h), progress=False)
         row = {"N": N, "Z": Z, "NZ": N * Z, "feasible": feasible, "verdict": "" if feasible else verdict[:300],
                "ndof": int(prob.model.ndof), "nnz": int(system.nnz),

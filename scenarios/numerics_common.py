@@ -29,12 +29,13 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import mbd
+from mbd.recorder import hermite
 from components.outputs import FAMILY, pin_reactions
 from components.params import with_overrides
 from components.presets import reference_dpgt
 
 __all__ = ["Problem", "dpgt_problem", "rig_problem", "settled_state", "StateSampler", "RunResult",
-           "run_hht", "run_scipy", "FrozenInternalHHT", "observables", "error_metrics", "scipy_atol", "peak_rss_mb",
+           "run_hht", "run_scipy", "observables", "error_metrics", "scipy_atol", "peak_rss_mb",
            "eval_costs", "machine_note", "wait_quiet", "load1",
            "design_verdict"]
 
@@ -99,10 +100,10 @@ def settled_state(prob: Problem, cache: Path | None = None, h: float = 5e-6) -> 
         s, extra = mbd.load_state(cache)
         if abs(s.t - prob.settle) < 1e-12 and s.q.size == prob.model.ndof and extra.get("fingerprint") == fp:
             return s, extra
-    stepper = mbd.HHT(alpha=-0.3)
-    res = mbd.simulate(prob.model, prob.built.q0, prob.built.v0, prob.settle, stepper=stepper,
-                       controller=mbd.Adaptive(h0=min(h, 1e-6), h_max=h, h_min=1e-10), progress=False)
-    extra = {"fingerprint": fp, "settle_wall_s": res.wall_s, "settle_steps": res.steps, "setting": "HHT alpha=-0.3 adaptive atol 1e-8 m"}
+    setting = dataclasses.replace(mbd.PRODUCTION, h=min(h, 1e-6), h_max=h, h_min=1e-10)
+    res = mbd.simulate(prob.model, prob.built.q0, prob.built.v0, prob.settle, stepper=setting.stepper(),
+                       controller=setting.controller(), progress=False)
+    extra = {"fingerprint": fp, "settle_wall_s": res.wall_s, "settle_steps": res.steps, "setting": repr(setting)}
     if cache is not None:
         Path(cache).parent.mkdir(parents=True, exist_ok=True)
         mbd.save_state(cache, res.state, extra)
@@ -130,57 +131,33 @@ def model_fingerprint(model: mbd.Model) -> str:
     return h.hexdigest()
 
 
-class FrozenInternalHHT(mbd.HHT):
-    """HHT that holds element internal states (a PI drive's integral) at their initial value — the
-    model :class:`mbd.FirstOrderSystem` integrates — so scipy runs can be scored against a reference of
-    the same equations."""
-
-    def _update_internal(self, system, s, t1, q1, v1):
-        return s.z
-
-
-class StateSampler:
-    """Recorder stand-in: (q, v, z) at the grid times, cubic Hermite between accepted steps (q with v,
-    v with a — the interpolation :class:`mbd.Recorder` uses). No element evaluation while timing."""
+class StateSampler(mbd.Observer):
+    """(q, v, z) at the grid times, cubic Hermite between accepted steps (:func:`mbd.recorder.hermite`,
+    the recorder's interpolation). An observer of the one loop; no element evaluation while timing."""
 
     def __init__(self, grid):
         self.grid = np.asarray(grid, float)
-        self.reset()
-
-    def bind(self, model, system, state):
-        pass
-
-    def reset(self):
         self.i = 0
         self.q, self.v, self.z = [], [], []
 
-    def _take(self, t, q, v, z):
+    def _take(self, q, v, z):
         self.q.append(q)
         self.v.append(v)
         self.z.append(z)
         self.i += 1
 
-    def record(self, s0, s1, first=False):
-        tol = 1e-12 * max(1.0, abs(s0.t))
-        if first:
-            while self.i < self.grid.size and self.grid[self.i] <= s0.t + tol:
-                self._take(self.grid[self.i], s0.q.copy(), s0.v.copy(), s0.z)
-            if s1 is None:
-                return
+    def bind(self, model, system, state):
+        tol = 1e-12 * max(1.0, abs(state.t))
+        while self.i < self.grid.size and self.grid[self.i] <= state.t + tol:
+            self._take(state.q.copy(), state.v.copy(), state.z)
+
+    def step(self, s0, s1):
+        tol = 1e-12 * max(1.0, abs(s1.t))
         h = s1.t - s0.t
         while self.i < self.grid.size and self.grid[self.i] <= s1.t + tol:
             th = min(1.0, max(0.0, (self.grid[self.i] - s0.t) / h))
-            h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
-            h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2
-            q = h00 * s0.q + h10 * h * s0.v + h01 * s1.q + h11 * h * s1.v
-            v = h00 * s0.v + h10 * h * s0.a + h01 * s1.v + h11 * h * s1.a
-            self._take(self.grid[self.i], q, v, s0.z)
-
-    def finalize(self, attrs=None):
-        return None
-
-    def checkpoint_state(self):
-        return {}
+            q, v, _ = hermite(s0, s1, th, h)
+            self._take(np.array(q, copy=True), np.array(v, copy=True), s0.z)
 
     @property
     def complete(self) -> bool:
@@ -216,22 +193,26 @@ class RunResult:
 
 def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float, h: float | None = None,
             atol_pos: float | None = None, repeats: int = 1, h_max: float = 2e-5, label: str = "",
-            newton_tol: float | None = None) -> RunResult:
-    """HHT fixed step (``h``) or adaptive (``atol_pos``; atol_rot = 100·atol_pos) from ``state``;
-    ``newton_tol`` overrides the HHT default (for the error-floor study)."""
+            newton_tol: float | None = None, tol: mbd.Tolerance | None = None,
+            freeze_internal: bool = False) -> RunResult:
+    """The one way the numerics scripts run HHT from a state and sample it on ``grid``: fixed step
+    (``h``) or adaptive (``atol_pos``; atol_rot = 100·atol_pos) from ``state``; ``newton_tol`` and ``tol``
+    override the HHT defaults (error-floor study, references); ``freeze_internal`` holds element internal
+    states (the equations the scipy adapter integrates)."""
     if (h is None) == (atol_pos is None):
         raise ValueError("give exactly one of h (fixed step) or atol_pos (adaptive)")
-    tol = mbd.Tolerance() if atol_pos is None else mbd.Tolerance(atol_pos=atol_pos, atol_rot=100 * atol_pos)
+    if tol is None:
+        tol = mbd.Tolerance() if atol_pos is None else mbd.Tolerance(atol_pos=atol_pos, atol_rot=100 * atol_pos)
     stepper = mbd.HHT(alpha=alpha, tol=tol) if newton_tol is None else mbd.HHT(alpha=alpha, tol=tol, newton_tol=newton_tol)
     walls, res, sampler, err = [], None, None, ""
     for r in range(max(1, repeats)):
         ctrl = mbd.FixedStep(h) if h is not None else mbd.Adaptive(h0=min(5e-6, h_max), h_max=h_max, h_min=1e-10)
         smp = StateSampler(grid) if r == 0 else None
-        system = mbd.System(prob.model)
+        system = mbd.System(prob.model, freeze_internal=freeze_internal)
         w0 = time.perf_counter()
         try:
             res = mbd.simulate(prob.model, t_end=t_end, state=state.copy(), stepper=stepper, controller=ctrl,
-                               recorder=smp, progress=False, system=system)
+                               observers=[smp] if smp is not None else [], progress=False, system=system)
         except mbd.IntegrationError as exc:
             c = system.counters
             return RunResult("HHT", label, False, str(exc), time.perf_counter() - w0, [time.perf_counter() - w0],

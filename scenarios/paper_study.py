@@ -10,6 +10,7 @@ DIR/c{condition}_time_histories.png, DIR/bars.png, and (with --animate) DIR/c{co
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import csv
 import io
 import json
@@ -19,9 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
+import mbd
+from components.outputs import relative_life as iso_relative_life
 from mbd.recorder import atomic_write_text
 
-from .runner import Integration, RunConfig
+from .runner import RunConfig
 from .sweep import Case, build_params, run_sweep
 
 QUANTITIES = [
@@ -90,7 +93,7 @@ def build_config(a) -> RunConfig:
 
     opts = {k: _bool(v) for k, v in parse_sets(a.option).items()}
     return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate,
-                     integration=Integration(method=a.method, h=a.h, alpha=a.alpha),
+                     integration=dataclasses.replace(mbd.PRODUCTION, method=a.method, h=a.h, alpha=a.alpha),
                      options=SceneOptions.from_dict(opts), progress=not a.no_progress)
 
 
@@ -120,7 +123,7 @@ def relative_life(results: dict) -> None:
                 s[kind]["life_L10_relative"] = None
                 continue
             P, Pf = s[kind]["equivalent_load_N"], fwd[kind]["equivalent_load_N"]
-            s[kind]["life_L10_relative"] = float((Pf / P) ** (10.0 / 3.0)) if P > 0 else None
+            s[kind]["life_L10_relative"] = iso_relative_life(P, Pf)
 
 
 def comparison_rows(results: dict) -> list[dict]:
@@ -183,31 +186,36 @@ def plots(results: dict, out: Path) -> list[Path]:
                 bmap = json.loads(ds.attrs["bearings"])
                 t = ds["time"].values
                 bodies = list(ds["motion.body"].values)
-                cols = {}
+                cols = {}       # label -> (values, units from the file's schema)
+
+                def col(var, i):
+                    return ds[var].values[:, i], ds[var].attrs.get("units", "")
+
                 for kind in ("inner", "outer"):
                     b = next(x for x in bmap if x["kind"] == kind)
                     if b["type"] != "rollers":
                         continue
-                    cols[f"{kind}: roller–inner race"] = ds[f"{FAMILY['race_inner']}.load"].values[:, b["race_inner"][0]]
-                    cols[f"{kind}: roller–outer race"] = ds[f"{FAMILY['race_outer']}.load"].values[:, b["race_outer"][0]]
+                    cols[f"{kind}: roller–inner race"] = col(f"{FAMILY['race_inner']}.load", b["race_inner"][0])
+                    cols[f"{kind}: roller–outer race"] = col(f"{FAMILY['race_outer']}.load", b["race_outer"][0])
                     if "pocket" in b:
-                        cols[f"{kind}: roller–cage"] = ds[f"{FAMILY['pocket']}.force"].values[:, b["pocket"][0]]
+                        cols[f"{kind}: roller–cage"] = col(f"{FAMILY['pocket']}.force", b["pocket"][0])
                     if "guide" in b:
-                        cols[f"{kind}: cage–guide"] = ds[f"{FAMILY['guide']}.force"].values[:, b["guide"]]
-                        a, q = ds["motion.a"].values, ds["motion.q"].values
+                        cols[f"{kind}: cage–guide"] = col(f"{FAMILY['guide']}.force", b["guide"])
+                        a, pos = ds["motion.acceleration"].values, ds["motion.position"].values
                         ic, ip, ik = (bodies.index(x) for x in (b["cage"], b["planet"], "carrier"))
-                        rad, tan = radial_tangential(a[:, ic, :2] - a[:, ip, :2], q[:, ip, :2], q[:, ik, :2])
-                        cols[f"{kind}: cage acc. rel. radial"] = rad
-                        cols[f"{kind}: cage acc. rel. tangential"] = tan
+                        rad, tan = radial_tangential(a[:, ic] - a[:, ip], pos[:, ip], pos[:, ik])
+                        u = ds["motion.acceleration"].attrs.get("units", "")
+                        cols[f"{kind}: cage acc. rel. radial"] = (rad, u)
+                        cols[f"{kind}: cage acc. rel. tangential"] = (tan, u)
                 data[d] = (t, cols)
         labels = list(next(iter(data.values()))[1])
         t = next(iter(data.values()))[0]
         for lab in labels:
-            fw = data.get("forward", (None, {}))[1].get(lab)
-            rv = data.get("reverse", (None, {}))[1].get(lab)
+            fw, fu = data.get("forward", (None, {}))[1].get(lab, (None, None))
+            rv, ru = data.get("reverse", (None, {}))[1].get(lab, (None, None))
             n = min(x.size for x in (fw, rv) if x is not None)
             series[lab] = (fw[:n] if fw is not None else None, rv[:n] if rv is not None else None)
-            units[lab] = "m/s^2" if "acc" in lab else "N"
+            units[lab] = fu or ru
         t = t[:n]
         if series:
             paths.append(vp.time_histories(t, series, units, out / f"c{c}_time_histories.png",

@@ -1,10 +1,13 @@
 """One DPGT run, end to end: build the scene, integrate with a checkpoint, record the window, summarise.
 
 Results layout of a run directory:
-    results.nc     netCDF4 (xarray/h5py): body motion in R ("motion.q/v/a"), carrier/sun/ring in the
-                   fixed frame ("fixed.q/v/a"), and element outputs "<family>.<key>" (e.g.
-                   race_inner.load, pocket.force, guide.force, mesh_sa.force); attrs hold the run summary
-                   and the bearing map (which family instances belong to which bearing)
+    results.nc     netCDF4 (xarray/h5py), every variable with CF units and long_name: body motion in R
+                   ("motion.position/angle/velocity/angular_velocity/acceleration/angular_acceleration"),
+                   sun/carrier/ring in the fixed frame ("fixed.*", same names), and element outputs
+                   "<family>.<key>" (e.g. race_inner.load, pocket.force, guide.force, mesh_sa.force) along
+                   "<family>.instance", whose coordinates name each instance ("a1.pb.roller3", "sun-a1")
+                   with its bearing, planet, pair, bearing_kind, roller (components.results_schema);
+                   attrs hold the run summary and, as JSON, the bearing map, meta, label and geometry
     summary.json   the statistics users read, taken on every accepted step over the window
                    (:class:`components.outputs.WindowStatistics`; the recording is for plots only)
     checkpoint.npz while running; a run started again resumes from it
@@ -26,11 +29,12 @@ import mbd
 from components.dpgt import RigSettings, build_dpgt
 from components.params import DPGTParams
 from components.scene import SceneOptions
-from mbd.recorder import BodyMotion, ElementOutput, Recorder, atomic_write_text
+from mbd.recorder import BodyMotion, Recorder, atomic_write_text
 
-from components.outputs import FAMILY, MESH_FAMILY, WindowStatistics, bearing_map, cage_period, default_window
+from components.outputs import WindowStatistics, bearing_map, cage_period, default_window
+from components.results_schema import element_probes
 
-__all__ = ["Integration", "RunConfig", "run_case", "run_fingerprint", "statistics_window"]
+__all__ = ["RunConfig", "run_case", "run_fingerprint", "statistics_window"]
 
 _ROOT = Path(__file__).resolve().parent.parent
 _CODE_DIGEST = None
@@ -58,34 +62,11 @@ def run_fingerprint(params: DPGTParams, cfg: "RunConfig") -> str:
 
 
 @dataclass(frozen=True)
-class Integration:
-    """Integrator choice for a run. ``method``: "hht-adaptive" (default) or "hht-fixed"."""
-    method: str = "hht-adaptive"
-    alpha: float = -0.3
-    h: float = 5e-6              # fixed step, or the initial step of the adaptive controller [s]
-    h_max: float = 1e-5
-    atol_pos: float = 1e-8       # m: local displacement error target of the adaptive controller
-    atol_rot: float = 1e-6       # rad
-
-    def __post_init__(self):
-        if self.method not in ("hht-adaptive", "hht-fixed"):
-            raise mbd.ModelError(f"integration.method must be 'hht-adaptive' or 'hht-fixed', got {self.method!r}")
-
-    def stepper(self) -> mbd.HHT:
-        return mbd.HHT(alpha=self.alpha, tol=mbd.Tolerance(atol_pos=self.atol_pos, atol_rot=self.atol_rot))
-
-    def controller(self):
-        if self.method == "hht-fixed":
-            return mbd.FixedStep(self.h)
-        return mbd.Adaptive(h0=self.h, h_max=self.h_max, h_min=1e-9)
-
-
-@dataclass(frozen=True)
 class RunConfig:
     settle: float = 0.03          # s discarded after the start (load ramp, drive and cage transients)
     window: float | None = None   # s recorded and analysed (None: :func:`statistics_window`)
     sample_rate: float = 25000.0  # Hz (> 4 f_m at condition 3)
-    integration: Integration = field(default_factory=Integration)
+    integration: mbd.IntegratorSettings = mbd.PRODUCTION
     options: SceneOptions = field(default_factory=SceneOptions)
     rig: RigSettings = field(default_factory=RigSettings)
     progress: bool = True
@@ -114,16 +95,11 @@ def statistics_window(scene, base: float = 0.02) -> float:
 
 
 def _probes(scene) -> list:
-    fams = {e.name for e in scene.model.elements}
-    probes = [BodyMotion("motion", frame="reference"),
-              BodyMotion("fixed", bodies=["sun", "carrier", "ring"], frame="fixed")]
-    mesh = ["force", "force_drive", "force_coast", "deflection", "deflection_coast", "fx", "fy"]
-    wanted = {FAMILY["race_inner"]: ["load", "fx", "fy", "angle", "deflection"],
-              FAMILY["race_outer"]: ["load", "fx", "fy"], FAMILY["pocket"]: ["force", "offset"],
-              FAMILY["guide"]: ["force", "fx", "fy", "eccentricity"], FAMILY["linear"]: ["fx", "fy"],
-              **{f: mesh for f in MESH_FAMILY.values()}, "carrier_drive": ["torque"]}
-    probes += [ElementOutput(f, keys) for f, keys in wanted.items() if f in fams]
-    return probes
+    """Body motion in R (all bodies) and in the fixed frame (sun, carrier, ring), and the element
+    outputs of :mod:`components.results_schema` (units, long names, instance coordinates)."""
+    return [BodyMotion("motion", frame="reference"),
+            BodyMotion("fixed", bodies=["sun", "carrier", "ring"], frame="fixed"),
+            *element_probes(scene)]
 
 
 def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None) -> dict:

@@ -132,7 +132,7 @@ def run_case_stability(name: str, window: float, cap: float, radau: bool = True,
         prob = _build(name, strict=False)
     model = prob.model
     system = mbd.System(model)
-    stepper = mbd.HHT(alpha=-0.3)
+    stepper = mbd.PRODUCTION.stepper()
     s0 = stepper.initial_state(system, 0.0, prob.built.q0, prob.built.v0)
     rows, row = [], {}
     if hht:
@@ -157,11 +157,11 @@ def _hht_row(prob, system, stepper, s0, base, window) -> dict:
     """HHT α = −0.3 adaptive from the kinematic start; sanity numbers over the last third."""
     grid = np.arange(2.0 * window / 3.0, window + 1e-12, 2e-5)
     smp = StateSampler(grid)
-    row = {**base, "integrator": "HHT α=-0.3 adaptive"}
+    row = {**base, "integrator": f"HHT α={mbd.PRODUCTION.alpha:g} adaptive"}
     w0 = time.perf_counter()
     try:
-        res = mbd.simulate(prob.model, t_end=window, state=s0, stepper=stepper, recorder=smp, system=system,
-                           controller=mbd.Adaptive(h0=5e-6, h_max=1e-5, h_min=1e-9), progress=False)
+        res = mbd.simulate(prob.model, t_end=window, state=s0, stepper=stepper, observers=[smp], system=system,
+                           controller=mbd.PRODUCTION.controller(), progress=False)
         row.update(completed=True, t_reached_s=res.state.t, message="", fraction_of_window=1.0)
         end = res.state
     except mbd.IntegrationError as exc:

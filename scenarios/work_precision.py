@@ -38,9 +38,11 @@ import shutil
 import sys
 import time
 from pathlib import Path
-from components.outputs import FAMILY
 
 import numpy as np
+
+import mbd
+from components.outputs import FAMILY
 
 from .numerics_common import (dpgt_problem, error_metrics, eval_costs, machine_note, observables, peak_rss_mb,
                               rig_problem, run_hht, run_scipy, settled_state)
@@ -190,18 +192,10 @@ def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None,
 def _hht_tight(prob, s0, t1, grid, h, frozen_z=False):
     """Reference-quality HHT run: α = −0.1, fixed h, Newton tolerance scaled by atol 0.1 nm / 10 nrad.
     ``frozen_z``: hold element internal states at their initial value (what the scipy adapter does)."""
-    import mbd
-    from .numerics_common import FrozenInternalHHT, RunResult, StateSampler
-    cls = FrozenInternalHHT if frozen_z else mbd.HHT
-    stepper = cls(alpha=-0.1, tol=mbd.Tolerance(atol_pos=1e-10, atol_rot=1e-8))
-    smp = StateSampler(grid)
-    w0 = time.perf_counter()
-    res = mbd.simulate(prob.model, t_end=t1, state=s0.copy(), stepper=stepper, controller=mbd.FixedStep(h),
-                       recorder=smp, progress=False)
-    wall = time.perf_counter() - w0
-    c = res.counters
-    return RunResult("HHT-ref", f"fixed h={h:.2e}", True, "", wall, [wall], res.steps, c["residual"], c["jacobian"],
-                     c["factor"], c["newton"], c["rejected"], res.state.t, np.array(smp.q), np.array(smp.v), smp.z)
+    r = run_hht(prob, s0, t1, grid, alpha=-0.1, h=h, tol=mbd.Tolerance(atol_pos=1e-10, atol_rot=1e-8),
+                freeze_internal=frozen_z, label=f"fixed h={h:.2e}")
+    r.method = "HHT-ref"
+    return r
 
 
 def _write(out: Path, problem: str, rows: list) -> None:

@@ -2,6 +2,8 @@
 IntegrationError with time, step and culprit, and save the last good state; the progress bar."""
 from __future__ import annotations
 
+import dataclasses
+
 import importlib
 
 import numpy as np
@@ -121,7 +123,13 @@ def test_bad_settings():
     with pytest.raises(mbd.ModelError, match="every"):
         mbd.Checkpoint("x", every=0)
     with pytest.raises(mbd.ModelError, match="newton_tol"):
-        mbd.HHT(newton_tol=2.0)
+        mbd.HHT(alpha=-0.3, newton_tol=2.0)
+    with pytest.raises(TypeError, match="alpha"):        # no default α: the production one is mbd.PRODUCTION
+        mbd.HHT()
+    with pytest.raises(mbd.ModelError, match="method"):
+        dataclasses.replace(mbd.PRODUCTION, method="rk4")
+    with pytest.raises(mbd.ModelError, match="alpha"):
+        dataclasses.replace(mbd.PRODUCTION, alpha=-0.5)
 
 
 @pytest.mark.parametrize("bad", ["q0", "v0"])

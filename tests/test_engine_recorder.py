@@ -33,7 +33,16 @@ def q0v0(model):
 
 
 PROBES = [mbd.BodyMotion(), mbd.BodyMotion(name="fixedmotion", frame="fixed"),
-          mbd.ElementOutput("link"), mbd.ElementOutput("bearing", keys=["fx"])]
+          mbd.ElementOutput("link", meta={"fx": ("N", "link force x"), "fy": ("N", "link force y"),
+                                          "deflection": ("m", "link deflection")},
+                            instances={"instance": ("link name", ["rotor-arm", "housing-arm"]),
+                                       "stiff": ("1 for the stiff link", [1, 0])}),
+          mbd.ElementOutput("bearing", keys=["fx"])]
+
+
+def pose(ds, name="motion"):
+    """(n_t, n_bodies, 3) poses (x, y, θ) reassembled from position [m] and angle [rad]."""
+    return np.concatenate([ds[f"{name}.position"].values, ds[f"{name}.angle"].values[..., None]], axis=-1)
 
 
 def run(model, path, t_end=0.05, dt=2e-3, h=5e-4, chunk=4, **kw):
@@ -48,21 +57,34 @@ def test_results_file_layout_readable_by_xarray(tmp_path):
     res = run(model, tmp_path / "out.nc")
     assert res.results_path == tmp_path / "out.nc"
     with xr.open_dataset(res.results_path, engine="h5netcdf") as ds:
-        assert ds["motion.q"].dims == ("time", "motion.body", "coord")
-        assert list(ds["coord"].values) == ["x", "y", "theta"]
+        assert ds["motion.position"].dims == ("time", "motion.body", "axis")
+        assert ds["motion.angle"].dims == ("time", "motion.body")
+        assert list(ds["axis"].values) == ["x", "y"]
         assert list(ds["motion.body"].values) == ["housing", "rotor", "arm"]
-        assert ds["fixedmotion.a"].shape == (ds.sizes["time"], 3, 3)
-        assert ds["link.fx"].dims == ("time", "link.n") and ds.sizes["link.n"] == 2
-        assert set(ds.data_vars) == {"motion.q", "motion.v", "motion.a", "fixedmotion.q", "fixedmotion.v",
-                                     "fixedmotion.a", "link.fx", "link.fy", "link.deflection", "bearing.fx"}
+        assert ds["fixedmotion.acceleration"].shape == (ds.sizes["time"], 3, 2)
+        assert ds["link.fx"].dims == ("time", "link.instance") and ds.sizes["link.instance"] == 2
+        kinds = ("position", "angle", "velocity", "angular_velocity", "acceleration", "angular_acceleration")
+        assert set(ds.data_vars) == {*(f"{p}.{k}" for p in ("motion", "fixedmotion") for k in kinds),
+                                     "link.fx", "link.fy", "link.deflection", "bearing.fx"}
+        units = {k: ds[k].attrs.get("units") for k in ds.variables}
+        assert units["motion.position"] == "m" and units["motion.angle"] == "rad"
+        assert units["fixedmotion.angular_acceleration"] == "rad/s^2" and units["link.deflection"] == "m"
+        assert "fixed frame" in ds["fixedmotion.velocity"].attrs["long_name"]
+        # instance coordinates: names given by the probe, extra ones attached; an index without them
+        assert list(ds["link.fx"]["link.instance"].values) == ["rotor-arm", "housing-arm"]
+        assert list(ds["link.fx"]["link.stiff"].values) == [1, 0]
+        assert list(ds["bearing.instance"].values) == [0] and "units" not in ds["bearing.fx"].attrs
+        assert ds["bearing.fx"].attrs["long_name"]
         assert ds.attrs["scene"] == "test"
         run_attrs = json.loads(ds.attrs["run"])
         assert run_attrs["steps"] == res.steps and run_attrs["n_accepted"] == res.steps
         assert ds["time"].attrs["units"] == "s" and ds["time"].dtype == float
         # the housing is fixed in I: in I it stays put with zero velocity and acceleration
-        np.testing.assert_allclose(ds["fixedmotion.q"].values[:, 0], [[0.0, 0.2, 0.0]] * ds.sizes["time"], atol=1e-14)
-        np.testing.assert_allclose(ds["fixedmotion.v"].values[:, 0], 0.0, atol=1e-12)
-        np.testing.assert_allclose(ds["fixedmotion.a"].values[:, 0], 0.0, atol=1e-10)
+        np.testing.assert_allclose(pose(ds, "fixedmotion")[:, 0], [[0.0, 0.2, 0.0]] * ds.sizes["time"], atol=1e-14)
+        for k in ("velocity", "angular_velocity"):
+            np.testing.assert_allclose(ds[f"fixedmotion.{k}"].values[:, 0], 0.0, atol=1e-12)
+        for k in ("acceleration", "angular_acceleration"):
+            np.testing.assert_allclose(ds[f"fixedmotion.{k}"].values[:, 0], 0.0, atol=1e-10)
     assert not (tmp_path / "out.nc.parts").exists()        # chunks removed after the final file
 
 
@@ -81,8 +103,8 @@ def test_sampling_times_and_interpolation(tmp_path, t_start, dt, h):
                        stepper=mbd.HHT(alpha=0.0, newton_tol=1e-8), recorder=rec, progress=False)
     with xr.open_dataset(res.results_path, engine="h5netcdf") as ds:
         t = ds["time"].values
-        x = ds["motion.q"].values[:, 0, 0]
-        vx = ds["motion.v"].values[:, 0, 0]
+        x = ds["motion.position"].values[:, 0, 0]
+        vx = ds["motion.velocity"].values[:, 0, 0]
     kmax = int(np.floor((t_end - t_start) / dt + 1e-9))
     np.testing.assert_array_equal(t, t_start + np.arange(kmax + 1) * dt)
     w = np.sqrt(k / m)
@@ -96,7 +118,7 @@ def test_samples_on_step_boundaries_equal_the_states(tmp_path):
     model = scene()
     res = run(model, tmp_path / "o.nc", t_end=0.01, dt=1e-3, h=5e-4)
     with xr.open_dataset(res.results_path, engine="h5netcdf") as ds:
-        q_last = ds["motion.q"].values[-1]
+        q_last = pose(ds)[-1]
         fx_last = ds["link.fx"].values[-1]
     qf, vf = model.full(res.state.t, res.state.q, res.state.v)
     np.testing.assert_array_equal(q_last, qf.reshape(-1, 3))
@@ -205,6 +227,9 @@ def test_recorder_rejects_bad_probes(tmp_path):
     model = scene()
     rec = mbd.Recorder(tmp_path / "x.nc", dt=1e-3, probes=[mbd.ElementOutput("link", keys=["fz"])])
     with pytest.raises(mbd.ModelError, match="fz"):
+        mbd.simulate(model, *q0v0(model), 0.001, controller=mbd.FixedStep(1e-3), recorder=rec, progress=False)
+    rec = mbd.Recorder(tmp_path / "x.nc", dt=1e-3, probes=[mbd.ElementOutput("link", instances={"instance": ("x", ["a"])})])
+    with pytest.raises(mbd.ModelError, match="1 values for dimension 'link.instance' of size 2"):
         mbd.simulate(model, *q0v0(model), 0.001, controller=mbd.FixedStep(1e-3), recorder=rec, progress=False)
     rec = mbd.Recorder(tmp_path / "x.nc", dt=1e-3, probes=[mbd.ElementOutput("nope")])
     with pytest.raises(mbd.ModelError, match="nope"):

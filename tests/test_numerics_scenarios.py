@@ -19,8 +19,8 @@ def test_state_sampler_hermite_is_exact_for_cubics():
     s0 = mbd.State(1.0, np.array([1.0]), np.array([3.0]), np.array([6.0]), np.zeros(1))
     s1 = mbd.State(2.0, np.array([8.0]), np.array([12.0]), np.array([12.0]), np.zeros(1))
     smp = StateSampler([1.0, 1.25, 1.5, 2.0])
-    smp.record(s0, None, first=True)
-    smp.record(s0, s1)
+    smp.bind(None, None, s0)          # an observer: the start state at bind, then every accepted step
+    smp.step(s0, s1)
     assert smp.complete
     assert np.allclose(np.ravel(smp.q), [1.0, 1.25**3, 1.5**3, 8.0], rtol=1e-14)
     assert np.allclose(np.ravel(smp.v), [3.0, 3 * 1.25**2, 3 * 1.5**2, 12.0], rtol=1e-14)

@@ -79,7 +79,7 @@ def test_sweep_resume_skips_finished_runs(zero_power_study, capsys):
 
 
 def test_failing_run_is_reported_and_others_finish(tmp_path):
-    from scenarios.runner import Integration, RunConfig
+    from scenarios.runner import RunConfig
     from scenarios.sweep import Case, run_sweep
 
     cfg = RunConfig(settle=0.0005, window=0.0005, progress=False)

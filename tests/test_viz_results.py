@@ -12,6 +12,7 @@ import json
 import shutil
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import h5py
@@ -84,7 +85,7 @@ def _pocket_axes(off: np.ndarray):
 def test_load_run_layout(runs, fwd):
     with xr.open_dataset(runs["forward"], engine="h5netcdf") as ds:
         t_file = ds["time"].values
-        q_file = ds["motion.q"].values
+        q_file = np.concatenate([ds["motion.position"].values, ds["motion.angle"].values[..., None]], axis=-1)
     np.testing.assert_array_equal(fwd.t, t_file)
     np.testing.assert_array_equal(fwd.q, q_file)
     assert fwd.n_t == 13 and np.all(np.diff(fwd.t) > 0)
@@ -214,13 +215,13 @@ def test_fixed_frame_run_seen_from_the_carrier(runs, fwd, tmp_path):
     with xr.open_dataset(runs["forward"], engine="h5netcdf") as ds:
         ds = ds.load()
     phi = fwd.frame_angle[:, None]
-    q = ds["motion.q"].values.copy()
+    q = ds["motion.position"].values.copy()
     x, y = q[..., 0].copy(), q[..., 1].copy()
     q[..., 0] = np.cos(phi) * x - np.sin(phi) * y
     q[..., 1] = np.sin(phi) * x + np.cos(phi) * y
-    q[..., 2] += phi
-    ds["motion.q"].values = q
-    ds = ds.drop_vars(["fixed.q", "fixed.v", "fixed.a"])  # R from the metadata alone
+    ds["motion.position"].values = q
+    ds["motion.angle"].values = ds["motion.angle"].values + phi
+    ds = ds.drop_vars([k for k in ds.data_vars if k.startswith("fixed.")] + ["fixed.body"])  # R from the metadata alone
     meta = dict(fwd.meta, frame="fixed")
     ds.attrs["meta"] = json.dumps(meta)
     ds.to_netcdf(tmp_path / "results.nc", engine="h5netcdf")
@@ -247,7 +248,7 @@ def test_bad_inputs_give_clear_errors(tmp_path, capsys, runs):
     foreign = tmp_path / "other.nc"
     xr.Dataset({"x": ("time", np.arange(3.0))}, coords={"time": np.arange(3.0)}).to_netcdf(
         foreign, engine="h5netcdf")
-    with pytest.raises(vr.ResultsError, match="not a DPGT results file.*motion.q"):
+    with pytest.raises(vr.ResultsError, match="not a DPGT results file.*motion.position"):
         vr.load_run(foreign)
     with pytest.raises(vr.ResultsError, match="without a results.nc"):
         vr.load_run(tmp_path)
@@ -333,3 +334,73 @@ def test_study_cage_animation(offscreen, runs, tmp_path):
     for k in range(4):
         quarter = last[:, k * 120:(k + 1) * 120]
         assert np.mean(quarter.min(axis=-1) < 200) > 0.01, f"panel {k} is empty"
+
+
+# ----------------------------------------------------------------------------------- schema
+_LENGTHS = {"m", "m/s", "m/s^2"}
+_ANGLES = {"rad", "rad/s", "rad/s^2"}
+
+
+def test_results_file_describes_itself(runs, fwd):
+    """Every variable and coordinate of a run_case results.nc has units and a long name; lengths and
+    angles live in separate variables; instance coordinates say which bearing/roller/mesh each is."""
+    with xr.open_dataset(runs["forward"], engine="h5netcdf") as ds:
+        for name in ds.variables:
+            attrs = ds[name].attrs
+            assert isinstance(attrs.get("units"), str) and attrs["units"].strip(), name
+            assert isinstance(attrs.get("long_name"), str) and attrs["long_name"].strip(), name
+        units = {k: ds[k].attrs["units"] for k in ds.data_vars}
+        for name, da in ds.data_vars.items():
+            assert not ({units[name]} & _LENGTHS and {units[name]} & _ANGLES)
+            if "axis" in da.dims:                          # vector components: x, y only, a length unit
+                assert list(da["axis"].values) == ["x", "y"] and units[name] in _LENGTHS, name
+            for d in da.dims:                              # no component dimension holds an angle
+                if d in ds.coords and ds[d].dtype == object:
+                    assert "theta" not in {str(v) for v in ds[d].values}, (name, d)
+        assert units["motion.position"] == "m" and units["motion.angle"] == "rad"
+        assert units["fixed.angular_acceleration"] == "rad/s^2" and units["race_inner.load"] == "N"
+        assert ds["motion.angle"].dims == ("time", "motion.body")
+        assert units["race_inner.angle"] == "rad" and units["carrier_drive.torque"] == "N m"
+
+        N, Z = 3, 12
+        order = [(n, p) for n in range(N) for p in "ab"]             # bearing order of the bearing map
+        rollers = [f"{p}{n + 1}.pb.roller{j}" for n, p in order for j in range(Z)]
+        load = ds["race_inner.load"]
+        assert load.dims == ("time", "race_inner.instance")
+        for fam in ("race_inner", "race_outer", "pocket"):
+            assert list(ds[f"{fam}.instance"].values) == rollers, fam
+            assert list(ds[f"{fam}.roller"].values) == list(range(Z)) * 2 * N
+        assert list(load["race_inner.bearing"].values) == [f"{p}{n + 1}.pb" for n, p in order for _ in range(Z)]
+        assert list(load["race_inner.planet"].values) == [f"{p}{n + 1}" for n, p in order for _ in range(Z)]
+        assert list(load["race_inner.pair"].values) == [n for n, _ in order for _ in range(Z)]
+        assert list(load["race_inner.bearing_kind"].values) == [
+            {"a": "inner", "b": "outer"}[p] for _, p in order for _ in range(Z)]
+        assert list(ds["guide.instance"].values) == [f"{p}{n + 1}.pb.cage" for n, p in order]
+        assert list(ds["mesh_sa.instance"].values) == [f"sun-a{n}" for n in range(1, N + 1)]
+        assert list(ds["mesh_ab.instance"].values) == [f"a{n}-b{n}" for n in range(1, N + 1)]
+        assert list(ds["mesh_br.instance"].values) == [f"b{n}-ring" for n in range(1, N + 1)]
+        assert list(ds["mesh_br.gear1"].values) == [f"b{n}" for n in range(1, N + 1)]
+        assert list(ds["carrier_drive.instance"].values) == ["carrier"]
+        # selecting by coordinate (the README example) = slicing with the JSON bearing map
+        b = fwd.bearing("a2.pb")
+        sel = load.where(load["race_inner.bearing"] == "a2.pb", drop=True)
+        np.testing.assert_array_equal(sel.values, fwd.output("race_inner.load")[:, slice(*b["race_inner"])])
+        assert list(sel["race_inner.instance"].values) == b["rollers"]
+        assert sel.mean("time").shape == (Z,)
+
+
+def test_linear_bearing_instances_are_named():
+    from components.dpgt import build_dpgt
+    from components.presets import reference_dpgt
+    from components.results_schema import OUTPUTS, instance_coords
+    from components.scene import SceneOptions
+    from scenarios.runner import RunConfig
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")                # design warnings of the reference machine
+        scene = build_dpgt(reference_dpgt(3, "forward"), SceneOptions(bearings="linear"), RunConfig().rig)
+    coords = instance_coords(scene)
+    lin = coords["bearing_linear"]
+    assert lin["instance"][1] == [f"{p}{n}.pb" for n in (1, 2, 3) for p in "ab"]
+    assert lin["bearing_kind"][1] == ["inner", "outer"] * 3 and lin["pair"][1] == [0, 0, 1, 1, 2, 2]
+    assert "race_inner" not in coords and "bearing_linear" in OUTPUTS

@@ -35,7 +35,7 @@ __all__ = ["ResultsError", "GeometryWarning", "Run", "load_run", "geometry_from_
            "preset_geometry", "cage_orbits", "roller_offsets", "train_bodies", "study_cage_animation",
            "cage_panels", "view_angle"]
 
-_REQUIRED_VARS = ("time", "motion.q")
+_REQUIRED_VARS = ("time", "motion.position", "motion.angle")
 _REQUIRED_ATTRS = ("bearings", "meta")
 
 
@@ -191,11 +191,22 @@ def _json_attr(attrs: Mapping, key: str, path: Path):
     return val
 
 
+def _pose(ds, probe: str, linear: str, angular: str) -> np.ndarray | None:
+    """(n_t, n_bodies, 3) array (x, y, θ) from the file's ``<probe>.<linear>`` (time, body, axis) and
+    ``<probe>.<angular>`` (time, body) variables; None when the file lacks them."""
+    lin, ang = f"{probe}.{linear}", f"{probe}.{angular}"
+    if lin not in ds or ang not in ds:
+        return None
+    return np.concatenate([np.asarray(ds[lin].values, float), np.asarray(ds[ang].values, float)[..., None]],
+                          axis=-1)
+
+
 def load_run(path) -> Run:
     """Read a DPGT results file (netCDF4 written by scenarios.runner) or a run directory holding one.
 
     Raises :class:`ResultsError` with a clear message for a missing file, a file that is not
-    netCDF4/HDF5, or a netCDF file without the DPGT layout (time, motion.q, bearings, meta)."""
+    netCDF4/HDF5, or a netCDF file without the DPGT layout (time, motion.position, motion.angle,
+    bearings, meta)."""
     import xarray as xr
 
     path = Path(path)
@@ -220,18 +231,15 @@ def load_run(path) -> Run:
         t = np.asarray(ds["time"].values, float)
         if t.ndim != 1 or t.size == 0:
             raise ResultsError(f"{path}: the results hold no samples (time is empty)")
-        qv = ds["motion.q"]
-        if qv.dims != ("time", "motion.body", "coord") or qv.shape[2] != 3:
-            raise ResultsError(f"{path} is not a DPGT results file: motion.q has dims {qv.dims}")
+        pos = ds["motion.position"]
+        if pos.dims != ("time", "motion.body", "axis") or pos.shape[2] != 2:
+            raise ResultsError(f"{path} is not a DPGT results file: motion.position has dims {pos.dims}")
         bodies = tuple(str(b) for b in ds["motion.body"].values)
-        q = np.asarray(qv.values, float)
-        v = np.asarray(ds["motion.v"].values, float) if "motion.v" in ds else None
-        a = np.asarray(ds["motion.a"].values, float) if "motion.a" in ds else None
-        if "fixed.q" in ds and "fixed.body" in ds.variables:
-            fixed_bodies = tuple(str(b) for b in ds["fixed.body"].values)
-            fixed_q = np.asarray(ds["fixed.q"].values, float)
-        else:
-            fixed_bodies, fixed_q = (), None
+        q = _pose(ds, "motion", "position", "angle")
+        v = _pose(ds, "motion", "velocity", "angular_velocity")
+        a = _pose(ds, "motion", "acceleration", "angular_acceleration")
+        fixed_q = _pose(ds, "fixed", "position", "angle") if "fixed.body" in ds.variables else None
+        fixed_bodies = tuple(str(b) for b in ds["fixed.body"].values) if fixed_q is not None else ()
         outputs = {k: np.asarray(ds[k].values, float) for k in ds.data_vars
                    if not (k.startswith("motion.") or k.startswith("fixed."))}
         attrs = dict(ds.attrs)
@@ -271,7 +279,7 @@ def load_run(path) -> Run:
         try:
             om = float(meta["speeds_rad_s"]["carrier"]) if rotating else 0.0
         except (KeyError, TypeError):
-            raise ResultsError(f"{path}: cannot tell how R turns (no fixed.q of the carrier and no "
+            raise ResultsError(f"{path}: cannot tell how R turns (no fixed.position/angle of the carrier and no "
                                "meta speeds_rad_s.carrier)") from None
         phi = om * t
     run = Run(path=path, t=t, bodies=bodies, q=q, v=v, a=a, fixed_bodies=fixed_bodies, fixed_q=fixed_q,

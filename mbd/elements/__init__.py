@@ -2,12 +2,12 @@
 from .contact import (TRACTION_LAWS, GuideContact, LubricantDrag, PocketContact, RaceContact, SlideRollTraction,
                       TanhTraction, Traction)
 from .drives import Ramp, SpeedDrive, TorqueSource
-from .gear_mesh import GearMesh, StiffnessShape, mesh_damping, mesh_u0
+from .gear_mesh import GearMesh, StiffnessShape, mesh_offset, mesh_u0
 from .loads import ForceSource
 from .springs import BodySpring, GroundSupport, TorsionalSpring
 
 __all__ = [
     "BodySpring", "ForceSource", "GearMesh", "GroundSupport", "GuideContact", "LubricantDrag", "PocketContact",
     "RaceContact", "Ramp", "SpeedDrive", "StiffnessShape", "TorqueSource", "TorsionalSpring", "Traction", "TanhTraction", "SlideRollTraction", "TRACTION_LAWS",
-    "mesh_damping", "mesh_u0",
+    "mesh_offset", "mesh_u0",
 ]

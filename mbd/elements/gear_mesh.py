@@ -44,7 +44,7 @@ from .. import ad
 from ..element import Element, body_dofs
 from ..errors import ModelError
 
-__all__ = ["StiffnessShape", "GearMesh", "mesh_damping", "mesh_u0", "contact_ratio_to_fraction"]
+__all__ = ["StiffnessShape", "GearMesh", "mesh_offset", "mesh_u0", "contact_ratio_to_fraction"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -151,14 +151,13 @@ def _rect_factor(p, h, s, single, ratio):
     return single * (1.0 + (ratio - 1.0) * w)
 
 
-def mesh_damping(zeta, k_mean, J1, J2, rb1, rb2):
-    """Mesh damping c_m = 2 ζ sqrt(k_mean m_eq), m_eq = J1 J2 / (J1 r_b2² + J2 r_b1²) [N·s/m]."""
-    zeta, k_mean, J1, J2, rb1, rb2 = (np.asarray(x, float) for x in (zeta, k_mean, J1, J2, rb1, rb2))
-    for name, x in (("zeta", zeta), ("k_mean", k_mean), ("J1", J1), ("J2", J2), ("rb1", rb1), ("rb2", rb2)):
-        if not np.all(np.isfinite(x)) or np.any(x < 0 if name == "zeta" else x <= 0):
-            raise ModelError(f"mesh_damping: {name} must be finite and {'>= 0' if name == 'zeta' else '> 0'}, got {x!r}")
-    m_eq = J1 * J2 / (J1 * rb2 ** 2 + J2 * rb1 ** 2)
-    return 2.0 * zeta * np.sqrt(k_mean * m_eq)
+def mesh_offset(internal: bool, rb1, rb2, theta1, theta2, phi):
+    """u0 for gear angles θ1, θ2 and line-of-centres angle φ_e: the transmission error is zero there,
+    so both flanks sit at δ = −b/2 (the law of the module docstring with s = 0)."""
+    rb1, rb2, th1, th2, phi = (np.asarray(x, float) for x in (rb1, rb2, theta1, theta2, phi))
+    if internal:
+        return rb2 * (th2 - phi) - rb1 * (th1 - phi)
+    return rb1 * (th1 - phi) + rb2 * (th2 - phi)
 
 
 def mesh_u0(internal: bool, rb1, rb2, pose1, pose2):
@@ -168,12 +167,7 @@ def mesh_u0(internal: bool, rb1, rb2, pose1, pose2):
     p1 = np.atleast_2d(np.asarray(pose1, float))
     p2 = np.atleast_2d(np.asarray(pose2, float))
     d = (p1 - p2) if internal else (p2 - p1)
-    phi = np.arctan2(d[:, 1], d[:, 0])
-    rb1 = np.asarray(rb1, float)
-    rb2 = np.asarray(rb2, float)
-    if internal:
-        return rb2 * (p2[:, 2] - phi) - rb1 * (p1[:, 2] - phi)
-    return rb1 * (p1[:, 2] - phi) + rb2 * (p2[:, 2] - phi)
+    return mesh_offset(internal, rb1, rb2, p1[:, 2], p2[:, 2], np.arctan2(d[:, 1], d[:, 0]))
 
 
 class GearMesh(Element):

@@ -1,0 +1,127 @@
+"""What a DPGT ``results.nc`` holds, in words and units: the one table the runner records from.
+
+* :data:`OUTPUTS` — per element family, the output keys the runner records with their CF units and
+  long names (from the element docstrings in ``mbd/elements``: contact.py, gear_mesh.py, drives.py,
+  springs.py). Forces are per physical roller (one row), vectors are in the reference frame R.
+* :func:`instance_coords` — per family, which bearing / roller / planet / mesh each instance is
+  (from ``scene.handles["pairs"]`` and :func:`components.outputs.bearing_map`).
+* :func:`element_probes` — the :class:`mbd.ElementOutput` probes carrying both.
+
+Body motion ("motion": all bodies in R; "fixed": sun, carrier, ring in the fixed frame) is described
+by the recorder itself (:mod:`mbd.recorder`): ``<probe>.position`` [m], ``.angle`` [rad],
+``.velocity`` [m/s], ``.angular_velocity`` [rad/s], ``.acceleration`` [m/s^2],
+``.angular_acceleration`` [rad/s^2].
+"""
+from __future__ import annotations
+
+from mbd.recorder import ElementOutput
+
+from .families import FAMILY, MESH_FAMILY
+from .outputs import bearing_map
+
+__all__ = ["OUTPUTS", "MESH_WORDS", "instance_coords", "element_probes"]
+
+MESH_WORDS = {MESH_FAMILY["sun_inner"]: "sun–inner planet mesh",
+              MESH_FAMILY["inner_outer"]: "inner planet–outer planet mesh",
+              MESH_FAMILY["outer_ring"]: "outer planet–ring mesh"}
+
+
+def _mesh(words: str) -> dict:
+    # the element names flank f = +1 "drive" and f = −1 "coast"; which one the torque path loads depends on
+    # the direction (summary.json meshes.<type>.drive_flank), so the file says flank +1 / −1
+    return {"force": ("N", f"{words} force, flank +1 minus flank −1"),
+            "force_drive": ("N", f"{words} flank +1 force"),
+            "force_coast": ("N", f"{words} flank −1 force"),
+            "deflection": ("m", f"{words} flank +1 deflection (< 0: a gap)"),
+            "deflection_coast": ("m", f"{words} flank −1 deflection (< 0: a gap)"),
+            "fx": ("N", f"{words} force on the second gear, x in R"),
+            "fy": ("N", f"{words} force on the second gear, y in R")}
+
+
+# family -> {output key: (units, long_name)}; the keys listed are the ones the runner records
+OUTPUTS = {
+    FAMILY["race_inner"]: {
+        "load": ("N", "roller–inner race contact load"),
+        "fx": ("N", "roller–inner race force on the roller, x in R"),
+        "fy": ("N", "roller–inner race force on the roller, y in R"),
+        "angle": ("rad", "roller angle about the pin centre, in pin axes"),
+        "deflection": ("m", "roller–inner race contact deflection (< 0: a gap)")},
+    FAMILY["race_outer"]: {
+        "load": ("N", "roller–outer race contact load"),
+        "fx": ("N", "roller–outer race force on the roller, x in R"),
+        "fy": ("N", "roller–outer race force on the roller, y in R")},
+    FAMILY["pocket"]: {
+        "force": ("N", "roller–cage pocket force (> 0: the roller pushes the cage forward)"),
+        "offset": ("m", "roller circumferential offset in its cage pocket")},
+    FAMILY["guide"]: {
+        "force": ("N", "cage–guide land normal force"),
+        "fx": ("N", "cage–guide land force on the cage, x in R"),
+        "fy": ("N", "cage–guide land force on the cage, y in R"),
+        "eccentricity": ("m", "cage centre eccentricity relative to the planet bore")},
+    FAMILY["linear"]: {
+        "fx": ("N", "linear planet bearing force on the planet, x in R"),
+        "fy": ("N", "linear planet bearing force on the planet, y in R")},
+    **{f: _mesh(w) for f, w in MESH_WORDS.items()},
+    "carrier_drive": {"torque": ("N m", "carrier speed-drive torque on the carrier")},
+}
+
+_BEARING_COORDS = {  # coordinate -> (long_name, field of the bearing_map record)
+    "bearing": ("planet bearing name", "name"),
+    "planet": ("planet the bearing carries", "planet"),
+    "pair": ("planet pair index (0-based: pair n holds planets a{n+1}, b{n+1})", "pair"),
+    "bearing_kind": ("bearing of the inner (a) or outer (b) planet of the pair", "kind"),
+}
+
+
+def instance_coords(scene) -> dict[str, dict[str, tuple[str, list]]]:
+    """family -> {coordinate: (long_name, one value per instance)}; "instance" names each instance
+    ("a1.pb.roller3", "a1.pb.cage", "a1.pb", "sun-a1", "carrier")."""
+    rows: dict[str, dict[int, dict]] = {}
+
+    def put(fam, i, **vals):
+        rows.setdefault(fam, {})[i] = vals
+
+    for b in bearing_map(scene):
+        base = {c: b[field] for c, (_, field) in _BEARING_COORDS.items()}
+        if b["type"] == "rollers":
+            for fam in ("race_inner", "race_outer", "pocket"):
+                if fam in b:
+                    start, stop = b[fam]
+                    for j, i in enumerate(range(start, stop)):
+                        put(FAMILY[fam], i, instance=b["rollers"][j], **base, roller=j)
+            if "guide" in b:
+                put(FAMILY["guide"], b["guide"], instance=f"{b['name']}.cage", **base)
+        else:
+            put(FAMILY["linear"], b["spring"], instance=b["name"], **base)
+    for n, pair in enumerate(scene.handles["pairs"]):
+        gears = {"sun_inner": ("sun", pair["inner"]), "inner_outer": (pair["inner"], pair["outer"]),
+                 "outer_ring": (pair["outer"], "ring")}
+        for key, (g1, g2) in gears.items():
+            put(MESH_FAMILY[key], n, instance=f"{g1}-{g2}", pair=n, gear1=g1, gear2=g2)
+    put("carrier_drive", 0, instance="carrier")
+
+    words = {"instance": "instance name", **{c: w for c, (w, _) in _BEARING_COORDS.items()},
+             "roller": "roller index in its bearing (pocket j at angle 2πj/Z in cage axes)",
+             "gear1": "first gear of the mesh", "gear2": "second gear of the mesh (fx, fy act on it)"}
+    out = {}
+    for fam, by_index in rows.items():
+        recs = [by_index[i] for i in sorted(by_index)]
+        if sorted(by_index) != list(range(len(recs))):
+            raise ValueError(f"family {fam!r}: instances {sorted(by_index)} do not cover 0..n-1")
+        names = [k for k in recs[0]]
+        if fam in MESH_WORDS:
+            words_f = dict(words, instance=f"{MESH_WORDS[fam]} name (first gear-second gear)")
+        else:
+            words_f = dict(words, instance={FAMILY["guide"]: "cage name", FAMILY["linear"]: "planet bearing name",
+                                            "carrier_drive": "driven body"}.get(fam, "roller name"))
+        out[fam] = {k: (words_f[k], [r[k] for r in recs]) for k in names}
+    return out
+
+
+def element_probes(scene) -> list[ElementOutput]:
+    """The element outputs the runner records: every family of :data:`OUTPUTS` the scene has, with
+    units, long names and instance coordinates."""
+    fams = {e.name for e in scene.model.elements}
+    coords = instance_coords(scene)
+    return [ElementOutput(f, list(meta), meta=meta, instances=coords.get(f))
+            for f, meta in OUTPUTS.items() if f in fams]
