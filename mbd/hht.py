@@ -16,7 +16,6 @@ evaluation, factorization and Newton iteration.
 """
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,9 +33,6 @@ def hht_coefficients(alpha: float) -> tuple[float, float]:
     if not (-1.0 / 3.0 - 1e-15 <= alpha <= 0.0):
         raise ModelError(f"HHT alpha must lie in [-1/3, 0], got {alpha!r}")
     return (1.0 - alpha) ** 2 / 4.0, 0.5 - alpha
-
-
-_ATOL: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True)
@@ -59,11 +55,7 @@ class Tolerance:
             raise ModelError(f"Tolerance.rtol must be >= 0, got {self.rtol!r}")
 
     def scale(self, model, q0, q1) -> np.ndarray:
-        key = (self.atol_pos, self.atol_rot)
-        cache = _ATOL.setdefault(model, {})
-        atol = cache.get(key)
-        if atol is None:   # built once per model: this runs in every Newton iteration
-            atol = cache[key] = np.where((model.free % 3) == 2, self.atol_rot, self.atol_pos)
+        atol = np.where(model.angle_dofs, self.atol_rot, self.atol_pos)
         if self.rtol == 0.0:
             return atol
         return atol + self.rtol * np.maximum(np.abs(q0), np.abs(q1))

@@ -8,6 +8,7 @@ the integrator sees only the free DOFs.
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
@@ -165,6 +166,11 @@ class Model:
     @property
     def ndof(self) -> int:
         return self.free.size
+
+    @functools.cached_property
+    def angle_dofs(self) -> np.ndarray:
+        """(ndof,) True where a free DOF is an angle θ (else a length x or y)."""
+        return (self.free % 3) == 2
 
     def body(self, name: str) -> BodyRef:
         try:
