@@ -30,7 +30,8 @@ from .bearing import bearing_kinematics
 from .families import FAMILY, MESH_FAMILY
 
 __all__ = ["FAMILY", "MESH_FAMILY", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
-           "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life"]
+           "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life",
+           "SUMMARY_WORDS"]
 
 LIFE_EXPONENT = 10.0 / 3.0     # ISO 281, roller bearings: L10 ∝ P^(−10/3)
 
@@ -110,6 +111,30 @@ def pin_reactions(race_inner: dict, rollers, bearing_of_roller, n_bearings: int,
     fy = np.asarray(race_inner["fy"], float)[rollers]
     return -rows * np.column_stack([np.bincount(bearing_of_roller, fx, n_bearings),
                                     np.bincount(bearing_of_roller, fy, n_bearings)])
+
+
+# what each summary key means, in words and units (for tables and plot axes)
+SUMMARY_WORDS = {
+    "bearing_load_mean_N": ("planet bearing load, mean", "N"),
+    "equivalent_load_N": ("planet bearing equivalent load (ISO 281)", "N"),
+    "life_L10_relative": ("L10 life relative to forward", "1"),
+    "roller_inner_race_rms_N": ("roller–inner race load RMS", "N"),
+    "roller_inner_race_max_N": ("roller–inner race load max", "N"),
+    "roller_outer_race_rms_N": ("roller–outer race load RMS", "N"),
+    "roller_outer_race_max_N": ("roller–outer race load max", "N"),
+    "roller_cage_rms_N": ("roller–cage force RMS", "N"),
+    "roller_cage_max_N": ("roller–cage force max", "N"),
+    "cage_guide_rms_N": ("cage–guide force RMS", "N"),
+    "cage_guide_max_N": ("cage–guide force max", "N"),
+    "cage_acc_radial_rms": ("cage acceleration RMS, radial", "m/s^2"),
+    "cage_acc_tangential_rms": ("cage acceleration RMS, tangential", "m/s^2"),
+    "cage_acc_rel_radial_rms": ("cage acceleration rel. to planet RMS, radial", "m/s^2"),
+    "cage_acc_rel_tangential_rms": ("cage acceleration rel. to planet RMS, tangential", "m/s^2"),
+    "cage_slip_pct": ("cage slip", "%"),
+    "pocket_impacts_per_rev": ("pocket impacts per cage revolution", "1"),
+    "pocket_impact_speed_max": ("pocket impact speed max", "m/s"),
+    "pocket_impact_peak_max_N": ("pocket impact peak force max", "N"),
+}
 
 
 def relative_life(P: float, P_ref: float) -> float | None:

@@ -21,20 +21,20 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.outputs import SUMMARY_WORDS
 from components.outputs import relative_life as iso_relative_life
 from mbd.recorder import atomic_write_text
 
 from .runner import RunConfig
 from .sweep import Case, build_params, run_sweep
 
-QUANTITIES = [
-    ("roller_cage_rms_N", "N"), ("roller_cage_max_N", "N"), ("cage_guide_rms_N", "N"), ("cage_guide_max_N", "N"),
-    ("roller_inner_race_rms_N", "N"), ("roller_inner_race_max_N", "N"), ("roller_outer_race_rms_N", "N"),
-    ("roller_outer_race_max_N", "N"), ("cage_acc_radial_rms", "m/s^2"), ("cage_acc_tangential_rms", "m/s^2"),
-    ("cage_acc_rel_radial_rms", "m/s^2"), ("cage_acc_rel_tangential_rms", "m/s^2"), ("cage_slip_pct", "%"),
-    ("pocket_impacts_per_rev", "-"), ("pocket_impact_speed_max", "m/s"), ("pocket_impact_peak_max_N", "N"),
-    ("bearing_load_mean_N", "N"), ("life_L10_relative", "-"),
-]
+# the summary keys the comparison shows, with their units (words: components.outputs.SUMMARY_WORDS)
+QUANTITIES = [(k, SUMMARY_WORDS[k][1]) for k in (
+    "roller_cage_rms_N", "roller_cage_max_N", "cage_guide_rms_N", "cage_guide_max_N", "roller_inner_race_rms_N",
+    "roller_inner_race_max_N", "roller_outer_race_rms_N", "roller_outer_race_max_N", "cage_acc_radial_rms",
+    "cage_acc_tangential_rms", "cage_acc_rel_radial_rms", "cage_acc_rel_tangential_rms", "cage_slip_pct",
+    "pocket_impacts_per_rev", "pocket_impact_speed_max", "pocket_impact_peak_max_N", "bearing_load_mean_N",
+    "life_L10_relative")]
 # bar chart: RMS values, cage accelerations relative to the planet, radial/tangential (comparable between
 # inner and outer planets, unlike x/y)
 BAR_QUANTITIES = ["roller_cage_rms_N", "cage_guide_rms_N", "roller_inner_race_rms_N", "roller_outer_race_rms_N",
@@ -136,8 +136,8 @@ def comparison_rows(results: dict) -> list[dict]:
                 fv = f.get(kind, {}).get(q) if "error" not in f else None
                 rv = r.get(kind, {}).get(q) if "error" not in r else None
                 diff = (rv - fv) / fv * 100.0 if (fv not in (None, 0) and rv is not None) else None
-                rows.append({"condition": c, "bearing": kind, "quantity": q, "unit": unit,
-                             "forward": fv, "reverse": rv, "difference_pct": diff})
+                rows.append({"condition": c, "bearing": kind, "quantity": q, "description": SUMMARY_WORDS[q][0],
+                             "unit": unit, "forward": fv, "reverse": rv, "difference_pct": diff})
     return rows
 
 
@@ -156,7 +156,7 @@ def write_tables(rows: list[dict], out: Path) -> tuple[Path, Path, str]:
         md.append(f"\n### Condition {c}\n\n| bearing | quantity | forward | reverse | difference % |\n|---|---|---|---|---|")
         for r in rows:
             if r["condition"] == c:
-                md.append(f"| {r['bearing']} | {r['quantity']} [{r['unit']}] | {_fmt(r['forward'])} | "
+                md.append(f"| {r['bearing']} | {r['description']} [{r['unit']}] | {_fmt(r['forward'])} | "
                           f"{_fmt(r['reverse'])} | {_fmt(r['difference_pct'], 3)} |")
     text = "\n".join(md).strip() + "\n"
     atomic_write_text(out / "comparison.md", text)
@@ -226,7 +226,7 @@ def plots(results: dict, out: Path) -> list[Path]:
         if q not in BAR_QUANTITIES:
             continue
         for kind in ("inner", "outer"):
-            key = f"{kind} {q}"
+            key = f"{kind} planets: {SUMMARY_WORDS[q][0]}"
             table[key] = {}
             bar_units[key] = unit
             for c in conds:
@@ -234,9 +234,8 @@ def plots(results: dict, out: Path) -> list[Path]:
                 fv = f.get(kind, {}).get(q) if "error" not in f else None
                 rv = r.get(kind, {}).get(q) if "error" not in r else None
                 table[key][c] = (fv, rv)
-    sel = {k: v for k, v in table.items() if "rms" in k}
-    if conds and sel:
-        paths.append(vp.bar_chart(conds, sel, {k: bar_units[k] for k in sel}, out / "bars.png",
+    if conds and table:
+        paths.append(vp.bar_chart(conds, table, bar_units, out / "bars.png",
                                   title="RMS across conditions: forward vs reverse"))
     return paths
 
