@@ -9,8 +9,6 @@ The initial state is the kinematic steady state (MODEL.md §4); the sun torque i
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
-
 import numpy as np
 
 from mbd.elements import GroundSupport, Ramp, SpeedDrive, TorqueSource
@@ -22,23 +20,12 @@ from .families import MESH_FAMILY
 from .params import DPGTParams
 from .scene import BuiltScene, Scene, SceneOptions
 
-__all__ = ["RigSettings", "build_dpgt"]
+__all__ = ["build_dpgt"]
 
 
-@dataclass(frozen=True)
-class RigSettings:
-    """Rig and start-up settings that are not machine data ([assumed], stated in the README)."""
-    drive_freq: float = 80.0      # carrier speed-drive bandwidth [Hz]: speed error < 0.1 rad/s by 30 ms (measured), far below f_m
-    drive_zeta: float = 0.7
-    ramp_meshes: float = 20.0     # sun-torque ramp length in mesh periods ...
-    ramp_max: float = 0.05        # ... but at most this long [s] (near-zero speeds have no mesh period)
-
-
-def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, rig: RigSettings | None = None,
-               strict: bool = True) -> BuiltScene:
+def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: bool = True) -> BuiltScene:
     """Build the DPGT scene. Design errors raise ParameterError; design warnings are issued."""
     opt = options or SceneOptions()
-    rig = rig or RigSettings()
     check_design(params, strict=strict)
     si = params.si()
     lay = si.layout
@@ -91,7 +78,8 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, rig: Rig
 
     # drives: sun torque (driving motor), carrier speed drive (loading motor)
     f_m = op.mesh_frequency
-    ramp_t = min(rig.ramp_meshes / f_m, rig.ramp_max) if f_m > 0 else 0.0
+    rig = si.rig
+    ramp_t = min(rig.load_ramp_mesh_periods / f_m, rig.load_ramp_max) if f_m > 0 else 0.0
     if T_s != 0:
         scene.add_element(TorqueSource("sun_torque", [scene.index["sun"]], T_s, ramp=Ramp(0.0, ramp_t)))
     # inertia the drive sees: every speed of the kinematic state scales with ω_c (ring fixed), so
@@ -101,9 +89,9 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, rig: Rig
         J_eff = scene.kinematic_inertia(wc)
     else:
         J_eff = G.carrier_inertia + N * (G.inner_planet.mass * lay.r_ca**2 + G.outer_planet.mass * lay.r_cb**2)
-    wd = 2 * np.pi * rig.drive_freq
+    wd = 2 * np.pi * rig.carrier_drive_bandwidth
     scene.add_element(SpeedDrive("carrier_drive", scene.index["carrier"], wc, k=J_eff * wd**2,
-                                 c=2 * rig.drive_zeta * J_eff * wd, k_i=J_eff * wd**3 / 5))
+                                 c=2 * rig.carrier_drive_damping_ratio * J_eff * wd, k_i=J_eff * wd**3 / 5))
     scene.handles.update({"pairs": pairs, "flanks": flanks})
     scene.meta.update({
         "speeds_rad_s": {"sun": W["sun"], "inner_planet": W["a"], "outer_planet": W["b"], "carrier": wc},

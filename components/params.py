@@ -47,7 +47,7 @@ from .units import ParameterError, Quantity, format_quantity, quantity, to_si
 __all__ = [
     "Source", "Sourced", "paper", "derived", "assumed", "SIView", "Params",
     "GearParams", "GearSetParams", "CageParams", "SlideRollTractionParams", "BearingParams", "LubricantParams", "SupportParams",
-    "MeshParams", "OperatingPoint", "DPGTParams",
+    "MeshParams", "OperatingPoint", "RigParams", "DPGTParams",
     "with_overrides", "parameter_names", "flatten", "describe", "to_toml", "overrides_from_toml",
 ]
 
@@ -564,6 +564,20 @@ class OperatingPoint(Params):
 
 
 @dataclass(frozen=True, kw_only=True)
+class RigParams(Params):
+    """The source's test rig around the train (MODEL.md §3.7): the loading motor holds the carrier at its
+    speed through a PI speed drive (stiffness, damping and integral gain from the bandwidth and damping
+    ratio on the train's kinetic inertia), and the driving motor's sun torque is ramped in."""
+
+    _prefix: ClassVar[str] = "rig"
+    carrier_drive_bandwidth: Quantity = _pos("frequency", "bandwidth of the carrier speed drive")
+    carrier_drive_damping_ratio: Quantity = _nonneg("dimensionless", "damping ratio of the carrier speed drive")
+    load_ramp_mesh_periods: Quantity = _nonneg("dimensionless", "length of the sun-torque ramp in mesh periods "
+                                                                "(0: the full torque at t = 0)")
+    load_ramp_max: Quantity = _nonneg("time", "longest sun-torque ramp (near-zero speeds have no mesh period)")
+
+
+@dataclass(frozen=True, kw_only=True)
 class DPGTParams(Params):
     """The whole machine: gears, planet bearing (with cage), lubricant, supports, meshes, operating
     point and gravity (magnitude, along −Y of the fixed frame).
@@ -580,6 +594,7 @@ class DPGTParams(Params):
     support: SupportParams = _nested(SupportParams, "supports")
     mesh: MeshParams = _nested(MeshParams, "meshes")
     operating: OperatingPoint = _nested(OperatingPoint, "operating point")
+    rig: RigParams = _nested(RigParams, "test rig: carrier speed drive and load ramp")
     gravity: Quantity = _nonneg("acceleration", "gravitational acceleration (0 switches gravity off)")
 
     def _derive(self, d):

@@ -79,6 +79,8 @@ KINDS: dict[str, Kind] = {
     "torque": Kind("a torque", "N*m", "100 N*m"),
     "power": Kind("a power", "W", "200 kW"),
     "stiffness": Kind("a stiffness (force per length)", "N/m", "1e8 N/m"),
+    "frequency": Kind("a frequency (cycles per second; for speeds use an angular velocity)", "Hz", "80 Hz"),
+    "time": Kind("a time", "s", "0.05 s"),
     "damping": Kind("a viscous damping coefficient (force per velocity)", "N*s/m", "2000 N*s/m"),
     "torsional_stiffness": Kind("a torsional stiffness", "N*m/rad", "1.5e7 N*m/rad"),
     "contact_stiffness": Kind("a line-contact stiffness (force per length^(10/9))", "N/m**(10/9)",

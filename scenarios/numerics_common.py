@@ -58,7 +58,7 @@ class Problem:
 
 
 def dpgt_problem(condition: int = 3, direction: str = "forward", overrides: dict | None = None,
-                 options=None, settle: float = 0.03, strict: bool = True, rig=None) -> Problem:
+                 options=None, settle: float = 0.03, strict: bool = True) -> Problem:
     """Full DPGT (reference_dpgt(condition, direction) with ``overrides``); reference bearing = the
     first inner planet's bearing, reference roller = its roller 0. ``strict=False`` builds a machine the
     design check refuses (e.g. overlapping planets: no planet–planet contact is modelled, so such a
@@ -67,7 +67,7 @@ def dpgt_problem(condition: int = 3, direction: str = "forward", overrides: dict
     params = with_overrides(reference_dpgt(condition, direction), overrides or {})
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # design warnings (tip overlap, N not assemblable) are known
-        sc = build_dpgt(params, options, rig, strict=strict)
+        sc = build_dpgt(params, options, strict=strict)
     h = sc.handles["pairs"][0]["inner_bearing"]
     if h["kind"] != "rollers":
         raise mbd.ModelError("the numerics scenarios need the roller bearing model")

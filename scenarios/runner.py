@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
-from components.dpgt import RigSettings, build_dpgt
+from components.dpgt import build_dpgt
 from components.params import DPGTParams
 from components.scene import SceneOptions
 from mbd.recorder import BodyMotion, Recorder, atomic_write_text
@@ -68,7 +68,6 @@ class RunConfig:
     sample_rate: float = 25000.0  # Hz (> 4 f_m at condition 3)
     integration: mbd.IntegratorSettings = mbd.PRODUCTION
     options: SceneOptions = field(default_factory=SceneOptions)
-    rig: RigSettings = field(default_factory=RigSettings)
     progress: bool = True
     checkpoint_every: int = 2000
 
@@ -109,7 +108,7 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
     out_dir.mkdir(parents=True, exist_ok=True)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
-        scene = build_dpgt(params, cfg.options, cfg.rig)
+        scene = build_dpgt(params, cfg.options)
     bmap = bearing_map(scene)
     meta = {k: v for k, v in scene.meta.items() if k != "bearing"}
     window = cfg.window if cfg.window is not None else statistics_window(scene)

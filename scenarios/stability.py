@@ -71,7 +71,7 @@ CASES = {
     # Z = 15 is the largest roller count the design check accepts for the reference bearing (Z = 16
     # leaves no cage bar between the pockets, Z ≥ 20 rollers overlap on the pitch circle)
     **{f"Z{z}": (f"Z = {z} rollers", {"bearing.rollers": z}, {}) for z in (8, 10, 14, 15, 16, 20, 24)},
-    "torque_step": ("sudden torque step: full sun torque at t = 0, no ramp", {}, {"ramp_meshes": 0.0}),
+    "torque_step": ("sudden torque step: full sun torque at t = 0, no ramp", {"rig.load_ramp_mesh_periods": 0.0}, {}),
 }
 QUICK = ["nominal", "contact_x100", "traction_slope_x100", "speed_x3", "clearance_0", "cage_mass_div10", "N1",
          "Z24", "torque_step"]
@@ -87,9 +87,8 @@ def case_overrides(name: str) -> tuple[dict, dict]:
 
 
 def _build(name: str, strict: bool = True) -> Problem:
-    from components.dpgt import RigSettings
-    ov, rig = case_overrides(name)
-    return dpgt_problem(overrides=ov, strict=strict, rig=RigSettings(**rig) if rig else None)
+    ov, _ = case_overrides(name)
+    return dpgt_problem(overrides=ov, strict=strict)
 
 
 def _pin_and_roller(prob: Problem, system, t, q, v, z):

@@ -464,7 +464,8 @@ def test_pocket_jacobian_and_balance(state, z):
         stored = np.zeros(N) if zz is None else zz[:, 0]
         Fe, v0 = expected_impact_force(K_P, np.abs(offsets) - C_P, out["penetration_rate"], stored)
         np.testing.assert_allclose(np.abs(out["force"]), Fe, rtol=1e-9, atol=1e-12 * K_P * C_P)
-        np.testing.assert_allclose(out["approach_speed"], v0, rtol=1e-12, atol=0)
+        # without a stored speed v₀ is the iterate's ε̇: the same round-off as the penetration rate above
+        np.testing.assert_allclose(out["approach_speed"], v0, rtol=1e-9, atol=0)
         assert np.all(out["force"][~inside][Fe[~inside] > 0] * offsets[~inside][Fe[~inside] > 0] > 0)
 
 
@@ -580,7 +581,8 @@ def test_guide_jacobian_and_balance(state, z):
         stored = np.zeros(N) if zz is None else zz[:, 0]
         Fe, v0 = expected_impact_force(K_G, ecc - C_G, np.array(state[4]), stored)
         np.testing.assert_allclose(out["force"], Fe, rtol=1e-9, atol=1e-12 * K_G * C_G)
-        np.testing.assert_allclose(out["approach_speed"], v0, rtol=1e-12, atol=0)
+        # without a stored speed v₀ is the iterate's ε̇: the same round-off as the penetration rate above
+        np.testing.assert_allclose(out["approach_speed"], v0, rtol=1e-9, atol=0)
 
 
 def test_guide_centred_cage_is_regular():

@@ -394,11 +394,10 @@ def test_linear_bearing_instances_are_named():
     from components.presets import reference_dpgt
     from components.results_schema import OUTPUTS, instance_coords
     from components.scene import SceneOptions
-    from scenarios.runner import RunConfig
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")                # design warnings of the reference machine
-        scene = build_dpgt(reference_dpgt(3, "forward"), SceneOptions(bearings="linear"), RunConfig().rig)
+        scene = build_dpgt(reference_dpgt(3, "forward"), SceneOptions(bearings="linear"))
     coords = instance_coords(scene)
     lin = coords["bearing_linear"]
     assert lin["instance"][1] == [f"{p}{n}.pb" for n in (1, 2, 3) for p in "ab"]
