@@ -530,20 +530,42 @@ def design_findings(params: "components.params.DPGTParams") -> list[Finding]:
     out: list[Finding] = []
     gs = params.gears.si()
     G = _gear_geometries(gs)
-    names = ("sun", "inner_planet", "outer_planet", "ring")
+    _gear_findings(gs, G, out)
+    if any(f.severity == "error" for f in out):
+        return out
+    try:
+        lay = layout(params, gears_si=gs)
+    except ParameterError as e:
+        out.append(Finding("error", e.parameter or "gears", e.problem or str(e)))
+        return out
+    _mesh_findings(lay, out)
+    _interference_findings(lay, G, out)
+    _bearing_findings(params.bearing.si(), G, out)
+    os_ = params.operating.si()
+    try:
+        kinematics(G["sun"].teeth, G["inner_planet"].teeth, G["outer_planet"].teeth, G["ring"].teeth,
+                   os_.carrier_speed, os_.output_power)
+    except ParameterError as e:
+        out.append(Finding("error", e.parameter, e.problem))
+    return out
 
-    # gears that mesh need one module and pressure angle; only the ring is internal
-    for n in names[1:]:
+
+_GEARS = ("sun", "inner_planet", "outer_planet", "ring")
+
+
+def _gear_findings(gs, G, out) -> None:
+    """Gears that mesh need one module and pressure angle; only the ring is internal; undercut, roots."""
+    for n in _GEARS[1:]:
         if abs(gs[n].module - gs.sun.module) > 1e-12 * gs.sun.module:
             out.append(Finding("error", f"gears.{n}.module", f"{gs[n].module * 1e3:g} mm differs from the sun's "
                                                              f"{gs.sun.module * 1e3:g} mm: meshing gears need one module"))
         if abs(gs[n].pressure_angle - gs.sun.pressure_angle) > 1e-12:
             out.append(Finding("error", f"gears.{n}.pressure_angle", "differs from the sun's: meshing gears need "
                                                                      "one pressure angle"))
-    for n in names:
+    for n in _GEARS:
         if gs[n].internal != (n == "ring"):
             out.append(Finding("error", f"gears.{n}.internal", "only the ring is an internal gear"))
-    for n in names[:3]:
+    for n in _GEARS[:3]:
         g = G[n]
         z_min = 2.0 * g.addendum_coefficient / math.sin(g.pressure_angle) ** 2
         if g.teeth < z_min:
@@ -551,15 +573,10 @@ def design_findings(params: "components.params.DPGTParams") -> list[Finding]:
                                                               f"profile is undercut (no profile shift modelled)"))
         if g.root_radius <= 0:
             out.append(Finding("error", f"gears.{n}.dedendum_coefficient", "root circle radius is not positive"))
-    if any(f.severity == "error" for f in out):
-        return out
 
-    # layout: centre distances, triangle, contact ratios
-    try:
-        lay = layout(params, gears_si=gs)
-    except ParameterError as e:
-        out.append(Finding("error", e.parameter or "gears", e.problem or str(e)))
-        return out
+
+def _mesh_findings(lay, out) -> None:
+    """Contact ratios, and the assembly condition of equally spaced double-planet pairs."""
     for m in lay.meshes.values():
         if m.contact_ratio < 1.0:
             out.append(Finding("error", f"gears.{m.gear1}", f"{m.name} contact ratio {m.contact_ratio:.3f} < 1: "
@@ -568,8 +585,6 @@ def design_findings(params: "components.params.DPGTParams") -> list[Finding]:
             out.append(Finding("warning", f"gears.{m.gear1}",
                                f"{m.name} contact ratio {m.contact_ratio:.3f} >= 2: the single/double tooth "
                                f"stiffness wave does not describe triple contact"))
-
-    # assembly condition of equally spaced double-planet pairs
     if not lay.assembles:
         mis = ", ".join(f"{x:+.3g}" for x in lay.phasing.ring_mismatch[1:])
         out.append(Finding("warning", "gears.planets",
@@ -577,8 +592,10 @@ def design_findings(params: "components.params.DPGTParams") -> list[Finding]:
                            f"not assemble (pairs 1.. are off the ring's teeth by {mis} pitch); each pair's meshes "
                            f"are phased from its real position"))
 
-    # tip-circle interference between gears that do not mesh
-    ra = {n: G[n].tip_radius for n in names}
+
+def _interference_findings(lay, G, out) -> None:
+    """Tip-circle interference between gears that do not mesh."""
+    ra = {n: G[n].tip_radius for n in _GEARS}
     zero = np.zeros((1, 2))
     _overlap_findings(out, "the sun", "outer planet", zero, lay.centres_b, ra["sun"], ra["outer_planet"], "gears.sun",
                       pitch=(G["sun"].pitch_radius, G["outer_planet"].pitch_radius))
@@ -595,15 +612,16 @@ def design_findings(params: "components.params.DPGTParams") -> list[Finding]:
         out.append(Finding("warning", "gears.ring", what))
     ca, cb = lay.centres_a, lay.centres_b
     if lay.planets > 1:
-        rp = {n: G[n].pitch_radius for n in names}
+        rp = {n: G[n].pitch_radius for n in _GEARS}
         for (ni, ci), (nj, cj) in ((("inner_planet", ca), ("inner_planet", ca)),
                                    (("outer_planet", cb), ("outer_planet", cb)),
                                    (("inner_planet", ca), ("outer_planet", cb))):  # a_n vs b_m, n != m
             _overlap_findings(out, ni.replace("_", " "), nj.replace("_", " "), ci, cj, ra[ni], ra[nj],
                               "gears.planets", same=True, pitch=(rp[ni], rp[nj]))
 
-    # planet bearing: pin, rollers, cage, bore inside the planet
-    bs = params.bearing.si()
+
+def _bearing_findings(bs, G, out) -> None:
+    """Planet bearing: pin, rollers, cage bars, the bore inside each planet's root circle."""
     dm, d, z = bs.pitch_diameter, bs.roller_diameter, bs.rollers
     if d >= dm:
         out.append(Finding("error", "bearing.roller_diameter", f"{d * 1e3:g} mm leaves no pin: the inner raceway "
@@ -631,15 +649,6 @@ def design_findings(params: "components.params.DPGTParams") -> list[Finding]:
                                f"{n.replace('_', ' ')} rim under the teeth is {rim * 1e3:.2f} mm, less than "
                                f"{RIM_BACKUP_RATIO} x tooth height ({height * 1e3:.2f} mm): a thin rim is flexible, "
                                f"which the rigid planet model ignores"))
-
-    # operating point
-    os_ = params.operating.si()
-    try:
-        kinematics(G["sun"].teeth, G["inner_planet"].teeth, G["outer_planet"].teeth, G["ring"].teeth,
-                   os_.carrier_speed, os_.output_power)
-    except ParameterError as e:
-        out.append(Finding("error", e.parameter, e.problem))
-    return out
 
 
 def check_design(params: "components.params.DPGTParams", strict: bool = True) -> list[Finding]:

@@ -93,7 +93,6 @@ def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None,
          f"{time.perf_counter() - w0:.1f} s here; cached)")
     # reference roller: the most loaded roller of the reference bearing at the start of the window (a
     # roller outside the load zone for the whole short window would have RMS 0 and no relative error)
-    import mbd
     ri = mbd.System(prob.model).outputs(s0.t, s0.q, s0.v, s0.z)[FAMILY["race_inner"]]["load"][prob.race_inner]
     prob.roller = prob.race_inner.start + int(np.argmax(ri))
     t0, t1 = s0.t, s0.t + P["window"]
@@ -151,30 +150,8 @@ def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None,
             r = run_scipy(prob, s0, t1, grid, method=method, tol=tol, max_wall_s=P["cap"], repeats=repeats)
             add(r, tol=tol)
             capped = not r.completed
-    # HHT order on this problem: slope of log(error) against log(h) per alpha
-    orders = {}
-    for alpha in P["alphas"]:
-        pts = [(r["h_s"], r["err_pin_max_N"]) for r in rows
-               if r["method"] == "HHT" and r["alpha"] == alpha and r["completed"] and r["err_pin_max_N"] != ""
-               and r["err_pin_max_N"] > 10 * ref_check["err_pin_max_N"]]
-        if len(pts) >= 2:
-            h_, e_ = np.log(np.array(pts, float)).T
-            orders[str(alpha)] = {"order": float(np.polyfit(h_, e_, 1)[0]), "points": len(pts),
-                                  "h_range_s": [float(np.exp(h_.min())), float(np.exp(h_.max()))]}
-    # error-floor check (what limits the error at small h): the same HHT runs with the old (0.03) and a
-    # 100x tighter (1e-5) Newton tolerance; the grid points are step points for every h that divides
-    # dt, so the sampling adds no interpolation error there
-    floor = []
-    if floor_check:
-        for nt in (0.03, 1e-3, 1e-5):
-            for h in P["fixed_h"][:3]:
-                r = run_hht(prob, s0, t1, grid, alpha=0.0, h=h, newton_tol=nt, label=f"newton_tol={nt:g}")
-                m = error_metrics(obs_of(r), ref_obs) if r.completed else {}
-                floor.append({"newton_tol": nt, "h_s": h, "alpha": 0.0, "completed": r.completed,
-                              "err_pin_rel": m.get("err_pin_rel"), "err_pin_max_N": m.get("err_pin_max_N"),
-                              "err_rms_inner": m.get("err_rms_inner"), "newton_per_step": r.newton / max(r.steps, 1)})
-                _log(f"[{problem}] floor check newton_tol={nt:g} h={h:.0e}: "
-                     + (f"pin {m['err_pin_rel']:.2e} ({m['err_pin_max_N']:.3f} N)" if m else r.message))
+    orders = _hht_orders(rows, P["alphas"], ref_check)
+    floor = _floor_check(problem, prob, s0, t1, grid, P["fixed_h"][:3], ref_obs, obs_of) if floor_check else []
     pin = ref_obs["pin_load"]
     ripple = {"max_N": float(pin.max()), "min_N": float(pin.min()), "pk_pk_N": float(pin.max() - pin.min()),
               "pk_pk_rel": float((pin.max() - pin.min()) / pin.max())}
@@ -187,6 +164,37 @@ def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None,
                           "frozen_internal_state_vs_reference": frozen_diff},
             "reference_roller": prob.roller - prob.race_inner.start, "hht_order": orders, "eval_costs_s": costs, "cap_s": P["cap"], "repeats": repeats,
             "settle": extra, "floor_check": floor, "pin_load_reference": ripple, "rows": rows}
+
+
+def _hht_orders(rows, alphas, ref_check) -> dict:
+    """HHT order on this problem: slope of log(error) against log(h) per α (errors well above the reference's)."""
+    orders = {}
+    for alpha in alphas:
+        pts = [(r["h_s"], r["err_pin_max_N"]) for r in rows
+               if r["method"] == "HHT" and r["alpha"] == alpha and r["completed"] and r["err_pin_max_N"] != ""
+               and r["err_pin_max_N"] > 10 * ref_check["err_pin_max_N"]]
+        if len(pts) >= 2:
+            h_, e_ = np.log(np.array(pts, float)).T
+            orders[str(alpha)] = {"order": float(np.polyfit(h_, e_, 1)[0]), "points": len(pts),
+                                  "h_range_s": [float(np.exp(h_.min())), float(np.exp(h_.max()))]}
+    return orders
+
+
+def _floor_check(problem, prob, s0, t1, grid, steps, ref_obs, obs_of) -> list:
+    """What limits the error at small h: the same HHT runs with the old (0.03), the default and a 100x
+    tighter (1e-5) Newton tolerance; the grid points are step points for every h that divides dt, so the
+    sampling adds no interpolation error there."""
+    floor = []
+    for nt in (0.03, 1e-3, 1e-5):
+        for h in steps:
+            r = run_hht(prob, s0, t1, grid, alpha=0.0, h=h, newton_tol=nt, label=f"newton_tol={nt:g}")
+            m = error_metrics(obs_of(r), ref_obs) if r.completed else {}
+            floor.append({"newton_tol": nt, "h_s": h, "alpha": 0.0, "completed": r.completed,
+                          "err_pin_rel": m.get("err_pin_rel"), "err_pin_max_N": m.get("err_pin_max_N"),
+                          "err_rms_inner": m.get("err_rms_inner"), "newton_per_step": r.newton / max(r.steps, 1)})
+            _log(f"[{problem}] floor check newton_tol={nt:g} h={h:.0e}: "
+                 + (f"pin {m['err_pin_rel']:.2e} ({m['err_pin_max_N']:.3f} N)" if m else r.message))
+    return floor
 
 
 def _hht_tight(prob, s0, t1, grid, h, frozen_z=False):
