@@ -235,6 +235,85 @@ def _screenshot(plotter: pv.Plotter, size: tuple[int, int]) -> np.ndarray:
 # ----------------------------------------------------------------------------------------------
 # cage orbits
 
+def _orbit_inputs(t, orbits, clearance_m, rollers):
+    """Checked arrays of :func:`cage_orbit_animation`: (t, labels, orbits, clearances, roller offsets)."""
+    t = np.asarray(t, float)
+    if not orbits:
+        raise ValueError("orbits is empty")
+    labels = list(orbits)
+    n_t = t.size
+    orb = {k: np.asarray(v, float) for k, v in orbits.items()}
+    for k, v in orb.items():
+        if v.shape != (n_t, 2):
+            raise ValueError(f"orbits[{k!r}] has shape {v.shape}, expected ({n_t}, 2)")
+    clr = {k: float(clearance_m[k] if isinstance(clearance_m, Mapping) else clearance_m)
+           for k in labels}
+    if any(not c > 0 for c in clr.values()):
+        raise ValueError("clearance_m must be positive")
+    rol = {}
+    for k, v in (rollers or {}).items():
+        if k not in orb:
+            raise ValueError(f"rollers[{k!r}] has no matching orbit")
+        v = np.asarray(v, float)
+        if v.ndim != 3 or v.shape[0] != n_t or v.shape[2] != 2:
+            raise ValueError(f"rollers[{k!r}] has shape {v.shape}, expected ({n_t}, Z, 2)")
+        rol[k] = v
+    return t, labels, orb, clr, rol
+
+
+def _panels_with_title(W, H, n, title):
+    """An offscreen plotter with n panels side by side under an optional title strip:
+    (plotter, row of the panels, height fraction of the strip)."""
+    strip = 0.13 if title else 0.0
+    if title:
+        p = pv.Plotter(off_screen=True, window_size=(W, H), shape=(2, n), row_weights=[strip, 1 - strip],
+                       groups=[(0, np.s_[:])], border=False)
+    else:
+        p = pv.Plotter(off_screen=True, window_size=(W, H), shape=(1, n), border=False)
+    p.set_background(_BG, all_renderers=True)
+    if title:
+        p.subplot(0, 0)
+        tt = p.add_text(title, position=(0.5, 0.5), viewport=True, font_size=_font(H, 0.045, title, W), color=_INK)
+        tt.prop.justification_horizontal = "center"
+        tt.prop.justification_vertical = "center"
+        tt.prop.bold = True
+    return p, (1 if title else 0), strip
+
+
+def _orbit_panel(p, view, orbit, clearance, extent, col, panel_px):
+    """Static parts of one orbit panel (clearance circle, bore-centre cross) and the moving trail and
+    marker, which are returned."""
+    z = view.z_step
+    circ = pv.PolyData(_xyz(clearance * _circle(180), z), lines=_lines_cells([list(range(180)) + [0]]))
+    p.add_mesh(circ, color="#888888", line_width=2, lighting=False)
+    cross = 0.06 * extent  # bore centre
+    cpts = np.array([[-cross, 0, z], [cross, 0, z], [0, -cross, z], [0, cross, z]])
+    p.add_mesh(pv.PolyData(cpts, lines=_lines_cells([[0, 1], [2, 3]])), color="#888888", line_width=1,
+               lighting=False)
+    trail = pv.PolyData(_xyz(orbit, 2 * z), lines=_lines_cells([[0, 0]]))
+    p.add_mesh(trail, color=col, line_width=1.5, lighting=False)
+    marker = pv.PolyData(_xyz(orbit[:1], 3 * z))
+    p.add_mesh(marker, color="#d50000", point_size=max(5, panel_px[1] // 40), render_points_as_spheres=True,
+               lighting=False)
+    return trail, marker
+
+
+def _roller_ring(p, view, Z, ring_r, r_roll, col):
+    """Z schematic rollers on a ring: grey ideal positions and a moving copy (returned with the ideal
+    centres and the roller outline, for the frame loop)."""
+    z = view.z_step
+    ang = 2 * np.pi * np.arange(Z) / Z
+    ideal = ring_r * np.column_stack([np.cos(ang), np.sin(ang)])
+    unit = _circle(32)
+    # one closed polyline per roller; ideal positions stay put, the others move
+    cells = _lines_cells([list(range(32 * i, 32 * i + 32)) + [32 * i] for i in range(Z)])
+    ghost = (ideal[:, None, :] + r_roll * unit[None]).reshape(-1, 2)
+    p.add_mesh(pv.PolyData(_xyz(ghost, z), lines=cells), color="#bbbbbb", line_width=1, lighting=False)
+    moving = pv.PolyData(_xyz(ghost, 2 * z), lines=cells)
+    p.add_mesh(moving, color=col, line_width=1.5, lighting=False)
+    return moving, ideal, r_roll * unit
+
+
 def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
                          magnify: float | None = None, rollers: Mapping[str, np.ndarray] | None = None,
                          fps: float = 20, size: Sequence[int] = (800, 400), title: str | None = None,
@@ -251,55 +330,20 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
     chosen so the largest offset is about half a roller-circle radius; the factor is printed).
     """
     path = _output_path(path, fps)
-    t = np.asarray(t, float)
-    if not orbits:
-        raise ValueError("orbits is empty")
-    labels = list(orbits)
+    t, labels, orb, clr, rol = _orbit_inputs(t, orbits, clearance_m, rollers)
     n_t = t.size
-    orb = {k: np.asarray(v, float) for k, v in orbits.items()}
-    for k, v in orb.items():
-        if v.shape != (n_t, 2):
-            raise ValueError(f"orbits[{k!r}] has shape {v.shape}, expected ({n_t}, 2)")
-    clr = {k: float(clearance_m[k] if isinstance(clearance_m, Mapping) else clearance_m)
-           for k in labels}
-    if any(not c > 0 for c in clr.values()):
-        raise ValueError("clearance_m must be positive")
-    rol = {}
-    if rollers:
-        for k, v in rollers.items():
-            if k not in orb:
-                raise ValueError(f"rollers[{k!r}] has no matching orbit")
-            v = np.asarray(v, float)
-            if v.ndim != 3 or v.shape[0] != n_t or v.shape[2] != 2:
-                raise ValueError(f"rollers[{k!r}] has shape {v.shape}, expected ({n_t}, Z, 2)")
-            rol[k] = v
     require_offscreen()
     W, H = _even_size(size, path)
     idx = frame_indices(n_t, max_frames)
     tfmt = _time_formatter(t[idx])
 
     n = len(labels)
-    strip = 0.13 if title else 0.0
-    if title:
-        p = pv.Plotter(off_screen=True, window_size=(W, H), shape=(2, n), row_weights=[strip, 1 - strip],
-                       groups=[(0, np.s_[:])], border=False)
-        row = 1
-    else:
-        p = pv.Plotter(off_screen=True, window_size=(W, H), shape=(1, n), border=False)
-        row = 0
+    p, row, strip = _panels_with_title(W, H, n, title)
     try:
-        p.set_background(_BG, all_renderers=True)
         panel_px = (W // n, int(round(H * (1 - strip))))
         longest = max(labels, key=len)
         fs = _font(panel_px[1], 0.04, longest, panel_px[0])
         fs_small = _font(panel_px[1], 0.03, "t = 00.00 ms", 0.6 * panel_px[0])
-        if title:
-            p.subplot(0, 0)
-            tt = p.add_text(title, position=(0.5, 0.5), viewport=True,
-                            font_size=_font(H, 0.045, title, W), color=_INK)
-            tt.prop.justification_horizontal = "center"
-            tt.prop.justification_vertical = "center"
-            tt.prop.bold = True
 
         # Panel geometry: E bounds the orbit; rollers sit on a schematic ring outside it.
         E = {k: 1.08 * max(clr[k], float(np.nanmax(np.hypot(v[:, 0], v[:, 1]))))
@@ -329,34 +373,12 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
                          band=(0.03, 0.97, bottom, top))
             views.append(view)
             col = _PANEL_COLORS[j % len(_PANEL_COLORS)]
-            z = view.z_step
-            circ = pv.PolyData(_xyz(clr[lab] * _circle(180), z),
-                               lines=_lines_cells([list(range(180)) + [0]]))
-            p.add_mesh(circ, color="#888888", line_width=2, lighting=False)
-            cross = 0.06 * E[lab]  # bore centre
-            cpts = np.array([[-cross, 0, z], [cross, 0, z], [0, -cross, z], [0, cross, z]])
-            p.add_mesh(pv.PolyData(cpts, lines=_lines_cells([[0, 1], [2, 3]])), color="#888888",
-                       line_width=1, lighting=False)
-            trail = pv.PolyData(_xyz(e, 2 * z), lines=_lines_cells([[0, 0]]))
-            p.add_mesh(trail, color=col, line_width=1.5, lighting=False)
+            trail, marker = _orbit_panel(p, view, e, clr[lab], E[lab], col, panel_px)
             trails.append(trail)
-            marker = pv.PolyData(_xyz(e[:1], 3 * z))
-            p.add_mesh(marker, color="#d50000", point_size=max(5, panel_px[1] // 40),
-                       render_points_as_spheres=True, lighting=False)
             markers.append(marker)
             if lab in rol:
-                Z = rol[lab].shape[1]
-                ang = 2 * np.pi * np.arange(Z) / Z
-                ideal = ring_r[lab] * np.column_stack([np.cos(ang), np.sin(ang)])
-                unit = _circle(32)
-                # one closed polyline per roller; ideal positions stay put, the others move
-                cells = _lines_cells([list(range(32 * i, 32 * i + 32)) + [32 * i] for i in range(Z)])
-                ghost = (ideal[:, None, :] + r_roll[lab] * unit[None]).reshape(-1, 2)
-                p.add_mesh(pv.PolyData(_xyz(ghost, z), lines=cells), color="#bbbbbb",
-                           line_width=1, lighting=False)
-                moving = pv.PolyData(_xyz(ghost, 2 * z), lines=cells)
-                p.add_mesh(moving, color=col, line_width=1.5, lighting=False)
-                roller_meshes.append((moving, ideal, r_roll[lab] * unit, lab))
+                moving, ideal, ring_pts = _roller_ring(p, view, rol[lab].shape[1], ring_r[lab], r_roll[lab], col)
+                roller_meshes.append((moving, ideal, ring_pts, lab))
                 if lab == first_rol:  # one factor for all panels: say it once
                     view.text(f"roller offsets ×{mag:.3g}", (0.5, 0.98 - view.line_height(fs)),
                               fs_small, justify="center", color="#666666", valign="top")
@@ -416,26 +438,10 @@ def _body_template(b: Mapping, kind: str) -> tuple[np.ndarray, np.ndarray, list[
     return np.concatenate(r_pts), np.concatenate(a_pts), segs
 
 
-def train_animation(path, t, bodies: Sequence[Mapping], magnify: float = 1.0, fps: float = 20,
-                    size: Sequence[int] = (600, 600), title: str | None = None,
-                    max_frames: int | None = None, force_label: str = "roller force (N)") -> Path:
-    """Animate a gear train: outlines rotating with θ, rollers as discs coloured by contact force.
-
-    bodies: dicts with
-      kind: "gear" | "ring" | "carrier" | "roller" | "cage";  radius: m (pitch radius for toothed bodies)
-      teeth: optional tooth count (ticks at the teeth);  xy: (n_t, 2) centre, m;  theta: (n_t,) rad
-      force: optional (n_t,) N, colours a roller;  ref: optional (2,) or (n_t, 2) nominal centre.
-    force_label: colour-bar title (parentheses: VTK's default font draws "[" and "]" as "(" and ")").
-    magnify: displacements xy − ref are drawn multiplied by this factor.  Without `ref` the time-mean
-    position is the reference, which is right only for bodies whose nominal centre is fixed in the
-    plotted frame; rollers travel round their bearing, so magnify != 1 requires `ref` for them.
-    """
-    path = _output_path(path, fps)
-    t = np.asarray(t, float)
-    n_t = t.size
+def _train_bodies(bodies, n_t: int, mag: float) -> list[dict]:
+    """Checked bodies of :func:`train_animation`, displacements from ``ref`` magnified by ``mag``."""
     if not bodies:
         raise ValueError("bodies is empty")
-    mag = float(magnify)
     parsed = []
     for i, b in enumerate(bodies):
         kind = b.get("kind")
@@ -464,6 +470,82 @@ def train_animation(path, t, bodies: Sequence[Mapping], magnify: float = 1.0, fp
             if f.shape != (n_t,):
                 raise ValueError(f"bodies[{i}]: force must be ({n_t},), got {f.shape}")
         parsed.append({**b, "kind": kind, "radius": R, "xy": xy, "theta": th, "force": f})
+    return parsed
+
+
+def _outline_groups(parsed) -> list[dict]:
+    """Outline groups, one PolyData per kind so each kind keeps its colour."""
+    groups = []
+    for kind in ("ring", "carrier", "gear", "cage", "roller"):
+        members = [b for b in parsed if b["kind"] == kind]
+        if not members:
+            continue
+        bi, rl, al, segs, off = [], [], [], [], 0
+        for m_i, b in enumerate(members):
+            r_loc, a_loc, s = _body_template(b, kind)
+            bi.append(np.full(r_loc.size, m_i))
+            rl.append(r_loc)
+            al.append(a_loc)
+            segs += [[off + q for q in seg] for seg in s]
+            off += r_loc.size
+        g = {"kind": kind, "bi": np.concatenate(bi), "r": np.concatenate(rl),
+             "a": np.concatenate(al), "xy": np.stack([b["xy"] for b in members]),
+             "th": np.stack([b["theta"] for b in members])}
+        g["mesh"] = pv.PolyData(np.zeros((off, 3)), lines=_lines_cells(segs))
+        groups.append(g)
+    return groups
+
+
+def _place_outline(g, i, zz):
+    """Points of an outline group at frame i, at depth zz."""
+    c = g["xy"][g["bi"], i]
+    ang = g["th"][g["bi"], i] + g["a"]
+    return np.column_stack([c[:, 0] + g["r"] * np.cos(ang), c[:, 1] + g["r"] * np.sin(ang),
+                            np.full(c.shape[0], zz)])
+
+
+_DISC_SIDES = 24
+
+
+def _roller_discs(p, rollers, idx, n_t, has_force, force_label, fs):
+    """Filled roller discs: one polygon per roller, coloured by its force (cell data) with a colour bar.
+    Returns (the disc mesh, the (n_r, n_t) forces or None)."""
+    nd = _DISC_SIDES
+    faces = np.hstack([np.r_[nd, np.arange(nd) + nd * k] for k in range(len(rollers))])
+    disc = pv.PolyData(np.zeros((nd * len(rollers), 3)), faces=faces)
+    if not has_force:
+        p.add_mesh(disc, color="#9ecae1", lighting=False)
+        return disc, None
+    fr = np.stack([b["force"] if b["force"] is not None else np.full(n_t, np.nan) for b in rollers])
+    fmin, fmax = float(np.nanmin(fr[:, idx])), float(np.nanmax(fr[:, idx]))
+    clim = [min(0.0, fmin), fmax if fmax > min(0.0, fmin) else min(0.0, fmin) + 1.0]
+    disc.cell_data["force"] = fr[:, idx[0]]
+    p.add_mesh(disc, scalars="force", cmap="viridis", clim=clim, lighting=False, nan_color="#cccccc",
+               show_scalar_bar=False)
+    p.add_scalar_bar(title=force_label, vertical=True, position_x=0.83, position_y=0.12, width=0.07, height=0.72,
+                     n_labels=4, title_font_size=fs, label_font_size=fs, color=_INK, fmt="%.3g",
+                     unconstrained_font_size=True)
+    return disc, fr
+
+
+def train_animation(path, t, bodies: Sequence[Mapping], magnify: float = 1.0, fps: float = 20,
+                    size: Sequence[int] = (600, 600), title: str | None = None,
+                    max_frames: int | None = None, force_label: str = "roller force (N)") -> Path:
+    """Animate a gear train: outlines rotating with θ, rollers as discs coloured by contact force.
+
+    bodies: dicts with
+      kind: "gear" | "ring" | "carrier" | "roller" | "cage";  radius: m (pitch radius for toothed bodies)
+      teeth: optional tooth count (ticks at the teeth);  xy: (n_t, 2) centre, m;  theta: (n_t,) rad
+      force: optional (n_t,) N, colours a roller;  ref: optional (2,) or (n_t, 2) nominal centre.
+    force_label: colour-bar title (parentheses: VTK's default font draws "[" and "]" as "(" and ")").
+    magnify: displacements xy − ref are drawn multiplied by this factor.  Without `ref` the time-mean
+    position is the reference, which is right only for bodies whose nominal centre is fixed in the
+    plotted frame; rollers travel round their bearing, so magnify != 1 requires `ref` for them.
+    """
+    path = _output_path(path, fps)
+    t = np.asarray(t, float)
+    n_t = t.size
+    parsed = _train_bodies(bodies, n_t, float(magnify))
     require_offscreen()
     W, H = _even_size(size, path)
     idx = frame_indices(n_t, max_frames)
@@ -492,55 +574,14 @@ def train_animation(path, t, bodies: Sequence[Mapping], magnify: float = 1.0, fp
         z = view.z_step
         fs = _font(H, 0.028)
 
-        # Outline groups, one PolyData per kind so each kind keeps its colour.
-        groups = []
-        for kind in ("ring", "carrier", "gear", "cage", "roller"):
-            members = [b for b in parsed if b["kind"] == kind]
-            if not members:
-                continue
-            bi, rl, al, segs, off = [], [], [], [], 0
-            for m_i, b in enumerate(members):
-                r_loc, a_loc, s = _body_template(b, kind)
-                bi.append(np.full(r_loc.size, m_i))
-                rl.append(r_loc)
-                al.append(a_loc)
-                segs += [[off + q for q in seg] for seg in s]
-                off += r_loc.size
-            g = {"kind": kind, "bi": np.concatenate(bi), "r": np.concatenate(rl),
-                 "a": np.concatenate(al), "xy": np.stack([b["xy"] for b in members]),
-                 "th": np.stack([b["theta"] for b in members])}
-            g["mesh"] = pv.PolyData(np.zeros((off, 3)), lines=_lines_cells(segs))
-            groups.append(g)
-
-        def place(g, i, zz):
-            c = g["xy"][g["bi"], i]
-            ang = g["th"][g["bi"], i] + g["a"]
-            return np.column_stack([c[:, 0] + g["r"] * np.cos(ang), c[:, 1] + g["r"] * np.sin(ang),
-                                    np.full(c.shape[0], zz)])
-
-        # Filled roller discs: one polygon per roller, coloured by its force (cell data).
-        disc = None
+        groups = _outline_groups(parsed)
+        place = _place_outline
+        disc, fr = None, None
         if rollers:
-            nd = 24
-            unit = _circle(nd)
+            disc, fr = _roller_discs(p, rollers, idx, n_t, has_force, force_label, fs)
             rr = np.array([b["radius"] for b in rollers])
             disc_xy = np.stack([b["xy"] for b in rollers])  # (n_r, n_t, 2)
-            faces = np.hstack([np.r_[nd, np.arange(nd) + nd * k] for k in range(len(rollers))])
-            disc = pv.PolyData(np.zeros((nd * len(rollers), 3)), faces=faces)
-            if has_force:
-                fr = np.stack([b["force"] if b["force"] is not None else np.full(n_t, np.nan)
-                               for b in rollers])  # (n_r, n_t)
-                fmin, fmax = float(np.nanmin(fr[:, idx])), float(np.nanmax(fr[:, idx]))
-                clim = [min(0.0, fmin), fmax if fmax > min(0.0, fmin) else min(0.0, fmin) + 1.0]
-                disc.cell_data["force"] = fr[:, idx[0]]
-                p.add_mesh(disc, scalars="force", cmap="viridis", clim=clim, lighting=False,
-                           nan_color="#cccccc", show_scalar_bar=False)
-                p.add_scalar_bar(title=force_label, vertical=True, position_x=0.83,
-                                 position_y=0.12, width=0.07, height=0.72, n_labels=4,
-                                 title_font_size=fs, label_font_size=fs, color=_INK, fmt="%.3g",
-                                 unconstrained_font_size=True)
-            else:
-                p.add_mesh(disc, color="#9ecae1", lighting=False)
+            unit = _circle(_DISC_SIDES)
 
         layer = {"ring": 2, "carrier": 3, "gear": 4, "cage": 5, "roller": 6}
         for g in groups:
