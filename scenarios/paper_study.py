@@ -220,22 +220,22 @@ def plots(results: dict, out: Path) -> list[Path]:
         if series:
             paths.append(vp.time_histories(t, series, units, out / f"c{c}_time_histories.png",
                                            title=f"Condition {c}: forward vs reverse (reference roller, pair 1)"))
-    table = {}
-    bar_units = {}
+    table, bar_units, ylabels = {}, {}, {}
     for q, unit in QUANTITIES:
         if q not in BAR_QUANTITIES:
             continue
         for kind in ("inner", "outer"):
-            key = f"{kind} planets: {SUMMARY_WORDS[q][0]}"
+            key = f"{kind} planets\n{SUMMARY_WORDS[q][0]}"
             table[key] = {}
             bar_units[key] = unit
+            ylabels[key] = SUMMARY_WORDS[q][0]
             for c in conds:
                 f, r = results.get(f"c{c}_forward", {}), results.get(f"c{c}_reverse", {})
                 fv = f.get(kind, {}).get(q) if "error" not in f else None
                 rv = r.get(kind, {}).get(q) if "error" not in r else None
                 table[key][c] = (fv, rv)
     if conds and table:
-        paths.append(vp.bar_chart(conds, table, bar_units, out / "bars.png",
+        paths.append(vp.bar_chart(conds, table, bar_units, out / "bars.png", ylabels=ylabels,
                                   title="RMS across conditions: forward vs reverse"))
     return paths
 

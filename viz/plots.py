@@ -89,10 +89,12 @@ def time_histories(t, series: Mapping[str, tuple], units: Mapping[str, str], pat
 
 
 def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]],
-              units: Mapping[str, str], path, *, title: str | None = None) -> Path:
+              units: Mapping[str, str], path, *, title: str | None = None,
+              ylabels: Mapping[str, str] | None = None) -> Path:
     """Grouped bars: one subplot per quantity (units differ), a forward/reverse pair per condition.
 
     table: quantity -> {condition: (fwd, rev)}; a missing condition or a None value leaves a gap.
+    ylabels: optional quantity -> words for the y axis (default: the quantity, which is the panel title).
     """
     conditions = list(conditions)
     if not table:
@@ -115,7 +117,7 @@ def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]
             ax.bar(x + w / 2, vals[:, 1], w, color=REV["color"], label="reverse", hatch="//",
                    edgecolor="white", linewidth=0)
             ax.set_xticks(x, conditions, rotation=20 if len(conditions) > 3 else 0)
-            ax.set_ylabel(_axis_label(quantity, units.get(quantity)))
+            ax.set_ylabel(_axis_label((ylabels or {}).get(quantity, quantity), units.get(quantity)))
             ax.set_xlabel(_axis_label("condition", "–"))
             ax.set_title(quantity)
             ax.grid(axis="x", visible=False)
