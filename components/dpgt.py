@@ -8,14 +8,13 @@ The initial state is the kinematic steady state (MODEL.md §4); the sun torque i
 """
 from __future__ import annotations
 
-import warnings
 import numpy as np
 
 from mbd.elements import GroundSupport, Ramp, SpeedDrive, TorqueSource
 
 from .bearing import add_planet_bearing, bearing_si
 from .gears import add_mesh_family
-from .geometry import check_design, layout, loaded_flanks
+from .geometry import check_design, loaded_flanks
 from .families import MESH_FAMILY
 from .params import DPGTParams
 from .scene import BuiltScene, Scene, SceneOptions

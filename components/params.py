@@ -35,7 +35,6 @@ import math
 import numbers
 import tomllib
 from dataclasses import MISSING, dataclass, field
-from pathlib import Path
 from types import MappingProxyType
 from typing import Any, ClassVar, Iterator, Mapping
 

@@ -11,13 +11,12 @@ import io
 import json
 import os
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from .assembly import Counters, System
-from .control import Adaptive, FixedStep
+from .assembly import System
 from .errors import IntegrationError, ModelError
 from .hht import HHT, NewtonCache
 from .model import Model, State

@@ -35,7 +35,6 @@ import io
 import json
 import pstats
 import sys
-import time
 from pathlib import Path
 
 import numpy as np

@@ -18,8 +18,6 @@ import sys
 import warnings
 from pathlib import Path
 
-import numpy as np
-
 import mbd
 from components.outputs import SUMMARY_WORDS
 from components.outputs import relative_life as iso_relative_life

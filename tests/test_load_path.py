@@ -4,8 +4,6 @@ hold the planets' centrifugal load. Statistics come from components.outputs.Wind
 accepted step, a window of one whole cage revolution relative to the carrier)."""
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
