@@ -6,6 +6,7 @@
 * :func:`instance_coords` — per family, which bearing / roller / planet / mesh each instance is
   (from ``scene.handles["pairs"]`` and :func:`components.outputs.bearing_map`).
 * :func:`element_probes` — the :class:`mbd.ElementOutput` probes carrying both.
+* :func:`drawing_geometry` — the gears' and bearings' drawing geometry, stored as the file's ``geometry``.
 
 Body motion ("motion": all bodies in R; "fixed": sun, carrier, ring in the fixed frame) is described
 by the recorder itself (:mod:`mbd.recorder`): ``<probe>.position`` [m], ``.angle`` [rad],
@@ -14,12 +15,14 @@ by the recorder itself (:mod:`mbd.recorder`): ``<probe>.position`` [m], ``.angle
 """
 from __future__ import annotations
 
+import numpy as np
+
 from mbd.recorder import ElementOutput
 
 from .families import FAMILY, MESH_FAMILY
 from .outputs import bearing_map
 
-__all__ = ["OUTPUTS", "MESH_WORDS", "instance_coords", "element_probes"]
+__all__ = ["OUTPUTS", "MESH_WORDS", "instance_coords", "element_probes", "drawing_geometry"]
 
 MESH_WORDS = {MESH_FAMILY["sun_inner"]: "sun–inner planet mesh",
               MESH_FAMILY["inner_outer"]: "inner planet–outer planet mesh",
@@ -125,3 +128,30 @@ def element_probes(scene) -> list[ElementOutput]:
     coords = instance_coords(scene)
     return [ElementOutput(f, list(meta), meta=meta, instances=coords.get(f))
             for f, meta in OUTPUTS.items() if f in fams]
+
+
+def drawing_geometry(params) -> dict:
+    """Drawing geometry of a :class:`components.params.DPGTParams`, SI floats, JSON-safe.
+
+    The runner stores it in the results file's ``geometry`` attribute, so that viz needs nothing but
+    the file to draw a run."""
+    si = params.si()
+    G, B, lay = si.gears, si.bearing, si.layout
+    parts = {"sun": G.sun, "inner_planet": G.inner_planet, "outer_planet": G.outer_planet, "ring": G.ring}
+    return {
+        "module": float(G.sun.module),
+        "teeth": {k: int(g.teeth) for k, g in parts.items()},
+        "pitch_radius": {k: float(g.pitch_radius) for k, g in parts.items()},
+        "r_ca": float(lay.r_ca),
+        "r_cb": float(lay.r_cb),
+        # the carrier plate as in the inertia rule of PARAMETERS.md (disc of radius 1.2 r_cb)
+        "carrier_radius": 1.2 * float(lay.r_cb),
+        # pin (bearing) centres in carrier axes, per planet pair: exact positions for the drawing
+        "pins": {"inner": np.asarray(lay.centres_a, float).tolist(),
+                 "outer": np.asarray(lay.centres_b, float).tolist()},
+        "bearing": {"d_m": float(B.pitch_diameter), "D": float(B.roller_diameter),
+                    "clearance": float(B.clearance), "Z": int(B.rollers),
+                    "R_i": float(B.inner_raceway_radius), "R_o": float(B.outer_raceway_radius),
+                    "guide_clearance": float(B.cage.guide_clearance),
+                    "pocket_clearance": float(B.cage.pocket_clearance)},
+    }

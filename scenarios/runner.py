@@ -32,7 +32,7 @@ from components.scene import SceneOptions
 from mbd.recorder import BodyMotion, Recorder, atomic_write_text
 
 from components.outputs import WindowStatistics, bearing_map, cage_period, default_window
-from components.results_schema import element_probes
+from components.results_schema import drawing_geometry, element_probes
 
 __all__ = ["RunConfig", "run_case", "run_fingerprint", "statistics_window"]
 
@@ -113,11 +113,9 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
     meta = {k: v for k, v in scene.meta.items() if k != "bearing"}
     window = cfg.window if cfg.window is not None else statistics_window(scene)
     stats = WindowStatistics(scene, cfg.settle, cfg.settle + window)
-    from viz.results import geometry_from_params   # drawing geometry travels with the results
-
     rec = Recorder(out_dir / "results.nc", dt=1.0 / cfg.sample_rate, probes=_probes(scene), t_start=cfg.settle,
                    attrs={"bearings": bmap, "meta": meta, "label": label or {},
-                          "geometry": geometry_from_params(params)})
+                          "geometry": drawing_geometry(params)})
     integ = cfg.integration
     t_end = stats.t_end          # the window plus a margin for slipping cages (WindowStatistics)
     fp = run_fingerprint(params, cfg)

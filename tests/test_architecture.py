@@ -76,6 +76,17 @@ def test_the_engine_knows_nothing_of_the_domain():
             assert not [d for d in deps if not d.startswith("mbd")], (mod, deps)
 
 
+def test_viz_reads_results_only_and_scenarios_build_without_viz():
+    """viz draws from files (no engine, no parameters); the simulation side builds without viz (the
+    scenarios that plot import it, the runner and the scene builders do not)."""
+    graph = import_graph()
+    for mod, deps in graph.items():
+        if mod.startswith("viz"):
+            assert not [d for d in deps if d.split(".")[0] in ("mbd", "components", "scenarios")], (mod, deps)
+        if mod.startswith(("components", "mbd")) or mod == "scenarios.runner":
+            assert not [d for d in deps if d.startswith("viz")], (mod, deps)
+
+
 # element constructor arguments that may have a default: structure, not physics
 STRUCTURAL = {"multiplicity": 1, "ramp": None, "anchor": (0.0, 0.0), "marker_a": (0.0, 0.0),
               "marker_b": (0.0, 0.0), "theta0": 0.0, "u0": 0.0, "p0": 0.0, "phi_ref": 0.0}

@@ -105,38 +105,44 @@ def test_load_run_layout(runs, fwd):
     assert vr.load_run(runs["forward"].parent).bodies == fwd.bodies
 
 
-def test_geometry_falls_back_to_preset_then_prefers_the_file(runs, fwd, tmp_path):
+def test_geometry_comes_from_the_file_or_is_given(runs, fwd, tmp_path):
     from components.presets import reference_dpgt
+    from components.results_schema import drawing_geometry
     assert fwd.geometry["source"] == "file"          # the runner stores the drawing geometry
-    bare = tmp_path / "bare.nc"                       # a file without it falls back to the preset
+    bare = tmp_path / "bare.nc"                       # a file without it needs the caller's geometry
     shutil.copy(runs["forward"], bare)
     with h5py.File(bare, "r+") as f:
         del f.attrs["geometry"]
-    g = vr.load_run(bare).geometry
-    assert g["source"] == "preset"
-    assert g == {**fwd.geometry, "source": "preset"}
+    with pytest.raises(vr.ResultsError, match="no drawing geometry.*fallback_geometry"):
+        vr.load_run(bare)
+    ref = drawing_geometry(reference_dpgt())
+    g = vr.load_run(bare, fallback_geometry=ref).geometry
+    assert g["source"] == "given"
+    assert g == {**fwd.geometry, "source": "given"}
     si = reference_dpgt().si()
     assert g["bearing"]["d_m"] == pytest.approx(si.bearing.pitch_diameter)
     assert g["bearing"]["guide_clearance"] == pytest.approx(0.15e-3)
     assert g["teeth"] == {"sun": 31, "inner_planet": 24, "outer_planet": 24, "ring": 82}
-    # geometry stored in the file wins; what it lacks still comes from the preset
+    # geometry stored in the file wins; what it lacks comes from the given geometry
     path = tmp_path / "results.nc"
     shutil.copy(runs["forward"], path)
     with h5py.File(path, "r+") as f:
         f.attrs["geometry"] = json.dumps({"bearing": {"guide_clearance": 0.2e-3}})
-    g2 = vr.load_run(path).geometry
-    assert g2["source"] == "file+preset"
+    g2 = vr.load_run(path, fallback_geometry=ref).geometry
+    assert g2["source"] == "file+given"
     assert g2["bearing"]["guide_clearance"] == 0.2e-3 and g2["bearing"]["d_m"] == g["bearing"]["d_m"]
 
 
 def test_geometry_mismatch_warns(runs, tmp_path):
+    from components.presets import reference_dpgt
+    from components.results_schema import drawing_geometry
     path = tmp_path / "results.nc"
     shutil.copy(runs["forward"], path)
     with h5py.File(path, "r+") as f:
         f.attrs["geometry"] = json.dumps({"bearing": {"d_m": 0.05}})
     with pytest.warns(vr.GeometryWarning, match="d_m/2"):
-        run = vr.load_run(path)
-    assert run.geometry["source"] == "file+preset"  # partly from the preset: checked against the motion
+        run = vr.load_run(path, fallback_geometry=drawing_geometry(reference_dpgt()))
+    assert run.geometry["source"] == "file+given"  # partly given: checked against the motion
 
 
 # ----------------------------------------------------------------------------------- orbits

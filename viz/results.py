@@ -11,15 +11,13 @@ element outputs, the bearing map and the run metadata.  The helpers turn a run i
 * :func:`study_cage_animation` — the four-panel forward/reverse cage-orbit animation of the study.
 
 Geometry (tooth counts, pitch radii, bearing d_m, D, guide clearance) is not part of the motion data.
-It is read from the file's ``geometry`` attribute (or ``meta["geometry"]``) when present, in the layout
-of :func:`geometry_from_params`; whatever is missing comes from the reference machine
-(``components.presets.reference_dpgt().si()``), and ``run.geometry["source"]`` says which was used
-("file", "file+preset" or "preset").  A preset fallback is checked against the recorded motion (planet
-centre distances, roller pitch radius) and a :class:`GeometryWarning` is issued when they disagree, e.g.
-for a run made with overridden gear or bearing data.
+It is read from the file's ``geometry`` attribute (or ``meta["geometry"]``), in the layout of
+:func:`components.results_schema.drawing_geometry`, which the runner stores there. A caller may pass
+``fallback_geometry`` for whatever a file lacks; ``run.geometry["source"]`` says which was used
+("file", "file+given" or "given"), and given geometry is checked against the recorded motion (planet
+centre distances, roller pitch radius): a :class:`GeometryWarning` is issued when they disagree.
 
-viz reads results only: nothing here imports mbd (its integrators) — only numpy, xarray and, for the
-fallback geometry, the parameter objects of ``components``.
+viz reads results only: it imports neither mbd nor components — only numpy, xarray and matplotlib/pyvista.
 """
 from __future__ import annotations
 
@@ -31,8 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["ResultsError", "GeometryWarning", "Run", "load_run", "geometry_from_params",
-           "preset_geometry", "cage_orbits", "roller_offsets", "train_bodies", "study_cage_animation",
+__all__ = ["ResultsError", "GeometryWarning", "Run", "load_run", "cage_orbits", "roller_offsets", "train_bodies", "study_cage_animation",
            "cage_panels", "view_angle"]
 
 _REQUIRED_VARS = ("time", "motion.position", "motion.angle")
@@ -49,45 +46,6 @@ class GeometryWarning(UserWarning):
 
 # ----------------------------------------------------------------------------------------------
 # geometry
-
-def geometry_from_params(params) -> dict:
-    """Drawing geometry of a :class:`components.params.DPGTParams`, SI floats, JSON-safe.
-
-    This is the layout a results file may carry in its ``geometry`` attribute (a runner can store
-    ``geometry_from_params(params)`` there so that viz never needs the preset)."""
-    si = params.si()
-    G, B, lay = si.gears, si.bearing, si.layout
-    parts = {"sun": G.sun, "inner_planet": G.inner_planet, "outer_planet": G.outer_planet, "ring": G.ring}
-    return {
-        "module": float(G.sun.module),
-        "teeth": {k: int(g.teeth) for k, g in parts.items()},
-        "pitch_radius": {k: float(g.pitch_radius) for k, g in parts.items()},
-        "r_ca": float(lay.r_ca),
-        "r_cb": float(lay.r_cb),
-        # the carrier plate as in the inertia rule of PARAMETERS.md (disc of radius 1.2 r_cb)
-        "carrier_radius": 1.2 * float(lay.r_cb),
-        # pin (bearing) centres in carrier axes, per planet pair: exact positions for the drawing
-        "pins": {"inner": np.asarray(lay.centres_a, float).tolist(),
-                 "outer": np.asarray(lay.centres_b, float).tolist()},
-        "bearing": {"d_m": float(B.pitch_diameter), "D": float(B.roller_diameter),
-                    "clearance": float(B.clearance), "Z": int(B.rollers),
-                    "R_i": float(B.inner_raceway_radius), "R_o": float(B.outer_raceway_radius),
-                    "guide_clearance": float(B.cage.guide_clearance),
-                    "pocket_clearance": float(B.cage.pocket_clearance)},
-    }
-
-
-_PRESET: dict | None = None
-
-
-def preset_geometry() -> dict:
-    """Geometry of the reference machine (PARAMETERS.md); the fallback for files without geometry."""
-    global _PRESET
-    if _PRESET is None:
-        from components.presets import reference_dpgt  # parameters only, no engine
-        _PRESET = geometry_from_params(reference_dpgt())
-    return json.loads(json.dumps(_PRESET))  # a fresh copy: callers may edit theirs
-
 
 def _merge(base: dict, over: Mapping) -> tuple[dict, bool]:
     """base updated recursively with over; also whether base supplied anything over lacked."""
@@ -201,8 +159,11 @@ def _pose(ds, probe: str, linear: str, angular: str) -> np.ndarray | None:
                           axis=-1)
 
 
-def load_run(path) -> Run:
+def load_run(path, fallback_geometry: Mapping | None = None) -> Run:
     """Read a DPGT results file (netCDF4 written by scenarios.runner) or a run directory holding one.
+
+    ``fallback_geometry`` (the layout of :func:`components.results_schema.drawing_geometry`) supplies
+    whatever drawing geometry the file lacks; it is checked against the recorded motion.
 
     Raises :class:`ResultsError` with a clear message for a missing file, a file that is not
     netCDF4/HDF5, or a netCDF file without the DPGT layout (time, motion.position, motion.angle,
@@ -257,18 +218,7 @@ def load_run(path) -> Run:
                 raise ResultsError(f"{path}: bearing {b.get('name')!r} names body {nm!r}, which is not "
                                    "in motion.body")
 
-    # Geometry: the file first, the reference machine for anything it lacks.
-    g_file = None
-    if "geometry" in attrs:
-        g_file = _json_attr(attrs, "geometry", path)
-    elif isinstance(meta.get("geometry"), Mapping):
-        g_file = meta["geometry"]
-    if g_file:
-        geometry, filled = _merge(preset_geometry(), g_file)
-        geometry["source"] = "file+preset" if filled else "file"
-    else:
-        geometry = preset_geometry()
-        geometry["source"] = "preset"
+    geometry = _resolve_geometry(path, attrs, meta, fallback_geometry)
 
     # φ_R: exact from the carrier's pose in both frames when the file has it (θ_I = θ_R + φ),
     # otherwise from the metadata (R turns at the nominal carrier speed, or not at all).
@@ -288,6 +238,23 @@ def load_run(path) -> Run:
     if geometry["source"] != "file":
         _check_geometry(run)
     return run
+
+
+def _resolve_geometry(path: Path, attrs: Mapping, meta: Mapping, given: Mapping | None) -> dict:
+    """The file's drawing geometry, completed from ``given``; ``source`` says which was used."""
+    g_file = None
+    if "geometry" in attrs:
+        g_file = _json_attr(attrs, "geometry", path)
+    elif isinstance(meta.get("geometry"), Mapping):
+        g_file = meta["geometry"]
+    if given is None:
+        if not g_file:
+            raise ResultsError(f"{path} has no drawing geometry (attribute 'geometry'); pass load_run(..., "
+                               "fallback_geometry=components.results_schema.drawing_geometry(params))")
+        return {**json.loads(json.dumps(g_file)), "source": "file"}
+    geometry, filled = _merge(json.loads(json.dumps(dict(given))), g_file or {})
+    geometry["source"] = ("file+given" if filled else "file") if g_file else "given"
+    return geometry
 
 
 def _check_geometry(run: Run) -> None:
