@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from mbd.elements import BodySpring
-from mbd.elements.contact import (TRACTION_LAWS, GuideContact, LubricantDrag, PocketContact, RaceContact,
-                                  SlideRollTraction, TanhTraction, Traction)
+from mbd.elements.contact import (TRACTION_LAWS, ExactRestitution, GuideContact, LubricantDrag, PocketContact,
+                                  RaceContact, SlideRollTraction, TanhTraction, Traction)
 
 from .families import FAMILY
 from .scene import Scene
@@ -142,12 +142,12 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
     if opt.cage:
         cage = f"{tag}.cage"
         scene.body(cage, b.cage_mass, b.cage_inertia, pose=(*pin_xy, 0.0), vel=(*pin_vel, wm), fixed=cage_held)
-        pocket = scene.family(FAMILY["pocket"], PocketContact, ("roller", "cage"))
+        pocket = scene.family(FAMILY["pocket"], PocketContact, ("roller", "cage"), impact_law=ExactRestitution())
         h["pocket"] = pocket.add(Z, roller=names, cage=[cage] * Z, pocket_angle=psi, pitch_radius=0.5 * b.d_m,
                                  clearance=b.C_p, K_p=b.K_p, restitution=b.restitution, v_min=b.v_min,
                                  mu=b.mu_pocket, v_mu=b.v_mu, D=b.D, multiplicity=b.rows)
         if not cage_held:
-            guide = scene.family(FAMILY["guide"], GuideContact, ("cage", "planet"))
+            guide = scene.family(FAMILY["guide"], GuideContact, ("cage", "planet"), impact_law=ExactRestitution())
             h["guide"] = guide.add(1, cage=[cage], planet=[outer_body], clearance=b.C_g, K_g=b.K_g,
                                    restitution=b.restitution, v_min=b.v_min, mu=b.mu_guide, v_mu=b.v_mu,
                                    land_radius=0.5 * (b.d_m + b.D))

@@ -123,10 +123,15 @@ def test_no_physics_value_hides_in_an_element_constructor_default():
     assert not bad, f"physics values as constructor defaults: {bad}"
 
 
-def test_law_variants_have_no_default_coefficients():
-    for name, law in TRACTION_LAWS.items():
-        fields = dataclasses.fields(law)
-        assert fields and all(f.default is dataclasses.MISSING for f in fields), name
+def test_law_variants_are_registered_classes_without_default_coefficients():
+    """Traction laws, impact laws and mesh-stiffness shapes: small dataclasses registered by name, every
+    coefficient required (it comes from the parameters)."""
+    from mbd.elements import IMPACT_LAWS, STIFFNESS_SHAPES
+    for registry in (TRACTION_LAWS, IMPACT_LAWS, STIFFNESS_SHAPES):
+        for name, law in registry.items():
+            assert dataclasses.is_dataclass(law) and law.__dataclass_params__.frozen, name
+            assert all(f.default is dataclasses.MISSING for f in dataclasses.fields(law)), name
+    assert dataclasses.fields(TRACTION_LAWS["tanh"]) and dataclasses.fields(STIFFNESS_SHAPES["rectangular"])
     from mbd.elements.gear_mesh import StiffnessShape
     sig = inspect.signature(StiffnessShape.rectangular).parameters
     assert all(sig[k].default is inspect.Parameter.empty for k in ("contact_ratio", "ratio", "smoothing"))

@@ -1,13 +1,22 @@
-"""Element families. Generic ones (supports, springs, loads, drives) and the contact/mesh laws used by components."""
-from .contact import (TRACTION_LAWS, GuideContact, LubricantDrag, PocketContact, RaceContact, SlideRollTraction,
-                      TanhTraction, Traction)
+"""Element families. Generic ones (supports, springs, loads, drives) and the contact/mesh laws used by components.
+
+Law variants are small classes registered by name (a parameter chooses one): :data:`TRACTION_LAWS`
+(roller–raceway traction), :data:`IMPACT_LAWS` (pocket and guide-land impact damping),
+:data:`STIFFNESS_SHAPES` (mesh stiffness over a mesh cycle)."""
+from .contact import (IMPACT_LAWS, TRACTION_LAWS, ExactRestitution, Flores, GuideContact, HuntCrossley, ImpactLaw,
+                      LankaraniNikravesh, LubricantDrag, PocketContact, RaceContact, SlideRollTraction, TanhTraction,
+                      Traction)
 from .drives import Ramp, SpeedDrive, TorqueSource
-from .gear_mesh import GearMesh, StiffnessShape, mesh_offset, mesh_u0
+from .gear_mesh import (STIFFNESS_SHAPES, ConstantStiffness, FourierStiffness, GearMesh, RectangularStiffness,
+                        StiffnessShape, mesh_offset, mesh_u0)
 from .loads import ForceSource
 from .springs import BodySpring, GroundSupport, TorsionalSpring
 
 __all__ = [
     "BodySpring", "ForceSource", "GearMesh", "GroundSupport", "GuideContact", "LubricantDrag", "PocketContact",
-    "RaceContact", "Ramp", "SpeedDrive", "StiffnessShape", "TorqueSource", "TorsionalSpring", "Traction", "TanhTraction", "SlideRollTraction", "TRACTION_LAWS",
+    "RaceContact", "Ramp", "SpeedDrive", "TorqueSource", "TorsionalSpring",
+    "Traction", "TanhTraction", "SlideRollTraction", "TRACTION_LAWS",
+    "ImpactLaw", "ExactRestitution", "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS",
+    "StiffnessShape", "ConstantStiffness", "RectangularStiffness", "FourierStiffness", "STIFFNESS_SHAPES",
     "mesh_offset", "mesh_u0",
 ]

@@ -27,7 +27,9 @@ from .. import ad
 from ..element import Element, body_dofs, marker, marker_velocity, point_force
 from ..errors import ModelError
 
-__all__ = ["Traction", "TanhTraction", "SlideRollTraction", "TRACTION_LAWS", "RaceContact", "PocketContact", "GuideContact", "LubricantDrag", "restitution_lambda"]
+__all__ = ["Traction", "TanhTraction", "SlideRollTraction", "TRACTION_LAWS", "ImpactLaw", "ExactRestitution",
+           "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS", "RaceContact", "PocketContact",
+           "GuideContact", "LubricantDrag", "restitution_lambda"]
 
 _ETA2 = 1e-24  # (1e-12 m)²: below round-off of any physical distance squared, keeps norms nonzero
 
@@ -85,12 +87,64 @@ def restitution_lambda(e) -> np.ndarray:
     return lam[inv].reshape(e.shape)
 
 
+class ImpactLaw:
+    """Base of the impact damping laws F = K x (1 + λ ẋ/v₀) (MODEL.md §3.4): a law is the dimensionless
+    damping λ(e) = c·v₀ for a coefficient of restitution e, a small frozen dataclass registered in
+    :data:`IMPACT_LAWS` by name (a parameter chooses one)."""
+
+    def damping(self, e: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
+        raise TypeError(f"{type(self).__name__} must define damping(e)")
+
+
+@dataclass(frozen=True)
+class ExactRestitution(ImpactLaw):
+    """λ(e) from ln((1 + λ)/(1 − λe)) = λ(1 + e) (:func:`restitution_lambda`): the body leaves with
+    exactly e at any approach speed, for any exponent n of K xⁿ. The reference law."""
+
+    def damping(self, e):
+        return restitution_lambda(e)
+
+
+@dataclass(frozen=True)
+class HuntCrossley(ImpactLaw):
+    """λ = 3(1 − e)/2 (Hunt & Crossley 1975): the limit of the exact law as e → 1; too little damping
+    below e ≈ 0.9 (set e = 0.5, the body leaves at 0.66)."""
+
+    def damping(self, e):
+        return 1.5 * (1.0 - np.asarray(e, float))
+
+
+@dataclass(frozen=True)
+class LankaraniNikravesh(ImpactLaw):
+    """λ = 3(1 − e²)/4 (Lankarani & Nikravesh 1990): energy balance with the Hertz-contact work; set
+    e = 0.5, the body leaves at 0.73."""
+
+    def damping(self, e):
+        e = np.asarray(e, float)
+        return 0.75 * (1.0 - e * e)
+
+
+@dataclass(frozen=True)
+class Flores(ImpactLaw):
+    """λ = 8(1 − e)/(5e) (Flores et al. 2011): meant for soft impacts (small e); set e = 0.5, the body
+    leaves at 0.47."""
+
+    def damping(self, e):
+        e = np.asarray(e, float)
+        return 1.6 * (1.0 - e) / e
+
+
+# the impact damping laws by name (a parameter chooses one)
+IMPACT_LAWS = MappingProxyType({"exact": ExactRestitution, "hunt_crossley": HuntCrossley,
+                                "lankarani_nikravesh": LankaraniNikravesh, "flores": Flores})
+
+
 class _Impact(Element):
     """Hunt–Crossley impact with the real approach speed (MODEL.md §3.4), shared by the pocket and
     guide-land contacts. Subclasses define ``_gap(q, v) -> (x, ẋ)`` (penetration and its rate).
 
     F = K x (1 + c ẋ) for x > 0, clipped at ≥ 0 (never pulling), else 0;  c = λ(e)/v₀ with λ(e) from
-    :func:`restitution_lambda` and v₀ the approach speed ẋ at this impact's onset (internal state).
+    the element's :class:`ImpactLaw` and v₀ the approach speed ẋ at this impact's onset (internal state).
     Internal state z, (n, 4): [v₀ (0 = not in contact), x, ẋ, valid] — x, ẋ at the last accepted state
     (valid = 1 once set). After each accepted step: open at the end → v₀ = 0; closed and v₀ was 0 (a new
     impact) → v₀ = ẋ at the sign change of x, linearly interpolated between the step's ends (the end rate
@@ -98,14 +152,18 @@ class _Impact(Element):
     Newton iterations of the step where contact begins (stored v₀ = 0) the iterate's max(ẋ, v_min) is
     used, so the kernel is stateless within a step and differentiable."""
 
-    def _impact_params(self, restitution, v_min):
+    def _impact_params(self, restitution, v_min, law):
+        if not isinstance(law, ImpactLaw):
+            raise ModelError(f"{self.name}: parameter 'impact_law' must be an ImpactLaw (one of "
+                             f"{sorted(IMPACT_LAWS)}), got {law!r}")
+        self.impact_law = law
         e = self._per_instance("restitution", restitution)
         if np.any(e <= 0.0) or np.any(e > 1.0):
             raise ModelError(f"{self.name}: parameter 'restitution' must lie in (0, 1] (0, perfectly plastic, "
                              f"would need infinite damping), got {restitution!r}")
         self.restitution = e
         self.v_min = self._per_instance("v_min", v_min, positive=True)
-        self.lam = restitution_lambda(e)
+        self.lam = np.asarray(law.damping(e), float)
 
     def init_internal(self):
         return np.zeros((self.n, 4))
@@ -336,14 +394,14 @@ class PocketContact(_Impact):
     k = 6
 
     def __init__(self, name, roller, cage, *, pocket_angle, pitch_radius, clearance, K_p, restitution,
-                 v_min, mu, v_mu, D, multiplicity=1):
+                 impact_law, v_min, mu, v_mu, D, multiplicity=1):
         self.name = name
         self.dofs = body_dofs(roller, cage)
         self.pocket_angle = self._per_instance("pocket_angle", pocket_angle)
         self.pitch_radius = self._per_instance("pitch_radius", pitch_radius, positive=True)
         self.clearance = self._per_instance("clearance", clearance, nonneg=True)
         self.K_p = self._per_instance("K_p", K_p, positive=True)
-        self._impact_params(restitution, v_min)
+        self._impact_params(restitution, v_min, impact_law)
         self.mu = self._per_instance("mu", mu, nonneg=True)
         self.v_mu = self._per_instance("v_mu", v_mu, positive=True)
         self.D = self._per_instance("D", D, positive=True)
@@ -415,12 +473,13 @@ class GuideContact(_Impact):
     """
     k = 6
 
-    def __init__(self, name, cage, planet, *, clearance, K_g, restitution, v_min, mu, v_mu, land_radius):
+    def __init__(self, name, cage, planet, *, clearance, K_g, restitution, impact_law, v_min, mu, v_mu,
+                 land_radius):
         self.name = name
         self.dofs = body_dofs(cage, planet)
         self.clearance = self._per_instance("clearance", clearance, nonneg=True)
         self.K_g = self._per_instance("K_g", K_g, positive=True)
-        self._impact_params(restitution, v_min)
+        self._impact_params(restitution, v_min, impact_law)
         self.mu = self._per_instance("mu", mu, nonneg=True)
         self.v_mu = self._per_instance("v_mu", v_mu, positive=True)
         self.land_radius = self._per_instance("land_radius", land_radius, positive=True)

@@ -30,13 +30,15 @@ gear 1's angle relative to the line of centres, measured from the direction e th
 centre to its contact zone in both kinds (external: towards gear 2; internal: from the ring centre out
 through the planet to where it touches the ring). It is computed from the states, never from time.
 
-Mesh-cycle convention of :class:`StiffnessShape` ("rectangular"): double-tooth contact is centred
+Mesh-cycle convention of :class:`RectangularStiffness`: double-tooth contact is centred
 on p = (ε_α − 1)/2, i.e. it spans p ∈ [0, ε_α − 1) (a new tooth pair enters at p = 0) and single
 contact spans [ε_α − 1, 1). Components choose p0 from the real tooth positions accordingly.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 
@@ -44,7 +46,8 @@ from .. import ad
 from ..element import Element, body_dofs
 from ..errors import ModelError
 
-__all__ = ["StiffnessShape", "GearMesh", "mesh_offset", "mesh_u0", "contact_ratio_to_fraction"]
+__all__ = ["StiffnessShape", "ConstantStiffness", "RectangularStiffness", "FourierStiffness", "STIFFNESS_SHAPES",
+           "GearMesh", "mesh_offset", "mesh_u0", "contact_ratio_to_fraction"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -57,88 +60,127 @@ def contact_ratio_to_fraction(contact_ratio) -> float:
     return eps - 1.0
 
 
-@dataclass(frozen=True)
 class StiffnessShape:
-    """Shape of the mesh stiffness over one mesh cycle: k(p) = k_mean · factor(p), mean(factor) = 1.
+    """Base of the mesh-stiffness shapes k(p) = k_mean · factor(p), mean(factor) = 1, p the mesh position
+    in cycles (any real; period 1). A shape is a small frozen dataclass registered in
+    :data:`STIFFNESS_SHAPES` by name; :class:`GearMesh` evaluates it per family through ``fuse_key``,
+    ``instance_args`` (per-instance arrays, so that families of one shape fuse) and ``family_factor``.
+    The constructors :meth:`constant`, :meth:`rectangular`, :meth:`fourier` build the registered kinds."""
+    single = 1.0     # k_single / k_mean and k_double / k_mean (1 unless the shape has two levels)
+    double = 1.0
 
-    kind "constant": factor 1.
-    kind "rectangular": smoothed rectangular wave between k_single and k_double = ratio·k_single;
-        double contact over the fraction ε_α − 1 of each cycle (p ∈ [0, ε_α − 1) with the ramps centred
-        on the edges); each edge is a quintic smoothstep (C², exactly periodic) of full width
-        ``smoothing`` cycles, which must not exceed min(ε_α − 1, 2 − ε_α).
-    kind "fourier": factor = 1 + Σ_j a_j cos(2πjp) + b_j sin(2πjp), j = 1, 2, ...; must stay > 0.
+    def factor(self, p):  # pragma: no cover - abstract
+        raise TypeError(f"{type(self).__name__} must define factor(p)")
 
-    Use the constructors :meth:`constant`, :meth:`rectangular`, :meth:`fourier`.
-    """
-    kind: str = "constant"
-    contact_ratio: float = 1.0      # the neutral values of the constant shape; rectangular() needs all three
-    ratio: float = 1.0
-    smoothing: float = 0.0
-    a: tuple = ()
-    b: tuple = ()
+    def fuse_key(self) -> tuple:
+        """Families whose shapes have equal keys can be evaluated as one."""
+        return (type(self).__name__, *(getattr(self, f.name) for f in dataclasses.fields(self)))
+
+    def instance_args(self, n: int) -> tuple:
+        """Per-instance (n,) arrays that ``family_factor`` reads (none: the shape is family-wide)."""
+        return ()
+
+    def family_factor(self, p, args: tuple):
+        """factor(p) of a (fused) family, from its concatenated ``instance_args``; Dual-capable."""
+        return self.factor(p)
+
+    @staticmethod
+    def constant() -> "ConstantStiffness":
+        return ConstantStiffness()
+
+    @staticmethod
+    def rectangular(contact_ratio: float, ratio: float, smoothing: float) -> "RectangularStiffness":
+        return RectangularStiffness(float(contact_ratio), float(ratio), float(smoothing))
+
+    @staticmethod
+    def fourier(a=(), b=()) -> "FourierStiffness":
+        return FourierStiffness(a=tuple(np.atleast_1d(np.asarray(a, float))),
+                                b=tuple(np.atleast_1d(np.asarray(b, float))))
+
+
+@dataclass(frozen=True)
+class ConstantStiffness(StiffnessShape):
+    """factor 1: k = k_mean."""
+
+    def factor(self, p):
+        return 1.0
+
+
+@dataclass(frozen=True)
+class RectangularStiffness(StiffnessShape):
+    """Smoothed rectangular wave between k_single and k_double = ratio·k_single: double contact over the
+    fraction ε_α − 1 of each cycle (p ∈ [0, ε_α − 1) with the ramps centred on the edges); each edge is a
+    quintic smoothstep (C², exactly periodic) of full width ``smoothing`` cycles, which must not exceed
+    min(ε_α − 1, 2 − ε_α)."""
+    contact_ratio: float
+    ratio: float
+    smoothing: float
 
     def __post_init__(self):
-        if self.kind not in ("constant", "rectangular", "fourier"):
-            raise ModelError(f"StiffnessShape: kind must be 'constant', 'rectangular' or 'fourier', got {self.kind!r}")
-        if self.kind == "rectangular":
-            frac = contact_ratio_to_fraction(self.contact_ratio)
-            if not (np.isfinite(self.ratio) and self.ratio > 0):
-                raise ModelError(f"StiffnessShape: ratio k_double/k_single must be > 0, got {self.ratio!r}")
-            s_max = min(frac, 1.0 - frac)
-            if not (np.isfinite(self.smoothing) and 0 < self.smoothing <= s_max):
-                raise ModelError(
-                    f"StiffnessShape: smoothing (ramp width, fraction of a mesh cycle) must be in (0, {s_max:.4g}] "
-                    f"for contact_ratio {self.contact_ratio!r} (ramps may not overlap), got {self.smoothing!r}")
-        if self.kind == "fourier":
-            a = np.asarray(self.a, float).ravel()
-            b = np.asarray(self.b, float).ravel()
-            if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
-                raise ModelError(f"StiffnessShape: Fourier coefficients a, b must be finite, got a={self.a!r}, b={self.b!r}")
-            object.__setattr__(self, "a", tuple(a.tolist()))
-            object.__setattr__(self, "b", tuple(b.tolist()))
-            nh = max(len(self.a), len(self.b), 1)
-            p = np.linspace(0.0, 1.0, 64 * nh, endpoint=False)
-            if np.min(self.factor(p)) <= 0.0:
-                raise ModelError("StiffnessShape: Fourier stiffness 1 + Σ a_j cos + b_j sin must stay > 0 over the cycle, "
-                                 f"got a={self.a!r}, b={self.b!r}")
+        frac = contact_ratio_to_fraction(self.contact_ratio)
+        if not (np.isfinite(self.ratio) and self.ratio > 0):
+            raise ModelError(f"StiffnessShape: ratio k_double/k_single must be > 0, got {self.ratio!r}")
+        s_max = min(frac, 1.0 - frac)
+        if not (np.isfinite(self.smoothing) and 0 < self.smoothing <= s_max):
+            raise ModelError(
+                f"StiffnessShape: smoothing (ramp width, fraction of a mesh cycle) must be in (0, {s_max:.4g}] "
+                f"for contact_ratio {self.contact_ratio!r} (ramps may not overlap), got {self.smoothing!r}")
 
-    @classmethod
-    def constant(cls) -> "StiffnessShape":
-        return cls("constant")
-
-    @classmethod
-    def rectangular(cls, contact_ratio: float, ratio: float, smoothing: float) -> "StiffnessShape":
-        return cls("rectangular", contact_ratio=float(contact_ratio), ratio=float(ratio), smoothing=float(smoothing))
-
-    @classmethod
-    def fourier(cls, a=(), b=()) -> "StiffnessShape":
-        return cls("fourier", a=tuple(np.atleast_1d(np.asarray(a, float))), b=tuple(np.atleast_1d(np.asarray(b, float))))
-
-    # rectangular wave levels relative to k_mean
     @property
     def single(self) -> float:
-        """k_single / k_mean (1 for the other kinds)."""
-        if self.kind != "rectangular":
-            return 1.0
         return 1.0 / (1.0 + (self.ratio - 1.0) * (self.contact_ratio - 1.0))
 
     @property
     def double(self) -> float:
-        """k_double / k_mean (1 for the other kinds)."""
-        return self.ratio * self.single if self.kind == "rectangular" else 1.0
+        return self.ratio * self.single
+
+    def _args(self):
+        return 0.5 * (self.contact_ratio - 1.0), self.smoothing, self.single, self.ratio
 
     def factor(self, p):
-        """k(p)/k_mean for mesh position p (any real; periodic with period 1); Dual-capable."""
-        if self.kind == "constant":
-            return 1.0
-        if self.kind == "fourier":
-            out = 1.0
-            for j, aj in enumerate(self.a, start=1):
-                out = out + aj * ad.cos(_TWO_PI * j * p)
-            for j, bj in enumerate(self.b, start=1):
-                out = out + bj * ad.sin(_TWO_PI * j * p)
-            return out
-        return _rect_factor(p, 0.5 * (self.contact_ratio - 1.0), self.smoothing, self.single, self.ratio)
+        return _rect_factor(p, *self._args())
+
+    def fuse_key(self):
+        return ("RectangularStiffness",)      # parameters are per instance: any two rectangular families fuse
+
+    def instance_args(self, n):
+        return tuple(np.full(n, x) for x in self._args())
+
+    def family_factor(self, p, args):
+        return _rect_factor(p, *args)
+
+
+@dataclass(frozen=True)
+class FourierStiffness(StiffnessShape):
+    """factor = 1 + Σ_j a_j cos(2πjp) + b_j sin(2πjp), j = 1, 2, ...; must stay > 0 over the cycle."""
+    a: tuple
+    b: tuple
+
+    def __post_init__(self):
+        a = np.asarray(self.a, float).ravel()
+        b = np.asarray(self.b, float).ravel()
+        if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+            raise ModelError(f"StiffnessShape: Fourier coefficients a, b must be finite, got a={self.a!r}, b={self.b!r}")
+        object.__setattr__(self, "a", tuple(a.tolist()))
+        object.__setattr__(self, "b", tuple(b.tolist()))
+        nh = max(len(self.a), len(self.b), 1)
+        p = np.linspace(0.0, 1.0, 64 * nh, endpoint=False)
+        if np.min(self.factor(p)) <= 0.0:
+            raise ModelError("StiffnessShape: Fourier stiffness 1 + Σ a_j cos + b_j sin must stay > 0 over the cycle, "
+                             f"got a={self.a!r}, b={self.b!r}")
+
+    def factor(self, p):
+        out = 1.0
+        for j, aj in enumerate(self.a, start=1):
+            out = out + aj * ad.cos(_TWO_PI * j * p)
+        for j, bj in enumerate(self.b, start=1):
+            out = out + bj * ad.sin(_TWO_PI * j * p)
+        return out
+
+
+# the mesh-stiffness shapes by name
+STIFFNESS_SHAPES = MappingProxyType({"constant": ConstantStiffness, "rectangular": RectangularStiffness,
+                                     "fourier": FourierStiffness})
 
 
 def _rect_factor(p, h, s, single, ratio):
@@ -232,17 +274,13 @@ class GearMesh(Element):
         # per instance, so that families of different kinds can be evaluated as one (System fusion)
         self.sigma = np.full(self.n, -1.0 if self.internal else 1.0)
         self.sin_alpha = np.sin(self.alpha)
-        sh = self.stiffness
-        if sh.kind == "rectangular":
-            self._wave = tuple(np.full(self.n, x) for x in
-                               (0.5 * (sh.contact_ratio - 1.0), sh.smoothing, sh.single, sh.ratio))
+        self._shape_args = self.stiffness.instance_args(self.n)
 
     _FUSED = ("dofs", "rb1", "rb2", "alpha", "a0", "teeth1", "k_mean", "c_mesh", "u0", "p0", "backlash",
               "phi_ref", "pitch", "kappa0", "sigma", "sin_alpha")
 
     def fuse_key(self):
-        sh = self.stiffness
-        return ("GearMesh", sh.kind, sh.a, sh.b) if sh.kind != "rectangular" else ("GearMesh", "rectangular")
+        return ("GearMesh", *self.stiffness.fuse_key())
 
     @classmethod
     def fuse(cls, parts):
@@ -250,14 +288,11 @@ class GearMesh(Element):
         f = super().fuse(parts)
         f.internal = None
         f.stiffness = parts[0].stiffness
-        if f.stiffness.kind == "rectangular":
-            f._wave = tuple(np.concatenate([p._wave[i] for p in parts]) for i in range(4))
+        f._shape_args = tuple(np.concatenate(cols) for cols in zip(*(p._shape_args for p in parts)))
         return f
 
     def _factor(self, p):
-        if self.stiffness.kind == "rectangular":
-            return _rect_factor(p, *self._wave)
-        return self.stiffness.factor(p)
+        return self.stiffness.family_factor(p, self._shape_args)
 
     def kernel(self, t, fs, q, v, z):
         x1, y1, th1, x2, y2, th2 = q
