@@ -314,6 +314,23 @@ def _roller_ring(p, view, Z, ring_r, r_roll, col):
     return moving, ideal, r_roll * unit
 
 
+def _orbit_scales(orb, clr, rol, magnify):
+    """Panel geometry of the orbit animation: E bounds each orbit; rollers sit on a schematic ring
+    (radius ring_r, drawn radius r_roll) outside it; one roller-offset magnification for all panels, so
+    that they compare (auto: the largest offset moves a roller by half its drawn radius in the
+    tightest panel)."""
+    E = {k: 1.08 * max(clr[k], float(np.nanmax(np.hypot(v[:, 0], v[:, 1])))) for k, v in orb.items()}
+    ring_r = {k: 1.45 * E[k] for k in rol}
+    r_roll = {k: min(0.32 * 2 * np.pi * ring_r[k] / v.shape[1], 0.22 * E[k]) for k, v in rol.items()}
+    max_off = {k: float(np.nanmax(np.hypot(v[..., 0], v[..., 1]))) for k, v in rol.items()}
+    if magnify is not None:
+        mag = float(magnify)
+    else:
+        ratios = [0.5 * r_roll[k] / max_off[k] for k in rol if max_off[k] > 0]
+        mag = min(ratios) if ratios else 1.0
+    return E, ring_r, r_roll, max_off, mag
+
+
 def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
                          magnify: float | None = None, rollers: Mapping[str, np.ndarray] | None = None,
                          fps: float = 20, size: Sequence[int] = (800, 400), title: str | None = None,
@@ -345,20 +362,7 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
         fs = _font(panel_px[1], 0.04, longest, panel_px[0])
         fs_small = _font(panel_px[1], 0.03, "t = 00.00 ms", 0.6 * panel_px[0])
 
-        # Panel geometry: E bounds the orbit; rollers sit on a schematic ring outside it.
-        E = {k: 1.08 * max(clr[k], float(np.nanmax(np.hypot(v[:, 0], v[:, 1]))))
-             for k, v in orb.items()}
-        ring_r = {k: 1.45 * E[k] for k in rol}
-        r_roll = {k: min(0.32 * 2 * np.pi * ring_r[k] / v.shape[1], 0.22 * E[k])
-                  for k, v in rol.items()}
-        max_off = {k: float(np.nanmax(np.hypot(v[..., 0], v[..., 1]))) for k, v in rol.items()}
-        # One magnification for all panels, so that they are comparable; auto: the largest offset
-        # moves a roller by half its drawn radius in the tightest panel.
-        if magnify is not None:
-            mag = float(magnify)
-        else:
-            ratios = [0.5 * r_roll[k] / max_off[k] for k in rol if max_off[k] > 0]
-            mag = min(ratios) if ratios else 1.0
+        E, ring_r, r_roll, max_off, mag = _orbit_scales(orb, clr, rol, magnify)
         first_rol = next((k for k in labels if k in rol), None)  # gets the magnification note
         views, trails, markers, time_actors, roller_meshes = [], [], [], [], []
         for j, lab in enumerate(labels):
@@ -391,13 +395,12 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
                 for j, lab in enumerate(labels):
                     seg = np.arange(i + 1) if i > 0 else np.zeros(2, int)  # orbit so far
                     trails[j].lines = np.r_[seg.size, seg]
-                    z = views[j].z_step
-                    markers[j].points = _xyz(orb[lab][i:i + 1], 3 * z)
+                    markers[j].points = _xyz(orb[lab][i:i + 1], 3 * views[j].z_step)
                     time_actors[j].input = tfmt(t[i])
                 for moving, ideal, ring_pts, lab in roller_meshes:
                     c = ideal + mag * rol[lab][i]
-                    z = views[labels.index(lab)].z_step
-                    moving.points = _xyz((c[:, None, :] + ring_pts[None]).reshape(-1, 2), 2 * z)
+                    moving.points = _xyz((c[:, None, :] + ring_pts[None]).reshape(-1, 2),
+                                         2 * views[labels.index(lab)].z_step)
                 writer.append(_screenshot(p, (W, H)))
     finally:
         p.close()
@@ -528,6 +531,20 @@ def _roller_discs(p, rollers, idx, n_t, has_force, force_label, fs):
     return disc, fr
 
 
+_LAYER = {"ring": 2, "carrier": 3, "gear": 4, "cage": 5, "roller": 6}   # drawing order, back to front
+
+
+def _train_extent(parsed, idx):
+    """(centre, half extents) of everything drawn over the frames shown, with a 3 % margin."""
+    lo = np.full(2, np.inf)
+    hi = np.full(2, -np.inf)
+    for b in parsed:
+        pad = b["radius"] * (1 + (2.0 / b["teeth"] if b.get("teeth") else 0.0))
+        lo = np.minimum(lo, b["xy"][idx].min(axis=0) - pad)
+        hi = np.maximum(hi, b["xy"][idx].max(axis=0) + pad)
+    return (hi + lo) / 2, (hi - lo) / 2 * 1.03
+
+
 def train_animation(path, t, bodies: Sequence[Mapping], magnify: float = 1.0, fps: float = 20,
                     size: Sequence[int] = (600, 600), title: str | None = None,
                     max_frames: int | None = None, force_label: str = "roller force (N)") -> Path:
@@ -551,15 +568,7 @@ def train_animation(path, t, bodies: Sequence[Mapping], magnify: float = 1.0, fp
     idx = frame_indices(n_t, max_frames)
     tfmt = _time_formatter(t[idx])
 
-    # Extent of everything drawn, over the frames shown.
-    lo = np.full(2, np.inf)
-    hi = np.full(2, -np.inf)
-    for b in parsed:
-        pad = b["radius"] * (1 + (2.0 / b["teeth"] if b.get("teeth") else 0.0))
-        lo = np.minimum(lo, b["xy"][idx].min(axis=0) - pad)
-        hi = np.maximum(hi, b["xy"][idx].max(axis=0) + pad)
-    centre = (hi + lo) / 2
-    half = (hi - lo) / 2 * 1.03
+    centre, half = _train_extent(parsed, idx)
 
     rollers = [b for b in parsed if b["kind"] == "roller"]
     forces = [b["force"] for b in rollers if b["force"] is not None]
@@ -575,7 +584,6 @@ def train_animation(path, t, bodies: Sequence[Mapping], magnify: float = 1.0, fp
         fs = _font(H, 0.028)
 
         groups = _outline_groups(parsed)
-        place = _place_outline
         disc, fr = None, None
         if rollers:
             disc, fr = _roller_discs(p, rollers, idx, n_t, has_force, force_label, fs)
@@ -583,24 +591,21 @@ def train_animation(path, t, bodies: Sequence[Mapping], magnify: float = 1.0, fp
             disc_xy = np.stack([b["xy"] for b in rollers])  # (n_r, n_t, 2)
             unit = _circle(_DISC_SIDES)
 
-        layer = {"ring": 2, "carrier": 3, "gear": 4, "cage": 5, "roller": 6}
         for g in groups:
-            g["mesh"].points = place(g, idx[0], layer[g["kind"]] * z)
+            g["mesh"].points = _place_outline(g, idx[0], _LAYER[g["kind"]] * z)
             width = 1.0 if g["kind"] == "roller" else 1.6
             p.add_mesh(g["mesh"], color=_KIND_COLOR[g["kind"]], line_width=width, lighting=False)
 
-        if title:
-            # shrink a long title to fit the width rather than let it run off the frame
-            ta = view.text(title, (0.02, 0.96), min(fs, _font(H, 0.028, title, int(0.96 * W))),
-                           bold=True)
-            ta.prop.justification_vertical = "top"
+        if title:     # shrink a long title to fit the width rather than let it run off the frame
+            view.text(title, (0.02, 0.96), min(fs, _font(H, 0.028, title, int(0.96 * W))), bold=True,
+                      valign="top")
         view.scale_bar(fx0=0.04, fy0=0.04, frac=0.22, size=fs)
         time_actor = view.text(tfmt(t[idx[0]]), (band_x1, 0.02), fs, justify="right")
 
         with _Writer(path, fps) as writer:
             for i in idx:
                 for g in groups:
-                    g["mesh"].points = place(g, i, layer[g["kind"]] * z)
+                    g["mesh"].points = _place_outline(g, i, _LAYER[g["kind"]] * z)
                 if disc is not None:
                     c = disc_xy[:, i, :]
                     pts = (c[:, None, :] + rr[:, None, None] * unit[None]).reshape(-1, 2)
