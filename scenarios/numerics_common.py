@@ -204,7 +204,7 @@ def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float
     if tol is None:
         tol = mbd.Tolerance() if atol_pos is None else mbd.Tolerance(atol_pos=atol_pos, atol_rot=100 * atol_pos)
     stepper = mbd.HHT(alpha=alpha, tol=tol) if newton_tol is None else mbd.HHT(alpha=alpha, tol=tol, newton_tol=newton_tol)
-    walls, res, sampler, err = [], None, None, ""
+    walls, res, sampler = [], None, None
     for r in range(max(1, repeats)):
         ctrl = mbd.FixedStep(h) if h is not None else mbd.Adaptive(h0=min(5e-6, h_max), h_max=h_max, h_min=1e-10)
         smp = StateSampler(grid) if r == 0 else None
