@@ -5,7 +5,7 @@ families (:mod:`mbd.element`); sparse assembly (:class:`System`); HHT-α stepper
 and one :func:`simulate` loop; chunked atomic :class:`Recorder`; a scipy ``solve_ivp`` adapter;
 linearization and modal analysis. It knows nothing about gears or bearings.
 """
-from .assembly import Counters, System
+from .assembly import Evaluation, System
 from .control import Adaptive, FixedStep
 from .element import Element, body_dofs, marker, marker_velocity, point_force
 from .errors import IntegrationError, ModelError
@@ -15,10 +15,10 @@ from .model import BodyRef, Frame, FrameState, Model, ModelBuilder, State, to_fi
 from .recorder import BodyMotion, ElementOutput, Recorder
 from .scipy_adapter import FirstOrderSystem, solve_scipy
 from .settings import PRODUCTION, IntegratorSettings
-from .simulate import Checkpoint, Observer, SimResult, TimeMean, load_state, save_state, simulate
+from .simulate import Checkpoint, Counters, Observer, SimResult, TimeMean, load_state, save_state, simulate
 
 __all__ = [
-    "Adaptive", "BodyMotion", "BodyRef", "Checkpoint", "Counters", "Element", "ElementOutput",
+    "Adaptive", "BodyMotion", "BodyRef", "Checkpoint", "Counters", "Element", "ElementOutput", "Evaluation",
     "FirstOrderSystem", "FixedStep", "Frame", "FrameState", "HHT", "IntegratorSettings", "PRODUCTION", "IntegrationError", "Model",
     "ModelBuilder", "ModelError", "Observer", "Recorder", "SimResult", "State", "System", "TimeMean", "Tolerance",
     "body_dofs", "hht_coefficients", "linearize", "load_state", "marker", "marker_velocity",

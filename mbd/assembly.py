@@ -1,10 +1,12 @@
 """Assembly: element families → residual forces and a sparse Newton matrix with a fixed pattern.
 
 The integrator sees only this interface (Chrono's ChIntegrable idea):
-    forces(t, q, v, z, jac)            -> F on the free DOFs (and Jacobian values on the pattern)
-    newton_matrix(c_M, c_C, c_K)       -> c_M·M + c_C·C + c_K·K as CSC (C = −∂F/∂v, K = −∂F/∂q)
+    evaluate(t, q, v, z, jac)          -> Evaluation: F on the free DOFs (and Jacobian values on the pattern)
+    newton_matrix(ev, c_M, c_C, c_K)   -> c_M·M + c_C·C + c_K·K as CSC (C = −∂F/∂v, K = −∂F/∂q)
 The sparsity pattern (every element block, the frame terms, the mass diagonal) is computed once;
-a Jacobian evaluation only refreshes the ``data`` array through a precomputed scatter map.
+a Jacobian evaluation only fills ``data`` arrays through a precomputed scatter map. A System holds
+no evaluation results between calls: what an evaluation computes is returned, and the caller (the
+stepper, a linearization) passes it on; evaluations are counted by the simulate loop, not here.
 """
 from __future__ import annotations
 
@@ -14,23 +16,19 @@ import numpy as np
 import scipy.sparse as sp
 
 from .element import evaluate
-from .errors import IntegrationError
+from .errors import IntegrationError, ModelError
 from .model import Model
 
-__all__ = ["System", "Counters"]
+__all__ = ["System", "Evaluation"]
 
 
-@dataclass
-class Counters:
-    residual: int = 0     # force evaluations without Jacobian
-    jacobian: int = 0     # force + Jacobian evaluations
-    factor: int = 0       # LU factorizations
-    newton: int = 0       # Newton iterations
-    accepted: int = 0
-    rejected: int = 0
-
-    def as_dict(self) -> dict:
-        return dict(self.__dict__)
+@dataclass(frozen=True)
+class Evaluation:
+    """The result of one force evaluation: ``F`` on the free DOFs and, when the Jacobian was asked
+    for, ∂F/∂q and ∂F/∂v as data arrays on the System's fixed CSC pattern (else None)."""
+    F: np.ndarray
+    Jq: np.ndarray | None = None
+    Jv: np.ndarray | None = None
 
 
 def _fused_families(elements, fuse: bool):
@@ -59,7 +57,6 @@ class System:
         self.model = model
         self.freeze_internal = bool(freeze_internal)
         self.ndof = n = model.ndof
-        self.counters = Counters()
         m = model
         f2f = m.full_to_free
         self._evals = _fused_families(m.elements, fuse)
@@ -102,8 +99,6 @@ class System:
             self._frame_map = inv[off: off + 4 * free_bodies.size]
             off += 4 * free_bodies.size
         self._diag_map = inv[off: off + n]
-        self.Jq = np.zeros(self.nnz)   # ∂F/∂q on the pattern
-        self.Jv = np.zeros(self.nnz)   # ∂F/∂v on the pattern
         self._M = np.zeros(self.nnz)
         self._M[self._diag_map] = m.mdiag
         self._mx = m.mass[free_bodies]
@@ -123,30 +118,31 @@ class System:
                 z[e.name] = np.asarray(zi, dtype=float)
         return z
 
-    def forces(self, t: float, q: np.ndarray, v: np.ndarray, z: dict, jac: bool = False) -> np.ndarray:
-        """Total generalized force on the free DOFs; with ``jac`` also refresh self.Jq / self.Jv."""
+    def evaluate(self, t: float, q: np.ndarray, v: np.ndarray, z: dict, jac: bool = False) -> Evaluation:
+        """Total generalized force on the free DOFs; with ``jac`` also ∂F/∂q and ∂F/∂v on the pattern."""
         m = self.model
         fs = m.frame.at(t)
         qf, vf = m.full(t, q, v)
         Ffull = np.zeros(3 * m.n_bodies)
-        if jac:
-            self.counters.jacobian += 1
-            self.Jq[:] = 0.0
-            self.Jv[:] = 0.0
-        else:
-            self.counters.residual += 1
+        Jq_all = np.zeros(self.nnz) if jac else None
+        Jv_all = np.zeros(self.nnz) if jac else None
         for (e, parts), flat, (keep, mp) in zip(self._evals, self._dofs_flat, self._maps):
             F, _, Jq, Jv = evaluate(e, t, fs, qf, vf, z.get(parts[0][0]) if len(parts) == 1 else None, jac)
             Ffull += np.bincount(flat, weights=F.ravel(), minlength=Ffull.size)
             if jac:
-                self.Jq += np.bincount(mp, weights=Jq.ravel()[keep], minlength=self.nnz)
-                self.Jv += np.bincount(mp, weights=Jv.ravel()[keep], minlength=self.nnz)
+                Jq_all += np.bincount(mp, weights=Jq.ravel()[keep], minlength=self.nnz)
+                Jv_all += np.bincount(mp, weights=Jv.ravel()[keep], minlength=self.nnz)
         F = Ffull[m.free]
-        self._add_frame_terms(F, fs, q, v, jac)
-        return F
+        self._add_frame_terms(F, Jq_all, Jv_all, fs, q, v)
+        return Evaluation(F, Jq_all, Jv_all)
 
-    def _add_frame_terms(self, F, fs, q, v, jac):
-        """Centrifugal, Coriolis, Euler and gravity terms of every free body (MODEL.md §2)."""
+    def forces(self, t: float, q: np.ndarray, v: np.ndarray, z: dict) -> np.ndarray:
+        """F alone (shorthand for ``evaluate(...).F``)."""
+        return self.evaluate(t, q, v, z).F
+
+    def _add_frame_terms(self, F, Jq, Jv, fs, q, v):
+        """Centrifugal, Coriolis, Euler and gravity terms of every free body (MODEL.md §2), added in
+        place to F and, when given (not None), to the Jacobian data Jq, Jv."""
         m = self.model
         bx, by, bt, mx = self._bx, self._by, self._bt, self._mx
         if self.has_gravity:
@@ -161,23 +157,32 @@ class System:
         F[bx] += mx * (W * W * x + 2 * W * vy + dW * y)
         F[by] += mx * (W * W * y - 2 * W * vx - dW * x)
         F[bt] -= self._J * dW
-        if jac:
+        if Jq is not None:
             nb = bx.size
             # pattern order: (bx,bx), (bx,by), (by,bx), (by,by)
             jq = np.concatenate([mx * W * W, mx * dW, -mx * dW, mx * W * W])
             jv = np.concatenate([np.zeros(nb), 2 * W * mx, -2 * W * mx, np.zeros(nb)])
-            self.Jq += np.bincount(self._frame_map, weights=jq, minlength=self.nnz)
-            self.Jv += np.bincount(self._frame_map, weights=jv, minlength=self.nnz)
+            Jq += np.bincount(self._frame_map, weights=jq, minlength=self.nnz)
+            Jv += np.bincount(self._frame_map, weights=jv, minlength=self.nnz)
 
-    def newton_matrix(self, c_M: float, c_C: float, c_K: float) -> sp.csc_matrix:
-        """c_M·M + c_C·C + c_K·K with C = −J_v, K = −J_q (values from the last Jacobian evaluation)."""
-        data = c_M * self._M - c_C * self.Jv - c_K * self.Jq
+    def _csc(self, data) -> sp.csc_matrix:
         return sp.csc_matrix((data, self._indices, self._indptr), shape=(self.ndof, self.ndof))
 
-    def matrices(self):
-        """(M, C, K) as CSC from the last Jacobian evaluation (for linearization)."""
-        mk = lambda d: sp.csc_matrix((d, self._indices, self._indptr), shape=(self.ndof, self.ndof))
-        return mk(self._M.copy()), mk(-self.Jv), mk(-self.Jq)
+    @staticmethod
+    def _jacobian(ev: Evaluation):
+        if ev.Jq is None or ev.Jv is None:
+            raise ModelError("this needs an evaluation with the Jacobian: System.evaluate(..., jac=True)")
+        return ev.Jq, ev.Jv
+
+    def newton_matrix(self, ev: Evaluation, c_M: float, c_C: float, c_K: float) -> sp.csc_matrix:
+        """c_M·M + c_C·C + c_K·K with C = −J_v, K = −J_q from the Jacobian evaluation ``ev``."""
+        Jq, Jv = self._jacobian(ev)
+        return self._csc(c_M * self._M - c_C * Jv - c_K * Jq)
+
+    def matrices(self, ev: Evaluation):
+        """(M, C, K) as CSC from the Jacobian evaluation ``ev`` (for linearization)."""
+        Jq, Jv = self._jacobian(ev)
+        return self._csc(self._M.copy()), self._csc(-Jv), self._csc(-Jq)
 
     # ------------------------------------------------------------------------------------------
     def family_forces(self, t, q, v, z) -> dict[str, float]:

@@ -6,9 +6,11 @@ class ModelError(ValueError):
 
 
 class IntegrationError(RuntimeError):
-    """The integrator could not continue (step too small, non-finite forces)."""
+    """The integrator could not continue (step too small, non-finite forces). ``counters``: the run's
+    counters (a dict as in SimResult) up to the failure, set by :func:`mbd.simulate`."""
 
-    def __init__(self, message: str, state=None, saved_to=None):
+    def __init__(self, message: str, state=None, saved_to=None, counters=None):
         super().__init__(message)
         self.state = state
         self.saved_to = saved_to
+        self.counters = counters

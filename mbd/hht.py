@@ -11,12 +11,14 @@ Jacobian/LU reuse policy (modified Newton, after SciPy's Radau): the LU is kept 
 h is unchanged; when Newton contracts too slowly (rate > ``rate_refresh``) the Jacobian is
 re-evaluated at the *current iterate* and the iteration continues (contacts that switch within a step
 make an old Jacobian stale); a step fails only when Newton diverges on a fresh Jacobian or runs out of
-iterations, and the controller then shrinks h. Counters record every residual evaluation, Jacobian
-evaluation, factorization and Newton iteration.
+iterations, and the controller then shrinks h. These decisions are :class:`NewtonPolicy`'s (pure, testable
+without a model). Each step reports in its :class:`StepInfo` how many residual evaluations, Jacobian
+evaluations, factorizations and Newton iterations it used; :func:`mbd.simulate` sums them.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import Enum
 
 import numpy as np
 import scipy.sparse.linalg as spla
@@ -25,7 +27,7 @@ from .assembly import System
 from .errors import ModelError
 from .model import State
 
-__all__ = ["HHT", "StepInfo", "hht_coefficients", "Tolerance", "NewtonCache"]
+__all__ = ["HHT", "StepInfo", "hht_coefficients", "Tolerance", "NewtonCache", "NewtonPolicy", "NewtonAction"]
 
 
 def hht_coefficients(alpha: float) -> tuple[float, float]:
@@ -64,28 +66,93 @@ class Tolerance:
 @dataclass
 class StepInfo:
     converged: bool
-    iterations: int
+    iterations: int           # Newton iterations (each evaluates the forces once)
     rate: float               # last Newton contraction rate
     error: float = np.nan     # scaled local error estimate (RMS), set by the stepper
     jacobian_refreshed: bool = False
     reason: str = ""
+    residuals: int = 0        # force evaluations without Jacobian
+    jacobians: int = 0        # force + Jacobian evaluations
+    factorizations: int = 0   # LU factorizations (attempted)
+
+
+class NewtonAction(Enum):
+    """What Newton does after an iteration that did not converge."""
+    CONTINUE = "continue"                        # iterate again on the same matrix
+    REFRESH = "refresh"                          # new Jacobian + LU at the current iterate
+    REFRESH_AT_PREVIOUS = "refresh at previous"  # the last correction made it worse: undo it, then refresh
+    DIVERGED = "diverged"
+    OUT_OF_ITERATIONS = "out of iterations"
+
+
+@dataclass(frozen=True)
+class NewtonPolicy:
+    """The modified-Newton rules of one HHT step, as pure functions of plain numbers.
+
+    Convergence (Hairer): η‖Δ‖ ≤ newton_tol with η = θ/(1−θ) from the rate θ observed on one matrix; the
+    first iteration on a matrix has no rate (η = ∞) and must be below 1e-2·newton_tol. A rate above
+    ``rate_refresh`` refreshes the Jacobian, at most ``max_refresh`` times per step; a rate ≥ 1 after that
+    is divergence."""
+    newton_tol: float = 1e-3     # bound on η‖Δq‖ (scaled by the Tolerance); 0.03 left ~k·3e-10 m of force
+                                 # error in stiff elements (a 2e-4 bias seen in a mesh test)
+    max_iter: int = 10
+    rate_refresh: float = 0.3    # contraction rate above which the Jacobian is refreshed
+    max_refresh: int = 2         # Jacobian refreshes per step before a rate >= 1 counts as divergence
+    reuse: bool = True           # False: fresh Jacobian + LU at the start of every step
+
+    def __post_init__(self):
+        if self.max_iter < 1 or not (0 < self.newton_tol < 1):
+            raise ModelError("HHT/Newton: max_iter must be >= 1 and newton_tol in (0, 1)")
+
+    def refactor_at_start(self, have_lu: bool, h_lu: float, h: float) -> bool:
+        """A fresh Jacobian + LU before the first iteration: none kept, made for another h, or no reuse."""
+        return not have_lu or h_lu != h or not self.reuse
+
+    @staticmethod
+    def rate(nrm: float, prev: float) -> float:
+        """Contraction rate θ of this correction against the previous one on the same matrix."""
+        return nrm / prev if prev > 0 else 0.0
+
+    @staticmethod
+    def eta(rate: float | None) -> float:
+        """η = θ/(1−θ); ∞ without a rate (first iteration on a matrix) or when θ ≥ 1."""
+        return rate / (1.0 - rate) if rate is not None and rate < 1.0 else np.inf
+
+    def converged(self, eta: float, nrm: float) -> bool:
+        return eta * nrm <= self.newton_tol or nrm <= 1e-2 * self.newton_tol
+
+    def after_iteration(self, it: int, rate: float | None, refreshes: int) -> NewtonAction:
+        """Next move after unconverged iteration ``it`` (1-based) with contraction ``rate`` (None on the
+        first iteration on a matrix) and ``refreshes`` Jacobian refreshes already made in this step."""
+        if rate is not None and rate > self.rate_refresh:
+            if rate >= 1.0 and refreshes >= self.max_refresh:
+                return NewtonAction.DIVERGED
+            if refreshes < self.max_refresh and it < self.max_iter:
+                return NewtonAction.REFRESH_AT_PREVIOUS if rate >= 1.0 else NewtonAction.REFRESH
+        return NewtonAction.OUT_OF_ITERATIONS if it >= self.max_iter else NewtonAction.CONTINUE
 
 
 @dataclass(frozen=True)
 class HHT:
+    """HHT-α stepper. The Newton settings (defaults and meaning in :class:`NewtonPolicy`) stay flat
+    fields so callers write ``HHT(alpha=..., newton_tol=...)``; :attr:`policy` bundles them."""
     alpha: float                 # no default: the production value is mbd.PRODUCTION.alpha
-    newton_tol: float = 1e-3     # Newton stops when η‖Δq‖ (scaled by the Tolerance) is below this; 0.03 left
-                                 # ~k·3e-10 m of force error in stiff elements (a 2e-4 bias seen in a mesh test)
-    max_iter: int = 10
-    rate_refresh: float = 0.3    # contraction rate above which the Jacobian is refreshed
-    max_refresh: int = 2         # Jacobian refreshes at an iterate per step before a rate >= 1 counts as divergence
-    reuse: bool = True           # False: fresh Jacobian + LU at the start of every step
+    newton_tol: float = NewtonPolicy.newton_tol
+    max_iter: int = NewtonPolicy.max_iter
+    rate_refresh: float = NewtonPolicy.rate_refresh
+    max_refresh: int = NewtonPolicy.max_refresh
+    reuse: bool = NewtonPolicy.reuse
     tol: Tolerance = Tolerance()
 
     def __post_init__(self):
         hht_coefficients(self.alpha)
-        if self.max_iter < 1 or not (0 < self.newton_tol < 1):
-            raise ModelError("HHT: max_iter must be >= 1 and newton_tol in (0, 1)")
+        self.policy   # checks the Newton settings
+
+    @property
+    def policy(self) -> NewtonPolicy:
+        """The Newton reuse/refresh rules from this stepper's settings."""
+        return NewtonPolicy(newton_tol=self.newton_tol, max_iter=self.max_iter, rate_refresh=self.rate_refresh,
+                            max_refresh=self.max_refresh, reuse=self.reuse)
 
     @property
     def beta_gamma(self):
@@ -98,6 +165,7 @@ class HHT:
 
     # ------------------------------------------------------------------------------------------
     def initial_state(self, system: System, t0: float, q0, v0, z=None) -> State:
+        """The start state with a₀ = M⁻¹F(q₀, v₀) (one residual evaluation; simulate counts it)."""
         q0 = np.asarray(q0, float)
         v0 = np.asarray(v0, float)
         n = system.ndof
@@ -139,11 +207,11 @@ class HHT:
         return State(t1, q1, v1, a1, f1, z1), info
 
     def _refresh(self, system, cache, t1, q1, v1, z, h, bh2, gh):
-        """New Jacobian + LU at (q1, v1). Returns the forces there (the next Newton iteration is at this
-        very point and reuses them), or None when the Newton matrix is not usable."""
-        F = system.forces(t1, q1, v1, z, jac=True)
-        A = system.newton_matrix(1.0, (1.0 + self.alpha) * gh, (1.0 + self.alpha) * bh2)
-        system.counters.factor += 1
+        """New Jacobian + LU at (q1, v1) (one Jacobian evaluation, one factorization). Returns the forces
+        there (the next Newton iteration is at this very point and reuses them), or None when the Newton
+        matrix is not usable."""
+        ev = system.evaluate(t1, q1, v1, z, jac=True)
+        A = system.newton_matrix(ev, 1.0, (1.0 + self.alpha) * gh, (1.0 + self.alpha) * bh2)
         cache.h = h
         if not np.all(np.isfinite(A.data)):
             cache.lu = None
@@ -159,66 +227,65 @@ class HHT:
             except RuntimeError:      # exactly singular
                 cache.lu = None
                 return None
-        return F
+        return ev.F
 
     def _newton(self, system, s, cache, t1, qp, vp, a1, bh2, gh, h, M):
-        """Newton on a₁. The LU is reused while it contracts well; when the contraction rate exceeds
-        ``rate_refresh`` the Jacobian is re-evaluated *at the better of the last two iterates* (contacts
-        that switched within the step make an older Jacobian stale) and the iteration continues, up to
-        ``max_refresh`` times per step; a rate ≥ 1 after that is divergence.
-        Convergence (Hairer): η‖Δ‖ ≤ tol with η = θ/(1−θ) from the rate θ observed on one matrix; the
-        first iteration on a matrix has no rate and must be far below the tolerance."""
-        a_ = self.alpha
-        cnt = system.counters
-        fresh = False
-        refreshes = 0
+        """Newton on a₁ under :class:`NewtonPolicy`: the LU is reused while it contracts well; a slow
+        iteration refreshes the Jacobian at the current iterate (at the previous one when the last
+        correction made it worse) and continues. Returns (a₁, StepInfo with this step's work)."""
+        pol, a_ = self.policy, self.alpha
+        n_res = n_jac = 0                     # this step's residual and Jacobian (+ LU) evaluations
+        fresh, refreshes = False, 0
+        rate = 0.0                            # last observed contraction rate (reported)
+
+        def info(converged, it, rate, reason=""):
+            return StepInfo(converged, it, rate, jacobian_refreshed=fresh, reason=reason,
+                                residuals=n_res, jacobians=n_jac, factorizations=n_jac)
+
         F_here = None                         # forces at the current iterate, when a refresh computed them
-        if cache.lu is None or cache.h != h or not self.reuse:
+        if pol.refactor_at_start(cache.lu is not None, cache.h, h):
             F_here = self._refresh(system, cache, t1, qp + bh2 * a1, vp + gh * a1, s.z, h, bh2, gh)
+            n_jac, fresh = n_jac + 1, True
             if F_here is None:
-                return a1, StepInfo(False, 0, np.inf, reason="singular Newton matrix", jacobian_refreshed=True)
-            fresh = True
+                return a1, info(False, 0, np.inf, "singular Newton matrix")
         prev = None                           # correction of the previous iteration with the same matrix
-        rate = 0.0
-        eta = np.inf
-        for it in range(1, self.max_iter + 1):
+        for it in range(1, pol.max_iter + 1):
             q1 = qp + bh2 * a1
             v1 = vp + gh * a1
-            F1 = system.forces(t1, q1, v1, s.z) if F_here is None else F_here
-            F_here = None
-            cnt.newton += 1
+            if F_here is None:
+                F1 = system.forces(t1, q1, v1, s.z)
+                n_res += 1
+            else:
+                F1, F_here = F_here, None
             if not np.all(np.isfinite(F1)):
-                return a1, StepInfo(False, it, np.inf, reason="non-finite forces", jacobian_refreshed=fresh)
+                return a1, info(False, it, np.inf, "non-finite forces")
             r = M * a1 - (1.0 + a_) * F1 + a_ * s.f
             da = cache.lu.solve(r)
             a1 = a1 - da
             nrm = float(np.max(np.abs(bh2 * da) / self.tol.scale(system.model, s.q, q1)))
             if not np.isfinite(nrm):
-                return a1, StepInfo(False, it, np.inf, reason="non-finite Newton correction", jacobian_refreshed=fresh)
-            if prev is not None:
-                rate = nrm / prev if prev > 0 else 0.0
-                eta = rate / (1.0 - rate) if rate < 1.0 else np.inf
-            if eta * nrm <= self.newton_tol or nrm <= 1e-2 * self.newton_tol:
-                return a1, StepInfo(True, it, rate, jacobian_refreshed=fresh)
-            if prev is not None and rate > self.rate_refresh:
-                if rate >= 1.0 and refreshes >= self.max_refresh:
-                    return a1, StepInfo(False, it, rate, reason="Newton diverged", jacobian_refreshed=fresh)
-                if refreshes < self.max_refresh and it < self.max_iter:
-                    if rate >= 1.0:
-                        a1 = a1 + da          # this correction made it worse: linearize at the previous iterate
-                    q1 = qp + bh2 * a1
-                    v1 = vp + gh * a1
-                    F_here = self._refresh(system, cache, t1, q1, v1, s.z, h, bh2, gh)
-                    if F_here is None:
-                        return a1, StepInfo(False, it, rate, reason="singular Newton matrix", jacobian_refreshed=True)
-                    fresh = True
-                    refreshes += 1
-                    prev = None
-                    eta = np.inf
-                    continue
+                return a1, info(False, it, np.inf, "non-finite Newton correction")
+            rate_now = None if prev is None else pol.rate(nrm, prev)
+            rate = rate if rate_now is None else rate_now
+            if pol.converged(pol.eta(rate_now), nrm):
+                return a1, info(True, it, rate)
+            action = pol.after_iteration(it, rate_now, refreshes)
+            if action is NewtonAction.DIVERGED:
+                return a1, info(False, it, rate, "Newton diverged")
+            if action is NewtonAction.OUT_OF_ITERATIONS:
+                break
+            if action in (NewtonAction.REFRESH, NewtonAction.REFRESH_AT_PREVIOUS):
+                if action is NewtonAction.REFRESH_AT_PREVIOUS:
+                    a1 = a1 + da
+                F_here = self._refresh(system, cache, t1, qp + bh2 * a1, vp + gh * a1, s.z, h, bh2, gh)
+                n_jac, fresh = n_jac + 1, True
+                if F_here is None:
+                    return a1, info(False, it, rate, "singular Newton matrix")
+                refreshes += 1
+                prev = None
+                continue
             prev = nrm
-        return a1, StepInfo(False, self.max_iter, rate, reason="Newton did not converge in max_iter",
-                            jacobian_refreshed=fresh)
+        return a1, info(False, pol.max_iter, rate, "Newton did not converge in max_iter")
 
     def _update_internal(self, system, s, t1, q1, v1):
         if not s.z or system.freeze_internal:

@@ -20,8 +20,8 @@ def linearize(model: Model, t: float, q, v, z=None):
     """Dense (M, C, K) about (t, q, v)."""
     system = System(model)
     z = system.init_internal() if z is None else z
-    system.forces(t, np.asarray(q, float), np.asarray(v, float), z, jac=True)
-    M, C, K = system.matrices()
+    ev = system.evaluate(t, np.asarray(q, float), np.asarray(v, float), z, jac=True)
+    M, C, K = system.matrices(ev)
     return M.toarray(), C.toarray(), K.toarray()
 
 

@@ -42,8 +42,8 @@ class FirstOrderSystem:
     def jac(self, t, y):
         self.njev += 1
         q, v = y[: self.n], y[self.n:]
-        self.system.forces(t, q, v, self.z, jac=True)
-        _, C, K = self.system.matrices()
+        ev = self.system.evaluate(t, q, v, self.z, jac=True)
+        _, C, K = self.system.matrices(ev)
         Minv = sp.diags(self.minv)
         top = sp.hstack([sp.csr_matrix((self.n, self.n)), self._I])
         bot = sp.hstack([Minv @ (-K), Minv @ (-C)])

@@ -1,5 +1,7 @@
 """The one loop: stepper + controller + recorder + checkpoints + progress bar.
 
+The run's counters are the loop's: the sum of the work each step reports in its StepInfo, plus
+accepted/rejected steps (and the one force evaluation of the initial state when the loop makes it).
 Checkpoints every K accepted steps save the state, the controller's h, the counters and the
 recorder's position atomically; a run started again with ``resume=True`` continues from the last
 checkpoint and ends with results identical to an uninterrupted run (a checkpoint also drops the
@@ -18,11 +20,32 @@ import numpy as np
 
 from .assembly import System
 from .errors import IntegrationError, ModelError
-from .hht import HHT, NewtonCache
+from .hht import HHT, NewtonCache, StepInfo
 from .model import Model, State
 from .recorder import Recorder, atomic_write_bytes
 
-__all__ = ["simulate", "SimResult", "Checkpoint", "Observer", "TimeMean", "save_state", "load_state"]
+__all__ = ["simulate", "SimResult", "Checkpoint", "Counters", "Observer", "TimeMean", "save_state", "load_state"]
+
+
+@dataclass
+class Counters:
+    """Work of one simulate run (summed from the steps' StepInfo)."""
+    residual: int = 0     # force evaluations without Jacobian
+    jacobian: int = 0     # force + Jacobian evaluations
+    factor: int = 0       # LU factorizations
+    newton: int = 0       # Newton iterations
+    accepted: int = 0
+    rejected: int = 0
+
+    def add(self, info: StepInfo) -> None:
+        """Add one step's work (accepted or not: a rejected step's evaluations were made too)."""
+        self.residual += info.residuals
+        self.jacobian += info.jacobians
+        self.factor += info.factorizations
+        self.newton += info.iterations
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
 
 
 @dataclass(frozen=True)
@@ -152,10 +175,12 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
         from .settings import PRODUCTION
         stepper = PRODUCTION.stepper()
     system = system or System(model)
+    counters = Counters()
     if state is None:
         if q0 is None or v0 is None:
             raise ModelError("simulate: give q0 and v0 (free DOFs) or a State")
         state = stepper.initial_state(system, t0, q0, v0)
+        counters.residual += 1       # initial_state evaluates the forces once
     if not (np.isfinite(t_end) and t_end >= state.t):
         raise ModelError(f"simulate: t_end must be >= the start time {state.t} s, got {t_end!r}")
     h = controller.initial()
@@ -170,8 +195,7 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
         state, extra, arrays = load_state(checkpoint.path, with_arrays=True)
         h = extra["h"]
         stats = extra["stats"]
-        for k, val in extra["counters"].items():
-            setattr(system.counters, k, val)
+        counters = Counters(**extra["counters"])
         if recorder is not None:
             recorder.restore(extra["recorder"])
         for i, ob in enumerate(observers):
@@ -192,14 +216,15 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
         while state.t < t_end - 1e-12 * span:
             h_try = min(h, t_end - state.t)
             new, info = stepper.step(system, state, h_try, cache)
+            counters.add(info)
             ok, h_next = controller.decide(h_try, info.converged, info.error)
             if not ok:
-                system.counters.rejected += 1
+                counters.rejected += 1
                 if h_next < h_floor:
                     _fail(system, state, h_next, info, failed_state_path)
                 h = h_next
                 continue
-            system.counters.accepted += 1
+            counters.accepted += 1
             if recorder is not None:
                 recorder.record(state, new)
             for ob in observers:
@@ -211,18 +236,21 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
             stats["h_lo"] = min(stats["h_lo"], h_try)
             stats["h_hi"] = max(stats["h_hi"], h_try)
             h = h_next
-            bar.update(state.t, system.counters)
+            bar.update(state.t, counters)
             if checkpoint is not None and stats["steps"] % checkpoint.every == 0:
                 rec = recorder.checkpoint_state() if recorder is not None else {}
                 obs = {f"obs{i}__{k}": v for i, ob in enumerate(observers) for k, v in ob.state_dict().items()}
-                save_state(checkpoint.path, state, {"h": h, "stats": stats, "counters": system.counters.as_dict(),
+                save_state(checkpoint.path, state, {"h": h, "stats": stats, "counters": counters.as_dict(),
                                                     "recorder": rec}, arrays=obs)
                 cache.lu = None
+    except IntegrationError as exc:
+        exc.counters = counters.as_dict()    # the work up to the failure, for the caller's report
+        raise
     finally:
         bar.close()
     wall = time.perf_counter() - wall0
     n = max(stats["steps"], 1)
-    res = SimResult(state=state, counters=system.counters.as_dict(), wall_s=wall, steps=stats["steps"],
+    res = SimResult(state=state, counters=counters.as_dict(), wall_s=wall, steps=stats["steps"],
                     error_max=float(stats["err_max"]), error_rms=float(np.sqrt(stats["err_sq"] / n)),
                     h_min_used=float(stats["h_lo"]), h_max_used=float(stats["h_hi"]), resumed_from=resumed_from)
     if recorder is not None:

@@ -204,7 +204,7 @@ def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float
     if tol is None:
         tol = mbd.Tolerance() if atol_pos is None else mbd.Tolerance(atol_pos=atol_pos, atol_rot=100 * atol_pos)
     stepper = mbd.HHT(alpha=alpha, tol=tol) if newton_tol is None else mbd.HHT(alpha=alpha, tol=tol, newton_tol=newton_tol)
-    walls, res, sampler, err = [], None, None, ""
+    walls, res, sampler = [], None, None
     for r in range(max(1, repeats)):
         ctrl = mbd.FixedStep(h) if h is not None else mbd.Adaptive(h0=min(5e-6, h_max), h_max=h_max, h_min=1e-10)
         smp = StateSampler(grid) if r == 0 else None
@@ -214,9 +214,9 @@ def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float
             res = mbd.simulate(prob.model, t_end=t_end, state=state.copy(), stepper=stepper, controller=ctrl,
                                observers=[smp] if smp is not None else [], progress=False, system=system)
         except mbd.IntegrationError as exc:
-            c = system.counters
+            c = exc.counters      # the loop's totals up to the failure
             return RunResult("HHT", label, False, str(exc), time.perf_counter() - w0, [time.perf_counter() - w0],
-                             c.accepted, c.residual, c.jacobian, c.factor, c.newton, c.rejected,
+                             c["accepted"], c["residual"], c["jacobian"], c["factor"], c["newton"], c["rejected"],
                              t_reached=float(exc.state.t) if getattr(exc, "state", None) is not None else np.nan)
         walls.append(time.perf_counter() - w0)
         if r == 0:
@@ -345,12 +345,12 @@ def eval_costs(model: mbd.Model, state: mbd.State, n: int = 200) -> dict:
     out = {}
     for jac in (False, True):
         for _ in range(5):
-            system.forces(state.t, state.q, state.v, state.z, jac=jac)
+            system.evaluate(state.t, state.q, state.v, state.z, jac=jac)
         batches = []
         for _ in range(max(1, n // 20)):
             t0 = time.perf_counter()
             for _ in range(20):
-                system.forces(state.t, state.q, state.v, state.z, jac=jac)
+                system.evaluate(state.t, state.q, state.v, state.z, jac=jac)
             batches.append((time.perf_counter() - t0) / 20)
         out["jacobian_s" if jac else "residual_s"] = statistics.median(batches)
     return out

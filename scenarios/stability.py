@@ -32,7 +32,6 @@ import csv
 import json
 import sys
 import time
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -162,16 +161,15 @@ def _hht_row(prob, system, stepper, s0, base, window) -> dict:
         res = mbd.simulate(prob.model, t_end=window, state=s0, stepper=stepper, observers=[smp], system=system,
                            controller=mbd.PRODUCTION.controller(), progress=False)
         row.update(completed=True, t_reached_s=res.state.t, message="", fraction_of_window=1.0)
-        end = res.state
+        end, c = res.state, res.counters
     except mbd.IntegrationError as exc:
         t_fail = exc.state.t if exc.state is not None else np.nan
         row.update(completed=False, t_reached_s=t_fail, message=" ".join(str(exc).split()),
                    fraction_of_window=round(float(t_fail) / window, 3) if np.isfinite(t_fail) else "")
-        end = None
-    c = system.counters
-    row.update(wall_s=round(time.perf_counter() - w0, 3), steps=c.accepted, rejected=c.rejected,
-               newton_per_step=round(c.newton / max(c.accepted, 1), 2), factorizations=c.factor,
-               jacobian_evals=c.jacobian)
+        end, c = None, exc.counters      # the loop's totals up to the failure
+    row.update(wall_s=round(time.perf_counter() - w0, 3), steps=c["accepted"], rejected=c["rejected"],
+               newton_per_step=round(c["newton"] / max(c["accepted"], 1), 2), factorizations=c["factor"],
+               jacobian_evals=c["jacobian"])
     if end is not None and smp.complete:
         pl = [_pin_and_roller(prob, system, t, q, v, z) for t, q, v, z in zip(grid, smp.q, smp.v, smp.z)]
         pins, rollers = np.array(pl).T

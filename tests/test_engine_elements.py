@@ -221,7 +221,7 @@ def _assembly_model(frame):
                                    mbd.Frame(profile=accelerating_profile(25.0, 400.0))],
                          ids=["inertial", "rotating", "accelerating"])
 def test_newton_matrix_equals_finite_differences_of_forces(frame):
-    """newton_matrix(c_M, c_C, c_K) = c_M M − c_C ∂F/∂v − c_K ∂F/∂q, frame terms (Ω̇ ≠ 0) included,
+    """newton_matrix(ev, c_M, c_C, c_K) = c_M M − c_C ∂F/∂v − c_K ∂F/∂q, frame terms (Ω̇ ≠ 0) included,
     with a fixed body whose coupling entries must be dropped from the pattern."""
     model = _assembly_model(frame)
     sys_ = mbd.System(model)
@@ -231,7 +231,8 @@ def test_newton_matrix_equals_finite_differences_of_forces(frame):
     v = 0.5 * rng.standard_normal(n)
     t = 0.137
     z = sys_.init_internal()
-    F0 = sys_.forces(t, q, v, z, jac=True)
+    ev = sys_.evaluate(t, q, v, z, jac=True)
+    F0 = ev.F
     Kfd = np.zeros((n, n))
     Cfd = np.zeros((n, n))
     for j in range(n):
@@ -244,10 +245,10 @@ def test_newton_matrix_equals_finite_differences_of_forces(frame):
             fm = sys_.forces(t, xm, v, z) if out is Kfd else sys_.forces(t, q, xm, z)
             out[:, j] = -(fp - fm) / (2 * hstep)       # K = −∂F/∂q, C = −∂F/∂v
     cM, cC, cK = 1.3, 2e-3, 4e-6
-    A = sys_.newton_matrix(cM, cC, cK).toarray()
+    A = sys_.newton_matrix(ev, cM, cC, cK).toarray()
     ref = cM * np.diag(model.mdiag) + cC * Cfd + cK * Kfd
     np.testing.assert_allclose(A, ref, rtol=0, atol=1e-7 * np.abs(ref).max())
-    M, C, K = (x.toarray() for x in sys_.matrices())
+    M, C, K = (x.toarray() for x in sys_.matrices(ev))
     np.testing.assert_allclose(K, Kfd, atol=1e-6 * np.abs(Kfd).max())
     np.testing.assert_allclose(C, Cfd, atol=1e-6 * np.abs(Cfd).max() + 1e-9)
     np.testing.assert_array_equal(M, np.diag(model.mdiag))
@@ -275,16 +276,29 @@ def test_system_forces_include_frame_terms_exactly():
     np.testing.assert_allclose(F, expect, rtol=1e-13)
 
 
-def test_counters_count_evaluations():
-    model = _assembly_model(mbd.Frame.inertial())
+def test_system_holds_no_evaluation_results():
+    """An evaluation returns its results; the System's attributes are the same before and after, and a
+    later evaluation leaves an earlier one's arrays untouched."""
+    model = _assembly_model(mbd.Frame.rotating(37.0))
     s = mbd.System(model)
     z = s.init_internal()
-    q = np.zeros(model.ndof)
-    s.forces(0.0, q, q, z)
-    s.forces(0.0, q, q, z, jac=True)
-    s.forces(0.0, q, q, z)
-    assert (s.counters.residual, s.counters.jacobian) == (2, 1)
-    assert set(s.counters.as_dict()) >= {"residual", "jacobian", "factor", "newton", "accepted", "rejected"}
+    q = 0.05 * np.random.default_rng(1).standard_normal(model.ndof)
+    before = {k: (id(v), v.copy() if isinstance(v, np.ndarray) else None) for k, v in vars(s).items()}
+    res = s.evaluate(0.0, q, q, z)
+    assert res.Jq is None and res.Jv is None
+    ev = s.evaluate(0.0, q, q, z, jac=True)
+    kept = (ev.F.copy(), ev.Jq.copy(), ev.Jv.copy())
+    assert ev.Jq.shape == ev.Jv.shape == (s.nnz,)
+    s.evaluate(0.1, 2 * q, -q, z, jac=True)
+    for a, b in zip((ev.F, ev.Jq, ev.Jv), kept):
+        np.testing.assert_array_equal(a, b)
+    assert set(vars(s)) == set(before)
+    for k, v in vars(s).items():
+        assert id(v) == before[k][0], k
+        if before[k][1] is not None:
+            np.testing.assert_array_equal(v, before[k][1])
+    with pytest.raises(mbd.ModelError, match="jac=True"):
+        s.newton_matrix(res, 1.0, 1.0, 1.0)
 
 
 def test_fd_helper_matches_known_linear_stiffness():

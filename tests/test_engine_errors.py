@@ -190,6 +190,10 @@ def test_step_below_minimum_raises_with_diagnostics_and_saves_state(tmp_path, co
     assert "t = 1.0" in msg and "h = " in msg and "'contact'" in msg, msg
     assert err.state is not None and 0.009 <= err.state.t <= 0.0105
     assert err.saved_to == str(saved) and saved.exists()
+    # the loop's counters up to the failure travel with the exception
+    c = err.counters
+    assert set(c) == {"residual", "jacobian", "factor", "newton", "accepted", "rejected"}
+    assert c["accepted"] > 0 and c["rejected"] > 0 and c["factor"] > 0 and c["newton"] >= c["accepted"]
     s, extra = mbd.load_state(saved)
     assert s.t == err.state.t and np.array_equal(s.q, err.state.q) and extra["reason"]
 
