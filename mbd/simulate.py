@@ -183,29 +183,9 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
         counters.residual += 1       # initial_state evaluates the forces once
     if not (np.isfinite(t_end) and t_end >= state.t):
         raise ModelError(f"simulate: t_end must be >= the start time {state.t} s, got {t_end!r}")
-    h = controller.initial()
-    resumed_from = None
-    stats = {"steps": 0, "err_max": 0.0, "err_sq": 0.0, "h_lo": np.inf, "h_hi": 0.0}
     observers = list(observers)
-    if recorder is not None:
-        recorder.bind(model, system, state)
-    for ob in observers:
-        ob.bind(model, system, state)
-    if checkpoint is not None and resume and Path(checkpoint.path).exists():
-        state, extra, arrays = load_state(checkpoint.path, with_arrays=True)
-        h = extra["h"]
-        stats = extra["stats"]
-        counters = Counters(**extra["counters"])
-        if recorder is not None:
-            recorder.restore(extra["recorder"])
-        for i, ob in enumerate(observers):
-            pre = f"obs{i}__"
-            ob.load_state_dict({k[len(pre):]: v for k, v in arrays.items() if k.startswith(pre)})
-        resumed_from = state.t
-    elif recorder is not None:
-        recorder.reset()
-        recorder.record(state, None, first=True)
-
+    h, stats, counters, state, resumed_from = _begin(model, system, state, controller, counters, recorder,
+                                                     observers, checkpoint, resume)
     show = progress if progress is not None else os.environ.get("DPGT_PROGRESS", "1") != "0"
     bar = _Progress(state.t, t_end, show, on_progress)
     cache = NewtonCache()
@@ -230,18 +210,11 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
             for ob in observers:
                 ob.step(state, new)
             state = new
-            stats["steps"] += 1
-            stats["err_max"] = max(stats["err_max"], info.error)
-            stats["err_sq"] += info.error ** 2
-            stats["h_lo"] = min(stats["h_lo"], h_try)
-            stats["h_hi"] = max(stats["h_hi"], h_try)
+            _add_step(stats, info.error, h_try)
             h = h_next
             bar.update(state.t, counters)
             if checkpoint is not None and stats["steps"] % checkpoint.every == 0:
-                rec = recorder.checkpoint_state() if recorder is not None else {}
-                obs = {f"obs{i}__{k}": v for i, ob in enumerate(observers) for k, v in ob.state_dict().items()}
-                save_state(checkpoint.path, state, {"h": h, "stats": stats, "counters": counters.as_dict(),
-                                                    "recorder": rec}, arrays=obs)
+                _save_checkpoint(checkpoint, state, h, stats, counters, recorder, observers)
                 cache.lu = None
     except IntegrationError as exc:
         exc.counters = counters.as_dict()    # the work up to the failure, for the caller's report
@@ -258,6 +231,45 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
     if checkpoint is not None and Path(checkpoint.path).exists():
         Path(checkpoint.path).unlink()
     return res
+
+
+def _begin(model, system, state, controller, counters, recorder, observers, checkpoint, resume):
+    """Bind recorder and observers; resume from the checkpoint when asked and one exists.
+    Returns (h, stats, counters, state, resumed_from)."""
+    h = controller.initial()
+    stats = {"steps": 0, "err_max": 0.0, "err_sq": 0.0, "h_lo": np.inf, "h_hi": 0.0}
+    if recorder is not None:
+        recorder.bind(model, system, state)
+    for ob in observers:
+        ob.bind(model, system, state)
+    if checkpoint is not None and resume and Path(checkpoint.path).exists():
+        state, extra, arrays = load_state(checkpoint.path, with_arrays=True)
+        if recorder is not None:
+            recorder.restore(extra["recorder"])
+        for i, ob in enumerate(observers):
+            pre = f"obs{i}__"
+            ob.load_state_dict({k[len(pre):]: v for k, v in arrays.items() if k.startswith(pre)})
+        return extra["h"], extra["stats"], Counters(**extra["counters"]), state, state.t
+    if recorder is not None:
+        recorder.reset()
+        recorder.record(state, None, first=True)
+    return h, stats, counters, state, None
+
+
+def _add_step(stats: dict, error: float, h: float) -> None:
+    """Error and step-size statistics of the accepted steps."""
+    stats["steps"] += 1
+    stats["err_max"] = max(stats["err_max"], error)
+    stats["err_sq"] += error ** 2
+    stats["h_lo"] = min(stats["h_lo"], h)
+    stats["h_hi"] = max(stats["h_hi"], h)
+
+
+def _save_checkpoint(checkpoint, state, h, stats, counters, recorder, observers) -> None:
+    rec = recorder.checkpoint_state() if recorder is not None else {}
+    obs = {f"obs{i}__{k}": v for i, ob in enumerate(observers) for k, v in ob.state_dict().items()}
+    save_state(checkpoint.path, state, {"h": h, "stats": stats, "counters": counters.as_dict(), "recorder": rec},
+               arrays=obs)
 
 
 def _fail(system: System, state: State, h: float, info, path) -> None:
