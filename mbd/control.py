@@ -5,6 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import rules
 from .errors import ModelError
 
 __all__ = ["FixedStep", "Adaptive"]
@@ -34,9 +35,8 @@ class FixedStep:
         return self.h / 2 ** self.max_halvings
 
     def decide(self, h: float, converged: bool, error: float) -> tuple[bool, float]:
-        if converged and error <= self.reject_error:
-            return True, self.h
-        return False, h / 2
+        ok, h_next = rules.fixed_decide(h, converged, error, self.h, self.reject_error)
+        return bool(ok), float(h_next)
 
 
 @dataclass(frozen=True)
@@ -61,12 +61,6 @@ class Adaptive:
         return self.h0
 
     def decide(self, h: float, converged: bool, error: float) -> tuple[bool, float]:
-        if not converged:
-            return False, h * self.fail_factor
-        err = max(error, 1e-10)
-        fac = self.safety * err ** (-1.0 / 3.0)
-        fac = min(self.grow_max, max(self.shrink_min, fac))
-        accept = err <= 1.0
-        if accept and 1.0 <= fac <= self.hold:
-            fac = 1.0   # small growth is not worth a new factorization
-        return accept, float(min(self.h_max, h * fac))
+        ok, h_next = rules.adaptive_decide(h, converged, error, self.h_max, self.safety, self.grow_max,
+                                           self.shrink_min, self.fail_factor, self.hold)
+        return bool(ok), float(h_next)

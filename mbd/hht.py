@@ -23,6 +23,7 @@ from enum import Enum
 import numpy as np
 import scipy.sparse.linalg as spla
 
+from . import rules
 from .assembly import System
 from .errors import ModelError
 from .model import State
@@ -111,25 +112,27 @@ class NewtonPolicy:
     @staticmethod
     def rate(nrm: float, prev: float) -> float:
         """Contraction rate θ of this correction against the previous one on the same matrix."""
-        return nrm / prev if prev > 0 else 0.0
+        return float(rules.newton_rate(nrm, prev))
 
     @staticmethod
     def eta(rate: float | None) -> float:
         """η = θ/(1−θ); ∞ without a rate (first iteration on a matrix) or when θ ≥ 1."""
-        return rate / (1.0 - rate) if rate is not None and rate < 1.0 else np.inf
+        return float(rules.newton_eta(0.0 if rate is None else rate, rate is not None))
 
     def converged(self, eta: float, nrm: float) -> bool:
-        return eta * nrm <= self.newton_tol or nrm <= 1e-2 * self.newton_tol
+        return bool(rules.newton_converged(eta, nrm, self.newton_tol))
 
     def after_iteration(self, it: int, rate: float | None, refreshes: int) -> NewtonAction:
         """Next move after unconverged iteration ``it`` (1-based) with contraction ``rate`` (None on the
         first iteration on a matrix) and ``refreshes`` Jacobian refreshes already made in this step."""
-        if rate is not None and rate > self.rate_refresh:
-            if rate >= 1.0 and refreshes >= self.max_refresh:
-                return NewtonAction.DIVERGED
-            if refreshes < self.max_refresh and it < self.max_iter:
-                return NewtonAction.REFRESH_AT_PREVIOUS if rate >= 1.0 else NewtonAction.REFRESH
-        return NewtonAction.OUT_OF_ITERATIONS if it >= self.max_iter else NewtonAction.CONTINUE
+        code = rules.newton_action(it, 0.0 if rate is None else rate, rate is not None, refreshes,
+                                   self.rate_refresh, self.max_refresh, self.max_iter)
+        return _ACTIONS[code]
+
+
+_ACTIONS = {rules.CONTINUE: NewtonAction.CONTINUE, rules.REFRESH: NewtonAction.REFRESH,
+            rules.REFRESH_AT_PREVIOUS: NewtonAction.REFRESH_AT_PREVIOUS, rules.DIVERGED: NewtonAction.DIVERGED,
+            rules.OUT_OF_ITERATIONS: NewtonAction.OUT_OF_ITERATIONS}
 
 
 @dataclass(frozen=True)
