@@ -12,26 +12,29 @@ import numpy as np
 
 from mbd.elements import GroundSupport, Ramp, SpeedDrive, TorqueSource
 
-from .bearing import add_planet_bearing, bearing_si
+from .bearing import add_planet_bearing
 from .gears import add_mesh_family
 from .geometry import check_design, loaded_flanks
 from .families import MESH_FAMILY
 from .params import DPGTParams
 from .scene import BuiltScene, Scene, SceneOptions
+from .units import ParameterError
 
 __all__ = ["build_dpgt"]
 
 
 def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: bool = True) -> BuiltScene:
     """Build the DPGT scene. Design errors raise ParameterError; design warnings are issued."""
-    opt = options or SceneOptions()
+    opt = (options or SceneOptions()).resolved()
+    if opt.cage == "held":   # a cage fixed to the carrier would need a joint the engine does not have
+        raise ParameterError.at("options.cage", "'held' is a bearing-rig option; the DPGT takes 'free' or 'none'")
     check_design(params, strict=strict)
     si = params.si()
     lay = si.layout
     G, op, sup, ms = si.gears, si.operating, si.support, si.mesh
     wc = op.carrier_speed
     W = {"sun": op.sun_speed, "a": op.inner_planet_speed, "b": op.outer_planet_speed}
-    b = bearing_si(si.bearing, si.lubricant)
+    b = si.bearing
     scene = Scene(frame_omega=wc if opt.frame == "rotating" else 0.0,
                   gravity=si.gravity if opt.gravity else 0.0, options=opt)
     N = lay.planets
@@ -58,7 +61,8 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
         pair = {"inner": a_names[n], "outer": b_names[n], "psi_a": float(lay.psi_a[n]), "psi_b": float(lay.psi_b[n])}
         for key, planet, p, v, w in (("inner", a_names[n], pa, va, W["a"]), ("outer", b_names[n], pb, vb, W["b"])):
             pair[f"{key}_bearing"] = add_planet_bearing(
-                scene, f"{planet}.pb", pin_body="carrier", pin_local=p, outer_body=planet, b=b,
+                scene, f"{planet}.pb", pin_body="carrier", pin_local=p, outer_body=planet, bearing=b,
+                lubricant=si.lubricant,
                 pin_xy=p, pin_vel=v, omega_pin=wc, omega_outer=w)
         pairs.append(pair)
 
@@ -96,6 +100,6 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
         "speeds_rad_s": {"sun": W["sun"], "inner_planet": W["a"], "outer_planet": W["b"], "carrier": wc},
         "f_c_hz": abs(op.carrier_frequency), "f_m_hz": f_m, "sun_torque_Nm": T_s, "carrier_torque_Nm": op.carrier_torque,
         "ramp_s": ramp_t, "ring_mismatch_teeth": [float(x) for x in ph.ring_mismatch], "planets": N,
-        "rollers": b.Z, "direction": op.direction, "frame": opt.frame, "bearings": opt.bearings, "bearing": b,
+        "rollers": b.rollers, "direction": op.direction, "frame": opt.frame, "bearings": opt.bearings, "bearing": b,
     })
     return scene.build()

@@ -183,7 +183,7 @@ class WindowStatistics(mbd.Observer):
     that slips more than the margin ends at the run's end and is reported with whole_revolutions false.
 
     ``scene``: a built scene with handles["pairs"] (see :func:`bearing_map`), meta["speeds_rad_s"]
-    ["carrier"] (the carrier frame's speed), meta["bearing"] (BearingSI) and handles["flanks"]
+    ["carrier"] (the carrier frame's speed), meta["bearing"] (:class:`~components.params.BearingSI`) and handles["flanks"]
     (the loaded flank of each mesh type). After the run, :meth:`summary` gives the numbers.
     """
 
@@ -216,7 +216,7 @@ class WindowStatistics(mbd.Observer):
         idx = lambda name: model.body(name).index
         rollers = bm[0]["type"] == "rollers"
         b = self.scene.meta["bearing"]
-        Ri, Ro = 0.5 * (b.d_m - b.D), 0.5 * (b.d_m + b.D)
+        Ri, Ro = 0.5 * (b.pitch_diameter - b.roller_diameter), 0.5 * (b.pitch_diameter + b.roller_diameter)
         cage = np.array([idx(x["cage"]) for x in bm]) if rollers and "cage" in bm[0] else None
         rb = np.concatenate([np.full(x["race_inner"][1] - x["race_inner"][0], i) for i, x in enumerate(bm)]) \
             if rollers else None

@@ -16,11 +16,16 @@ Design (ARCHITECTURE.md idea 6)
 * Overrides: :func:`with_overrides` ``(params, {"bearing.clearance": "30 um", "gears.planets": 4})``
   with dotted paths (unknown paths raise ParameterError listing the valid ones); :func:`components.presets.load_toml`
   reads the same dotted structure from a TOML file; :func:`to_toml` writes it back (lossless).
-* Conversion to SI happens once: ``obj.si()`` returns an immutable :class:`SIView` of floats (SI base
-  units: m, kg, s, rad, rad/s, N/m, N/m^(10/9) ...), with the rule-based values resolved and the
-  convenient derived values added (gear radii, raceway radii, ...). ``DPGTParams.si()`` also contains
-  ``layout`` (:class:`components.geometry.Layout`: planet positions, meshes, phases) and the nominal
-  kinematics/torques in ``operating``. Builders read only ``si()``; nothing downstream touches pint.
+* Conversion to SI happens once: ``obj.si()`` returns a frozen, typed SI dataclass (``GearParams.si()``
+  → :class:`GearSI`, ``BearingParams`` → :class:`BearingSI`, ..., ``DPGTParams`` → :class:`DPGTSI`) of
+  floats (SI base units: m, kg, s, rad, rad/s, N/m, N/m^(10/9) ...), ints, strings, flags and nested SI
+  objects, with the rule-based values resolved and the convenient derived values added (gear radii,
+  raceway radii, ...). Each SI class is generated from its Params class's fields (:func:`_with_si`) plus
+  the ``_si_derived`` declarations (name, type, doc) that ``_si_values`` computes: one field list.
+  ``DPGTParams.si()`` also contains ``layout`` (:class:`components.geometry.Layout`: planet positions,
+  meshes, phases) and the nominal kinematics/torques in ``operating`` (:class:`DPGTOperatingSI`).
+  ``si()`` is computed once per object; SI objects have ``replace`` and ``to_dict``. Builders read
+  only ``si()``; nothing downstream touches pint.
 
 Single values are checked here (positive masses, clearances ≥ 0, N ≥ 1, Z ≥ 3, h = ±1, ...); how
 values fit together (rollers fit, gears assemble, tip circles clear) is checked by
@@ -36,7 +41,7 @@ import numbers
 import tomllib
 from dataclasses import MISSING, dataclass, field
 from types import MappingProxyType
-from typing import Any, ClassVar, Iterator, Mapping
+from typing import Any, ClassVar, Mapping
 
 import numpy as np
 
@@ -44,9 +49,11 @@ from . import geometry as geo
 from .units import ParameterError, Quantity, format_quantity, quantity, to_si
 
 __all__ = [
-    "Source", "Sourced", "paper", "derived", "assumed", "SIView", "Params",
+    "Source", "Sourced", "paper", "derived", "assumed", "SI", "Derived", "Params",
     "GearParams", "GearSetParams", "CageParams", "SlideRollTractionParams", "BearingParams", "LubricantParams", "SupportParams",
-    "MeshParams", "OperatingPoint", "RigParams", "DPGTParams",
+    "MeshParams", "OperatingPoint", "RigParams", "DPGTParams", "BearingRigParams",
+    "GearSI", "GearSetSI", "CageSI", "SlideRollTractionSI", "BearingSI", "LubricantSI", "SupportSI", "MeshSI",
+    "OperatingSI", "RigSI", "DPGTSI", "DPGTOperatingSI", "DPGTSupportSI", "BearingRigSI",
     "with_overrides", "parameter_names", "flatten", "describe", "to_toml", "overrides_from_toml",
 ]
 
@@ -94,45 +101,6 @@ def assumed(value, note: str = "") -> Sourced:
 
 
 _USER = Source("user")
-
-
-# ---------------------------------------------------------------------------------------------
-# SI view
-# ---------------------------------------------------------------------------------------------
-class SIView(Mapping):
-    """Read-only nested mapping of SI floats with attribute access (``si.bearing.clearance``)."""
-
-    __slots__ = ("_d",)
-
-    def __init__(self, data: Mapping):
-        object.__setattr__(self, "_d", dict(data))
-
-    def __getattr__(self, key):
-        try:
-            return self._d[key]
-        except KeyError:
-            raise AttributeError(f"no SI value {key!r}; available: {', '.join(self._d)}") from None
-
-    def __setattr__(self, key, value):
-        raise AttributeError("SIView is read-only")
-
-    def __getitem__(self, key):
-        return self._d[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._d)
-
-    def __len__(self) -> int:
-        return len(self._d)
-
-    def replace(self, **changes) -> "SIView":
-        return SIView({**self._d, **changes})
-
-    def to_dict(self) -> dict:
-        return {k: v.to_dict() if isinstance(v, SIView) else v for k, v in self._d.items()}
-
-    def __repr__(self) -> str:
-        return "SIView(" + ", ".join(f"{k}={v!r}" for k, v in self._d.items()) + ")"
 
 
 # ---------------------------------------------------------------------------------------------
@@ -267,6 +235,98 @@ def _same(a, b) -> bool:
 
 
 # ---------------------------------------------------------------------------------------------
+# SI classes: one frozen dataclass per parameter class, generated from its fields
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Derived:
+    """A value ``si()`` computes, declared on the Params class (``_si_derived``) with its type and doc.
+    A name that is also a parameter field is that parameter's rule-resolved value (its SI type wins)."""
+
+    name: str
+    type: Any
+    doc: str
+
+
+@dataclass(frozen=True)
+class SI:
+    """Base of the generated SI classes (``GearSI``, ``BearingSI``, ..., ``DPGTSI``): frozen, keyword-only
+    dataclasses of SI floats, ints, strings, flags and nested SI objects."""
+
+    def replace(self, **changes) -> "SI":
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict:
+        """{name: value}, nested SI objects as dicts (other objects, e.g. the layout, as they are)."""
+        return {f.name: _si_dict(getattr(self, f.name)) for f in dataclasses.fields(self)}
+
+    def __getitem__(self, name: str):
+        """Field by name (for code that picks a field from a string, e.g. ``si.gears[name]``)."""
+        if name not in self.__dataclass_fields__:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def __getattr__(self, name):   # only reached for names that are not fields: say what there is
+        if name.startswith("__"):
+            raise AttributeError(name)
+        raise AttributeError(f"no SI value {name!r} in {type(self).__name__}; available: "
+                             f"{', '.join(self.__dataclass_fields__)}")
+
+
+def _si_dict(v):
+    return v.to_dict() if isinstance(v, SI) else v
+
+
+def _si_type(spec: "_Spec"):
+    if spec.kind == "nested":
+        return spec.cls.SI
+    t = {"count": int, "sign": int, "flag": bool, "choice": str}.get(spec.kind, float)
+    return t | None if spec.optional else t
+
+
+def _make_si(name: str, fields: list, doc: str, bases: tuple = (SI,)) -> type:
+    cls = dataclasses.make_dataclass(name, fields, bases=bases, frozen=True, kw_only=True,
+                                     namespace={"__doc__": doc, "__module__": __name__})
+    cls.__module__ = __name__
+    return cls
+
+
+def _si_fields(items) -> list:
+    """make_dataclass field specs from (name, type, doc) triples."""
+    return [(n, t, field(metadata={"doc": d})) for n, t, d in items]
+
+
+def _si_doc(title: str, items) -> str:
+    return title + "\n\nFields (SI units):\n" + "\n".join(f"* ``{n}``: {d}" for n, _, d in items)
+
+
+def _with_si(name: str):
+    """Class decorator (above ``@dataclass``): build the SI class ``name`` from the parameter fields
+    and the ``_si_derived`` declarations, as ``cls.SI``; ``si()`` returns instances of it."""
+    def deco(cls):
+        derived = {d.name: d for d in cls.__dict__.get("_si_derived", ())}
+        items = []
+        for f in _param_fields(cls):
+            spec = f.metadata["spec"]
+            d = derived.pop(f.name, None)
+            items.append((f.name, d.type if d else _si_type(spec), d.doc if d else spec.doc))
+        items += [(d.name, d.type, d.doc) for d in derived.values()]
+        cls.SI = _make_si(name, _si_fields(items), _si_doc(f"SI values of :class:`{cls.__name__}`.", items))
+        return cls
+    return deco
+
+
+def _extend_si(name: str, base: type, items, title: str) -> type:
+    """An SI class with ``base``'s fields plus ``items`` (name, type, doc): a section as the whole
+    machine sees it (e.g. the operating point with its kinematics)."""
+    return _make_si(name, _si_fields(items), _si_doc(title, items), bases=(base,))
+
+
+def _fields_of(obj) -> dict:
+    """{name: value} of a dataclass, one level (nested objects kept as they are)."""
+    return {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)}
+
+
+# ---------------------------------------------------------------------------------------------
 # base class
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True, kw_only=True)
@@ -274,6 +334,8 @@ class Params:
     """Base of all parameter classes: conversion, provenance, replace, SI view."""
 
     _prefix: ClassVar[str] = ""
+    SI: ClassVar[type]                      # the SI class, made by @_with_si from the fields
+    _si_derived: ClassVar[tuple] = ()       # Derived(...): values si() computes
     sources: Mapping[str, Source] = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self):
@@ -328,32 +390,36 @@ class Params:
                 raise ParameterError.at(self._path(key), f"unknown parameter; valid: {valid}")
         return dataclasses.replace(self, **changes)
 
-    def si(self) -> SIView:
-        """All values as SI floats (rule-based values resolved, derived values added)."""
-        d: dict[str, Any] = {}
-        for f in _param_fields(type(self)):
-            v = getattr(self, f.name)
-            if isinstance(v, Params):
-                d[f.name] = v.si()
-            elif isinstance(v, Quantity):
-                d[f.name] = to_si(v)
-            else:
-                d[f.name] = v
-        self._derive(d)
-        return SIView(d)
+    def si(self) -> SI:
+        """All values in SI units as a ``type(self).SI`` (rule-based values resolved, derived values
+        added). Computed once per object (parameter objects are immutable)."""
+        cached = self.__dict__.get("_si_cache")
+        if cached is None:
+            base = {f.name: _to_si_value(getattr(self, f.name)) for f in _param_fields(type(self))}
+            cached = self.SI(**{**base, **self._si_values(base)})
+            object.__setattr__(self, "_si_cache", cached)
+        return cached
 
-    def _derive(self, d: dict) -> None:
-        """Resolve rule-based values and add derived ones to the SI dict (subclasses)."""
+    def _si_values(self, v: dict) -> dict:
+        """Rule-resolved and derived values (see ``_si_derived``) from the fields' SI values ``v``."""
+        return {}
+
+
+def _to_si_value(v):
+    if isinstance(v, Params):
+        return v.si()
+    return to_si(v) if isinstance(v, Quantity) else v
 
 
 # ---------------------------------------------------------------------------------------------
 # gears
 # ---------------------------------------------------------------------------------------------
+@_with_si("GearSI")
 @dataclass(frozen=True, kw_only=True)
 class GearParams(Params):
     """One standard involute spur gear (no profile shift).
 
-    si() adds pitch_radius, base_radius, tip_radius, root_radius and resolves ``inertia``.
+    si() (:class:`GearSI`) adds pitch_radius, base_radius, tip_radius, root_radius and resolves ``inertia``.
     """
 
     _prefix: ClassVar[str] = "gear"
@@ -370,16 +436,27 @@ class GearParams(Params):
     addendum_coefficient: Quantity = _nonneg("dimensionless", "addendum h_a/m (standard 1)", default=1.0)
     dedendum_coefficient: Quantity = _nonneg("dimensionless", "dedendum h_f/m (standard 1.25)", default=1.25)
 
-    def _derive(self, d):
-        g = geo.GearGeometry(teeth=d["teeth"], module=d["module"], pressure_angle=d["pressure_angle"],
-                             internal=d["internal"], addendum_coefficient=d["addendum_coefficient"],
-                             dedendum_coefficient=d["dedendum_coefficient"])
-        if d["inertia"] is None:
-            d["inertia"] = d["mass"] * g.pitch_radius ** 2 * (1.0 if self.internal else 0.5)
-        d.update(pitch_radius=g.pitch_radius, base_radius=g.base_radius, tip_radius=g.tip_radius,
-                 root_radius=g.root_radius)
+    _si_derived: ClassVar[tuple] = (
+        Derived("inertia", float, "polar moment of inertia [kg m^2] (given, or the rule)"),
+        Derived("pitch_radius", float, "pitch circle radius m z / 2 [m]"),
+        Derived("base_radius", float, "base circle radius [m]"),
+        Derived("tip_radius", float, "tip (addendum) circle radius [m]"),
+        Derived("root_radius", float, "root (dedendum) circle radius [m]"),
+    )
+
+    def _si_values(self, v):
+        g = geo.GearGeometry(teeth=v["teeth"], module=v["module"], pressure_angle=v["pressure_angle"],
+                             internal=v["internal"], addendum_coefficient=v["addendum_coefficient"],
+                             dedendum_coefficient=v["dedendum_coefficient"])
+        inertia = v["inertia"]
+        if inertia is None:
+            inertia = v["mass"] * g.pitch_radius ** 2 * (1.0 if self.internal else 0.5)
+        return dict(inertia=inertia, pitch_radius=g.pitch_radius, base_radius=g.base_radius,
+                    tip_radius=g.tip_radius, root_radius=g.root_radius)
+GearSI = GearParams.SI
 
 
+@_with_si("GearSetSI")
 @dataclass(frozen=True, kw_only=True)
 class GearSetParams(Params):
     """Sun, inner planets, outer planets, ring and carrier of the double planetary set.
@@ -399,18 +476,27 @@ class GearSetParams(Params):
     handedness: int = _param("sign", "planet-pair handedness h = +1 or -1")
     planet_angle: Quantity = _param("angle", "angle psi_0 of the first inner planet", default="0 deg")
 
-    def _derive(self, d):
-        if d["carrier_inertia"] is None:
-            r_cb = 0.5 * d["sun"].module * (d["ring"].teeth - d["outer_planet"].teeth)
-            d["carrier_inertia"] = 0.5 * d["carrier_mass"] * (1.2 * r_cb) ** 2
+    _si_derived: ClassVar[tuple] = (
+        Derived("carrier_inertia", float, "carrier polar moment of inertia [kg m^2] (given, or the rule)"),)
+
+    def _si_values(self, v):
+        if v["carrier_inertia"] is not None:
+            return {}
+        r_cb = 0.5 * v["sun"].module * (v["ring"].teeth - v["outer_planet"].teeth)
+        return dict(carrier_inertia=0.5 * v["carrier_mass"] * (1.2 * r_cb) ** 2)
+GearSetSI = GearSetParams.SI
 
 
 # ---------------------------------------------------------------------------------------------
 # planet bearing
 # ---------------------------------------------------------------------------------------------
+@_with_si("CageSI")
 @dataclass(frozen=True, kw_only=True)
 class CageParams(Params):
-    """Cage of a planet bearing: outer-raceway (planet bore) guided, with Z pockets."""
+    """Cage of a planet bearing: outer-raceway (planet bore) guided, with Z pockets.
+
+    :class:`CageSI` ``inertia`` stays None when the rule applies: the rule needs the bearing's pitch
+    diameter, and ``BearingParams.si().cage`` has it resolved."""
 
     _prefix: ClassVar[str] = "bearing.cage"
     mass: Quantity = _pos("mass", "cage mass")
@@ -427,8 +513,13 @@ class CageParams(Params):
                                                 "rise to mu (tanh regularisation)")
     impact_speed_floor: Quantity = _pos("velocity", "smallest approach speed v0 in the impact damping "
                                                     "c = lambda(e)/v0 (slower contacts count as this speed)")
+    impact_law: str = _param("choice", "impact damping law lambda(e) of pocket and guide impacts "
+                                       "(mbd.elements.IMPACT_LAWS)",
+                             choices=("exact", "hunt_crossley", "lankarani_nikravesh", "flores"))
+CageSI = CageParams.SI
 
 
+@_with_si("SlideRollTractionSI")
 @dataclass(frozen=True, kw_only=True)
 class SlideRollTractionParams(Params):
     """Coefficients of the slide-to-roll traction curve μ(s) = (A + B s) e^(−C s) + D
@@ -441,8 +532,10 @@ class SlideRollTractionParams(Params):
     D: Quantity = _param("dimensionless", "traction at large slide-to-roll ratio D")
     rolling_speed_reg: Quantity = _pos("velocity", "rolling speed below which the slide-to-roll ratio is regularised")
     ratio_reg: Quantity = _pos("dimensionless", "slide-to-roll ratio smoothing at s = 0")
+SlideRollTractionSI = SlideRollTractionParams.SI
 
 
+@_with_si("BearingSI")
 @dataclass(frozen=True, kw_only=True)
 class BearingParams(Params):
     """Cylindrical roller planet bearing (same for inner and outer planets), with its cage.
@@ -477,23 +570,33 @@ class BearingParams(Params):
     linear_damping: Quantity = _nonneg("damping", "radial damping of a bearing modelled as a linear spring")
     cage: CageParams = _nested(CageParams, "cage")
 
-    def _derive(self, d):
-        dm, dr, ln = d["pitch_diameter"], d["roller_diameter"], d["roller_length"]
-        if d["roller_mass"] is None:
-            d["roller_mass"] = d["roller_density"] * math.pi * dr ** 2 * ln / 4.0
-        if d["roller_inertia"] is None:
-            d["roller_inertia"] = d["roller_mass"] * dr ** 2 / 8.0
-        if d["contact_stiffness"] is None:
-            d["contact_stiffness"] = geo.palmgren_stiffness(ln)
-        if d["cage"].inertia is None:
-            d["cage"] = d["cage"].replace(inertia=d["cage"].mass * (dm / 2.0) ** 2)
-        d["inner_raceway_radius"] = (dm - dr) / 2.0
-        d["outer_raceway_radius"] = (dm + dr + d["clearance"]) / 2.0
+    _si_derived: ClassVar[tuple] = (
+        Derived("roller_mass", float, "mass of one physical roller [kg] (given, or the rule)"),
+        Derived("roller_inertia", float, "polar moment of inertia of one roller [kg m^2] (given, or the rule)"),
+        Derived("contact_stiffness", float, "roller-raceway line contact stiffness K [N/m^(10/9)] (given, or Palmgren)"),
+        Derived("inner_raceway_radius", float, "R_i = (d_m - D)/2, the pin [m]"),
+        Derived("outer_raceway_radius", float, "R_o = (d_m + D + P_d)/2, the planet bore [m]"),
+    )
+
+    def _si_values(self, v):
+        dm, dr, ln = v["pitch_diameter"], v["roller_diameter"], v["roller_length"]
+        m = v["roller_mass"] if v["roller_mass"] is not None else v["roller_density"] * math.pi * dr ** 2 * ln / 4.0
+        cage = v["cage"]
+        if cage.inertia is None:
+            cage = cage.replace(inertia=cage.mass * (dm / 2.0) ** 2)
+        return dict(roller_mass=m,
+                    roller_inertia=v["roller_inertia"] if v["roller_inertia"] is not None else m * dr ** 2 / 8.0,
+                    contact_stiffness=(v["contact_stiffness"] if v["contact_stiffness"] is not None
+                                       else geo.palmgren_stiffness(ln)),
+                    cage=cage, inner_raceway_radius=(dm - dr) / 2.0,
+                    outer_raceway_radius=(dm + dr + v["clearance"]) / 2.0)
+BearingSI = BearingParams.SI
 
 
 # ---------------------------------------------------------------------------------------------
 # environment, supports, meshes, operating point
 # ---------------------------------------------------------------------------------------------
+@_with_si("LubricantSI")
 @dataclass(frozen=True, kw_only=True)
 class LubricantParams(Params):
     """Oil–air mixture for roller drag F = C_d ρ D l (d_m Ω_m)^2 / 8."""
@@ -501,8 +604,10 @@ class LubricantParams(Params):
     _prefix: ClassVar[str] = "lubricant"
     drag_coefficient: Quantity = _nonneg("dimensionless", "drag coefficient C_d")
     density: Quantity = _nonneg("density", "oil-air mixture density")
+LubricantSI = LubricantParams.SI
 
 
+@_with_si("SupportSI")
 @dataclass(frozen=True, kw_only=True)
 class SupportParams(Params):
     """Isotropic translational supports of sun, ring and carrier; torsional support of the ring.
@@ -518,8 +623,10 @@ class SupportParams(Params):
     damping_ratio: Quantity = _nonneg("dimensionless", "support damping ratio")
     ring_tangential_stiffness: Quantity = _nonneg("stiffness", "ring torsional support as tangential stiffness "
                                                                "at the ring pitch radius")
+SupportSI = SupportParams.SI
 
 
+@_with_si("MeshSI")
 @dataclass(frozen=True, kw_only=True)
 class MeshParams(Params):
     """Mesh stiffness and damping, common to the three meshes.
@@ -540,8 +647,10 @@ class MeshParams(Params):
     backlash_sun_inner: Quantity | None = _backlash("sun-inner planet meshes")
     backlash_inner_outer: Quantity | None = _backlash("inner-outer planet meshes")
     backlash_outer_ring: Quantity | None = _backlash("outer planet-ring meshes")
+MeshSI = MeshParams.SI
 
 
+@_with_si("OperatingSI")
 @dataclass(frozen=True, kw_only=True)
 class OperatingPoint(Params):
     """Ring fixed, sun driven, carrier loaded. ``carrier_speed`` is a magnitude; ``direction`` gives
@@ -557,11 +666,18 @@ class OperatingPoint(Params):
     output_power: Quantity = _nonneg("power", "output power P")
     direction: str = _param("choice", "sense of rotation", choices=("forward", "reverse"), default="forward")
 
-    def _derive(self, d):
-        d["sign"] = 1 if d["direction"] == "forward" else -1
-        d["carrier_speed"] = d["sign"] * d["carrier_speed"]
+    _si_derived: ClassVar[tuple] = (
+        Derived("carrier_speed", float, "signed carrier speed [rad/s] (+: forward)"),
+        Derived("sign", int, "+1 forward, -1 reverse"),
+    )
+
+    def _si_values(self, v):
+        sign = 1 if v["direction"] == "forward" else -1
+        return dict(sign=sign, carrier_speed=sign * v["carrier_speed"])
+OperatingSI = OperatingPoint.SI
 
 
+@_with_si("RigSI")
 @dataclass(frozen=True, kw_only=True)
 class RigParams(Params):
     """The source's test rig around the train (MODEL.md §3.7): the loading motor holds the carrier at its
@@ -574,8 +690,23 @@ class RigParams(Params):
     load_ramp_mesh_periods: Quantity = _nonneg("dimensionless", "length of the sun-torque ramp in mesh periods "
                                                                 "(0: the full torque at t = 0)")
     load_ramp_max: Quantity = _nonneg("time", "longest sun-torque ramp (near-zero speeds have no mesh period)")
+RigSI = RigParams.SI
 
 
+# the operating point and the supports as the whole machine sees them (they need the gears)
+DPGTOperatingSI = _extend_si(
+    "DPGTOperatingSI", OperatingSI,
+    [(f.name, float, "see geometry.Kinematics") for f in dataclasses.fields(geo.Kinematics)
+     if f.name not in {g.name for g in dataclasses.fields(OperatingSI)}],
+    "An operating point with its nominal speeds [rad/s], frequencies [Hz] and torques [N m] "
+    "(:class:`geometry.Kinematics`).")
+DPGTSupportSI = _extend_si(
+    "DPGTSupportSI", SupportSI,
+    [("ring_torsional_stiffness", float, "ring_tangential_stiffness x r_ring^2 [N m/rad]")],
+    "Supports with the ring's torsional stiffness.")
+
+
+@_with_si("DPGTSI")
 @dataclass(frozen=True, kw_only=True)
 class DPGTParams(Params):
     """The whole machine: gears, planet bearing (with cage), lubricant, supports, meshes, operating
@@ -596,22 +727,65 @@ class DPGTParams(Params):
     rig: RigParams = _nested(RigParams, "test rig: carrier speed drive and load ramp")
     gravity: Quantity = _nonneg("acceleration", "gravitational acceleration (0 switches gravity off)")
 
-    def _derive(self, d):
-        g = d["gears"]
-        bore = d["bearing"].outer_raceway_radius
-        for name in ("inner_planet", "outer_planet"):   # the planet's bore is the bearing's outer raceway
-            if getattr(self.gears, name).inertia is None:
-                gp = g[name]
-                g = g.replace(**{name: gp.replace(inertia=0.5 * gp.mass * (gp.pitch_radius ** 2 + bore ** 2))})
-        d["gears"] = g
-        d["support"] = d["support"].replace(
-            ring_torsional_stiffness=d["support"].ring_tangential_stiffness * g.ring.pitch_radius ** 2)
-        d["layout"] = geo.layout(self, gears_si=g, mesh_si=d["mesh"])
-        d["mesh"] = d["mesh"].replace(**{f"backlash_{k}": m.backlash for k, m in d["layout"].meshes.items()})
-        op = d["operating"]
-        kin = geo.kinematics(g.sun.teeth, g.inner_planet.teeth, g.outer_planet.teeth, g.ring.teeth,
-                             op.carrier_speed, op.output_power)
-        d["operating"] = op.replace(**dataclasses.asdict(kin))
+    _si_derived: ClassVar[tuple] = (
+        Derived("gears", GearSetSI, "gear set; planet inertias resolved with the bearing bore"),
+        Derived("support", DPGTSupportSI, "supports and the ring's torsional stiffness"),
+        Derived("mesh", MeshSI, "meshes, backlash resolved per mesh type"),
+        Derived("operating", DPGTOperatingSI, "operating point with its nominal speeds and torques"),
+        Derived("layout", geo.Layout, "planet positions, meshes, phases (geometry.Layout)"),
+    )
+
+    def _si_values(self, v):
+        gears = _planets_with_bore(self.gears, v["gears"], v["bearing"].outer_raceway_radius)
+        sup = v["support"]
+        support = DPGTSupportSI(**_fields_of(sup), ring_torsional_stiffness=(
+            sup.ring_tangential_stiffness * gears.ring.pitch_radius ** 2))
+        lay = geo.layout(self, gears_si=gears, mesh_si=v["mesh"])
+        mesh = v["mesh"].replace(**{f"backlash_{k}": m.backlash for k, m in lay.meshes.items()})
+        op = v["operating"]
+        kin = geo.kinematics(gears.sun.teeth, gears.inner_planet.teeth, gears.outer_planet.teeth,
+                             gears.ring.teeth, op.carrier_speed, op.output_power)
+        operating = DPGTOperatingSI(**{**_fields_of(op), **_fields_of(kin)})
+        return dict(gears=gears, support=support, mesh=mesh, operating=operating, layout=lay)
+DPGTSI = DPGTParams.SI
+
+
+def _planets_with_bore(gears: GearSetParams, g: "GearSetSI", bore: float) -> "GearSetSI":
+    """The planets' inertia rule in a DPGT: an annulus m (r^2 + r_bore^2)/2, the bore being the
+    bearing's outer raceway (given inertias stay)."""
+    for name in ("inner_planet", "outer_planet"):
+        if getattr(gears, name).inertia is None:
+            gp = getattr(g, name)
+            g = g.replace(**{name: gp.replace(inertia=0.5 * gp.mass * (gp.pitch_radius ** 2 + bore ** 2))})
+    return g
+
+
+@_with_si("BearingRigSI")
+@dataclass(frozen=True, kw_only=True)
+class BearingRigParams(Params):
+    """The single-bearing test rig (:func:`components.rig.build_bearing_rig`, MODEL.md §6 check 4): a
+    planet-like outer ring on the bearing, its spin held by a speed drive, the radial load ramped in and
+    a settling dashpot from the ring to ground. The ramp and the dashpot do not change the static solution."""
+
+    _prefix: ClassVar[str] = "bearing_rig"
+    ring_mass: Quantity = _pos("mass", "outer ring mass")
+    ring_radius: Quantity = _pos("length", "outer ring radius for its inertia rule")
+    ring_inertia: Quantity | None = _rule("inertia", "assumed", "solid disc of the ring radius, m r^2/2")
+    drive_bandwidth: Quantity = _pos("frequency", "bandwidth of the ring's speed drive")
+    drive_damping_ratio: Quantity = _nonneg("dimensionless", "damping ratio of the ring's speed drive")
+    settle_damping_ratio: Quantity = _nonneg("dimensionless", "ring-to-ground dashpot as a fraction of the critical "
+                                                              "damping of the ring's radial mode on the loaded bearing")
+    load_ramp_periods: Quantity = _nonneg("dimensionless", "length of the load ramp in periods of that radial mode")
+    gravity: Quantity = _nonneg("acceleration", "gravitational acceleration along -y (scene option gravity)")
+
+    _si_derived: ClassVar[tuple] = (
+        Derived("ring_inertia", float, "outer ring polar moment of inertia [kg m^2] (given, or the rule)"),)
+
+    def _si_values(self, v):
+        if v["ring_inertia"] is not None:
+            return {}
+        return dict(ring_inertia=0.5 * v["ring_mass"] * v["ring_radius"] ** 2)
+BearingRigSI = BearingRigParams.SI
 
 
 # ---------------------------------------------------------------------------------------------

@@ -11,13 +11,13 @@ from types import MappingProxyType
 
 from pathlib import Path
 
-from .params import (BearingParams, CageParams, DPGTParams, GearParams, GearSetParams, LubricantParams,
+from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, GearParams, GearSetParams, LubricantParams,
                      MeshParams, OperatingPoint, RigParams, SlideRollTractionParams, SupportParams, assumed, derived,
                      overrides_from_toml, paper, with_overrides)
 from .units import Q_, ParameterError
 
 __all__ = ["CONDITIONS", "DIRECTIONS", "operating_point", "reference_gears", "reference_bearing",
-           "reference_dpgt", "load_toml"]
+           "reference_dpgt", "reference_bearing_rig", "load_toml"]
 
 # the study's four operating conditions: carrier speed n_c and output power P (ring fixed)
 CONDITIONS = MappingProxyType({
@@ -78,6 +78,8 @@ def reference_bearing() -> BearingParams:
         friction_speed=assumed("0.01 m/s", "tanh-regularised Coulomb friction: full mu above ~2 cm/s of sliding"),
         impact_speed_floor=assumed("0.01 m/s", "bounds the Hunt-Crossley damping of slow, quasi-static pocket "
                                                "and land contacts; a roller at 1 cm/s carries ~1e-7 J"),
+        impact_law=derived("exact", "lambda(e) from ln((1+lambda)/(1-lambda e)) = lambda (1+e): the set e holds "
+                                    "at any approach speed (MODEL.md 3.4)"),
     )
     return BearingParams(
         pitch_diameter=paper("39 mm"),
@@ -134,6 +136,20 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
             load_ramp_mesh_periods=assumed(20.0, "no impulse at the start (MODEL.md 4)"),
             load_ramp_max=assumed("0.05 s", "near-zero speeds have no mesh period")),
         gravity=assumed("9.81 m/s^2", "standard gravity along -Y of the fixed frame"),
+    )
+
+
+def reference_bearing_rig() -> BearingRigParams:
+    """The single-bearing rig (MODEL.md §6 check 4): a planet-like outer ring, its speed drive and the
+    aids that let the loaded ring settle (they do not change the static solution)."""
+    return BearingRigParams(
+        ring_mass=assumed("0.557 kg", "a planet-like outer ring: the reference planet's mass"),
+        ring_radius=assumed("0.036 m", "the reference planet's pitch radius (36 mm)"),
+        drive_bandwidth=assumed("100 Hz", "holds the ring's spin; far above the rig's slow settling"),
+        drive_damping_ratio=assumed(0.7),
+        settle_damping_ratio=assumed(0.2, "of the ring's radial mode: settles in a few periods"),
+        load_ramp_periods=assumed(20.0, "of the ring's radial mode: no impulse at the start"),
+        gravity=assumed("9.81 m/s^2", "standard gravity along -y, when the scene option gravity is on"),
     )
 
 

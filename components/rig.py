@@ -26,18 +26,15 @@ import mbd
 from mbd.ad import wrap_angle
 from mbd.elements import ForceSource, GroundSupport, Ramp, SpeedDrive
 
-from .bearing import BearingSI, add_planet_bearing, bearing_si
+from .bearing import add_planet_bearing
 from .families import FAMILY
 from .outputs import pin_reactions
+from .params import BearingParams, BearingRigParams, BearingRigSI, BearingSI, LubricantParams, LubricantSI
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError
 
-__all__ = ["RING_MASS", "RING_INERTIA", "build_bearing_rig", "run_sampled", "rig_loads", "RigSolution",
+__all__ = ["build_bearing_rig", "rig_options", "run_sampled", "rig_loads", "RigSolution",
            "rig_static_solution", "discrete_load_distribution", "DiscreteDistribution"]
-
-RING_MASS = 0.557                         # [assumed] a planet-like outer ring: the reference planet's mass, kg
-RING_INERTIA = 0.5 * RING_MASS * 0.036**2  # [assumed] solid disc at the planet's pitch radius (36 mm), kg m^2
-_EXP = 10.0 / 9.0                          # Palmgren line-contact exponent
 
 
 # ----------------------------------------------------------------------------------------------
@@ -81,22 +78,24 @@ def _zone_angle(deflection: float, clearance: float) -> float:
 
 def discrete_load_distribution(b: BearingSI, radial_load: float, angles=None) -> DiscreteDistribution:
     """Classical reference: rigid rings, the rollers at ``angles`` [rad] from the load-zone centre
-    (default: one roller on the load line, Z equally spaced), Palmgren contacts Q = K δ^(10/9) at both
-    raceways in series (equal loads: Q = K (δ/2)^(10/9) for a total compression δ), diametral clearance
-    P_d. Solves the ring's equilibrium F_r = rows·Σ Q_j cos ψ_j (and Σ Q_j sin ψ_j = 0 with a sideways
-    shift): ``loads`` are per physical roller, each of the ``b.rows`` identical rows carrying F_r/rows."""
+    (default: one roller on the load line, Z equally spaced), contacts Q = K δ^p (Palmgren: p = 10/9, the
+    bearing's contact_exponent) at both raceways in series (equal loads: Q = K (δ/2)^p for a total
+    compression δ), diametral clearance P_d. ``b``: ``BearingParams.si()``. Solves the ring's equilibrium
+    F_r = rows·Σ Q_j cos ψ_j (and Σ Q_j sin ψ_j = 0 with a sideways shift): ``loads`` are per physical
+    roller, each of the ``b.rows`` identical rows carrying F_r/rows."""
     F = float(radial_load)
     if not (np.isfinite(F) and F > 0):
         raise ParameterError.at("radial_load", f"must be > 0 N for a load distribution, got {radial_load!r}")
     F_total, F = F, F / b.rows
-    psi = 2 * np.pi * np.arange(b.Z) / b.Z if angles is None else np.asarray(angles, float)
+    Z, p = b.rollers, b.contact_exponent
+    psi = 2 * np.pi * np.arange(Z) / Z if angles is None else np.asarray(angles, float)
     c, s = np.cos(psi), np.sin(psi)
-    K2 = b.K * 2.0 ** (-_EXP)
+    K2 = b.contact_stiffness * 2.0 ** (-p)
     half = 0.5 * b.clearance
 
     def loads(d):   # d = (along the load, sideways): compression δ_r cos ψ + d_s sin ψ − P_d/2
         comp = d[0] * c + d[1] * s - half
-        return K2 * np.where(comp > 0, np.abs(comp), 0.0) ** _EXP
+        return K2 * np.where(comp > 0, np.abs(comp), 0.0) ** p
 
     # 1-D solve (symmetric set) as the start, then the 2-D equilibrium
     f1 = lambda x: np.sum(loads((x, 0.0)) * c) - F
@@ -117,102 +116,107 @@ def discrete_load_distribution(b: BearingSI, radial_load: float, angles=None) ->
 # the scene
 # ----------------------------------------------------------------------------------------------
 def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 * np.pi, outer_speed: float = 0.0,
-                      cage: str = "free", gravity: bool = False, options: SceneOptions | None = None,
-                      lubricant=None, ring_mass: float = RING_MASS, ring_inertia: float = RING_INERTIA,
-                      ramp_time: float | None = None, settle_damping_ratio: float = 0.2,
-                      drive_freq: float = 100.0, drive_zeta: float = 0.7) -> BuiltScene:
+                      options: SceneOptions | None = None, lubricant=None,
+                      rig: BearingRigParams | None = None) -> BuiltScene:
     """A bearing between a fixed pin and a loaded outer ring (SI arguments).
 
-    ``bearing``: :class:`~components.params.BearingParams` (then ``lubricant`` a LubricantParams, or None
-    for no lubricant drag) or a :class:`~components.bearing.BearingSI`. ``radial_load`` F_r ≥ 0 [N] on the
-    outer ring along ``load_angle`` [rad, fixed frame; default downwards]. ``outer_speed`` [rad/s] the
-    ring's spin, held by a speed drive (``drive_freq`` [Hz], ``drive_zeta``). ``cage``: "free" (guided by
-    the outer ring), "held" (a fixed body: the rollers cannot orbit) or "none". ``options``: the scene's
-    switches (``drag``; ``bearings`` must be "rollers"); the rig is always inertial and ``gravity`` (a
-    bool, 9.81 m/s² along −y) overrides options.gravity.
+    ``bearing``: :class:`~components.params.BearingParams` or its SI object (``.si()``); ``lubricant`` a
+    LubricantParams (or its SI object), or None for no lubricant drag. ``radial_load`` F_r ≥ 0 [N] on
+    the outer ring along ``load_angle`` [rad, fixed frame; default downwards]. ``outer_speed`` [rad/s]
+    the ring's spin, held by a speed drive. ``rig``: the ring, its drive, the load ramp and the settling
+    dashpot (:class:`~components.params.BearingRigParams`; default
+    :func:`components.presets.reference_bearing_rig`). ``options``: the scene switches, see
+    :func:`rig_options` (cage "free": guided by the outer ring, "held": a fixed body, the rollers cannot
+    orbit, "none").
 
-    Rig aids [assumed], neither changes the static solution: the load is ramped over ``ramp_time``
-    (default 20 periods of the ring's radial mode on the loaded bearing), and a dashpot from the ring
-    to ground with ``settle_damping_ratio`` of that mode's critical damping lets it settle (the Hertz
-    contacts alone damp the ring very little).
+    Rig aids [assumed], neither changes the static solution: the load is ramped over
+    ``rig.load_ramp_periods`` periods of the ring's radial mode on the loaded bearing, and a dashpot
+    from the ring to ground with ``rig.settle_damping_ratio`` of that mode's critical damping lets it
+    settle (the Hertz contacts alone damp the ring very little).
 
     meta: radial_load, load_angle, zone_angle (direction of the load-zone centre), ramp_s, t_settle_s
-    (a suggested start of the averaging window), period_s (the ring mode), bearing (BearingSI).
+    (a suggested start of the averaging window), period_s (the ring mode), cage, bearing (BearingSI).
     handles: "bearing" (from add_planet_bearing), "ring", "pin".
     """
-    b = _bearing_si(bearing, lubricant)
+    b, lub, rs = _rig_inputs(bearing, lubricant, rig)
     _check_bearing(b)
     F = _finite("radial_load", radial_load, nonneg=True)
     a = _finite("load_angle", load_angle)
     w = _finite("outer_speed", outer_speed)
-    if cage not in ("free", "held", "none"):
-        raise ParameterError.at("cage", f"expected 'free', 'held' or 'none', got {cage!r}")
-    _finite("ring_mass", ring_mass, positive=True)
-    _finite("ring_inertia", ring_inertia, positive=True)
-    _finite("settle_damping_ratio", settle_damping_ratio, nonneg=True)
-    _finite("drive_freq", drive_freq, positive=True)
-    _finite("drive_zeta", drive_zeta, nonneg=True)
-    opt = options or SceneOptions()
-    if opt.bearings != "rollers":
-        raise ParameterError.at("options.bearings", f"the bearing rig needs the roller model ('rollers'), got {opt.bearings!r}")
-    has_lubricant = isinstance(bearing, BearingSI) or lubricant is not None   # else: no drag family at all
-    opt = dataclasses.replace(opt, cage=cage != "none", gravity=bool(gravity), frame="fixed",
-                              drag=opt.drag and has_lubricant)
-    scene = Scene(frame_omega=0.0, gravity=9.81 if gravity else 0.0, options=opt)
+    opt = rig_options(options, has_lubricant=lub is not None)
+    scene = Scene(frame_omega=0.0, gravity=rs.gravity if opt.gravity else 0.0, options=opt)
     scene.body("pin", 1.0, 1.0, fixed=True)
-    scene.body("ring", ring_mass, ring_inertia, vel=(0.0, 0.0, w))
-    h = add_planet_bearing(scene, "pb", pin_body="pin", pin_local=(0.0, 0.0), outer_body="ring", b=b,
-                           pin_xy=(0.0, 0.0), pin_vel=(0.0, 0.0), omega_pin=0.0, omega_outer=w,
-                           cage_held=cage == "held")
+    scene.body("ring", rs.ring_mass, rs.ring_inertia, vel=(0.0, 0.0, w))
+    h = add_planet_bearing(scene, "pb", pin_body="pin", pin_local=(0.0, 0.0), outer_body="ring", bearing=b,
+                           lubricant=lub, pin_xy=(0.0, 0.0), pin_vel=(0.0, 0.0), omega_pin=0.0, omega_outer=w)
     # radial mode of the ring on the loaded bearing (stiffness dF/dδ_r of the classical solution)
     if F > 0:
-        ref = discrete_load_distribution(b, F, _roller_angles_from_zone(b.Z, a))
+        ref = discrete_load_distribution(b, F, _roller_angles_from_zone(b.rollers, a))
         k_r = _radial_stiffness(b, F, a)
-        period = 2 * np.pi * np.sqrt(ring_mass / k_r)
+        period = 2 * np.pi * np.sqrt(rs.ring_mass / k_r)
     else:
-        ref, k_r, period = None, 0.0, 1e-3
-    ramp = 20.0 * period if ramp_time is None else _finite("ramp_time", ramp_time, nonneg=True)
+        ref, k_r, period = None, 0.0, 1e-3       # unloaded: no mode, a nominal time scale for the meta
+    ramp = rs.load_ramp_periods * period
     u = np.array([np.cos(a), np.sin(a)])
     scene.add_element(ForceSource("radial_load", [scene.index["ring"]], F * u, ramp=Ramp(0.0, ramp)))
-    wd = 2 * np.pi * drive_freq
-    scene.add_element(SpeedDrive("ring_drive", scene.index["ring"], w, k=ring_inertia * wd**2,
-                                 c=2 * drive_zeta * ring_inertia * wd))
-    c_settle = 2.0 * settle_damping_ratio * np.sqrt(k_r * ring_mass)
+    wd = 2 * np.pi * rs.drive_bandwidth
+    scene.add_element(SpeedDrive("ring_drive", scene.index["ring"], w, k=rs.ring_inertia * wd**2,
+                                 c=2 * rs.drive_damping_ratio * rs.ring_inertia * wd))
+    c_settle = 2.0 * rs.settle_damping_ratio * np.sqrt(k_r * rs.ring_mass)
     if c_settle > 0:
         scene.add_element(GroundSupport("ring_damper", [scene.index["ring"]], kx=0.0, cx=c_settle))
     scene.handles.update({"bearing": h, "ring": "ring", "pin": "pin"})
     scene.meta.update({"radial_load": F, "load_angle": a, "zone_angle": a + np.pi, "outer_speed": w,
                        "ramp_s": ramp, "period_s": period, "t_settle_s": ramp + 10.0 * period,
-                       "radial_stiffness": k_r, "cage": cage, "bearing": b, "reference": ref})
+                       "radial_stiffness": k_r, "cage": opt.cage, "bearing": b, "reference": ref})
     return scene.build()
 
 
-def _bearing_si(bearing, lubricant) -> BearingSI:
-    if isinstance(bearing, BearingSI):
-        return bearing
-    from .params import BearingParams, LubricantParams
-    if not isinstance(bearing, BearingParams):
+def rig_options(options: SceneOptions | None, has_lubricant: bool) -> SceneOptions:
+    """The rig's scene switches: the given ones, else the rig's own (frame "fixed", bearings "rollers",
+    cage "free", gravity off, drag when there is a lubricant). A given switch the rig cannot honour is
+    refused, never replaced: frame must be "fixed", bearings "rollers", drag needs a lubricant."""
+    opt = options or SceneOptions()
+    given = opt.given()
+    needs = {"frame": "fixed", "bearings": "rollers"}
+    for key, value in needs.items():
+        if given.get(key, value) != value:
+            raise ParameterError.at(f"options.{key}", f"the bearing rig needs {value!r}, got {given[key]!r}")
+    if given.get("drag") and not has_lubricant:
+        raise ParameterError.at("options.drag", "lubricant drag needs a lubricant: pass lubricant=LubricantParams")
+    return opt.resolved(**needs, cage="free", gravity=False, drag=has_lubricant)
+
+
+def _rig_inputs(bearing, lubricant, rig) -> tuple[BearingSI, LubricantSI | None, BearingRigSI]:
+    """SI objects of the bearing, the lubricant (None: no drag) and the rig parameters."""
+    if isinstance(bearing, BearingParams):
+        bearing = bearing.si()
+    if not isinstance(bearing, BearingSI):
         raise ParameterError.at("bearing", f"expected BearingParams or BearingSI, got {type(bearing).__name__}")
-    if lubricant is None:
-        lub = LubricantParams(drag_coefficient=0.0, density="0 kg/m^3").si()
-    elif isinstance(lubricant, LubricantParams):
-        lub = lubricant.si()
-    else:
+    if isinstance(lubricant, LubricantParams):
+        lubricant = lubricant.si()
+    if lubricant is not None and not isinstance(lubricant, LubricantSI):
         raise ParameterError.at("lubricant", f"expected LubricantParams or None, got {type(lubricant).__name__}")
-    return bearing_si(bearing.si(), lub)
+    if rig is None:
+        from .presets import reference_bearing_rig
+        rig = reference_bearing_rig()
+    if not isinstance(rig, BearingRigParams):
+        raise ParameterError.at("rig", f"expected BearingRigParams, got {type(rig).__name__}")
+    return bearing, lubricant, rig.si()
 
 
 def _check_bearing(b: BearingSI) -> None:
     """The fit checks of :func:`components.geometry.design_findings` that concern the bearing alone."""
-    if b.Z < 3:
-        raise ParameterError.at("bearing.rollers", f"must be >= 3, got {b.Z}")
-    if not b.D < b.d_m:
-        raise ParameterError.at("bearing.roller_diameter", f"{b.D * 1e3:g} mm leaves no pin inside the pitch "
-                                                           f"diameter {b.d_m * 1e3:g} mm")
-    chord = b.d_m * np.sin(np.pi / b.Z)
-    if chord <= b.D:
-        raise ParameterError.at("bearing.rollers", f"{b.Z} rollers of {b.D * 1e3:g} mm do not fit on the "
-                                                   f"{b.d_m * 1e3:g} mm pitch circle (centre spacing {chord * 1e3:.3f} mm)")
+    Z, D, d_m = b.rollers, b.roller_diameter, b.pitch_diameter
+    if Z < 3:     # an SI object may have been replaced by hand: no check ran on it
+        raise ParameterError.at("bearing.rollers", f"must be >= 3, got {Z}")
+    if not D < d_m:
+        raise ParameterError.at("bearing.roller_diameter", f"{D * 1e3:g} mm leaves no pin inside the pitch "
+                                                           f"diameter {d_m * 1e3:g} mm")
+    chord = d_m * np.sin(np.pi / Z)
+    if chord <= D:
+        raise ParameterError.at("bearing.rollers", f"{Z} rollers of {D * 1e3:g} mm do not fit on the "
+                                                   f"{d_m * 1e3:g} mm pitch circle (centre spacing {chord * 1e3:.3f} mm)")
     if b.clearance < 0:
         raise ParameterError.at("bearing.clearance", f"must be >= 0, got {b.clearance!r} m")
 
@@ -235,7 +239,7 @@ def _roller_angles_from_zone(Z: int, load_angle: float) -> np.ndarray:
 
 def _radial_stiffness(b: BearingSI, F: float, a: float) -> float:
     """dF_r/dδ_r of the classical solution (central difference)."""
-    ang = _roller_angles_from_zone(b.Z, a)
+    ang = _roller_angles_from_zone(b.rollers, a)
     d1 = discrete_load_distribution(b, 0.99 * F, ang).deflection
     d2 = discrete_load_distribution(b, 1.01 * F, ang).deflection
     return 0.02 * F / (d2 - d1)
@@ -343,7 +347,7 @@ def rig_static_solution(built: BuiltScene, *, t_settle: float | None = None, win
     equally spaced samples in it; ``controller`` Adaptive (h0 = 1 µs, h_max = period/20)."""
     import time
     meta = built.meta
-    F, a, Z = meta["radial_load"], meta["load_angle"], meta["bearing"].Z
+    F, a, Z = meta["radial_load"], meta["load_angle"], meta["bearing"].rollers
     t_settle = meta["t_settle_s"] if t_settle is None else float(t_settle)
     window = 10.0 * meta["period_s"] if window is None else float(window)
     if controller is None:

@@ -8,8 +8,8 @@ A scene contains only what its components added: nothing unused is built or eval
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass, field, fields
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -21,29 +21,47 @@ __all__ = ["Scene", "BuiltScene", "FamilyCollector", "SceneOptions"]
 
 @dataclass(frozen=True)
 class SceneOptions:
-    """Physics switches of a scene (PyBaMM-style validated options). Unknown keys fail loudly."""
-    bearings: str = "rollers"          # "rollers": full roller/cage model; "linear": radial spring
-    cage: bool = True                  # cage body + pocket and guide contacts (rollers only)
-    drag: bool = True                  # lubricant drag on rollers
-    gravity: bool = True
-    mesh_stiffness: str = "time_varying"   # "time_varying" | "constant"
-    frame: str = "rotating"            # "rotating" (R turns with the nominal carrier speed) | "fixed"
+    """Physics switches of a scene (PyBaMM-style validated options). Unknown keys fail loudly.
 
-    _CHOICES = {"bearings": ("rollers", "linear"), "mesh_stiffness": ("time_varying", "constant"),
-                "frame": ("rotating", "fixed")}
+    A switch left None takes the scene's own default: :attr:`DEFAULTS` for the DPGT, the rig's values
+    for the bearing rig (:func:`components.rig.build_bearing_rig`). A scene never overrides a switch
+    that was given: it refuses one it cannot honour. ``cage`` also accepts true/false (old TOML and
+    CLI input) as "free"/"none"."""
+    bearings: str | None = None        # "rollers": full roller/cage model; "linear": radial spring
+    cage: str | None = None            # "free": cage body + pocket and guide contacts; "held": a cage that
+                                       # cannot turn (bearing rig only); "none": no cage (rollers only)
+    drag: bool | None = None           # lubricant drag on rollers
+    gravity: bool | None = None
+    mesh_stiffness: str | None = None  # "time_varying" | "constant"
+    frame: str | None = None           # "rotating" (R turns with the nominal carrier speed) | "fixed"
+
+    DEFAULTS: ClassVar[dict] = {"bearings": "rollers", "cage": "free", "drag": True, "gravity": True,
+                                "mesh_stiffness": "time_varying", "frame": "rotating"}
+    _CHOICES: ClassVar[dict] = {"bearings": ("rollers", "linear"), "cage": ("free", "held", "none"),
+                                "mesh_stiffness": ("time_varying", "constant"), "frame": ("rotating", "fixed")}
 
     def __post_init__(self):
+        if isinstance(self.cage, (bool, np.bool_)):
+            object.__setattr__(self, "cage", "free" if self.cage else "none")
         for key, allowed in self._CHOICES.items():
-            if getattr(self, key) not in allowed:
+            if getattr(self, key) not in (None, *allowed):
                 raise mbd.ModelError(f"scene option {key!r} must be one of {allowed}, got {getattr(self, key)!r}")
-        for key in ("cage", "drag", "gravity"):
-            if not isinstance(getattr(self, key), bool):
+        for key in ("drag", "gravity"):
+            if getattr(self, key) is not None and not isinstance(getattr(self, key), bool):
                 raise mbd.ModelError(f"scene option {key!r} must be true or false, got {getattr(self, key)!r}")
+
+    def given(self) -> dict:
+        """The switches that were set (not None)."""
+        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
+
+    def resolved(self, **defaults) -> "SceneOptions":
+        """Every switch set: the given ones, else ``defaults`` (a scene's own), else :attr:`DEFAULTS`."""
+        return SceneOptions(**{**self.DEFAULTS, **defaults, **self.given()})
 
     @classmethod
     def from_dict(cls, d: dict | None) -> "SceneOptions":
         d = dict(d or {})
-        valid = [f for f in cls.__dataclass_fields__ if not f.startswith("_")]
+        valid = [f.name for f in fields(cls)]
         unknown = set(d) - set(valid)
         if unknown:
             raise mbd.ModelError(f"unknown scene option(s) {sorted(unknown)}; valid options: {valid}")
@@ -101,7 +119,7 @@ class BuiltScene:
 
 class Scene:
     def __init__(self, frame_omega: float = 0.0, gravity: float = 0.0, options: SceneOptions | None = None):
-        self.options = options or SceneOptions()
+        self.options = (options or SceneOptions()).resolved()     # components read every switch
         frame = mbd.Frame.rotating(frame_omega) if frame_omega != 0.0 else mbd.Frame.inertial()
         self.mb = mbd.ModelBuilder(frame=frame, gravity=(0.0, -gravity))
         self.frame_omega = frame_omega

@@ -60,13 +60,13 @@ def run(a) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         built = build_bearing_rig(params.bearing, lubricant=None if a.no_drag else params.lubricant, radial_load=F,
-                                  outer_speed=w, cage=a.cage, options=SceneOptions(drag=not a.no_drag, gravity=False))
+                                  outer_speed=w, options=SceneOptions(cage=a.cage, drag=not a.no_drag, gravity=False))
     sol = rig_static_solution(built)
     b = built.meta["bearing"]
     theory = discrete_load_distribution(b, F)
     order = np.argsort(sol.angles)
     summary = {
-        "radial_load_N": F, "clearance_m": b.clearance, "rollers": b.Z, "outer_speed_rad_s": w, "cage": a.cage,
+        "radial_load_N": F, "clearance_m": b.clearance, "rollers": b.rollers, "outer_speed_rad_s": w, "cage": a.cage,
         "roller_angle_deg": np.degrees(sol.angles[order]).tolist(),   # from the load-zone centre
         "angle_reference": "centre of the load zone (opposite the pull on the outer ring)",
         "roller_load_N": sol.loads[order].tolist(),
@@ -87,8 +87,8 @@ def run(a) -> dict:
 
     fig = vp.load_distribution(sol.angles[order], {"simulated (time mean)": sol.loads[order]},
                                out / "load_distribution.png",
-                               title=f"Roller loads, F_r = {F / 1e3:.3g} kN, P_d = {b.clearance * 1e6:.0f} µm, Z = {b.Z}")
-    print(f"F_r = {F:.0f} N, P_d = {b.clearance * 1e6:.1f} um, Z = {b.Z}: Q_max = {sol.q_max:.0f} N, "
+                               title=f"Roller loads, F_r = {F / 1e3:.3g} kN, P_d = {b.clearance * 1e6:.0f} µm, Z = {b.rollers}")
+    print(f"F_r = {F:.0f} N, P_d = {b.clearance * 1e6:.1f} um, Z = {b.rollers}: Q_max = {sol.q_max:.0f} N, "
           f"Q_max·Z/F_r = {sol.stribeck:.2f}, load zone {np.degrees(sol.zone_angle):.0f} deg, "
           f"ring deflection {sol.deflection * 1e6:.2f} um, Σ roller loads vs F_r: {summary['load_balance_error']:.2e}")
     print(f"discrete-roller theory: Q_max = {theory.q_max:.0f} N, Q_max·Z/F_r = {theory.stribeck:.2f}, "

@@ -24,11 +24,9 @@ CONTROLLER = mbd.Adaptive(h0=1e-6, h_max=1e-5, h_min=1e-9)
 
 def cage_revolution(params) -> float:
     """One cage revolution relative to the carrier [s] (inner and outer cages turn alike here)."""
-    from components.bearing import bearing_si
     si = params.si()
     op = si.operating
-    b = bearing_si(si.bearing, si.lubricant)
-    return max(cage_period(b, op.carrier_speed, w) for w in (op.inner_planet_speed, op.outer_planet_speed))
+    return max(cage_period(si.bearing, op.carrier_speed, w) for w in (op.inner_planet_speed, op.outer_planet_speed))
 
 
 def build(params, **options):

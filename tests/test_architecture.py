@@ -135,3 +135,12 @@ def test_law_variants_are_registered_classes_without_default_coefficients():
     from mbd.elements.gear_mesh import StiffnessShape
     sig = inspect.signature(StiffnessShape.rectangular).parameters
     assert all(sig[k].default is inspect.Parameter.empty for k in ("contact_ratio", "ratio", "smoothing"))
+
+
+def test_parameter_choices_name_the_registered_laws():
+    """A law chosen by a parameter must exist in its registry, and every registered law is selectable."""
+    from components.params import BearingParams, CageParams
+    from mbd.elements import IMPACT_LAWS
+    choices = lambda cls, name: set(cls._spec(name).choices)
+    assert choices(CageParams, "impact_law") == set(IMPACT_LAWS)
+    assert choices(BearingParams, "traction_law") == set(TRACTION_LAWS)

@@ -280,7 +280,7 @@ def test_quasi_static_force_polygon(polygons, direction):
     b = bs.meta["bearing"]
     W = bs.model.frame.omega
     assert w_c == pytest.approx(W, rel=3e-3)                  # the carrier runs at the reference speed
-    m_s = bs.model.mass[bs.model.body("a1").index] + b.Z * b.roller_mass + b.cage_mass
+    m_s = bs.model.mass[bs.model.body("a1").index] + b.rollers * b.roller_mass + b.cage.mass
     radius = {"inner": 0.0825, "outer": 0.087}
     for k, (n, key, h, bodies, on) in enumerate(rows):
         pin, mesh, drag, frame = mean[k, 0:2], mean[k, 2:4], mean[k, 4:6], mean[k, 6:8]
@@ -323,7 +323,7 @@ def rig_runs():
     out = {}
     for c in ("0 um", "20 um", "80 um"):
         bp = with_overrides(ref, {"bearing.clearance": c}).bearing
-        rig = build_bearing_rig(bp, radial_load=10e3, cage="held")
+        rig = build_bearing_rig(bp, radial_load=10e3, options=SceneOptions(cage="held"))
         out[c] = rig_static_solution(rig)
     return out
 
@@ -353,7 +353,7 @@ def test_a_double_row_bearing_under_twice_the_load_carries_per_roller_what_one_r
     sol = {}
     for rows, F in ((1, 5e3), (2, 10e3)):
         bp = with_overrides(ref, {"bearing.rows": rows}).bearing
-        sol[rows] = rig_static_solution(build_bearing_rig(bp, radial_load=F, cage="held"))
+        sol[rows] = rig_static_solution(build_bearing_rig(bp, radial_load=F, options=SceneOptions(cage="held")))
     np.testing.assert_allclose(sol[2].loads, sol[1].loads, rtol=5e-3, atol=5e-3 * sol[1].q_max)
     np.testing.assert_allclose(sol[2].load_sum, sol[2].load_vector, atol=0.01 * sol[2].radial_load)
     assert sol[2].stribeck == pytest.approx(sol[1].stribeck, rel=5e-3)

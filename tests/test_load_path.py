@@ -56,7 +56,7 @@ def test_bearing_load_is_the_drive_flank_polygon_plus_centrifugal_force(runs, ca
     flanks = bs.handles["flanks"]
     F = {key: stats.stats(f"{key}_drive_force")["mean"] for key in MESH_FAMILY}
     lr, lt = stats.stats("load_radial")["mean"], stats.stats("load_tangential")["mean"]
-    carried = b.Z * b.rows * b.roller_mass + b.cage_mass
+    carried = b.rollers * b.rows * b.roller_mass + b.cage.mass
     i = 0
     for n, pair in enumerate(bs.handles["pairs"]):
         ca, cb = lay.centres_a[n], lay.centres_b[n]

@@ -15,8 +15,8 @@ from components.bearing import bearing_kinematics
 from components.params import LubricantParams
 from components.planetary import (EXAMPLE_PLANETARY, build_single_planetary, load_planetary_toml,
                                   modal_state, planetary_modes, planetary_spec)
-from components.presets import reference_bearing
-from components.rig import (_bearing_si, build_bearing_rig, discrete_load_distribution, rig_loads,
+from components.presets import reference_bearing, reference_bearing_rig, reference_dpgt
+from components.rig import (build_bearing_rig, discrete_load_distribution, rig_loads,
                             rig_static_solution, run_sampled)
 from components.scene import SceneOptions
 from components.units import ParameterError
@@ -30,7 +30,7 @@ def bearing(clearance="20 um", **kw):
 
 # ============================================================================ classical reference
 def test_discrete_reference_reproduces_stribeck_numbers():
-    b = _bearing_si(bearing("0 um"), None)
+    b = bearing("0 um").si()
     ref = discrete_load_distribution(b, F_R)
     # Z = 12, a roller on the load line, zero clearance: F_r = Q_max Σ cos^(1 + 10/9) over |ψ| < 90°
     expect = 12 / (1 + 2 * math.cos(math.pi / 6) ** (19 / 9) + 2 * math.cos(math.pi / 3) ** (19 / 9))
@@ -39,10 +39,10 @@ def test_discrete_reference_reproduces_stribeck_numbers():
     np.testing.assert_allclose(np.sum(ref.loads * np.cos(ref.angles)), F_R, rtol=1e-10)
     # many rollers: the continuous line-contact integral (Stribeck's 4.08)
     integral = 1.0 / (quad(lambda p: np.cos(p) ** (19 / 9), -np.pi / 2, np.pi / 2)[0] / (2 * np.pi))
-    many = discrete_load_distribution(dataclasses.replace(b, Z=400), F_R)
+    many = discrete_load_distribution(dataclasses.replace(b, rollers=400), F_R)
     assert many.stribeck == pytest.approx(integral, rel=1e-4)
     # clearance concentrates the load: larger Q_max, smaller zone
-    s = [discrete_load_distribution(_bearing_si(bearing(c), None), F_R) for c in ("0 um", "20 um", "40 um")]
+    s = [discrete_load_distribution(bearing(c).si(), F_R) for c in ("0 um", "20 um", "40 um")]
     assert s[0].stribeck < s[1].stribeck < s[2].stribeck
     assert s[0].zone_angle == pytest.approx(np.pi) and s[0].zone_angle > s[1].zone_angle > s[2].zone_angle
 
@@ -53,7 +53,7 @@ def held_rig_solutions():
     """Cage held, ring at rest, F_r = 5 kN downwards, at three clearances."""
     out = {}
     for c in ("0 um", "20 um", "40 um"):
-        rig = build_bearing_rig(bearing(c), radial_load=F_R, cage="held")
+        rig = build_bearing_rig(bearing(c), radial_load=F_R, options=SceneOptions(cage="held"))
         out[c] = (rig, rig_static_solution(rig))
     return out
 
@@ -87,7 +87,7 @@ def test_rig_zero_clearance_gives_stribeck_4_08(held_rig_solutions):
 def test_rig_oblique_load_on_an_unsymmetric_roller_set():
     """Load at 100°: no roller on the load line; the ring also shifts sideways (2-D equilibrium)."""
     a = np.radians(100.0)
-    rig = build_bearing_rig(bearing("10 um"), radial_load=F_R, load_angle=a, cage="held")
+    rig = build_bearing_rig(bearing("10 um"), radial_load=F_R, load_angle=a, options=SceneOptions(cage="held"))
     sol = rig_static_solution(rig)
     ref = rig.meta["reference"]
     np.testing.assert_allclose(sol.load_sum, F_R * np.array([np.cos(a), np.sin(a)]), atol=2e-3 * F_R)
@@ -104,7 +104,7 @@ def test_rig_turning_ring_with_free_cage():
     load zone around the zone centre."""
     w = 300.0
     lub = LubricantParams(drag_coefficient=1.0, density="45 kg/m^3")
-    rig = build_bearing_rig(bearing(), radial_load=F_R, outer_speed=w, cage="free", lubricant=lub)
+    rig = build_bearing_rig(bearing(), radial_load=F_R, outer_speed=w, options=SceneOptions(cage="free"), lubricant=lub)
     m = rig.model
     names = [e.name for e in m.elements]
     assert {"race_inner", "race_outer", "pocket", "guide", "drag", "radial_load", "ring_drive"} <= set(names)
@@ -126,7 +126,7 @@ def test_rig_turning_ring_with_free_cage():
 def test_rig_held_cage_with_turning_ring_starts_consistently():
     """A held cage stops the orbit: the rollers start without orbital speed (no pocket impact at t = 0)
     and stay in their pockets; the rollers' forces on the ring still balance the load."""
-    rig = build_bearing_rig(bearing(), radial_load=F_R, outer_speed=300.0, cage="held")
+    rig = build_bearing_rig(bearing(), radial_load=F_R, outer_speed=300.0, options=SceneOptions(cage="held"))
     m = rig.model
     qf, vf = m.full(0.0, rig.q0, rig.v0)
     rollers = [m.body(n).index for n in rig.handles["bearing"]["rollers"]]
@@ -137,17 +137,17 @@ def test_rig_held_cage_with_turning_ring_starts_consistently():
     sol = rig_static_solution(rig, window=1e-3, samples=21)
     np.testing.assert_allclose(sol.ring_force, sol.load_vector, atol=2e-3 * F_R)
     b = rig.meta["bearing"]
-    start = wrap_angle(2 * np.pi * np.arange(b.Z) / b.Z - rig.meta["zone_angle"])    # the rig's wrap, (−π, π]
+    start = wrap_angle(2 * np.pi * np.arange(b.rollers) / b.rollers - rig.meta["zone_angle"])    # the rig's wrap, (−π, π]
     # the two tractions push each loaded roller forwards (ω > 0) against its pocket wall: it sits within
     # the pocket clearance plus the wall's deflection under the traction force 2 μ Q
-    offset = (sol.angles - np.sort(start)) * 0.5 * b.d_m      # sol.angles are sorted
-    bound = b.C_p + 2 * b.traction.mu_max * sol.q_max / b.K_p
+    offset = (sol.angles - np.sort(start)) * 0.5 * b.pitch_diameter      # sol.angles are sorted
+    bound = b.cage.pocket_clearance + 2 * b.traction_mu_max * sol.q_max / b.cage.pocket_stiffness
     assert np.all(np.abs(offset) <= bound)
-    assert np.all(offset[sol.loads > 0.1 * sol.q_max] > 0.5 * b.C_p)
+    assert np.all(offset[sol.loads > 0.1 * sol.q_max] > 0.5 * b.cage.pocket_clearance)
 
 
 def test_rig_handles_meta_and_instantaneous_loads():
-    rig = build_bearing_rig(bearing(), radial_load=F_R, cage="none", gravity=True)
+    rig = build_bearing_rig(bearing(), radial_load=F_R, options=SceneOptions(cage="none", gravity=True))
     m = rig.model
     assert m.body("pin").index == 0 and bool(m.fixed[0])
     assert "pocket" not in [e.name for e in m.elements] and "drag" not in [e.name for e in m.elements]
@@ -160,15 +160,39 @@ def test_rig_handles_meta_and_instantaneous_loads():
 @pytest.mark.parametrize("kwargs, parameter", [
     ({"radial_load": -1.0}, "radial_load"),
     ({"radial_load": float("nan")}, "radial_load"),
-    ({"radial_load": F_R, "cage": "loose"}, "cage"),
     ({"radial_load": F_R, "load_angle": float("inf")}, "load_angle"),
-    ({"radial_load": F_R, "ring_mass": 0.0}, "ring_mass"),
+    ({"radial_load": F_R, "rig": {"ring_mass": 0.0}}, "rig"),
     ({"radial_load": F_R, "options": SceneOptions(bearings="linear")}, "options.bearings"),
+    ({"radial_load": F_R, "options": SceneOptions(frame="rotating")}, "options.frame"),
+    ({"radial_load": F_R, "options": SceneOptions(drag=True)}, "options.drag"),     # no lubricant given
 ])
 def test_rig_bad_input_names_the_parameter(kwargs, parameter):
     with pytest.raises(ParameterError) as e:
         build_bearing_rig(bearing(), **kwargs)
     assert e.value.parameter == parameter
+
+
+def test_rig_parameters_are_checked_with_their_names_and_units():
+    with pytest.raises(ParameterError, match=r"^bearing_rig\.ring_mass: must be > 0"):
+        reference_bearing_rig().replace(ring_mass="0 kg")
+    with pytest.raises(ParameterError, match=r"^bearing_rig\.drive_bandwidth: expected a frequency"):
+        reference_bearing_rig().replace(drive_bandwidth="3 m")
+    assert reference_bearing_rig().source("settle_damping_ratio").tag == "assumed"
+
+
+def test_scene_option_cage_vocabulary():
+    """cage is "free" | "held" | "none" everywhere; old true/false input maps to "free"/"none"."""
+    assert SceneOptions(cage=True).cage == "free" and SceneOptions(cage=False).cage == "none"
+    assert SceneOptions.from_dict({"cage": "held"}).cage == "held"
+    with pytest.raises(mbd.ModelError, match="'cage' must be one of"):
+        SceneOptions(cage="loose")
+    # the rig takes its own values only where the user gave none, and keeps the user's
+    rig = build_bearing_rig(bearing(), radial_load=F_R, options=SceneOptions(cage="none"))
+    assert rig.meta["cage"] == "none" and np.allclose(rig.model.gravity, 0.0)
+    assert build_bearing_rig(bearing(), radial_load=F_R).meta["cage"] == "free"
+    from components.dpgt import build_dpgt
+    with pytest.raises(ParameterError, match=r"^options\.cage: 'held' is a bearing-rig option"):
+        build_dpgt(reference_dpgt(3), SceneOptions(cage="held"))
 
 
 def test_rig_rollers_that_do_not_fit():

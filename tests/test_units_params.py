@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from components import geometry as geo
-from components.params import (BearingParams, CageParams, GearParams, SIView, Source, assumed,
+from components.params import (SI, BearingParams, CageParams, DPGTSI, GearParams, Params, Source, assumed,
                                describe, flatten, overrides_from_toml, parameter_names, to_toml,
                                with_overrides)
 from components.presets import CONDITIONS, load_toml, operating_point, reference_bearing, reference_dpgt
@@ -151,7 +151,7 @@ def test_direct_construction_checks_values():
     with pytest.raises(ParameterError, match=r"^bearing\.cage\.mass: is required"):
         CageParams(mass=None, pocket_clearance="0.1 mm", guide_clearance="0.1 mm", pocket_stiffness="1e7 N/m",
                    guide_stiffness="1e7 N/m", restitution=0.8, pocket_friction=0.1, guide_friction=0.1,
-                   friction_speed="0.01 m/s", impact_speed_floor="0.01 m/s")
+                   friction_speed="0.01 m/s", impact_speed_floor="0.01 m/s", impact_law="exact")
     with pytest.raises(TypeError):  # a forgotten field is a programming error, caught by the dataclass
         BearingParams(pitch_diameter="39 mm")
 
@@ -266,7 +266,7 @@ def test_toml_round_trip_is_lossless():
 # ------------------------------------------------------------------ SI view and operating points
 def test_si_view_is_plain_floats_and_read_only():
     s = reference_dpgt().si()
-    assert isinstance(s, SIView)
+    assert isinstance(s, DPGTSI)
     for sect in ("bearing", "gears", "mesh", "support", "lubricant"):
         for k, v in s[sect].to_dict().items():
             if isinstance(v, dict):
@@ -280,6 +280,35 @@ def test_si_view_is_plain_floats_and_read_only():
     with pytest.raises(AttributeError, match="no SI value"):
         s.bearing.clearence
     assert s.support.ring_torsional_stiffness == pytest.approx(1e9 * 0.123 ** 2)
+
+
+def _params_classes(cls=Params):
+    for sub in cls.__subclasses__():
+        yield sub
+        yield from _params_classes(sub)
+
+
+@pytest.mark.parametrize("cls", list(_params_classes()), ids=lambda c: c.__name__)
+def test_si_classes_have_the_parameter_fields_and_the_declared_derived_values(cls):
+    si_fields = {f.name: f.type for f in dataclasses.fields(cls.SI)}
+    params = [f.name for f in dataclasses.fields(cls) if "spec" in f.metadata]
+    derived = [d.name for d in cls._si_derived]
+    assert list(si_fields) == params + [n for n in derived if n not in params]
+    assert issubclass(cls.SI, SI) and cls.SI.__dataclass_params__.frozen
+
+
+def test_si_objects_are_cached_and_support_replace_and_to_dict():
+    p = reference_dpgt()
+    s = p.si()
+    assert p.si() is s and p.bearing.si() is p.bearing.si()
+    b = dataclasses.replace(s.bearing, clearance=1e-5)
+    assert b.clearance == 1e-5 and s.bearing.clearance == pytest.approx(20e-6)
+    assert s.bearing.replace(rows=2).rows == 2
+    d = s.to_dict()
+    assert d["bearing"]["cage"]["mass"] == pytest.approx(0.04) and d["layout"] is s.layout
+    assert s.gears["sun"] is s.gears.sun
+    with pytest.raises(KeyError):
+        s.gears["moon"]
 
 
 def test_operating_conditions():
