@@ -1,0 +1,102 @@
+"""The compiled engine path as :func:`mbd.simulate` drives it: a :class:`CompiledRunner` advances blocks of
+accepted steps in compiled code and hands each block back as states, so that the recorder, the
+observers, checkpoints and the progress bar work unchanged."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..assembly import System
+from ..control import Adaptive, FixedStep
+from ..hht import HHT, StepInfo
+from ..model import State
+from .sparse_lu import FixedPatternLU
+from .stepper import FAIL_REASONS, advance
+from .system import CompiledSystem
+
+__all__ = ["CompiledRunner", "Block"]
+
+
+@dataclass
+class Block:
+    """What one compiled call did: the accepted steps (start state, end state, h, error), the work
+    (counter increments), the state and h it ended with, and — when the step size fell below the
+    controller's floor — the last failed step's StepInfo."""
+    steps: list
+    counters: dict
+    state: State
+    h: float
+    failed: StepInfo | None = None
+
+
+def _controller_array(controller) -> np.ndarray:
+    if isinstance(controller, FixedStep):
+        return np.array([0.0, controller.h, controller.reject_error, 0, 0, 0, 0, controller.h_min])
+    if isinstance(controller, Adaptive):
+        c = controller
+        return np.array([1.0, c.h_max, c.safety, c.grow_max, c.shrink_min, c.fail_factor, c.hold, c.h_min])
+    raise NotImplementedError(f"compiled path: controller {type(controller).__name__} is not compiled "
+                              "(FixedStep and Adaptive are)")
+
+
+class CompiledRunner:
+    """HHT-α (settings of ``stepper``) with ``controller`` on the compiled twin of ``system``. Raises
+    NotImplementedError naming what the compiled path cannot do (the caller then uses the numpy path)."""
+
+    def __init__(self, system: System, stepper: HHT, controller):
+        if type(stepper) is not HHT:
+            raise NotImplementedError(f"compiled path: stepper {type(stepper).__name__} is not compiled")
+        self.ctrl = _controller_array(controller)
+        self.cs = CompiledSystem(system)
+        m, n, nnz = system.model, system.ndof, system.nnz
+        self.n = n
+        beta, gamma = stepper.beta_gamma
+        self.prm = np.array([stepper.alpha, beta, gamma, stepper.error_constant(), stepper.newton_tol,
+                             stepper.max_iter, stepper.rate_refresh, stepper.max_refresh, float(stepper.reuse)])
+        self.atol = np.where(m.angle_dofs, stepper.tol.atol_rot, stepper.tol.atol_pos).astype(float)
+        self.rtol = float(stepper.tol.rtol)
+        self.freeze = bool(system.freeze_internal)
+        lu = FixedPatternLU(system._indptr, system._indices, n)
+        dense = np.zeros((n, n)) if n <= 3000 else np.zeros((0, 0))
+        self.lu = (lu.perm, lu.iperm, lu.Lp, lu.Li, lu.Lx, lu.Up, lu.Ui, lu.Ux, lu._x, lu._y, dense,
+                   np.zeros(n, np.int64))
+        self.pat = (lu.indptr, lu.indices, np.ascontiguousarray(system._M, float), np.asarray(m.mdiag, float))
+        self.cache = np.array([0.0, np.nan, 0.0])        # LU valid, its h, sparse (0) or dense (1)
+        self.work = tuple(np.zeros(n) for _ in range(8)) + (np.zeros(nnz), np.zeros(nnz), np.zeros(nnz))
+        self.out = tuple(np.zeros(n) for _ in range(4))
+        self.z_shapes = [(name, self.cs.zs[i].shape) for i, name in enumerate(self.cs.state_names, start=1)]
+        self.n_z = sum(int(np.prod(s)) for _, s in self.z_shapes)
+
+    def drop_lu(self) -> None:
+        """Forget the LU (the numpy path drops it at checkpoints: both refactorise at the same step)."""
+        self.cache[0] = 0.0
+
+    def _state(self, row) -> State:
+        n = self.n
+        z, off = {}, 3 + 4 * n
+        for name, shape in self.z_shapes:
+            size = int(np.prod(shape))
+            z[name] = row[off:off + size].reshape(shape).copy()
+            off += size
+        return State(float(row[0]), row[3:3 + n].copy(), row[3 + n:3 + 2 * n].copy(),
+                     row[3 + 2 * n:3 + 3 * n].copy(), row[3 + 3 * n:3 + 4 * n].copy(), z)
+
+    def advance(self, state: State, h: float, t_end: float, max_steps: int) -> Block:
+        """Up to ``max_steps`` accepted steps from ``state`` (not modified) towards t_end."""
+        self.cs.set_internal(state.z)
+        q, v, a, f = (np.array(x, float) for x in (state.q, state.v, state.a, state.f))
+        log = np.empty((max(int(max_steps), 1), 3 + 4 * self.n + self.n_z))
+        counters = np.zeros(6, np.int64)
+        t, h, acc, status, it, rate, reason = advance(
+            float(state.t), q, v, a, f, float(h), float(t_end), int(max_steps), self.prm, self.ctrl, self.atol,
+            self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu, self.cache,
+            self.work, counters, self.out, log)
+        steps, s0 = [], state
+        for i in range(acc):
+            s1 = self._state(log[i])
+            steps.append((s0, s1, float(log[i, 1]), float(log[i, 2])))
+            s0 = s1
+        keys = ("residual", "jacobian", "factor", "newton", "accepted", "rejected")
+        failed = StepInfo(False, int(it), float(rate), reason=FAIL_REASONS[reason]) if status == 2 else None
+        return Block(steps, dict(zip(keys, (int(c) for c in counters))), s0, float(h), failed)

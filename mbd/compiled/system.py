@@ -1,0 +1,158 @@
+"""The compiled assembly: every element family, the rotating-frame and gravity terms, the scatter into
+the fixed sparse pattern — one compiled call, the same quantities as :meth:`mbd.System.evaluate`.
+
+:class:`CompiledSystem` is built from a :class:`mbd.System` (its fused families, pattern and maps):
+each family is packed once (:mod:`mbd.compiled` convention) into a record of a numba typed list; the
+compiled :func:`assemble` loops over the records and dispatches on the family's kind id to its kernel.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from numba.typed import List
+
+from ..assembly import Evaluation, System
+from .registry import KINDS, evaluate_kind, update_kind
+
+__all__ = ["CompiledSystem", "assemble"]
+
+
+@njit(cache=True)
+def _full(t, q, v, free, fixed_idx, fixed_q_I, omega, n_full):
+    """Full coordinates in R: free DOFs from (q, v), fixed bodies at rest in the fixed frame I."""
+    qf = np.zeros(n_full)
+    vf = np.zeros(n_full)
+    phi = omega * t
+    c, s = np.cos(phi), np.sin(phi)
+    for b in range(fixed_idx.size):          # to_reference with zero velocity in I
+        i = fixed_idx[b]
+        x, y = fixed_q_I[b, 0], fixed_q_I[b, 1]
+        xr, yr = c * x + s * y, -s * x + c * y
+        qf[i], qf[i + 1], qf[i + 2] = xr, yr, fixed_q_I[b, 2] - phi
+        vf[i], vf[i + 1], vf[i + 2] = omega * yr, -omega * xr, -omega
+    for j in range(free.size):
+        qf[free[j]] = q[j]
+        vf[free[j]] = v[j]
+    return qf, vf
+
+
+@njit(cache=True)
+def assemble(t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
+    """Generalized forces F on the free DOFs and, with ``jac``, J_q, J_v on the pattern (in place)."""
+    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full) = sysd
+    qf, vf = _full(t, q, v, free, fixed_idx, fixed_q_I, omega, n_full)
+    phi = omega * t
+    Ffull = np.zeros(n_full)
+    if jac:
+        Jq[:] = 0.0
+        Jv[:] = 0.0
+    for rec in fams:
+        kind, dofs, P, G, zi, keep, mp, ql, vl, Fl, Jql, Jvl = rec
+        n, k = dofs.shape
+        for i in range(n):
+            for j in range(k):
+                ql[i, j] = qf[dofs[i, j]]
+                vl[i, j] = vf[dofs[i, j]]
+        evaluate_kind(kind, t, phi, omega, 0.0, ql, vl, zs[zi], P, G, Fl, Jql, Jvl, jac)
+        for i in range(n):
+            for j in range(k):
+                Ffull[dofs[i, j]] += Fl[i, j]
+        if jac:
+            flat_q = Jql.reshape(-1)
+            flat_v = Jvl.reshape(-1)
+            for e in range(keep.size):
+                Jq[mp[e]] += flat_q[keep[e]]
+                Jv[mp[e]] += flat_v[keep[e]]
+    for j in range(free.size):
+        F[j] = Ffull[free[j]]
+    c, s = np.cos(phi), np.sin(phi)
+    W2 = omega * omega
+    nb = bx.size
+    for b in range(nb):                       # gravity (given in I), then the frame's inertial forces,
+        x, y, vx, vy = q[bx[b]], q[by[b]], v[bx[b]], v[by[b]]     # added in the numpy path's order
+        F[bx[b]] += mx[b] * (c * gx + s * gy)
+        F[by[b]] += mx[b] * (-s * gx + c * gy)
+        F[bx[b]] += mx[b] * (W2 * x + 2 * omega * vy)
+        F[by[b]] += mx[b] * (W2 * y - 2 * omega * vx)
+    if jac and frame_map.size:                # pattern order: (bx,bx), (bx,by), (by,bx), (by,by)
+        for b in range(nb):
+            Jq[frame_map[b]] += mx[b] * W2
+            Jq[frame_map[3 * nb + b]] += mx[b] * W2
+            Jv[frame_map[nb + b]] += 2 * omega * mx[b]
+            Jv[frame_map[2 * nb + b]] -= 2 * omega * mx[b]
+
+
+@njit(cache=True)
+def update_internal(t0, t1, q0, v0, q1, v1, fams, zs, sysd):
+    """Every stateful family's internal state after an accepted step (in place in zs)."""
+    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full) = sysd
+    q0f, v0f = _full(t0, q0, v0, free, fixed_idx, fixed_q_I, omega, n_full)
+    q1f, v1f = _full(t1, q1, v1, free, fixed_idx, fixed_q_I, omega, n_full)
+    for rec in fams:
+        kind, dofs, P, G, zi, keep, mp, ql, vl, Fl, Jql, Jvl = rec
+        if zs[zi].shape[1] == 0:
+            continue
+        n, k = dofs.shape
+        ql0, vl0 = np.empty((n, k)), np.empty((n, k))
+        for i in range(n):
+            for j in range(k):
+                ql0[i, j], vl0[i, j] = q0f[dofs[i, j]], v0f[dofs[i, j]]
+                ql[i, j], vl[i, j] = q1f[dofs[i, j]], v1f[dofs[i, j]]
+        zs[zi][:, :] = update_kind(kind, zs[zi], t0, t1, omega * t0, omega * t1, ql0, vl0, ql, vl, P, G)
+
+
+class CompiledSystem:
+    """The compiled twin of a :class:`mbd.System` (same fused families, pattern and maps).
+
+    Raises NotImplementedError (naming the family or the frame) for what the compiled path cannot do:
+    a frame with a Python speed profile, or a family without a compiled kernel (see :mod:`.registry`)."""
+
+    def __init__(self, system: System):
+        m = system.model
+        if m.frame.profile is not None:
+            raise NotImplementedError("compiled path: the reference frame has a Python speed profile")
+        self.system, self.model, self.ndof, self.nnz = system, m, system.ndof, system.nnz
+        self.state_names: list[str | None] = []
+        fams, zs = List(), List()
+        zs.append(np.zeros((0, 0)))                    # slot 0: families without internal state
+        for (e, parts), (keep, mp) in zip(system._evals, system._maps):
+            kind = KINDS.get(type(e))
+            if kind is None:
+                raise NotImplementedError(f"compiled path: no compiled kernel for family {e.name!r} "
+                                          f"({type(e).__name__})")
+            P, G = kind.pack(e)
+            zi = 0
+            if e.init_internal() is not None:
+                zi = len(zs)
+                zs.append(np.ascontiguousarray(e.init_internal(), dtype=float))
+                self.state_names.append(parts[0][0])
+            n, k = e.dofs.shape
+            fams.append((kind.id, np.ascontiguousarray(e.dofs, dtype=np.int64), P, G, zi,
+                         keep.astype(np.int64), np.asarray(mp, np.int64), np.zeros((n, k)), np.zeros((n, k)),
+                         np.zeros((n, k)), np.zeros((n, k, k)), np.zeros((n, k, k))))
+        self.fams, self.zs = fams, zs
+        fixed = np.flatnonzero(m.fixed)
+        frame_map = system._frame_map if system.rotating else np.zeros(0, np.int64)
+        self.sysd = (m.free.astype(np.int64), (3 * fixed).astype(np.int64), np.ascontiguousarray(m.pose0[fixed], float),
+                     float(m.frame.omega), float(m.gravity[0]), float(m.gravity[1]),
+                     np.asarray(system._mx, float), np.asarray(system._J, float), system._bx.astype(np.int64),
+                     system._by.astype(np.int64), system._bt.astype(np.int64), np.asarray(frame_map, np.int64),
+                     3 * m.n_bodies)
+
+    def set_internal(self, z: dict) -> None:
+        """Load the element internal states of a :class:`mbd.State` into the compiled slots."""
+        for i, name in enumerate(self.state_names, start=1):
+            self.zs[i][:, :] = z[name]
+
+    def internal(self) -> dict:
+        return {name: self.zs[i].copy() for i, name in enumerate(self.state_names, start=1)}
+
+    def evaluate(self, t, q, v, z: dict | None = None, jac: bool = False) -> Evaluation:
+        """As :meth:`mbd.System.evaluate` (z: the internal states; None keeps the loaded ones)."""
+        if z is not None:
+            self.set_internal(z)
+        F = np.empty(self.ndof)
+        Jq, Jv = (np.empty(self.nnz), np.empty(self.nnz)) if jac else (np.empty(0), np.empty(0))
+        assemble(float(t), np.ascontiguousarray(q, float), np.ascontiguousarray(v, float), self.fams, self.zs,
+                 jac, self.sysd, F, Jq, Jv)
+        return Evaluation(F, Jq if jac else None, Jv if jac else None)
