@@ -1,0 +1,318 @@
+"""Compiled generic families: supports, springs, drives and loads (kernel convention in :mod:`mbd.compiled`).
+
+Each kernel repeats the reference kernel's operations in the same order and writes its Jacobians
+by hand; (φ, Ω) are the reference frame's angle and speed. Layouts (one row of P per instance):
+
+GroundSupport    P = [kx, ky, cx, cy, anchor_x, anchor_y, k_θ, c_θ, θ0]      G = [isotropic (1/0)]
+BodySpring       P = [k, c, marker_a x, marker_a y, marker_b x, marker_b y]   G = []
+TorsionalSpring  P = [k, c, θ0]                                               G = []
+TorqueSource     P = [torque]                                                 G = RAMP
+ForceSource      P = [F_X, F_Y] (fixed frame)                                 G = RAMP
+SpeedDrive       P = [k, c, k_i, θ0, ω_ref]                                   G = []
+
+RAMP = [has_ramp (1/0), t0, t1]: a :class:`~mbd.elements.drives.Ramp` (or none). A load or speed
+profile given as an arbitrary Python callable of t cannot be compiled: ``pack`` raises
+NotImplementedError. SpeedDrive's internal state z is (n, 1) (the integral of the angle error) when
+any k_i > 0, else (n, 0), as ``init_internal`` gives (n,) or None.
+
+SpeedDrive's update needs the frame angle at both ends of the step (its error is measured in the
+fixed frame), which the convention's update signature does not carry: ``update_speed_drive`` takes
+them as two extra trailing arguments phi0, phi1.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..elements.drives import Ramp, SpeedDrive, TorqueSource
+from ..elements.loads import ForceSource
+from ..elements.springs import BodySpring, GroundSupport, TorsionalSpring
+
+__all__ = ["pack_ground_support", "evaluate_ground_support", "pack_body_spring", "evaluate_body_spring",
+           "pack_torsional_spring", "evaluate_torsional_spring", "pack_torque_source", "evaluate_torque_source",
+           "pack_force_source", "evaluate_force_source", "pack_speed_drive", "evaluate_speed_drive",
+           "update_speed_drive", "KERNELS"]
+
+_NO_G = np.zeros(0)
+
+
+def _columns(n, *cols):
+    return np.ascontiguousarray(np.column_stack([np.broadcast_to(np.asarray(c, float), (n,)) for c in cols]))
+
+
+def _ramp_g(family, elem, ramp):
+    """RAMP layout of an optional Ramp; any other callable cannot be compiled."""
+    if ramp is None:
+        return np.array([0.0, 0.0, 0.0])
+    if type(ramp) is not Ramp:
+        raise NotImplementedError(f"{family} {elem.name!r}: ramp {ramp!r} is a Python callable of time, which the "
+                                  "compiled path cannot evaluate (use mbd.elements.Ramp or the numpy path)")
+    return np.array([1.0, ramp.t0, ramp.t1])
+
+
+@njit(cache=True)
+def _ramp(t, G):
+    """Ramp.__call__ from the RAMP layout (1 without a ramp)."""
+    if G[0] == 0.0:
+        return 1.0
+    t0, t1 = G[1], G[2]
+    if t >= t1:
+        return 1.0
+    if t <= t0:
+        return 0.0
+    s = (t - t0) / (t1 - t0)
+    return s * s * (3.0 - 2.0 * s)
+
+
+@njit(cache=True)
+def _zero_jacobians(Jq, Jv, i):
+    for r in range(Jq.shape[1]):
+        for c in range(Jq.shape[2]):
+            Jq[i, r, c] = 0.0
+            Jv[i, r, c] = 0.0
+
+
+# ------------------------------------------------------------------------------------ GroundSupport
+def pack_ground_support(elem: GroundSupport):
+    P = _columns(elem.n, elem.kx, elem.ky, elem.cx, elem.cy, elem.anchor[:, 0], elem.anchor[:, 1],
+                 elem.k_theta, elem.c_theta, elem.theta0)
+    return P, np.array([1.0 if elem.isotropic else 0.0])
+
+
+@njit(cache=True)
+def evaluate_ground_support(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    c, s = np.cos(phi), np.sin(phi)
+    W = omega
+    iso = G[0] != 0.0
+    for i in range(ql.shape[0]):
+        kx, ky, cx, cy, ax, ay = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5]
+        k_th, c_th, th0 = P[i, 6], P[i, 7], P[i, 8]
+        x, y, th = ql[i, 0], ql[i, 1], ql[i, 2]
+        # displacement from the anchor and ground-relative velocity, in R
+        dx = x - (c * ax + s * ay)
+        dy = y - (-s * ax + c * ay)
+        ux = vl[i, 0] - W * y
+        uy = vl[i, 1] + W * x
+        if iso:
+            F[i, 0] = -kx * dx - cx * ux
+            F[i, 1] = -kx * dy - cx * uy
+        else:  # the law is axis-aligned in I: rotate in, apply, rotate back
+            dX, dY = c * dx - s * dy, s * dx + c * dy
+            uX, uY = c * ux - s * uy, s * ux + c * uy
+            FX = -kx * dX - cx * uX
+            FY = -ky * dY - cy * uY
+            F[i, 0] = c * FX + s * FY
+            F[i, 1] = -s * FX + c * FY
+        F[i, 2] = -k_th * (th + phi - th0) - c_th * (vl[i, 2] + W)
+        if not jac:
+            continue
+        _zero_jacobians(Jq, Jv, i)
+        if iso:   # u = v + Ω k × q: ∂ux/∂y = −Ω, ∂uy/∂x = Ω
+            Jq[i, 0, 0], Jq[i, 0, 1] = -kx, cx * W
+            Jq[i, 1, 0], Jq[i, 1, 1] = -cx * W, -kx
+            Jv[i, 0, 0], Jv[i, 1, 1] = -cx, -cx
+        else:
+            # ∂(FX, FY)/∂(x, y) and ∂/∂(vx, vy), then rotated back to R
+            aXx, aXy = -kx * c - cx * (-s * W), -kx * (-s) - cx * (-c * W)
+            aYx, aYy = -ky * s - cy * (c * W), -ky * c - cy * (-s * W)
+            bXx, bXy = -cx * c, -cx * (-s)
+            bYx, bYy = -cy * s, -cy * c
+            Jq[i, 0, 0], Jq[i, 0, 1] = c * aXx + s * aYx, c * aXy + s * aYy
+            Jq[i, 1, 0], Jq[i, 1, 1] = -s * aXx + c * aYx, -s * aXy + c * aYy
+            Jv[i, 0, 0], Jv[i, 0, 1] = c * bXx + s * bYx, c * bXy + s * bYy
+            Jv[i, 1, 0], Jv[i, 1, 1] = -s * bXx + c * bYx, -s * bXy + c * bYy
+        Jq[i, 2, 2] = -k_th
+        Jv[i, 2, 2] = -c_th
+
+
+# --------------------------------------------------------------------------------------- BodySpring
+def pack_body_spring(elem: BodySpring):
+    P = _columns(elem.n, elem.stiffness, elem.damping, elem.marker_a[:, 0], elem.marker_a[:, 1],
+                 elem.marker_b[:, 0], elem.marker_b[:, 1])
+    return P, _NO_G
+
+
+@njit(cache=True)
+def evaluate_body_spring(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    # gradients over (q_a, q_b, v_a, v_b), 12 entries, allocated once
+    gdx, gdy, gux, guy, gFx, gFy = np.zeros(12), np.zeros(12), np.zeros(12), np.zeros(12), np.zeros(12), np.zeros(12)
+    for i in range(ql.shape[0]):
+        k, cd = P[i, 0], P[i, 1]
+        ca, sa = np.cos(ql[i, 2]), np.sin(ql[i, 2])
+        cb, sb = np.cos(ql[i, 5]), np.sin(ql[i, 5])
+        rax, ray = ca * P[i, 2] - sa * P[i, 3], sa * P[i, 2] + ca * P[i, 3]
+        rbx, rby = cb * P[i, 4] - sb * P[i, 5], sb * P[i, 4] + cb * P[i, 5]
+        wa, wb = vl[i, 2], vl[i, 5]
+        dx = (ql[i, 3] + rbx) - (ql[i, 0] + rax)
+        dy = (ql[i, 4] + rby) - (ql[i, 1] + ray)
+        # ḋ_A: velocity of P_B relative to the point of A under it
+        ux = (vl[i, 3] - wb * rby) - (vl[i, 0] - wa * ray) + wa * dy
+        uy = (vl[i, 4] + wb * rbx) - (vl[i, 1] + wa * rax) - wa * dx
+        Fx = -k * dx - cd * ux
+        Fy = -k * dy - cd * uy
+        F[i, 0] = -Fx
+        F[i, 1] = -Fy
+        F[i, 2] = (rax + dx) * (-Fy) - (ray + dy) * (-Fx)     # A is loaded at P_B
+        F[i, 3] = Fx
+        F[i, 4] = Fy
+        F[i, 5] = rbx * Fy - rby * Fx
+        if not jac:
+            continue
+        for j in range(12):
+            gdx[j] = gdy[j] = gux[j] = guy[j] = 0.0
+        # ∂r/∂θ = k × r
+        gdx[0], gdx[2], gdx[3], gdx[5] = -1.0, ray, 1.0, -rby
+        gdy[1], gdy[2], gdy[4], gdy[5] = -1.0, -rax, 1.0, rbx
+        for j in range(6):
+            gux[j] = wa * gdy[j]
+            guy[j] = -wa * gdx[j]
+        gux[2] += wa * rax
+        gux[5] += -wb * rbx
+        guy[2] += wa * ray
+        guy[5] += -wb * rby
+        gux[6], gux[8], gux[9], gux[11] = -1.0, ray + dy, 1.0, -rby
+        guy[7], guy[8], guy[10], guy[11] = -1.0, -rax - dx, 1.0, rbx
+        for j in range(12):
+            gFx[j] = -k * gdx[j] - cd * gux[j]
+            gFy[j] = -k * gdy[j] - cd * guy[j]
+        for j in range(12):
+            J, col = (Jq, j) if j < 6 else (Jv, j - 6)
+            # ∂r_a/∂θ_a and ∂r_b/∂θ_b enter the torques' lever arms
+            drax = -ray if j == 2 else 0.0
+            dray = rax if j == 2 else 0.0
+            drbx = -rby if j == 5 else 0.0
+            drby = rbx if j == 5 else 0.0
+            J[i, 0, col] = -gFx[j]
+            J[i, 1, col] = -gFy[j]
+            J[i, 2, col] = (-(drax + gdx[j]) * Fy - (rax + dx) * gFy[j]
+                            + (dray + gdy[j]) * Fx + (ray + dy) * gFx[j])
+            J[i, 3, col] = gFx[j]
+            J[i, 4, col] = gFy[j]
+            J[i, 5, col] = drbx * Fy + rbx * gFy[j] - drby * Fx - rby * gFx[j]
+
+
+# ---------------------------------------------------------------------------------- TorsionalSpring
+def pack_torsional_spring(elem: TorsionalSpring):
+    return _columns(elem.n, elem.stiffness, elem.damping, elem.theta0), _NO_G
+
+
+@njit(cache=True)
+def evaluate_torsional_spring(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    for i in range(ql.shape[0]):
+        k, c = P[i, 0], P[i, 1]
+        T = -k * (ql[i, 5] - ql[i, 2] - P[i, 2]) - c * (vl[i, 5] - vl[i, 2])
+        zero = 0.0 * ql[i, 0]
+        F[i, 0], F[i, 1], F[i, 2], F[i, 3], F[i, 4], F[i, 5] = zero, zero, -T, zero, zero, T
+        if not jac:
+            continue
+        _zero_jacobians(Jq, Jv, i)
+        Jq[i, 2, 2], Jq[i, 2, 5], Jq[i, 5, 2], Jq[i, 5, 5] = -k, k, k, -k
+        Jv[i, 2, 2], Jv[i, 2, 5], Jv[i, 5, 2], Jv[i, 5, 5] = -c, c, c, -c
+
+
+# ------------------------------------------------------------------------------------- TorqueSource
+def pack_torque_source(elem: TorqueSource):
+    if elem.fn is not None:
+        raise NotImplementedError(f"TorqueSource {elem.name!r}: torque given as a Python callable of time "
+                                  f"({elem.fn!r}) cannot be compiled (use a constant with a Ramp, or the numpy path)")
+    return _columns(elem.n, elem.torque), _ramp_g("TorqueSource", elem, elem.ramp)
+
+
+@njit(cache=True)
+def evaluate_torque_source(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    r = _ramp(t, G)
+    for i in range(ql.shape[0]):
+        F[i, 0], F[i, 1], F[i, 2] = 0.0, 0.0, P[i, 0] * r
+        if jac:
+            _zero_jacobians(Jq, Jv, i)
+
+
+# -------------------------------------------------------------------------------------- ForceSource
+def pack_force_source(elem: ForceSource):
+    if elem.fn is not None:
+        raise NotImplementedError(f"ForceSource {elem.name!r}: force given as a Python callable of time "
+                                  f"({elem.fn!r}) cannot be compiled (use a constant with a Ramp, or the numpy path)")
+    return _columns(elem.n, elem.force[:, 0], elem.force[:, 1]), _ramp_g("ForceSource", elem, elem.ramp)
+
+
+@njit(cache=True)
+def evaluate_force_source(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    r = _ramp(t, G)
+    c, sn = np.cos(phi), np.sin(phi)
+    for i in range(ql.shape[0]):
+        FX, FY = r * P[i, 0], r * P[i, 1]
+        F[i, 0], F[i, 1], F[i, 2] = c * FX + sn * FY, -sn * FX + c * FY, 0.0     # fixed frame → R
+        if jac:
+            _zero_jacobians(Jq, Jv, i)
+
+
+# --------------------------------------------------------------------------------------- SpeedDrive
+def _constant_speed_profile(elem: SpeedDrive):
+    """(θ0, ω_ref) of a drive built with a constant omega_ref, else None (a callable profile).
+
+    SpeedDrive keeps only the closure ``profile``; the constant-speed one is recognised by its code
+    object (the lambda in SpeedDrive.__init__) and read from its cells."""
+    prof = elem.profile
+    code = getattr(prof, "__code__", None)
+    if code is None or code not in SpeedDrive.__init__.__code__.co_consts:
+        return None
+    cells = dict(zip(code.co_freevars, (c.cell_contents for c in prof.__closure__)))
+    if set(cells) != {"self", "th0", "w"}:
+        return None
+    return cells["th0"], cells["w"]
+
+
+def pack_speed_drive(elem: SpeedDrive):
+    prof = _constant_speed_profile(elem)
+    if prof is None:
+        raise NotImplementedError(f"SpeedDrive {elem.name!r}: speed profile {elem.profile!r} is a Python callable "
+                                  "of time, which the compiled path cannot evaluate (use a constant omega_ref, or "
+                                  "the numpy path)")
+    th0, w = prof
+    return _columns(elem.n, elem.stiffness, elem.damping, elem.k_i, th0, w), _NO_G
+
+
+@njit(cache=True)
+def _angle_error(t, phi, P, i, theta):
+    return (P[i, 3] + P[i, 4] * t) - (theta + phi)
+
+
+@njit(cache=True)
+def evaluate_speed_drive(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    has_z = z.shape[1] > 0
+    for i in range(ql.shape[0]):
+        e = _angle_error(t, phi, P, i, ql[i, 2])
+        de = P[i, 4] - (vl[i, 2] + omega)
+        T = P[i, 0] * e + P[i, 1] * de
+        if has_z:
+            T = T + P[i, 2] * z[i, 0]
+        zero = 0.0 * ql[i, 0]
+        F[i, 0], F[i, 1], F[i, 2] = zero, zero, T
+        if jac:
+            _zero_jacobians(Jq, Jv, i)
+            Jq[i, 2, 2] = -P[i, 0]
+            Jv[i, 2, 2] = -P[i, 1]
+
+
+@njit(cache=True)
+def update_speed_drive(z, t0, t1, ql0, vl0, ql1, vl1, P, G, phi0, phi1):
+    """The integral of the angle error after a step (trapezoidal rule), as SpeedDrive.update_internal;
+    phi0, phi1 the frame angle at t0 and t1."""
+    z1 = z.copy()
+    if z.shape[1] == 0:
+        return z1
+    for i in range(z.shape[0]):
+        e0 = _angle_error(t0, phi0, P, i, ql0[i, 2])
+        e1 = _angle_error(t1, phi1, P, i, ql1[i, 2])
+        z1[i, 0] = z[i, 0] + 0.5 * (t1 - t0) * (e0 + e1)
+    return z1
+
+
+KERNELS = {
+    GroundSupport: (pack_ground_support, evaluate_ground_support, None),
+    BodySpring: (pack_body_spring, evaluate_body_spring, None),
+    TorsionalSpring: (pack_torsional_spring, evaluate_torsional_spring, None),
+    TorqueSource: (pack_torque_source, evaluate_torque_source, None),
+    ForceSource: (pack_force_source, evaluate_force_source, None),
+    SpeedDrive: (pack_speed_drive, evaluate_speed_drive, update_speed_drive),
+}

@@ -1,0 +1,218 @@
+"""Compiled :class:`~mbd.elements.gear_mesh.GearMesh` (kernel convention in :mod:`mbd.compiled`).
+
+The force law is the reference kernel's, operation for operation (so values agree to the round-off
+of arctan2/cos/sin), with its Jacobians derived by hand. One family may mix external and internal
+meshes (σ per instance, as after System fusion).
+
+P, shape (n, 14) or (n, 18), one row per mesh (constants ``P_*`` below):
+
+    0 σ (+1 external, −1 internal)   1 r_b1     2 r_b2      3 a0     4 sin α    5 κ0 = σ r_b1 + r_b2
+    6 p_b base pitch                 7 z1       8 k_mean    9 c_m   10 u0      11 p0
+    12 b backlash                   13 φ_ref
+    RectangularStiffness only: 14 h = (ε_α − 1)/2   15 s smoothing   16 k_single/k_mean   17 ratio
+
+G, the family's stiffness shape (constants ``SHAPE_*``):
+
+    constant     [0]
+    rectangular  [1]                                   (its parameters are per instance, in P)
+    fourier      [2, na, nb, a_1 … a_na, b_1 … b_nb]
+
+Jacobians. With d the centre vector along e (σ(c2 − c1)), ḋ its rate, t = k × e, a = |d|, every
+quantity is a function of (d, θ1, θ2) and (ḋ, ω1, ω2); the kernel carries gradients over these
+8 variables and maps them to the 6 local coordinates at the end (∂d/∂c1 = −σ, ∂d/∂c2 = σ). Used:
+∂e/∂d = t tᵀ/a, ∂t/∂d = −e tᵀ/a, ∂a/∂d = e, ∂φ_e/∂d = (−d_y, d_x)/a², so
+∂(t·ḋ)/∂d = −t (e·ḋ)/a and ∂(e·ḋ)/∂d = t (t·ḋ)/a.
+Branches follow :mod:`mbd.ad`: chosen by value, the derivative of the branch taken (0 when clipped).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..elements.gear_mesh import ConstantStiffness, FourierStiffness, GearMesh, RectangularStiffness
+
+__all__ = ["pack_gear_mesh", "evaluate_gear_mesh", "KERNELS"]
+
+_TWO_PI = 2.0 * np.pi
+
+(P_SIGMA, P_RB1, P_RB2, P_A0, P_SIN_ALPHA, P_KAPPA0, P_PITCH, P_TEETH1, P_K_MEAN, P_C_MESH, P_U0, P_P0,
+ P_BACKLASH, P_PHI_REF, P_RECT_H, P_RECT_S, P_RECT_SINGLE, P_RECT_RATIO) = range(18)
+SHAPE_CONSTANT, SHAPE_RECTANGULAR, SHAPE_FOURIER = 0, 1, 2
+
+
+def pack_gear_mesh(elem: GearMesh):
+    """(P, G) of a GearMesh family (layouts in the module docstring)."""
+    cols = [elem.sigma, elem.rb1, elem.rb2, elem.a0, elem.sin_alpha, elem.kappa0, elem.pitch, elem.teeth1,
+            elem.k_mean, elem.c_mesh, elem.u0, elem.p0, elem.backlash, elem.phi_ref]
+    shape = elem.stiffness
+    if type(shape) is ConstantStiffness:
+        G = np.array([SHAPE_CONSTANT], float)
+    elif type(shape) is RectangularStiffness:
+        G = np.array([SHAPE_RECTANGULAR], float)
+        cols += list(elem._shape_args)          # (h, s, single, ratio) per instance, concatenated when fused
+    elif type(shape) is FourierStiffness:
+        G = np.array([SHAPE_FOURIER, len(shape.a), len(shape.b), *shape.a, *shape.b], float)
+    else:
+        raise NotImplementedError(f"GearMesh {elem.name!r}: the compiled path has no stiffness shape "
+                                  f"{type(shape).__name__} (only constant, rectangular, fourier)")
+    P = np.ascontiguousarray(np.column_stack([np.broadcast_to(np.asarray(c, float), (elem.n,)) for c in cols]))
+    return P, G
+
+
+@njit(cache=True)
+def _wrap(x):
+    """ad.wrap_angle: into (−π, π] by whole turns (derivative 1)."""
+    return x - _TWO_PI * np.rint(x / _TWO_PI)
+
+
+@njit(cache=True)
+def _rect_factor(p, h, s, single, ratio):
+    """(factor, dfactor/dp) of the smoothed rectangular wave, as gear_mesh._rect_factor."""
+    u = _wrap(_TWO_PI * (p - h)) * (1.0 / _TWO_PI)
+    x = (h + 0.5 * s - abs(u)) * (1.0 / s)
+    dx = -np.sign(u) * (1.0 / s)               # du/dp = 1; d|u|/du = sign(u) (0 at 0, as ad.abs_)
+    if x > 1.0:
+        x, dx = 1.0, 0.0
+    elif x < 0.0:
+        x, dx = 0.0, 0.0
+    w = x * x * x * (10.0 + x * (-15.0 + 6.0 * x))
+    dw = 30.0 * x * x * (1.0 - x) * (1.0 - x) * dx
+    return single * (1.0 + (ratio - 1.0) * w), single * (ratio - 1.0) * dw
+
+
+@njit(cache=True)
+def _fourier_factor(p, G):
+    """(factor, dfactor/dp) of 1 + Σ a_j cos 2πjp + b_j sin 2πjp, coefficients from G."""
+    na, nb = int(G[1]), int(G[2])
+    f, df = 1.0, 0.0
+    for j in range(na):
+        w = _TWO_PI * (j + 1)
+        f = f + G[3 + j] * np.cos(w * p)
+        df -= G[3 + j] * w * np.sin(w * p)
+    for j in range(nb):
+        w = _TWO_PI * (j + 1)
+        f = f + G[3 + na + j] * np.sin(w * p)
+        df += G[3 + na + j] * w * np.cos(w * p)
+    return f, df
+
+
+@njit(cache=True)
+def _factor(shape, p, P, i, G):
+    if shape == SHAPE_RECTANGULAR:
+        return _rect_factor(p, P[i, P_RECT_H], P[i, P_RECT_S], P[i, P_RECT_SINGLE], P[i, P_RECT_RATIO])
+    if shape == SHAPE_FOURIER:
+        return _fourier_factor(p, G)
+    return 1.0, 0.0
+
+
+@njit(cache=True)
+def _put_row(Jq, Jv, i, r, scale, h, sig):
+    """Row r of instance i's Jacobians from scale·h, h the gradient over (d, θ1, θ2, ḋ, ω1, ω2)."""
+    Jq[i, r, 0] = -sig * scale * h[0]
+    Jq[i, r, 1] = -sig * scale * h[1]
+    Jq[i, r, 2] = scale * h[2]
+    Jq[i, r, 3] = sig * scale * h[0]
+    Jq[i, r, 4] = sig * scale * h[1]
+    Jq[i, r, 5] = scale * h[3]
+    Jv[i, r, 0] = -sig * scale * h[4]
+    Jv[i, r, 1] = -sig * scale * h[5]
+    Jv[i, r, 2] = scale * h[6]
+    Jv[i, r, 3] = sig * scale * h[4]
+    Jv[i, r, 4] = sig * scale * h[5]
+    Jv[i, r, 5] = scale * h[7]
+
+
+@njit(cache=True)
+def evaluate_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    """Forces (and Jacobians) of n meshes; the mesh is frame-invariant, so phi/omega/domega are unused."""
+    shape = int(G[0])
+    # gradients over (dx, dy, θ1, θ2, ḋx, ḋy, ω1, ω2), allocated once
+    ds, dsd, dr, drd, dkp = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
+    gp, gm, hx, hy, hnet = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
+    for i in range(ql.shape[0]):
+        sig, rb1, rb2 = P[i, P_SIGMA], P[i, P_RB1], P[i, P_RB2]
+        sa, kappa0, pb, z1 = P[i, P_SIN_ALPHA], P[i, P_KAPPA0], P[i, P_PITCH], P[i, P_TEETH1]
+        x1, y1, th1, x2, y2, th2 = ql[i, 0], ql[i, 1], ql[i, 2], ql[i, 3], ql[i, 4], ql[i, 5]
+        vx1, vy1, w1, vx2, vy2, w2 = vl[i, 0], vl[i, 1], vl[i, 2], vl[i, 3], vl[i, 4], vl[i, 5]
+        # --- values, in the reference kernel's order of operations
+        dx, dy, ddx, ddy = sig * (x2 - x1), sig * (y2 - y1), sig * (vx2 - vx1), sig * (vy2 - vy1)
+        r2 = dx * dx + dy * dy
+        a = np.sqrt(r2)
+        inv_a = 1.0 / a
+        ex, ey = dx * inv_a, dy * inv_a
+        tx, ty = -ey, ex
+        phi_ref = P[i, P_PHI_REF]
+        phi_e = phi_ref + _wrap(np.arctan2(dy, dx) - phi_ref)
+        raw = sig * rb1 * (th1 - phi_e) + rb2 * (th2 - phi_e) - P[i, P_U0]
+        roll = sig * rb1 * w1 + rb2 * w2
+        s = _wrap(raw * (_TWO_PI / pb)) * (pb / _TWO_PI)
+        kappa = kappa0 * inv_a
+        radial = sig * sa * (a - P[i, P_A0])
+        half_b = 0.5 * P[i, P_BACKLASH]
+        t_dd = tx * ddx + ty * ddy
+        e_dd = ex * ddx + ey * ddy
+        s_dot = roll - kappa * t_dd
+        radial_dot = sig * sa * e_dd
+        d_plus = s - radial - half_b
+        d_minus = -1.0 * s - radial - half_b
+        r_plus = s_dot - radial_dot
+        r_minus = -1.0 * s_dot - radial_dot
+        p = z1 * (th1 - phi_e) * (1.0 / _TWO_PI) + P[i, P_P0]
+        fac, dfac = _factor(shape, p, P, i, G)
+        k_mean, c = P[i, P_K_MEAN], P[i, P_C_MESH]
+        kp = k_mean * fac
+        g_plus = kp * d_plus + c * r_plus
+        g_minus = kp * d_minus + c * r_minus
+        on_plus = d_plus > 0.0 and g_plus > 0.0          # flank in contact and not pulling
+        on_minus = d_minus > 0.0 and g_minus > 0.0
+        F_plus = g_plus if on_plus else 0.0
+        F_minus = g_minus if on_minus else 0.0
+        F_net = F_plus - F_minus
+        F_sum = F_plus + F_minus
+        Fx_head = F_net * kappa * tx + sig * sa * F_sum * ex
+        Fy_head = F_net * kappa * ty + sig * sa * F_sum * ey
+        F[i, 0] = -sig * Fx_head
+        F[i, 1] = -sig * Fy_head
+        F[i, 2] = -sig * rb1 * F_net
+        F[i, 3] = sig * Fx_head
+        F[i, 4] = sig * Fy_head
+        F[i, 5] = -1.0 * rb2 * F_net
+        if not jac:
+            continue
+        # --- gradients of the scalars the flank forces are built from
+        phx, phy = -dy / r2, dx / r2                      # ∂φ_e/∂d
+        ds[0], ds[1], ds[2], ds[3] = -kappa0 * phx, -kappa0 * phy, sig * rb1, rb2
+        dr[0], dr[1] = sig * sa * ex, sig * sa * ey
+        ka = kappa * inv_a
+        dsd[0], dsd[1] = ka * (ex * t_dd + tx * e_dd), ka * (ey * t_dd + ty * e_dd)
+        dsd[4], dsd[5], dsd[6], dsd[7] = -kappa * tx, -kappa * ty, sig * rb1, rb2
+        drd[0], drd[1] = sig * sa * inv_a * tx * t_dd, sig * sa * inv_a * ty * t_dd
+        drd[4], drd[5] = sig * sa * ex, sig * sa * ey
+        dpdth = z1 * (1.0 / _TWO_PI)
+        dk = k_mean * dfac
+        dkp[0], dkp[1], dkp[2] = -dk * dpdth * phx, -dk * dpdth * phy, dk * dpdth
+        for j in range(8):
+            gp[j] = (dkp[j] * d_plus + kp * (ds[j] - dr[j]) + c * (dsd[j] - drd[j])) if on_plus else 0.0
+            gm[j] = (dkp[j] * d_minus + kp * (-ds[j] - dr[j]) + c * (-dsd[j] - drd[j])) if on_minus else 0.0
+        # --- head force (F_net κ t + σ F_sum sin α e) and torques
+        for j in range(8):
+            dnet, dsum = gp[j] - gm[j], gp[j] + gm[j]
+            hnet[j] = dnet
+            hx[j] = dnet * kappa * tx + sig * sa * dsum * ex
+            hy[j] = dnet * kappa * ty + sig * sa * dsum * ey
+        # d-dependence of κ, t, e (only the two d components)
+        for j in range(2):
+            ej = ex if j == 0 else ey
+            tj = tx if j == 0 else ty
+            dkappa = -ka * ej
+            hx[j] += F_net * (dkappa * tx - kappa * ex * tj * inv_a) + sig * sa * F_sum * tx * tj * inv_a
+            hy[j] += F_net * (dkappa * ty - kappa * ey * tj * inv_a) + sig * sa * F_sum * ty * tj * inv_a
+        _put_row(Jq, Jv, i, 0, -sig, hx, sig)
+        _put_row(Jq, Jv, i, 1, -sig, hy, sig)
+        _put_row(Jq, Jv, i, 2, -sig * rb1, hnet, sig)
+        _put_row(Jq, Jv, i, 3, sig, hx, sig)
+        _put_row(Jq, Jv, i, 4, sig, hy, sig)
+        _put_row(Jq, Jv, i, 5, -1.0 * rb2, hnet, sig)
+
+
+KERNELS = {GearMesh: (pack_gear_mesh, evaluate_gear_mesh, None)}
