@@ -247,29 +247,12 @@ def evaluate_force_source(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac
 
 
 # --------------------------------------------------------------------------------------- SpeedDrive
-def _constant_speed_profile(elem: SpeedDrive):
-    """(θ0, ω_ref) of a drive built with a constant omega_ref, else None (a callable profile).
-
-    SpeedDrive keeps only the closure ``profile``; the constant-speed one is recognised by its code
-    object (the lambda in SpeedDrive.__init__) and read from its cells."""
-    prof = elem.profile
-    code = getattr(prof, "__code__", None)
-    if code is None or code not in SpeedDrive.__init__.__code__.co_consts:
-        return None
-    cells = dict(zip(code.co_freevars, (c.cell_contents for c in prof.__closure__)))
-    if set(cells) != {"self", "th0", "w"}:
-        return None
-    return cells["th0"], cells["w"]
-
-
 def pack_speed_drive(elem: SpeedDrive):
-    prof = _constant_speed_profile(elem)
-    if prof is None:
+    if elem.omega_ref is None:
         raise NotImplementedError(f"SpeedDrive {elem.name!r}: speed profile {elem.profile!r} is a Python callable "
                                   "of time, which the compiled path cannot evaluate (use a constant omega_ref, or "
                                   "the numpy path)")
-    th0, w = prof
-    return _columns(elem.n, elem.stiffness, elem.damping, elem.k_i, th0, w), _NO_G
+    return _columns(elem.n, elem.stiffness, elem.damping, elem.k_i, elem.theta0, elem.omega_ref), _NO_G
 
 
 @njit(cache=True)

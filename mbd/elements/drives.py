@@ -66,6 +66,7 @@ class SpeedDrive(Element):
     def __init__(self, name, body, omega_ref, k, c=0.0, k_i=0.0, theta0=0.0):
         self.name = name
         self.dofs = body_dofs(body)
+        self.theta0 = self.omega_ref = None        # constant speed: θ0 (n,) and ω_ref [rad/s]
         if callable(omega_ref):
             self.profile = omega_ref
         else:
@@ -73,6 +74,7 @@ class SpeedDrive(Element):
             if not np.isfinite(w):
                 raise ModelError(f"{name}: omega_ref must be a finite speed in rad/s, got {omega_ref!r}")
             th0 = self._per_instance("theta0", theta0)
+            self.theta0, self.omega_ref = th0, w
             self.profile = lambda t: (th0 + w * t, np.full(self.n, w))
         self.stiffness = self._per_instance("k", k, positive=True)
         self.damping = self._per_instance("c", c, nonneg=True)
