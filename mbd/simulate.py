@@ -70,11 +70,13 @@ class SimResult:
     h_max_used: float
     results_path: Path | None = None
     resumed_from: float | None = None
+    engine: str = "numpy"      # which engine path ran ("compiled" or "numpy")
 
     def summary(self) -> dict:
         return {"wall_s": self.wall_s, "steps": self.steps, "error_estimate_max": self.error_max,
                 "error_estimate_rms": self.error_rms, "h_min_s": self.h_min_used,
-                "h_max_s": self.h_max_used, **{f"n_{k}": v for k, v in self.counters.items()}}
+                "h_max_s": self.h_max_used, "engine": self.engine,
+                **{f"n_{k}": v for k, v in self.counters.items()}}
 
 
 def save_state(path, s: State, extra: dict | None = None, arrays: dict | None = None) -> None:
@@ -160,14 +162,16 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
              stepper: HHT | None = None, controller=None, recorder: Recorder | None = None,
              checkpoint: Checkpoint | None = None, resume: bool = False, progress: bool | None = None,
              failed_state_path=None, state: State | None = None, system: System | None = None,
-             on_progress=None, observers=()) -> SimResult:
+             on_progress=None, observers=(), engine: str = "auto") -> SimResult:
     """Integrate from (t0, q0, v0) — or from ``state`` — to t_end.
 
     ``stepper`` defaults to ``mbd.PRODUCTION.stepper()``; ``controller`` is required (FixedStep or Adaptive), since
-    the step size is the user's accuracy decision. Progress bar: on for runs of more than ~2 s wall
-    unless ``progress=False`` or the environment sets DPGT_PROGRESS=0. ``on_progress(t, t_end, counters)``
-    is called at most twice a second (e.g. to report progress from a worker process). ``observers``
-    (:class:`Observer`) see every accepted step, whatever the recorder's sample rate.
+    the step size is the user's accuracy decision. ``engine``: "compiled" (:mod:`mbd.compiled`; an error
+    when it cannot be built for this model), "numpy" (the reference path) or "auto" (compiled when it can
+    be built, else numpy; ``SimResult.engine`` says which ran). Progress bar: on for runs of more than ~2 s
+    wall unless ``progress=False`` or the environment sets DPGT_PROGRESS=0. ``on_progress(t, t_end,
+    counters)`` is called at most twice a second (e.g. to report progress from a worker process).
+    ``observers`` (:class:`Observer`) see every accepted step, whatever the recorder's sample rate.
     """
     if controller is None:
         raise ModelError("simulate: pass controller=FixedStep(h) or Adaptive(h0=..., ...)")
@@ -175,6 +179,7 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
         from .settings import PRODUCTION
         stepper = PRODUCTION.stepper()
     system = system or System(model)
+    runner, engine = _engine(engine, system, stepper, controller)
     counters = Counters()
     if state is None:
         if q0 is None or v0 is None:
@@ -187,50 +192,116 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
     h, stats, counters, state, resumed_from = _begin(model, system, state, controller, counters, recorder,
                                                      observers, checkpoint, resume)
     show = progress if progress is not None else os.environ.get("DPGT_PROGRESS", "1") != "0"
-    bar = _Progress(state.t, t_end, show, on_progress)
-    cache = NewtonCache()
+    loop = _Loop(recorder, observers, stats, counters, _Progress(state.t, t_end, show, on_progress), checkpoint)
     wall0 = time.perf_counter()
-    h_floor = getattr(controller, "h_min", 0.0)
-    span = max(abs(t_end), 1.0)
     try:
-        while state.t < t_end - 1e-12 * span:
-            h_try = min(h, t_end - state.t)
-            new, info = stepper.step(system, state, h_try, cache)
-            counters.add(info)
-            ok, h_next = controller.decide(h_try, info.converged, info.error)
-            if not ok:
-                counters.rejected += 1
-                if h_next < h_floor:
-                    _fail(system, state, h_next, info, failed_state_path)
-                h = h_next
-                continue
-            counters.accepted += 1
-            if recorder is not None:
-                recorder.record(state, new)
-            for ob in observers:
-                ob.step(state, new)
-            state = new
-            _add_step(stats, info.error, h_try)
-            h = h_next
-            bar.update(state.t, counters)
-            if checkpoint is not None and stats["steps"] % checkpoint.every == 0:
-                _save_checkpoint(checkpoint, state, h, stats, counters, recorder, observers)
-                cache.lu = None
+        if runner is None:
+            state = _numpy_steps(loop, system, stepper, controller, state, h, t_end, failed_state_path)
+        else:
+            state = _compiled_steps(loop, system, runner, state, h, t_end, failed_state_path)
     except IntegrationError as exc:
         exc.counters = counters.as_dict()    # the work up to the failure, for the caller's report
         raise
     finally:
-        bar.close()
+        loop.bar.close()
     wall = time.perf_counter() - wall0
     n = max(stats["steps"], 1)
     res = SimResult(state=state, counters=counters.as_dict(), wall_s=wall, steps=stats["steps"],
                     error_max=float(stats["err_max"]), error_rms=float(np.sqrt(stats["err_sq"] / n)),
-                    h_min_used=float(stats["h_lo"]), h_max_used=float(stats["h_hi"]), resumed_from=resumed_from)
+                    h_min_used=float(stats["h_lo"]), h_max_used=float(stats["h_hi"]), resumed_from=resumed_from,
+                    engine=engine)
     if recorder is not None:
         res.results_path = recorder.finalize(attrs={"run": res.summary()})
     if checkpoint is not None and Path(checkpoint.path).exists():
         Path(checkpoint.path).unlink()
     return res
+
+
+ENGINES = ("auto", "compiled", "numpy")
+
+
+def _engine(engine: str, system: System, stepper, controller):
+    """(compiled runner or None, the engine that will run)."""
+    if engine not in ENGINES:
+        raise ModelError(f"simulate: engine must be one of {ENGINES}, got {engine!r}")
+    if engine == "numpy":
+        return None, "numpy"
+    try:
+        from .compiled.runner import CompiledRunner
+        return CompiledRunner(system, stepper, controller), "compiled"
+    except (ImportError, NotImplementedError) as exc:
+        if engine == "compiled":
+            raise ModelError(f"simulate: the compiled engine cannot run this model: {exc}") from None
+        return None, "numpy"
+
+
+class _Loop:
+    """What happens after every accepted step, whichever engine took it: recorder, observers,
+    statistics, progress and checkpoints."""
+
+    def __init__(self, recorder, observers, stats, counters, bar, checkpoint):
+        self.recorder, self.observers, self.stats, self.counters = recorder, observers, stats, counters
+        self.bar, self.checkpoint = bar, checkpoint
+
+    def steps_to_checkpoint(self) -> int | None:
+        ck = self.checkpoint
+        return None if ck is None else ck.every - self.stats["steps"] % ck.every
+
+    def accepted(self, s0: State, s1: State, error: float, h_try: float, h_next: float) -> bool:
+        """Hand the step to everyone; True when a checkpoint was written (the LU is then dropped)."""
+        if self.recorder is not None:
+            self.recorder.record(s0, s1)
+        for ob in self.observers:
+            ob.step(s0, s1)
+        _add_step(self.stats, error, h_try)
+        self.bar.update(s1.t, self.counters)
+        if self.checkpoint is not None and self.stats["steps"] % self.checkpoint.every == 0:
+            _save_checkpoint(self.checkpoint, s1, h_next, self.stats, self.counters, self.recorder, self.observers)
+            return True
+        return False
+
+
+def _numpy_steps(loop: _Loop, system, stepper, controller, state, h, t_end, failed_state_path) -> State:
+    cache = NewtonCache()
+    h_floor = getattr(controller, "h_min", 0.0)
+    span = max(abs(t_end), 1.0)
+    while state.t < t_end - 1e-12 * span:
+        h_try = min(h, t_end - state.t)
+        new, info = stepper.step(system, state, h_try, cache)
+        loop.counters.add(info)
+        ok, h_next = controller.decide(h_try, info.converged, info.error)
+        if not ok:
+            loop.counters.rejected += 1
+            if h_next < h_floor:
+                _fail(system, state, h_next, info, failed_state_path)
+            h = h_next
+            continue
+        loop.counters.accepted += 1
+        if loop.accepted(state, new, info.error, h_try, h_next):
+            cache.lu = None
+        state, h = new, h_next
+    return state
+
+
+BLOCK = 256      # accepted steps per compiled call (then the recorder and observers see them)
+
+
+def _compiled_steps(loop: _Loop, system, runner, state, h, t_end, failed_state_path) -> State:
+    span = max(abs(t_end), 1.0)
+    while state.t < t_end - 1e-12 * span:
+        todo = loop.steps_to_checkpoint()
+        blk = runner.advance(state, h, t_end, BLOCK if todo is None else min(BLOCK, todo))
+        for k, val in blk.counters.items():
+            setattr(loop.counters, k, getattr(loop.counters, k) + val)
+        last = len(blk.steps) - 1
+        for i, (s0, s1, h_try, err) in enumerate(blk.steps):
+            h_next = blk.h if i == last else blk.steps[i + 1][2]
+            if loop.accepted(s0, s1, err, h_try, h_next):
+                runner.drop_lu()
+        state, h = blk.state, blk.h
+        if blk.failed is not None:
+            _fail(system, state, h, blk.failed, failed_state_path)
+    return state
 
 
 def _begin(model, system, state, controller, counters, recorder, observers, checkpoint, resume):

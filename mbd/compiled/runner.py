@@ -65,7 +65,7 @@ class CompiledRunner:
         self.cache = np.array([0.0, np.nan, 0.0])        # LU valid, its h, sparse (0) or dense (1)
         self.work = tuple(np.zeros(n) for _ in range(8)) + (np.zeros(nnz), np.zeros(nnz), np.zeros(nnz))
         self.out = tuple(np.zeros(n) for _ in range(4))
-        self.z_shapes = [(name, self.cs.zs[i].shape) for i, name in enumerate(self.cs.state_names, start=1)]
+        self.z_shapes = list(zip(self.cs.state_names, self.cs.state_shapes))
         self.n_z = sum(int(np.prod(s)) for _, s in self.z_shapes)
 
     def drop_lu(self) -> None:

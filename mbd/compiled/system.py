@@ -112,7 +112,8 @@ class CompiledSystem:
         if m.frame.profile is not None:
             raise NotImplementedError("compiled path: the reference frame has a Python speed profile")
         self.system, self.model, self.ndof, self.nnz = system, m, system.ndof, system.nnz
-        self.state_names: list[str | None] = []
+        self.state_names: list[str] = []
+        self.state_shapes: list[tuple] = []
         fams, zs = List(), List()
         zs.append(np.zeros((0, 0)))                    # slot 0: families without internal state
         for (e, parts), (keep, mp) in zip(system._evals, system._maps):
@@ -122,10 +123,12 @@ class CompiledSystem:
                                           f"({type(e).__name__})")
             P, G = kind.pack(e)
             zi = 0
-            if e.init_internal() is not None:
+            z0 = e.init_internal()
+            if z0 is not None:                     # kept (n, n_z) here, the element's own shape in a State
                 zi = len(zs)
-                zs.append(np.ascontiguousarray(e.init_internal(), dtype=float))
+                zs.append(np.ascontiguousarray(np.reshape(z0, (e.n, -1)), dtype=float))
                 self.state_names.append(parts[0][0])
+                self.state_shapes.append(np.shape(z0))
             n, k = e.dofs.shape
             fams.append((kind.id, np.ascontiguousarray(e.dofs, dtype=np.int64), P, G, zi,
                          keep.astype(np.int64), np.asarray(mp, np.int64), np.zeros((n, k)), np.zeros((n, k)),
@@ -142,10 +145,11 @@ class CompiledSystem:
     def set_internal(self, z: dict) -> None:
         """Load the element internal states of a :class:`mbd.State` into the compiled slots."""
         for i, name in enumerate(self.state_names, start=1):
-            self.zs[i][:, :] = z[name]
+            self.zs[i][:, :] = np.reshape(z[name], self.zs[i].shape)
 
     def internal(self) -> dict:
-        return {name: self.zs[i].copy() for i, name in enumerate(self.state_names, start=1)}
+        return {name: self.zs[i].reshape(shape).copy()
+                for i, (name, shape) in enumerate(zip(self.state_names, self.state_shapes), start=1)}
 
     def evaluate(self, t, q, v, z: dict | None = None, jac: bool = False) -> Evaluation:
         """As :meth:`mbd.System.evaluate` (z: the internal states; None keeps the loaded ones)."""
