@@ -1,0 +1,503 @@
+"""Compiled kernels of the planet-bearing contact families (:mod:`mbd.elements.contact`), following the
+convention of :mod:`mbd.compiled` (pack / evaluate / update). The numpy kernels stay the reference.
+
+Layouts (P: one row per instance, columns in this order; G: family-wide values):
+
+``RaceContact``   P (n, 8): κ (+1 inner, −1 outer: per instance, so a fused inner + outer family packs
+                  as one), race_marker x, y [m], R_race [m], D [m], K, c₀ = 2ζ·sqrt(m_roller·p·K), multiplicity
+                  G (8,): exponent p, traction law id, then the law's coefficients:
+                  law 0 (TanhTraction): mu_max, v0, 0, 0, 0, 0;  law 1 (SlideRollTraction): A, B, C, D, u_reg, s_eps
+``PocketContact`` P (n, 10): pocket_angle ψ, pitch_radius, clearance, K_p, λ (impact law damping), v_min, mu,
+                  v_mu, D, multiplicity;  G (0,)
+``GuideContact``  P (n, 7): clearance, K_g, λ, v_min, mu, v_mu, land_radius;  G (0,)
+``LubricantDrag`` P (n, 4): race_marker x, y [m], coef = C_d ρ D l d_m²/8, multiplicity;  G (0,)
+
+The impact families' internal state z (n, 4) is the reference's: [v₀, x, ẋ, valid].
+
+How the Jacobians are made. Each kernel computes the reference kernel's values line by line, in the same
+operation order (values agree with numpy to an ulp of the transcendental functions). When ``jac``, the
+nonlinear scalar laws give their partial derivatives once per instance (traction μ(v_s, u), Hertz load
+Q(δ, δ̇), impact force F(x, ẋ), friction tanh), and the hand-written differential of every line is then
+evaluated along each of the 12 unit directions (6 local coordinates q, then 6 velocities v): a direction
+is one column of J_q (j < 6) or J_v (j ≥ 6). All scalars, no temporaries, exact (no differencing).
+
+Regularisations and branches mirror the reference: the safe norm sqrt(x² + y² + η²); ad.where / ad.pos
+semantics (the branch is chosen on values, an inactive branch contributes a zero derivative); the impact
+force K x (1 + λ ẋ/v₀) with v₀ the stored approach speed z[:, 0] if > 0, else max(ẋ, v_min) of the iterate,
+clipped at ≥ 0; the derivative of arctan2 uses x² + y² (no η), as :func:`mbd.ad.arctan2`.
+
+The frame state (φ, Ω, Ω̇) does not enter these forces (they depend on relative motion only).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..elements.contact import (GuideContact, LubricantDrag, PocketContact, RaceContact, SlideRollTraction,
+                                TanhTraction)
+
+__all__ = ["pack_race", "evaluate_race", "pack_pocket", "evaluate_pocket", "update_pocket", "pack_guide",
+           "evaluate_guide", "update_guide", "pack_drag", "evaluate_drag", "KERNELS", "TRACTION_IDS"]
+
+_ETA2 = 1e-24          # the reference's η² (mbd.elements.contact._ETA2)
+_TWO_PI = 2.0 * np.pi
+TANH, SLIDE_ROLL = 0, 1
+TRACTION_IDS = {TanhTraction: TANH, SlideRollTraction: SLIDE_ROLL}
+
+
+# ------------------------------------------------------------------------------------------ pack
+def _rows(*cols) -> np.ndarray:
+    return np.ascontiguousarray(np.column_stack([np.asarray(c, dtype=float) for c in cols]), dtype=np.float64)
+
+
+def _require(elem, cls):
+    if type(elem) is not cls:
+        raise NotImplementedError(f"{elem.name}: the compiled {cls.__name__} kernel does not cover "
+                                  f"{type(elem).__name__}")
+
+
+def pack_race(elem):
+    _require(elem, RaceContact)
+    tr = elem.traction
+    law = TRACTION_IDS.get(type(tr))
+    if law == TANH:
+        coef = [tr.mu_max, tr.v0, 0.0, 0.0, 0.0, 0.0]
+    elif law == SLIDE_ROLL:
+        coef = [tr.A, tr.B, tr.C, tr.D, tr.u_reg, tr.s_eps]
+    else:
+        raise NotImplementedError(f"{elem.name}: RaceContact with traction law {type(tr).__name__} has no "
+                                  f"compiled kernel (compiled: {sorted(c.__name__ for c in TRACTION_IDS)})")
+    mk = elem.race_marker
+    P = _rows(elem.kappa, mk[:, 0], mk[:, 1], elem.R_race, elem.D, elem.K, elem._c0, elem.multiplicity)
+    G = np.array([elem.exponent, float(law), *coef], dtype=np.float64)
+    return P, G
+
+
+def pack_pocket(elem):
+    _require(elem, PocketContact)
+    P = _rows(elem.pocket_angle, elem.pitch_radius, elem.clearance, elem.K_p, elem.lam, elem.v_min, elem.mu,
+              elem.v_mu, elem.D, elem.multiplicity)
+    return P, np.zeros(0)
+
+
+def pack_guide(elem):
+    _require(elem, GuideContact)
+    P = _rows(elem.clearance, elem.K_g, elem.lam, elem.v_min, elem.mu, elem.v_mu, elem.land_radius)
+    return P, np.zeros(0)
+
+
+def pack_drag(elem):
+    _require(elem, LubricantDrag)
+    mk = elem.race_marker
+    return _rows(mk[:, 0], mk[:, 1], elem.coef, elem.multiplicity), np.zeros(0)
+
+
+# ----------------------------------------------------------------------------------- scalar helpers
+@njit(cache=True)
+def _u(j, m):
+    return 1.0 if j == m else 0.0
+
+
+@njit(cache=True)
+def _unit(j):
+    """Direction j of (q, v) (6 + 6 local coordinates) as 12 scalars."""
+    return (_u(j, 0), _u(j, 1), _u(j, 2), _u(j, 3), _u(j, 4), _u(j, 5),
+            _u(j, 6), _u(j, 7), _u(j, 8), _u(j, 9), _u(j, 10), _u(j, 11))
+
+
+@njit(cache=True)
+def _sign(x):
+    """np.sign (0 at 0)."""
+    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
+
+
+@njit(cache=True)
+def _wrap(x):
+    """mbd.ad.wrap_angle: x − 2π·round(x/2π) (its derivative is 1)."""
+    return x - _TWO_PI * np.round(x / _TWO_PI)
+
+
+@njit(cache=True)
+def _d_cross(rx, ry, drx, dry, fx, fy, dfx, dfy):
+    """Differential of the torque r × f = rx·fy − ry·fx."""
+    return drx * fy + rx * dfy - dry * fx - ry * dfx
+
+
+@njit(cache=True)
+def _write(F, Jq, Jv, i, j, m, f0, f1, f2, f3, f4, f5):
+    """Generalized forces (j < 0) or the derivative column j of instance i, times the multiplicity m."""
+    if j < 0:
+        F[i, 0], F[i, 1], F[i, 2] = f0 * m, f1 * m, f2 * m
+        F[i, 3], F[i, 4], F[i, 5] = f3 * m, f4 * m, f5 * m
+        return
+    J = Jq if j < 6 else Jv
+    c = j % 6
+    J[i, 0, c], J[i, 1, c], J[i, 2, c] = f0 * m, f1 * m, f2 * m
+    J[i, 3, c], J[i, 4, c], J[i, 5, c] = f3 * m, f4 * m, f5 * m
+
+
+@njit(cache=True)
+def _zero(F, Jq, Jv, i, jac):
+    """An inactive instance: no force, and (ad.where) no derivative."""
+    for a in range(6):
+        F[i, a] = 0.0
+        if jac:
+            for b in range(6):
+                Jq[i, a, b] = 0.0
+                Jv[i, a, b] = 0.0
+
+
+@njit(cache=True)
+def _traction(law, G, v_s, u):
+    """Traction coefficient μ(v_s, u_roll) and its partials ∂μ/∂v_s, ∂μ/∂u_roll (G layout: module doc)."""
+    if law == TANH:
+        mu_max, v0 = G[2], G[3]
+        th = np.tanh(v_s * (1.0 / v0))
+        return mu_max * th, mu_max * (1.0 - th * th) / v0, 0.0
+    A, B, C, D, u_reg, s_eps = G[2], G[3], G[4], G[5], G[6], G[7]
+    h = np.sqrt(u * u + u_reg ** 2)
+    s = v_s / h                                # regularised slide-to-roll ratio
+    a = np.sqrt(s * s + s_eps ** 2)            # smoothed |s|
+    ex = np.exp(a * (-C))
+    g = (A + B * a) * ex + D
+    r = s / a
+    dg = (B - C * (A + B * a)) * ex            # g'(a)
+    # d/ds [(s/a)·g(a)] with da/ds = s/a; d(s/a)/ds = (1 − r²)/a = s_eps²/a³, written without the cancellation
+    # of 1 − r² at |s| ≫ s_eps (the reference's dual numbers carry it: see the test module)
+    dmu_ds = g * (s_eps * s_eps / (a * a * a)) + r * r * dg
+    return r * g, dmu_ds / h, -dmu_ds * s * u / (h * h)
+
+
+@njit(cache=True)
+def _impact(K, lam, v_min, x, xd, v_stored):
+    """Impact force F = K x (1 + λ ẋ/v₀) ≥ 0 for x > 0 (else 0) and its partials ∂F/∂x, ∂F/∂ẋ (0 where
+    F is clipped). v₀ = v_stored if > 0, else max(ẋ, v_min) of the iterate (then v₀ follows ẋ)."""
+    if not x > 0.0:
+        return 0.0, 0.0, 0.0
+    if v_stored > 0.0:
+        v_app, dv = v_stored, 0.0
+    elif xd > v_min:
+        v_app, dv = xd, 1.0
+    else:
+        v_app, dv = v_min, 0.0
+    F = K * x * (1.0 + lam * xd / v_app)
+    if not F > 0.0:
+        return 0.0, 0.0, 0.0
+    return F, K * (1.0 + lam * xd / v_app), K * x * lam * (1.0 - dv * xd / v_app) / v_app
+
+
+@njit(cache=True)
+def _impact_state(v0, x0, xd0, x1, xd1, v_min):
+    """Approach speed after an accepted step (the rule of ``_Impact.update_internal``)."""
+    closed = x1 > 0.0
+    opened = x0 <= 0.0                          # start out of contact: interpolate the onset
+    den = x0 - x1 if (opened and closed) else -1.0
+    theta = x0 / den
+    onset = xd0 + theta * (xd1 - xd0) if opened else xd1
+    v_app = v0 if v0 > 0.0 else onset
+    if not closed:
+        return 0.0
+    return v_min if v_min > v_app else v_app    # np.maximum(v_app, v_min)
+
+
+# ----------------------------------------------------------------------------------- race contact
+@njit(cache=True)
+def evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    p, law = G[0], int(G[1])
+    pe = 0.5 * (p - 1.0)                        # exponent of the damping's δ factor
+    for i in range(ql.shape[0]):
+        kap, mx, my, R, D, K, c0, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6], P[i, 7]
+        xr, yr = ql[i, 0], ql[i, 1]
+        xb, yb, thb = ql[i, 3], ql[i, 4], ql[i, 5]
+        vr0, vr1, vr2 = vl[i, 0], vl[i, 1], vl[i, 2]
+        vb0, vb1, vb2 = vl[i, 3], vl[i, 4], vl[i, 5]
+        # raceway centre c = c_b + rc, roller centre relative to it, normal e and tangent t = k × e
+        cth, sth = np.cos(thb), np.sin(thb)
+        rcx, rcy = cth * mx - sth * my, sth * mx + cth * my
+        dx, dy = xr - (xb + rcx), yr - (yb + rcy)
+        rho = np.sqrt(dx * dx + dy * dy + _ETA2)
+        ex, ey = dx / rho, dy / rho
+        tx, ty = -ey, ex
+        delta = 0.5 * D - kap * (rho - R)
+        Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
+        wx, wy = vr0 - Vcx, vr1 - Vcy
+        delta_dot = -kap * (ex * wx + ey * wy)
+        # Hertz load with contact damping, clipped at >= 0 (ad.where: zero derivative when clipped)
+        if not delta > 0.0:
+            _zero(F, Jq, Jv, i, jac)
+            continue
+        dpe = delta ** pe
+        Q = K * delta ** p + c0 * dpe * delta_dot
+        if not Q > 0.0:
+            _zero(F, Jq, Jv, i, jac)
+            continue
+        # contact point P = c + R e seen from the roller centre (rr) and from the race body's centre (rb)
+        rl = R - rho
+        rrx, rry = rl * ex, rl * ey
+        rbx, rby = rcx + R * ex, rcy + R * ey
+        Vrx, Vry = vr0 - vr2 * rry, vr1 + vr2 * rrx
+        Vbx, Vby = vb0 - vb2 * rby, vb1 + vb2 * rbx
+        ur = Vrx * tx + Vry * ty
+        ub = Vbx * tx + Vby * ty
+        v_s = ur - ub
+        wt = wx * tx + wy * ty
+        u = 0.0
+        if law == SLIDE_ROLL:                    # rolling speed relative to the moving contact point
+            u = 0.5 * (ur + ub) - (Vcx * tx + Vcy * ty + R * wt / rho)
+        mu, mu_s, mu_u = _traction(law, G, v_s, u)
+        Ft = -mu * Q
+        Fx = kap * Q * ex + Ft * tx
+        Fy = kap * Q * ey + Ft * ty
+        _write(F, Jq, Jv, i, -1, mult, Fx, Fy, rrx * Fy - rry * Fx, -Fx, -Fy, rbx * (-Fy) - rby * (-Fx))
+        if not jac:
+            continue
+        Q_d = K * p * delta ** (p - 1.0) + c0 * pe * delta ** (pe - 1.0) * delta_dot   # ∂Q/∂δ
+        Q_r = c0 * dpe                                                                  # ∂Q/∂δ̇
+        for j in range(12):
+            dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, dvr2, dvb0, dvb1, dvb2 = _unit(j)
+            drcx, drcy = -dthb * rcy, dthb * rcx
+            ddx, ddy = dxr - dxb - drcx, dyr - dyb - drcy
+            drho = (dx * ddx + dy * ddy) / rho
+            dex, dey = (ddx - ex * drho) / rho, (ddy - ey * drho) / rho
+            dtx, dty = -dey, dex
+            dVcx, dVcy = dvb0 - dvb2 * rcy - vb2 * drcy, dvb1 + dvb2 * rcx + vb2 * drcx
+            dwx, dwy = dvr0 - dVcx, dvr1 - dVcy
+            ddelta_dot = -kap * (dex * wx + ex * dwx + dey * wy + ey * dwy)
+            dQ = Q_d * (-kap * drho) + Q_r * ddelta_dot
+            drrx, drry = -drho * ex + rl * dex, -drho * ey + rl * dey
+            drbx, drby = drcx + R * dex, drcy + R * dey
+            dVrx, dVry = dvr0 - dvr2 * rry - vr2 * drry, dvr1 + dvr2 * rrx + vr2 * drrx
+            dVbx, dVby = dvb0 - dvb2 * rby - vb2 * drby, dvb1 + dvb2 * rbx + vb2 * drbx
+            dur = dVrx * tx + Vrx * dtx + dVry * ty + Vry * dty
+            dub = dVbx * tx + Vbx * dtx + dVby * ty + Vby * dty
+            dmu = mu_s * (dur - dub)
+            if law == SLIDE_ROLL:
+                dwt = dwx * tx + wx * dtx + dwy * ty + wy * dty
+                dvP = dVcx * tx + Vcx * dtx + dVcy * ty + Vcy * dty + R * (dwt - wt * drho / rho) / rho
+                dmu += mu_u * (0.5 * (dur + dub) - dvP)
+            dFt = -(dmu * Q + mu * dQ)
+            dFx = kap * (dQ * ex + Q * dex) + dFt * tx + Ft * dtx
+            dFy = kap * (dQ * ey + Q * dey) + dFt * ty + Ft * dty
+            _write(F, Jq, Jv, i, j, mult, dFx, dFy, _d_cross(rrx, rry, drrx, drry, Fx, Fy, dFx, dFy),
+                   -dFx, -dFy, -_d_cross(rbx, rby, drbx, drby, Fx, Fy, dFx, dFy))
+
+
+# ----------------------------------------------------------------------------------- pocket contact
+@njit(cache=True)
+def _pocket_gap(xr, yr, xg, yg, thg, vr0, vr1, vg0, vg1, vg2, psi, rm, clearance):
+    """Pocket geometry (PocketContact._geometry): dx, dy, ρ², s, wx, wy, penetration d, rate ḋ."""
+    dx, dy = xr - xg, yr - yg
+    rho2 = dx * dx + dy * dy + _ETA2
+    s = rm * _wrap(np.arctan2(dy, dx) - thg - psi)
+    wx, wy = vr0 - vg0, vr1 - vg1
+    s_dot = rm * ((dx * wy - dy * wx) / rho2 - vg2)
+    return dx, dy, rho2, s, wx, wy, abs(s) - clearance, _sign(s) * s_dot
+
+
+@njit(cache=True)
+def evaluate_pocket(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    for i in range(ql.shape[0]):
+        psi, rm, clr, Kp, lam, v_min = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5]
+        mu, v_mu, D, mult = P[i, 6], P[i, 7], P[i, 8], P[i, 9]
+        xr, yr, xg, yg, thg = ql[i, 0], ql[i, 1], ql[i, 3], ql[i, 4], ql[i, 5]
+        vr0, vr1, vr2 = vl[i, 0], vl[i, 1], vl[i, 2]
+        vg0, vg1, vg2 = vl[i, 3], vl[i, 4], vl[i, 5]
+        dx, dy, rho2, s, wx, wy, pen, pen_dot = _pocket_gap(xr, yr, xg, yg, thg, vr0, vr1, vg0, vg1, vg2, psi,
+                                                            rm, clr)
+        Fi, F_x, F_xd = _impact(Kp, lam, v_min, pen, pen_dot, z[i, 0])
+        if Fi == 0.0:
+            _zero(F, Jq, Jv, i, jac)
+            continue
+        sg = _sign(s)
+        Fs = Fi * sg
+        # potential form −Fs ∂s/∂q: ∂s/∂p = rm (−dy, dx)/ρ² = (gx, gy)
+        gx, gy = rm * (-dy) / rho2, rm * dx / rho2
+        fnx, fny = -Fs * gx, -Fs * gy
+        # wall friction at the roller's contact point with the wall: r_w from the roller, r_g from the cage
+        rho = np.sqrt(rho2)
+        ex, ey = dx / rho, dy / rho
+        half = 0.5 * D * sg
+        rwx, rwy = -half * ey, half * ex
+        rgx, rgy = dx + rwx, dy + rwy
+        Vrx, Vry = vr0 - vr2 * rwy, vr1 + vr2 * rwx
+        Vgx, Vgy = vg0 - vg2 * rgy, vg1 + vg2 * rgx
+        v_rad = (Vrx - Vgx) * ex + (Vry - Vgy) * ey
+        th = np.tanh(v_rad / v_mu)
+        f = -mu * th * Fi
+        fx, fy = f * ex, f * ey
+        _write(F, Jq, Jv, i, -1, mult, fnx + fx, fny + fy, rwx * fy - rwy * fx, -fnx - fx, -fny - fy,
+               Fs * rm + (rgx * (-fy) - rgy * (-fx)))
+        if not jac:
+            continue
+        r2 = dx * dx + dy * dy                   # ad.arctan2's derivative: no η
+        num = dx * wy - dy * wx
+        f_v = -mu * (1.0 - th * th) / v_mu * Fi  # ∂f/∂v_rad
+        for j in range(12):
+            dxr, dyr, _, dxg, dyg, dthg, dvr0, dvr1, dvr2, dvg0, dvg1, dvg2 = _unit(j)
+            ddx, ddy = dxr - dxg, dyr - dyg
+            ds = rm * (ddy * (dx / r2) - ddx * (dy / r2) - dthg)
+            drho2 = 2.0 * (dx * ddx + dy * ddy)
+            dwx, dwy = dvr0 - dvg0, dvr1 - dvg1
+            dnum = ddx * wy + dx * dwy - ddy * wx - dy * dwx
+            ds_dot = rm * ((dnum - num * drho2 / rho2) / rho2 - dvg2)
+            dFi = F_x * sg * ds + F_xd * sg * ds_dot       # d = |s| − C, ḋ = sign(s)·ṡ
+            dFs = dFi * sg
+            dgx, dgy = (-rm * ddy - gx * drho2) / rho2, (rm * ddx - gy * drho2) / rho2
+            dfnx, dfny = -(dFs * gx + Fs * dgx), -(dFs * gy + Fs * dgy)
+            drho = 0.5 * drho2 / rho
+            dex, dey = (ddx - ex * drho) / rho, (ddy - ey * drho) / rho
+            drwx, drwy = -half * dey, half * dex
+            drgx, drgy = ddx + drwx, ddy + drwy
+            dVrx, dVry = dvr0 - dvr2 * rwy - vr2 * drwy, dvr1 + dvr2 * rwx + vr2 * drwx
+            dVgx, dVgy = dvg0 - dvg2 * rgy - vg2 * drgy, dvg1 + dvg2 * rgx + vg2 * drgx
+            dv_rad = (dVrx - dVgx) * ex + (Vrx - Vgx) * dex + (dVry - dVgy) * ey + (Vry - Vgy) * dey
+            df = f_v * dv_rad - mu * th * dFi
+            dfx, dfy = df * ex + f * dex, df * ey + f * dey
+            _write(F, Jq, Jv, i, j, mult, dfnx + dfx, dfny + dfy, _d_cross(rwx, rwy, drwx, drwy, fx, fy, dfx, dfy),
+                   -dfnx - dfx, -dfny - dfy, dFs * rm - _d_cross(rgx, rgy, drgx, drgy, fx, fy, dfx, dfy))
+
+
+@njit(cache=True)
+def update_pocket(z, t0, t1, ql0, vl0, ql1, vl1, P, G):
+    n = z.shape[0]
+    z1 = np.empty((n, 4))
+    for i in range(n):
+        psi, rm, clr, v_min = P[i, 0], P[i, 1], P[i, 2], P[i, 5]
+        g1 = _pocket_gap(ql1[i, 0], ql1[i, 1], ql1[i, 3], ql1[i, 4], ql1[i, 5], vl1[i, 0], vl1[i, 1],
+                         vl1[i, 3], vl1[i, 4], vl1[i, 5], psi, rm, clr)
+        x1, xd1 = g1[6], g1[7]
+        x0, xd0 = z[i, 1], z[i, 2]
+        if not z[i, 3] > 0:                      # first step: the start state is not cached
+            g0 = _pocket_gap(ql0[i, 0], ql0[i, 1], ql0[i, 3], ql0[i, 4], ql0[i, 5], vl0[i, 0], vl0[i, 1],
+                             vl0[i, 3], vl0[i, 4], vl0[i, 5], psi, rm, clr)
+            x0, xd0 = g0[6], g0[7]
+        z1[i, 0] = _impact_state(z[i, 0], x0, xd0, x1, xd1, v_min)
+        z1[i, 1], z1[i, 2], z1[i, 3] = x1, xd1, 1.0
+    return z1
+
+
+# ----------------------------------------------------------------------------------- guide contact
+@njit(cache=True)
+def _guide_gap(xg, yg, xo, yo, vg0, vg1, vo0, vo1, clearance):
+    """Guide geometry (GuideContact._geometry): e = c_g − c_o, ε, n = e/ε, penetration x, rate ε̇."""
+    ex, ey = xg - xo, yg - yo
+    eps = np.sqrt(ex * ex + ey * ey + _ETA2)
+    nx, ny = ex / eps, ey / eps
+    return ex, ey, eps, nx, ny, eps - clearance, nx * (vg0 - vo0) + ny * (vg1 - vo1)
+
+
+@njit(cache=True)
+def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    for i in range(ql.shape[0]):
+        clr, Kg, lam, v_min, mu, v_mu, rL = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
+        vg0, vg1, vg2 = vl[i, 0], vl[i, 1], vl[i, 2]
+        vo0, vo1, vo2 = vl[i, 3], vl[i, 4], vl[i, 5]
+        ex, ey, eps, nx, ny, pen, eps_dot = _guide_gap(ql[i, 0], ql[i, 1], ql[i, 3], ql[i, 4], vg0, vg1, vo0,
+                                                       vo1, clr)
+        Fi, F_x, F_xd = _impact(Kg, lam, v_min, pen, eps_dot, z[i, 0])
+        if Fi == 0.0:
+            _zero(F, Jq, Jv, i, jac)
+            continue
+        tx, ty = -ny, nx
+        # land contact point from the cage centre (rg) and from the planet's (ro)
+        rgx, rgy = rL * nx, rL * ny
+        rox, roy = ex + rgx, ey + rgy
+        Vgx, Vgy = vg0 - vg2 * rgy, vg1 + vg2 * rgx
+        Vox, Voy = vo0 - vo2 * roy, vo1 + vo2 * rox
+        v_t = (Vgx - Vox) * tx + (Vgy - Voy) * ty
+        th = np.tanh(v_t / v_mu)
+        fr = -mu * th * Fi
+        Fx = -Fi * nx + fr * tx
+        Fy = -Fi * ny + fr * ty
+        _write(F, Jq, Jv, i, -1, 1.0, Fx, Fy, rgx * Fy - rgy * Fx, -Fx, -Fy, rox * (-Fy) - roy * (-Fx))
+        if not jac:
+            continue
+        wx, wy = vg0 - vo0, vg1 - vo1
+        f_v = -mu * (1.0 - th * th) / v_mu * Fi  # ∂fr/∂v_t
+        for j in range(12):
+            dxg, dyg, _, dxo, dyo, _, dvg0, dvg1, dvg2, dvo0, dvo1, dvo2 = _unit(j)
+            dex, dey = dxg - dxo, dyg - dyo
+            deps = (ex * dex + ey * dey) / eps
+            dnx, dny = (dex - nx * deps) / eps, (dey - ny * deps) / eps
+            dwx, dwy = dvg0 - dvo0, dvg1 - dvo1
+            deps_dot = dnx * wx + nx * dwx + dny * wy + ny * dwy
+            dFi = F_x * deps + F_xd * deps_dot
+            dtx, dty = -dny, dnx
+            drgx, drgy = rL * dnx, rL * dny
+            drox, droy = dex + drgx, dey + drgy
+            dVgx, dVgy = dvg0 - dvg2 * rgy - vg2 * drgy, dvg1 + dvg2 * rgx + vg2 * drgx
+            dVox, dVoy = dvo0 - dvo2 * roy - vo2 * droy, dvo1 + dvo2 * rox + vo2 * drox
+            dv_t = (dVgx - dVox) * tx + (Vgx - Vox) * dtx + (dVgy - dVoy) * ty + (Vgy - Voy) * dty
+            dfr = f_v * dv_t - mu * th * dFi
+            dFx = -(dFi * nx + Fi * dnx) + dfr * tx + fr * dtx
+            dFy = -(dFi * ny + Fi * dny) + dfr * ty + fr * dty
+            _write(F, Jq, Jv, i, j, 1.0, dFx, dFy, _d_cross(rgx, rgy, drgx, drgy, Fx, Fy, dFx, dFy),
+                   -dFx, -dFy, -_d_cross(rox, roy, drox, droy, Fx, Fy, dFx, dFy))
+
+
+@njit(cache=True)
+def update_guide(z, t0, t1, ql0, vl0, ql1, vl1, P, G):
+    n = z.shape[0]
+    z1 = np.empty((n, 4))
+    for i in range(n):
+        clr, v_min = P[i, 0], P[i, 3]
+        g1 = _guide_gap(ql1[i, 0], ql1[i, 1], ql1[i, 3], ql1[i, 4], vl1[i, 0], vl1[i, 1], vl1[i, 3], vl1[i, 4], clr)
+        x1, xd1 = g1[5], g1[6]
+        x0, xd0 = z[i, 1], z[i, 2]
+        if not z[i, 3] > 0:                      # first step: the start state is not cached
+            g0 = _guide_gap(ql0[i, 0], ql0[i, 1], ql0[i, 3], ql0[i, 4], vl0[i, 0], vl0[i, 1], vl0[i, 3],
+                            vl0[i, 4], clr)
+            x0, xd0 = g0[5], g0[6]
+        z1[i, 0] = _impact_state(z[i, 0], x0, xd0, x1, xd1, v_min)
+        z1[i, 1], z1[i, 2], z1[i, 3] = x1, xd1, 1.0
+    return z1
+
+
+# ----------------------------------------------------------------------------------- lubricant drag
+@njit(cache=True)
+def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    for i in range(ql.shape[0]):
+        mx, my, coef, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3]
+        xr, yr = ql[i, 0], ql[i, 1]
+        xb, yb, thb = ql[i, 3], ql[i, 4], ql[i, 5]
+        vr0, vr1 = vl[i, 0], vl[i, 1]
+        vb0, vb1, vb2 = vl[i, 3], vl[i, 4], vl[i, 5]
+        cth, sth = np.cos(thb), np.sin(thb)
+        rcx, rcy = cth * mx - sth * my, sth * mx + cth * my
+        dx, dy = xr - (xb + rcx), yr - (yb + rcy)
+        rho2 = dx * dx + dy * dy + _ETA2
+        rho = np.sqrt(rho2)
+        Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
+        wx, wy = vr0 - Vcx, vr1 - Vcy
+        num = dx * wy - dy * wx
+        om = num / rho2 - vb2                   # orbital speed relative to the race body
+        Fd = coef * om * abs(om)
+        Fx, Fy = Fd * dy / rho, -Fd * dx / rho   # −Fd·t at the roller centre
+        px, py = rcx + dx, rcy + dy              # roller centre from the race body's centre
+        _write(F, Jq, Jv, i, -1, mult, Fx, Fy, 0.0, -Fx, -Fy, px * (-Fy) - py * (-Fx))
+        if not jac:
+            continue
+        Fd_om = 2.0 * coef * abs(om)             # d(Ω|Ω|)/dΩ = 2|Ω|
+        for j in range(12):
+            dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, _, dvb0, dvb1, dvb2 = _unit(j)
+            drcx, drcy = -dthb * rcy, dthb * rcx
+            ddx, ddy = dxr - dxb - drcx, dyr - dyb - drcy
+            drho2 = 2.0 * (dx * ddx + dy * ddy)
+            drho = 0.5 * drho2 / rho
+            dVcx, dVcy = dvb0 - dvb2 * rcy - vb2 * drcy, dvb1 + dvb2 * rcx + vb2 * drcx
+            dwx, dwy = dvr0 - dVcx, dvr1 - dVcy
+            dnum = ddx * wy + dx * dwy - ddy * wx - dy * dwx
+            dFd = Fd_om * ((dnum - num * drho2 / rho2) / rho2 - dvb2)
+            dFx = (dFd * dy + Fd * ddy - Fx * drho) / rho
+            dFy = (-dFd * dx - Fd * ddx - Fy * drho) / rho
+            _write(F, Jq, Jv, i, j, mult, dFx, dFy, 0.0, -dFx, -dFy,
+                   -_d_cross(px, py, drcx + ddx, drcy + ddy, Fx, Fy, dFx, dFy))
+
+
+# families -> (pack, evaluate, update or None), for the assembler
+KERNELS = {
+    RaceContact: (pack_race, evaluate_race, None),
+    PocketContact: (pack_pocket, evaluate_pocket, update_pocket),
+    GuideContact: (pack_guide, evaluate_guide, update_guide),
+    LubricantDrag: (pack_drag, evaluate_drag, None),
+}
