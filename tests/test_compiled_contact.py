@@ -31,7 +31,7 @@ from test_contact import (DM, DR, EHL, K_HZ, M_ROLLER, N, TANH, drag_scene, drag
 RTOL = 1e-10           # of the largest entry of the instance's block
 ATOL_F = 1e-300        # forces: an all-zero reference row must be matched by zeros
 ATOL_J = 1e-10         # Jacobians: the reference's round-off floor (module docstring)
-SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 TRACTIONS = {"tanh": TANH, "ehl": EHL}
 LAWS = st.sampled_from(sorted(IMPACT_LAWS))
 MULTS = st.one_of(st.just(1), st.lists(st.integers(1, 3), min_size=N, max_size=N))
