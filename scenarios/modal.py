@@ -75,7 +75,7 @@ def dpgt(a):
                            SceneOptions(bearings="linear", mesh_stiffness="constant", gravity=False))
     setting = dataclasses.replace(mbd.PRODUCTION, h_max=2e-5)     # linear bearings: larger steps are fine
     r = mbd.simulate(built.model, built.q0, built.v0, a.settle, stepper=setting.stepper(),
-                     controller=setting.controller(), progress=False)
+                     controller=setting.controller(), progress=False, engine=setting.engine)
     res = mbd.modal_analysis(built.model, r.state.t, r.state.q, r.state.v, r.state.z)
     modes = classify_modes(built.model, res.frequencies_hz, res.shapes, tol=1e-3, freq_tol=1e-3)
     return built, modes.frequencies_hz, modes.shapes, list(modes.kind), modes.groups

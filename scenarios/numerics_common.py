@@ -102,7 +102,7 @@ def settled_state(prob: Problem, cache: Path | None = None, h: float = 5e-6) -> 
             return s, extra
     setting = dataclasses.replace(mbd.PRODUCTION, h=min(h, 1e-6), h_max=h, h_min=1e-10)
     res = mbd.simulate(prob.model, prob.built.q0, prob.built.v0, prob.settle, stepper=setting.stepper(),
-                       controller=setting.controller(), progress=False)
+                       controller=setting.controller(), progress=False, engine=setting.engine)
     extra = {"fingerprint": fp, "settle_wall_s": res.wall_s, "settle_steps": res.steps, "setting": repr(setting)}
     if cache is not None:
         Path(cache).parent.mkdir(parents=True, exist_ok=True)

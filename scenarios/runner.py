@@ -133,6 +133,7 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
             {"t": t, "t_end": t_end, "wall_s": time.perf_counter() - wall0, "steps": counters.accepted}))
 
     res = mbd.simulate(scene.model, scene.q0, scene.v0, t_end, stepper=integ.stepper(), controller=integ.controller(),
+                       engine=integ.engine,
                        recorder=rec, checkpoint=mbd.Checkpoint(out_dir / "checkpoint.npz", cfg.checkpoint_every),
                        resume=True, progress=cfg.progress, failed_state_path=out_dir / "failed_state.npz",
                        on_progress=report, observers=[stats])

@@ -231,7 +231,10 @@ def test_update_matches_update_internal(kind, data, z):
         onset = (x0 <= 0) & (x1 > 0) & (zz[:, 0] == 0)
         spread = np.abs(xd1 - xd0) * 2 * ax / np.maximum(np.abs(x0 - x1), 1e-300)
         tol = 1e-14 * np.abs(ref[:, 0]) + np.where(onset, spread, 0.0)
-        assert np.all(np.abs(got[:, 0] - ref[:, 0]) <= tol), (got[:, 0], ref[:, 0], tol)
+        # a roller centred at the start: the start rate ḋ₀ = sign(s)·ṡ has the sign of s's round-off
+        start_centred = np.abs(elem._geometry(cols(q0), cols(v0))[3]) <= ax if kind == "pocket" else centred
+        ok = np.abs(got[:, 0] - ref[:, 0]) <= tol
+        assert np.all(ok | (onset & start_centred)), (got[:, 0], ref[:, 0], tol)
 
 
 # ----------------------------------------------------------------------------------------------- drag

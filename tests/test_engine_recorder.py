@@ -172,29 +172,34 @@ def test_results_file_is_atomic(tmp_path):
     assert not path.exists()
 
 
+class _Interrupt(mbd.Observer):
+    """Ctrl-C once the run passes t (an observer sees every accepted step, on either engine)."""
+
+    def __init__(self, t):
+        self.t, self.armed = t, True
+
+    def step(self, s0, s1):
+        if self.armed and s1.t > self.t:
+            self.armed = False
+            raise KeyboardInterrupt
+
+
+@pytest.mark.parametrize("engine", ["compiled", "numpy"])
 @pytest.mark.parametrize("controller", [mbd.FixedStep(4e-4), mbd.Adaptive(h0=1e-4, h_min=1e-9)],
                          ids=["fixed", "adaptive"])
-def test_checkpoint_resume_gives_identical_results(tmp_path, controller):
+def test_checkpoint_resume_gives_identical_results(tmp_path, controller, engine):
     stepper = mbd.HHT(alpha=-0.1, tol=mbd.Tolerance(rtol=1e-5, atol_pos=1e-9, atol_rot=1e-8))
     t_end = 0.06
+    kw = dict(t_end=t_end, controller=controller, stepper=stepper, engine=engine)
     # reference: uninterrupted, with the same checkpoint cadence (a checkpoint drops the cached LU)
-    ref = run(scene(), tmp_path / "ref.nc", t_end=t_end, controller=controller, stepper=stepper,
-              checkpoint=mbd.Checkpoint(tmp_path / "ref.ckpt", every=7))
-    state = {"armed": True}
-
-    def torque(t):
-        if state["armed"] and t > 0.037:
-            state["armed"] = False
-            raise KeyboardInterrupt
-        return 0.05
-
-    model = scene(torque=torque)
+    ref = run(scene(), tmp_path / "ref.nc", checkpoint=mbd.Checkpoint(tmp_path / "ref.ckpt", every=7), **kw)
+    assert ref.engine == engine
+    model = scene()
     ck = mbd.Checkpoint(tmp_path / "run.ckpt", every=7)
     with pytest.raises(KeyboardInterrupt):
-        run(model, tmp_path / "run.nc", t_end=t_end, controller=controller, stepper=stepper, checkpoint=ck)
+        run(model, tmp_path / "run.nc", checkpoint=ck, observers=[_Interrupt(0.037)], **kw)
     assert ck.path.exists() and not (tmp_path / "run.nc").exists()
-    res = run(model, tmp_path / "run.nc", t_end=t_end, controller=controller, stepper=stepper,
-              checkpoint=ck, resume=True)
+    res = run(model, tmp_path / "run.nc", checkpoint=ck, resume=True, observers=[_Interrupt(np.inf)], **kw)
     assert res.resumed_from is not None and 0.0 < res.resumed_from <= 0.037
     assert not ck.path.exists()                              # removed after a complete run
     np.testing.assert_array_equal(res.state.q, ref.state.q)
