@@ -64,8 +64,8 @@ class System:
         # element blocks: entry (i, j) of every instance, kept where both DOFs are free
         for e, _ in self._evals:
             fr = f2f[e.dofs]                                   # (n, k)
-            r = np.repeat(fr[:, :, None], e.k, axis=2)         # (n, k, k): row = local i
-            c = np.repeat(fr[:, None, :], e.k, axis=1)         # col = local j
+            r = np.repeat(fr[:, :, None], e.n_local, axis=2)         # (n, k, k): row = local i
+            c = np.repeat(fr[:, None, :], e.n_local, axis=1)         # col = local j
             keep = ((r >= 0) & (c >= 0)).ravel()
             self._blocks.append(np.flatnonzero(keep))
             rows.append(r.ravel()[keep])

@@ -1,7 +1,7 @@
 """The element protocol: one object is a *family* of n force elements.
 
 A family owns an (n, k) integer array ``dofs`` of indices into the full coordinate vector (3 per
-body: x, y, θ), resolved when the scene is built, and a vectorised ``kernel``:
+body: x, y, θ; k = ``n_local``, the local coordinates of one instance), resolved when the scene is built, and a vectorised ``kernel``:
 
     kernel(t, fs, q, v, z) -> (forces, outputs)
 
@@ -44,9 +44,10 @@ def body_dofs(*bodies) -> np.ndarray:
 
 
 class Element:
-    """Base class. Subclasses set ``k`` and ``dofs`` and implement ``kernel``."""
+    """Base class. Subclasses set ``n_local`` (local coordinates per instance: 3 per body) and ``dofs``
+    and implement ``kernel``."""
 
-    k: int = 0
+    n_local: int = 0
     name: str = "element"
     dofs: np.ndarray
 
@@ -113,7 +114,7 @@ def evaluate(elem: Element, t, fs, q_full, v_full, z, jac: bool):
     """Forces (n, k), outputs and, if ``jac``, J_q and J_v (n, k, k) of one family."""
     ql = q_full[elem.dofs]
     vl = v_full[elem.dofs]
-    k = elem.k
+    k = elem.n_local
     if not jac:
         f, out = elem.kernel(t, fs, list(ql.T), list(vl.T), z)
         F = np.empty((elem.n, k))

@@ -123,8 +123,8 @@ class ModelBuilder:
         nfull = 3 * nb
         for e in self._elements:
             d = np.asarray(e.dofs)
-            if d.ndim != 2 or d.shape[1] != e.k or d.dtype.kind not in "iu":
-                raise ModelError(f"element {e.name!r}: dofs must be an integer (n, {e.k}) array, got shape {d.shape}")
+            if d.ndim != 2 or d.shape[1] != e.n_local or d.dtype.kind not in "iu":
+                raise ModelError(f"element {e.name!r}: dofs must be an integer (n, {e.n_local}) array, got shape {d.shape}")
             if d.size and (d.min() < 0 or d.max() >= nfull):
                 raise ModelError(f"element {e.name!r}: dof index out of range [0, {nfull}) — "
                                  "does it refer to a body of another model?")

@@ -141,8 +141,8 @@ def element_jacobians_full(elem, t, fs, q, v, z=None):
     """(F, ∂F/∂q, ∂F/∂v) of one family on the full coordinate vector, from evaluate(jac=True)."""
     nfull = q.size
     F, _, Jq, Jv = evaluate(elem, t, fs, q, v, z, jac=True)
-    r = np.repeat(elem.dofs[:, :, None], elem.k, axis=2).ravel()
-    c = np.repeat(elem.dofs[:, None, :], elem.k, axis=1).ravel()
+    r = np.repeat(elem.dofs[:, :, None], elem.n_local, axis=2).ravel()
+    c = np.repeat(elem.dofs[:, None, :], elem.n_local, axis=1).ravel()
     JQ = np.zeros((nfull, nfull))
     JV = np.zeros((nfull, nfull))
     np.add.at(JQ, (r, c), Jq.ravel())
@@ -191,7 +191,7 @@ def assert_jacobians_match(elem, t, fs, q, v, z=None, rtol=1e-6, rel=1e-6):
 def assert_third_law(elem, t, fs, q, v, z=None, rtol=1e-10):
     """Per instance: Σ F = 0 and Σ moments about the origin (torques + r × F at body centres) = 0."""
     F, _, _, _ = evaluate(elem, t, fs, q, v, z, jac=False)
-    nbod = elem.k // 3
+    nbod = elem.n_local // 3
     fx = F[:, 0::3]
     fy = F[:, 1::3]
     tq = F[:, 2::3]

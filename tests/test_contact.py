@@ -63,8 +63,8 @@ def fd_jacobians(elem, qf, vf, z=None):
     ql, vl = qf[elem.dofs], vf[elem.dofs]
     out = []
     for wrt_v, steps in ((False, STEP_Q), (True, STEP_V)):
-        J = np.empty((elem.n, elem.k, elem.k))
-        for j in range(elem.k):
+        J = np.empty((elem.n, elem.n_local, elem.n_local))
+        for j in range(elem.n_local):
             h = steps[j % 3]
 
             def f(m):
@@ -92,7 +92,7 @@ def assert_jacobians(elem, qf, vf, rtol=1e-6, z=None):
         np.testing.assert_allclose(out[key], out0[key], rtol=1e-12, atol=OUT_ATOL.get(key, 1e-12 * np.abs(F0).max()))
     assert np.all(np.isfinite(Jq)) and np.all(np.isfinite(Jv))
     Nq, Nv = fd_jacobians(elem, qf, vf, z)
-    k = elem.k
+    k = elem.n_local
     S = np.ones((k, k))
     S[2::3, :] /= LEVER      # torque rows
     S[:, 2::3] *= LEVER      # angle columns

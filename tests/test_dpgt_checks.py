@@ -564,9 +564,9 @@ def test_random_designs_build_consistent_models(over, bearings, frame, stiffness
     for e in m.elements:   # every instance addresses whole bodies (x, y, θ triplets), in range, distinct
         d = e.dofs
         assert d.min() >= 0 and d.max() < 3 * m.n_bodies
-        for j in range(0, e.k, 3):
+        for j in range(0, e.n_local, 3):
             assert np.all(d[:, j] % 3 == 0) and np.all(d[:, j + 1] == d[:, j] + 1) and np.all(d[:, j + 2] == d[:, j] + 2)
-        if e.k == 6:
+        if e.n_local == 6:
             assert np.all(d[:, 0] != d[:, 3])
     sysm = mbd.System(m)
     z = sysm.init_internal()

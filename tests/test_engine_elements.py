@@ -169,7 +169,7 @@ def test_fixed_frame_elements_agree_in_R_and_I(state, fs, aniso, k, c):
     for e in elems:
         FR, _, _, _ = evaluate(e, 0.7, fs, q, v, None, jac=False)
         FI, _, _, _ = evaluate(e, 0.7, fI, QI.ravel(), VI.ravel(), None, jac=False)
-        for b in range(e.k // 3):
+        for b in range(e.n_local // 3):
             fr = R @ FR[:, 3 * b: 3 * b + 2].T        # rotate R-components into I
             scale = 1e-9 * (1 + np.abs(FI).max())
             np.testing.assert_allclose(fr.T, FI[:, 3 * b: 3 * b + 2], atol=scale, err_msg=e.name)

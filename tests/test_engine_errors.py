@@ -159,7 +159,7 @@ def test_simulate_argument_errors():
 # -------------------------------------------------------------------------- integration errors
 class Breaker(Element):
     """A stiff contact that turns non-finite after t_break (a stand-in for a contact law blowing up)."""
-    k = 3
+    n_local = 3
 
     def __init__(self, name, body, t_break):
         self.name = name

@@ -284,7 +284,7 @@ class RaceContact(Element):
     centre's angle about the raceway centre measured in the race body's axes [rad] (wrapped to (−π, π]);
     "fx", "fy" the contact force on one physical roller, in R [N].
     """
-    k = 6
+    n_local = 6
 
     def __init__(self, name, roller, race_body, *, kind, race_marker, R_race, D, K, exponent, zeta, m_roller,
                  traction: Traction, multiplicity=1):
@@ -391,7 +391,7 @@ class PocketContact(_Impact):
     the cage forward); "offset" s [m]; "penetration" max(d, 0) [m]; "penetration_rate" ḋ [m/s] (+ when
     closing); "approach_speed" v₀ in use [m/s] (0 out of contact).
     """
-    k = 6
+    n_local = 6
 
     def __init__(self, name, roller, cage, *, pocket_angle, pitch_radius, clearance, K_p, restitution,
                  impact_law, v_min, mu, v_mu, D, multiplicity=1):
@@ -471,7 +471,7 @@ class GuideContact(_Impact):
     "fx", "fy" force on the cage, in R [N]; "penetration_rate" ε̇ [m/s]; "approach_speed" v₀ in use [m/s]
     (0 out of contact).
     """
-    k = 6
+    n_local = 6
 
     def __init__(self, name, cage, planet, *, clearance, K_g, restitution, impact_law, v_min, mu, v_mu,
                  land_radius):
@@ -532,7 +532,7 @@ class LubricantDrag(Element):
 
     Output: "force" signed F_d [N] on one physical roller (the drag on it is −force·t).
     """
-    k = 6
+    n_local = 6
 
     def __init__(self, name, roller, race_body, *, race_marker, C_d, rho, D, l, d_m, multiplicity=1):
         self.name = name

@@ -32,7 +32,7 @@ class Ramp:
 class TorqueSource(Element):
     """Torque on bodies: ``torque`` [N·m] scalar/(n,) constant, scaled by ``ramp`` (a callable of t),
     or ``torque`` a callable t -> (n,) torques."""
-    k = 3
+    n_local = 3
 
     def __init__(self, name, bodies, torque, ramp: Callable[[float], float] | None = None):
         self.name = name
@@ -61,7 +61,7 @@ class SpeedDrive(Element):
     advanced (trapezoidal rule) after each accepted step and held constant within a step.
     ``omega_ref`` may be a callable t -> (θ_ref, ω_ref) for speed profiles.
     """
-    k = 3
+    n_local = 3
 
     def __init__(self, name, body, omega_ref, k, c=0.0, k_i=0.0, theta0=0.0):
         self.name = name

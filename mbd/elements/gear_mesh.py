@@ -230,7 +230,7 @@ class GearMesh(Element):
     ``deflection_coast`` δ_− [m]; ``deflection_rate``, ``deflection_rate_coast`` δ̇_± [m/s]; ``stiffness`` k(p) [N/m];
     ``position`` p in [0, 1); ``fx``, ``fy`` the mesh force on gear 2 in R [N] (gear 1 gets minus it).
     """
-    k = 6
+    n_local = 6
 
     def __init__(self, name, gear1, gear2, *, internal: bool, rb1, rb2, alpha, a0, teeth1, k_mean,
                  c_mesh=0.0, u0=0.0, p0=0.0, backlash=0.0, stiffness: StiffnessShape | None = None,

@@ -11,7 +11,7 @@ from ..element import Element, body_dofs
 class ForceSource(Element):
     """Force (Fx, Fy) in the *fixed* frame on each body's centre, scaled by ``ramp(t)``.
     ``force`` is an (n, 2) / (2,) constant [N] or a callable t -> (n, 2)."""
-    k = 3
+    n_local = 3
 
     def __init__(self, name, bodies, force, ramp: Callable[[float], float] | None = None):
         self.name = name
