@@ -89,19 +89,19 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
     outer = scene.family(FAMILY["race_outer"], RaceContact, ("roller", "race_body"), kind="outer", **law)
     s_out = outer.add(Z, roller=names, race_body=[outer_body] * Z, race_marker=np.zeros((Z, 2)),
                       R_race=b.outer_raceway_radius, **common)
-    h = {"kind": "rollers", "rollers": names, "race_inner": s_in, "race_outer": s_out,
+    handles = {"kind": "rollers", "rollers": names, "race_inner": s_in, "race_outer": s_out,
          "omega_cage": wm, "omega_roller": wr}
     if opt.drag:
         if lubricant is None:
             raise ParameterError.at("lubricant", "the scene has lubricant drag on (option drag) but no lubricant "
                                                  "was given")
         drag = scene.family(FAMILY["drag"], LubricantDrag, ("roller", "race_body"))
-        h["drag"] = drag.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker,
+        handles["drag"] = drag.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker,
                              C_d=lubricant.drag_coefficient, rho=lubricant.density, D=D, l=b.roller_length,
                              d_m=d_m, multiplicity=b.rows)
     if opt.cage != "none":
-        h.update(_add_cage(scene, tag, b, names, psi, pin_xy, pin_vel, wm, outer_body, opt.cage == "held"))
-    return h
+        handles.update(_add_cage(scene, tag, b, names, psi, pin_xy, pin_vel, wm, outer_body, opt.cage == "held"))
+    return handles
 
 
 def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel, wm, outer_body, held) -> dict:
@@ -111,16 +111,16 @@ def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel,
     scene.body(cage, c.mass, c.inertia, pose=(*pin_xy, 0.0), vel=(*pin_vel, wm), fixed=held)
     law = IMPACT_LAWS[c.impact_law]()
     pocket = scene.family(FAMILY["pocket"], PocketContact, ("roller", "cage"), impact_law=law)
-    h = {}
-    h["pocket"] = pocket.add(Z, roller=names, cage=[cage] * Z, pocket_angle=psi, pitch_radius=0.5 * b.pitch_diameter,
+    handles = {}
+    handles["pocket"] = pocket.add(Z, roller=names, cage=[cage] * Z, pocket_angle=psi, pitch_radius=0.5 * b.pitch_diameter,
                              clearance=c.pocket_clearance, K_p=c.pocket_stiffness, restitution=c.restitution,
                              v_min=c.impact_speed_floor, mu=c.pocket_friction, v_mu=c.friction_speed, D=D,
                              multiplicity=b.rows)
     if not held:
         guide = scene.family(FAMILY["guide"], GuideContact, ("cage", "planet"), impact_law=law)
-        h["guide"] = guide.add(1, cage=[cage], planet=[outer_body], clearance=c.guide_clearance,
+        handles["guide"] = guide.add(1, cage=[cage], planet=[outer_body], clearance=c.guide_clearance,
                                K_g=c.guide_stiffness, restitution=c.restitution, v_min=c.impact_speed_floor,
                                mu=c.guide_friction, v_mu=c.friction_speed,
                                land_radius=0.5 * (b.pitch_diameter + D))
-    h["cage"] = cage
-    return h
+    handles["cage"] = cage
+    return handles

@@ -33,13 +33,13 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     lay = si.layout
     G, op, sup, ms = si.gears, si.operating, si.support, si.mesh
     wc = op.carrier_speed
-    W = {"sun": op.sun_speed, "a": op.inner_planet_speed, "b": op.outer_planet_speed}
+    speed = {"sun": op.sun_speed, "a": op.inner_planet_speed, "b": op.outer_planet_speed}
     b = si.bearing
     scene = Scene(frame_omega=wc if opt.frame == "rotating" else 0.0,
                   gravity=si.gravity if opt.gravity else 0.0, options=opt)
     N = lay.planets
     ph = lay.phasing
-    scene.body("sun", G.sun.mass, G.sun.inertia, vel=(0, 0, W["sun"]))
+    scene.body("sun", G.sun.mass, G.sun.inertia, vel=(0, 0, speed["sun"]))
     scene.body("ring", G.ring.mass, G.ring.inertia, pose=(0, 0, ph.gamma_ring))
     scene.body("carrier", G.carrier_mass, G.carrier_inertia, vel=(0, 0, wc))
     sup_f = scene.family("support", GroundSupport, ("bodies",))
@@ -56,10 +56,10 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     for n in range(N):
         pa, pb = lay.centres_a[n], lay.centres_b[n]
         va, vb = wc * np.array([-pa[1], pa[0]]), wc * np.array([-pb[1], pb[0]])
-        scene.body(a_names[n], G.inner_planet.mass, G.inner_planet.inertia, pose=(*pa, ph.gamma_inner[n]), vel=(*va, W["a"]))
-        scene.body(b_names[n], G.outer_planet.mass, G.outer_planet.inertia, pose=(*pb, ph.gamma_outer[n]), vel=(*vb, W["b"]))
+        scene.body(a_names[n], G.inner_planet.mass, G.inner_planet.inertia, pose=(*pa, ph.gamma_inner[n]), vel=(*va, speed["a"]))
+        scene.body(b_names[n], G.outer_planet.mass, G.outer_planet.inertia, pose=(*pb, ph.gamma_outer[n]), vel=(*vb, speed["b"]))
         pair = {"inner": a_names[n], "outer": b_names[n], "psi_a": float(lay.psi_a[n]), "psi_b": float(lay.psi_b[n])}
-        for key, planet, p, v, w in (("inner", a_names[n], pa, va, W["a"]), ("outer", b_names[n], pb, vb, W["b"])):
+        for key, planet, p, v, w in (("inner", a_names[n], pa, va, speed["a"]), ("outer", b_names[n], pb, vb, speed["b"])):
             pair[f"{key}_bearing"] = add_planet_bearing(
                 scene, f"{planet}.pb", pin_body="carrier", pin_local=p, outer_body=planet, bearing=b,
                 lubricant=si.lubricant,
@@ -68,7 +68,7 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
 
     # meshes, phased for the flank the torque path loads (reverse rotation loads the other flanks)
     T_s = op.sun_torque
-    flanks = loaded_flanks(np.sign(T_s) if T_s != 0 else np.sign(W["sun"]))
+    flanks = loaded_flanks(np.sign(T_s) if T_s != 0 else np.sign(speed["sun"]))
     common = dict(time_varying=opt.mesh_stiffness == "time_varying", smoothing=ms.smoothing_width,
                   ratio=ms.stiffness_ratio)
     M = lay.meshes
@@ -97,7 +97,7 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
                                  c=2 * rig.carrier_drive_damping_ratio * J_eff * wd, k_i=J_eff * wd**3 / 5))
     scene.handles.update({"pairs": pairs, "flanks": flanks})
     scene.meta.update({
-        "speeds_rad_s": {"sun": W["sun"], "inner_planet": W["a"], "outer_planet": W["b"], "carrier": wc},
+        "speeds_rad_s": {"sun": speed["sun"], "inner_planet": speed["a"], "outer_planet": speed["b"], "carrier": wc},
         "f_c_hz": abs(op.carrier_frequency), "f_m_hz": f_m, "sun_torque_Nm": T_s, "carrier_torque_Nm": op.carrier_torque,
         "ramp_s": ramp_t, "ring_mismatch_teeth": [float(x) for x in ph.ring_mismatch], "planets": N,
         "rollers": b.rollers, "direction": op.direction, "frame": opt.frame, "bearings": opt.bearings, "bearing": b,

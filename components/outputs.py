@@ -93,13 +93,13 @@ def carrier_frame_motion(model, t, q, v, a, omega_c: float):
     Xi, Vi, Ai = mbd.to_fixed(X, V, model.frame.at(t), A)
     c, s = math.cos(omega_c * t), math.sin(omega_c * t)
     rot = lambda x, y: (c * x + s * y, -s * x + c * y)          # Rot(−φ)
-    W = omega_c
+    Om = omega_c
     x, y = rot(Xi[:, 0], Xi[:, 1])
     vx, vy = rot(Vi[:, 0], Vi[:, 1])
-    vx, vy = vx + W * y, vy - W * x                               # v_C = Rot(−φ) v_I − Ω k × x_C
+    vx, vy = vx + Om * y, vy - Om * x                               # v_C = Rot(−φ) v_I − Ω k × x_C
     ax, ay = rot(Ai[:, 0], Ai[:, 1])
-    ax, ay = ax + 2 * W * vy + W * W * x, ay - 2 * W * vx + W * W * y   # a_C = Rot(−φ) a_I − 2Ω k × v_C + Ω² x_C
-    return (np.column_stack([x, y, Xi[:, 2] - W * t]), np.column_stack([vx, vy, Vi[:, 2] - W]),
+    ax, ay = ax + 2 * Om * vy + Om * Om * x, ay - 2 * Om * vx + Om * Om * y   # a_C = Rot(−φ) a_I − 2Ω k × v_C + Ω² x_C
+    return (np.column_stack([x, y, Xi[:, 2] - Om * t]), np.column_stack([vx, vy, Vi[:, 2] - Om]),
             np.column_stack([ax, ay, Ai[:, 2]]))
 
 
