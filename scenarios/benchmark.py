@@ -2,13 +2,16 @@
 
     python -m scenarios.benchmark [--json] [--window S] [--ref-window S] [--h S] [--alpha A] [--newton-tol T]
                                   [--scipy-cap S] [--scipy-tols T1,T2] [--scipy-methods M,...]
-                                  [--quiet LOAD] [--quiet-wait S] [--profile] [--scaling] [--out DIR]
+                                  [--repeats K] [--profile] [--scaling] [--out DIR]
 
-Settles once (HHT α = −0.3 adaptive, cached in OUT/dpgt_settled.npz, shared with work_precision),
-waits until the 1-min load average is below --quiet (default 1.2; other jobs share the machine; gives
-up after --quiet-wait s and records that), then times the window with the chosen setting — HHT
-α = −0.3, fixed h (default 5 µs: the cheapest fixed step on this problem once Newton converges properly,
-measured against 2.5 and 10 µs; see docs/numerics.md §4).
+Settles once (HHT α = −0.3 adaptive, cached in OUT/dpgt_settled.npz, shared with work_precision), then
+times the window with the chosen setting — HHT α = −0.3, fixed h (default 5 µs: the cheapest fixed step
+on this problem once Newton converges properly, measured against 2.5 and 10 µs; see docs/numerics.md
+§4) — on the compiled engine (``mbd.compiled``). The machine is shared and never quiet: nothing waits
+for it; the speed ratio against the numpy reference path is measured within this run, the two engines
+interleaved on the first ``--ref-window`` seconds of the window (``--repeats`` times each, medians):
+``reference_wall_s`` is the numpy path's median scaled to the window, ``speedup_vs_reference`` the
+ratio of the medians. The 1-min load average is recorded before and after.
 
 Error: a reference run (HHT α = −0.1, h/8, Newton tolerance 100× tighter) over the first
 ``--ref-window`` seconds of the window (default 0.01 s: one reference over the whole 0.1 s costs
@@ -21,7 +24,7 @@ sub-window, each capped at --scipy-cap seconds, each with a tolerance ladder (lo
 error ≤ 1 % (else the one that got furthest). Its wall time is scaled to the full window (wall per
 simulated second) for the speed ratio; both the measured and scaled numbers are recorded.
 
-per_step_over_eval = (wall / steps) / (one residual + Jacobian evaluation, measured in this run).
+per_step_over_eval = (wall / steps) / (one compiled residual + Jacobian evaluation, measured in this run).
 Peak RSS is recorded after the timed HHT run (peak_rss_after_hht_mb) and at the end (scipy's LSODA
 gets a dense Jacobian). --profile prints the cProfile top entries of 2 ms of the window; --scaling
 times the cost per step against N·Z (see SCALING; machines the design check refuses, or whose gears
@@ -34,6 +37,7 @@ import cProfile
 import io
 import json
 import pstats
+import statistics
 import sys
 from pathlib import Path
 
@@ -43,7 +47,7 @@ import mbd
 from components.outputs import FAMILY
 
 from .numerics_common import (design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note,
-                              observables, peak_rss_mb, run_hht, run_scipy, settled_state, wait_quiet)
+                              observables, peak_rss_mb, run_hht, run_scipy, settled_state)
 
 __all__ = ["main", "benchmark", "scaling", "profile_window"]
 
@@ -56,7 +60,7 @@ def _grid(t0, t1, dt=5e-6):
 
 def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: float, scipy_cap: float,
               scipy_tols=(1e-3, 1e-4), log=print, settle: float = 0.03,
-              scipy_methods=("Radau", "BDF", "LSODA", "RK45"), quiet: float = 1.2, quiet_wait_s: float = 600.0,
+              scipy_methods=("Radau", "BDF", "LSODA", "RK45"), repeats: int = 3,
               newton_tol: float | None = None) -> dict:
     prob = dpgt_problem(settle=settle)
     s0, extra = settled_state(prob, out / "dpgt_settled.npz")
@@ -65,11 +69,12 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
     t0, t1 = s0.t, s0.t + window
     ref_window = min(ref_window, window)
     sub = _grid(t0, t0 + ref_window)
-    # other developers' jobs share the 2 cores: time only on a quiet machine (or say that we could not)
-    qw = wait_quiet(quiet, quiet_wait_s, log=log) if quiet > 0 else {"quiet": None}
-    log(f"load before timing: {qw}")
+    load_before = load1()
     costs = eval_costs(prob.model, s0)
-    log(f"one residual {costs['residual_s'] * 1e3:.2f} ms, residual+Jacobian {costs['jacobian_s'] * 1e3:.2f} ms")
+    log(f"one residual+Jacobian: compiled {costs['compiled_jacobian_s'] * 1e6:.0f} µs, numpy "
+        f"{costs['jacobian_s'] * 1e6:.0f} µs (residual alone {costs['compiled_residual_s'] * 1e6:.0f} / "
+        f"{costs['residual_s'] * 1e6:.0f} µs)")
+    engines = _engine_ratio(prob, s0, sub, alpha, h, newton_tol, repeats, log)
     # the timed run (sampling only q, v on the sub-window grid: no element evaluation in the loop)
     run = run_hht(prob, s0, t1, sub, alpha=alpha, h=h, newton_tol=newton_tol, label=f"fixed h={h:.1e}")
     if not run.completed:
@@ -123,11 +128,31 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
         "scipy_best_completed": best["completed"], "scipy_rel_error": best["rel_error_rms_inner_race"],
         "scipy_reached_1pct": bool(good), "scipy_tols": list(scipy_tols), "scipy_cap_s": scipy_cap,
         "speedup_vs_scipy": best["wall_per_simulated_s"] / hht_per_sim, "scipy": sc,
-        "per_step_s": wall / run.steps, "eval_residual_s": costs["residual_s"], "eval_jacobian_s": costs["jacobian_s"],
-        "per_step_over_eval": (wall / run.steps) / costs["jacobian_s"],
+        "per_step_s": wall / run.steps, "eval_residual_s": costs["compiled_residual_s"],
+        "eval_jacobian_s": costs["compiled_jacobian_s"], "numpy_eval_jacobian_s": costs["jacobian_s"],
+        "per_step_over_eval": (wall / run.steps) / costs["compiled_jacobian_s"],
+        "engine": run.engine, "reference_wall_s": engines["numpy_s"] * window / ref_window,
+        "speedup_vs_reference": engines["numpy_s"] / engines["compiled_s"], "engine_ratio": engines,
         "peak_rss_after_hht_mb": rss_hht, "peak_rss_mb": peak_rss_mb(), "machine": machine_note(), "settle": extra,
-        "load": {**qw, "after_timed_run": load_after, "after_scipy": load1()},
+        "load": {"before": load_before, "after_timed_run": load_after, "after_scipy": load1()},
     }
+
+
+def _engine_ratio(prob, s0, grid, alpha, h, newton_tol, repeats, log) -> dict:
+    """Median wall time of the compiled and the numpy engine over the same sub-window (the grid's span),
+    interleaved so that both see the same machine load."""
+    walls = {"compiled": [], "numpy": []}
+    for _ in range(max(1, repeats)):
+        for engine in walls:
+            r = run_hht(prob, s0, grid[-1], grid, alpha=alpha, h=h, newton_tol=newton_tol, engine=engine)
+            if not r.completed:
+                raise mbd.IntegrationError(f"benchmark ({engine} engine) failed: {r.message}")
+            walls[engine].append(r.wall_s)
+    med = {k: statistics.median(v) for k, v in walls.items()}
+    log(f"engines over {grid[-1] - grid[0]:g} s, {repeats} interleaved repeats: compiled {med['compiled']:.2f} s, "
+        f"numpy {med['numpy']:.2f} s (medians) -> {med['numpy'] / med['compiled']:.1f}x")
+    return {"compiled_s": med["compiled"], "numpy_s": med["numpy"], "walls": walls,
+            "span_s": float(grid[-1] - grid[0]), "repeats": repeats}
 
 
 def profile_window(out: Path, h: float, alpha: float, span: float = 2e-3, top: int = 18, settle: float = 0.03) -> str:
@@ -194,8 +219,7 @@ def main(argv=None) -> int:
     ap.add_argument("--scipy-tols", default="1e-3,1e-4",
                     help="rtol ladder per scipy method, loosest first (stops at the first with <= 1 %% error)")
     ap.add_argument("--scipy-methods", default="Radau,BDF,LSODA,RK45")
-    ap.add_argument("--quiet", type=float, default=1.2, help="wait for a 1-min load average below this (0: do not wait)")
-    ap.add_argument("--quiet-wait", type=float, default=600.0, help="give up waiting after this many seconds")
+    ap.add_argument("--repeats", type=int, default=3, help="interleaved repeats of each engine on the sub-window")
     ap.add_argument("--profile", action="store_true", help="print the cProfile top entries (2 ms of the window)")
     ap.add_argument("--scaling", action="store_true", help="cost per step against N·Z")
     ap.add_argument("--settle", type=float, default=0.03, help="settling time before the window [s]")
@@ -207,7 +231,7 @@ def main(argv=None) -> int:
     log(machine_note())
     res = benchmark(out, a.window, a.ref_window, a.h, a.alpha, a.scipy_cap,
                     [float(x) for x in a.scipy_tols.split(",")], log, a.settle,
-                    [m.strip() for m in a.scipy_methods.split(",") if m.strip()], a.quiet, a.quiet_wait, a.newton_tol)
+                    [m.strip() for m in a.scipy_methods.split(",") if m.strip()], a.repeats, a.newton_tol)
     if a.profile:
         prof = profile_window(out, a.h, a.alpha, settle=a.settle)
         res["profile_top"] = prof
@@ -220,8 +244,9 @@ def main(argv=None) -> int:
         print(json.dumps({k: v for k, v in res.items() if k not in ("scipy", "profile_top", "scaling", "settle")},
                          default=str))
     else:
-        for k in ("wall_s", "simulated_s", "steps", "rel_error_rms_inner_race", "scipy_best_method", "scipy_best_wall_s",
-                  "scipy_rel_error", "speedup_vs_scipy", "per_step_over_eval", "peak_rss_after_hht_mb", "peak_rss_mb"):
+        for k in ("wall_s", "simulated_s", "steps", "newton_per_step", "rel_error_rms_inner_race", "reference_wall_s",
+                  "speedup_vs_reference", "scipy_best_method", "scipy_best_wall_s", "scipy_rel_error", "speedup_vs_scipy",
+                  "per_step_over_eval", "peak_rss_after_hht_mb", "peak_rss_mb"):
             print(f"{k:28s} {res[k]}")
     return 0
 

@@ -36,7 +36,7 @@ from components.presets import reference_dpgt
 
 __all__ = ["Problem", "dpgt_problem", "rig_problem", "settled_state", "StateSampler", "RunResult",
            "run_hht", "run_scipy", "observables", "error_metrics", "scipy_atol", "peak_rss_mb",
-           "eval_costs", "machine_note", "wait_quiet", "load1",
+           "eval_costs", "machine_note", "load1",
            "design_verdict"]
 
 
@@ -180,6 +180,7 @@ class RunResult:
     rejected: int = 0
     t_reached: float = np.nan
     q: np.ndarray | None = None
+    engine: str = ""
     v: np.ndarray | None = None
     z: list | None = None
 
@@ -194,11 +195,11 @@ class RunResult:
 def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float, h: float | None = None,
             atol_pos: float | None = None, repeats: int = 1, h_max: float = 2e-5, label: str = "",
             newton_tol: float | None = None, tol: mbd.Tolerance | None = None,
-            freeze_internal: bool = False) -> RunResult:
+            freeze_internal: bool = False, engine: str = "auto") -> RunResult:
     """The one way the numerics scripts run HHT from a state and sample it on ``grid``: fixed step
     (``h``) or adaptive (``atol_pos``; atol_rot = 100·atol_pos) from ``state``; ``newton_tol`` and ``tol``
     override the HHT defaults (error-floor study, references); ``freeze_internal`` holds element internal
-    states (the equations the scipy adapter integrates)."""
+    states (the equations the scipy adapter integrates); ``engine`` as in :func:`mbd.simulate`."""
     if (h is None) == (atol_pos is None):
         raise ValueError("give exactly one of h (fixed step) or atol_pos (adaptive)")
     if tol is None:
@@ -212,6 +213,7 @@ def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float
         w0 = time.perf_counter()
         try:
             res = mbd.simulate(prob.model, t_end=t_end, state=state.copy(), stepper=stepper, controller=ctrl,
+                               engine=engine,
                                observers=[smp] if smp is not None else [], progress=False, system=system)
         except mbd.IntegrationError as exc:
             c = exc.counters      # the loop's totals up to the failure
@@ -224,7 +226,7 @@ def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float
     c = res.counters
     return RunResult("HHT", label, True, "", statistics.median(walls), walls, res.steps, c["residual"], c["jacobian"],
                      c["factor"], c["newton"], c["rejected"], t_reached=res.state.t,
-                     q=np.array(sampler.q), v=np.array(sampler.v), z=sampler.z)
+                     q=np.array(sampler.q), v=np.array(sampler.v), z=sampler.z, engine=res.engine)
 
 
 def scipy_atol(model: mbd.Model, tol: float) -> np.ndarray:
@@ -340,20 +342,23 @@ def error_metrics(obs: dict, ref: dict) -> dict:
 
 
 def eval_costs(model: mbd.Model, state: mbd.State, n: int = 200) -> dict:
-    """Median wall time [s] of one residual and of one residual+Jacobian evaluation (batches of 20)."""
+    """Median wall time [s] of one residual and of one residual+Jacobian evaluation (batches of 20), on
+    the numpy path (``residual_s``, ``jacobian_s``) and the compiled one (``compiled_…``), interleaved."""
+    from mbd.compiled.system import CompiledSystem
     system = mbd.System(model)
-    out = {}
-    for jac in (False, True):
-        for _ in range(5):
-            system.evaluate(state.t, state.q, state.v, state.z, jac=jac)
-        batches = []
-        for _ in range(max(1, n // 20)):
-            t0 = time.perf_counter()
-            for _ in range(20):
-                system.evaluate(state.t, state.q, state.v, state.z, jac=jac)
-            batches.append((time.perf_counter() - t0) / 20)
-        out["jacobian_s" if jac else "residual_s"] = statistics.median(batches)
-    return out
+    paths = {"": system, "compiled_": CompiledSystem(system)}
+    batches = {f"{p}{k}": [] for p in paths for k in ("residual_s", "jacobian_s")}
+    for _ in range(5):
+        for s in paths.values():
+            s.evaluate(state.t, state.q, state.v, state.z, jac=True)
+    for _ in range(max(1, n // 20)):
+        for prefix, s in paths.items():
+            for jac in (False, True):
+                t0 = time.perf_counter()
+                for _ in range(20):
+                    s.evaluate(state.t, state.q, state.v, state.z, jac=jac)
+                batches[f"{prefix}{'jacobian_s' if jac else 'residual_s'}"].append((time.perf_counter() - t0) / 20)
+    return {k: statistics.median(v) for k, v in batches.items()}
 
 
 def peak_rss_mb() -> float:
@@ -373,20 +378,6 @@ def load1() -> float:
     """1-min load average (nan where the OS has none)."""
     import os
     return os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-
-
-def wait_quiet(threshold: float = 1.2, max_wait_s: float = 600.0, poll_s: float = 15.0, log=print) -> dict:
-    """Wait until the 1-min load average is below ``threshold`` (other jobs share the machine and
-    inflate wall times), at most ``max_wait_s``; returns what happened, for the report."""
-    t0 = time.monotonic()
-    first = load1()
-    while load1() >= threshold and time.monotonic() - t0 < max_wait_s:
-        log(f"waiting for a quiet machine: 1-min load {load1():.2f} >= {threshold:g} "
-            f"({time.monotonic() - t0:.0f} s of at most {max_wait_s:.0f} s)")
-        time.sleep(poll_s)
-    now = load1()
-    return {"threshold": threshold, "load_at_call": first, "load_at_start": now,
-            "waited_s": round(time.monotonic() - t0, 1), "quiet": bool(now < threshold)}
 
 
 def design_verdict(overrides: dict | None = None, condition: int = 3, direction: str = "forward") -> dict:
