@@ -79,12 +79,12 @@ def solve_scipy(model: Model, q0, v0, t_span, method="Radau", rtol=1e-6, atol=1e
     fo = FirstOrderSystem(model, z)
     y0 = np.concatenate([np.asarray(q0, float), np.asarray(v0, float)])
     start = time.perf_counter()
-    fun = fo.fun
-    if max_wall_s is not None:
-        def fun(t, y):
-            if time.perf_counter() - start > max_wall_s:
-                raise TimeoutError(f"{method} exceeded {max_wall_s:.0f} s wall time at t = {t:.6e} s")
-            return fo.fun(t, y)
+    def capped(t, y):
+        if time.perf_counter() - start > max_wall_s:
+            raise TimeoutError(f"{method} exceeded {max_wall_s:.0f} s wall time at t = {t:.6e} s")
+        return fo.fun(t, y)
+
+    fun = fo.fun if max_wall_s is None else capped
     opts = dict(method=method, rtol=rtol, atol=atol, t_eval=t_eval, **kw)
     if method == "LSODA":   # LSODA's Fortran core takes only a dense (or banded) Jacobian
         opts["jac"] = lambda t, y: fo.jac(t, y).toarray()

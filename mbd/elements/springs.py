@@ -5,7 +5,6 @@ import numpy as np
 
 from .. import ad
 from ..element import Element, body_dofs, marker, marker_velocity, point_force
-from ..errors import ModelError
 
 
 class GroundSupport(Element):
