@@ -1,7 +1,14 @@
 """Engine benchmark: a ring of M stiff, light bodies (roller-like) integrated with HHT and with
-scipy's Radau (sparse Jacobian) on the same model.
+scipy's Radau (sparse Jacobian) on the same model; and (``--chain``) the network a compiled C++ engine
+was measured on, timed on both engine paths.
 
     python -m scenarios.bench_engine [--sizes 10 50 100 250] [--steps 2000] [--repeats 3] [--json out.json]
+    python -m scenarios.bench_engine --chain [--sizes 10 50 100 250] [--repeats 3]
+
+The chain (issue "Speed"): M planar bodies (3 g, 2e-8 kg·m²), body 0 tied to the ground and each body to
+the next per coordinate by linear spring-dampers (x, y: 3e8 N/m, 50 N·s/m; rotation 1e3 N·m/rad), 100 N
+along x on the last body, 2000 fixed steps of 5 µs, HHT. Exudyn 1.13.6's fast module took 5.2 / 24.7 /
+49.9 / 139 µs per step for M = 10 / 50 / 100 / 250 on this kind of machine (``EXUDYN_US_PER_STEP``).
 
 Each body (3.1 g, 7.5 mm "roller") is joined to its two neighbours by BodySprings (3e8 N/m, light
 damping) between markers at the midpoints of the chords and to its second neighbours by softer ties
@@ -24,7 +31,7 @@ import time
 import numpy as np
 
 import mbd
-from mbd.elements import BodySpring, GroundSupport, Ramp, TorqueSource
+from mbd.elements import BodySpring, ForceSource, GroundSupport, Ramp, TorqueSource, TorsionalSpring
 
 ROLLER_D = 7.5e-3                      # m
 ROLLER_M = 3.1e-3                      # kg
@@ -74,6 +81,56 @@ def ring_model(M: int, frame=None) -> tuple[mbd.Model, np.ndarray, np.ndarray]:
     return model, q0, v0
 
 
+EXUDYN_US_PER_STEP = {10: 5.2, 50: 24.7, 100: 49.9, 250: 139.0}
+
+
+def chain_model(M: int) -> tuple[mbd.Model, np.ndarray, np.ndarray]:
+    """The chain of the Exudyn comparison: coordinate springs (zero length: markers at the centres)."""
+    b = mbd.ModelBuilder()
+    for i in range(M):
+        b.add_body(f"b{i}", 3e-3, 2e-8)
+    ia = np.arange(M - 1)
+    b.add(GroundSupport("ground", [0], kx=3e8, cx=50.0, k_theta=1e3))
+    b.add(BodySpring("links", ia, ia + 1, k=3e8, c=50.0))
+    b.add(TorsionalSpring("joints", ia, ia + 1, k=1e3))
+    b.add(ForceSource("pull", [M - 1], force=(100.0, 0.0)))
+    model = b.build()
+    return model, np.zeros(model.ndof), np.zeros(model.ndof)
+
+
+def run_chain(M: int, steps: int, repeats: int) -> dict:
+    """µs per step of the chain on both engines (interleaved repeats, medians)."""
+    model, q0, v0 = chain_model(M)
+    walls, res = {"compiled": [], "numpy": []}, {}
+    for _ in range(repeats):
+        for engine in walls:
+            t0 = time.perf_counter()
+            res[engine] = mbd.simulate(model, q0, v0, steps * H, controller=mbd.FixedStep(H),
+                                       stepper=mbd.HHT(alpha=-0.1), progress=False, engine=engine)
+            walls[engine].append(time.perf_counter() - t0)
+    c = res["compiled"]
+    us = {k: 1e6 * statistics.median(v) / c.steps for k, v in walls.items()}
+    return {"M": M, "ndof": model.ndof, "steps": c.steps, "us_per_step_compiled": us["compiled"],
+            "us_per_step_numpy": us["numpy"], "exudyn_us_per_step": EXUDYN_US_PER_STEP.get(M),
+            "newton_per_step": c.counters["newton"] / c.steps, "jacobian_evals": c.counters["jacobian"],
+            "same_counters": c.counters == res["numpy"].counters,
+            "max_state_difference_m": float(np.abs(c.state.q - res["numpy"].state.q).max())}
+
+
+def chain_table(sizes, steps: int, repeats: int) -> list[dict]:
+    hdr = f"{'M':>5} {'DOF':>6} {'compiled µs/step':>17} {'numpy µs/step':>14} {'Exudyn µs/step':>15} {'Newton/step':>11}"
+    print(hdr)
+    print("-" * len(hdr))
+    rows = []
+    for M in sizes:
+        r = run_chain(M, steps, repeats)
+        ex = f"{r['exudyn_us_per_step']:15.1f}" if r["exudyn_us_per_step"] else f"{'':>15}"
+        print(f"{M:5d} {r['ndof']:6d} {r['us_per_step_compiled']:17.1f} {r['us_per_step_numpy']:14.1f} {ex}"
+              f" {r['newton_per_step']:11.2f}", flush=True)
+        rows.append(r)
+    return rows
+
+
 def run_hht(M: int, steps: int, repeats: int) -> dict:
     times, res = [], None
     for _ in range(repeats):
@@ -120,7 +177,14 @@ def main(argv=None) -> int:
     p.add_argument("--no-radau", action="store_true", help="skip the solve_ivp(Radau) comparison")
     p.add_argument("--radau-max-wall", type=float, default=600.0, help="wall-time cap per Radau run [s]")
     p.add_argument("--json", help="write the results to this JSON file")
+    p.add_argument("--chain", action="store_true", help="the Exudyn comparison chain on both engines")
     a = p.parse_args(argv)
+    if a.chain:
+        rows = chain_table(a.sizes, a.steps, a.repeats)
+        if a.json:
+            with open(a.json, "w") as fh:
+                json.dump({"h_s": H, "steps": a.steps, "repeats": a.repeats, "chain": rows}, fh, indent=2)
+        return 0
 
     rows = []
     hdr = (f"{'M':>5} {'DOF':>6} {'µs/step':>9} {'Newton/step':>11} {'LU':>5} {'residual':>9} {'Jacobian':>9}"
