@@ -1,8 +1,10 @@
 """The same Model as a first-order system y = (q, v) for scipy.integrate.solve_ivp.
 
 ẏ = (v, M⁻¹ F(q, v, t)) with the sparse Jacobian [[0, I], [M⁻¹ ∂F/∂q, M⁻¹ ∂F/∂v]], so Radau, BDF
-and LSODA use the same physics and the same analytic element Jacobians as HHT. Element internal
-states (a PI drive's integral) are held at their initial value here: compare scenes without them.
+and LSODA use the same physics and the same analytic element Jacobians as HHT — evaluated by the
+same engine path (``engine``: the compiled one wherever it can be built, as :func:`mbd.simulate`).
+Element internal states (a PI drive's integral) are held at their initial value here: compare scenes
+without them.
 """
 from __future__ import annotations
 
@@ -22,10 +24,19 @@ IMPLICIT = ("Radau", "BDF", "LSODA")
 
 
 class FirstOrderSystem:
-    def __init__(self, model: Model, z=None):
+    def __init__(self, model: Model, z=None, engine: str = "auto"):
         self.model = model
         self.system = System(model)
         self.z = self.system.init_internal() if z is None else z
+        self.evaluator, self.engine = self.system, "numpy"
+        if engine != "numpy":
+            try:
+                from .compiled.system import CompiledSystem
+                self.evaluator, self.engine = CompiledSystem(self.system), "compiled"
+                self.evaluator.set_internal(self.z)
+            except (ImportError, NotImplementedError):
+                if engine == "compiled":
+                    raise
         self.n = model.ndof
         self.minv = 1.0 / model.mdiag
         n = self.n
@@ -36,13 +47,13 @@ class FirstOrderSystem:
     def fun(self, t, y):
         self.nfev += 1
         q, v = y[: self.n], y[self.n:]
-        F = self.system.forces(t, q, v, self.z)
+        F = self.evaluator.evaluate(t, q, v, self.z).F
         return np.concatenate([v, self.minv * F])
 
     def jac(self, t, y):
         self.njev += 1
         q, v = y[: self.n], y[self.n:]
-        ev = self.system.evaluate(t, q, v, self.z, jac=True)
+        ev = self.evaluator.evaluate(t, q, v, self.z, jac=True)
         _, C, K = self.system.matrices(ev)
         Minv = sp.diags(self.minv)
         top = sp.hstack([sp.csr_matrix((self.n, self.n)), self._I])
@@ -71,12 +82,14 @@ class ScipyResult:
     nfev: int
     njev: int
     nlu: int
+    engine: str = "numpy"      # the engine path that evaluated the residual and Jacobian
 
 
 def solve_scipy(model: Model, q0, v0, t_span, method="Radau", rtol=1e-6, atol=1e-9, t_eval=None,
-                max_wall_s: float | None = None, z=None, **kw) -> ScipyResult:
-    """Integrate with solve_ivp. ``max_wall_s`` stops a run that takes too long (reported, not hidden)."""
-    fo = FirstOrderSystem(model, z)
+                max_wall_s: float | None = None, z=None, engine: str = "auto", **kw) -> ScipyResult:
+    """Integrate with solve_ivp. ``max_wall_s`` stops a run that takes too long (reported, not hidden);
+    ``engine`` evaluates the residual and Jacobian (as :func:`mbd.simulate`)."""
+    fo = FirstOrderSystem(model, z, engine)
     y0 = np.concatenate([np.asarray(q0, float), np.asarray(v0, float)])
     start = time.perf_counter()
     def capped(t, y):
@@ -95,4 +108,4 @@ def solve_scipy(model: Model, q0, v0, t_span, method="Radau", rtol=1e-6, atol=1e
         ok, msg, t, y, nlu = sol.success, sol.message, sol.t, sol.y, getattr(sol, "nlu", 0)
     except TimeoutError as exc:
         ok, msg, t, y, nlu = False, str(exc), np.array([]), np.zeros((y0.size, 0)), 0
-    return ScipyResult(t, y, ok, msg, time.perf_counter() - start, fo.nfev, fo.njev, nlu)
+    return ScipyResult(t, y, ok, msg, time.perf_counter() - start, fo.nfev, fo.njev, nlu, fo.engine)

@@ -106,7 +106,8 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
                        "simulated_s": frac * ref_window, "wall_per_simulated_s": per_sim_s,
                        "rel_error_rms_inner_race": e["err_rms_inner"] if e else None,
                        "rel_error_pin_history": e["err_pin_rel"] if e else None,
-                       "steps": r.steps, "nfev": r.residual, "njev": r.jacobian, "nlu": r.factor, "message": r.message})
+                       "steps": r.steps, "nfev": r.residual, "njev": r.jacobian, "nlu": r.factor, "message": r.message,
+                       "engine": r.engine})
             log(f"{method} rtol={tol:g}: {'done' if r.completed else 'NOT finished'} in {r.wall_s:.1f} s "
                 f"({frac:.0%} of {ref_window:g} s), error RMS inner {e['err_rms_inner'] if e else float('nan'):.2e}, "
                 f"pin history {e['err_pin_rel'] if e else float('nan'):.2e} {r.message}")
@@ -127,6 +128,7 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
         "scipy_best_measured_wall_s": best["wall_s"], "scipy_best_measured_simulated_s": best["simulated_s"],
         "scipy_best_completed": best["completed"], "scipy_rel_error": best["rel_error_rms_inner_race"],
         "scipy_reached_1pct": bool(good), "scipy_tols": list(scipy_tols), "scipy_cap_s": scipy_cap,
+        "scipy_same_residual": all(s["engine"] == run.engine for s in sc),
         "speedup_vs_scipy": best["wall_per_simulated_s"] / hht_per_sim, "scipy": sc,
         "per_step_s": wall / run.steps, "eval_residual_s": costs["compiled_residual_s"],
         "eval_jacobian_s": costs["compiled_jacobian_s"], "numpy_eval_jacobian_s": costs["jacobian_s"],

@@ -244,7 +244,8 @@ class _WallCap(Exception):
 def run_scipy(prob: Problem, state: mbd.State, t_end: float, grid, *, method: str, tol: float,
               max_wall_s: float, repeats: int = 1) -> RunResult:
     """solve_ivp from ``state`` with the sparse analytic Jacobian (implicit methods; LSODA gets it
-    dense, as its Fortran core needs). Stops with completed=False at ``max_wall_s``."""
+    dense, as its Fortran core needs), evaluated by the compiled engine where it can be built (the same
+    residual HHT uses). Stops with completed=False at ``max_wall_s``."""
     walls, out = [], None
     for r in range(max(1, repeats)):
         fo = mbd.FirstOrderSystem(prob.model, z={k: np.array(v) for k, v in state.z.items()})
@@ -277,7 +278,8 @@ def run_scipy(prob: Problem, state: mbd.State, t_end: float, grid, *, method: st
         walls.append(wall)
         nlu = int(getattr(sol, "nlu", 0) or 0) if sol is not None else 0
         res = RunResult(method, f"rtol={tol:g}", ok, msg, wall, walls, len(sol.t) - 1 if sol is not None else -1,
-                        fo.nfev, fo.njev, nlu, t_reached=float(sol.t[-1]) if sol is not None else t_last[0])
+                        fo.nfev, fo.njev, nlu, t_reached=float(sol.t[-1]) if sol is not None else t_last[0],
+                        engine=fo.engine)
         if r == 0:
             out = res
             if ok:

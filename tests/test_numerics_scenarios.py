@@ -87,6 +87,7 @@ def test_benchmark_json_last_line(tmp_path, capsys):
               "speedup_vs_reference", "scipy_best_method", "scipy_best_wall_s", "scipy_rel_error", "per_step_over_eval"):
         assert k in d, k
     assert d["engine"] == "compiled" and d["reference_wall_s"] > 0 and d["speedup_vs_reference"] > 0
+    assert d["scipy_same_residual"] is True          # scipy's solvers call the same compiled residual
     # fixed step: a step whose Newton fails is retried with h/2, so at least window/h steps
     assert d["steps"] >= 20 and d["simulated_s"] == pytest.approx(2e-4)
     assert d["per_step_over_eval"] > 0 and d["wall_s"] > 0
