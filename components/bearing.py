@@ -6,6 +6,8 @@ guide, drag), so adding a bearing adds instances, never element objects.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
+
 import numpy as np
 
 from mbd.elements import BodySpring
@@ -17,7 +19,24 @@ from .params import BearingSI, LubricantSI
 from .scene import Scene
 from .units import ParameterError
 
-__all__ = ["add_planet_bearing", "bearing_kinematics", "traction"]
+__all__ = ["BearingHandles", "add_planet_bearing", "bearing_kinematics", "traction"]
+
+
+@dataclass(frozen=True)
+class BearingHandles:
+    """What :func:`add_planet_bearing` added: body names and the instance slices of its contacts in the
+    shared families (None where the scene leaves a part out)."""
+    kind: str                                 # "rollers" (roller and cage model) or "linear" (radial spring)
+    rollers: tuple[str, ...] = ()
+    race_inner: slice | None = None
+    race_outer: slice | None = None
+    drag: slice | None = None
+    pocket: slice | None = None
+    guide: slice | None = None
+    cage: str | None = None
+    spring: slice | None = None               # the linear bearing's spring
+    omega_cage: float | None = None           # pure-rolling start speeds [rad/s]
+    omega_roller: float | None = None
 
 
 # each traction law from the bearing's SI parameters (a parameter, bearing.traction_law, names one)
@@ -47,7 +66,7 @@ def bearing_kinematics(b: BearingSI, omega_inner: float, omega_outer: float) -> 
 
 
 def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, outer_body: str, bearing: BearingSI,
-                       lubricant: LubricantSI | None, pin_xy, pin_vel, omega_pin: float, omega_outer: float) -> dict:
+                       lubricant: LubricantSI | None, pin_xy, pin_vel, omega_pin: float, omega_outer: float) -> BearingHandles:
     """Add one bearing (``bearing``: ``params.si().bearing``; ``lubricant``: ``params.si().lubricant``,
     needed when the scene has drag on). ``pin_local`` is the raceway centre in pin_body axes;
     ``pin_xy``/``pin_vel`` its position/velocity in the fixed frame at t = 0 (the kinematic steady
@@ -60,7 +79,7 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
         fam = scene.family(FAMILY["linear"], BodySpring, ("body_a", "body_b"))
         sl = fam.add(1, body_a=[pin_body], body_b=[outer_body], k=b.linear_stiffness, c=b.linear_damping,
                      marker_a=pin_local[None, :], marker_b=np.zeros((1, 2)))
-        return {"kind": "linear", "spring": sl}
+        return BearingHandles("linear", spring=sl)
 
     Z, D, d_m = int(b.rollers), b.roller_diameter, b.pitch_diameter
     wm, wr = bearing_kinematics(b, omega_pin, omega_outer)
@@ -89,23 +108,26 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
     outer = scene.family(FAMILY["race_outer"], RaceContact, ("roller", "race_body"), kind="outer", **law)
     s_out = outer.add(Z, roller=names, race_body=[outer_body] * Z, race_marker=np.zeros((Z, 2)),
                       R_race=b.outer_raceway_radius, **common)
-    handles = {"kind": "rollers", "rollers": names, "race_inner": s_in, "race_outer": s_out,
-         "omega_cage": wm, "omega_roller": wr}
+    handles = BearingHandles("rollers", rollers=tuple(names), race_inner=s_in, race_outer=s_out, omega_cage=wm,
+                             omega_roller=wr)
     if opt.drag:
         if lubricant is None:
             raise ParameterError.at("lubricant", "the scene has lubricant drag on (option drag) but no lubricant "
                                                  "was given")
         drag = scene.family(FAMILY["drag"], LubricantDrag, ("roller", "race_body"))
-        handles["drag"] = drag.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker,
-                             C_d=lubricant.drag_coefficient, rho=lubricant.density, D=D, l=b.roller_length,
-                             d_m=d_m, multiplicity=b.rows)
+        drag_slice = drag.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker,
+                              C_d=lubricant.drag_coefficient, rho=lubricant.density, D=D, l=b.roller_length, d_m=d_m,
+                              multiplicity=b.rows)
+        handles = replace(handles, drag=drag_slice)
     if opt.cage != "none":
-        handles.update(_add_cage(scene, tag, b, names, psi, pin_xy, pin_vel, wm, outer_body, opt.cage == "held"))
+        handles = replace(handles, **_add_cage(scene, tag, b, names, psi, pin_xy, pin_vel, wm, outer_body,
+                                               opt.cage == "held"))
     return handles
 
 
 def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel, wm, outer_body, held) -> dict:
-    """The cage body, its pockets and (a free cage) its guide land on the outer raceway."""
+    """The cage body, its pockets and (a free cage) its guide land on the outer raceway: the
+    BearingHandles fields they fill."""
     c, Z, D = b.cage, len(names), b.roller_diameter
     cage = f"{tag}.cage"
     scene.body(cage, c.mass, c.inertia, pose=(*pin_xy, 0.0), vel=(*pin_vel, wm), fixed=held)

@@ -8,11 +8,13 @@ The initial state is the kinematic steady state (MODEL.md §4); the sun torque i
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from mbd.elements import GroundSupport, Ramp, SpeedDrive, TorqueSource
 
-from .bearing import add_planet_bearing
+from .bearing import BearingHandles, add_planet_bearing
 from .gears import add_mesh_family
 from .geometry import check_design, loaded_flanks
 from .families import MESH_FAMILY
@@ -20,7 +22,26 @@ from .params import DPGTParams
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError
 
-__all__ = ["build_dpgt"]
+__all__ = ["build_dpgt", "PairHandles"]
+
+
+@dataclass(frozen=True)
+class PairHandles:
+    """One planet pair of the DPGT: the planets' body names, their angles ψ on the carrier [rad] and
+    what their bearings added (``scene.handles["pairs"]`` holds one per pair)."""
+    inner: str
+    outer: str
+    psi_a: float
+    psi_b: float
+    inner_bearing: BearingHandles
+    outer_bearing: BearingHandles
+
+    def planet(self, kind: str) -> str:
+        """The inner or outer planet's body name."""
+        return self.inner if kind == "inner" else self.outer
+
+    def bearing(self, kind: str) -> BearingHandles:
+        return self.inner_bearing if kind == "inner" else self.outer_bearing
 
 
 def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: bool = True) -> BuiltScene:
@@ -58,13 +79,11 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
         va, vb = wc * np.array([-pa[1], pa[0]]), wc * np.array([-pb[1], pb[0]])
         scene.body(a_names[n], G.inner_planet.mass, G.inner_planet.inertia, pose=(*pa, ph.gamma_inner[n]), vel=(*va, speed["a"]))
         scene.body(b_names[n], G.outer_planet.mass, G.outer_planet.inertia, pose=(*pb, ph.gamma_outer[n]), vel=(*vb, speed["b"]))
-        pair = {"inner": a_names[n], "outer": b_names[n], "psi_a": float(lay.psi_a[n]), "psi_b": float(lay.psi_b[n])}
-        for key, planet, p, v, w in (("inner", a_names[n], pa, va, speed["a"]), ("outer", b_names[n], pb, vb, speed["b"])):
-            pair[f"{key}_bearing"] = add_planet_bearing(
-                scene, f"{planet}.pb", pin_body="carrier", pin_local=p, outer_body=planet, bearing=b,
-                lubricant=si.lubricant,
-                pin_xy=p, pin_vel=v, omega_pin=wc, omega_outer=w)
-        pairs.append(pair)
+        bearings = [add_planet_bearing(scene, f"{planet}.pb", pin_body="carrier", pin_local=p, outer_body=planet,
+                                       bearing=b, lubricant=si.lubricant, pin_xy=p, pin_vel=v, omega_pin=wc,
+                                       omega_outer=w)
+                    for planet, p, v, w in ((a_names[n], pa, va, speed["a"]), (b_names[n], pb, vb, speed["b"]))]
+        pairs.append(PairHandles(a_names[n], b_names[n], float(lay.psi_a[n]), float(lay.psi_b[n]), *bearings))
 
     # meshes, phased for the flank the torque path loads (reverse rotation loads the other flanks)
     T_s = op.sun_torque
@@ -95,7 +114,7 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     wd = 2 * np.pi * rig.carrier_drive_bandwidth
     scene.add_element(SpeedDrive("carrier_drive", scene.index["carrier"], wc, k=J_eff * wd**2,
                                  c=2 * rig.carrier_drive_damping_ratio * J_eff * wd, k_i=J_eff * wd**3 / 5))
-    scene.handles.update({"pairs": pairs, "flanks": flanks})
+    scene.handles.update({"pairs": tuple(pairs), "flanks": flanks})
     scene.meta.update({
         "speeds_rad_s": {"sun": speed["sun"], "inner_planet": speed["a"], "outer_planet": speed["b"], "carrier": wc},
         "f_c_hz": abs(op.carrier_frequency), "f_m_hz": f_m, "sun_torque_Nm": T_s, "carrier_torque_Nm": op.carrier_torque,

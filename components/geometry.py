@@ -45,14 +45,11 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .units import ParameterError
 
-if TYPE_CHECKING:     # type names only: params imports geometry
-    from .params import DPGTParams
 
 
 __all__ = [
@@ -383,7 +380,7 @@ def _gear_geometries(gs) -> dict:
             for name, g in ((n, gs[n]) for n in ("sun", "inner_planet", "outer_planet", "ring"))}
 
 
-def layout(params: "DPGTParams", gears_si=None, mesh_si=None) -> Layout:
+def layout(params, gears_si=None, mesh_si=None) -> Layout:
     """The nominal layout of ``params`` (a DPGTParams; or pass the SI views of its gears and mesh).
 
     Raises ParameterError (naming the parameter) when the gears cannot be laid out at all.
@@ -525,7 +522,7 @@ def _overlap_findings(out, name_i, name_j, ci, cj, ri, rj, parameter, same=False
         out.append(Finding("warning", parameter, what))
 
 
-def design_findings(params: "DPGTParams") -> list[Finding]:
+def design_findings(params) -> list[Finding]:
     """All design findings for ``params``; never raises for a constructible parameter set.
 
     Sign and type checks of single values (positive masses, clearances ≥ 0, N ≥ 1, Z ≥ 3, h = ±1...)
@@ -655,7 +652,7 @@ def _bearing_findings(bs, G, out) -> None:
                                f"which the rigid planet model ignores"))
 
 
-def check_design(params: "DPGTParams", strict: bool = True) -> list[Finding]:
+def check_design(params, strict: bool = True) -> list[Finding]:
     """Run :func:`design_findings`; warn (:class:`DesignWarning`) for each warning; with ``strict``
     raise ParameterError listing every error, else warn for errors too. Returns the findings."""
     found = design_findings(params)

@@ -45,19 +45,19 @@ def bearing_map(scene) -> list[dict]:
     out = []
     for n, pair in enumerate(scene.handles["pairs"]):
         for kind in ("inner", "outer"):
-            h = pair[f"{kind}_bearing"]
-            rec = {"name": f"{pair[kind]}.pb", "kind": kind, "pair": n, "planet": pair[kind], "type": h["kind"]}
-            if h["kind"] == "rollers":
-                rec.update({"rollers": h["rollers"], "race_inner": [h["race_inner"].start, h["race_inner"].stop],
-                            "race_outer": [h["race_outer"].start, h["race_outer"].stop]})
-                if "pocket" in h:
-                    rec["pocket"] = [h["pocket"].start, h["pocket"].stop]
-                if "guide" in h:
-                    rec["guide"] = h["guide"].start
-                if "cage" in h:
-                    rec["cage"] = h["cage"]
+            h, planet = pair.bearing(kind), pair.planet(kind)
+            rec = {"name": f"{planet}.pb", "kind": kind, "pair": n, "planet": planet, "type": h.kind}
+            if h.kind == "rollers":
+                rec.update({"rollers": list(h.rollers), "race_inner": [h.race_inner.start, h.race_inner.stop],
+                            "race_outer": [h.race_outer.start, h.race_outer.stop]})
+                if h.pocket is not None:
+                    rec["pocket"] = [h.pocket.start, h.pocket.stop]
+                if h.guide is not None:
+                    rec["guide"] = h.guide.start
+                if h.cage is not None:
+                    rec["cage"] = h.cage
             else:
-                rec["spring"] = h["spring"].start
+                rec["spring"] = h.spring.start
             out.append(rec)
     return out
 

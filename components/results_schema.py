@@ -97,8 +97,8 @@ def instance_coords(scene) -> dict[str, dict[str, tuple[str, list]]]:
         else:
             put(FAMILY["linear"], b["spring"], instance=b["name"], **base)
     for n, pair in enumerate(scene.handles["pairs"]):
-        gears = {"sun_inner": ("sun", pair["inner"]), "inner_outer": (pair["inner"], pair["outer"]),
-                 "outer_ring": (pair["outer"], "ring")}
+        gears = {"sun_inner": ("sun", pair.inner), "inner_outer": (pair.inner, pair.outer),
+                 "outer_ring": (pair.outer, "ring")}
         for key, (g1, g2) in gears.items():
             put(MESH_FAMILY[key], n, instance=f"{g1}-{g2}", pair=n, gear1=g1, gear2=g2)
     put("carrier_drive", 0, instance="carrier")

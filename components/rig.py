@@ -280,7 +280,7 @@ def rig_loads(built: BuiltScene, system: mbd.System, s: mbd.State) -> dict:
     m = built.model
     out = system.outputs(s.t, s.q, s.v, s.z)
     h = built.handles["bearing"]
-    si, so = h["race_inner"], h["race_outer"]
+    si, so = h.race_inner, h.race_outer
     inner, outer = out[FAMILY["race_inner"]], out[FAMILY["race_outer"]]
     ang = inner["angle"][si]                            # about the pin (fixed, θ = 0): fixed-frame angle
     e = np.column_stack([np.cos(ang), np.sin(ang)])

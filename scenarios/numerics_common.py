@@ -68,11 +68,11 @@ def dpgt_problem(condition: int = 3, direction: str = "forward", overrides: dict
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # design warnings (tip overlap, N not assemblable) are known
         sc = build_dpgt(params, options, strict=strict)
-    h = sc.handles["pairs"][0]["inner_bearing"]
-    if h["kind"] != "rollers":
+    h = sc.handles["pairs"][0].inner_bearing
+    if h.kind != "rollers":
         raise mbd.ModelError("the numerics scenarios need the roller bearing model")
-    return Problem("dpgt", sc, h["race_inner"], h["race_inner"].start, h.get("guide").start if "guide" in h else None,
-                   h.get("cage"), sc.handles["pairs"][0]["inner"], settle, {"params": params})
+    return Problem("dpgt", sc, h.race_inner, h.race_inner.start, h.guide.start if h.guide is not None else None,
+                   h.cage, sc.handles["pairs"][0].inner, settle, {"params": params})
 
 
 def rig_problem(radial_load: float = 5000.0, overrides: dict | None = None, outer_speed: float | None = None) -> Problem:
@@ -87,7 +87,7 @@ def rig_problem(radial_load: float = 5000.0, overrides: dict | None = None, oute
     sc = build_bearing_rig(params.bearing, radial_load=radial_load, outer_speed=outer_speed,
                            lubricant=params.lubricant)
     h = sc.handles["bearing"]
-    return Problem("rig", sc, h["race_inner"], h["race_inner"].start, h["guide"].start, h["cage"], "ring",
+    return Problem("rig", sc, h.race_inner, h.race_inner.start, h.guide.start, h.cage, "ring",
                    float(sc.meta["t_settle_s"]), {"params": params, "outer_speed": outer_speed})
 
 

@@ -7,6 +7,8 @@ import dataclasses
 import inspect
 from pathlib import Path
 
+import pytest
+
 import mbd.elements as elements
 from mbd.element import Element
 from mbd.elements.contact import TRACTION_LAWS
@@ -144,3 +146,22 @@ def test_parameter_choices_name_the_registered_laws():
     choices = lambda cls, name: set(cls._spec(name).choices)
     assert choices(CageParams, "impact_law") == set(IMPACT_LAWS)
     assert choices(BearingParams, "traction_law") == set(TRACTION_LAWS)
+
+
+def test_scene_handles_are_typed():
+    """A DPGT's pairs and bearings are frozen dataclasses (attributes, not string keys)."""
+    import dataclasses as dc
+    import warnings
+
+    from components.bearing import BearingHandles
+    from components.dpgt import PairHandles, build_dpgt
+    from components.presets import reference_dpgt
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sc = build_dpgt(reference_dpgt(3, "forward"))
+    pair = sc.handles["pairs"][0]
+    assert isinstance(pair, PairHandles) and isinstance(pair.bearing("outer"), BearingHandles)
+    with pytest.raises(dc.FrozenInstanceError):
+        pair.inner = "x"
+    b = pair.inner_bearing
+    assert b.kind == "rollers" and len(b.rollers) == 12 and b.guide is not None and b.spring is None

@@ -208,8 +208,8 @@ def polygon_terms(bs):
     rows = []
     for n, pair in enumerate(bs.handles["pairs"]):
         for key in ("inner", "outer"):
-            h = pair[f"{key}_bearing"]
-            bodies = np.array([m.body(x).index for x in (pair[key], *h["rollers"], h["cage"])])
+            h = pair.bearing(key)
+            bodies = np.array([m.body(x).index for x in (pair.planet(key), *h.rollers, h.cage)])
             # mesh forces on this planet: fx, fy are the force on gear 2, gear 1 gets minus it
             on = ((("mesh_sa", 1.0), ("mesh_ab", -1.0)) if key == "inner" else (("mesh_ab", 1.0), ("mesh_br", -1.0)))
             rows.append((n, key, h, bodies, on))
@@ -220,10 +220,10 @@ def polygon_terms(bs):
         Fd, _, _, _ = evaluate(drag, s.t, m.frame.at(s.t), qf, vf, s.z.get("drag"), False)
         vals = []
         for n, key, h, bodies, on in rows:
-            si = h["race_inner"]
+            si = h.race_inner
             pin = -np.array([out["race_inner"]["fx"][si].sum(), out["race_inner"]["fy"][si].sum()])
             mesh = sum(sgn * np.array([out[f]["fx"][n], out[f]["fy"][n]]) for f, sgn in on)
-            dr = Fd[h["drag"], :2].sum(axis=0)
+            dr = Fd[h.drag, :2].sum(axis=0)
             mb = m.mass[bodies]
             x, y, vx, vy = qf[3 * bodies], qf[3 * bodies + 1], vf[3 * bodies], vf[3 * bodies + 1]
             frame = np.array([np.sum(mb * (W * W * x + 2 * W * vy)), np.sum(mb * (W * W * y - 2 * W * vx))])
@@ -285,7 +285,8 @@ def test_quasi_static_force_polygon(polygons, direction):
     for k, (n, key, h, bodies, on) in enumerate(rows):
         pin, mesh, drag, frame = mean[k, 0:2], mean[k, 2:4], mean[k, 4:6], mean[k, 6:8]
         assert m_s == pytest.approx(bs.model.mass[bodies].sum(), rel=1e-12)
-        psi = bs.handles["pairs"][n]["psi_a" if key == "inner" else "psi_b"]
+        pair = bs.handles["pairs"][n]
+        psi = pair.psi_a if key == "inner" else pair.psi_b
         centrifugal = m_s * radius[key] * W * W * np.array([math.cos(psi), math.sin(psi)])
         P = np.linalg.norm(pin)
         assert P > 5e3                                         # a real load: ≈ 7–13 kN at condition 3
@@ -401,10 +402,10 @@ def _frame_differences(res):
         per = []
         for pair in b_.handles["pairs"]:
             for key in ("inner", "outer"):
-                h = pair[f"{key}_bearing"]
-                per.append(np.hypot(out["fx"][h["race_inner"]].sum(), out["fy"][h["race_inner"]].sum()))
-                pin = m.body(pair[key]).index
-                for name in h["rollers"]:
+                h = pair.bearing(key)
+                per.append(np.hypot(out["fx"][h.race_inner].sum(), out["fy"][h.race_inner].sum()))
+                pin = m.body(pair.planet(key)).index
+                for name in h.rollers:
                     j = m.body(name).index
                     d_roll = max(d_roll, np.linalg.norm((qa[j, :2] - qa[pin, :2]) - (qb[j, :2] - qb[pin, :2])))
         loads.append(np.array(per))
@@ -493,8 +494,8 @@ def test_mirror_symmetry(bearings, t_end):
     if bearings == "rollers":   # bearing loads mirrored across the x axis
         for n, pair in enumerate(A.handles["pairs"]):
             for key in ("inner", "outer"):
-                ha = pair[f"{key}_bearing"]["race_inner"]
-                hb = B.handles["pairs"][pairs[n]][f"{key}_bearing"]["race_inner"]
+                ha = pair.bearing(key).race_inner
+                hb = B.handles["pairs"][pairs[n]].bearing(key).race_inner
                 fa = np.array([oa["race_inner"]["fx"][ha].sum(), oa["race_inner"]["fy"][ha].sum()])
                 fb = np.array([ob["race_inner"]["fx"][hb].sum(), -ob["race_inner"]["fy"][hb].sum()])
                 np.testing.assert_allclose(fa, fb, atol=rel * np.linalg.norm(fa) + 1e-6)

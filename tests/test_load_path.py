@@ -75,7 +75,7 @@ def test_bearing_load_is_the_drive_flank_polygon_plus_centrifugal_force(runs, ca
             r = np.linalg.norm(c)
             er = c / r
             et = np.array([-er[1], er[0]])
-            mass = m.mass[m.body(pair[kind]).index] + carried
+            mass = m.mass[m.body(pair.planet(kind)).index] + carried
             poly = on[kind] + mass * r * W * W * er
             pin = lr[i] * er + lt[i] * et
             P = np.linalg.norm(pin)

@@ -129,7 +129,7 @@ def test_rig_held_cage_with_turning_ring_starts_consistently():
     rig = build_bearing_rig(bearing(), radial_load=F_R, outer_speed=300.0, options=SceneOptions(cage="held"))
     m = rig.model
     qf, vf = m.full(0.0, rig.q0, rig.v0)
-    rollers = [m.body(n).index for n in rig.handles["bearing"]["rollers"]]
+    rollers = [m.body(n).index for n in rig.handles["bearing"].rollers]
     np.testing.assert_allclose(vf[3 * np.array(rollers)], 0.0, atol=1e-12)
     np.testing.assert_allclose(vf[3 * np.array(rollers) + 1], 0.0, atol=1e-12)
     sysm = mbd.System(m)
