@@ -88,6 +88,23 @@ def _refresh(t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F, Jq, Jv, A):
 
 
 @njit(cache=True)
+def _refresh_at(t1, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
+    """Jacobian + LU at the current iterate a₁ (its forces left in work's F1); False when unusable."""
+    qp, vp, a1, q1, v1, F1, r, sc, Jq, Jv, A = work
+    for i in range(a1.size):
+        q1[i] = qp[i] + bh2 * a1[i]
+        v1[i] = vp[i] + gh * a1[i]
+    kind = _refresh(t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F1, Jq, Jv, A)
+    cnt[1] += 1
+    cache[1] = h
+    if kind < 0:
+        cache[0] = 0.0
+        return False
+    cache[0], cache[2] = 1.0, kind
+    return True
+
+
+@njit(cache=True)
 def _lu_solve(kind, lu, r, n):
     perm, iperm, Lp, Li, Lx, Up, Ui, Ux, xw, yw, D, dpiv = lu
     if kind == 0:
@@ -116,16 +133,8 @@ def _newton(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, w
     refreshes = 0
     rate = 0.0
     if cache[0] == 0.0 or cache[1] != h or not reuse:
-        for i in range(n):
-            q1[i] = qp[i] + bh2 * a1[i]
-            v1[i] = vp[i] + gh * a1[i]
-        kind = _refresh(t + h, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F1, Jq, Jv, A)
-        cnt[1] += 1
-        cache[1] = h
-        if kind < 0:
-            cache[0] = 0.0
+        if not _refresh_at(t + h, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
             return False, 0, np.inf, _SINGULAR
-        cache[0], cache[2] = 1.0, kind
         have_F = True
     has_prev = False
     prev = 0.0
@@ -163,16 +172,8 @@ def _newton(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, w
             if action == rules.REFRESH_AT_PREVIOUS:
                 for i in range(n):
                     a1[i] += da[i]
-            for i in range(n):
-                q1[i] = qp[i] + bh2 * a1[i]
-                v1[i] = vp[i] + gh * a1[i]
-            kind = _refresh(t + h, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F1, Jq, Jv, A)
-            cnt[1] += 1
-            cache[1] = h
-            if kind < 0:
-                cache[0] = 0.0
+            if not _refresh_at(t + h, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
                 return False, it, rate, _SINGULAR
-            cache[0], cache[2] = 1.0, kind
             have_F = True
             refreshes += 1
             has_prev = False
