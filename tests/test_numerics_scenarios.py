@@ -80,7 +80,9 @@ def test_stability_reports_success_and_refusal(tmp_path):
 
 def test_benchmark_json_last_line(tmp_path, capsys):
     assert benchmark.main(["--json", "--settle", "2e-4", "--window", "2e-4", "--ref-window", "1e-4",
-                           "--h", "1e-5", "--scipy-cap", "3", "--repeats", "1", "--out", str(tmp_path)]) == 0
+                           "--h", "1e-5", "--scipy-cap", "3", "--repeats", "1", "--out", str(tmp_path),
+                           "--stiff", "10", "--stiff-settle", "2e-4", "--stiff-window", "1e-4",
+                           "--scipy-methods", "BDF"]) == 0
     last = capsys.readouterr().out.strip().splitlines()[-1]
     d = json.loads(last)
     for k in ("wall_s", "simulated_s", "steps", "newton_per_step", "rel_error_rms_inner_race", "reference_wall_s",
@@ -88,6 +90,8 @@ def test_benchmark_json_last_line(tmp_path, capsys):
         assert k in d, k
     assert d["engine"] == "compiled" and d["reference_wall_s"] > 0 and d["speedup_vs_reference"] > 0
     assert d["scipy_same_residual"] is True          # scipy's solvers call the same compiled residual
+    (stiff,) = d["stiff"]                            # the stiff comparison: contacts x10, HHT against scipy
+    assert stiff["factor"] == 10 and stiff["hht_completed"] and stiff["scipy"][0]["engine"] == "compiled"
     # fixed step: a step whose Newton fails is retried with h/2, so at least window/h steps
     assert d["steps"] >= 20 and d["simulated_s"] == pytest.approx(2e-4)
     assert d["per_step_over_eval"] > 0 and d["wall_s"] > 0
