@@ -52,3 +52,17 @@ def test_a_zero_pivot_is_reported_not_divided_by():
     bad = ok.data.copy()
     bad[0] = np.nan
     assert not lu.factor(bad)
+
+
+def test_the_dense_fallback_pivots_where_the_diagonal_is_zero():
+    from mbd.compiled.stepper import _dense_lu, _dense_solve
+    rng = np.random.default_rng(4)
+    A = rng.standard_normal((6, 6))
+    A[0, 0] = 0.0                                      # diagonal pivoting would divide by zero here
+    D = A.copy()
+    ok, piv = _dense_lu(D)
+    b = rng.standard_normal(6)
+    assert ok
+    np.testing.assert_allclose(_dense_solve(D, piv, b), np.linalg.solve(A, b), rtol=1e-12, atol=1e-12)
+    ok, _ = _dense_lu(np.zeros((3, 3)))
+    assert not ok

@@ -58,7 +58,9 @@ class CompiledRunner:
         self.rtol = float(stepper.tol.rtol)
         self.freeze = bool(system.freeze_internal)
         lu = FixedPatternLU(system._indptr, system._indices, n)
-        dense = np.zeros((n, n)) if n <= 3000 else np.zeros((0, 0))
+        # the zero-pivot fallback (dense partial pivoting) needs n² floats: kept for n ≤ 1000 (8 MB); a larger
+        # model whose diagonal pivot vanishes fails that step instead, and the controller shrinks h
+        dense = np.zeros((n, n)) if n <= 1000 else np.zeros((0, 0))
         self.lu = (lu.perm, lu.iperm, lu.Lp, lu.Li, lu.Lx, lu.Up, lu.Ui, lu.Ux, lu._x, lu._y, dense,
                    np.zeros(n, np.int64))
         self.pat = (lu.indptr, lu.indices, np.ascontiguousarray(system._M, float), np.asarray(m.mdiag, float))

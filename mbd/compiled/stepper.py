@@ -78,6 +78,8 @@ def _refresh(t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F, Jq, Jv, A):
             return -1
     if _factor(n, indptr, indices, A, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, xw):
         return 0
+    if D.shape[0] != n:                               # no room for the dense fallback (a large model)
+        return -1
     D[:, :] = 0.0                                     # a zero diagonal pivot: partial pivoting
     for c in range(n):
         for p in range(indptr[c], indptr[c + 1]):
