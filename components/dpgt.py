@@ -120,5 +120,6 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
         "f_c_hz": abs(op.carrier_frequency), "f_m_hz": f_m, "sun_torque_Nm": T_s, "carrier_torque_Nm": op.carrier_torque,
         "ramp_s": ramp_t, "ring_mismatch_teeth": [float(x) for x in ph.ring_mismatch], "planets": N,
         "rollers": b.rollers, "direction": op.direction, "frame": opt.frame, "bearings": opt.bearings, "bearing": b,
+        "lubricant": si.lubricant,
     })
     return scene.build()

@@ -28,6 +28,7 @@ from mbd.ad import wrap_angle
 
 from .bearing import bearing_kinematics
 from .families import FAMILY, MESH_FAMILY
+from .lubrication import bearing_film
 
 __all__ = ["FAMILY", "MESH_FAMILY", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
            "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life",
@@ -207,6 +208,7 @@ class WindowStatistics(mbd.Observer):
             if np.all(np.isfinite(revs)) and np.all(revs >= 0.5):
                 self.target = np.maximum(np.round(revs), 1.0)
         self.t_end = self.t1 + (self.MARGIN * (self.t1 - self.t0) if self.target is not None else 0.0)
+        self._lubricant = scene.meta.get("lubricant")       # None: no film statistics (e.g. the bearing rig)
 
     # setup -------------------------------------------------------------------------------------
     def bind(self, model, system, state) -> None:
@@ -254,7 +256,7 @@ class WindowStatistics(mbd.Observer):
             return p.roller_bearing
         if key == "pocket_force":
             return p.pocket_bearing
-        if key.startswith(("load_", "cage_", "guide_", "planet_")):
+        if key.startswith(("load_", "cage_", "guide_", "planet_", "film_")):
             return np.arange(p.planet.size)
         return None
 
@@ -272,6 +274,9 @@ class WindowStatistics(mbd.Observer):
             pin = pin_reactions(ri, slice(None), p.roller_bearing, nb, p.rows)
             snap["roller_inner_load"] = np.asarray(ri["load"], float)
             snap["roller_outer_load"] = np.asarray(out[FAMILY["race_outer"]]["load"], float)
+            if self._lubricant is not None:
+                snap["film_thinnest"] = self._thinnest_film(ri, out[FAMILY["race_outer"]], nb)
+                snap["film_lambda"] = snap["film_thinnest"] / self._lubricant.roughness
             if p.pocket_bearing is not None:
                 snap["pocket_force"] = np.asarray(out[FAMILY["pocket"]]["force"], float)
         else:
@@ -304,6 +309,15 @@ class WindowStatistics(mbd.Observer):
         if p.rollers:
             snap["_roller_angle"] = self._roller_angles(X)
         return snap
+
+    def _thinnest_film(self, race_inner, race_outer, nb) -> np.ndarray:
+        """Per bearing, the thinnest EHL film h_min [m] over its loaded roller contacts, both raceways."""
+        b, lub, owner = self.scene.meta["bearing"], self._lubricant, self.plan.roller_bearing
+        thinnest = np.full(nb, np.inf)
+        for race, inner in ((race_inner, True), (race_outer, False)):
+            h_min, _ = bearing_film(race["load"], race["rolling_speed"], b, lub, inner)
+            np.minimum.at(thinnest, owner, np.where(np.isnan(h_min), np.inf, h_min))
+        return np.where(np.isfinite(thinnest), thinnest, np.nan)      # NaN: no roller loaded at this instant
 
     def _to_carrier(self, vec, t):
         """A vector given in the model's frame R, in the carrier frame C."""
@@ -523,6 +537,8 @@ class WindowStatistics(mbd.Observer):
             d["equivalent_load_N"] = float(self.stats("load_life")["mean"][ref] ** (1.0 / LIFE_EXPONENT))
             if p.rollers:
                 self._roller_summary(d, kind, sel)
+                if self._lubricant is not None:
+                    self._film_summary(d, sel)
             if p.cage is not None:
                 self._cage_summary(d, ref, sel)
             d["life_L10_relative"] = None     # filled by a study relative to its forward run
@@ -564,6 +580,15 @@ class WindowStatistics(mbd.Observer):
                 d["pocket_impact_peak_max_N"] = float(im["peak_max"][pk].max())
                 d["pocket_impact_peak_mean_N"] = float(im["peak_sum"][pk].sum() / count) if count else 0.0
         d["all_rollers"] = al
+
+    def _film_summary(self, d, sel):
+        """The thinnest EHL film of the bearings ``sel`` (every bearing of this kind): its smallest value in
+        the window and its time mean (the worst bearing's), in metres and as Λ = h_min/σ."""
+        h, lam = self.stats("film_thinnest"), self.stats("film_lambda")
+        d["film_min_m"] = float(h["min"][sel].min())
+        d["film_mean_m"] = float(h["mean"][sel].min())
+        d["lambda_min"] = float(lam["min"][sel].min())
+        d["lambda_mean"] = float(lam["mean"][sel].min())
 
     def _cage_revolutions(self, sel) -> float:
         """Cage revolutions relative to the carrier in the windows of the bearings ``sel``, summed."""

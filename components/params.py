@@ -568,6 +568,9 @@ class BearingParams(Params):
     linear_stiffness: Quantity = _pos("stiffness", "radial stiffness of a bearing modelled as a linear spring "
                                                    "(scene option bearings=linear)")
     linear_damping: Quantity = _nonneg("damping", "radial damping of a bearing modelled as a linear spring")
+    elastic_modulus: Quantity = _pos("pressure", "Young's modulus of rollers and raceways (EHL film)")
+    poisson_ratio: Quantity = _param("dimensionless", "Poisson's ratio of rollers and raceways", lo=0.0, hi=0.5,
+                                     hi_open=True, bound_text="in [0, 0.5)")
     cage: CageParams = _nested(CageParams, "cage")
 
     _si_derived: ClassVar[tuple] = (
@@ -599,11 +602,35 @@ BearingSI = BearingParams.SI
 @_with_si("LubricantSI")
 @dataclass(frozen=True, kw_only=True)
 class LubricantParams(Params):
-    """Oil–air mixture for roller drag F = C_d ρ D l (d_m Ω_m)^2 / 8."""
+    """The oil and the oil–air mixture around the rollers (MODEL.md §3.6, §3.8).
+
+    Drag: F = C_d ρ D l (d_m Ω_m)^2 / 8 with the mixture density. Film: the oil's kinematic viscosity at
+    40 °C and 100 °C (an ISO VG grade's data sheet) gives its viscosity at the operating temperature by
+    Walther's equation (ASTM D341); with the pressure–viscosity coefficient and the surfaces' composite
+    roughness it sets the EHL film of every roller contact (:mod:`components.lubrication`).
+    ``si()`` adds ``oil_viscosity``, the dynamic viscosity at the operating temperature [Pa·s]."""
 
     _prefix: ClassVar[str] = "lubricant"
     drag_coefficient: Quantity = _nonneg("dimensionless", "drag coefficient C_d")
     density: Quantity = _nonneg("density", "oil-air mixture density")
+    oil_density: Quantity = _pos("density", "density of the oil itself")
+    viscosity_40: Quantity = _pos("kinematic_viscosity", "kinematic viscosity at 40 degC (ISO VG: the grade)")
+    viscosity_100: Quantity = _pos("kinematic_viscosity", "kinematic viscosity at 100 degC")
+    temperature: Quantity = _pos("temperature", "oil temperature in the bearing")
+    pressure_viscosity: Quantity = _pos("pressure_viscosity", "pressure-viscosity coefficient alpha_p (Barus)")
+    roughness: Quantity = _pos("length", "composite roughness sigma = sqrt(Rq1^2 + Rq2^2) of roller and raceway")
+
+    _si_derived: ClassVar[tuple] = (
+        Derived("oil_viscosity", float, "dynamic viscosity at the operating temperature [Pa s] (Walther, ASTM D341)"),
+    )
+
+    def _si_values(self, v):
+        if not v["viscosity_100"] < v["viscosity_40"]:
+            raise ParameterError.at("lubricant.viscosity_100", "must be below lubricant.viscosity_40 "
+                                                                 "(an oil thins as it warms)")
+        from .lubrication import walther_viscosity
+        return dict(oil_viscosity=v["oil_density"] * walther_viscosity(v["viscosity_40"], v["viscosity_100"],
+                                                                       v["temperature"]))
 LubricantSI = LubricantParams.SI
 
 

@@ -16,7 +16,7 @@ from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, Ge
                      overrides_from_toml, paper, with_overrides)
 from .units import Q_, ParameterError
 
-__all__ = ["CONDITIONS", "DIRECTIONS", "operating_point", "reference_gears", "reference_bearing",
+__all__ = ["CONDITIONS", "DIRECTIONS", "OIL_GRADES", "oil_grade", "operating_point", "reference_gears", "reference_bearing",
            "reference_dpgt", "reference_bearing_rig", "load_toml"]
 
 # the study's four operating conditions: carrier speed n_c and output power P (ring fixed)
@@ -64,6 +64,25 @@ def reference_gears() -> GearSetParams:
     )
 
 
+# ISO VG grades (ISO 3448: the grade is the kinematic viscosity at 40 degC, mm^2/s) of mineral oils with a
+# viscosity index near 100; the 100 degC values are typical of such oils' data sheets
+OIL_GRADES = {
+    "VG32": {"viscosity_40": assumed("32 mm^2/s", "ISO 3448 grade VG 32"),
+             "viscosity_100": assumed("5.4 mm^2/s", "mineral oil, VI ~ 100")},
+    "VG68": {"viscosity_40": assumed("68 mm^2/s", "ISO 3448 grade VG 68; the source names no oil"),
+             "viscosity_100": assumed("8.7 mm^2/s", "mineral oil, VI ~ 100")},
+    "VG150": {"viscosity_40": assumed("150 mm^2/s", "ISO 3448 grade VG 150"),
+              "viscosity_100": assumed("14.7 mm^2/s", "mineral oil, VI ~ 100")},
+}
+
+
+def oil_grade(name: str) -> dict:
+    """Overrides {"lubricant.viscosity_40": ..., "lubricant.viscosity_100": ...} of an ISO VG grade."""
+    if name not in OIL_GRADES:
+        raise ParameterError.at("lubricant grade", f"expected one of {sorted(OIL_GRADES)}, got {name!r}")
+    return {f"lubricant.{k}": v for k, v in OIL_GRADES[name].items()}
+
+
 def reference_bearing() -> BearingParams:
     """The planet bearing (same for inner and outer planets) and its cage."""
     cage = CageParams(
@@ -101,6 +120,8 @@ def reference_bearing() -> BearingParams:
             ratio_reg=assumed(1e-4)),
         linear_stiffness=assumed("5e8 N/m", "a planet bearing's radial stiffness near its loaded state"),
         linear_damping=assumed("2000 N*s/m"),
+        elastic_modulus=assumed("210 GPa", "bearing steel"),
+        poisson_ratio=assumed(0.3, "bearing steel"),
         cage=cage,
     )
 
@@ -113,6 +134,13 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
         lubricant=LubricantParams(
             drag_coefficient=assumed(1.0),
             density=assumed("45 kg/m^3", "oil-air mixture: 5 % oil of 870 kg/m^3"),
+            oil_density=assumed("870 kg/m^3", "mineral oil at 15 degC"),
+            viscosity_40=OIL_GRADES["VG68"]["viscosity_40"],
+            viscosity_100=OIL_GRADES["VG68"]["viscosity_100"],
+            temperature=assumed("60 degC", "oil in the bearings of a running gearbox; not stated by the source"),
+            pressure_viscosity=assumed("2.2e-8 1/Pa", "mineral oil (Hamrock, Fundamentals of Fluid Film "
+                                                      "Lubrication: 1.5-2.5e-8 1/Pa)"),
+            roughness=assumed("0.15 um", "composite Rq of a ground raceway (~0.1 um) and a roller (~0.1 um)"),
         ),
         support=SupportParams(
             sun_stiffness=assumed("1e8 N/m"),

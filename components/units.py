@@ -86,6 +86,11 @@ KINDS: dict[str, Kind] = {
     "contact_stiffness": Kind("a line-contact stiffness (force per length^(10/9))", "N/m**(10/9)",
                               "1.22e9 N/m**(10/9)"),
     "stiffness_per_width": Kind("a mesh stiffness per face width", "N/m**2", "20 N/(mm*um)"),
+    "temperature": Kind("a temperature", "K", "60 degC"),
+    "kinematic_viscosity": Kind("a kinematic viscosity", "m**2/s", "68 mm^2/s"),
+    "dynamic_viscosity": Kind("a dynamic viscosity", "Pa*s", "0.03 Pa*s"),
+    "pressure_viscosity": Kind("a pressure-viscosity coefficient", "1/Pa", "2e-8 1/Pa"),
+    "pressure": Kind("a pressure or elastic modulus", "Pa", "210 GPa"),
 }
 
 _TOL = 1e-9  # tolerance on dimension exponents (pint stores 10/9 as a float)
@@ -110,6 +115,15 @@ def _shown(value) -> str:
     return value if isinstance(value, str) else str(value)
 
 
+def _offset_quantity(text: str):
+    """'<number> <unit>' read as Q_(number, unit) — the form pint needs for offset units (degC, degF)."""
+    num, _, unit = text.strip().partition(" ")
+    try:
+        return Q_(float(num), unit.strip())
+    except Exception:
+        return None
+
+
 def quantity(name: str, value, dimension: str) -> Quantity:
     """``value`` as a pint quantity of ``dimension`` (a key of :data:`KINDS` or a unit string).
 
@@ -128,7 +142,9 @@ def quantity(name: str, value, dimension: str) -> Quantity:
         try:
             q = Q_(value.strip())
         except Exception:
-            raise ParameterError.at(name, f"{expect}, got {value!r} which is not a quantity pint can read") from None
+            q = _offset_quantity(value)          # "60 degC": pint cannot multiply an offset unit
+            if q is None:
+                raise ParameterError.at(name, f"{expect}, got {value!r} which is not a quantity pint can read") from None
         if not isinstance(q, pint.Quantity):  # pint returns a plain number for e.g. "3"
             q = Q_(q)
     elif isinstance(value, numbers.Real):

@@ -110,7 +110,7 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
         scene = build_dpgt(params, cfg.options)
     bmap = bearing_map(scene)
-    meta = {k: v for k, v in scene.meta.items() if k != "bearing"}
+    meta = {k: v for k, v in scene.meta.items() if k not in ("bearing", "lubricant")}   # SI objects, not JSON
     window = cfg.window if cfg.window is not None else statistics_window(scene)
     stats = WindowStatistics(scene, cfg.settle, cfg.settle + window)
     rec = Recorder(out_dir / "results.nc", dt=1.0 / cfg.sample_rate, probes=_probes(scene), t_start=cfg.settle,

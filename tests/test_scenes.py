@@ -12,7 +12,6 @@ from scipy.integrate import quad
 import mbd
 from mbd.ad import wrap_angle
 from components.bearing import bearing_kinematics
-from components.params import LubricantParams
 from components.planetary import (EXAMPLE_PLANETARY, build_single_planetary, load_planetary_toml,
                                   modal_state, planetary_modes, planetary_spec)
 from components.presets import reference_bearing, reference_bearing_rig, reference_dpgt
@@ -103,7 +102,7 @@ def test_rig_turning_ring_with_free_cage():
     contact force on the ring balances the load (normal + traction), and the binned loads still form a
     load zone around the zone centre."""
     w = 300.0
-    lub = LubricantParams(drag_coefficient=1.0, density="45 kg/m^3")
+    lub = reference_dpgt(3, "forward").lubricant.replace(drag_coefficient=1.0, density="45 kg/m^3")
     rig = build_bearing_rig(bearing(), radial_load=F_R, outer_speed=w, options=SceneOptions(cage="free"), lubricant=lub)
     m = rig.model
     names = [e.name for e in m.elements]

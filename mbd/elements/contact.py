@@ -280,8 +280,10 @@ class RaceContact(Element):
     m_roller the mass of one physical roller), and the generalized forces are multiplied by it.
 
     Outputs, all per physical contact: "load" Q ≥ 0 [N]; "deflection" δ [m] (negative: a gap); "traction"
-    tangential force on the roller along t [N] (opposes v_s); "slip_velocity" v_s [m/s]; "angle" the roller
-    centre's angle about the raceway centre measured in the race body's axes [rad] (wrapped to (−π, π]);
+    tangential force on the roller along t [N] (opposes v_s); "slip_velocity" v_s [m/s]; "rolling_speed"
+    the entraining speed u_e = (u_roller + u_race)/2 relative to the contact point [m/s] (what builds an
+    EHL film); "angle" the roller centre's angle about the raceway centre measured in the race body's
+    axes [rad] (wrapped to (−π, π]);
     "fx", "fy" the contact force on one physical roller, in R [N].
     """
     n_local = 6
@@ -350,12 +352,11 @@ class RaceContact(Element):
         ur = Vr[0] * tx + Vr[1] * ty
         ub = Vb[0] * tx + Vb[1] * ty
         v_s = ur - ub
-        if self.traction.needs_rolling_speed:
-            # velocity of the geometric contact point P along t: ċ·t + R (ṗ − ċ)·t / ρ
-            vP = Vc[0] * tx + Vc[1] * ty + R * (wx * tx + wy * ty) / rho
-            mu = self.traction.coefficient(v_s, 0.5 * (ur + ub) - vP)
-        else:
-            mu = self.traction.coefficient(v_s)
+        # entraining (rolling) speed: the surfaces' mean speed relative to the geometric contact point P,
+        # whose velocity along t is ċ·t + R (ṗ − ċ)·t / ρ
+        vP = Vc[0] * tx + Vc[1] * ty + R * (wx * tx + wy * ty) / rho
+        u_e = 0.5 * (ur + ub) - vP
+        mu = self.traction.coefficient(v_s, u_e) if self.traction.needs_rolling_speed else self.traction.coefficient(v_s)
         Ft = -1.0 * mu * Q
         Fx = kap * Q * ex + Ft * tx
         Fy = kap * Q * ey + Ft * ty
@@ -363,7 +364,7 @@ class RaceContact(Element):
         forces = _scaled(forces, self.multiplicity, self._multi)
         angle = ad.wrap_angle(ad.arctan2(dy, dx) - qb[2])
         return forces, {"load": Q, "deflection": delta, "traction": Ft, "slip_velocity": v_s, "angle": angle,
-                        "fx": Fx, "fy": Fy}   # fx, fy: force on one physical roller, in R
+                        "rolling_speed": u_e, "fx": Fx, "fy": Fy}   # fx, fy: force on one physical roller, in R
 
 
 # --------------------------------------------------------------------------------------------

@@ -1,0 +1,110 @@
+"""The lubricant film of the roller contacts (components.lubrication, MODEL.md §3.8)."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+import mbd
+from components.dpgt import build_dpgt
+from components.lubrication import (dowson_higginson_film, line_contact_film, reduced_modulus,
+                                    roller_contact_radius, walther_viscosity)
+from components.outputs import WindowStatistics
+from components.params import with_overrides
+from components.presets import OIL_GRADES, oil_grade, reference_dpgt
+from components.units import ParameterError
+
+E_STEEL = reduced_modulus(210e9, 0.3, 210e9, 0.3)
+
+
+def test_walther_passes_through_its_data_and_thins_with_temperature():
+    for grade in OIL_GRADES.values():
+        nu40, nu100 = (float(grade[k].value.split()[0]) * 1e-6 for k in ("viscosity_40", "viscosity_100"))
+        assert walther_viscosity(nu40, nu100, 313.15) == pytest.approx(nu40, rel=1e-12)
+        assert walther_viscosity(nu40, nu100, 373.15) == pytest.approx(nu100, rel=1e-12)
+        T = np.linspace(273.15, 423.15, 31)
+        assert np.all(np.diff([walther_viscosity(nu40, nu100, x) for x in T]) < 0)
+
+
+def test_reduced_modulus_and_radius():
+    assert E_STEEL == pytest.approx(210e9 / (1 - 0.09), rel=1e-14)     # two equal bodies: E/(1 − ν²)
+    D, R = 7.5e-3, 15.75e-3
+    assert roller_contact_radius(D, R, True) == pytest.approx(1 / (2 / D + 1 / R), rel=1e-14)
+    assert roller_contact_radius(D, R + D, False) == pytest.approx(1 / (2 / D - 1 / (R + D)), rel=1e-14)
+
+
+@settings(max_examples=60, deadline=None)
+@given(U=st.floats(-12, -9), W=st.floats(-5, -3), G=st.floats(3000, 7000))
+def test_pan_hamrock_agrees_with_dowson_higginson(U, W, G):
+    """Two published line-contact formulas, over the bearing range of the dimensionless groups: within
+    11 % of each other (Pan–Hamrock's regression is the thinner, 0.90–0.97 of Dowson–Higginson)."""
+    R, eta = 3e-3, 0.025
+    u, w, alpha = 10 ** U * E_STEEL * R / eta, 10 ** W * E_STEEL * R, G / E_STEEL
+    h_min, h_c = line_contact_film(u, w, R, eta, alpha, E_STEEL)
+    ratio = h_min / dowson_higginson_film(u, w, R, eta, alpha, E_STEEL)
+    assert 0.89 < ratio < 0.97
+    # central film over the exit constriction: ≈ 1.3 in EHL; the two regressions meet at the heaviest loads
+    assert 0.9 < h_c / h_min < 1.6
+
+
+def test_film_grows_with_speed_and_viscosity_and_thins_weakly_with_load():
+    R, eta, alpha = 3e-3, 0.025, 2.2e-8
+    h = lambda u=5.0, w=3e5, eta=eta: line_contact_film(u, w, R, eta, alpha, E_STEEL)[0]   # noqa: E731
+    assert h(u=10.0) / h() == pytest.approx(2 ** 0.694, rel=1e-12)
+    assert h(eta=2 * eta) / h() == pytest.approx(2 ** 0.694, rel=1e-12)
+    assert h(w=6e5) / h() == pytest.approx(2 ** -0.128, rel=1e-12)    # doubling the load: 8.5 % thinner
+    assert h(u=-5.0) == h()                             # only the entraining speed's magnitude builds a film
+
+
+def test_oil_grades_and_bad_viscosities():
+    base = reference_dpgt(3, "forward")
+    eta = [with_overrides(base, oil_grade(g)).si().lubricant.oil_viscosity for g in ("VG32", "VG68", "VG150")]
+    assert eta[0] < eta[1] < eta[2]
+    assert 0.020 < eta[1] < 0.030            # VG 68 at 60 °C: ≈ 29 mm²/s (data sheets: 27–31) × 870 kg/m³
+    with pytest.raises(ParameterError, match="viscosity_100.*below"):
+        with_overrides(base, {"lubricant.viscosity_100": "80 mm^2/s"}).si()
+    with pytest.raises(ParameterError, match="lubricant grade"):
+        oil_grade("VG46")
+    assert with_overrides(base, {"lubricant.temperature": "80 degC"}).si().lubricant.oil_viscosity < eta[1]
+
+
+@pytest.fixture(scope="module")
+def loaded_state():
+    """The DPGT 3 ms into its load ramp, and its scene."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sc = build_dpgt(reference_dpgt(3, "forward"))
+    res = mbd.simulate(sc.model, sc.q0, sc.v0, 0.003, stepper=mbd.PRODUCTION.stepper(),
+                       controller=mbd.PRODUCTION.controller(), progress=False)
+    return sc, res.state
+
+
+def _snapshot(scene, state, lubricant):
+    scene.meta["lubricant"] = lubricant
+    stats = WindowStatistics(scene, 0.001, 0.002, whole_revolutions=False)
+    stats.bind(scene.model, mbd.System(scene.model), state)
+    return stats.snapshot(state)
+
+
+def test_the_thinnest_film_of_each_bearing_scales_with_the_oil(loaded_state):
+    """Same state, two oils: every bearing's thinnest film scales as η^0.694 (Pan–Hamrock), Λ = h/σ."""
+    sc, s = loaded_state
+    base = reference_dpgt(3, "forward")
+    thin, thick = (with_overrides(base, oil_grade(g)).si().lubricant for g in ("VG32", "VG150"))
+    a, b = _snapshot(sc, s, thin), _snapshot(sc, s, thick)
+    assert np.all(np.isfinite(a["film_thinnest"])) and np.all(a["film_thinnest"] > 0)
+    np.testing.assert_allclose(b["film_thinnest"] / a["film_thinnest"],
+                               (thick.oil_viscosity / thin.oil_viscosity) ** 0.694, rtol=1e-12)
+    np.testing.assert_allclose(a["film_lambda"], a["film_thinnest"] / thin.roughness, rtol=1e-15)
+    # the film of one contact by hand: the most loaded roller of bearing 0 on its pin
+    out = mbd.System(sc.model).outputs(s.t, s.q, s.v, s.z)["race_inner"]
+    b0 = sc.meta["bearing"]
+    Z = b0.rollers
+    j = int(np.argmax(out["load"][:Z]))
+    R = roller_contact_radius(b0.roller_diameter, b0.inner_raceway_radius, True)
+    E = reduced_modulus(b0.elastic_modulus, b0.poisson_ratio, b0.elastic_modulus, b0.poisson_ratio)
+    h_j, _ = line_contact_film(out["rolling_speed"][j], out["load"][j] / b0.roller_length, R, thin.oil_viscosity,
+                               thin.pressure_viscosity, E)
+    assert a["film_thinnest"][0] <= h_j * (1 + 1e-12)
