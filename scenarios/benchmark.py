@@ -48,7 +48,7 @@ from components.outputs import FAMILY
 from components.presets import reference_dpgt
 
 from .numerics_common import (design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note,
-                              observables, peak_rss_mb, run_hht, run_scipy, settled_state)
+                              observables, peak_rss_mb, run_hht, run_scipy, settled_state, warm_up)
 
 __all__ = ["main", "benchmark", "scaling", "profile_window"]
 
@@ -71,6 +71,7 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
     ref_window = min(ref_window, window)
     sub = _grid(t0, t0 + ref_window)
     load_before = load1()
+    warm_up(prob, s0)
     costs = eval_costs(prob.model, s0)
     log(f"one residual+Jacobian: compiled {costs['compiled_jacobian_s'] * 1e6:.0f} µs, numpy "
         f"{costs['jacobian_s'] * 1e6:.0f} µs (residual alone {costs['compiled_residual_s'] * 1e6:.0f} / "

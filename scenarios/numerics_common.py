@@ -36,7 +36,7 @@ from components.presets import reference_dpgt
 
 __all__ = ["Problem", "dpgt_problem", "rig_problem", "settled_state", "StateSampler", "RunResult",
            "run_hht", "run_scipy", "observables", "error_metrics", "scipy_atol", "peak_rss_mb",
-           "eval_costs", "machine_note", "load1",
+           "eval_costs", "machine_note", "load1", "warm_up",
            "design_verdict"]
 
 
@@ -190,6 +190,13 @@ class RunResult:
                 "residual_evals": self.residual, "jacobian_evals": self.jacobian, "factorizations": self.factor,
                 "newton_iterations": self.newton, "rejected": self.rejected, "t_reached": self.t_reached,
                 "wall_repeats": self.walls}
+
+
+def warm_up(prob: Problem, state: mbd.State) -> None:
+    """Two compiled steps from ``state``, untimed: the first compiled run of a process loads every kernel from
+    numba's disk cache (≈ 0.3–1 s), which would otherwise be charged to whichever contender runs first."""
+    mbd.simulate(prob.model, t_end=state.t + 2e-7, state=state.copy(), stepper=mbd.PRODUCTION.stepper(),
+                 controller=mbd.FixedStep(1e-7), progress=False)
 
 
 def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float, h: float | None = None,

@@ -45,7 +45,7 @@ import mbd
 from components.outputs import FAMILY
 
 from .numerics_common import (dpgt_problem, error_metrics, eval_costs, machine_note, observables, peak_rss_mb,
-                              rig_problem, run_hht, run_scipy, settled_state)
+                              rig_problem, run_hht, run_scipy, settled_state, warm_up)
 
 __all__ = ["main", "study", "FIELDS"]
 
@@ -95,6 +95,7 @@ def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None,
     # roller outside the load zone for the whole short window would have RMS 0 and no relative error)
     ri = mbd.System(prob.model).outputs(s0.t, s0.q, s0.v, s0.z)[FAMILY["race_inner"]]["load"][prob.race_inner]
     prob.roller = prob.race_inner.start + int(np.argmax(ri))
+    warm_up(prob, s0)
     t0, t1 = s0.t, s0.t + P["window"]
     grid = t0 + P["dt"] * np.arange(int(round(P["window"] / P["dt"])) + 1)
     grid[-1] = min(grid[-1], t1)
