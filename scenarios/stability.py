@@ -40,8 +40,8 @@ import mbd
 from components.outputs import FAMILY
 from components.units import Q_
 
-from .numerics_common import Problem, StateSampler, design_verdict, dpgt_problem, machine_note, run_scipy,
-                              warm_up
+from .numerics_common import (Problem, StateSampler, design_verdict, dpgt_problem, machine_note, run_scipy,
+                              warm_up)
 
 __all__ = ["CASES", "case_overrides", "run_case_stability", "main", "FIELDS"]
 
