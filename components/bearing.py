@@ -11,10 +11,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from mbd.elements import BodySpring
-from mbd.elements.contact import (IMPACT_LAWS, TRACTION_LAWS, GuideContact, LubricantDrag, PocketContact,
-                                  RaceContact, SlideRollTraction, TanhTraction, Traction)
+from mbd.elements.contact import (IMPACT_LAWS, TRACTION_LAWS, EHLTraction, GuideContact, LubricantDrag,
+                                  PocketContact, RaceContact, SlideRollTraction, TanhTraction, Traction)
 
 from .families import FAMILY
+from .lubrication import reduced_modulus
 from .params import BearingSI, LubricantSI
 from .scene import Scene
 from .units import ParameterError
@@ -40,19 +41,31 @@ class BearingHandles:
 
 
 # each traction law from the bearing's SI parameters (a parameter, bearing.traction_law, names one)
+def _ehl(b, lub):
+    if lub is None:
+        raise ParameterError.at("bearing.traction_law", "'ehl' needs a lubricant (its viscosity and limiting "
+                                                        "shear); this scene has none")
+    E_red = reduced_modulus(b.elastic_modulus, b.poisson_ratio, b.elastic_modulus, b.poisson_ratio)
+    return EHLTraction(eta0=lub.oil_viscosity, alpha_p=lub.pressure_viscosity, E_red=E_red, length=b.roller_length,
+                       tau_L0=lub.limiting_shear_stress, gamma_L=lub.limiting_shear_slope,
+                       G_e=lub.film_shear_modulus, u_reg=lub.film_speed_reg)
+
+
 _TRACTION_FROM = {
-    "tanh": lambda b: TanhTraction(mu_max=b.traction_mu_max, v0=b.traction_v0),
-    "slide_roll": lambda b: SlideRollTraction(
+    "tanh": lambda b, lub: TanhTraction(mu_max=b.traction_mu_max, v0=b.traction_v0),
+    "slide_roll": lambda b, lub: SlideRollTraction(
         A=b.slide_roll_traction.A, B=b.slide_roll_traction.B, C=b.slide_roll_traction.C,
         D=b.slide_roll_traction.D, u_reg=b.slide_roll_traction.rolling_speed_reg,
         s_eps=b.slide_roll_traction.ratio_reg),
+    "ehl": _ehl,
 }
 assert set(_TRACTION_FROM) == set(TRACTION_LAWS)
 
 
-def traction(b: BearingSI) -> Traction:
-    """The roller–raceway traction law named by ``bearing.traction_law``, with its SI parameters."""
-    return _TRACTION_FROM[b.traction_law](b)
+def traction(b: BearingSI, lubricant: LubricantSI | None = None) -> Traction:
+    """The roller–raceway traction law named by ``bearing.traction_law``, with its SI parameters (the
+    lubricant's too, for the EHL law)."""
+    return _TRACTION_FROM[b.traction_law](b, lubricant)
 
 
 def bearing_kinematics(b: BearingSI, omega_inner: float, omega_outer: float) -> tuple[float, float]:
@@ -101,7 +114,7 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
     marker = np.tile(pin_local, (Z, 1))
     common = dict(D=D, K=b.contact_stiffness, zeta=b.contact_damping_ratio, m_roller=b.roller_mass,
                   multiplicity=b.rows)
-    law = dict(traction=traction(b), exponent=b.contact_exponent)     # family-wide laws
+    law = dict(traction=traction(b, lubricant), exponent=b.contact_exponent)     # family-wide laws
     inner = scene.family(FAMILY["race_inner"], RaceContact, ("roller", "race_body"), kind="inner", **law)
     s_in = inner.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker, R_race=b.inner_raceway_radius,
                      **common)

@@ -5,7 +5,8 @@
 * :func:`reduced_modulus` — E' = 2 / ((1 − ν₁²)/E₁ + (1 − ν₂²)/E₂) (Hamrock's convention).
 * :func:`roller_contact_radius` — the reduced radius R of a roller (diameter D) on a raceway of radius
   R_race: 1/R = 2/D + 1/R_race on the inner raceway (convex on convex), 2/D − 1/R_race on the outer one.
-* :func:`line_contact_film` — isothermal EHL film of a rectangular (line) contact, Pan & Hamrock (1989,
+* :func:`line_contact_film` — isothermal EHL film of a rectangular (line) contact (the formulas live in
+  :mod:`mbd.elements.ehl`, shared with the EHL traction law), Pan & Hamrock (1989,
   J. Tribol. 111: 246–251): with U = η₀u/(E'R), W' = w'/(E'R), G = α_p E' (u the entraining speed, w'
   the load per unit length),
       h_min / R = 1.714 W'^(−0.128) U^0.694 G^0.568,    h_c / R = 2.922 W'^(−0.166) U^0.692 G^0.470.
@@ -18,6 +19,8 @@ Scalars or numpy arrays (broadcast); SI units throughout.
 from __future__ import annotations
 
 import numpy as np
+
+from mbd.elements.ehl import film_central, film_min
 
 __all__ = ["walther_viscosity", "reduced_modulus", "roller_contact_radius", "line_contact_film",
            "dowson_higginson_film", "bearing_film"]
@@ -44,15 +47,12 @@ def roller_contact_radius(D, R_race, inner: bool):
 
 
 def line_contact_film(u, w_per_length, R, eta0, alpha_p, E_red):
-    """(h_min, h_c) [m] of Pan & Hamrock (1989). ``u`` entraining speed [m/s] (its magnitude counts),
-    ``w_per_length`` load per unit length [N/m] (> 0), ``R`` reduced radius [m], ``eta0`` dynamic viscosity
-    at the inlet [Pa·s], ``alpha_p`` pressure–viscosity coefficient [1/Pa], ``E_red`` E' [Pa]."""
-    U = eta0 * np.abs(u) / (E_red * R)
-    W = np.asarray(w_per_length, float) / (E_red * R)
-    G = alpha_p * E_red
-    h_min = R * 1.714 * W ** -0.128 * U ** 0.694 * G ** 0.568
-    h_c = R * 2.922 * W ** -0.166 * U ** 0.692 * G ** 0.470
-    return h_min, h_c
+    """(h_min, h_c) [m] of Pan & Hamrock (1989) (:mod:`mbd.elements.ehl` owns the formulas; the EHL
+    traction law uses the same). ``u`` entraining speed [m/s] (its magnitude counts), ``w_per_length``
+    load per unit length [N/m] (> 0), ``R`` reduced radius [m], ``eta0`` dynamic viscosity at the inlet
+    [Pa·s], ``alpha_p`` pressure–viscosity coefficient [1/Pa], ``E_red`` E' [Pa]."""
+    u, w, R = np.abs(np.asarray(u, float)), np.asarray(w_per_length, float), np.asarray(R, float)
+    return film_min(u, w, R, eta0, alpha_p, E_red), film_central(u, w, R, eta0, alpha_p, E_red)
 
 
 def dowson_higginson_film(u, w_per_length, R, eta0, alpha_p, E_red):

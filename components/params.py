@@ -561,7 +561,8 @@ class BearingParams(Params):
     contact_exponent: Quantity = _param("dimensionless", "load-deflection exponent p of Q = K delta^p", lo=1.0,
                                         bound_text=">= 1")
     contact_damping_ratio: Quantity = _nonneg("dimensionless", "roller-raceway contact damping ratio")
-    traction_law: str = _param("choice", "roller-raceway traction law", choices=("tanh", "slide_roll"))
+    traction_law: str = _param("choice", "roller-raceway traction law (ehl: from the lubricant's film)",
+                               choices=("tanh", "slide_roll", "ehl"))
     traction_mu_max: Quantity = _nonneg("dimensionless", "traction curve maximum mu_max (mu = mu_max tanh(v/v0))")
     traction_v0: Quantity = _pos("velocity", "traction curve slip velocity scale v0")
     slide_roll_traction: SlideRollTractionParams = _nested(SlideRollTractionParams, "slide-to-roll traction curve")
@@ -619,6 +620,12 @@ class LubricantParams(Params):
     temperature: Quantity = _pos("temperature", "oil temperature in the bearing")
     pressure_viscosity: Quantity = _pos("pressure_viscosity", "pressure-viscosity coefficient alpha_p (Barus)")
     roughness: Quantity = _pos("length", "composite roughness sigma = sqrt(Rq1^2 + Rq2^2) of roller and raceway")
+    limiting_shear_stress: Quantity = _pos("pressure", "limiting shear stress at zero pressure tau_L0 (EHL traction)")
+    limiting_shear_slope: Quantity = _nonneg("dimensionless", "pressure slope gamma_L of the limiting shear stress "
+                                                              "tau_L = tau_L0 + gamma_L p (Bair-Winer)")
+    film_speed_reg: Quantity = _pos("velocity", "entraining speed below which the EHL traction's film is regularised")
+    film_shear_modulus: Quantity = _pos("pressure", "elastic shear modulus G_e of the film in the contact (EHL "
+                                                    "traction's linear region, Johnson-Tevaarwerk)")
 
     _si_derived: ClassVar[tuple] = (
         Derived("oil_viscosity", float, "dynamic viscosity at the operating temperature [Pa s] (Walther, ASTM D341)"),

@@ -141,6 +141,12 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
             pressure_viscosity=assumed("2.2e-8 1/Pa", "mineral oil (Hamrock, Fundamentals of Fluid Film "
                                                       "Lubrication: 1.5-2.5e-8 1/Pa)"),
             roughness=assumed("0.15 um", "composite Rq of a ground raceway (~0.1 um) and a roller (~0.1 um)"),
+            limiting_shear_stress=assumed("2 MPa", "Bair and Winer (1979): small at zero pressure"),
+            limiting_shear_slope=assumed(0.07, "Bair and Winer (1979), mineral oils: tau_L/p ~ 0.05-0.1; with "
+                                               "it the EHL traction plateau is near the tanh law's 0.08"),
+            film_speed_reg=assumed("0.1 m/s", "far below the entraining speeds of m/s: matters only near rest"),
+            film_shear_modulus=assumed("1 GPa", "Johnson and Tevaarwerk (1977): 0.5-2 GPa for mineral oils in EHL "
+                                                "contacts"),
         ),
         support=SupportParams(
             sun_stiffness=assumed("1e8 N/m"),

@@ -7,6 +7,8 @@ Geometry from PARAMETERS.md: d_m = 39 mm, D = 7.5 mm, l = 9 mm, K = 1.22e9 N/m^(
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
@@ -15,7 +17,7 @@ import mbd
 from mbd.element import evaluate
 from mbd.errors import ModelError
 from mbd.model import FrameState
-from mbd.elements.contact import (IMPACT_LAWS, TRACTION_LAWS, ExactRestitution, GuideContact, ImpactLaw,
+from mbd.elements.contact import (IMPACT_LAWS, TRACTION_LAWS, EHLTraction, ExactRestitution, GuideContact, ImpactLaw,
                                   LubricantDrag, PocketContact, RaceContact, SlideRollTraction, TanhTraction,
                                   restitution_lambda)
 
@@ -80,7 +82,7 @@ def fd_jacobians(elem, qf, vf, z=None):
 # round-off scales of the outputs that are not forces (SI); forces are compared relative to the largest
 # (penetration rates: the direction of a tiny guide eccentricity carries the round-off of the centres)
 OUT_ATOL = {"deflection": 1e-15, "offset": 1e-15, "penetration": 1e-15, "eccentricity": 1e-15,
-            "slip_velocity": 1e-11, "angle": 1e-12, "penetration_rate": 1e-9, "approach_speed": 1e-9}
+            "slip_velocity": 1e-11, "rolling_speed": 1e-11, "angle": 1e-12, "penetration_rate": 1e-9, "approach_speed": 1e-9}
 
 
 def assert_jacobians(elem, qf, vf, rtol=1e-6, z=None):
@@ -187,6 +189,8 @@ def race_scene(kind, pose, vel, psi, angles, deltas, v_normal, v_orbit, slips):
 # the test laws (the preset's values, PARAMETERS.md): elements have no defaults for them
 TANH = TanhTraction(mu_max=0.08, v0=0.3)
 EHL = SlideRollTraction(A=-0.04, B=5.0, C=40.0, D=0.04, u_reg=0.1, s_eps=1e-4)
+FILM = EHLTraction(eta0=0.025, alpha_p=2.2e-8, E_red=2.31e11, length=LR, tau_L0=2e6, gamma_L=0.07, G_e=1e9,
+                   u_reg=0.1)
 LAW = dict(exponent=10.0 / 9.0, zeta=0.05, traction=TANH)
 
 
@@ -379,11 +383,82 @@ def test_ehl_curve_shape():
     slope = tr.coefficient(x, np.array([10.0])).der[0, 0] * np.sqrt(100.0 + tr.u_reg ** 2)
     assert slope == pytest.approx(f(tr.s_eps) / tr.s_eps, rel=1e-9)           # d/ds (s/a)f(a) at 0
     assert slope == pytest.approx(tr.B - tr.A * tr.C, rel=tr.C * tr.s_eps)   # ≈ f'(0), to O(C s_eps)
-    assert TRACTION_LAWS == {"tanh": TanhTraction, "slide_roll": SlideRollTraction}
+    assert TRACTION_LAWS == {"tanh": TanhTraction, "slide_roll": SlideRollTraction, "ehl": EHLTraction}
     with pytest.raises(ModelError, match="v0"):
         TanhTraction(mu_max=0.08, v0=0.0)
     with pytest.raises(TypeError):          # no defaults: every coefficient comes from the parameters
         SlideRollTraction(A=-0.04, B=5.0, C=40.0, D=0.04)
+
+
+def _film_mu(law, v_s, u=5.0, Q=2000.0, R=3e-3):
+    return law.coefficient(np.asarray(v_s, float), np.full(np.shape(v_s), u), np.full(np.shape(v_s), Q),
+                           np.full(np.shape(v_s), R))
+
+
+def test_ehl_traction_is_the_tanh_law_without_pressure_effects():
+    """γ_L = 0, a rigid film (G_e → ∞) and α_p·p ≪ 1 (viscosity and limiting shear uniform over the strip):
+    the tanh law with μ_max = τ_L0/p̄ and v0 = h_c τ_L0/η₀ (MODEL.md §3.8's limit), to α_p·p_max."""
+    from mbd.elements import ehl
+    law = EHLTraction(eta0=0.025, alpha_p=1e-13, E_red=2.31e11, length=LR, tau_L0=2e6, gamma_L=0.0, G_e=1e300,
+                      u_reg=0.1)
+    u, Q, R = 5.0, 2000.0, 3e-3
+    w = Q / LR
+    p_max = ehl.hertz_peak_pressure(w, R, law.E_red)
+    h_c = ehl.film_central(np.hypot(u, law.u_reg), w, R, law.eta0, law.alpha_p, law.E_red)
+    tanh = TanhTraction(mu_max=law.tau_L0 / (0.25 * np.pi * p_max), v0=h_c * law.tau_L0 / law.eta0)
+    v = np.linspace(-3.0, 3.0, 61) * tanh.v0
+    np.testing.assert_allclose(_film_mu(law, v, u, Q, R), tanh.coefficient(v) * np.sum(ehl.STRIP_WEIGHTS),
+                               rtol=2 * law.alpha_p * p_max, atol=1e-15)
+
+
+@settings(max_examples=60, deadline=None)
+@given(v_s=st.floats(-0.5, 0.5), u=st.floats(1.0, 10.0), Q=st.floats(100.0, 5000.0), R=st.floats(2e-3, 5e-3))
+def test_ehl_traction_derivatives_are_exact(v_s, u, Q, R):
+    """The law's dual-number derivatives in v_s, u and Q against central differences, at bearing-like
+    states (entraining speeds of m/s; at u → 0 the film vanishes and the law tends to a Coulomb step,
+    where no finite difference resolves it). The race element's Jacobian is built from these."""
+    from mbd import ad
+    args = [np.array([x]) for x in (v_s, u, Q)]
+    for j, step in enumerate((1e-7, 1e-6, 1e-3)):
+        dual = [ad.Dual(a, np.array([[1.0 if k == j else 0.0]])) for k, a in enumerate(args)]
+        d = FILM.coefficient(dual[0], dual[1], dual[2], np.array([R])).der[0, 0]
+        f = lambda x: FILM.coefficient(*[np.array([x]) if k == j else a for k, a in enumerate(args)],  # noqa: E731
+                                       np.array([R]))[0]
+        x0 = args[j][0]
+        fd = (8 * (f(x0 + step) - f(x0 - step)) - (f(x0 + 2 * step) - f(x0 - 2 * step))) / (12 * step)
+        assert d == pytest.approx(fd, rel=1e-5, abs=1e-9 * abs(f(x0)) / step)
+
+
+def test_ehl_traction_in_the_race_contact_balances():
+    """The race element with the EHL law: forces balance and the traction opposes the slip."""
+    state = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.3, [0.1, 1.0, 2.0, 3.0], [1e-5, 2e-5, -1e-5, 5e-6], \
+        [0.0] * 4, [3.0] * 4, [0.01, -0.02, 0.0, 0.2]
+    qf, vf, mk, R = race_scene("inner", *state)
+    elem = race_element("inner", N, mk, R, FILM)
+    F, out = assert_balanced(elem, qf, vf)
+    loaded = out["load"] > 0
+    assert np.all(out["traction"][loaded] * np.array(state[7])[loaded] <= 0)
+    assert np.all(np.abs(out["traction"][loaded]) < 0.08 * out["load"][loaded])
+
+
+def test_ehl_traction_curve_shape():
+    """Odd, linear at small slip, rising monotonically to the limiting-shear plateau
+    Σ w_k τ_L(p_k) / p̄ (isothermal Bair–Winer: no thermal drop after the maximum)."""
+    from mbd.elements import ehl
+    v = np.concatenate([[1e-6, 2e-6], np.logspace(-4, 1, 60)])
+    mu = _film_mu(FILM, v)
+    np.testing.assert_allclose(_film_mu(FILM, -v), -mu, rtol=1e-14)
+    assert mu[1] / mu[0] == pytest.approx(2.0, rel=1e-6)                  # linear at low slip
+    assert np.all(np.diff(mu) >= 0) and np.all(np.diff(mu[:8]) > 0)    # rises, then saturates (tanh = 1)
+    w = 2000.0 / LR
+    p_max = ehl.hertz_peak_pressure(w, 3e-3, FILM.E_red)
+    plateau = np.sum(ehl.STRIP_WEIGHTS * (FILM.tau_L0 + FILM.gamma_L * p_max * ehl.STRIP_NODES)) / (0.25 * np.pi * p_max)
+    assert mu[-1] == pytest.approx(plateau, rel=1e-6) and 0.06 < plateau < 0.08
+    # a thicker oil builds a thicker film: where the film's elasticity limits the shear (η_eff ≈ G_e b/u,
+    # independent of η at these pressures) the same slip shears it less; the plateau is the limiting shear
+    thick = dataclasses.replace(FILM, eta0=0.1)
+    assert _film_mu(thick, 1e-3) < _film_mu(FILM, 1e-3)
+    assert _film_mu(thick, 10.0) == pytest.approx(_film_mu(FILM, 10.0), rel=1e-9)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -1,9 +1,9 @@
 """Element families. Generic ones (supports, springs, loads, drives) and the contact/mesh laws used by components.
 
 Law variants are small classes registered by name (a parameter chooses one): :data:`TRACTION_LAWS`
-(roller–raceway traction), :data:`IMPACT_LAWS` (pocket and guide-land impact damping),
+(roller–raceway traction: tanh, slide_roll, ehl), :data:`IMPACT_LAWS` (pocket and guide-land impact damping),
 :data:`STIFFNESS_SHAPES` (mesh stiffness over a mesh cycle)."""
-from .contact import (IMPACT_LAWS, TRACTION_LAWS, ExactRestitution, Flores, GuideContact, HuntCrossley, ImpactLaw,
+from .contact import (IMPACT_LAWS, TRACTION_LAWS, EHLTraction, ExactRestitution, Flores, GuideContact, HuntCrossley, ImpactLaw,
                       LankaraniNikravesh, LubricantDrag, PocketContact, RaceContact, SlideRollTraction, TanhTraction,
                       Traction)
 from .drives import Ramp, SpeedDrive, TorqueSource
@@ -15,7 +15,7 @@ from .springs import BodySpring, GroundSupport, TorsionalSpring
 __all__ = [
     "BodySpring", "ForceSource", "GearMesh", "GroundSupport", "GuideContact", "LubricantDrag", "PocketContact",
     "RaceContact", "Ramp", "SpeedDrive", "TorqueSource", "TorsionalSpring",
-    "Traction", "TanhTraction", "SlideRollTraction", "TRACTION_LAWS",
+    "Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS",
     "ImpactLaw", "ExactRestitution", "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS",
     "StiffnessShape", "ConstantStiffness", "RectangularStiffness", "FourierStiffness", "STIFFNESS_SHAPES",
     "mesh_offset", "mesh_u0",

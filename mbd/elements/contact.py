@@ -24,10 +24,11 @@ from types import MappingProxyType
 import numpy as np
 
 from .. import ad
+from . import ehl
 from ..element import Element, body_dofs, marker, marker_velocity, point_force
 from ..errors import ModelError
 
-__all__ = ["Traction", "TanhTraction", "SlideRollTraction", "TRACTION_LAWS", "ImpactLaw", "ExactRestitution",
+__all__ = ["Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS", "ImpactLaw", "ExactRestitution",
            "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS", "RaceContact", "PocketContact",
            "GuideContact", "LubricantDrag", "restitution_lambda"]
 
@@ -202,6 +203,8 @@ class Traction:
     small frozen dataclass registered in :data:`TRACTION_LAWS` by name; its fields have no defaults
     (every value comes from the parameters)."""
     needs_rolling_speed = False
+    needs_load = False          # True: coefficient(v_s, u_roll, load, radius) — the contact's load Q [N] and
+                                # reduced radius [m] as well (laws of the lubricant film)
 
     def _check(self, positive=(), nonneg=()):
         name = type(self).__name__
@@ -257,8 +260,52 @@ class SlideRollTraction(Traction):
         return (s / a) * ((self.A + self.B * a) * ad.exp(a * (-self.C)) + self.D)
 
 
+@dataclass(frozen=True)
+class EHLTraction(Traction):
+    """EHL traction of a lubricated line contact (MODEL.md §3.8). Over the Hertz strip (8 Gauss points),
+    the oil film shears with the effective viscosity of a Maxwell fluid crossing the contact,
+    1/η_eff = 1/η(p) + u/(G_e b) (Barus η = eta0·e^(alpha_p·p); G_e the film's elastic shear modulus,
+    b the Hertz half-width, u the entraining speed: a film element is sheared only for the transit time
+    b/u, Johnson & Tevaarwerk 1977), limited by the limiting shear stress τ_L = tau_L0 + gamma_L·p
+    (Bair & Winer 1979): τ = τ_L·tanh(η_eff v_s /(h_c τ_L)), smooth and odd in v_s; μ = mean τ / mean p.
+    h_c is Pan & Hamrock's central film (:mod:`mbd.elements.ehl`) with the entraining speed regularised to
+    √(u² + u_reg²); the load per unit length is Q/length, E_red the reduced modulus E'. Without the
+    elastic limit (G_e → ∞) Barus makes the low-slip slope astronomically steep (η e^(α p) ~ 1e12 Pa·s
+    at 1.5 GPa); with alpha_p = gamma_L = 0 and G_e → ∞ it is the tanh law with μ_max = tau_L0/p̄ and
+    v0 = h_c·tau_L0/eta0 (p̄ the mean Hertz pressure)."""
+    eta0: float
+    alpha_p: float
+    E_red: float
+    length: float
+    tau_L0: float
+    gamma_L: float
+    G_e: float
+    u_reg: float
+    needs_rolling_speed = True
+    needs_load = True
+
+    def __post_init__(self):
+        self._check(positive=("eta0", "E_red", "length", "tau_L0", "G_e", "u_reg"), nonneg=("alpha_p", "gamma_L"))
+
+    def coefficient(self, v_s, u_roll=None, load=None, radius=None):
+        w = load * (1.0 / self.length)
+        u = ad.sqrt(u_roll * u_roll + self.u_reg ** 2)
+        h_c = ehl.film_central(u, w, radius, self.eta0, self.alpha_p, self.E_red)
+        p_max = ehl.hertz_peak_pressure(w, radius, self.E_red)
+        elastic = u / (self.G_e * ehl.hertz_half_width(w, radius, self.E_red))   # transit-time compliance
+        shear_rate = v_s / h_c
+        tau = 0.0
+        for a, wq in zip(ehl.STRIP_NODES, ehl.STRIP_WEIGHTS):
+            p = p_max * a
+            tau_L = self.tau_L0 + self.gamma_L * p
+            eta_eff = 1.0 / (ad.exp(-self.alpha_p * p) * (1.0 / self.eta0) + elastic)
+            tau = tau + wq * tau_L * ad.tanh(eta_eff * shear_rate / tau_L)
+        return tau / (p_max * (0.25 * np.pi))
+
+
 # the traction laws by name (a parameter chooses one)
-TRACTION_LAWS = MappingProxyType({"tanh": TanhTraction, "slide_roll": SlideRollTraction})
+TRACTION_LAWS = MappingProxyType({"tanh": TanhTraction, "slide_roll": SlideRollTraction,
+                                  "ehl": EHLTraction})
 
 
 # --------------------------------------------------------------------------------------------
@@ -311,10 +358,11 @@ class RaceContact(Element):
         self.traction = traction
         self._c0 = 2.0 * self.zeta * np.sqrt(self.m_roller * self.exponent * self.K)
         self.kappa = np.full(self.n, self.kappa)   # per instance: inner and outer families can be fused
+        self.R_red = 1.0 / (2.0 / self.D + self.kappa / self.R_race)   # reduced radius: convex inner, concave outer
         self.multiplicity = _multiplicity(self, multiplicity)
         self._multi = bool(np.any(self.multiplicity != 1.0))
 
-    _FUSED = ("dofs", "race_marker", "R_race", "D", "K", "zeta", "m_roller", "_c0", "kappa", "multiplicity")
+    _FUSED = ("dofs", "race_marker", "R_race", "D", "K", "zeta", "m_roller", "_c0", "kappa", "R_red", "multiplicity")
 
     def fuse_key(self):
         return ("RaceContact", self.exponent, self.traction)
@@ -356,7 +404,11 @@ class RaceContact(Element):
         # whose velocity along t is ċ·t + R (ṗ − ċ)·t / ρ
         vP = Vc[0] * tx + Vc[1] * ty + R * (wx * tx + wy * ty) / rho
         u_e = 0.5 * (ur + ub) - vP
-        mu = self.traction.coefficient(v_s, u_e) if self.traction.needs_rolling_speed else self.traction.coefficient(v_s)
+        tr = self.traction
+        if tr.needs_load:           # a law of the film: the load per contact (1 N where none: F_t = −μQ = 0)
+            mu = tr.coefficient(v_s, u_e, ad.where(ad.value(Q) > 0.0, Q, 1.0), self.R_red)
+        else:
+            mu = tr.coefficient(v_s, u_e) if tr.needs_rolling_speed else tr.coefficient(v_s)
         Ft = -1.0 * mu * Q
         Fx = kap * Q * ex + Ft * tx
         Fy = kap * Q * ey + Ft * ty
