@@ -23,17 +23,18 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 from mbd.compiled.contact import KERNELS, TRACTION_IDS, pack_race
 from mbd.element import evaluate
 from mbd.model import FrameState
-from mbd.elements.contact import (IMPACT_LAWS, GuideContact, LubricantDrag, PocketContact, RaceContact,
-                                  SlideRollTraction, TanhTraction, Traction)
+from mbd.elements.contact import (IMPACT_LAWS, EHLTraction, GuideContact, LubricantDrag, PocketContact,
+                                  RaceContact, SlideRollTraction, TanhTraction, Traction)
 from strategies import frame_states
-from test_contact import (C_G, DM, DR, EHL, K_G, K_HZ, M_ROLLER, N, TANH, drag_scene, drag_states, guide_scene,
+from test_contact import (C_G, DM, DR, EHL, FILM, K_G, K_HZ, M_ROLLER, N, TANH, drag_scene, drag_states, guide_scene,
                           guide_states, pocket_scene, pocket_states, race_scene, race_states, stored_speeds)
 
 RTOL = 1e-10           # of the largest entry of the instance's block
+RTOL_FILM = 1e-8       # Jacobians with the EHL traction law (see assert_matches_reference)
 ATOL = 1e-300          # F and J_q: an all-zero reference block must be matched by zeros
 ATOL_JV = 1e-10        # J_v: the reference's round-off floor (module docstring)
 SETTINGS = settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-TRACTIONS = {"tanh": TANH, "ehl": EHL}
+TRACTIONS = {"tanh": TANH, "ehl": EHL, "film": FILM}
 LAWS = st.sampled_from(sorted(IMPACT_LAWS))
 MULTS = st.one_of(st.just(1), st.lists(st.integers(1, 3), min_size=N, max_size=N))
 
@@ -50,13 +51,13 @@ def compiled(elem, fs, qf, vf, z, jac, t=0.0):
     return F, Jq, Jv
 
 
-def assert_blocks_close(name, A, B, atol):
-    """|A − B| <= RTOL·max|B| + atol per instance block."""
+def assert_blocks_close(name, A, B, atol, rtol=RTOL):
+    """|A − B| <= rtol·max|B| + atol per instance block."""
     assert A.shape == B.shape and np.all(np.isfinite(A)), name
     for i in range(B.shape[0]):
         err = np.abs(A[i] - B[i]).max()
         scale = np.abs(B[i]).max()
-        assert err <= RTOL * scale + atol, f"{name} instance {i}: max error {err:.3e}, scale {scale:.3e}\n{A[i]}\n{B[i]}"
+        assert err <= rtol * scale + atol, f"{name} instance {i}: max error {err:.3e}, scale {scale:.3e}\n{A[i]}\n{B[i]}"
 
 
 def assert_matches_reference(elem, fs, qf, vf, z=None):
@@ -67,10 +68,13 @@ def assert_matches_reference(elem, fs, qf, vf, z=None):
     F0r, _, _, _ = evaluate(elem, t, fs, qf, vf, zr, False)
     F, Jq, Jv = compiled(elem, fs, qf, vf, z, True, t)
     F0, _, _ = compiled(elem, fs, qf, vf, z, False, t)
+    # the EHL film law's Jacobian passes through exp(−α_p p) (α_p p up to ≈ 40) and a saturating tanh, whose
+    # 1 − tanh² the reference's dual numbers form with cancellation: seen up to 2.4e-10 of the block
+    rj = RTOL_FILM if isinstance(getattr(elem, "traction", None), EHLTraction) else RTOL
     assert_blocks_close(f"{elem.name} F", F, Fr, ATOL)
     assert_blocks_close(f"{elem.name} F (no jac)", F0, F0r, ATOL)
-    assert_blocks_close(f"{elem.name} J_q", Jq, Jqr, ATOL)
-    assert_blocks_close(f"{elem.name} J_v", Jv, Jvr, ATOL_JV)
+    assert_blocks_close(f"{elem.name} J_q", Jq, Jqr, ATOL, rj)
+    assert_blocks_close(f"{elem.name} J_v", Jv, Jvr, ATOL_JV, rj)
     np.testing.assert_array_equal(F0, F)     # the value path does not depend on jac
     return Fr
 
@@ -87,7 +91,7 @@ RACE_LAW = dict(exponent=st.sampled_from([10.0 / 9.0, 1.5, 1.0]), zeta=st.sample
 
 # ---------------------------------------------------------------------------------------------- race
 @pytest.mark.parametrize("kind", ["inner", "outer"])
-@pytest.mark.parametrize("law", ["tanh", "ehl"])
+@pytest.mark.parametrize("law", ["tanh", "ehl", "film"])
 @SETTINGS
 @given(data=st.data(), fs=frame_states(), **RACE_LAW)
 def test_race_matches_reference(kind, law, data, fs, exponent, zeta, multiplicity):
@@ -101,7 +105,7 @@ def _joined(a, b):
     return np.concatenate([a[0], b[0]]), np.concatenate([a[1], b[1]])
 
 
-@pytest.mark.parametrize("law", ["tanh", "ehl"])
+@pytest.mark.parametrize("law", ["tanh", "ehl", "film"])
 @SETTINGS
 @given(data=st.data(), fs=frame_states(), m_in=MULTS, m_out=MULTS)
 def test_fused_inner_outer_race_family(law, data, fs, m_in, m_out):
@@ -129,7 +133,7 @@ def test_race_pack_layout_and_unknown_traction():
     P, G = pack_race(race("inner", mk, R, EHL, multiplicity=2, bodies=([1], 0)))
     assert P.shape == (1, 8) and P.flags.c_contiguous and P[0, 0] == 1.0 and P[0, 7] == 2.0
     np.testing.assert_array_equal(G, [10.0 / 9.0, TRACTION_IDS[SlideRollTraction], EHL.A, EHL.B, EHL.C, EHL.D,
-                                      EHL.u_reg, EHL.s_eps])
+                                      EHL.u_reg, EHL.s_eps, 0.0, 0.0])
     assert TRACTION_IDS[TanhTraction] == 0 and pack_race(race("inner", mk, R, TANH, bodies=([1], 0)))[1][1] == 0
 
     class Linear(Traction):

@@ -109,3 +109,24 @@ def test_what_cannot_be_compiled_falls_back_or_says_why():
         mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="compiled", **kw)
     with pytest.raises(mbd.ModelError, match="engine must be one of"):
         mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="fast", **kw)
+
+
+def test_the_kernel_cache_is_dropped_when_any_compiled_source_changes(tmp_path, monkeypatch):
+    """numba caches a function against its own file only: the compiled package keeps a hash of all its
+    sources beside the cache and drops every cached kernel when it changes (a stale dispatch once kept
+    an old race kernel)."""
+    import importlib
+
+    import mbd.compiled as mc
+    from numba import config
+    monkeypatch.setattr(config, "CACHE_DIR", str(tmp_path))
+    stale = tmp_path / "registry.evaluate_kind-45.py311.nbi"
+    stale.write_text("old")
+    keep = tmp_path / "other_module.f-1.py311.nbi"
+    keep.write_text("not ours")
+    importlib.reload(mc)                       # the hash in tmp_path is missing: a change
+    assert not stale.exists() and keep.exists()
+    stamp = (tmp_path / "compiled_sources.sha256").read_text()
+    stale.write_text("fresh")                  # same sources: nothing is dropped
+    importlib.reload(mc)
+    assert stale.exists() and (tmp_path / "compiled_sources.sha256").read_text() == stamp

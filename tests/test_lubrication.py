@@ -111,9 +111,8 @@ def test_the_thinnest_film_of_each_bearing_scales_with_the_oil(loaded_state):
 
 
 def test_ehl_traction_is_selectable_and_runs_on_the_rig():
-    """bearing.traction_law = "ehl" builds the EHL law from the lubricant; a loaded rig runs with it
-    (on the numpy engine: the compiled kernels do not have this law yet, and the auto engine says so by
-    falling back)."""
+    """bearing.traction_law = "ehl" builds the EHL law from the lubricant; a loaded rig runs with it on
+    the compiled engine."""
     from mbd.elements import EHLTraction
     from scenarios.numerics_common import rig_problem
     prob = rig_problem(overrides={"bearing.traction_law": "ehl"})
@@ -122,7 +121,7 @@ def test_ehl_traction_is_selectable_and_runs_on_the_rig():
     assert isinstance(law, EHLTraction) and law.eta0 == lub.oil_viscosity and law.G_e == lub.film_shear_modulus
     res = mbd.simulate(prob.model, prob.built.q0, prob.built.v0, 0.002, stepper=mbd.PRODUCTION.stepper(),
                        controller=mbd.PRODUCTION.controller(), progress=False)
-    assert res.engine == "numpy"
+    assert res.engine == "compiled"
     out = mbd.System(prob.model).outputs(res.state.t, res.state.q, res.state.v, res.state.z)["race_inner"]
     loaded = out["load"] > 0
     assert loaded.any() and np.all(np.abs(out["traction"][loaded]) <= 0.08 * out["load"][loaded])

@@ -18,3 +18,37 @@ Kernel convention (one module per group of element families; every function ``@n
 ``update(z, t0, t1, ql0, vl0, ql1, vl1, P, G) -> z1`` (families with internal state only)
     the internal state after an accepted step, as ``Element.update_internal``.
 """
+
+import hashlib as _hashlib
+import os as _os
+from pathlib import Path as _Path
+
+
+def _drop_stale_kernels() -> None:
+    """numba's disk cache keys a function on its own source file only: a kernel compiled into the
+    dispatch (registry), the assembly or the step loop keeps a changed kernel's old code. So the cache of
+    the whole compiled path is dropped whenever any source it compiles from changes (a hash of those
+    files, kept beside the cache)."""
+    here = _Path(__file__).resolve().parent
+    sources = sorted(here.glob("*.py")) + [here.parent / "rules.py", here.parent / "elements" / "ehl.py"]
+    digest = _hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()
+    from numba import config
+    roots = [_Path(config.CACHE_DIR)] if config.CACHE_DIR else [here / "__pycache__", here.parent / "__pycache__"]
+    stamp = roots[0] / "compiled_sources.sha256"
+    try:
+        if stamp.is_file() and stamp.read_text().strip() == digest:
+            return
+        names = tuple(p.stem + "." for p in sources)
+        for root in roots:
+            for f in root.rglob("*.nb[ic]") if root.is_dir() else ():
+                if f.name.startswith(names):
+                    f.unlink(missing_ok=True)
+        stamp.parent.mkdir(parents=True, exist_ok=True)
+        tmp = stamp.with_suffix(f".{_os.getpid()}.tmp")
+        tmp.write_text(digest)
+        _os.replace(tmp, stamp)
+    except OSError:          # a read-only install: numba then compiles in memory (it cannot cache either)
+        pass
+
+
+_drop_stale_kernels()

@@ -5,8 +5,9 @@ Layouts (P: one row per instance, columns in this order; G: family-wide values):
 
 ``RaceContact``   P (n, 8): κ (+1 inner, −1 outer: per instance, so a fused inner + outer family packs
                   as one), race_marker x, y [m], R_race [m], D [m], K, c₀ = 2ζ·sqrt(m_roller·p·K), multiplicity
-                  G (8,): exponent p, traction law id, then the law's coefficients:
-                  law 0 (TanhTraction): mu_max, v0, 0, 0, 0, 0;  law 1 (SlideRollTraction): A, B, C, D, u_reg, s_eps
+                  G (10,): exponent p, traction law id, then the law's coefficients (zero-padded):
+                  law 0 (TanhTraction): mu_max, v0;  law 1 (SlideRollTraction): A, B, C, D, u_reg, s_eps;
+                  law 2 (EHLTraction): eta0, alpha_p, E_red, length, tau_L0, gamma_L, G_e, u_reg
 ``PocketContact`` P (n, 10): pocket_angle ψ, pitch_radius, clearance, K_p, λ (impact law damping), v_min, mu,
                   v_mu, D, multiplicity;  G (0,)
 ``GuideContact``  P (n, 7): clearance, K_g, λ, v_min, mu, v_mu, land_radius;  G (0,)
@@ -33,16 +34,18 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..elements.contact import (GuideContact, LubricantDrag, PocketContact, RaceContact, SlideRollTraction,
-                                TanhTraction)
+from ..elements import ehl
+from ..elements.contact import (EHLTraction, GuideContact, LubricantDrag, PocketContact, RaceContact,
+                                SlideRollTraction, TanhTraction)
 
 __all__ = ["pack_race", "evaluate_race", "pack_pocket", "evaluate_pocket", "update_pocket", "pack_guide",
            "evaluate_guide", "update_guide", "pack_drag", "evaluate_drag", "KERNELS", "TRACTION_IDS"]
 
 _ETA2 = 1e-24          # the reference's η² (mbd.elements.contact._ETA2)
 _TWO_PI = 2.0 * np.pi
-TANH, SLIDE_ROLL = 0, 1
-TRACTION_IDS = {TanhTraction: TANH, SlideRollTraction: SLIDE_ROLL}
+TANH, SLIDE_ROLL, EHL = 0, 1, 2
+TRACTION_IDS = {TanhTraction: TANH, SlideRollTraction: SLIDE_ROLL, EHLTraction: EHL}
+_STRIP_A, _STRIP_W = ehl.STRIP_NODES.copy(), ehl.STRIP_WEIGHTS.copy()
 
 
 # ------------------------------------------------------------------------------------------ pack
@@ -61,15 +64,18 @@ def pack_race(elem):
     tr = elem.traction
     law = TRACTION_IDS.get(type(tr))
     if law == TANH:
-        coef = [tr.mu_max, tr.v0, 0.0, 0.0, 0.0, 0.0]
+        coef = [tr.mu_max, tr.v0]
     elif law == SLIDE_ROLL:
         coef = [tr.A, tr.B, tr.C, tr.D, tr.u_reg, tr.s_eps]
+    elif law == EHL:
+        coef = [tr.eta0, tr.alpha_p, tr.E_red, tr.length, tr.tau_L0, tr.gamma_L, tr.G_e, tr.u_reg]
     else:
         raise NotImplementedError(f"{elem.name}: RaceContact with traction law {type(tr).__name__} has no "
                                   f"compiled kernel (compiled: {sorted(c.__name__ for c in TRACTION_IDS)})")
     mk = elem.race_marker
     P = _rows(elem.kappa, mk[:, 0], mk[:, 1], elem.R_race, elem.D, elem.K, elem._c0, elem.multiplicity)
-    G = np.array([elem.exponent, float(law), *coef], dtype=np.float64)
+    G = np.zeros(10)
+    G[:2 + len(coef)] = [elem.exponent, float(law), *coef]
     return P, G
 
 
@@ -149,7 +155,8 @@ def _zero(F, Jq, Jv, i, jac):
 
 @njit(cache=True)
 def _traction(law, G, v_s, u):
-    """Traction coefficient μ(v_s, u_roll) and its partials ∂μ/∂v_s, ∂μ/∂u_roll (G layout: module doc)."""
+    """Traction coefficient μ(v_s, u_roll) and its partials ∂μ/∂v_s, ∂μ/∂u_roll (G layout: module doc) of
+    the laws that do not depend on the load (tanh, slide_roll)."""
     if law == TANH:
         mu_max, v0 = G[2], G[3]
         th = np.tanh(v_s * (1.0 / v0))
@@ -166,6 +173,47 @@ def _traction(law, G, v_s, u):
     # of 1 − r² at |s| ≫ s_eps (the reference's dual numbers carry it: see the test module)
     dmu_ds = g * (s_eps * s_eps / (a * a * a)) + r * r * dg
     return r * g, dmu_ds / h, -dmu_ds * s * u / (h * h)
+
+
+@njit(cache=True)
+def _ehl_traction(G, v_s, u, Q, Rr):
+    """EHLTraction.coefficient (the reference's operations) and ∂μ/∂v_s, ∂μ/∂u, ∂μ/∂Q for a contact of
+    reduced radius Rr. Film h_c = C w^−0.166 ũ^0.692, p_max, b ∝ √w, so each scales as a power of Q."""
+    eta0, alpha, E, length, tauL0, gam, G_e, u_reg = G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9]
+    w = Q * (1.0 / length)
+    ut = np.sqrt(u * u + u_reg ** 2)
+    U, W, Gm = eta0 * ut / (E * Rr), w * (1.0 / (E * Rr)), alpha * E
+    h_c = Rr * 2.922 * Gm ** 0.470 * W ** -0.166 * U ** 0.692
+    hc_u, hc_Q = 0.692 * h_c * u / (ut * ut), -0.166 * h_c / Q
+    p_max = np.sqrt(w * (E / (2.0 * np.pi * Rr)))
+    b = np.sqrt(w * (8.0 * Rr / (np.pi * E)))
+    el = ut / (G_e * b)
+    el_u, el_Q = (u / ut) / (G_e * b), -0.5 * el / Q
+    sr = v_s / h_c
+    tau, t_s, t_u, t_Q = 0.0, 0.0, 0.0, 0.0
+    for k in range(_STRIP_A.size):
+        p = p_max * _STRIP_A[k]
+        p_Q = 0.5 * p / Q
+        L = tauL0 + gam * p
+        inv_eta = np.exp(-alpha * p) * (1.0 / eta0)
+        e = 1.0 / (inv_eta + el)
+        X = e * sr / L
+        th = np.tanh(X)
+        wk = _STRIP_W[k]
+        tau += wk * L * th
+        dX = L * (1.0 - th * th)                       # ∂τ/∂X; ∂τ/∂L|_X = th, ∂X/∂L = −X/L
+        e2 = e * e
+        # v_s: only the shear rate; u: the film and the elastic compliance; Q: all of p, L, η, b, h_c
+        t_s += wk * dX * e / (h_c * L)
+        de_u = -e2 * el_u
+        t_u += wk * dX * (de_u * sr - e * sr * hc_u / h_c) / L
+        L_Q = gam * p_Q
+        de_Q = -e2 * (-alpha * inv_eta * p_Q + el_Q)
+        X_Q = (de_Q * sr - e * sr * hc_Q / h_c) / L - X * L_Q / L
+        t_Q += wk * (th * L_Q + dX * X_Q)
+    pbar = 0.25 * np.pi * p_max
+    mu = tau / pbar
+    return mu, t_s / pbar, t_u / pbar, t_Q / pbar - mu * 0.5 / Q
 
 
 @njit(cache=True)
@@ -242,9 +290,13 @@ def evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         v_s = ur - ub
         wt = wx * tx + wy * ty
         u = 0.0
-        if law == SLIDE_ROLL:                    # rolling speed relative to the moving contact point
+        if law != TANH:                          # rolling speed relative to the moving contact point
             u = 0.5 * (ur + ub) - (Vcx * tx + Vcy * ty + R * wt / rho)
-        mu, mu_s, mu_u = _traction(law, G, v_s, u)
+        mu_Q = 0.0
+        if law == EHL:                           # the film's law needs the load and the reduced radius
+            mu, mu_s, mu_u, mu_Q = _ehl_traction(G, v_s, u, Q, 1.0 / (2.0 / D + kap / R))
+        else:
+            mu, mu_s, mu_u = _traction(law, G, v_s, u)
         Ft = -mu * Q
         Fx = kap * Q * ex + Ft * tx
         Fy = kap * Q * ey + Ft * ty
@@ -270,8 +322,8 @@ def evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
             dVbx, dVby = dvb0 - dvb2 * rby - vb2 * drby, dvb1 + dvb2 * rbx + vb2 * drbx
             dur = dVrx * tx + Vrx * dtx + dVry * ty + Vry * dty
             dub = dVbx * tx + Vbx * dtx + dVby * ty + Vby * dty
-            dmu = mu_s * (dur - dub)
-            if law == SLIDE_ROLL:
+            dmu = mu_s * (dur - dub) + mu_Q * dQ
+            if law != TANH:
                 dwt = dwx * tx + wx * dtx + dwy * ty + wy * dty
                 dvP = dVcx * tx + Vcx * dtx + dVcy * ty + Vcy * dty + R * (dwt - wt * drho / rho) / rho
                 dmu += mu_u * (0.5 * (dur + dub) - dvP)
