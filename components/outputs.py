@@ -256,7 +256,7 @@ class WindowStatistics(mbd.Observer):
             return p.roller_bearing
         if key == "pocket_force":
             return p.pocket_bearing
-        if key.startswith(("load_", "cage_", "guide_", "planet_", "film_")):
+        if key.startswith(("load_", "cage_", "guide_", "planet_", "film_", "heat_", "traction_")):
             return np.arange(p.planet.size)
         return None
 
@@ -274,8 +274,10 @@ class WindowStatistics(mbd.Observer):
             pin = pin_reactions(ri, slice(None), p.roller_bearing, nb, p.rows)
             snap["roller_inner_load"] = np.asarray(ri["load"], float)
             snap["roller_outer_load"] = np.asarray(out[FAMILY["race_outer"]]["load"], float)
+            ro = out[FAMILY["race_outer"]]
+            snap["heat_traction"], snap["traction_coefficient"] = self._traction_heat(ri, ro, nb)
             if self._lubricant is not None:
-                snap["film_thinnest"] = self._thinnest_film(ri, out[FAMILY["race_outer"]], nb)
+                snap["film_thinnest"] = self._thinnest_film(ri, ro, nb)
                 snap["film_lambda"] = snap["film_thinnest"] / self._lubricant.roughness
             if p.pocket_bearing is not None:
                 snap["pocket_force"] = np.asarray(out[FAMILY["pocket"]]["force"], float)
@@ -298,7 +300,9 @@ class WindowStatistics(mbd.Observer):
             snap["cage_speed_rel"] = V[p.cage, 2] - V[p.carrier, 2]
             snap["planet_speed_rel"] = V[p.planet, 2] - V[p.carrier, 2]
             if p.guide is not None:
-                snap["guide_force"] = np.asarray(out[FAMILY["guide"]]["force"], float)[p.guide]
+                g = out[FAMILY["guide"]]
+                snap["guide_force"] = np.asarray(g["force"], float)[p.guide]
+                snap["heat_land"] = np.abs(np.asarray(g["friction"], float) * g["sliding_speed"])[p.guide]
         for key, fam in self.meshes.items():
             o, f = out[fam], self.flanks.get(key, 1)
             drive, coast = ("", "_coast") if f > 0 else ("_coast", "")
@@ -309,6 +313,17 @@ class WindowStatistics(mbd.Observer):
         if p.rollers:
             snap["_roller_angle"] = self._roller_angles(X)
         return snap
+
+    def _traction_heat(self, race_inner, race_outer, nb) -> tuple[np.ndarray, np.ndarray]:
+        """Per bearing: the power the roller–raceway traction dissipates, Σ |F_t v_s| over every physical
+        roller and both raceways [W], and the largest traction coefficient |F_t|/Q of a loaded contact."""
+        owner, rows = self.plan.roller_bearing, self.plan.rows
+        heat, mu = np.zeros(nb), np.zeros(nb)
+        for race in (race_inner, race_outer):
+            Ft, Q = np.asarray(race["traction"], float), np.asarray(race["load"], float)
+            heat += np.bincount(owner, weights=rows * np.abs(Ft * race["slip_velocity"]), minlength=nb)
+            np.maximum.at(mu, owner, np.where(Q > 0.0, np.abs(Ft) / np.where(Q > 0.0, Q, 1.0), 0.0))
+        return heat, mu
 
     def _thinnest_film(self, race_inner, race_outer, nb) -> np.ndarray:
         """Per bearing, the thinnest EHL film h_min [m] over its loaded roller contacts, both raceways."""
@@ -537,6 +552,7 @@ class WindowStatistics(mbd.Observer):
             d["equivalent_load_N"] = float(self.stats("load_life")["mean"][ref] ** (1.0 / LIFE_EXPONENT))
             if p.rollers:
                 self._roller_summary(d, kind, sel)
+                self._heat_summary(d, ref, sel)
                 if self._lubricant is not None:
                     self._film_summary(d, sel)
             if p.cage is not None:
@@ -580,6 +596,16 @@ class WindowStatistics(mbd.Observer):
                 d["pocket_impact_peak_max_N"] = float(im["peak_max"][pk].max())
                 d["pocket_impact_peak_mean_N"] = float(im["peak_sum"][pk].sum() / count) if count else 0.0
         d["all_rollers"] = al
+
+    def _heat_summary(self, d, ref, sel):
+        """Heat from traction and land friction (time means, W): the reference bearing's and the mean of its
+        kind; the largest traction coefficient of a loaded contact."""
+        for key, name in (("heat_traction", "traction"), ("heat_land", "land")):
+            if key in (self._keys or ()):
+                m = self.stats(key)["mean"]
+                d[f"heat_{name}_W"] = float(m[ref])
+                d[f"heat_{name}_W_all"] = float(m[sel].mean())
+        d["traction_coefficient_max"] = float(self.stats("traction_coefficient")["max"][sel].max())
 
     def _film_summary(self, d, sel):
         """The thinnest EHL film of the bearings ``sel`` (every bearing of this kind): its smallest value in

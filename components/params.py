@@ -609,7 +609,8 @@ class LubricantParams(Params):
     40 °C and 100 °C (an ISO VG grade's data sheet) gives its viscosity at the operating temperature by
     Walther's equation (ASTM D341); with the pressure–viscosity coefficient and the surfaces' composite
     roughness it sets the EHL film of every roller contact (:mod:`components.lubrication`).
-    ``si()`` adds ``oil_viscosity``, the dynamic viscosity at the operating temperature [Pa·s]."""
+    ``oil_viscosity`` (the dynamic viscosity at the operating temperature [Pa·s]) follows from these unless
+    given (a study of viscosity sets it directly)."""
 
     _prefix: ClassVar[str] = "lubricant"
     drag_coefficient: Quantity = _nonneg("dimensionless", "drag coefficient C_d")
@@ -627,14 +628,19 @@ class LubricantParams(Params):
     film_shear_modulus: Quantity = _pos("pressure", "elastic shear modulus G_e of the film in the contact (EHL "
                                                     "traction's linear region, Johnson-Tevaarwerk)")
 
+    oil_viscosity: Quantity | None = _rule("dynamic_viscosity", "derived", "Walther (ASTM D341) at the temperature, "
+                                                                          "times the oil density")
+
     _si_derived: ClassVar[tuple] = (
-        Derived("oil_viscosity", float, "dynamic viscosity at the operating temperature [Pa s] (Walther, ASTM D341)"),
+        Derived("oil_viscosity", float, "dynamic viscosity at the operating temperature [Pa s] (given, or Walther)"),
     )
 
     def _si_values(self, v):
         if not v["viscosity_100"] < v["viscosity_40"]:
             raise ParameterError.at("lubricant.viscosity_100", "must be below lubricant.viscosity_40 "
                                                                  "(an oil thins as it warms)")
+        if v["oil_viscosity"] is not None:
+            return dict(oil_viscosity=v["oil_viscosity"])
         from .lubrication import walther_viscosity
         return dict(oil_viscosity=v["oil_density"] * walther_viscosity(v["viscosity_40"], v["viscosity_100"],
                                                                        v["temperature"]))

@@ -11,7 +11,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, example, given, settings, strategies as st
 
 import mbd
 from mbd.element import evaluate
@@ -413,6 +413,7 @@ def test_ehl_traction_is_the_tanh_law_without_pressure_effects():
 
 @settings(max_examples=60, deadline=None)
 @given(v_s=st.floats(-0.5, 0.5), u=st.floats(1.0, 10.0), Q=st.floats(100.0, 5000.0), R=st.floats(2e-3, 5e-3))
+@example(v_s=0.0, u=1.0, Q=100.0, R=2e-3)       # pure rolling: μ = 0 and ∂μ/∂u = ∂μ/∂Q = 0
 def test_ehl_traction_derivatives_are_exact(v_s, u, Q, R):
     """The law's dual-number derivatives in v_s, u and Q against central differences, at bearing-like
     states (entraining speeds of m/s; at u → 0 the film vanishes and the law tends to a Coulomb step,
@@ -426,7 +427,8 @@ def test_ehl_traction_derivatives_are_exact(v_s, u, Q, R):
                                        np.array([R]))[0]
         x0 = args[j][0]
         fd = (8 * (f(x0 + step) - f(x0 - step)) - (f(x0 + 2 * step) - f(x0 - 2 * step))) / (12 * step)
-        assert d == pytest.approx(fd, rel=1e-5, abs=1e-9 * abs(f(x0)) / step)
+        # differencing noise ~ ε·μ/step, with μ's scale 0.1 (at v_s = 0 both are 0, up to a denormal)
+        assert d == pytest.approx(fd, rel=1e-5, abs=1e-9 * 0.1 / step)
 
 
 def test_ehl_traction_in_the_race_contact_balances():

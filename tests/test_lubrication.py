@@ -125,3 +125,27 @@ def test_ehl_traction_is_selectable_and_runs_on_the_rig():
     out = mbd.System(prob.model).outputs(res.state.t, res.state.q, res.state.v, res.state.z)["race_inner"]
     loaded = out["load"] > 0
     assert loaded.any() and np.all(np.abs(out["traction"][loaded]) <= 0.08 * out["load"][loaded])
+
+
+def test_a_given_viscosity_replaces_the_walther_value():
+    base = reference_dpgt(3, "forward")
+    p = with_overrides(base, {"lubricant.oil_viscosity": "30 mPa*s"})
+    assert p.si().lubricant.oil_viscosity == pytest.approx(0.03, rel=1e-15)
+    assert p.lubricant.source("oil_viscosity").tag == "user"
+
+
+def test_heat_and_traction_coefficient_of_each_bearing(loaded_state):
+    """Traction heat = Σ rows·|F_t v_s| over a bearing's rollers and raceways; land heat = |friction·v_t|;
+    the largest |F_t|/Q of a loaded contact stays below the tanh law's μ_max."""
+    sc, s = loaded_state
+    snap = _snapshot(sc, s, reference_dpgt(3, "forward").si().lubricant)
+    out = mbd.System(sc.model).outputs(s.t, s.q, s.v, s.z)
+    Z = sc.meta["bearing"].rollers
+    for k in range(len(snap["heat_traction"])):
+        sl = slice(k * Z, (k + 1) * Z)
+        by_hand = sum(np.sum(np.abs(out[f]["traction"][sl] * out[f]["slip_velocity"][sl]))
+                      for f in ("race_inner", "race_outer"))
+        assert snap["heat_traction"][k] == pytest.approx(by_hand, rel=1e-12)
+        g = out["guide"]
+        assert snap["heat_land"][k] == pytest.approx(abs(g["friction"][k] * g["sliding_speed"][k]), rel=1e-12)
+    assert np.all(snap["traction_coefficient"] <= 0.08) and np.any(snap["traction_coefficient"] > 0)

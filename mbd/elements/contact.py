@@ -521,6 +521,7 @@ class GuideContact(_Impact):
     ẋ [m/s] at the last accepted state and a valid flag.
 
     Outputs: "force" F_n ≥ 0 [N]; "eccentricity" ε [m]; "friction" tangential force on the cage along t [N];
+    "sliding_speed" v_t of the cage land on the bore [m/s];
     "fx", "fy" force on the cage, in R [N]; "penetration_rate" ε̇ [m/s]; "approach_speed" v₀ in use [m/s]
     (0 out of contact).
     """
@@ -566,7 +567,7 @@ class GuideContact(_Impact):
         forces = point_force(r_g, (Fx, Fy)) + point_force(r_o, (-1.0 * Fx, -1.0 * Fy))
         ecc = np.hypot(ad.value(ex), ad.value(ey))  # the plain norm for the record
         return forces, {"force": F, "eccentricity": ecc, "friction": fr, "fx": Fx, "fy": Fy,  # fx, fy on the cage, in R
-                        "penetration_rate": eps_dot, "approach_speed": v_app}
+                        "sliding_speed": v_t, "penetration_rate": eps_dot, "approach_speed": v_app}
 
 
 # --------------------------------------------------------------------------------------------
