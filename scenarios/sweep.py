@@ -28,10 +28,11 @@ class Case:
     overrides: dict = field(default_factory=dict)   # dotted parameter path -> value string
     params_file: str | None = None
     window: float | None = None                     # per-case recorded window [s] (None: the config's)
+    tag: str = ""                                   # tells apart cases of one operating point (e.g. the oil)
 
     @property
     def label(self) -> str:
-        return f"c{self.condition}_{self.direction}"
+        return f"c{self.condition}_{self.direction}" + (f"_{self.tag}" if self.tag else "")
 
 
 def build_params(case: Case):

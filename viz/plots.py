@@ -18,7 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
-__all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution",
+__all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution", "against_viscosity",
            "mode_shapes", "FWD", "REV", "STYLE"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
@@ -287,6 +287,35 @@ def mode_shapes(freqs_hz, shapes, labels: Sequence[str], path, *, max_modes: int
             ax.grid(axis="x", visible=False)
         for ax in axes[n:]:
             ax.set_visible(False)
+        if title:
+            fig.suptitle(title)
+        return _save(fig, path)
+
+
+def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple], path, *,
+                      title: str | None = None) -> Path:
+    """Quantities against the oil's viscosity, forward vs reverse, one column per bearing type.
+
+    series: (quantity key, bearing, direction) -> (viscosities [Pa·s], values);  quantities: (key, words,
+    unit, log scale) — one row each;  bearings and directions are read from the series' keys."""
+    bearings = sorted({b for _, b, _ in series})
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(3.4 * len(bearings) + 0.6, 2.6 * len(quantities) + 0.6), layout="constrained")
+        axes = fig.subplots(len(quantities), len(bearings), squeeze=False)
+        for r, (key, words, unit, log) in enumerate(quantities):
+            for c, b in enumerate(bearings):
+                ax = axes[r, c]
+                for d, style in (("forward", FWD), ("reverse", REV)):
+                    if (key, b, d) in series:
+                        x, y = series[(key, b, d)]
+                        ax.plot(np.asarray(x) * 1e3, y, marker="o", **style)
+                ax.set_xscale("log")
+                if log:
+                    ax.set_yscale("log")
+                ax.set_title(f"{b} planet bearings")
+                ax.set_ylabel(_axis_label(words, unit))
+                ax.set_xlabel(_axis_label("oil viscosity", "mPa·s"))
+                ax.legend(loc="best")
         if title:
             fig.suptitle(title)
         return _save(fig, path)
