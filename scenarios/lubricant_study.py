@@ -78,7 +78,7 @@ def lubricants(a) -> dict[str, dict]:
             eta = to_si(quantity("--viscosities", q, "dynamic_viscosity"))
             if not eta > 0:
                 raise ParameterError.at("--viscosities", f"expected positive viscosities, got {q!r}")
-            out[q.replace(" ", "")] = {"lubricant.oil_viscosity": q}
+            out[q.replace(" ", "").replace("*", "")] = {"lubricant.oil_viscosity": q}   # a file-name-safe label
         return out
     grades = [s.strip() for s in (a.grades or ",".join(OIL_GRADES)).split(",") if s.strip()]
     return {g: {k: v.value for k, v in oil_grade(g).items()} for g in grades}
