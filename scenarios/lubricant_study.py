@@ -14,7 +14,8 @@ Writes ``summary.csv`` / ``summary.md`` (one row per run and bearing type: film,
 guide, cage slip, pocket impacts, heat), ``film_and_slip.png`` and the answer in words (``answer.md``,
 printed): per direction the oils that keep the thinnest film at Λ ≥ 1.5 (the customary bound of full film
 separation: below it asperities carry load) with the cage at most 5 % below its epicyclic speed (beyond
-that the cage skids: the rollers slide instead of rolling).
+that the cage skids: the rollers slide instead of rolling), and the least viscosity for a full film in
+each direction (from the film's η^0.694 scaling) — so whether reverse wants a stronger oil, and by how much.
 """
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ import csv
 import dataclasses
 import io
 import json
+import math
 import sys
 import warnings
 from pathlib import Path
@@ -119,7 +121,7 @@ def answer(rows: list[dict]) -> str:
     bearing types with neither cage skidding."""
     lines = [f"Which oil? Full film: the thinnest film over every loaded roller contact at Λ ≥ {LAMBDA_MIN:g}; "
              f"no skid: cage slip ≤ {SKID_PCT:g} %. Per oil: Λ_min inner/outer, cage slip inner/outer.", ""]
-    ok_by = {}
+    ok_by, need = {}, {}
     for (c, d) in sorted({(r["condition"], r["direction"]) for r in rows}):
         lines.append(f"condition {c}, {d}:")
         good = []
@@ -135,15 +137,30 @@ def answer(rows: list[dict]) -> str:
                          f"{rr['outer']['lambda_min']:.2f}, slip {rr['inner']['cage_slip_pct']:.2f} / "
                          f"{rr['outer']['cage_slip_pct']:.2f} % -> {'suits' if fine else 'does not suit'}")
         ok_by[(c, d)] = good
-        lines.append(f"  suits: {', '.join(good) if good else 'none of the oils studied'}")
+        need[(c, d)] = _needed_viscosity([r for r in rows if (r["condition"], r["direction"]) == (c, d)])
+        lines.append(f"  suits: {', '.join(good) if good else 'none of the oils studied'}; full film from "
+                     f"{1e3 * need[(c, d)]:.3g} mPa·s")
     for c in sorted({k[0] for k in ok_by}):
         f, r = ok_by.get((c, "forward")), ok_by.get((c, "reverse"))
         if f is not None and r is not None:
             same = "the same oils suit both directions" if f == r else \
                 f"forward and reverse want different oils (forward: {', '.join(f) or 'none'}; reverse: " \
                 f"{', '.join(r) or 'none'})"
-            lines.append(f"condition {c}: {same}.")
+            ratio = need[(c, "reverse")] / need[(c, "forward")]
+            lines.append(f"condition {c}: {same}; for a full film reverse needs {100 * (ratio - 1):+.1f} % "
+                         f"viscosity against forward ({1e3 * need[(c, 'forward')]:.3g} vs "
+                         f"{1e3 * need[(c, 'reverse')]:.3g} mPa·s).")
     return "\n".join(lines)
+
+
+def _needed_viscosity(rows: list[dict]) -> float:
+    """The least viscosity for Λ_min = LAMBDA_MIN in both bearing types, from the oil whose Λ is nearest
+    the bound: the film scales as η^0.694 at fixed load and speed (Pan & Hamrock), so
+    η_needed = η (LAMBDA_MIN / Λ)^(1/0.694)."""
+    best = min(rows, key=lambda r: abs(math.log(r["lambda_min"] / LAMBDA_MIN)))
+    same = [r for r in rows if r["lubricant"] == best["lubricant"]]
+    worst = min(r["lambda_min"] for r in same)
+    return best["viscosity_Pa_s"] * (LAMBDA_MIN / worst) ** (1.0 / 0.694)
 
 
 def _eta(rows, lab) -> float:
