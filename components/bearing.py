@@ -11,8 +11,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from mbd.elements import BodySpring
-from mbd.elements.contact import (IMPACT_LAWS, TRACTION_LAWS, EHLTraction, GuideContact, LubricantDrag,
-                                  PocketContact, RaceContact, SlideRollTraction, TanhTraction, Traction)
+from mbd.elements.contact import (IMPACT_LAWS, TRACTION_LAWS, DryLand, EHLTraction, GuideContact, HydrodynamicLand,
+                                  LubricantDrag, PocketContact, RaceContact, SlideRollTraction, TanhTraction, Traction)
 
 from .families import FAMILY
 from .lubrication import reduced_modulus
@@ -134,11 +134,21 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
         handles = replace(handles, drag=drag_slice)
     if opt.cage != "none":
         handles = replace(handles, **_add_cage(scene, tag, b, names, psi, pin_xy, pin_vel, wm, outer_body,
-                                               opt.cage == "held"))
+                                               opt.cage == "held", lubricant))
     return handles
 
 
-def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel, wm, outer_body, held) -> dict:
+def _land(c, lubricant):
+    """The guide-land law named by ``bearing.cage.land_law`` (the hydrodynamic land needs the oil)."""
+    if c.land_law == "dry":
+        return DryLand()
+    if lubricant is None:
+        raise ParameterError.at("bearing.cage.land_law", "'hydrodynamic' needs a lubricant; this scene has none")
+    return HydrodynamicLand(eta=lubricant.oil_viscosity, width=c.land_width, min_film=c.land_min_film)
+
+
+def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel, wm, outer_body, held,
+              lubricant) -> dict:
     """The cage body, its pockets and (a free cage) its guide land on the outer raceway: the
     BearingHandles fields they fill."""
     c, Z, D = b.cage, len(names), b.roller_diameter
@@ -152,7 +162,8 @@ def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel,
                              v_min=c.impact_speed_floor, mu=c.pocket_friction, v_mu=c.friction_speed, D=D,
                              multiplicity=b.rows)
     if not held:
-        guide = scene.family(FAMILY["guide"], GuideContact, ("cage", "planet"), impact_law=law)
+        guide = scene.family(FAMILY["guide"], GuideContact, ("cage", "planet"), impact_law=law,
+                             land=_land(c, lubricant))
         handles["guide"] = guide.add(1, cage=[cage], planet=[outer_body], clearance=c.guide_clearance,
                                K_g=c.guide_stiffness, restitution=c.restitution, v_min=c.impact_speed_floor,
                                mu=c.guide_friction, v_mu=c.friction_speed,

@@ -516,6 +516,10 @@ class CageParams(Params):
     impact_law: str = _param("choice", "impact damping law lambda(e) of pocket and guide impacts "
                                        "(mbd.elements.IMPACT_LAWS)",
                              choices=("exact", "hunt_crossley", "lankarani_nikravesh", "flores"))
+    land_law: str = _param("choice", "guide land: dry (solid contact, Coulomb friction) or hydrodynamic (an oil "
+                                     "film, short journal bearing)", choices=("dry", "hydrodynamic"))
+    land_width: Quantity = _pos("length", "axial width of the guide lands (both sides together), for the film")
+    land_min_film: Quantity = _pos("length", "thinnest film the hydrodynamic land keeps before the solid contact")
 CageSI = CageParams.SI
 
 

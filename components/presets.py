@@ -97,6 +97,9 @@ def reference_bearing() -> BearingParams:
         friction_speed=assumed("0.01 m/s", "tanh-regularised Coulomb friction: full mu above ~2 cm/s of sliding"),
         impact_speed_floor=assumed("0.01 m/s", "bounds the Hunt-Crossley damping of slow, quasi-static pocket "
                                                "and land contacts; a roller at 1 cm/s carries ~1e-7 J"),
+        land_law=assumed("dry", "the source's model; 'hydrodynamic' runs the land in the oil film"),
+        land_width=assumed("4 mm", "two side rails of about 2 mm"),
+        land_min_film=assumed("1 um", "a few composite roughnesses"),
         impact_law=derived("exact", "lambda(e) from ln((1+lambda)/(1-lambda e)) = lambda (1+e): the set e holds "
                                     "at any approach speed (MODEL.md 3.4)"),
     )

@@ -145,6 +145,8 @@ def test_parameter_choices_name_the_registered_laws():
     from mbd.elements import IMPACT_LAWS
     choices = lambda cls, name: set(cls._spec(name).choices)
     assert choices(CageParams, "impact_law") == set(IMPACT_LAWS)
+    from mbd.elements import LAND_LAWS
+    assert choices(CageParams, "land_law") == set(LAND_LAWS)
     assert choices(BearingParams, "traction_law") == set(TRACTION_LAWS)
 
 

@@ -17,7 +17,8 @@ import mbd
 from mbd.element import evaluate
 from mbd.errors import ModelError
 from mbd.model import FrameState
-from mbd.elements.contact import (IMPACT_LAWS, TRACTION_LAWS, EHLTraction, ExactRestitution, GuideContact, ImpactLaw,
+from mbd.elements.contact import (IMPACT_LAWS, TRACTION_LAWS, DryLand, EHLTraction, ExactRestitution, GuideContact,
+                                  HydrodynamicLand, ImpactLaw,
                                   LubricantDrag, PocketContact, RaceContact, SlideRollTraction, TanhTraction,
                                   restitution_lambda)
 
@@ -82,7 +83,7 @@ def fd_jacobians(elem, qf, vf, z=None):
 # round-off scales of the outputs that are not forces (SI); forces are compared relative to the largest
 # (penetration rates: the direction of a tiny guide eccentricity carries the round-off of the centres)
 OUT_ATOL = {"deflection": 1e-15, "offset": 1e-15, "penetration": 1e-15, "eccentricity": 1e-15,
-            "slip_velocity": 1e-11, "rolling_speed": 1e-11, "angle": 1e-12, "penetration_rate": 1e-9, "approach_speed": 1e-9}
+            "slip_velocity": 1e-11, "rolling_speed": 1e-11, "sliding_speed": 1e-11, "angle": 1e-12, "penetration_rate": 1e-9, "approach_speed": 1e-9}
 
 
 def assert_jacobians(elem, qf, vf, rtol=1e-6, z=None):
@@ -463,6 +464,61 @@ def test_ehl_traction_curve_shape():
     assert _film_mu(thick, 10.0) == pytest.approx(_film_mu(FILM, 10.0), rel=1e-9)
 
 
+def _pi_film_forces(eps, eps_dot, wbar, eta, R, L, C, n=20001):
+    """Short-bearing (Ocvirk) π-film forces on the journal by quadrature of the pressure: with θ from the
+    widest gap (h = C(1 + ε cos θ)) in the sense of the surfaces' mean motion, Reynolds' short-bearing
+    equation integrated over the width gives ∫p dz = −(L³/12)·12η/h³·(−(ω̄/2)Cε sin θ + C ε̇ cos θ), taken
+    over the converging half θ ∈ (0, π). Returns (F_n, F_t) along n (widest gap → narrowest) and t = k × n."""
+    th = np.linspace(0.0, np.pi, n)
+    h = C * (1.0 + eps * np.cos(th))
+    p = -(L ** 3 / 12.0) * 12.0 * eta / h ** 3 * (-(wbar / 2.0) * C * eps * np.sin(th) + C * eps_dot * np.cos(th))
+    # force on the journal: −∫ p (cos θ, sin θ) R dθ in (x̂ towards the widest gap, ŷ = k × x̂); n = −x̂, t = −ŷ
+    Fx = -np.trapezoid(p * np.cos(th), th) * R
+    Fy = -np.trapezoid(p * np.sin(th), th) * R
+    return -Fx, -Fy
+
+
+@pytest.mark.parametrize("eps,eps_dot", [(0.3, 0.0), (0.7, 0.0), (0.5, 40.0), (0.6, -25.0)])
+def test_hydrodynamic_land_matches_the_short_bearing_pressure(eps, eps_dot):
+    """The land's closed-form film forces equal the quadrature of the short-bearing π-film pressure; the
+    steady load and attitude angle are Ocvirk's: W = (η ω̄R L³/4C²) ε √(16ε² + π²(1−ε²)) / (1−ε²)²,
+    tan φ = π√(1−ε²)/(4ε)."""
+    land = HydrodynamicLand(eta=0.025, width=4e-3, min_film=1e-6)
+    C, R, w_cage, w_planet = C_G, R_LAND, 900.0, 400.0
+    e_abs = eps * C
+    # cage centre at angle 0.4 from the bore centre, moving radially at eps_dot·C, no whirl
+    n = np.array([np.cos(0.4), np.sin(0.4)])
+    qf, vf = np.zeros(6), np.zeros(6)
+    qf[3:5] = e_abs * n
+    vf[3:6] = (*(eps_dot * C * n), w_cage)
+    vf[2] = w_planet
+    elem = GuideContact("g", [1], 0, clearance=C, K_g=K_G, restitution=0.8, impact_law=ExactRestitution(),
+                        v_min=V_MIN, mu=0.1, v_mu=0.05, land_radius=R, land=land)
+    Fn, Ft, _ = land.film(qf[3] - qf[0], qf[4] - qf[1], list(vf[3:6]), list(vf[0:3]), R, C)
+    qn, qt = _pi_film_forces(eps, eps_dot, w_cage + w_planet, land.eta, R, land.width, C)
+    assert float(Fn) == pytest.approx(qn, rel=1e-6) and float(Ft) == pytest.approx(qt, rel=1e-6)
+    if eps_dot == 0.0:
+        U = (w_cage + w_planet) * R
+        W = land.eta * U * land.width ** 3 / (4 * C * C) * eps * np.sqrt(16 * eps ** 2 + np.pi ** 2 * (1 - eps ** 2)) \
+            / (1 - eps ** 2) ** 2
+        assert np.hypot(float(Fn), float(Ft)) == pytest.approx(W, rel=1e-12)
+        assert float(Ft) / -float(Fn) == pytest.approx(np.pi * np.sqrt(1 - eps ** 2) / (4 * eps), rel=1e-12)
+    # the element applies it (inside the clearance: no solid contact), balanced, with exact Jacobians
+    F, out = assert_balanced(elem, qf, vf)
+    assert out["force"][0] == 0.0
+    assert_jacobians(elem, qf, vf)
+
+
+def test_hydrodynamic_land_friction_is_the_film_shear():
+    """Nearly centred cage (ε ≈ 7e-4): no film force to speak of, and the land friction is Petroff's
+    −η v_t 2πRL/C."""
+    land = HydrodynamicLand(eta=0.025, width=4e-3, min_film=1e-6)
+    Fn, Ft, shear = land.film(1e-7, 0.0, [0.0, 0.0, 900.0], [0.0, 0.0, 400.0], R_LAND, C_G)
+    assert abs(float(Fn)) < 1e-6 and abs(float(Ft)) < 2e-3
+    v_t = 900.0 * R_LAND - 400.0 * (R_LAND + 1e-7)          # the bore's point is e further out
+    assert float(shear) == pytest.approx(-0.025 * v_t * 2 * np.pi * R_LAND * 4e-3 / C_G, rel=1e-6)
+
+
 # ---------------------------------------------------------------------------------------------
 # pocket: body 0 cage, bodies 1..n rollers
 def pocket_scene(pose, vel, pockets, offsets, radial, v_circ, v_rad, spins, mu=0.1, restitution=E_SET,
@@ -608,7 +664,7 @@ def test_pocket_hunt_crossley_damping():
 
 # ---------------------------------------------------------------------------------------------
 # guide: body 0 planet, bodies 1..n cages (one per instance)
-def guide_scene(pose, vel, ecc, angles, v_rad, v_tan, cage_spin, mu=0.1, e=E_SET):
+def guide_scene(pose, vel, ecc, angles, v_rad, v_tan, cage_spin, mu=0.1, e=E_SET, land=None):
     n = len(ecc)
     qf, vf = np.zeros(3 * (n + 1)), np.zeros(3 * (n + 1))
     qf[:3], vf[:3] = pose, vel
@@ -621,7 +677,8 @@ def guide_scene(pose, vel, ecc, angles, v_rad, v_tan, cage_spin, mu=0.1, e=E_SET
         qf[3 * (j + 1):3 * (j + 2)] = (cg[0], cg[1], 0.2 * j)
         vf[3 * (j + 1):3 * (j + 2)] = (vg[0], vg[1], cage_spin[j])
     elem = GuideContact("guide", np.arange(1, n + 1), 0, clearance=C_G, K_g=K_G, restitution=e,
-                        impact_law=ExactRestitution(), v_min=V_MIN, mu=mu, v_mu=0.05, land_radius=R_LAND)
+                        impact_law=ExactRestitution(), v_min=V_MIN, mu=mu, v_mu=0.05, land_radius=R_LAND,
+                        land=land if land is not None else DryLand())
     return qf, vf, elem
 
 
@@ -780,7 +837,7 @@ def test_parameter_errors_name_the_parameter():
     pocket = dict(pocket_angle=0.0, pitch_radius=DM / 2, clearance=C_P, K_p=K_P, restitution=0.8, v_min=V_MIN,
                   mu=0.1, v_mu=0.05, D=DR, impact_law=ExactRestitution())
     guide = dict(clearance=C_G, K_g=K_G, restitution=0.8, v_min=V_MIN, mu=0.1, v_mu=0.05, land_radius=R_LAND,
-                 impact_law=ExactRestitution())
+                 impact_law=ExactRestitution(), land=DryLand())
     PocketContact("p", [1], 0, **pocket)
     GuideContact("g", [1], 0, **guide)
     for e in (1.5, 0.0, -0.2):     # e = 0 (perfectly plastic) would need infinite damping
@@ -893,8 +950,7 @@ def _impact_run(kind, v_imp, e, gap_time=5e-6, periods=3.5, law=ExactRestitution
         p, vel = (C - v_imp * gap_time) * n, v_imp * n
         mb.add_body("cage", m, 1e-5)
         mb.add(GuideContact("guide", [1], 0, clearance=C, K_g=K, restitution=e, impact_law=law, v_min=V_MIN, mu=0.0,
-                            v_mu=0.05,
-                            land_radius=R_LAND + C))
+                            v_mu=0.05, land_radius=R_LAND + C, land=DryLand()))
     model = mb.build()
     omega = np.sqrt(K / m)
     h = 0.01 / omega                                   # 300+ steps per contact

@@ -149,3 +149,24 @@ def test_heat_and_traction_coefficient_of_each_bearing(loaded_state):
         g = out["guide"]
         assert snap["heat_land"][k] == pytest.approx(abs(g["friction"][k] * g["sliding_speed"][k]), rel=1e-12)
     assert np.all(snap["traction_coefficient"] <= 0.08) and np.any(snap["traction_coefficient"] > 0)
+
+
+def test_the_hydrodynamic_land_carries_the_cage_in_oil():
+    """bearing.cage.land_law = "hydrodynamic": the rig's cage rides on the film inside its clearance (numpy
+    engine: the compiled guide kernel is dry only) and the land's friction is the film's shear, Petroff's
+    η v_t 2πRL/C up to the eccentricity factor 1/√(1−ε²)."""
+    from mbd.elements import HydrodynamicLand
+    from scenarios.numerics_common import rig_problem
+    prob = rig_problem(overrides={"bearing.cage.land_law": "hydrodynamic"})
+    land = prob.model.element("guide").land
+    assert isinstance(land, HydrodynamicLand)
+    res = mbd.simulate(prob.model, prob.built.q0, prob.built.v0, 0.003, stepper=mbd.PRODUCTION.stepper(),
+                       controller=mbd.PRODUCTION.controller(), progress=False)
+    assert res.engine == "numpy"
+    g = mbd.System(prob.model).outputs(res.state.t, res.state.q, res.state.v, res.state.z)["guide"]
+    C = prob.model.element("guide").clearance[0]
+    R = prob.model.element("guide").land_radius[0]
+    eps = g["eccentricity"][0] / C
+    assert eps < 1.0 and g["force"][0] == 0.0                     # no solid contact: the film carries it
+    petroff = land.eta * abs(g["sliding_speed"][0]) * 2 * np.pi * R * land.width / C
+    assert petroff <= abs(g["friction"][0]) <= petroff / np.sqrt(1 - min(eps, 1 - land.min_film / C) ** 2) * (1 + 1e-9)

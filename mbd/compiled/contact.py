@@ -35,7 +35,7 @@ import numpy as np
 from numba import njit
 
 from ..elements import ehl
-from ..elements.contact import (EHLTraction, GuideContact, LubricantDrag, PocketContact, RaceContact,
+from ..elements.contact import (DryLand, EHLTraction, GuideContact, LubricantDrag, PocketContact, RaceContact,
                                 SlideRollTraction, TanhTraction)
 
 __all__ = ["pack_race", "evaluate_race", "pack_pocket", "evaluate_pocket", "update_pocket", "pack_guide",
@@ -88,6 +88,9 @@ def pack_pocket(elem):
 
 def pack_guide(elem):
     _require(elem, GuideContact)
+    if type(elem.land) is not DryLand:
+        raise NotImplementedError(f"{elem.name}: GuideContact with land law {type(elem.land).__name__} has no "
+                                  "compiled kernel (compiled: DryLand)")
     P = _rows(elem.clearance, elem.K_g, elem.lam, elem.v_min, elem.mu, elem.v_mu, elem.land_radius)
     return P, np.zeros(0)
 

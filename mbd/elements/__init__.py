@@ -1,9 +1,10 @@
 """Element families. Generic ones (supports, springs, loads, drives) and the contact/mesh laws used by components.
 
 Law variants are small classes registered by name (a parameter chooses one): :data:`TRACTION_LAWS`
-(roller–raceway traction: tanh, slide_roll, ehl), :data:`IMPACT_LAWS` (pocket and guide-land impact damping),
+(roller–raceway traction: tanh, slide_roll, ehl), :data:`IMPACT_LAWS` (pocket and guide-land impact damping), :data:`LAND_LAWS` (dry or
+hydrodynamic guide land),
 :data:`STIFFNESS_SHAPES` (mesh stiffness over a mesh cycle)."""
-from .contact import (IMPACT_LAWS, TRACTION_LAWS, EHLTraction, ExactRestitution, Flores, GuideContact, HuntCrossley, ImpactLaw,
+from .contact import (IMPACT_LAWS, LAND_LAWS, TRACTION_LAWS, DryLand, EHLTraction, HydrodynamicLand, LandLaw, ExactRestitution, Flores, GuideContact, HuntCrossley, ImpactLaw,
                       LankaraniNikravesh, LubricantDrag, PocketContact, RaceContact, SlideRollTraction, TanhTraction,
                       Traction)
 from .drives import Ramp, SpeedDrive, TorqueSource
@@ -16,6 +17,7 @@ __all__ = [
     "BodySpring", "ForceSource", "GearMesh", "GroundSupport", "GuideContact", "LubricantDrag", "PocketContact",
     "RaceContact", "Ramp", "SpeedDrive", "TorqueSource", "TorsionalSpring",
     "Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS",
+    "LandLaw", "DryLand", "HydrodynamicLand", "LAND_LAWS",
     "ImpactLaw", "ExactRestitution", "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS",
     "StiffnessShape", "ConstantStiffness", "RectangularStiffness", "FourierStiffness", "STIFFNESS_SHAPES",
     "mesh_offset", "mesh_u0",

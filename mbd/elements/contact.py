@@ -30,7 +30,8 @@ from ..errors import ModelError
 
 __all__ = ["Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS", "ImpactLaw", "ExactRestitution",
            "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS", "RaceContact", "PocketContact",
-           "GuideContact", "LubricantDrag", "restitution_lambda"]
+           "GuideContact", "LubricantDrag", "restitution_lambda", "LandLaw", "DryLand", "HydrodynamicLand",
+           "LAND_LAWS"]
 
 _ETA2 = 1e-24  # (1e-12 m)²: below round-off of any physical distance squared, keeps norms nonzero
 
@@ -505,6 +506,64 @@ class PocketContact(_Impact):
 
 
 # --------------------------------------------------------------------------------------------
+class LandLaw:
+    """Base of the cage guide-land laws (MODEL.md §3.5, §3.8), registered in :data:`LAND_LAWS` by name."""
+
+
+@dataclass(frozen=True)
+class DryLand(LandLaw):
+    """The land runs dry: only the solid contact beyond the clearance, with Coulomb friction μ_g·F_n."""
+
+
+@dataclass(frozen=True)
+class HydrodynamicLand(LandLaw):
+    """The land as a short journal bearing (Ocvirk; π-film: the film carries load over the half where it
+    converges, the other half cavitates) of width ``width`` [m] in oil of viscosity ``eta`` [Pa·s]. With C the
+    radial clearance, R the land radius, ε = |e|/C (capped at 1 − min_film/C: the solid contact of
+    §3.5 takes over beyond the clearance), ε̇ its rate, φ̇ the whirl of e and ω̄ = ω_cage + ω_planet − 2φ̇,
+    K₀ = η R L³ / (2C²), the film force on the cage along n = e/|e| and t = k × n is
+        F_n = −K₀ [2ε²|ω̄|/(1−ε²)² + π(1+2ε²) ε̇/(1−ε²)^(5/2)],
+        F_t = sign(ω̄) K₀ [πε|ω̄|/(2(1−ε²)^(3/2)) + 4εε̇/(1−ε²)²],
+    and the film's shear on the land, −η v_t 2πRL / (C √(1−ε²)), replaces the dry friction (Petroff with
+    eccentricity; v_t the land's sliding speed)."""
+    eta: float
+    width: float
+    min_film: float
+
+    def __post_init__(self):
+        for k in ("eta", "width", "min_film"):
+            if not (np.isfinite(getattr(self, k)) and getattr(self, k) > 0):
+                raise ModelError(f"HydrodynamicLand: {k} must be > 0, got {getattr(self, k)!r}")
+
+    def film(self, ex, ey, vg, vo, R, C):
+        """(F_n, F_t, shear friction along t) of the film, from e = c_cage − c_bore and both velocities."""
+        e2 = ex * ex + ey * ey + _ETA2
+        e_abs = ad.sqrt(e2)
+        dex, dey = vg[0] - vo[0], vg[1] - vo[1]
+        eps_cap = 1.0 - self.min_film / C
+        eps_raw = e_abs / C
+        eps = ad.where(ad.value(eps_raw) < eps_cap, eps_raw, eps_cap)
+        eps_dot = ad.where(ad.value(eps_raw) < eps_cap, (ex * dex + ey * dey) / (e_abs * C), 0.0)
+        whirl = (ex * dey - ey * dex) / e2
+        wbar = vg[2] + vo[2] - 2.0 * whirl
+        sgn = np.where(ad.value(wbar) >= 0.0, 1.0, -1.0)
+        w_abs = sgn * wbar
+        K0 = self.eta * R * self.width ** 3 / (2.0 * C * C)
+        s = 1.0 - eps * eps
+        Fn = -1.0 * K0 * (2.0 * eps * eps * w_abs / (s * s) + np.pi * (1.0 + 2.0 * eps * eps) * eps_dot / (s * s * ad.sqrt(s)))
+        Ft = sgn * K0 * (np.pi * eps * w_abs / (2.0 * s * ad.sqrt(s)) + 4.0 * eps * eps_dot / (s * s))
+        nx, ny = ex / e_abs, ey / e_abs
+        tx, ty = -1.0 * ny, nx
+        Vg, Vo = marker_velocity(vg, (R * nx, R * ny)), marker_velocity(vo, (ex + R * nx, ey + R * ny))
+        v_t = (Vg[0] - Vo[0]) * tx + (Vg[1] - Vo[1]) * ty
+        shear = -1.0 * self.eta * v_t * (2.0 * np.pi * R * self.width) / (C * ad.sqrt(s))
+        return Fn, Ft, shear
+
+
+# the guide-land laws by name (a parameter chooses one)
+LAND_LAWS = MappingProxyType({"dry": DryLand, "hydrodynamic": HydrodynamicLand})
+
+
 class GuideContact(_Impact):
     """Cage–guide-land impact for an outer-raceway-guided cage (MODEL.md §3.5).
 
@@ -528,7 +587,7 @@ class GuideContact(_Impact):
     n_local = 6
 
     def __init__(self, name, cage, planet, *, clearance, K_g, restitution, impact_law, v_min, mu, v_mu,
-                 land_radius):
+                 land_radius, land: "LandLaw"):
         self.name = name
         self.dofs = body_dofs(cage, planet)
         self.clearance = self._per_instance("clearance", clearance, nonneg=True)
@@ -537,6 +596,12 @@ class GuideContact(_Impact):
         self.mu = self._per_instance("mu", mu, nonneg=True)
         self.v_mu = self._per_instance("v_mu", v_mu, positive=True)
         self.land_radius = self._per_instance("land_radius", land_radius, positive=True)
+        if not isinstance(land, LandLaw):
+            raise ModelError(f"{name}: parameter 'land' must be a LandLaw (one of {sorted(LAND_LAWS)}), got {land!r}")
+        if isinstance(land, HydrodynamicLand) and np.any(self.clearance <= land.min_film):
+            raise ModelError(f"{name}: the hydrodynamic land needs a clearance above its min_film "
+                             f"{land.min_film!r} m, got {clearance!r}")
+        self.land = land
 
     def _geometry(self, q, v):
         qg, qo, vg, vo = q[:3], q[3:], v[:3], v[3:]
@@ -562,8 +627,13 @@ class GuideContact(_Impact):
         Vo = marker_velocity(vo, r_o)
         v_t = (Vg[0] - Vo[0]) * tx + (Vg[1] - Vo[1]) * ty
         fr = -1.0 * self.mu * ad.tanh(v_t / self.v_mu) * F
-        Fx = -1.0 * F * nx + fr * tx
-        Fy = -1.0 * F * ny + fr * ty
+        if isinstance(self.land, HydrodynamicLand):       # the oil film carries the cage; its shear is the friction
+            Fn_film, Ft_film, fr_film = self.land.film(ex, ey, vg, vo, rL, self.clearance)
+            fr = fr + fr_film
+        else:
+            Fn_film = Ft_film = 0.0
+        Fx = -1.0 * F * nx + fr * tx + Fn_film * nx + Ft_film * tx
+        Fy = -1.0 * F * ny + fr * ty + Fn_film * ny + Ft_film * ty
         forces = point_force(r_g, (Fx, Fy)) + point_force(r_o, (-1.0 * Fx, -1.0 * Fy))
         ecc = np.hypot(ad.value(ex), ad.value(ey))  # the plain norm for the record
         return forces, {"force": F, "eccentricity": ecc, "friction": fr, "fx": Fx, "fy": Fy,  # fx, fy on the cage, in R
