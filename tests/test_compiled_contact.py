@@ -23,8 +23,8 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 from mbd.compiled.contact import KERNELS, TRACTION_IDS, pack_race
 from mbd.element import evaluate
 from mbd.model import FrameState
-from mbd.elements.contact import (IMPACT_LAWS, EHLTraction, GuideContact, LubricantDrag, PocketContact,
-                                  RaceContact, SlideRollTraction, TanhTraction, Traction)
+from mbd.elements.contact import (IMPACT_LAWS, EHLTraction, GuideContact, HydrodynamicLand, LubricantDrag,
+                                  PocketContact, RaceContact, SlideRollTraction, TanhTraction, Traction)
 from strategies import frame_states
 from test_contact import (C_G, DM, DR, EHL, FILM, K_G, K_HZ, M_ROLLER, N, TANH, drag_scene, drag_states, guide_scene,
                           guide_states, pocket_scene, pocket_states, race_scene, race_states, stored_speeds)
@@ -170,15 +170,17 @@ def test_pocket_matches_reference(state, z, fs, law, mult, fast, mu):
     assert_matches_reference(_with_law(elem, law), fs, qf, vf, z)
 
 
+@pytest.mark.parametrize("land", ["dry", "hydrodynamic"])
 @SETTINGS
 @given(state=guide_states(), z=impact_z(), fs=frame_states(), law=LAWS,
        fast=st.one_of(st.none(), st.lists(st.floats(-5.0, 5.0), min_size=N, max_size=N)),
        mu=st.sampled_from([0.0, 0.1]))
-def test_guide_matches_reference(state, z, fs, law, fast, mu):
+def test_guide_matches_reference(land, state, z, fs, law, fast, mu):
     state = list(state)
     if fast is not None:          # fast radial motion
         state[4] = fast
-    qf, vf, elem = guide_scene(*state, mu=mu)
+    film = HydrodynamicLand(eta=0.025, width=4e-3, min_film=1e-6) if land == "hydrodynamic" else None
+    qf, vf, elem = guide_scene(*state, mu=mu, land=film)
     assert_matches_reference(_with_law(elem, law), fs, qf, vf, z)
 
 

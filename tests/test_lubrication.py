@@ -152,9 +152,9 @@ def test_heat_and_traction_coefficient_of_each_bearing(loaded_state):
 
 
 def test_the_hydrodynamic_land_carries_the_cage_in_oil():
-    """bearing.cage.land_law = "hydrodynamic": the rig's cage rides on the film inside its clearance (numpy
-    engine: the compiled guide kernel is dry only) and the land's friction is the film's shear, Petroff's
-    η v_t 2πRL/C up to the eccentricity factor 1/√(1−ε²)."""
+    """bearing.cage.land_law = "hydrodynamic": the rig's cage rides on the film inside its clearance (both
+    engines) and the land's friction is the film's shear, Petroff's η v_t 2πRL/C up to the eccentricity
+    factor 1/√(1−ε²)."""
     from mbd.elements import HydrodynamicLand
     from scenarios.numerics_common import rig_problem
     prob = rig_problem(overrides={"bearing.cage.land_law": "hydrodynamic"})
@@ -162,7 +162,7 @@ def test_the_hydrodynamic_land_carries_the_cage_in_oil():
     assert isinstance(land, HydrodynamicLand)
     res = mbd.simulate(prob.model, prob.built.q0, prob.built.v0, 0.003, stepper=mbd.PRODUCTION.stepper(),
                        controller=mbd.PRODUCTION.controller(), progress=False)
-    assert res.engine == "numpy"
+    assert res.engine == "compiled"
     g = mbd.System(prob.model).outputs(res.state.t, res.state.q, res.state.v, res.state.z)["guide"]
     C = prob.model.element("guide").clearance[0]
     R = prob.model.element("guide").land_radius[0]

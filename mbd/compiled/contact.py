@@ -10,7 +10,8 @@ Layouts (P: one row per instance, columns in this order; G: family-wide values):
                   law 2 (EHLTraction): eta0, alpha_p, E_red, length, tau_L0, gamma_L, G_e, u_reg
 ``PocketContact`` P (n, 10): pocket_angle ψ, pitch_radius, clearance, K_p, λ (impact law damping), v_min, mu,
                   v_mu, D, multiplicity;  G (0,)
-``GuideContact``  P (n, 7): clearance, K_g, λ, v_min, mu, v_mu, land_radius;  G (0,)
+``GuideContact``  P (n, 7): clearance, K_g, λ, v_min, mu, v_mu, land_radius;  G (4,): land law (0 dry,
+                  1 hydrodynamic), then for the film: eta, width, min_film
 ``LubricantDrag`` P (n, 4): race_marker x, y [m], coef = C_d ρ D l d_m²/8, multiplicity;  G (0,)
 
 The impact families' internal state z (n, 4) is the reference's: [v₀, x, ẋ, valid].
@@ -35,8 +36,8 @@ import numpy as np
 from numba import njit
 
 from ..elements import ehl
-from ..elements.contact import (DryLand, EHLTraction, GuideContact, LubricantDrag, PocketContact, RaceContact,
-                                SlideRollTraction, TanhTraction)
+from ..elements.contact import (DryLand, EHLTraction, GuideContact, HydrodynamicLand, LubricantDrag, PocketContact,
+                                RaceContact, SlideRollTraction, TanhTraction)
 
 __all__ = ["pack_race", "evaluate_race", "pack_pocket", "evaluate_pocket", "update_pocket", "pack_guide",
            "evaluate_guide", "update_guide", "pack_drag", "evaluate_drag", "KERNELS", "TRACTION_IDS"]
@@ -88,11 +89,16 @@ def pack_pocket(elem):
 
 def pack_guide(elem):
     _require(elem, GuideContact)
-    if type(elem.land) is not DryLand:
-        raise NotImplementedError(f"{elem.name}: GuideContact with land law {type(elem.land).__name__} has no "
-                                  "compiled kernel (compiled: DryLand)")
+    land = elem.land
+    if type(land) is DryLand:
+        G = np.zeros(4)
+    elif type(land) is HydrodynamicLand:
+        G = np.array([1.0, land.eta, land.width, land.min_film])
+    else:
+        raise NotImplementedError(f"{elem.name}: GuideContact with land law {type(land).__name__} has no "
+                                  "compiled kernel (compiled: DryLand, HydrodynamicLand)")
     P = _rows(elem.clearance, elem.K_g, elem.lam, elem.v_min, elem.mu, elem.v_mu, elem.land_radius)
-    return P, np.zeros(0)
+    return P, G
 
 
 def pack_drag(elem):
@@ -442,7 +448,51 @@ def _guide_gap(xg, yg, xo, yo, vg0, vg1, vo0, vo1, clearance):
 
 
 @njit(cache=True)
+def _film(C, eta, width, min_film, R, ex, ey, e_abs, wx, wy, w_g, w_o, v_t):
+    """HydrodynamicLand.film (the reference's operations): F_n, F_t, the shear, and what their derivatives
+    need — (r, ṙ, ω̄ sign, |ω̄|, whirl, s, active cap flag)."""
+    cap = 1.0 - min_film / C
+    r_raw = e_abs / C
+    act = r_raw < cap
+    r = r_raw if act else cap
+    rdot = (ex * wx + ey * wy) / (e_abs * C) if act else 0.0
+    e2 = ex * ex + ey * ey + _ETA2
+    whirl = (ex * wy - ey * wx) / e2
+    wbar = w_g + w_o - 2.0 * whirl
+    sgn = 1.0 if wbar >= 0.0 else -1.0
+    wa = sgn * wbar
+    K0 = eta * R * width ** 3 / (2.0 * C * C)
+    s = 1.0 - r * r
+    ss = np.sqrt(s)
+    Fn = -1.0 * K0 * (2.0 * r * r * wa / (s * s) + np.pi * (1.0 + 2.0 * r * r) * rdot / (s * s * ss))
+    Ft = sgn * K0 * (np.pi * r * wa / (2.0 * s * ss) + 4.0 * r * rdot / (s * s))
+    ks = eta * (2.0 * np.pi * R * width) / C
+    sh = -1.0 * v_t * ks / ss
+    return Fn, Ft, sh, r, rdot, sgn, wa, whirl, s, act, K0, ks, e2
+
+
+@njit(cache=True)
+def _dfilm(film, ex, ey, e_abs, wx, wy, dex, dey, de_abs, dwx, dwy, dw_g, dw_o, v_t, dv_t, C):
+    """Differentials of (F_n, F_t, shear) along one direction (inputs' differentials given)."""
+    Fn, Ft, sh, r, rdot, sgn, wa, whirl, s, act, K0, ks, e2 = film
+    dr = de_abs / C if act else 0.0
+    drdot = ((dex * wx + ex * dwx + dey * wy + ey * dwy) / (e_abs * C) - rdot * de_abs / e_abs) if act else 0.0
+    dwhirl = (dex * wy + ex * dwy - dey * wx - ey * dwx) / e2 - whirl * 2.0 * e_abs * de_abs / e2
+    dwa = sgn * (dw_g + dw_o - 2.0 * dwhirl)
+    ds = -2.0 * r * dr
+    ss = np.sqrt(s)
+    dA = (4.0 * r * wa * dr + 2.0 * r * r * dwa) / (s * s) - 4.0 * r * r * wa * ds / (s * s * s)
+    dB = np.pi * (4.0 * r * dr * rdot + (1.0 + 2.0 * r * r) * drdot) / (s * s * ss) \
+        - 2.5 * np.pi * (1.0 + 2.0 * r * r) * rdot * ds / (s * s * s * ss)
+    dCc = np.pi * (dr * wa + r * dwa) / (2.0 * s * ss) - 1.5 * np.pi * r * wa * ds / (2.0 * s * s * ss)
+    dDd = 4.0 * (dr * rdot + r * drdot) / (s * s) - 8.0 * r * rdot * ds / (s * s * s)
+    dsh = -1.0 * ks * (dv_t / ss - 0.5 * v_t * ds / (s * ss))
+    return -1.0 * K0 * (dA + dB), sgn * K0 * (dCc + dDd), dsh
+
+
+@njit(cache=True)
 def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    hydro = G.size > 0 and G[0] == 1.0
     for i in range(ql.shape[0]):
         clr, Kg, lam, v_min, mu, v_mu, rL = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
         vg0, vg1, vg2 = vl[i, 0], vl[i, 1], vl[i, 2]
@@ -450,7 +500,7 @@ def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         ex, ey, eps, nx, ny, pen, eps_dot = _guide_gap(ql[i, 0], ql[i, 1], ql[i, 3], ql[i, 4], vg0, vg1, vo0,
                                                        vo1, clr)
         Fi, F_x, F_xd = _impact(Kg, lam, v_min, pen, eps_dot, z[i, 0])
-        if Fi == 0.0:
+        if Fi == 0.0 and not hydro:
             _zero(F, Jq, Jv, i, jac)
             continue
         tx, ty = -ny, nx
@@ -462,12 +512,17 @@ def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         v_t = (Vgx - Vox) * tx + (Vgy - Voy) * ty
         th = np.tanh(v_t / v_mu)
         fr = -mu * th * Fi
-        Fx = -Fi * nx + fr * tx
-        Fy = -Fi * ny + fr * ty
+        wx, wy = vg0 - vo0, vg1 - vo1
+        Fn_f, Ft_f, sh = 0.0, 0.0, 0.0
+        if hydro:      # the oil film carries the cage; its shear adds to the friction (MODEL.md §3.8)
+            film = _film(clr, G[1], G[2], G[3], rL, ex, ey, eps, wx, wy, vg2, vo2, v_t)
+            Fn_f, Ft_f, sh = film[0], film[1], film[2]
+        Fnt, Ftt = -Fi + Fn_f, fr + sh + Ft_f
+        Fx = Fnt * nx + Ftt * tx
+        Fy = Fnt * ny + Ftt * ty
         _write(F, Jq, Jv, i, -1, 1.0, Fx, Fy, rgx * Fy - rgy * Fx, -Fx, -Fy, rox * (-Fy) - roy * (-Fx))
         if not jac:
             continue
-        wx, wy = vg0 - vo0, vg1 - vo1
         f_v = -mu * (1.0 - th * th) / v_mu * Fi  # ∂fr/∂v_t
         for j in range(12):
             dxg, dyg, _, dxo, dyo, _, dvg0, dvg1, dvg2, dvo0, dvo1, dvo2 = _unit(j)
@@ -484,8 +539,13 @@ def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
             dVox, dVoy = dvo0 - dvo2 * roy - vo2 * droy, dvo1 + dvo2 * rox + vo2 * drox
             dv_t = (dVgx - dVox) * tx + (Vgx - Vox) * dtx + (dVgy - dVoy) * ty + (Vgy - Voy) * dty
             dfr = f_v * dv_t - mu * th * dFi
-            dFx = -(dFi * nx + Fi * dnx) + dfr * tx + fr * dtx
-            dFy = -(dFi * ny + Fi * dny) + dfr * ty + fr * dty
+            dFn_f, dFt_f, dsh = 0.0, 0.0, 0.0
+            if hydro:
+                dFn_f, dFt_f, dsh = _dfilm(film, ex, ey, eps, wx, wy, dex, dey, deps, dwx, dwy, dvg2, dvo2, v_t,
+                                           dv_t, clr)
+            dFnt, dFtt = -dFi + dFn_f, dfr + dsh + dFt_f
+            dFx = dFnt * nx + Fnt * dnx + dFtt * tx + Ftt * dtx
+            dFy = dFnt * ny + Fnt * dny + dFtt * ty + Ftt * dty
             _write(F, Jq, Jv, i, j, 1.0, dFx, dFy, _d_cross(rgx, rgy, drgx, drgy, Fx, Fy, dFx, dFy),
                    -dFx, -dFy, -_d_cross(rox, roy, drox, droy, Fx, Fy, dFx, dFy))
 
