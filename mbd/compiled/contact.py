@@ -449,42 +449,48 @@ def _guide_gap(xg, yg, xo, yo, vg0, vg1, vo0, vo1, clearance):
 
 @njit(cache=True)
 def _film(C, eta, width, min_film, R, ex, ey, e_abs, wx, wy, w_g, w_o, v_t):
-    """HydrodynamicLand.film (the reference's operations): F_n, F_t, the shear, and what their derivatives
-    need — (r, ṙ, ω̄ sign, |ω̄|, whirl, s, active cap flag)."""
+    """HydrodynamicLand.film (the reference's operations, with ε·φ̇ and ε²·φ̇ from e × ė): F_n, F_t, the
+    shear, and the intermediates its differentials need."""
     cap = 1.0 - min_film / C
     r_raw = e_abs / C
     act = r_raw < cap
     r = r_raw if act else cap
     rdot = (ex * wx + ey * wy) / (e_abs * C) if act else 0.0
-    e2 = ex * ex + ey * ey + _ETA2
-    whirl = (ex * wy - ey * wx) / e2
-    wbar = w_g + w_o - 2.0 * whirl
-    sgn = 1.0 if wbar >= 0.0 else -1.0
-    wa = sgn * wbar
+    cross = ex * wy - ey * wx
+    spin = w_g + w_o
+    sgn = 1.0 if spin >= 0.0 else -1.0
+    scale = 1.0 if act else cap / r_raw
+    e_w = sgn * (r * spin - 2.0 * scale * cross / (e_abs * C))
+    e2_w = sgn * (r * r * spin - 2.0 * scale * scale * cross / (C * C))
     K0 = eta * R * width ** 3 / (2.0 * C * C)
     s = 1.0 - r * r
     ss = np.sqrt(s)
-    Fn = -1.0 * K0 * (2.0 * r * r * wa / (s * s) + np.pi * (1.0 + 2.0 * r * r) * rdot / (s * s * ss))
-    Ft = sgn * K0 * (np.pi * r * wa / (2.0 * s * ss) + 4.0 * r * rdot / (s * s))
+    Fn = -1.0 * K0 * (2.0 * e2_w / (s * s) + np.pi * (1.0 + 2.0 * r * r) * rdot / (s * s * ss))
+    Ft = sgn * K0 * (np.pi * e_w / (2.0 * s * ss) + 4.0 * r * rdot / (s * s))
     ks = eta * (2.0 * np.pi * R * width) / C
     sh = -1.0 * v_t * ks / ss
-    return Fn, Ft, sh, r, rdot, sgn, wa, whirl, s, act, K0, ks, e2
+    return Fn, Ft, sh, r, rdot, sgn, cross, spin, scale, e_w, e2_w, s, act, K0, ks, cap, r_raw
 
 
 @njit(cache=True)
 def _dfilm(film, ex, ey, e_abs, wx, wy, dex, dey, de_abs, dwx, dwy, dw_g, dw_o, v_t, dv_t, C):
     """Differentials of (F_n, F_t, shear) along one direction (inputs' differentials given)."""
-    Fn, Ft, sh, r, rdot, sgn, wa, whirl, s, act, K0, ks, e2 = film
+    Fn, Ft, sh, r, rdot, sgn, cross, spin, scale, e_w, e2_w, s, act, K0, ks, cap, r_raw = film
     dr = de_abs / C if act else 0.0
     drdot = ((dex * wx + ex * dwx + dey * wy + ey * dwy) / (e_abs * C) - rdot * de_abs / e_abs) if act else 0.0
-    dwhirl = (dex * wy + ex * dwy - dey * wx - ey * dwx) / e2 - whirl * 2.0 * e_abs * de_abs / e2
-    dwa = sgn * (dw_g + dw_o - 2.0 * dwhirl)
+    dcross = dex * wy + ex * dwy - dey * wx - ey * dwx
+    dspin = dw_g + dw_o
+    dscale = 0.0 if act else -cap * (de_abs / C) / (r_raw * r_raw)
+    de_w = sgn * (dr * spin + r * dspin - 2.0 * (dscale * cross / (e_abs * C) + scale * dcross / (e_abs * C)
+                                                 - scale * cross * de_abs / (e_abs * e_abs * C)))
+    de2_w = sgn * (2.0 * r * dr * spin + r * r * dspin - 2.0 * (2.0 * scale * dscale * cross + scale * scale * dcross)
+                   / (C * C))
     ds = -2.0 * r * dr
     ss = np.sqrt(s)
-    dA = (4.0 * r * wa * dr + 2.0 * r * r * dwa) / (s * s) - 4.0 * r * r * wa * ds / (s * s * s)
+    dA = 2.0 * de2_w / (s * s) - 4.0 * e2_w * ds / (s * s * s)
     dB = np.pi * (4.0 * r * dr * rdot + (1.0 + 2.0 * r * r) * drdot) / (s * s * ss) \
         - 2.5 * np.pi * (1.0 + 2.0 * r * r) * rdot * ds / (s * s * s * ss)
-    dCc = np.pi * (dr * wa + r * dwa) / (2.0 * s * ss) - 1.5 * np.pi * r * wa * ds / (2.0 * s * s * ss)
+    dCc = np.pi * de_w / (2.0 * s * ss) - 1.5 * np.pi * e_w * ds / (2.0 * s * s * ss)
     dDd = 4.0 * (dr * rdot + r * drdot) / (s * s) - 8.0 * r * rdot * ds / (s * s * s)
     dsh = -1.0 * ks * (dv_t / ss - 0.5 * v_t * ds / (s * ss))
     return -1.0 * K0 * (dA + dB), sgn * K0 * (dCc + dDd), dsh

@@ -520,10 +520,11 @@ class HydrodynamicLand(LandLaw):
     """The land as a short journal bearing (Ocvirk; π-film: the film carries load over the half where it
     converges, the other half cavitates) of width ``width`` [m] in oil of viscosity ``eta`` [Pa·s]. With C the
     radial clearance, R the land radius, ε = |e|/C (capped at 1 − min_film/C: the solid contact of
-    §3.5 takes over beyond the clearance), ε̇ its rate, φ̇ the whirl of e and ω̄ = ω_cage + ω_planet − 2φ̇,
-    K₀ = η R L³ / (2C²), the film force on the cage along n = e/|e| and t = k × n is
-        F_n = −K₀ [2ε²|ω̄|/(1−ε²)² + π(1+2ε²) ε̇/(1−ε²)^(5/2)],
-        F_t = sign(ω̄) K₀ [πε|ω̄|/(2(1−ε²)^(3/2)) + 4εε̇/(1−ε²)²],
+    §3.5 takes over beyond the clearance), ε̇ its rate, φ̇ the whirl of e, ω̄ = ω_cage + ω_planet − 2φ̇ and
+    σ the sign of ω_cage + ω_planet (the side of the converging film), K₀ = η R L³ / (2C²), the film force on
+    the cage along n = e/|e| and t = k × n is
+        F_n = −K₀ [2σε²ω̄/(1−ε²)² + π(1+2ε²) ε̇/(1−ε²)^(5/2)],
+        F_t = σ K₀ [πσεω̄/(2(1−ε²)^(3/2)) + 4εε̇/(1−ε²)²],
     and the film's shear on the land, −η v_t 2πRL / (C √(1−ε²)), replaces the dry friction (Petroff with
     eccentricity; v_t the land's sliding speed)."""
     eta: float
@@ -536,22 +537,28 @@ class HydrodynamicLand(LandLaw):
                 raise ModelError(f"HydrodynamicLand: {k} must be > 0, got {getattr(self, k)!r}")
 
     def film(self, ex, ey, vg, vo, R, C):
-        """(F_n, F_t, shear friction along t) of the film, from e = c_cage − c_bore and both velocities."""
+        """(F_n, F_t, shear friction along t) of the film, from e = c_cage − c_bore and both velocities.
+        Written with ε·φ̇ and ε²·φ̇ (bounded and smooth as e → 0) rather than the whirl φ̇ itself, which a
+        nearly centred cage makes singular; the film side follows the sign of the surfaces' spin sum."""
         e2 = ex * ex + ey * ey + _ETA2
         e_abs = ad.sqrt(e2)
         dex, dey = vg[0] - vo[0], vg[1] - vo[1]
         eps_cap = 1.0 - self.min_film / C
         eps_raw = e_abs / C
-        eps = ad.where(ad.value(eps_raw) < eps_cap, eps_raw, eps_cap)
-        eps_dot = ad.where(ad.value(eps_raw) < eps_cap, (ex * dex + ey * dey) / (e_abs * C), 0.0)
-        whirl = (ex * dey - ey * dex) / e2
-        wbar = vg[2] + vo[2] - 2.0 * whirl
-        sgn = np.where(ad.value(wbar) >= 0.0, 1.0, -1.0)
-        w_abs = sgn * wbar
+        act = ad.value(eps_raw) < eps_cap
+        eps = ad.where(act, eps_raw, eps_cap)
+        eps_dot = ad.where(act, (ex * dex + ey * dey) / (e_abs * C), 0.0)
+        cross = ex * dey - ey * dex                          # |e|² φ̇
+        spin = vg[2] + vo[2]
+        sgn = np.where(ad.value(spin) >= 0.0, 1.0, -1.0)
+        # ε ω̄ and ε² ω̄ with ω̄ = spin − 2φ̇, on the side of the spin (ε taken at its cap beyond it)
+        scale = ad.where(act, 1.0, eps_cap / eps_raw)        # ε / ε_raw
+        e_w = sgn * (eps * spin - 2.0 * scale * cross / (e_abs * C))
+        e2_w = sgn * (eps * eps * spin - 2.0 * scale * scale * cross / (C * C))
         K0 = self.eta * R * self.width ** 3 / (2.0 * C * C)
         s = 1.0 - eps * eps
-        Fn = -1.0 * K0 * (2.0 * eps * eps * w_abs / (s * s) + np.pi * (1.0 + 2.0 * eps * eps) * eps_dot / (s * s * ad.sqrt(s)))
-        Ft = sgn * K0 * (np.pi * eps * w_abs / (2.0 * s * ad.sqrt(s)) + 4.0 * eps * eps_dot / (s * s))
+        Fn = -1.0 * K0 * (2.0 * e2_w / (s * s) + np.pi * (1.0 + 2.0 * eps * eps) * eps_dot / (s * s * ad.sqrt(s)))
+        Ft = sgn * K0 * (np.pi * e_w / (2.0 * s * ad.sqrt(s)) + 4.0 * eps * eps_dot / (s * s))
         nx, ny = ex / e_abs, ey / e_abs
         tx, ty = -1.0 * ny, nx
         Vg, Vo = marker_velocity(vg, (R * nx, R * ny)), marker_velocity(vo, (ex + R * nx, ey + R * ny))
