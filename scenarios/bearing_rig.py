@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from mbd.recorder import atomic_write_text
+from .command import command
 
 
 def parse_args(argv):
@@ -97,6 +98,7 @@ def run(a) -> dict:
     return summary
 
 
+@command
 def main(argv=None) -> int:
     run(parse_args(sys.argv[1:] if argv is None else argv))
     return 0

@@ -32,6 +32,7 @@ import numpy as np
 
 import mbd
 from mbd.elements import BodySpring, ForceSource, GroundSupport, Ramp, TorqueSource, TorsionalSpring
+from .command import command
 
 ROLLER_D = 7.5e-3                      # m
 ROLLER_M = 3.1e-3                      # kg
@@ -169,6 +170,7 @@ def agreement(hht: dict, radau: dict, model: mbd.Model) -> float:
     return float(np.abs(hht["q_end"][pos] - radau["q_end"][pos]).max() / disp)
 
 
+@command
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--sizes", type=int, nargs="+", default=[10, 50, 100, 250], help="numbers of bodies M")

@@ -49,6 +49,7 @@ from components.presets import reference_dpgt
 
 from .numerics_common import (design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note,
                               observables, peak_rss_mb, run_hht, run_scipy, settled_state, warm_up)
+from .command import command
 
 __all__ = ["main", "benchmark", "scaling", "profile_window"]
 
@@ -257,6 +258,7 @@ def scaling(configs=SCALING, steps: int = 200, h: float = 5e-6, log=print) -> li
     return rows
 
 
+@command
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", action="store_true", help="print one JSON object on the last line")

@@ -9,6 +9,8 @@ from __future__ import annotations
 import importlib
 import sys
 
+from .command import command
+
 SCENARIOS = {
     "demo": "the default job: forward vs reverse study at condition 3 (what `make demo` runs)",
     "paper_study": "forward/reverse study over operating conditions, comparison tables and plots",
@@ -46,7 +48,8 @@ def main(argv=None) -> int:
         print(f"dpgt: unknown scenario {name!r}; available: {', '.join(have)}", file=sys.stderr)
         return 2
     mod = importlib.import_module("viz.cli" if name == "animate" else f"scenarios.{name}")
-    return int(mod.main(rest) or 0)
+    main = mod.main if hasattr(mod.main, "__wrapped__") else command(mod.main)   # viz's too: one-line errors
+    return main(rest)
 
 
 if __name__ == "__main__":

@@ -9,8 +9,10 @@ from __future__ import annotations
 import sys
 
 from . import paper_study
+from .command import command
 
 
+@command
 def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if any(a in ("-h", "--help") for a in argv):

@@ -37,6 +37,7 @@ from mbd.recorder import atomic_write_text
 from .paper_study import parse_sets
 from .runner import RunConfig
 from .sweep import Case, build_params, run_sweep
+from .command import command
 
 __all__ = ["main", "run", "LAMBDA_MIN", "SKID_PCT", "COLUMNS"]
 
@@ -213,13 +214,9 @@ def run(a) -> dict:
     return {"rows": rows, "failed": failed, "files": files, "answer": answer(rows) if rows else ""}
 
 
+@command
 def main(argv=None) -> int:
-    a = parse_args(sys.argv[1:] if argv is None else argv)
-    try:
-        r = run(a)
-    except ParameterError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    r = run(parse_args(sys.argv[1:] if argv is None else argv))
     print(r["answer"])
     for k, v in r["failed"].items():
         print(f"FAILED {k}: {v}")

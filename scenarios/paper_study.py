@@ -25,6 +25,7 @@ from mbd.recorder import atomic_write_text
 
 from .runner import RunConfig
 from .sweep import Case, build_params, run_sweep
+from .command import command
 
 # the summary keys the comparison shows, with their units (words: components.outputs.SUMMARY_WORDS)
 QUANTITIES = [(k, SUMMARY_WORDS[k][1]) for k in (
@@ -303,6 +304,7 @@ def run(a) -> dict:
     return {"results": results, "rows": rows, "failed": failed, "figures": figs, "animations": anims}
 
 
+@command
 def main(argv=None) -> int:
     a = parse_args(sys.argv[1:] if argv is None else argv)
     r = run(a)

@@ -27,6 +27,7 @@ from mbd.recorder import atomic_write_text
 
 from .analysis import amplitude_spectrum, peak_table
 from .runner import RunConfig, run_case
+from .command import command
 
 
 def parse_args(argv):
@@ -118,6 +119,7 @@ def run(a) -> dict:
     return summary
 
 
+@command
 def main(argv=None) -> int:
     run(parse_args(sys.argv[1:] if argv is None else argv))
     return 0

@@ -42,6 +42,7 @@ from components.units import Q_
 
 from .numerics_common import (Problem, StateSampler, design_verdict, dpgt_problem, machine_note, run_scipy,
                               warm_up)
+from .command import command
 
 __all__ = ["CASES", "case_overrides", "run_case_stability", "main", "FIELDS"]
 
@@ -208,6 +209,7 @@ def markdown(rows: list[dict], window: float, cap: float) -> str:
     return "\n".join(lines) + "\n"
 
 
+@command
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer cases, 1.5 ms window")

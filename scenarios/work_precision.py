@@ -46,6 +46,7 @@ from components.outputs import FAMILY
 
 from .numerics_common import (dpgt_problem, error_metrics, eval_costs, machine_note, observables, peak_rss_mb,
                               rig_problem, run_hht, run_scipy, settled_state, warm_up)
+from .command import command
 
 __all__ = ["main", "study", "FIELDS"]
 
@@ -287,6 +288,7 @@ def markdown(res: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+@command
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--problems", default="rig,dpgt", help="comma-separated: rig, dpgt")

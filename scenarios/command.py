@@ -1,0 +1,59 @@
+"""How every command ends (README "What a user can expect"): one line on standard error and an exit code,
+never a traceback unless ``--debug`` asks for it.
+
+    exit 0    done
+    exit 1    a run failed (an integration failure names the time, the element family and failed_state.npz)
+    exit 2    a usage error: a bad argument or parameter, named with its value and what is expected
+    exit 130  interrupted (Ctrl-C): finished runs and checkpoints are kept; the same command resumes
+"""
+from __future__ import annotations
+
+import functools
+import sys
+
+from components.units import ParameterError
+from mbd.errors import IntegrationError, ModelError
+
+__all__ = ["command", "USAGE", "FAILED", "INTERRUPTED"]
+
+USAGE, FAILED, INTERRUPTED = 2, 1, 130
+
+
+def command(main):
+    """Wrap a scenario's ``main(argv) -> int`` with the exit-code and one-line-error rules above."""
+
+    @functools.wraps(main)
+    def wrapped(argv=None) -> int:
+        args = list(sys.argv[1:] if argv is None else argv)
+        debug = "--debug" in args
+        if debug:
+            args.remove("--debug")
+        try:
+            return int(main(args) or 0)
+        except KeyboardInterrupt:
+            print("interrupted: finished runs and checkpoints are kept; run the same command again to resume",
+                  file=sys.stderr)
+            return INTERRUPTED
+        except SystemExit as exc:            # argparse's own usage errors (already printed) and our messages
+            if isinstance(exc.code, str):
+                print(exc.code if exc.code.startswith("error:") else f"error: {exc.code}", file=sys.stderr)
+                return USAGE
+            return exc.code if isinstance(exc.code, int) else 0
+        except (ParameterError, ModelError) as exc:
+            if debug:
+                raise
+            print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
+            return USAGE
+        except IntegrationError as exc:
+            if debug:
+                raise
+            print(f"error: the run failed: {' '.join(str(exc).split())}", file=sys.stderr)
+            return FAILED
+        except Exception as exc:             # a defect: say what, keep the traceback for --debug
+            if debug:
+                raise
+            print(f"error: {type(exc).__name__}: {' '.join(str(exc).split())} (run with --debug for the traceback)",
+                  file=sys.stderr)
+            return FAILED
+
+    return wrapped
