@@ -14,6 +14,8 @@ import sys
 from components.units import ParameterError
 from mbd.errors import IntegrationError, ModelError
 
+from .lock import FolderLocked
+
 __all__ = ["command", "USAGE", "FAILED", "INTERRUPTED"]
 
 USAGE, FAILED, INTERRUPTED = 2, 1, 130
@@ -48,6 +50,9 @@ def command(main):
             if debug:
                 raise
             print(f"error: the run failed: {' '.join(str(exc).split())}", file=sys.stderr)
+            return FAILED
+        except FolderLocked as exc:
+            print(f"error: {exc}", file=sys.stderr)
             return FAILED
         except Exception as exc:             # a defect: say what, keep the traceback for --debug
             if debug:

@@ -38,6 +38,7 @@ from .paper_study import parse_sets
 from .runner import RunConfig
 from .sweep import Case, build_params, run_sweep
 from .command import command
+from .lock import folder_lock
 
 __all__ = ["main", "run", "LAMBDA_MIN", "SKID_PCT", "COLUMNS"]
 
@@ -196,6 +197,11 @@ def write_outputs(rows: list[dict], out: Path) -> list[Path]:
 
 
 def run(a) -> dict:
+    with folder_lock(a.out):                 # one study per folder at a time
+        return _run(a)
+
+
+def _run(a) -> dict:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     cases = make_cases(a, out)

@@ -26,6 +26,7 @@ from mbd.recorder import atomic_write_text
 from .runner import RunConfig
 from .sweep import Case, build_params, run_sweep
 from .command import command
+from .lock import folder_lock
 
 # the summary keys the comparison shows, with their units (words: components.outputs.SUMMARY_WORDS)
 QUANTITIES = [(k, SUMMARY_WORDS[k][1]) for k in (
@@ -260,6 +261,11 @@ def animate(results: dict, out: Path) -> list[Path]:
 
 
 def run(a) -> dict:
+    with folder_lock(a.out):                 # one study per folder at a time
+        return _run(a)
+
+
+def _run(a) -> dict:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     cfg = build_config(a)

@@ -34,6 +34,8 @@ from mbd.recorder import BodyMotion, Recorder, atomic_write_text
 from components.outputs import WindowStatistics, bearing_map, cage_period, default_window
 from components.results_schema import drawing_geometry, element_probes
 
+from .lock import folder_lock
+
 __all__ = ["RunConfig", "run_case", "run_fingerprint", "statistics_window"]
 
 _ROOT = Path(__file__).resolve().parent.parent
@@ -103,9 +105,12 @@ def _probes(scene) -> list:
 
 def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None) -> dict:
     """Run one operating point; write results.nc and summary.json atomically into out_dir.
-    An interrupted run resumes from out_dir/checkpoint.npz."""
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    An interrupted run resumes from out_dir/checkpoint.npz. One run at a time per folder (scenarios.lock)."""
+    with folder_lock(out_dir):
+        return _run_case(params, cfg, Path(out_dir), label)
+
+
+def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
         scene = build_dpgt(params, cfg.options)
