@@ -260,6 +260,20 @@ def animate(results: dict, out: Path) -> list[Path]:
     return paths
 
 
+def _keep_finished_on_disk(results: dict, out: Path) -> None:
+    """A run that failed this time but finished before keeps its summary in the tables: a re-run in which
+    nothing succeeds never replaces good tables with empty ones (its failure is still reported)."""
+    for label, s in list(results.items()):
+        done = out / label / "summary.json"
+        if "error" in s and done.exists():
+            try:
+                old = json.loads(done.read_text())
+            except (OSError, ValueError):
+                continue                      # damaged: not a valid summary
+            if "error" not in old and "inner" in old:
+                results[label] = {**old, "stale_after_failure": s["error"]}
+
+
 def run(a) -> dict:
     with folder_lock(a.out):                 # one study per folder at a time
         return _run(a)
@@ -285,9 +299,10 @@ def _run(a) -> dict:
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
     results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress)
+    _keep_finished_on_disk(results, out)
     relative_life(results)
     for label, s in results.items():   # store the relative life in each run's summary (atomic rewrite)
-        if "error" not in s:
+        if "error" not in s and "stale_after_failure" not in s:
             s.pop("skipped", None)
             atomic_write_text(out / label / "summary.json", json.dumps(s, indent=2, default=str))
     rows = comparison_rows(results)
@@ -295,7 +310,8 @@ def _run(a) -> dict:
     figs = plots(results, out)
     anims = animate(results, out) if a.animate else []
     print("\n" + text)
-    failed = {k: v["error"] for k, v in results.items() if "error" in v}
+    failed = {k: v.get("error", v.get("stale_after_failure")) for k, v in results.items()
+              if "error" in v or "stale_after_failure" in v}
     for k, v in failed.items():
         print(f"FAILED {k}: {v}  (details in {out / k / 'error.json'})")
     print("run time and accuracy per run:")

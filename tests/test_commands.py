@@ -41,3 +41,17 @@ def test_a_bad_condition_through_the_dpgt_command(tmp_path, capsys):
     assert capsys.readouterr().err.strip() == "error: --conditions takes 1, 2, 3 and/or 4 (PARAMETERS.md), got 7"
     assert paper_study.main(["--set", 'bearing.clearance=-1 um', "--out", str(tmp_path)]) == USAGE
     assert "bearing.clearance" in capsys.readouterr().err
+
+
+def test_a_failed_rerun_keeps_the_finished_summaries_in_the_tables(tmp_path):
+    import json
+    good, damaged = tmp_path / "c4_forward", tmp_path / "c4_reverse"
+    good.mkdir()
+    damaged.mkdir()
+    (good / "summary.json").write_text(json.dumps({"inner": {"bearing_load_mean_N": 1.0}, "outer": {}}))
+    (damaged / "summary.json").write_text("{not json")
+    results = {"c4_forward": {"error": "boom"}, "c4_reverse": {"error": "bang"}}
+    paper_study._keep_finished_on_disk(results, tmp_path)
+    assert results["c4_forward"]["inner"] == {"bearing_load_mean_N": 1.0}
+    assert results["c4_forward"]["stale_after_failure"] == "boom"      # still reported as failed
+    assert results["c4_reverse"] == {"error": "bang"}                 # a damaged summary is not used
