@@ -55,3 +55,14 @@ def line_of_action(e, flank, alpha, internal):
     t = np.array([-e[1], e[0]])
     s = -1.0 if internal else 1.0
     return s * math.sin(alpha) * e + flank * math.cos(alpha) * t
+
+
+def ramp_state(t: float = 0.003, engine: str = "compiled"):
+    """(scene, state) of the reference DPGT (condition 3, forward) ``t`` into its load ramp: every contact
+    family active, for tests that need one loaded state rather than statistics."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sc = build_dpgt(reference_dpgt(3, "forward"))
+    res = mbd.simulate(sc.model, sc.q0, sc.v0, t, stepper=mbd.PRODUCTION.stepper(),
+                       controller=mbd.PRODUCTION.controller(), progress=False, engine=engine)
+    return sc, res.state

@@ -9,15 +9,12 @@ spin after 300 steps. So the engines are held together over 150 steps exactly (c
 """
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 
 import mbd
-from components.dpgt import build_dpgt
 from components.planetary import build_single_planetary
-from components.presets import reference_dpgt
+from dpgt_runs import ramp_state
 from mbd.compiled.system import CompiledSystem
 
 H = 5e-6
@@ -26,12 +23,8 @@ H = 5e-6
 @pytest.fixture(scope="module")
 def dpgt_state():
     """The DPGT 3 ms into its load ramp (every contact family active), by the compiled engine."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        sc = build_dpgt(reference_dpgt(3, "forward"))
-    res = mbd.simulate(sc.model, sc.q0, sc.v0, 0.003, stepper=mbd.PRODUCTION.stepper(),
-                       controller=mbd.PRODUCTION.controller(), progress=False, engine="compiled")
-    return sc.model, res.state
+    sc, s = ramp_state(0.003, "compiled")
+    return sc.model, s
 
 
 def _run(model, state, n, engine, observers=()):

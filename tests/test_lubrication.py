@@ -1,20 +1,18 @@
 """The lubricant film of the roller contacts (components.lubrication, MODEL.md §3.8)."""
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
 import mbd
-from components.dpgt import build_dpgt
 from components.lubrication import (dowson_higginson_film, line_contact_film, reduced_modulus,
                                     roller_contact_radius, walther_viscosity)
 from components.outputs import WindowStatistics
 from components.params import with_overrides
 from components.presets import OIL_GRADES, oil_grade, reference_dpgt
 from components.units import ParameterError
+from dpgt_runs import ramp_state
 
 E_STEEL = reduced_modulus(210e9, 0.3, 210e9, 0.3)
 
@@ -73,12 +71,7 @@ def test_oil_grades_and_bad_viscosities():
 @pytest.fixture(scope="module")
 def loaded_state():
     """The DPGT 3 ms into its load ramp, and its scene."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        sc = build_dpgt(reference_dpgt(3, "forward"))
-    res = mbd.simulate(sc.model, sc.q0, sc.v0, 0.003, stepper=mbd.PRODUCTION.stepper(),
-                       controller=mbd.PRODUCTION.controller(), progress=False)
-    return sc, res.state
+    return ramp_state(0.003, "auto")
 
 
 def _snapshot(scene, state, lubricant):
