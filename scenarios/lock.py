@@ -9,7 +9,7 @@ import socket
 import time
 from pathlib import Path
 
-__all__ = ["FolderLocked", "folder_lock", "LOCK_NAME"]
+__all__ = ["FolderLocked", "folder_lock", "holds_out_folder", "LOCK_NAME"]
 
 LOCK_NAME = ".dpgt.lock"
 
@@ -59,3 +59,14 @@ def folder_lock(folder):
             lock.unlink(missing_ok=True)
         return
     raise FolderLocked(f"{folder}: could not take the lock {lock}")
+
+
+def holds_out_folder(run):
+    """A study's ``run(args)`` holding the lock of ``args.out`` throughout (one study per folder at a time)."""
+    import functools
+
+    @functools.wraps(run)
+    def locked(a):
+        with folder_lock(a.out):
+            return run(a)
+    return locked

@@ -38,7 +38,7 @@ from .paper_study import parse_sets
 from .runner import RunConfig
 from .sweep import Case, build_params, run_sweep
 from .command import command
-from .lock import folder_lock
+from .lock import holds_out_folder
 
 __all__ = ["main", "run", "LAMBDA_MIN", "SKID_PCT", "COLUMNS"]
 
@@ -196,12 +196,8 @@ def write_outputs(rows: list[dict], out: Path) -> list[Path]:
     return [out / "summary.csv", out / "summary.md", out / "answer.md", fig]
 
 
+@holds_out_folder
 def run(a) -> dict:
-    with folder_lock(a.out):                 # one study per folder at a time
-        return _run(a)
-
-
-def _run(a) -> dict:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     cases = make_cases(a, out)

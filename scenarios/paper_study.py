@@ -26,7 +26,7 @@ from mbd.recorder import atomic_write_text
 from .runner import RunConfig
 from .sweep import Case, build_params, run_sweep
 from .command import command
-from .lock import folder_lock
+from .lock import holds_out_folder
 
 # the summary keys the comparison shows, with their units (words: components.outputs.SUMMARY_WORDS)
 QUANTITIES = [(k, SUMMARY_WORDS[k][1]) for k in (
@@ -274,12 +274,8 @@ def _keep_finished_on_disk(results: dict, out: Path) -> None:
                 results[label] = {**old, "stale_after_failure": s["error"]}
 
 
+@holds_out_folder
 def run(a) -> dict:
-    with folder_lock(a.out):                 # one study per folder at a time
-        return _run(a)
-
-
-def _run(a) -> dict:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     cfg = build_config(a)
