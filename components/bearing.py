@@ -79,13 +79,15 @@ def bearing_kinematics(b: BearingSI, omega_inner: float, omega_outer: float) -> 
 
 
 def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, outer_body: str, bearing: BearingSI,
-                       lubricant: LubricantSI | None, pin_xy, pin_vel, omega_pin: float, omega_outer: float) -> BearingHandles:
+                       lubricant: LubricantSI | None, pin_xy, pin_vel, omega_pin: float, omega_outer: float,
+                       damage: dict) -> BearingHandles:
     """Add one bearing (``bearing``: ``params.si().bearing``; ``lubricant``: ``params.si().lubricant``,
     needed when the scene has drag on). ``pin_local`` is the raceway centre in pin_body axes;
     ``pin_xy``/``pin_vel`` its position/velocity in the fixed frame at t = 0 (the kinematic steady
     state); ``omega_pin`` and ``omega_outer`` the absolute spin speeds of the inner and outer raceway
     bodies. The scene's option ``cage`` says "free", "held" (a fixed cage body: the rollers cannot
-    orbit) or "none". Returns handles."""
+    orbit) or "none". ``damage``: {} for a perfect bearing, else (:mod:`components.faults`) ``D`` the (Z,)
+    roller diameters and ``inner``/``outer`` the raceways' spall parameters. Returns handles."""
     b, opt = bearing, scene.options
     pin_local = np.asarray(pin_local, float)
     if opt.bearings == "linear":
@@ -112,15 +114,15 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
                    pose=(*(pin_xy + off), 0.0), vel=(*vel, wr))
     names = [f"{tag}.roller{j}" for j in range(Z)]
     marker = np.tile(pin_local, (Z, 1))
-    common = dict(D=D, K=b.contact_stiffness, zeta=b.contact_damping_ratio, m_roller=b.roller_mass,
+    common = dict(D=damage.get("D", D), K=b.contact_stiffness, zeta=b.contact_damping_ratio, m_roller=b.roller_mass,
                   multiplicity=b.rows)
     law = dict(traction=traction(b, lubricant), exponent=b.contact_exponent)     # family-wide laws
     inner = scene.family(FAMILY["race_inner"], RaceContact, ("roller", "race_body"), kind="inner", **law)
     s_in = inner.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker, R_race=b.inner_raceway_radius,
-                     **common)
+                     **common, **damage.get("inner", {}))
     outer = scene.family(FAMILY["race_outer"], RaceContact, ("roller", "race_body"), kind="outer", **law)
     s_out = outer.add(Z, roller=names, race_body=[outer_body] * Z, race_marker=np.zeros((Z, 2)),
-                      R_race=b.outer_raceway_radius, **common)
+                      R_race=b.outer_raceway_radius, **common, **damage.get("outer", {}))
     handles = BearingHandles("rollers", rollers=tuple(names), race_inner=s_in, race_outer=s_out, omega_cage=wm,
                              omega_roller=wr)
     if opt.drag:

@@ -14,6 +14,7 @@ import numpy as np
 
 from mbd.elements import GroundSupport, Ramp, SpeedDrive, TorqueSource
 
+from . import faults
 from .bearing import BearingHandles, add_planet_bearing
 from .gears import add_mesh_family
 from .geometry import check_design, loaded_flanks
@@ -44,6 +45,14 @@ class PairHandles:
         return self.inner_bearing if kind == "inner" else self.outer_bearing
 
 
+def _bearing_damage(si, planet: str, psi: float) -> dict:
+    """Roller diameters and raceway spalls of one planet's bearing ({} for a perfect one)."""
+    if not (si.errors.roller_diameter or si.errors.spall):
+        return {}
+    return dict(D=faults.roller_diameters(si, planet), inner=faults.spall_args(si, planet, "inner", psi),
+                outer=faults.spall_args(si, planet, "outer", psi))
+
+
 def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: bool = True) -> BuiltScene:
     """Build the DPGT scene. Design errors raise ParameterError; design warnings are issued."""
     opt = (options or SceneOptions()).resolved()
@@ -51,6 +60,7 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
         raise ParameterError.at("options.cage", "'held' is a bearing-rig option; the DPGT takes 'free' or 'none'")
     check_design(params, strict=strict)
     si = params.si()
+    faults.check_errors(si)
     lay = si.layout
     G, op, sup, ms = si.gears, si.operating, si.support, si.mesh
     wc = op.carrier_speed
@@ -75,14 +85,16 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     a_names = [f"a{n + 1}" for n in range(N)]
     b_names = [f"b{n + 1}" for n in range(N)]
     for n in range(N):
-        pa, pb = lay.centres_a[n], lay.centres_b[n]
+        # pins (and the planets on them) where the carrier's pinholes really are (errors.pinhole)
+        pa, pb = faults.pin_position(si, a_names[n], lay.centres_a[n]), faults.pin_position(si, b_names[n], lay.centres_b[n])
         va, vb = wc * np.array([-pa[1], pa[0]]), wc * np.array([-pb[1], pb[0]])
         scene.body(a_names[n], G.inner_planet.mass, G.inner_planet.inertia, pose=(*pa, ph.gamma_inner[n]), vel=(*va, speed["a"]))
         scene.body(b_names[n], G.outer_planet.mass, G.outer_planet.inertia, pose=(*pb, ph.gamma_outer[n]), vel=(*vb, speed["b"]))
         bearings = [add_planet_bearing(scene, f"{planet}.pb", pin_body="carrier", pin_local=p, outer_body=planet,
                                        bearing=b, lubricant=si.lubricant, pin_xy=p, pin_vel=v, omega_pin=wc,
-                                       omega_outer=w)
-                    for planet, p, v, w in ((a_names[n], pa, va, speed["a"]), (b_names[n], pb, vb, speed["b"]))]
+                                       omega_outer=w, damage=_bearing_damage(si, planet, psi))
+                    for planet, p, v, w, psi in ((a_names[n], pa, va, speed["a"], lay.psi_a[n]),
+                                                 (b_names[n], pb, vb, speed["b"], lay.psi_b[n]))]
         pairs.append(PairHandles(a_names[n], b_names[n], float(lay.psi_a[n]), float(lay.psi_b[n]), *bearings))
 
     # meshes, phased for the flank the torque path loads (reverse rotation loads the other flanks)
@@ -91,12 +103,11 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     common = dict(time_varying=opt.mesh_stiffness == "time_varying", smoothing=ms.smoothing_width,
                   ratio=ms.stiffness_ratio)
     M = lay.meshes
-    add_mesh_family(scene, MESH_FAMILY["sun_inner"], M["sun_inner"], gear1=["sun"] * N, gear2=a_names, theta1_0=np.zeros(N),
-                    theta2_0=ph.gamma_inner, flank=flanks["sun_inner"], **common)
-    add_mesh_family(scene, MESH_FAMILY["inner_outer"], M["inner_outer"], gear1=a_names, gear2=b_names, theta1_0=ph.gamma_inner,
-                    theta2_0=ph.gamma_outer, flank=flanks["inner_outer"], **common)
-    add_mesh_family(scene, MESH_FAMILY["outer_ring"], M["outer_ring"], gear1=b_names, gear2=["ring"] * N, theta1_0=ph.gamma_outer,
-                    theta2_0=np.full(N, ph.gamma_ring), flank=flanks["outer_ring"], **common)
+    for key, g1, g2, th1, th2 in (("sun_inner", ["sun"] * N, a_names, np.zeros(N), ph.gamma_inner),
+                                  ("inner_outer", a_names, b_names, ph.gamma_inner, ph.gamma_outer),
+                                  ("outer_ring", b_names, ["ring"] * N, ph.gamma_outer, np.full(N, ph.gamma_ring))):
+        add_mesh_family(scene, MESH_FAMILY[key], M[key], gear1=g1, gear2=g2, theta1_0=th1, theta2_0=th2,
+                        flank=flanks[key], errors=faults.mesh_error_args(si, M[key], flanks[key], g1, g2), **common)
 
     # drives: sun torque (driving motor), carrier speed drive (loading motor)
     f_m = op.mesh_frequency

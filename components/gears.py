@@ -20,10 +20,11 @@ __all__ = ["add_mesh_family"]
 
 
 def add_mesh_family(scene: Scene, family: str, mg, *, gear1: list[str], gear2: list[str], theta1_0, theta2_0,
-                    flank: int, time_varying: bool, smoothing: float, ratio: float) -> slice:
+                    flank: int, time_varying: bool, smoothing: float, ratio: float, errors: dict) -> slice:
     """Add the N meshes of one type (``mg`` a :class:`components.geometry.MeshGeometry`).
     ``theta*_0`` are the gears' body angles at assembly (tooth 0 at the body angle); u0 makes both
-    flanks' compression zero there."""
+    flanks' compression zero there. ``errors``: per-instance runout and tooth-fault parameters
+    (:func:`components.faults.mesh_error_args`; {} for a perfect machine)."""
     th1, th2 = np.asarray(theta1_0, float), np.asarray(theta2_0, float)
     phi = np.asarray(mg.line_angle, float)
     rb1, rb2 = mg.base_radius1, mg.base_radius2
@@ -48,4 +49,5 @@ def add_mesh_family(scene: Scene, family: str, mg, *, gear1: list[str], gear2: l
     fam = scene.family(family, GearMesh, ("gear1", "gear2"), internal=mg.internal, stiffness=shape)
     n = phi.size
     return fam.add(n, gear1=gear1, gear2=gear2, rb1=rb1, rb2=rb2, alpha=mg.pressure_angle, a0=mg.centre_distance,
-                   teeth1=mg.z1, k_mean=mg.k_mean, c_mesh=mg.damping, u0=u0, p0=p0, backlash=mg.backlash, phi_ref=phi)
+                   teeth1=mg.z1, k_mean=mg.k_mean, c_mesh=mg.damping, u0=u0, p0=p0, backlash=mg.backlash, phi_ref=phi,
+                   **errors)

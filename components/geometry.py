@@ -331,11 +331,14 @@ class MeshGeometry:
         enters, p' ∈ [0, ε−1) (the convention of ``mbd.elements.gear_mesh.StiffnessShape.rectangular``):
         p' = z_1(θ_1 − φ_e)/2π + wave_p0(f) reproduces :meth:`pairs_in_contact` on flank f. The two
         flanks differ (by about half a cycle): phase each mesh for its loaded flank (:func:`loaded_flanks`)."""
+        return _frac(self.p0 + self.entry_shift(flank))
+
+    def entry_shift(self, flank: int) -> float:
+        """Cycles from a new tooth pair's entry on ``flank`` to the moment its gear-1 tooth is centred on
+        the pitch point: the pair whose gear-1 tooth is centred at p = p_i enters at p_i − entry_shift."""
         if self.sigma * flank > 0:   # contact runs from gear 2's tip end (s = −g_2) as p grows
-            shift = 0.25 + self.path2 / self.base_pitch
-        else:                        # contact runs from gear 1's tip end (s = g_1) as p grows
-            shift = self.path1 / self.base_pitch - 0.25
-        return _frac(self.p0 + shift)
+            return 0.25 + self.path2 / self.base_pitch
+        return self.path1 / self.base_pitch - 0.25   # contact runs from gear 1's tip end (s = g_1) as p grows
 
     def pairs_in_contact(self, p, flank: int):
         """Number of tooth pairs in contact on ``flank`` at mesh position p (rigid teeth, no load)."""

@@ -546,6 +546,9 @@ class WindowStatistics(mbd.Observer):
             mean_vec = np.hypot(lr["mean"], lt["mean"])
             d["bearing_load_mean_N"] = float(mean_vec[ref])
             d["bearing_load_mean_all_N"] = float(mean_vec[sel].mean())
+            # load sharing between the planets of this row (ISO 6336's K_γ: the most loaded over the mean)
+            d["bearing_load_mean_per_planet_N"] = [float(x) for x in mean_vec[sel]]
+            d["load_sharing_factor"] = float(mean_vec[sel].max() / mean_vec[sel].mean())
             d["bearing_load_radial_mean_N"] = float(lr["mean"][ref])
             d["bearing_load_tangential_mean_N"] = float(lt["mean"][ref])
             d["bearing_load_max_N"] = float(lm["max"][ref])

@@ -38,6 +38,7 @@ import difflib
 import json
 import math
 import numbers
+import re
 import tomllib
 from dataclasses import MISSING, dataclass, field
 from types import MappingProxyType
@@ -51,7 +52,8 @@ from .units import ParameterError, Quantity, format_quantity, quantity, to_si
 __all__ = [
     "Source", "Sourced", "paper", "derived", "assumed", "SI", "Derived", "Params",
     "GearParams", "GearSetParams", "CageParams", "SlideRollTractionParams", "BearingParams", "LubricantParams", "SupportParams",
-    "MeshParams", "OperatingPoint", "RigParams", "DPGTParams", "BearingRigParams",
+    "MeshParams", "OperatingPoint", "RigParams", "DPGTParams", "BearingRigParams", "ErrorsParams", "PinholeErrorParams",
+    "RunoutParams", "RollerDiameterErrorParams", "SpallParams", "ToothFaultParams",
     "GearSI", "GearSetSI", "CageSI", "SlideRollTractionSI", "BearingSI", "LubricantSI", "SupportSI", "MeshSI",
     "OperatingSI", "RigSI", "DPGTSI", "DPGTOperatingSI", "DPGTSupportSI", "BearingRigSI",
     "with_overrides", "parameter_names", "flatten", "describe", "to_toml", "overrides_from_toml",
@@ -108,7 +110,7 @@ _USER = Source("user")
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class _Spec:
-    kind: str                      # a units kind, or "count" | "sign" | "flag" | "choice" | "nested"
+    kind: str                      # a units kind, or "count" | "sign" | "flag" | "choice" | "name" | "nested" | "entries"
     lo: float | None = None        # bounds on the SI value
     hi: float | None = None
     lo_open: bool = False
@@ -117,7 +119,8 @@ class _Spec:
     optional: bool = False         # None allowed: the value then follows ``rule``
     rule: Source | None = None
     choices: tuple = ()
-    cls: type | None = None
+    cls: type | None = None        # "nested": the parameter class; "entries": the class of one entry
+    pattern: str = ""              # "name": the regular expression a value must match
     doc: str = ""
 
 
@@ -149,6 +152,15 @@ def _backlash(which: str):
 
 def _nested(cls, doc=""):
     return _param("nested", doc, cls=cls)
+
+
+def _entries(cls, doc=""):
+    """A list of tables, each one ``cls`` (e.g. one manufacturing error); empty by default."""
+    return _param("entries", doc, cls=cls, default=())
+
+
+def _name(pattern: str, what: str, doc=""):
+    return _param("name", doc, pattern=pattern, bound_text=what)
 
 
 def _check_bounds(spec: _Spec, name: str, x: float, shown) -> None:
@@ -210,6 +222,12 @@ def _convert(spec: _Spec, name: str, value):
         if not isinstance(value, (bool, np.bool_)):
             raise ParameterError.at(name, f"expected true or false, got {value!r}")
         return bool(value)
+    if k == "name":
+        if not (isinstance(value, str) and re.fullmatch(spec.pattern, value)):
+            raise ParameterError.at(name, f"expected {spec.bound_text}, got {value!r}")
+        return value
+    if k == "entries":
+        return _convert_entries(spec, name, value)
     if k == "choice":
         if value not in spec.choices:
             raise ParameterError.at(name, f"expected one of {list(spec.choices)}, got {value!r}")
@@ -217,6 +235,33 @@ def _convert(spec: _Spec, name: str, value):
     q = quantity(name, value, k)
     _check_bounds(spec, name, to_si(q), value if isinstance(value, (str, numbers.Real)) else str(q))
     return q
+
+
+def _convert_entries(spec: _Spec, name: str, value) -> tuple:
+    """A list of tables (mappings or ``spec.cls`` objects) → a tuple of ``spec.cls``; errors name the entry,
+    e.g. ``errors.pinhole[1].radial``."""
+    if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, (list, tuple)):
+        raise ParameterError.at(name, f"expected a list of {spec.cls.__name__} tables (TOML: [[{name}]]), "
+                                      f"got {type(value).__name__}")
+    out = []
+    for i, item in enumerate(value):
+        path = f"{name}[{i}]"
+        if isinstance(item, spec.cls):
+            out.append(item)
+            continue
+        if not isinstance(item, Mapping):
+            raise ParameterError.at(path, f"expected a table of {[f.name for f in _param_fields(spec.cls)]}, "
+                                          f"got {type(item).__name__}")
+        try:
+            out.append(spec.cls(**item))
+        except ParameterError as e:
+            raise e.renamed(spec.cls._prefix, path) from None
+        except TypeError:
+            fs = _param_fields(spec.cls)
+            unknown = sorted(set(item) - {f.name for f in fs})
+            missing = [f.name for f in fs if f.name not in item and f.default is MISSING]
+            raise ParameterError.at(path, f"needs {missing} (unknown keys: {unknown})") from None
+    return tuple(out)
 
 
 def _param_fields(cls) -> tuple:
@@ -279,7 +324,9 @@ def _si_dict(v):
 def _si_type(spec: "_Spec"):
     if spec.kind == "nested":
         return spec.cls.SI
-    t = {"count": int, "sign": int, "flag": bool, "choice": str}.get(spec.kind, float)
+    if spec.kind == "entries":
+        return tuple
+    t = {"count": int, "sign": int, "flag": bool, "choice": str, "name": str}.get(spec.kind, float)
     return t | None if spec.optional else t
 
 
@@ -408,6 +455,8 @@ class Params:
 def _to_si_value(v):
     if isinstance(v, Params):
         return v.si()
+    if isinstance(v, tuple):
+        return tuple(_to_si_value(x) for x in v)
     return to_si(v) if isinstance(v, Quantity) else v
 
 
@@ -750,6 +799,102 @@ DPGTSupportSI = _extend_si(
     "Supports with the ring's torsional stiffness.")
 
 
+# ---------------------------------------------------------------------------------------------
+# manufacturing errors and faults (MODEL.md §3.9): lists of entries, none by default (a perfect machine)
+# ---------------------------------------------------------------------------------------------
+_PLANET = r"[ab][1-9][0-9]*"
+_PLANET_TEXT = "a planet name 'a1'..'aN' (inner) or 'b1'..'bN' (outer)"
+_GEAR = r"sun|ring|" + _PLANET
+_GEAR_TEXT = "a gear name: 'sun', 'ring', 'a1'..'aN' or 'b1'..'bN'"
+
+
+@_with_si("PinholeErrorSI")
+@dataclass(frozen=True, kw_only=True)
+class PinholeErrorParams(Params):
+    """A carrier pinhole off its nominal position: the planet's pin (its bearing's inner raceway) is
+    displaced on the carrier, radially (away from the carrier axis +) and tangentially (+ in the sense of
+    increasing planet angle)."""
+    _prefix: ClassVar[str] = "errors.pinhole"
+    planet: str = _name(_PLANET, _PLANET_TEXT, "the planet whose pin is displaced")
+    radial: Quantity = _param("length", "radial position error of the pin (+ outwards)")
+    tangential: Quantity = _param("length", "tangential position error of the pin (+ with the planet angle)")
+PinholeErrorSI = PinholeErrorParams.SI
+
+
+@_with_si("RunoutSI")
+@dataclass(frozen=True, kw_only=True)
+class RunoutParams(Params):
+    """Eccentricity of a gear's teeth: their centre sits ``eccentricity`` from the gear's rotation centre,
+    at ``phase`` in the gear's body axes (tooth 0 at phase 0), turning with the gear; the meshes see it
+    through their exact kinematics. Radial runout (total indicator reading) = 2 × eccentricity."""
+    _prefix: ClassVar[str] = "errors.runout"
+    gear: str = _name(_GEAR, _GEAR_TEXT, "the eccentric gear")
+    eccentricity: Quantity = _nonneg("length", "offset of the tooth centre from the rotation centre (runout / 2)")
+    phase: Quantity = _param("angle", "direction of the offset in the gear's body axes")
+RunoutSI = RunoutParams.SI
+
+
+@_with_si("RollerDiameterErrorSI")
+@dataclass(frozen=True, kw_only=True)
+class RollerDiameterErrorParams(Params):
+    """One roller of a planet bearing larger (+) or smaller (−) than nominal (every row of that roller)."""
+    _prefix: ClassVar[str] = "errors.roller_diameter"
+    planet: str = _name(_PLANET, _PLANET_TEXT, "the planet whose bearing has the roller")
+    roller: int = _param("count", "roller index 0..Z-1 (roller 0 starts on the carrier's radial line)", lo=0.0,
+                         bound_text=">= 0")
+    deviation: Quantity = _param("length", "diameter deviation of the roller (+ larger)")
+RollerDiameterErrorSI = RollerDiameterErrorParams.SI
+
+
+@_with_si("SpallSI")
+@dataclass(frozen=True, kw_only=True)
+class SpallParams(Params):
+    """A local raceway defect: a roller over it loses ``depth`` of its contact deflection, ramped in over
+    ``edge`` at both ends. On the pin (raceway "inner", fixed on the carrier: ``position`` measured from
+    the carrier's radial line through the planet, + with the planet angle) or on the planet's bore
+    (raceway "outer", turning with the planet: ``position`` in the planet's body axes)."""
+    _prefix: ClassVar[str] = "errors.spall"
+    planet: str = _name(_PLANET, _PLANET_TEXT, "the planet whose bearing has the defect")
+    raceway: str = _param("choice", "inner (the pin) or outer (the planet bore)", choices=("inner", "outer"))
+    position: Quantity = _param("angle", "angular position of the defect's centre on its raceway")
+    width: Quantity = _pos("length", "length of the defect along the raceway")
+    depth: Quantity = _pos("length", "depth of the defect")
+    edge: Quantity = _pos("length", "length over which the depth ramps in at each end (<= width)")
+SpallSI = SpallParams.SI
+
+
+@_with_si("ToothFaultSI")
+@dataclass(frozen=True, kw_only=True)
+class ToothFaultParams(Params):
+    """One tooth of a gear weakened (a crack: the stiffness of every tooth pair it forms scaled by
+    ``stiffness_factor``) or missing (factor 0), in every mesh the tooth enters."""
+    _prefix: ClassVar[str] = "errors.tooth_fault"
+    gear: str = _name(_GEAR, _GEAR_TEXT, "the gear with the faulty tooth")
+    tooth: int = _param("count", "tooth index 0..z-1 (tooth 0 on the gear's body x axis)", lo=0.0, bound_text=">= 0")
+    stiffness_factor: Quantity = _param("dimensionless", "stiffness of the faulty tooth's pairs / healthy (0: missing)",
+                                        lo=0.0, hi=1.0, bound_text="in [0, 1]")
+ToothFaultSI = ToothFaultParams.SI
+
+
+@_with_si("ErrorsSI")
+@dataclass(frozen=True, kw_only=True)
+class ErrorsParams(Params):
+    """Manufacturing errors and faults of the machine (MODEL.md §3.9); every list empty: the perfect
+    machine. In TOML each entry is a table, e.g. ``[[errors.pinhole]]`` with ``planet``, ``radial``,
+    ``tangential`` (README, "A damaged machine")."""
+    _prefix: ClassVar[str] = "errors"
+    pinhole: tuple = _entries(PinholeErrorParams, "carrier pinhole position errors")
+    runout: tuple = _entries(RunoutParams, "gear eccentricities")
+    roller_diameter: tuple = _entries(RollerDiameterErrorParams, "roller diameter deviations")
+    spall: tuple = _entries(SpallParams, "raceway spalls")
+    tooth_fault: tuple = _entries(ToothFaultParams, "cracked or missing teeth")
+
+    @property
+    def perfect(self) -> bool:
+        return not any(getattr(self, f.name) for f in _param_fields(type(self)))
+ErrorsSI = ErrorsParams.SI
+
+
 @_with_si("DPGTSI")
 @dataclass(frozen=True, kw_only=True)
 class DPGTParams(Params):
@@ -770,6 +915,7 @@ class DPGTParams(Params):
     operating: OperatingPoint = _nested(OperatingPoint, "operating point")
     rig: RigParams = _nested(RigParams, "test rig: carrier speed drive and load ramp")
     gravity: Quantity = _nonneg("acceleration", "gravitational acceleration (0 switches gravity off)")
+    errors: ErrorsParams = _nested(ErrorsParams, "manufacturing errors and faults (every list empty: the perfect machine)")
 
     _si_derived: ClassVar[tuple] = (
         Derived("gears", GearSetSI, "gear set; planet inertias resolved with the bearing bore"),
@@ -896,6 +1042,9 @@ def with_overrides(params: Params, overrides: Mapping[str, Any] | None) -> Param
 def _describe_value(v) -> str:
     if isinstance(v, Quantity):
         return f"{v:~P}"
+    if isinstance(v, tuple):                 # a list of entries (e.g. manufacturing errors)
+        return "; ".join(", ".join(f"{f.name}={_describe_value(getattr(e, f.name))}" for f in _param_fields(type(e)))
+                         for e in v) or "none"
     return repr(v) if isinstance(v, str) else str(v)
 
 
@@ -946,15 +1095,22 @@ def to_toml(params: Params) -> str:
     lines: list[str] = []
 
     def emit(obj: Params, path: str):
-        subs = []
+        subs, lists = [], []
         for f in _param_fields(type(obj)):
             v = getattr(obj, f.name)
             if isinstance(v, Params):
                 subs.append((f.name, v))
+            elif f.metadata["spec"].kind == "entries":
+                lists.append((f.name, v))
             elif v is None:
                 lines.append(f"# {f.name}: {obj.source(f.name)}")
             else:
                 lines.append(f"{f.name} = {_toml_value(v)}  # {obj.source(f.name)}")
+        for name, entries in lists:          # arrays of tables: [[path.name]] per entry
+            for entry in entries:
+                lines.append("")
+                lines.append(f"[[{path}{name}]]")
+                emit(entry, f"{path}{name}.")
         for name, sub in subs:
             lines.append("")
             lines.append(f"[{path}{name}]")

@@ -11,13 +11,13 @@ from types import MappingProxyType
 
 from pathlib import Path
 
-from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, GearParams, GearSetParams, LubricantParams,
+from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, ErrorsParams, GearParams, GearSetParams, LubricantParams,
                      MeshParams, OperatingPoint, RigParams, SlideRollTractionParams, SupportParams, assumed, derived,
                      overrides_from_toml, paper, with_overrides)
 from .units import Q_, ParameterError
 
 __all__ = ["CONDITIONS", "DIRECTIONS", "OIL_GRADES", "oil_grade", "operating_point", "reference_gears", "reference_bearing",
-           "reference_dpgt", "reference_bearing_rig", "load_toml"]
+           "reference_dpgt", "reference_bearing_rig", "load_toml", "perfect_machine"]
 
 # the study's four operating conditions: carrier speed n_c and output power P (ring fixed)
 CONDITIONS = MappingProxyType({
@@ -129,6 +129,12 @@ def reference_bearing() -> BearingParams:
     )
 
 
+def perfect_machine() -> ErrorsParams:
+    """No manufacturing errors or faults: the machine the source models (MODEL.md §3.9)."""
+    return ErrorsParams(**{f: paper((), "the source models a perfect machine")
+                           for f in ("pinhole", "runout", "roller_diameter", "spall", "tooth_fault")})
+
+
 def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams:
     """The reference DPGT exactly per PARAMETERS.md, at operating ``condition`` (1..4) and ``direction``."""
     return DPGTParams(
@@ -173,6 +179,7 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
             load_ramp_mesh_periods=assumed(20.0, "no impulse at the start (MODEL.md 4)"),
             load_ramp_max=assumed("0.05 s", "near-zero speeds have no mesh period")),
         gravity=assumed("9.81 m/s^2", "standard gravity along -Y of the fixed frame"),
+        errors=perfect_machine(),
     )
 
 

@@ -148,7 +148,8 @@ def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 *
     scene.body("pin", 1.0, 1.0, fixed=True)
     scene.body("ring", rs.ring_mass, rs.ring_inertia, vel=(0.0, 0.0, w))
     h = add_planet_bearing(scene, "pb", pin_body="pin", pin_local=(0.0, 0.0), outer_body="ring", bearing=b,
-                           lubricant=lub, pin_xy=(0.0, 0.0), pin_vel=(0.0, 0.0), omega_pin=0.0, omega_outer=w)
+                           lubricant=lub, pin_xy=(0.0, 0.0), pin_vel=(0.0, 0.0), omega_pin=0.0, omega_outer=w,
+                           damage={})   # the rig's bearing is perfect
     # radial mode of the ring on the loaded bearing (stiffness dF/dδ_r of the classical solution)
     if F > 0:
         ref = discrete_load_distribution(b, F, _roller_angles_from_zone(b.rollers, a))

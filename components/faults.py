@@ -1,0 +1,182 @@
+"""Manufacturing errors and faults of the DPGT (MODEL.md §3.9) as element parameters.
+
+``params.errors`` (:class:`components.params.ErrorsParams`) names planets ("a1".."aN" inner, "b1".."bN"
+outer) and gears ("sun", "ring" or a planet). :func:`check_errors` checks those names and sizes against
+the machine; the other functions resolve the errors into the per-instance parameters of the element
+families that feel them:
+
+* pinhole error → the pin's marker on the carrier (:func:`pin_position`);
+* roller diameter deviation → that roller's D in both raceway contacts (:func:`roller_diameters`);
+* spall → the raceway contacts' defect parameters (:func:`spall_args`);
+* runout and tooth faults → the mesh families' geometric-centre offsets and fault coordinates
+  (:func:`mesh_error_args`).
+
+A machine without errors gets none of these parameters: its elements are evaluated exactly as before.
+A family that holds one damaged instance holds the "healthy" values (depth 0, factor 1, offset 0) for
+the others, which its law reduces to exactly.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .units import ParameterError
+
+__all__ = ["check_errors", "pin_position", "roller_diameters", "spall_args", "mesh_error_args", "GEAR_OF"]
+
+TWO_PI = 2.0 * np.pi
+GEAR_OF = {"sun": "sun", "ring": "ring", "a": "inner_planet", "b": "outer_planet"}   # name → si.gears field
+
+
+def _gear_si(si, name: str):
+    return si.gears[GEAR_OF[name if name in ("sun", "ring") else name[0]]]
+
+
+def _planet_index(name: str) -> int:
+    return int(name[1:]) - 1
+
+
+def check_errors(si) -> None:
+    """Every error names a planet/gear/roller/tooth the machine has; a spall fits its raceway."""
+    e, N, b = si.errors, si.layout.planets, si.bearing
+
+    def planet(path, name):
+        if name not in ("sun", "ring") and _planet_index(name) >= N:
+            raise ParameterError.at(path, f"{name!r} names planet {_planet_index(name) + 1}, but the machine has "
+                                          f"{N} planets per row ('a1'..'a{N}', 'b1'..'b{N}')")
+
+    for i, x in enumerate(e.pinhole):
+        planet(f"errors.pinhole[{i}].planet", x.planet)
+    for i, x in enumerate(e.runout):
+        planet(f"errors.runout[{i}].gear", x.gear)
+    for i, x in enumerate(e.roller_diameter):
+        planet(f"errors.roller_diameter[{i}].planet", x.planet)
+        if x.roller >= b.rollers:
+            raise ParameterError.at(f"errors.roller_diameter[{i}].roller", f"must be in 0..{b.rollers - 1} "
+                                                                           f"(Z = {b.rollers}), got {x.roller}")
+        if abs(x.deviation) >= 0.01 * b.roller_diameter:
+            raise ParameterError.at(f"errors.roller_diameter[{i}].deviation",
+                                    f"must be smaller than 1 % of the roller diameter ({0.01 * b.roller_diameter:.3g} m), "
+                                    f"got {x.deviation:.3g} m")
+    for i, x in enumerate(e.spall):
+        planet(f"errors.spall[{i}].planet", x.planet)
+        R = b.inner_raceway_radius if x.raceway == "inner" else b.outer_raceway_radius
+        if x.edge > x.width:
+            raise ParameterError.at(f"errors.spall[{i}].edge", f"must be <= the width ({x.width:.3g} m), got {x.edge:.3g} m")
+        if x.width + x.edge >= np.pi * R:
+            raise ParameterError.at(f"errors.spall[{i}].width", f"must be shorter than half the raceway "
+                                                                f"({np.pi * R:.3g} m), got {x.width:.3g} m")
+    keys = [(x.planet, x.raceway) for x in e.spall]
+    if len(set(keys)) < len(keys):
+        raise ParameterError.at("errors.spall", "at most one spall per raceway (two entries name the same "
+                                                "planet and raceway)")
+    for i, x in enumerate(e.tooth_fault):
+        planet(f"errors.tooth_fault[{i}].gear", x.gear)
+        z = _gear_si(si, x.gear).teeth
+        if x.tooth >= z:
+            raise ParameterError.at(f"errors.tooth_fault[{i}].tooth", f"must be in 0..{z - 1} ({x.gear} has {z} teeth), "
+                                                                      f"got {x.tooth}")
+    gears = [x.gear for x in e.tooth_fault]
+    if len(set(gears)) < len(gears):
+        raise ParameterError.at("errors.tooth_fault", "at most one faulty tooth per gear")
+    runout = [x.gear for x in e.runout]
+    if len(set(runout)) < len(runout):
+        raise ParameterError.at("errors.runout", "at most one runout entry per gear")
+
+
+def pin_position(si, planet: str, nominal) -> np.ndarray:
+    """The pin centre of ``planet`` in the carrier's axes: nominal plus its pinhole errors (radial along the
+    planet's angle ψ, tangential along ψ + 90°)."""
+    n = _planet_index(planet)
+    psi = (si.layout.psi_a if planet[0] == "a" else si.layout.psi_b)[n]
+    er, et = np.array([np.cos(psi), np.sin(psi)]), np.array([-np.sin(psi), np.cos(psi)])
+    out = np.array(nominal, float)
+    for x in si.errors.pinhole:
+        if x.planet == planet:
+            out = out + x.radial * er + x.tangential * et
+    return out
+
+
+def roller_diameters(si, planet: str) -> np.ndarray:
+    """(Z,) roller diameters of ``planet``'s bearing [m]."""
+    D = np.full(si.bearing.rollers, si.bearing.roller_diameter)
+    for x in si.errors.roller_diameter:
+        if x.planet == planet:
+            D[x.roller] += x.deviation
+    return D
+
+
+def spall_args(si, planet: str, raceway: str, angle_of_planet: float) -> dict:
+    """Spall parameters of the Z contacts of ``planet``'s ``raceway`` ({} when the machine has no spall at
+    all; depth 0 on a healthy raceway of a machine that has one). On the pin the position counts from the
+    carrier's radial line through the planet (``angle_of_planet`` ψ), on the bore in the planet's axes."""
+    if not si.errors.spall:
+        return {}
+    Z = si.bearing.rollers
+    hit = [x for x in si.errors.spall if x.planet == planet and x.raceway == raceway]
+    if not hit:
+        return dict(spall_angle=np.zeros(Z), spall_width=np.ones(Z), spall_depth=np.zeros(Z), spall_edge=np.ones(Z))
+    x = hit[0]
+    angle = x.position + (angle_of_planet if raceway == "inner" else 0.0)
+    return dict(spall_angle=np.full(Z, angle), spall_width=np.full(Z, x.width), spall_depth=np.full(Z, x.depth),
+                spall_edge=np.full(Z, x.edge))
+
+
+def _offset(si, gear: str) -> np.ndarray:
+    for x in si.errors.runout:
+        if x.gear == gear:
+            return x.eccentricity * np.array([np.cos(x.phase), np.sin(x.phase)])
+    return np.zeros(2)
+
+
+def _tooth_fault(si, gear: str):
+    return next((x for x in si.errors.tooth_fault if x.gear == gear), None)
+
+
+def _fault_coordinate(mg, flank: int, which: int, tooth: int) -> tuple[float, float, float]:
+    """(A1, A2, c_f) of the fault coordinate p_f = A1 θ1 + A2 θ2 − (A1 + A2) φ_e + c_f, which is 0 (mod the
+    faulty gear's tooth count) when the pair of tooth ``tooth`` of gear ``which`` (1 or 2) enters on ``flank``.
+
+    Gear 1 (body angle θ1 holds its tooth 0): tooth i is centred on the pitch point at
+    p_geo = z1(θ1 − φ_e)/2π ≡ −i, and its pair enters entry_shift = h earlier, so p_f = p_geo + i + h.
+    Gear 2: its tooth phase at the pitch point q = z2(θ2 − φ_e − π·[external])/2π is ≡ −k when tooth k is
+    centred there, and rolling gives q = −σ p_geo + const. The pair (i, k) on flank f has its contact at
+    s = (σ f (p − p_i) + 1/4) p_b, at −p_b/4 when tooth k is centred (symmetry), so tooth k is centred at
+    p_i − σf/2 and the pair enters σf/2 − h after that. With A2 = −σ z2/2π:
+    A2(θ2 − φ_e) = −σ q − σ (z2/2)·[external], hence c_f = −(σk − σ(z2/2)[external] + σf/2 − h)."""
+    h = mg.entry_shift(flank)
+    if which == 1:
+        return mg.z1 / TWO_PI, 0.0, tooth + h
+    sig = mg.sigma
+    ext = 0.0 if mg.internal else 1.0
+    return 0.0, -sig * mg.z2 / TWO_PI, -(sig * tooth - sig * 0.5 * mg.z2 * ext + 0.5 * sig * flank - h)
+
+
+def mesh_error_args(si, mg, flank: int, gear1: list[str], gear2: list[str]) -> dict:
+    """Runout offsets and tooth-fault parameters of one mesh family (``mg`` its
+    :class:`components.geometry.MeshGeometry`, ``gear1``/``gear2`` the gear names per instance); {} for a
+    machine with neither."""
+    e = si.errors
+    out = {}
+    if e.runout:
+        out["offset1"] = np.array([_offset(si, g) for g in gear1])
+        out["offset2"] = np.array([_offset(si, g) for g in gear2])
+    if e.tooth_fault:
+        n = len(gear1)
+        cols = {k: np.zeros(n) for k in ("fault_coef1", "fault_coef2", "fault_offset")}
+        cols["fault_period"] = np.full(n, float(mg.z1))
+        cols["fault_factor"] = np.ones(n)
+        for i, (g1, g2) in enumerate(zip(gear1, gear2)):
+            f1, f2 = _tooth_fault(si, g1), _tooth_fault(si, g2)
+            if f1 is not None and f2 is not None:
+                raise ParameterError.at("errors.tooth_fault", f"faulty teeth on both gears of the {g1}-{g2} mesh: "
+                                                              "one faulty gear per mesh is supported")
+            f, which = (f1, 1) if f1 is not None else (f2, 2)
+            if f is None:
+                continue
+            A1, A2, c = _fault_coordinate(mg, flank, which, f.tooth)
+            cols["fault_coef1"][i], cols["fault_coef2"][i], cols["fault_offset"][i] = A1, A2, c
+            cols["fault_period"][i] = float(mg.z1 if which == 1 else mg.z2)
+            cols["fault_factor"][i] = f.stiffness_factor
+        out.update(cols, fault_contact_ratio=np.full(n, mg.contact_ratio),
+                   fault_smoothing=np.full(n, si.mesh.smoothing_width))
+    return out

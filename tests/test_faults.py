@@ -1,0 +1,123 @@
+"""Manufacturing errors and faults (MODEL.md §3.9): the parameters, the perfect machine, and each
+error's signature."""
+from __future__ import annotations
+
+import re
+import warnings
+
+import numpy as np
+import pytest
+
+import mbd
+from components import faults
+from components.dpgt import build_dpgt
+from components.params import ErrorsParams, to_toml, with_overrides
+from components.presets import load_toml, reference_dpgt
+from components.units import ParameterError
+
+import dpgt_runs
+
+REF = "tests/data/perfect_machine_a223f98.npz"
+PINHOLE_B1 = {"errors.pinhole": [{"planet": "b1", "radial": "0 um", "tangential": "30 um"}]}
+
+
+def _build(params):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return build_dpgt(params)
+
+
+@pytest.mark.parametrize("condition, direction", [(3, "forward"), (1, "reverse")])
+def test_perfect_machine_reproduces_the_machine_before_errors_existed(condition, direction):
+    """0.5 ms of the reference DPGT from its kinematic start, numpy engine, against the states the code
+    gave before errors existed (commit a223f98): bit-identical on the machine that wrote them; the bound
+    allows only another CPU's BLAS/LU rounding."""
+    ref = np.load(REF)
+    sc = _build(reference_dpgt(condition, direction))
+    key = f"{condition}{direction}"
+    assert np.array_equal(sc.q0, ref[f"q0_{key}"]) and np.array_equal(sc.v0, ref[f"v0_{key}"])
+    res = mbd.simulate(sc.model, sc.q0, sc.v0, 5e-4, stepper=mbd.PRODUCTION.stepper(),
+                       controller=mbd.PRODUCTION.controller(), progress=False, engine="numpy")
+    for name, x in (("q", res.state.q), ("v", res.state.v)):
+        r = ref[f"{name}_{key}"]
+        np.testing.assert_allclose(x, r, rtol=1e-10, atol=1e-12 * np.max(np.abs(r)))
+
+
+def test_errors_round_trip_through_toml_and_name_what_is_wrong(tmp_path):
+    p = with_overrides(reference_dpgt(), {**PINHOLE_B1, "errors.tooth_fault": [{"gear": "ring", "tooth": 5,
+                                                                               "stiffness_factor": 0.0}]})
+    f = tmp_path / "damaged.toml"
+    f.write_text(to_toml(p))
+    assert load_toml(f).errors == p.errors
+    assert reference_dpgt().errors.perfect and not p.errors.perfect
+    bad = {
+        "errors.pinhole[0].planet": [{"planet": "c1", "radial": "1 um", "tangential": "0 um"}],
+        "errors.pinhole[0].radial": [{"planet": "b1", "radial": "1 kg", "tangential": "0 um"}],
+        "errors.spall[0]": [{"planet": "a1", "raceway": "inner", "position": "0 deg", "width": "1 mm"}],
+    }
+    for where, entries in bad.items():
+        with pytest.raises(ParameterError, match="^" + re.escape(where)):
+            with_overrides(reference_dpgt(), {f"errors.{where.split('.')[1].split('[')[0]}": entries})
+    # names and sizes are checked against the machine when it is built
+    for override, where in (({"errors.pinhole": [{"planet": "b4", "radial": "1 um", "tangential": "0 um"}]},
+                             "errors.pinhole[0].planet"),
+                            ({"errors.tooth_fault": [{"gear": "sun", "tooth": 31, "stiffness_factor": 0.5}]},
+                             "errors.tooth_fault[0].tooth"),
+                            ({"errors.roller_diameter": [{"planet": "a1", "roller": 0, "deviation": "1 mm"}]},
+                             "errors.roller_diameter[0].deviation"),
+                            ({"errors.spall": [{"planet": "a1", "raceway": "outer", "position": "0 deg",
+                                                "width": "1 mm", "depth": "10 um", "edge": "2 mm"}]},
+                             "errors.spall[0].edge")):
+        with pytest.raises(ParameterError, match="^" + re.escape(where)):
+            _build(with_overrides(reference_dpgt(), override))
+
+
+def test_pinhole_error_moves_the_pin_and_the_planet():
+    p = with_overrides(reference_dpgt(), {"errors.pinhole": [{"planet": "b2", "radial": "20 um",
+                                                              "tangential": "-10 um"}]})
+    si = p.si()
+    psi = si.layout.psi_b[1]
+    moved = faults.pin_position(si, "b2", si.layout.centres_b[1]) - si.layout.centres_b[1]
+    expect = 20e-6 * np.array([np.cos(psi), np.sin(psi)]) - 10e-6 * np.array([-np.sin(psi), np.cos(psi)])
+    np.testing.assert_allclose(moved, expect, rtol=1e-12, atol=0)
+    assert np.array_equal(faults.pin_position(si, "b1", si.layout.centres_b[0]), si.layout.centres_b[0])
+
+
+def _pinhole_run(tangential_um):
+    """Condition 3, linear planet bearings: per-planet outer bearing loads, K_γ, the sun centre in R."""
+    ov = {} if tangential_um == 0 else {"errors.pinhole": [{"planet": "b1", "radial": "0 um",
+                                                             "tangential": f"{tangential_um} um"}]}
+    sun = []
+
+    def observers(bs, t0, t1):
+        i = bs.model.body("sun").index
+        xy = bs.model.full_to_free[[3 * i, 3 * i + 1]]
+
+        class Sun(mbd.Observer):           # the sun's centre in R (the carrier frame) on every step
+            def step(self, s0, s1):
+                if s1.t >= t0:
+                    sun.append(s1.q[xy].copy())
+        return [Sun()]
+    bs, stats, _, _ = dpgt_runs.run(3, "forward", ov, window=0.01, bearings="linear", extra=observers)
+    s = stats.summary()["outer"]
+    return np.array(s["bearing_load_mean_per_planet_N"]), s["load_sharing_factor"], np.array(sun).mean(axis=0)
+
+
+def test_pinhole_error_shifts_load_between_planets_and_turns_with_the_carrier():
+    """Condition 3, linear planet bearings (load sharing is the gears' business): a pinhole ±30 µm off
+    tangentially on outer planet b1 changes b1's bearing load by opposite amounts (linear for such small
+    errors) while the mean stays (the torque is the same); the planets no longer share equally (K_γ > 1),
+    and the floating sun is pushed off centre by a force fixed in the carrier frame: in the fixed frame a
+    carrier-rate (f_c) harmonic. The perfect machine shares equally and keeps the sun centred."""
+    loads0, k0, sun0 = _pinhole_run(0)
+    loads_p, k_p, sun_p = _pinhole_run(30)
+    loads_m, k_m, sun_m = _pinhole_run(-30)
+    dp, dm = loads_p[0] - loads0[0], loads_m[0] - loads0[0]
+    assert abs(dp) > 20 * np.ptp(loads0) and abs(dm) > 20 * np.ptp(loads0)    # far above the perfect spread
+    assert dp * dm < 0 and abs(dp + dm) < 0.2 * abs(dp)                        # opposite, nearly linear
+    for loads, d in ((loads_p, dp), (loads_m, dm)):
+        assert abs(loads.mean() - loads0.mean()) < 0.1 * abs(d)                # the mean stays
+    assert min(k_p, k_m) - 1 > 10 * (k0 - 1)
+    off0 = np.linalg.norm(sun0)
+    assert np.linalg.norm(sun_p) > 10 * off0 and np.linalg.norm(sun_m) > 10 * off0
+    assert np.dot(sun_p - sun0, sun_m - sun0) < 0                              # pushed the other way
