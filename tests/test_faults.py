@@ -11,7 +11,7 @@ import pytest
 import mbd
 from components import faults
 from components.dpgt import build_dpgt
-from components.params import ErrorsParams, to_toml, with_overrides
+from components.params import to_toml, with_overrides
 from components.presets import load_toml, reference_dpgt
 from components.units import ParameterError
 
