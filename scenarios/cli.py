@@ -15,6 +15,7 @@ SCENARIOS = {
     "demo": "the default job: forward vs reverse study at condition 3 (what `make demo` runs)",
     "paper_study": "forward/reverse study over operating conditions, comparison tables and plots",
     "lubricant_study": "which oil for which direction: film, traction, cage slip and heat against viscosity",
+    "fault_study": "what errors and faults do to the planet bearings and the rig's sensor",
     "spectrum": "fixed-frame carrier-housing acceleration spectrum (the source's test rig)",
     "bearing_rig": "one planet bearing on a rig: roller load distribution, load zone, Q_max",
     "modal": "natural frequencies and mode shapes (single planetary set, DPGT with linear bearings)",

@@ -19,7 +19,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
 __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution", "against_viscosity",
-           "mode_shapes", "FWD", "REV", "STYLE"]
+           "mode_shapes", "fault_spectra", "fault_loads", "FWD", "REV", "STYLE"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
 STYLE = {
@@ -318,4 +318,56 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
                 ax.legend(loc="best")
         if title:
             fig.suptitle(title)
+        return _save(fig, path)
+
+
+def fault_spectra(panels: Sequence[tuple], path, *, quantity: str = "sensor acceleration",
+                  unit: str = "m/s^2") -> Path:
+    """One panel per damaged machine: its spectrum against the perfect machine's, on a band around the mesh
+    frequency, with its characteristic frequencies marked.
+
+    panels: (title, freq_hz, amplitude, reference amplitude, marks {label: Hz}, (f_lo, f_hi))."""
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(7.5, 2.4 * len(panels) + 0.4), layout="constrained")
+        axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
+        for ax, (title, f, amp, ref, marks, (lo, hi)) in zip(axes, panels):
+            f = np.asarray(f, float)
+            keep = (f >= lo) & (f <= hi)
+            ax.plot(f[keep], np.asarray(ref, float)[keep], color="0.6", lw=1.0, label="perfect machine")
+            ax.plot(f[keep], np.asarray(amp, float)[keep], color=FWD["color"], lw=1.0, label=title)
+            ax.set_yscale("log")
+            ax.set_xlim(lo, hi)
+            ax.set_ylabel(_axis_label(quantity, unit))
+            ax.legend(loc="lower right")
+            _mark_frequencies(fig, ax, {k: v for k, v in marks.items() if lo <= v <= hi}, hi)
+        axes[-1].set_xlabel(_axis_label("frequency", "Hz"))
+        return _save(fig, path)
+
+
+def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = (
+        ("load_sharing_factor", "load sharing K_γ", None), ("bearing_load_max_N", "largest bearing load", "N"),
+        ("life_relative", "life / perfect machine's", None), ("cage_slip_pct", "cage slip", "%"),
+        ("pocket_impacts_per_rev", "pocket impacts per cage rev.", None))) -> Path:
+    """Bars per fault (forward solid, reverse hatched), one row per quantity, one column per bearing type.
+    rows: dicts with "fault", "direction", "bearing" and the quantities' keys (None: not available)."""
+    faults = list(dict.fromkeys(r["fault"] for r in rows))
+    bearings = sorted({r["bearing"] for r in rows})
+    x = np.arange(len(faults))
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(3.8 * len(bearings) + 0.6, 2.0 * len(quantities) + 0.8), layout="constrained")
+        axes = fig.subplots(len(quantities), len(bearings), squeeze=False, sharex=True)
+        for r, (key, words, unit) in enumerate(quantities):
+            for c, b in enumerate(bearings):
+                ax = axes[r, c]
+                for k, (d, st) in enumerate((("forward", FWD), ("reverse", REV))):
+                    val = {row["fault"]: row.get(key) for row in rows if row["bearing"] == b and row["direction"] == d}
+                    y = [np.nan if val.get(f) is None else float(val[f]) for f in faults]
+                    ax.bar(x + (k - 0.5) * 0.38, y, width=0.38, color=st["color"], label=d,
+                           hatch="//" if d == "reverse" else None, alpha=0.85)
+                ax.set_ylabel(_axis_label(words, unit))
+                if r == 0:
+                    ax.set_title(f"{b} planet bearings")
+                    ax.legend(loc="best")
+        for ax in axes[-1]:
+            ax.set_xticks(x, faults, rotation=30, ha="right")
         return _save(fig, path)

@@ -1,0 +1,275 @@
+"""What errors and faults do to the planet bearings and to the rig's sensor (MODEL.md §3.9–3.10).
+
+    python -m scenarios.fault_study [--condition 2] [--directions forward,reverse]
+        [--faults pinhole,runout,roller,spall_pin,spall_bore,cracked_tooth,missing_tooth]
+        [--machine NAME=FILE.toml ...] [--settle S] [--window S] [--sample-rate HZ]
+        [--set KEY=VALUE ...] [--workers N | --scheduler ADDR] [--out DIR]
+
+Every fault (the catalogue :data:`FAULTS`, each a stated size with its basis; or a damaged machine described
+in a TOML file, README "A damaged machine") runs beside the perfect machine in every direction, through the
+one runner (resumable, on Dask like the other studies). Per run and bearing type the table holds the
+planet-bearing loads (per planet and the load-sharing factor K_γ), the most loaded roller, cage slip,
+pocket impacts and cage acceleration, the bearing lives (ISO 281 relative to the perfect machine), and the
+sensor spectrum's amplitude at f_m, f_m ± f_c, f_m ± 3 f_c and at the fault's own frequencies (roller-pass
+frequencies over pin and bore, the rotation of the faulty gear, the cage's revolution).
+
+Writes ``summary.csv`` / ``summary.md``, ``spectra.png`` (each fault's sensor spectrum against the perfect
+machine's, its characteristic frequencies marked), ``loads.png`` and ``study.json``.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import dataclasses
+import io
+import json
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import mbd
+from components.units import ParameterError
+from mbd.recorder import atomic_write_text
+
+from .command import command
+from .lock import holds_out_folder
+from .paper_study import parse_sets
+from .runner import RunConfig
+from .sweep import Case, build_params, run_sweep
+
+__all__ = ["FAULTS", "main", "run", "characteristic_frequencies", "COLUMNS"]
+
+# the catalogue: name -> (errors overrides, what it is and why this size)
+FAULTS = {
+    "pinhole": ({"errors.pinhole": [{"planet": "b1", "radial": "0 um", "tangential": "30 um"}]},
+                "outer planet b1's pin 30 µm ahead (carrier pinhole position errors of tens of µm: Bodas & "
+                "Kahraman 2004)"),
+    "runout": ({"errors.runout": [{"gear": "sun", "eccentricity": "16 um", "phase": "0 deg"}]},
+               "sun eccentric by 16 µm (radial runout 32 µm: ISO 1328-2 grade 7 for m = 3 mm, d = 93 mm)"),
+    "roller": ({"errors.roller_diameter": [{"planet": "b1", "roller": 0, "deviation": "5 um"}]},
+               "one roller of b1's bearing 5 µm oversize (a mis-sorted roller)"),
+    "spall_pin": ({"errors.spall": [{"planet": "b1", "raceway": "inner", "position": "0 deg", "width": "2 mm",
+                                     "depth": "20 um", "edge": "0.5 mm"}]},
+                  "2 mm spall, 20 µm deep, on b1's pin in its load zone (radially outwards)"),
+    "spall_bore": ({"errors.spall": [{"planet": "b1", "raceway": "outer", "position": "0 deg", "width": "2 mm",
+                                      "depth": "20 um", "edge": "0.5 mm"}]},
+                   "the same spall on b1's bore (turning with the planet)"),
+    "cracked_tooth": ({"errors.tooth_fault": [{"gear": "b1", "tooth": 0, "stiffness_factor": 0.5}]},
+                      "a cracked tooth on outer planet b1: its pairs at half stiffness"),
+    "missing_tooth": ({"errors.tooth_fault": [{"gear": "b1", "tooth": 0, "stiffness_factor": 0.0}]},
+                      "the same tooth missing"),
+}
+COLUMNS = ["fault", "direction", "bearing", "load_sharing_factor", "bearing_load_mean_N", "bearing_load_max_N",
+           "roller_max_N", "life_relative", "cage_slip_pct", "pocket_impacts_per_rev", "cage_acc_rel_rms",
+           "sensor_f_m", "sensor_f_m-1f_c", "sensor_f_m+1f_c", "sensor_f_m-3f_c", "sensor_f_m+3f_c",
+           "sensor_own", "own_frequency"]
+LIFE_EXPONENT = 10.0 / 3.0
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(prog="python -m scenarios.fault_study", description=__doc__.split("\n\n")[0])
+    p.add_argument("--condition", type=int, default=2, choices=(1, 2, 3, 4),
+                   help="operating condition (default 2: carrier 2000 r/min, the source's rig speed)")
+    p.add_argument("--directions", default="forward,reverse", help="comma list: forward, reverse")
+    p.add_argument("--faults", default=",".join(FAULTS), help=f"comma list from {', '.join(FAULTS)} ('' for none)")
+    p.add_argument("--machine", action="append", default=[], metavar="NAME=FILE.toml",
+                   help="a damaged machine described in a TOML file (repeatable)")
+    p.add_argument("--settle", type=float, default=0.03, help="seconds discarded after the start (default 0.03)")
+    p.add_argument("--window", type=float, default=0.1,
+                   help="seconds analysed (default 0.1: 10 Hz resolution, the f_c sidebands at 2000 r/min)")
+    p.add_argument("--sample-rate", type=float, default=20000.0, help="recording rate [Hz] (> 2 f_m)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a parameter (repeatable)")
+    p.add_argument("--workers", type=int, default=None, help="Dask local workers (default: one per core)")
+    p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
+    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--out", default="results/faults", help="output directory")
+    return p.parse_args(argv)
+
+
+def make_cases(a, out: Path) -> list[Case]:
+    dirs = [d.strip() for d in str(a.directions).split(",") if d.strip()]
+    if not dirs or any(d not in ("forward", "reverse") for d in dirs):
+        raise ParameterError.at("--directions", f"expected a comma list of forward, reverse; got {a.directions!r}")
+    names = [f.strip() for f in str(a.faults).split(",") if f.strip()]
+    unknown = [f for f in names if f not in FAULTS]
+    if unknown:
+        raise ParameterError.at("--faults", f"unknown {unknown}; the catalogue has {', '.join(FAULTS)}")
+    machines: dict[str, tuple[dict, str | None]] = {"perfect": ({}, None)}
+    machines.update({f: (FAULTS[f][0], None) for f in names})
+    for m in a.machine:
+        name, _, path = m.partition("=")
+        if not name.strip() or not path.strip() or not Path(path.strip()).is_file():
+            raise ParameterError.at("--machine", f"expected NAME=FILE.toml with an existing file, got {m!r}")
+        machines[name.strip()] = ({}, path.strip())
+    user = parse_sets(a.set)
+    return [Case(a.condition, d, str(out / f"{name}_{d}"), {**user, **ov}, path, tag=name)
+            for name, (ov, path) in machines.items() for d in dirs]
+
+
+def characteristic_frequencies(si) -> dict[str, float]:
+    """[Hz] the frequencies faults excite, in the fixed frame: carrier f_c, mesh f_m, each gear's rotation
+    relative to the carrier, and per bearing type the cage's revolution relative to the carrier and the
+    roller-pass frequencies over the pin (Z·|ω_cage − ω_c|) and over the bore (Z·|ω_cage − ω_planet|)."""
+    from components.bearing import bearing_kinematics
+
+    op, b = si.operating, si.bearing
+    wc = op.carrier_speed
+    hz = lambda w: abs(w) / (2 * np.pi)
+    out = {"f_c": hz(wc), "f_m": op.mesh_frequency, "sun_rel": hz(op.sun_speed - wc)}
+    for kind, w in (("inner", op.inner_planet_speed), ("outer", op.outer_planet_speed)):
+        wm, _ = bearing_kinematics(b, wc, w)
+        out[f"{kind}_planet_rel"] = hz(w - wc)
+        out[f"{kind}_cage_rel"] = hz(wm - wc)
+        out[f"{kind}_roller_pass_pin"] = b.rollers * hz(wm - wc)
+        out[f"{kind}_roller_pass_bore"] = b.rollers * hz(wm - w)
+    return out
+
+
+def _own_frequency(case: Case, si, fr: dict) -> float | None:
+    """The sideband spacing a fault of this case should bring in around f_m (None: none specific)."""
+    e = si.errors
+    for x in e.tooth_fault + e.runout:
+        g = getattr(x, "gear")
+        return fr["f_c"] if g == "ring" else fr["sun_rel"] if g == "sun" else \
+            fr[f"{'inner' if g[0] == 'a' else 'outer'}_planet_rel"]
+    for x in e.spall:
+        kind = "inner" if x.planet[0] == "a" else "outer"
+        return fr[f"{kind}_roller_pass_{'pin' if x.raceway == 'inner' else 'bore'}"]
+    for x in e.roller_diameter:
+        return fr[f"{'inner' if x.planet[0] == 'a' else 'outer'}_cage_rel"]
+    return fr["f_c"] if e.pinhole else None
+
+
+def sensor_spectrum(run_dir: Path):
+    """(f, amplitude) of the recorded sensor signal of a run (scenarios.spectrum's definition)."""
+    from .spectrum import sensor_signal
+    from .analysis import amplitude_spectrum
+
+    t, x = sensor_signal(run_dir / "results.nc")
+    f, amp, _ = amplitude_spectrum(t, x)
+    return f, amp
+
+
+def _amplitude_at(f, amp, f0: float) -> float:
+    """Largest amplitude within ±1 bin of f0 (a Hann-windowed line spreads over its neighbours)."""
+    i = int(np.argmin(np.abs(f - f0)))
+    return float(amp[max(i - 1, 0):i + 2].max())
+
+
+def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
+    rows, spectra = [], {}
+    perfect = {c.direction: results.get(c.label, {}) for c in cases if c.tag == "perfect"}
+    for case in cases:
+        s = results.get(case.label, {})
+        if not s or "error" in s:
+            continue
+        si = build_params(case).si()
+        fr = characteristic_frequencies(si)
+        f, amp = sensor_spectrum(Path(case.out_dir))
+        own = _own_frequency(case, si, fr)
+        spectra[(case.tag, case.direction)] = (f, amp, fr, own)
+        sensor = {f"sensor_f_m{k:+d}f_c" if k else "sensor_f_m": _amplitude_at(f, amp, fr["f_m"] + k * fr["f_c"])
+                  for k in (-3, -1, 0, 1, 3)}
+        for kind in ("inner", "outer"):
+            d, p0 = s[kind], perfect.get(case.direction, {}).get(kind)
+            life = (d["equivalent_load_N"] / p0["equivalent_load_N"]) ** -LIFE_EXPONENT if p0 else None
+            row = {"fault": case.tag, "direction": case.direction, "bearing": kind,
+                   "load_sharing_factor": d.get("load_sharing_factor"),
+                   "bearing_load_mean_N": d["bearing_load_mean_all_N"], "bearing_load_max_N": d["bearing_load_max_N"],
+                   "roller_max_N": d.get("all_rollers", {}).get("roller_inner_race_max_N"),
+                   "life_relative": life, "cage_slip_pct": d.get("cage_slip_pct"),
+                   "pocket_impacts_per_rev": d.get("pocket_impacts_per_rev"),
+                   "cage_acc_rel_rms": d.get("cage_acc_rel_magnitude_rms"), **sensor,
+                   "sensor_own": None if own is None else min(_amplitude_at(f, amp, fr["f_m"] - own),
+                                                              _amplitude_at(f, amp, fr["f_m"] + own)),
+                   "own_frequency": own}
+            rows.append(row)
+    return rows, spectra
+
+
+def write_outputs(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=COLUMNS)
+    w.writeheader()
+    w.writerows(rows)
+    atomic_write_text(out / "summary.csv", buf.getvalue())
+    fmt = lambda v: f"{v:.4g}" if isinstance(v, float) else ("" if v is None else str(v))
+    md = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    md += ["| " + " | ".join(fmt(r[c]) for c in COLUMNS) + " |" for r in rows]
+    atomic_write_text(out / "summary.md", "\n".join(md) + "\n")
+    from viz.plots import fault_loads, fault_spectra
+
+    files = [out / "summary.csv", out / "summary.md", fault_loads(rows, out / "loads.png")]
+    panels = _spectrum_panels(spectra)
+    if panels:
+        files.append(fault_spectra(panels, out / "spectra.png"))
+    return files
+
+
+def _spectrum_panels(spectra: dict) -> list[tuple]:
+    """Each damaged machine's sensor spectrum against the perfect one's (same direction), around f_m."""
+    panels = []
+    for (tag, direction), (f, amp, fr, own) in spectra.items():
+        ref = spectra.get(("perfect", direction))
+        if ref is None or tag == "perfect":
+            continue
+        fm, fc = fr["f_m"], fr["f_c"]
+        marks = {"f_m": fm, **{f"f_m{k:+d}f_c": fm + k * fc for k in (-3, -1, 1, 3)}}
+        if own is not None and abs(own - fc) > 1e-9 * fc:
+            marks.update({"f_m−f_x": fm - own, "f_m+f_x": fm + own})
+        half = max(6.5 * fc, 1.3 * (own or 0.0))
+        panels.append((f"{tag}, {direction}", f, amp, ref[1], marks, (fm - half, fm + half)))
+    return panels
+
+
+@holds_out_folder
+def run(a) -> dict:
+    out = Path(a.out)
+    cases = make_cases(a, out)
+    cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
+                    progress=not a.no_progress)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")      # design warnings of the reference machine are known
+        for c in cases:
+            _check_case(c, cfg)              # every parameter checked before any run starts
+    out.mkdir(parents=True, exist_ok=True)
+    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress)
+    rows, spectra = rows_of(cases, results)
+    files = write_outputs(rows, spectra, out) if rows else []
+    failed = {k: v["error"] for k, v in results.items() if "error" in v}
+    atomic_write_text(out / "study.json", json.dumps({"cases": [dataclasses.asdict(c) for c in cases],
+                                                      "faults": {k: v[1] for k, v in FAULTS.items()},
+                                                      "failed": failed}, indent=2, default=str))
+    return {"rows": rows, "failed": failed, "files": files}
+
+
+def _check_case(case: Case, cfg: RunConfig) -> None:
+    """The parameters and the named planets, rollers and teeth of a case exist (fails before any run)."""
+    from components import faults
+
+    si = build_params(case).si()
+    faults.check_errors(si)
+    f_m = si.operating.mesh_frequency
+    if cfg.sample_rate <= 2 * (f_m + 6 * si.operating.carrier_frequency):
+        raise ParameterError.at("--sample-rate", f"{cfg.sample_rate:g} Hz cannot resolve the mesh sidebands: needs "
+                                                 f"> {2 * (f_m + 6 * abs(si.operating.carrier_frequency)):.0f} Hz")
+
+
+@command
+def main(argv=None) -> int:
+    r = run(parse_args(sys.argv[1:] if argv is None else argv))
+    for row in r["rows"]:
+        if row["bearing"] == "outer":
+            print(f"{row['fault']:>14} {row['direction']:>8}: K_γ {row['load_sharing_factor']:.3f}, "
+                  f"max bearing load {row['bearing_load_max_N']:.0f} N, life {row['life_relative'] or float('nan'):.2f}, "
+                  f"sensor at f_m {row['sensor_f_m']:.3g}")
+    for k, v in r["failed"].items():
+        print(f"FAILED {k}: {v}")
+    print("\nwritten:\n" + "\n".join(f"  {p}" for p in r["files"]))
+    return 1 if r["failed"] else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
