@@ -32,7 +32,7 @@ from .lubrication import bearing_film
 
 __all__ = ["FAMILY", "MESH_FAMILY", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
            "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life",
-           "SUMMARY_WORDS"]
+           "contact_film", "SUMMARY_WORDS"]
 
 LIFE_EXPONENT = 10.0 / 3.0     # ISO 281, roller bearings: L10 ∝ P^(−10/3)
 
@@ -112,6 +112,15 @@ def pin_reactions(race_inner: dict, rollers, bearing_of_roller, n_bearings: int,
     fy = np.asarray(race_inner["fy"], float)[rollers]
     return -rows * np.column_stack([np.bincount(bearing_of_roller, fx, n_bearings),
                                     np.bincount(bearing_of_roller, fy, n_bearings)])
+
+
+def contact_film(race: dict, bearing, lubricant, inner: bool) -> dict[str, np.ndarray]:
+    """The EHL film of every contact of one raceway family, from its outputs ``race`` ("load" [N] per
+    physical roller, "rolling_speed" [m/s]): "film_min" h_min and "film_central" h_c [m] (Pan & Hamrock,
+    :func:`components.lubrication.bearing_film`) and "film_lambda" Λ = h_min/σ; NaN where a roller carries
+    no load. ``bearing``, ``lubricant``: the SI parameter objects; ``inner``: the pin's raceway."""
+    h_min, h_c = bearing_film(race["load"], race["rolling_speed"], bearing, lubricant, inner)
+    return {"film_min": h_min, "film_central": h_c, "film_lambda": h_min / lubricant.roughness}
 
 
 # what each summary key means, in words and units (for tables and plot axes)
@@ -330,7 +339,7 @@ class WindowStatistics(mbd.Observer):
         b, lub, owner = self.scene.meta["bearing"], self._lubricant, self.plan.roller_bearing
         thinnest = np.full(nb, np.inf)
         for race, inner in ((race_inner, True), (race_outer, False)):
-            h_min, _ = bearing_film(race["load"], race["rolling_speed"], b, lub, inner)
+            h_min = contact_film(race, b, lub, inner)["film_min"]
             np.minimum.at(thinnest, owner, np.where(np.isnan(h_min), np.inf, h_min))
         return np.where(np.isfinite(thinnest), thinnest, np.nan)      # NaN: no roller loaded at this instant
 

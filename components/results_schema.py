@@ -3,6 +3,8 @@
 * :data:`OUTPUTS` — per element family, the output keys the runner records with their CF units and
   long names (from the element docstrings in ``mbd/elements``: contact.py, gear_mesh.py, drives.py,
   springs.py). Forces are per physical roller (one row), vectors are in the reference frame R.
+* :data:`FILM_OUTPUTS` — the EHL film of every roller–raceway contact, recorded along the raceway
+  families when the scene has a lubricant (computed by :func:`components.outputs.contact_film`).
 * :func:`instance_coords` — per family, which bearing / roller / planet / mesh each instance is
   (from ``scene.handles["pairs"]`` and :func:`components.outputs.bearing_map`).
 * :func:`element_probes` — the :class:`mbd.ElementOutput` probes carrying both.
@@ -15,14 +17,16 @@ by the recorder itself (:mod:`mbd.recorder`): ``<probe>.position`` [m], ``.angle
 """
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 
 from mbd.recorder import ElementOutput
 
 from .families import FAMILY, MESH_FAMILY
-from .outputs import bearing_map
+from .outputs import bearing_map, contact_film
 
-__all__ = ["OUTPUTS", "MESH_WORDS", "instance_coords", "element_probes", "drawing_geometry"]
+__all__ = ["OUTPUTS", "FILM_OUTPUTS", "MESH_WORDS", "instance_coords", "element_probes", "drawing_geometry"]
 
 MESH_WORDS = {MESH_FAMILY["sun_inner"]: "sun–inner planet mesh",
               MESH_FAMILY["inner_outer"]: "inner planet–outer planet mesh",
@@ -67,6 +71,17 @@ OUTPUTS = {
     **{f: _mesh(w) for f, w in MESH_WORDS.items()},
     "carrier_drive": {"torque": ("N m", "carrier speed-drive torque on the carrier")},
 }
+
+
+def _film(race: str) -> dict:
+    where = f"roller–{race} race contact"
+    return {"film_min": ("m", f"EHL minimum film thickness h_min of the {where} (Pan–Hamrock; NaN: no load)"),
+            "film_central": ("m", f"EHL central film thickness h_c of the {where} (Pan–Hamrock; NaN: no load)"),
+            "film_lambda": ("1", f"film parameter Λ = h_min/σ of the {where} (NaN: no load)")}
+
+
+# the film of each raceway family (recorded when the scene has a lubricant): family -> (inner raceway?, keys)
+FILM_OUTPUTS = {FAMILY["race_inner"]: (True, _film("inner")), FAMILY["race_outer"]: (False, _film("outer"))}
 
 _BEARING_COORDS = {  # coordinate -> (long_name, field of the bearing_map record)
     "bearing": ("planet bearing name", "name"),
@@ -123,11 +138,22 @@ def instance_coords(scene) -> dict[str, dict[str, tuple[str, list]]]:
 
 def element_probes(scene) -> list[ElementOutput]:
     """The element outputs the runner records: every family of :data:`OUTPUTS` the scene has, with
-    units, long names and instance coordinates."""
+    units, long names and instance coordinates; with a lubricant (``scene.meta["lubricant"]``), the
+    raceway families' film (:data:`FILM_OUTPUTS`) as well."""
     fams = {e.name for e in scene.model.elements}
     coords = instance_coords(scene)
-    return [ElementOutput(f, list(meta), meta=meta, instances=coords.get(f))
-            for f, meta in OUTPUTS.items() if f in fams]
+    lub = scene.meta.get("lubricant")
+    probes = []
+    for f, meta in OUTPUTS.items():
+        if f not in fams:
+            continue
+        derived = None
+        if lub is not None and f in FILM_OUTPUTS:
+            inner, film = FILM_OUTPUTS[f]
+            meta = {**meta, **film}
+            derived = partial(contact_film, bearing=scene.meta["bearing"], lubricant=lub, inner=inner)
+        probes.append(ElementOutput(f, list(meta), meta=meta, instances=coords.get(f), derived=derived))
+    return probes
 
 
 def drawing_geometry(params) -> dict:

@@ -26,7 +26,7 @@ import os
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -83,11 +83,19 @@ class ElementOutput:
     ``meta`` maps an output key to (units, long_name) for the file's attributes (CF units: "N", "m",
     "rad", "1" for dimensionless). ``instances`` maps a coordinate name to (long_name, one value per
     instance): the entry "instance" names the instances (the dimension's own coordinate, e.g. roller
-    names), others (e.g. "planet", "pair") become extra coordinates ``<family>.<name>`` along it."""
+    names), others (e.g. "planet", "pair") become extra coordinates ``<family>.<name>`` along it.
+    ``derived`` (optional): a function of the family's outputs (the dict of one evaluation) returning
+    further per-instance arrays a caller derives from them (e.g. the film of a contact), recorded under
+    their keys like the family's own."""
     element: str
     keys: Sequence[str] | None = None
     meta: Mapping[str, tuple[str, str]] | None = None
     instances: Mapping[str, tuple[str, Sequence]] | None = None
+    derived: Callable[[Mapping[str, np.ndarray]], Mapping[str, np.ndarray]] | None = None
+
+    def evaluate(self, outputs: Mapping[str, np.ndarray]) -> Mapping[str, np.ndarray]:
+        """The family's outputs with the derived ones added."""
+        return outputs if self.derived is None else {**outputs, **self.derived(outputs)}
 
 
 class Recorder:
@@ -130,7 +138,7 @@ class Recorder:
                 self._plan.append(("body", p, idx))
             elif isinstance(p, ElementOutput):
                 e = model.element(p.element)
-                probe_out = system.outputs(state.t, state.q, state.v, state.z)[e.name]
+                probe_out = p.evaluate(system.outputs(state.t, state.q, state.v, state.z)[e.name])
                 keys = list(p.keys) if p.keys is not None else list(probe_out)
                 missing = set(keys) - set(probe_out)
                 if missing:
@@ -151,7 +159,7 @@ class Recorder:
                     if inst:
                         attrs["coordinates"] = " ".join(f"{e.name}.{c}" for c in inst)
                     self.vars[f"{e.name}.{k}"] = (("time", dim), attrs)
-                self._plan.append(("elem", e, keys))
+                self._plan.append(("elem", p, keys))
             else:
                 raise ModelError(f"unknown probe {p!r}")
         self._buf = {k: [] for k in self.vars}
@@ -218,9 +226,9 @@ class Recorder:
             else:
                 if outs is None:
                     outs = self.system.outputs(t, q, v, z)
-                o = outs[p.name]
+                o = p.evaluate(outs[p.element])
                 for k in sel:
-                    self._buf[f"{p.name}.{k}"].append(np.asarray(o[k], dtype=float).copy())
+                    self._buf[f"{p.element}.{k}"].append(np.asarray(o[k], dtype=float).copy())
         self._times.append(t)
         if len(self._times) >= self.chunk:
             self.flush()

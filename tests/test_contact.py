@@ -452,6 +452,13 @@ def test_ehl_traction_curve_shape():
     mu = _film_mu(FILM, v)
     np.testing.assert_allclose(_film_mu(FILM, -v), -mu, rtol=1e-14)
     assert mu[1] / mu[0] == pytest.approx(2.0, rel=1e-6)                  # linear at low slip
+    # its slope: the Maxwell film's Newtonian shear, Σ w_k η_eff(p_k) / (h_c p̄), 1/η_eff = e^(−α p)/η₀ + u/(G_e b)
+    u, w, R = np.hypot(5.0, FILM.u_reg), 2000.0 / LR, 3e-3
+    p_max, b = ehl.hertz_peak_pressure(w, R, FILM.E_red), ehl.hertz_half_width(w, R, FILM.E_red)
+    eta_eff = 1.0 / (np.exp(-FILM.alpha_p * p_max * ehl.STRIP_NODES) / FILM.eta0 + u / (FILM.G_e * b))
+    h_c = ehl.film_central(u, w, R, FILM.eta0, FILM.alpha_p, FILM.E_red)
+    slope = np.sum(ehl.STRIP_WEIGHTS * eta_eff) / (h_c * 0.25 * np.pi * p_max)
+    assert mu[0] / v[0] == pytest.approx(slope, rel=1e-6)
     assert np.all(np.diff(mu) >= 0) and np.all(np.diff(mu[:8]) > 0)    # rises, then saturates (tanh = 1)
     w = 2000.0 / LR
     p_max = ehl.hertz_peak_pressure(w, 3e-3, FILM.E_red)
