@@ -12,9 +12,10 @@ Writes the one-sided amplitude spectrum (Hann window) to DIR/spectrum.csv (frequ
 sensor; amplitude_y or amplitude_axis for comparison), DIR/spectrum.png with f_m = z_r f_c and f_m ± f_c,
 f_m ± 3 f_c marked, DIR/lines.csv (f_m + k f_c, |k| ≤ 6: amplitude, over the band's median, and what lets the
 sensor see the line: planet phasing, the transfer path, or errors — :func:`components.geometry.sideband_origin`),
-the strongest peaks near f_m in DIR/peaks.csv, and DIR/summary.json. The frequency resolution is 1/window:
-resolve f_c sidebands with a window of several carrier periods (default 0.1 s → 10 Hz against f_c = 33.3 Hz
-at 2000 r/min).
+the strongest peaks near f_m in DIR/peaks.csv, and DIR/summary.json. The spectrum covers the first whole number
+of carrier revolutions of the window (the lines then fall on bins); its resolution is f_c/revolutions: resolve
+f_c sidebands with a window of several carrier periods (default 0.1 s: 3 revolutions at 2000 r/min, 11.1 Hz
+against f_c = 33.3 Hz).
 
 The machine is one argument of :func:`measure` (a :class:`components.params.DPGTParams`, built by
 :func:`machine`), the sensor one option.
@@ -118,6 +119,7 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path) -> dict:
         warnings.simplefilter("ignore")
         s = run_case(params, cfg, out / "run", label={"scenario": "spectrum", "sensor": sensor})
     t, signals = _signals(out / "run" / "results.nc", sensor)
+    t, signals = _whole_revolutions(t, signals, s["f_c_hz"])
     spectra = {k: amplitude_spectrum(t, x) for k, x in signals.items()}
     f, amp, df = spectra["amplitude"]
     f_c, f_m = s["f_c_hz"], s["f_m_hz"]
@@ -153,6 +155,15 @@ def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
         if sensor == "axis":
             return t, {"amplitude": acc[:, 0], "amplitude_y": acc[:, 1]}
         return t, {"amplitude": ds["sensor.acceleration"].values[:, 0], "amplitude_axis": acc[:, 0]}
+
+
+def _whole_revolutions(t, signals: dict, f_c: float):
+    """The first whole number of carrier revolutions of the samples (all of them if less than one): the
+    lines f_m + k f_c then fall on frequency bins, and the Hann window's leakage stays within ±1 bin."""
+    dt, fc = float(np.median(np.diff(t))), abs(f_c)
+    revs = np.floor(len(t) * dt * fc + 1e-9) if fc > 0 else 0.0
+    n = min(int(round(revs / (fc * dt))), len(t)) if revs >= 1 else len(t)
+    return t[:n], {k: x[:n] for k, x in signals.items()}
 
 
 def _lines(f, amp, f_m, f_c, z_r: int, planets: int, sensor: str) -> list[dict]:
