@@ -56,7 +56,7 @@ __all__ = [
     "STANDARD_ADDENDUM", "STANDARD_DEDENDUM", "GearGeometry", "MeshGeometry", "Phasing", "Layout",
     "Kinematics", "Finding", "DesignWarning",
     "centre_distances", "pair_angle", "planet_angles", "speed_ratio", "planet_speed_ratios", "iso_minimum_backlash",
-    "mesh_frequency", "contact_path", "contact_ratio", "assembly_number", "mesh_phases",
+    "mesh_frequency", "SIDEBAND_ORIGINS", "sideband_origin", "contact_path", "contact_ratio", "assembly_number", "mesh_phases",
     "mesh_stiffness_levels", "mesh_damping", "mesh_equivalent_mass", "palmgren_stiffness", "kinematics", "layout", "loaded_flanks",
     "design_findings", "check_design",
 ]
@@ -213,6 +213,37 @@ def planet_speed_ratios(z_a: int, z_b: int, z_r: int) -> tuple[float, float]:
 def mesh_frequency(z_r: int, f_c: float) -> float:
     """f_m = z_r·|f_c| (ring fixed; all three meshes share it)."""
     return z_r * abs(f_c)
+
+
+SIDEBAND_ORIGINS = ("phasing", "transfer path", "errors")
+
+
+def sideband_origin(k: int, z_r: int, n_planets: int, harmonic: int = 1) -> str:
+    """What lets a sensor fixed to the housing see the line harmonic·f_m + k·f_c of a ring-fixed train
+    with N equally spaced, identical planets (sequence-of-planet phasing: McFadden & Smith 1985,
+    Parker & Lin 2004, Inalpolat & Kahraman 2009).
+
+    Everything planet n contributes is a function of its angle ψ_n = ψ_c + 2πn/N alone: its ring-mesh
+    phase z_r ψ_n/2π, the transfer path's weight w(ψ_n − ψ_s), the direction its force acts in. Written as
+    Σ_m c_m e^{i m ψ_n} (carrier orders m; the line l·f_m + k·f_c is m = l z_r + k), the sum over the N
+    planets keeps c_m·N e^{i m ψ_c} when N divides m and cancels it otherwise. Hence:
+
+    * ``"phasing"``: N | (l z_r + k) and |k| = 1 — a sensor at the axis reads a fixed-frame component of
+      forces that turn with the carrier, e^{±iψ_n} times mesh orders l z_r, so it carries k = ±1 only
+      (z_r = 82, N = 3: f_m − f_c alone);
+    * ``"transfer path"``: N | (l z_r + k), |k| ≠ 1 — allowed, but only a path whose weight depends on the
+      planet's angle (a passing-planet window) carries carrier order k (82, 3: f_m + 2f_c, f_m − 4f_c, ...);
+    * ``"errors"``: N ∤ (l z_r + k) — cancelled in a perfect machine; something that differs between
+      planets (MODEL.md §3.9 errors, bearing states that differ) brings it (82, 3: f_m, f_m ± 3f_c, f_m + f_c).
+
+    Gravity (fixed in I) turns in the carrier frame and adds orders ±1 to each planet's force, so a sensor at
+    the axis may also carry a weak k = 0, ±2 where N | (l z_r + k) (82, 3: f_m + 2f_c). The rule needs the
+    planets to assemble ((z_r − z_s)/N integer); otherwise the sun meshes break the symmetry."""
+    if n_planets < 1:
+        raise ValueError(f"n_planets must be >= 1, got {n_planets!r}")
+    if (harmonic * z_r + k) % n_planets:
+        return "errors"
+    return "phasing" if abs(k) == 1 else "transfer path"
 
 
 def assembly_number(z_s: int, z_r: int, n_planets: int) -> float:

@@ -52,10 +52,10 @@ from .units import ParameterError, Quantity, format_quantity, quantity, to_si
 __all__ = [
     "Source", "Sourced", "paper", "derived", "assumed", "SI", "Derived", "Params",
     "GearParams", "GearSetParams", "CageParams", "SlideRollTractionParams", "BearingParams", "LubricantParams", "SupportParams",
-    "MeshParams", "OperatingPoint", "RigParams", "DPGTParams", "BearingRigParams", "ErrorsParams", "PinholeErrorParams",
-    "RunoutParams", "RollerDiameterErrorParams", "SpallParams", "ToothFaultParams",
+    "MeshParams", "OperatingPoint", "SensorParams", "RigParams", "DPGTParams", "BearingRigParams", "ErrorsParams",
+    "PinholeErrorParams", "RunoutParams", "RollerDiameterErrorParams", "SpallParams", "ToothFaultParams",
     "GearSI", "GearSetSI", "CageSI", "SlideRollTractionSI", "BearingSI", "LubricantSI", "SupportSI", "MeshSI",
-    "OperatingSI", "RigSI", "DPGTSI", "DPGTOperatingSI", "DPGTSupportSI", "BearingRigSI",
+    "OperatingSI", "SensorSI", "RigSI", "DPGTSI", "DPGTOperatingSI", "DPGTSupportSI", "BearingRigSI",
     "with_overrides", "parameter_names", "flatten", "describe", "to_toml", "overrides_from_toml",
 ]
 
@@ -770,6 +770,28 @@ class OperatingPoint(Params):
 OperatingSI = OperatingPoint.SI
 
 
+@_with_si("SensorSI")
+@dataclass(frozen=True, kw_only=True)
+class SensorParams(Params):
+    """The rig's accelerometer on the housing (MODEL.md §3.10): at angle ``angle`` ψ_s of the fixed frame it
+    reads a(t) = Σ_n w(ψ_n(t) − ψ_s)·(F_n(t)·e)/m_eq + a_h(t)·e along its axis e (radial at ψ_s, or
+    tangential 90° ahead), w a Hann window of full angular width ``window_width`` of the outer planet's
+    distance from the sensor (McFadden & Smith 1985; Inalpolat & Kahraman 2009), F_n the outer planet n's
+    ring-mesh force on the ring, m_eq = ``equivalent_mass``, a_h the carrier housing's acceleration
+    (:class:`components.outputs.HousingSensor`)."""
+
+    _prefix: ClassVar[str] = "sensor"
+    angle: Quantity = _param("angle", "angle psi_s of the sensor on the housing, in the fixed frame")
+    window_width: Quantity = _param("angle", "full angular width of the Hann window over which a passing "
+                                             "planet's ring-mesh force reaches the sensor",
+                                    lo=0.0, hi=2.0 * math.pi, lo_open=True, bound_text="in (0, 360 deg]")
+    equivalent_mass: Quantity = _pos("mass", "equivalent mass m_eq of the path: mesh force / m_eq is the "
+                                             "acceleration the sensor reads")
+    direction: str = _param("choice", "sensor axis: radial (through the ring's axis) or tangential",
+                            choices=("radial", "tangential"))
+SensorSI = SensorParams.SI
+
+
 @_with_si("RigSI")
 @dataclass(frozen=True, kw_only=True)
 class RigParams(Params):
@@ -783,6 +805,7 @@ class RigParams(Params):
     load_ramp_mesh_periods: Quantity = _nonneg("dimensionless", "length of the sun-torque ramp in mesh periods "
                                                                 "(0: the full torque at t = 0)")
     load_ramp_max: Quantity = _nonneg("time", "longest sun-torque ramp (near-zero speeds have no mesh period)")
+    sensor: SensorParams = _nested(SensorParams, "the accelerometer on the housing (recorded when a run asks)")
 RigSI = RigParams.SI
 
 

@@ -11,13 +11,14 @@ from types import MappingProxyType
 
 from pathlib import Path
 
-from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, ErrorsParams, GearParams, GearSetParams, LubricantParams,
-                     MeshParams, OperatingPoint, RigParams, SlideRollTractionParams, SupportParams, assumed, derived,
+from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, ErrorsParams, GearParams, GearSetParams,
+                     LubricantParams, MeshParams, OperatingPoint, RigParams, SensorParams, SlideRollTractionParams,
+                     SupportParams, assumed, derived,
                      overrides_from_toml, paper, with_overrides)
 from .units import Q_, ParameterError
 
 __all__ = ["CONDITIONS", "DIRECTIONS", "OIL_GRADES", "oil_grade", "operating_point", "reference_gears", "reference_bearing",
-           "reference_dpgt", "reference_bearing_rig", "load_toml", "perfect_machine"]
+           "reference_dpgt", "reference_bearing_rig", "rig_accelerometer", "load_toml", "perfect_machine"]
 
 # the study's four operating conditions: carrier speed n_c and output power P (ring fixed)
 CONDITIONS = MappingProxyType({
@@ -135,6 +136,20 @@ def perfect_machine() -> ErrorsParams:
                            for f in ("pinhole", "runout", "roller_diameter", "spall", "tooth_fault")})
 
 
+def rig_accelerometer() -> SensorParams:
+    """The housing accelerometer of MODEL.md §3.10. The source gives only "on the carrier bearing housing near
+    the carrier axis"; where on the housing, how wide a planet is heard and through what mass are assumed."""
+    return SensorParams(
+        angle=assumed("90 deg", "top of the housing (+Y of the fixed frame), where a rig's accelerometer is "
+                                "usually mounted; the source does not say"),
+        window_width=assumed("120 deg", "Hann window (McFadden & Smith 1985; Inalpolat & Kahraman 2009) as wide "
+                                        "as the spacing of N = 3 planets: the sensor hears one planet at a time"),
+        equivalent_mass=assumed("6.07 kg", "the ring gear's mass (Table 1): the mass a ring-mesh force "
+                                           "accelerates before it reaches the housing"),
+        direction=assumed("radial", "an accelerometer screwed onto the housing's outer surface"),
+    )
+
+
 def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams:
     """The reference DPGT exactly per PARAMETERS.md, at operating ``condition`` (1..4) and ``direction``."""
     return DPGTParams(
@@ -177,7 +192,8 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
                                                      "it still swung 8 rad/s), far below the mesh frequency"),
             carrier_drive_damping_ratio=assumed(0.7),
             load_ramp_mesh_periods=assumed(20.0, "no impulse at the start (MODEL.md 4)"),
-            load_ramp_max=assumed("0.05 s", "near-zero speeds have no mesh period")),
+            load_ramp_max=assumed("0.05 s", "near-zero speeds have no mesh period"),
+            sensor=rig_accelerometer()),
         gravity=assumed("9.81 m/s^2", "standard gravity along -Y of the fixed frame"),
         errors=perfect_machine(),
     )

@@ -17,7 +17,9 @@ Layout of the file (every variable and coordinate carries CF-style ``units`` and
 * per :class:`ElementOutput` of family ``<f>``: ``<f>.<key>`` (time, <f>.instance) with the units and
   long name given in ``ElementOutput.meta``; the dimension ``<f>.instance`` has a coordinate of the same
   name (instance names from ``ElementOutput.instances``, else the index 0..n-1) and any further
-  per-instance coordinates ``<f>.<coord>`` given there (listed in each variable's ``coordinates``).
+  per-instance coordinates ``<f>.<coord>`` given there (listed in each variable's ``coordinates``);
+* per :class:`DerivedOutput` ``<name>``: ``<name>`` (time, <name>.instance), a quantity a caller derives
+  from each sample (e.g. a virtual sensor), with its units and long name.
 """
 from __future__ import annotations
 
@@ -33,7 +35,7 @@ import numpy as np
 from .errors import ModelError
 from .model import to_fixed
 
-__all__ = ["BodyMotion", "ElementOutput", "Recorder", "atomic_write_bytes", "atomic_write_text", "hermite"]
+__all__ = ["BodyMotion", "ElementOutput", "DerivedOutput", "Recorder", "atomic_write_bytes", "atomic_write_text", "hermite"]
 
 
 def atomic_write_bytes(path, data: bytes) -> None:
@@ -98,6 +100,19 @@ class ElementOutput:
         return outputs if self.derived is None else {**outputs, **self.derived(outputs)}
 
 
+@dataclass(frozen=True)
+class DerivedOutput:
+    """A quantity derived from each sample: ``fn(t, X, V, A, outputs)`` → one float per instance, where
+    X, V, A are (n_bodies, 3) arrays of every body in the reference frame R (bodies at rest in I with
+    their frame acceleration) and ``outputs`` the element outputs at the sample (evaluated once per sample
+    and shared with the :class:`ElementOutput` probes). Recorded as ``<name>`` along ``<name>.instance``."""
+    name: str
+    fn: Callable
+    units: str
+    long_name: str
+    instances: Sequence[str] = ("0",)
+
+
 class Recorder:
     def __init__(self, path, dt: float, probes: Sequence, t_start: float = 0.0, chunk: int = 2000,
                  attrs: dict | None = None):
@@ -160,6 +175,11 @@ class Recorder:
                         attrs["coordinates"] = " ".join(f"{e.name}.{c}" for c in inst)
                     self.vars[f"{e.name}.{k}"] = (("time", dim), attrs)
                 self._plan.append(("elem", p, keys))
+            elif isinstance(p, DerivedOutput):
+                dim = f"{p.name}.instance"
+                self._coord(dim, dim, p.instances, "1", f"instance of {p.name}")
+                self.vars[p.name] = (("time", dim), {"units": p.units, "long_name": p.long_name})
+                self._plan.append(("derived", p, None))
             else:
                 raise ModelError(f"unknown probe {p!r}")
         self._buf = {k: [] for k in self.vars}
@@ -226,6 +246,10 @@ class Recorder:
             else:
                 if outs is None:
                     outs = self.system.outputs(t, q, v, z)
+                if kind == "derived":
+                    X, V, A = qf.reshape(-1, 3), vf.reshape(-1, 3), af.reshape(-1, 3)
+                    self._buf[p.name].append(np.asarray(p.fn(t, X, V, A, outs), dtype=float).reshape(-1).copy())
+                    continue
                 o = p.evaluate(outs[p.element])
                 for k in sel:
                     self._buf[f"{p.element}.{k}"].append(np.asarray(o[k], dtype=float).copy())

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["amplitude_spectrum", "peak_table"]
+__all__ = ["amplitude_spectrum", "peak_table", "line_table"]
 
 
 def amplitude_spectrum(t: np.ndarray, x: np.ndarray, detrend: bool = True):
@@ -43,4 +43,20 @@ def peak_table(f: np.ndarray, amp: np.ndarray, centre: float, span: float, expec
         rows.append({"frequency_hz": float(f[i]), "amplitude": float(amp[i]), "nearest": lab,
                      "expected_hz": float(fe), "distance_hz": float(f[i] - fe),
                      "distance_bins": float((f[i] - fe) / df)})
+    return rows
+
+
+def line_table(f: np.ndarray, amp: np.ndarray, lines: dict[str, float], band: tuple[float, float]) -> list[dict]:
+    """Each expected line: its amplitude (the largest bin within one bin of it — a Hann window spreads a
+    line that falls between bins over two) and that amplitude over the median amplitude of the band
+    [lo, hi] (the spectrum's floor there: most of its bins hold no line)."""
+    f, amp = np.asarray(f, float), np.asarray(amp, float)
+    df = f[1] - f[0]
+    floor = float(np.median(amp[(f >= band[0]) & (f <= band[1])]))
+    rows = []
+    for label, fl in lines.items():
+        near = np.abs(f - fl) <= 1.0001 * df
+        a = float(amp[near].max()) if near.any() else float("nan")
+        rows.append({"line": label, "frequency_hz": float(fl), "amplitude": a,
+                     "over_median": a / floor if floor > 0 else float("inf")})
     return rows

@@ -7,6 +7,7 @@ Results layout of a run directory:
                    "<family>.<key>" (e.g. race_inner.load, pocket.force, guide.force, mesh_sa.force) along
                    "<family>.instance", whose coordinates name each instance ("a1.pb.roller3", "sun-a1")
                    with its bearing, planet, pair, bearing_kind, roller (components.results_schema);
+                   with RunConfig.sensor the housing accelerometer "sensor.acceleration" (MODEL.md §3.10);
                    attrs hold the run summary and, as JSON, the bearing map, meta, label and geometry
     summary.json   the statistics users read, taken on every accepted step over the window
                    (:class:`components.outputs.WindowStatistics`; the recording is for plots only)
@@ -31,7 +32,7 @@ from components.params import DPGTParams
 from components.scene import SceneOptions
 from mbd.recorder import BodyMotion, Recorder, atomic_write_text
 
-from components.outputs import WindowStatistics, bearing_map, cage_period, default_window
+from components.outputs import HousingSensor, WindowStatistics, bearing_map, cage_period, default_window
 from components.results_schema import drawing_geometry, element_probes
 
 from .lock import folder_lock
@@ -72,6 +73,7 @@ class RunConfig:
     options: SceneOptions = field(default_factory=SceneOptions)
     progress: bool = True
     checkpoint_every: int = 2000
+    sensor: bool = False          # record the housing accelerometer (rig.sensor, MODEL.md §3.10) per sample
 
     def __post_init__(self):
         for k in ("settle", "window"):
@@ -95,12 +97,14 @@ def statistics_window(scene, base: float = 0.02) -> float:
     return default_window(base, [cage_period(b, wc, sp[k]) for k in ("inner_planet", "outer_planet")])
 
 
-def _probes(scene) -> list:
-    """Body motion in R (all bodies) and in the fixed frame (sun, carrier, ring), and the element
-    outputs of :mod:`components.results_schema` (units, long names, instance coordinates)."""
+def _probes(scene, sensor=None) -> list:
+    """Body motion in R (all bodies) and in the fixed frame (sun, carrier, ring), the element outputs of
+    :mod:`components.results_schema` (units, long names, instance coordinates), and the housing
+    accelerometer when ``sensor`` (:class:`components.params.SensorSI`) is given."""
     return [BodyMotion("motion", frame="reference"),
             BodyMotion("fixed", bodies=["sun", "carrier", "ring"], frame="fixed"),
-            *element_probes(scene)]
+            *element_probes(scene),
+            *([HousingSensor(scene, sensor).probe()] if sensor is not None else [])]
 
 
 def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None) -> dict:
@@ -118,7 +122,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     meta = {k: v for k, v in scene.meta.items() if k not in ("bearing", "lubricant")}   # SI objects, not JSON
     window = cfg.window if cfg.window is not None else statistics_window(scene)
     stats = WindowStatistics(scene, cfg.settle, cfg.settle + window)
-    rec = Recorder(out_dir / "results.nc", dt=1.0 / cfg.sample_rate, probes=_probes(scene), t_start=cfg.settle,
+    rec = Recorder(out_dir / "results.nc", dt=1.0 / cfg.sample_rate, probes=_probes(scene, params.si().rig.sensor if cfg.sensor else None), t_start=cfg.settle,
                    attrs={"bearings": bmap, "meta": meta, "label": label or {},
                           "geometry": drawing_geometry(params)})
     integ = cfg.integration

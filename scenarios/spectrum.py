@@ -1,13 +1,24 @@
-"""Spectrum check (the source's test rig): carrier-housing acceleration in the fixed frame.
+"""Spectrum check (the source's test rig): what an accelerometer on the housing reads.
 
-    python -m scenarios.spectrum --out results/spectrum [--carrier-rpm 2000] [--sun-rpm 3290] [--power "200 kW"]
+    python -m scenarios.spectrum --out results/spectrum [--sensor housing|axis] [--carrier-rpm 2000] [--power "200 kW"]
 
-A fixed accelerometer near the carrier axis reads the carrier's acceleration in the inertial frame. Its
-one-sided amplitude spectrum (Hann window) is written to DIR/spectrum.csv (frequency_hz, amplitude =
-x component; amplitude_y), with f_m = z_r f_c and the sidebands f_m ± f_c, f_m ± 3 f_c marked in
-DIR/spectrum.png, the strongest peaks near f_m in DIR/peaks.csv, and DIR/summary.json (f_m_hz, f_c_hz,
-resolution_hz, window_s, peaks). The frequency resolution is 1/window: resolve f_c sidebands with a
-window of several carrier periods (default 0.1 s → 10 Hz against f_c = 33.3 Hz at 2000 r/min).
+``--sensor housing`` (default): the rig's accelerometer on the housing at ψ_s (MODEL.md §3.10,
+``rig.sensor.*``): each outer planet's ring-mesh force weighted by a Hann window of its angular distance
+from the sensor, over m_eq, plus the carrier-housing acceleration, along the sensor's axis.
+``--sensor axis``: an ideal sensor at the carrier axis (w ≡ 1): the carrier's acceleration in the fixed frame,
+x component (amplitude_y: y).
+
+Writes the one-sided amplitude spectrum (Hann window) to DIR/spectrum.csv (frequency_hz, amplitude = the
+sensor; amplitude_y or amplitude_axis for comparison), DIR/spectrum.png with f_m = z_r f_c and f_m ± f_c,
+f_m ± 3 f_c marked, DIR/lines.csv (f_m + k f_c, |k| ≤ 6: amplitude, over the band's median, and what lets the
+sensor see the line: planet phasing, the transfer path, or errors — :func:`components.geometry.sideband_origin`),
+the strongest peaks near f_m in DIR/peaks.csv, and DIR/summary.json. The spectrum covers the first whole number
+of carrier revolutions of the window (the lines then fall on bins); its resolution is f_c/revolutions: resolve
+f_c sidebands with a window of several carrier periods (default 0.1 s: 3 revolutions at 2000 r/min, 11.1 Hz
+against f_c = 33.3 Hz).
+
+The machine is one argument of :func:`measure` (a :class:`components.params.DPGTParams`, built by
+:func:`machine`), the sensor one option.
 """
 from __future__ import annotations
 
@@ -25,9 +36,17 @@ import numpy as np
 import mbd
 from mbd.recorder import atomic_write_text
 
-from .analysis import amplitude_spectrum, peak_table
+from .analysis import amplitude_spectrum, line_table, peak_table
 from .runner import RunConfig, run_case
 from .command import command
+
+SENSORS = {
+    "housing": "housing accelerometer (MODEL.md 3.10): Hann-windowed ring-mesh forces / m_eq + carrier-housing "
+               "acceleration, along the sensor's axis [m/s^2]",
+    "axis": "ideal sensor at the carrier axis: carrier acceleration in the fixed frame, x component [m/s^2] "
+            "(amplitude_y: y component)",
+}
+SIDEBANDS = 6         # the line table covers f_m + k f_c, |k| <= SIDEBANDS
 
 
 def parse_args(argv):
@@ -37,6 +56,8 @@ def parse_args(argv):
                    help="sun speed [r/min] magnitude; must match the ring-fixed ratio (3290 at 2000)")
     p.add_argument("--power", default="200 kW", help='output power with unit (default "200 kW")')
     p.add_argument("--direction", default="forward", choices=["forward", "reverse"])
+    p.add_argument("--sensor", default="housing", choices=list(SENSORS),
+                   help="housing: the rig's windowed accelerometer (rig.sensor.*, default); axis: ideal, at the carrier axis")
     p.add_argument("--settle", type=float, default=0.06,
                    help="seconds discarded (default 0.06: a lightly damped ~2.6 kHz mode rings for ~50 ms after the start)")
     p.add_argument("--window", type=float, default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")
@@ -49,16 +70,15 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def run(a) -> dict:
+def machine(a):
+    """The machine on the rig: the reference DPGT at the operating point asked for, with ``--set``
+    overrides (a usage error names the parameter). Its manufacturing errors are part of it."""
     from components.params import with_overrides
     from components.presets import reference_dpgt
-    from components.scene import SceneOptions
     from components.units import ParameterError
 
-    from .paper_study import _bool, parse_sets
+    from .paper_study import parse_sets
 
-    out = Path(a.out)
-    out.mkdir(parents=True, exist_ok=True)
     overrides = {"operating.carrier_speed": f"{a.carrier_rpm} rpm", "operating.output_power": a.power,
                  "operating.direction": a.direction, **parse_sets(a.set)}
     try:
@@ -66,57 +86,137 @@ def run(a) -> dict:
         si = params.si()
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
-    op = si.operating
-    sun_rpm = abs(op.sun_speed) * 30 / np.pi
+    sun_rpm = abs(si.operating.sun_speed) * 30 / np.pi
     if a.sun_rpm is not None and abs(a.sun_rpm - sun_rpm) > 0.001 * sun_rpm + 1.0:
         raise SystemExit(f"error: --sun-rpm {a.sun_rpm} does not match the ring-fixed kinematics: with the carrier at "
                          f"{a.carrier_rpm} r/min the sun turns at {sun_rpm:.1f} r/min (omega_s/omega_c = 1 - z_r/z_s)")
+    return params
+
+
+def run_config(a) -> RunConfig:
+    """The run settings from the command line (window, recording, integration, scene switches)."""
+    from components.scene import SceneOptions
+
+    from .paper_study import _bool, parse_sets
+
     opts = SceneOptions.from_dict({k: _bool(v) for k, v in parse_sets(a.option).items()})
-    cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, options=opts,
-                    integration=dataclasses.replace(mbd.PRODUCTION, h=a.h), progress=not a.no_progress)
+    return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, options=opts,
+                     integration=dataclasses.replace(mbd.PRODUCTION, h=a.h), progress=not a.no_progress)
+
+
+def run(a) -> dict:
+    return measure(machine(a), a.sensor, run_config(a), Path(a.out))
+
+
+def measure(params, sensor: str, cfg: RunConfig, out: Path) -> dict:
+    """Run ``params`` (:class:`components.params.DPGTParams`) on the rig, read ``sensor`` ("housing" |
+    "axis"), and write its spectrum, line table and peaks into ``out`` (module docstring)."""
+    if sensor not in SENSORS:
+        raise SystemExit(f"error: --sensor {sensor!r}: expected one of {list(SENSORS)}")
+    out.mkdir(parents=True, exist_ok=True)
+    cfg = dataclasses.replace(cfg, sensor=sensor == "housing")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        s = run_case(params, cfg, out / "run", label={"scenario": "spectrum"})
+        s = run_case(params, cfg, out / "run", label={"scenario": "spectrum", "sensor": sensor})
+    t, signals = _signals(out / "run" / "results.nc", sensor)
+    t, signals = _whole_revolutions(t, signals, s["f_c_hz"])
+    spectra = {k: amplitude_spectrum(t, x) for k, x in signals.items()}
+    f, amp, df = spectra["amplitude"]
+    f_c, f_m = s["f_c_hz"], s["f_m_hz"]
+    gears = params.si().gears
+    lines = _lines(f, amp, f_m, f_c, int(gears.ring.teeth), int(gears.planets), sensor)
+    expected = {r["line"]: r["frequency_hz"] for r in lines}
+    peaks = peak_table(f, amp, f_m, (SIDEBANDS + 0.5) * f_c, expected, n=8)
+    _write_csv(out / "spectrum.csv", [{"frequency_hz": fi, **{k: a[1][i] for k, a in spectra.items()}}
+                                      for i, fi in enumerate(f.tolist())])
+    _write_csv(out / "lines.csv", lines)
+    _write_csv(out / "peaks.csv", peaks)
+    summary = {"f_m_hz": f_m, "f_c_hz": f_c, "resolution_hz": df, "window_s": s["window_s"],
+               "carrier_rpm": s["carrier_rpm"], "sun_rpm": s["sun_rpm"], "power_W": s["power_W"],
+               "sensor": sensor, "quantity": SENSORS[sensor],
+               "sensor_parameters": dataclasses.asdict(params.si().rig.sensor) if sensor == "housing" else None,
+               "lines": lines, "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"],
+               "error_estimate": s["error_estimate"]}
+    atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
+    fig = _plot(f, spectra, f_m, f_c, s, sensor, out)
+    _report(lines, peaks, f_m, f_c, df, t, sensor)
+    print(f"written: {out / 'spectrum.csv'}, {out / 'lines.csv'}, {out / 'peaks.csv'}, {out / 'summary.json'}, {fig}")
+    return summary
+
+
+def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
+    """Sample times and the sensor's signal ("amplitude") with its comparison signal."""
     import xarray as xr
 
-    with xr.open_dataset(out / "run" / "results.nc", engine="h5netcdf") as ds:
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
         t = ds["time"].values
         ic = list(ds["fixed.body"].values).index("carrier")
         acc = ds["fixed.acceleration"].values[:, ic]
-    f, ax, df = amplitude_spectrum(t, acc[:, 0])
-    _, ay, _ = amplitude_spectrum(t, acc[:, 1])
-    f_c, f_m = s["f_c_hz"], s["f_m_hz"]
-    marks = {"f_m": f_m, **{f"f_m{'+' if k > 0 else '−'}{abs(k)}f_c": f_m + k * f_c for k in (-3, -1, 1, 3)}}
-    expected = {f"f_m{k:+d}f_c" if k else "f_m": f_m + k * f_c for k in range(-6, 7)}
-    peaks = peak_table(f, ax, f_m, 6.5 * f_c, expected, n=8)
+        if sensor == "axis":
+            return t, {"amplitude": acc[:, 0], "amplitude_y": acc[:, 1]}
+        return t, {"amplitude": ds["sensor.acceleration"].values[:, 0], "amplitude_axis": acc[:, 0]}
+
+
+def _whole_revolutions(t, signals: dict, f_c: float):
+    """The first whole number of carrier revolutions of the samples (all of them if less than one): the
+    lines f_m + k f_c then fall on frequency bins, and the Hann window's leakage stays within ±1 bin."""
+    dt, fc = float(np.median(np.diff(t))), abs(f_c)
+    revs = np.floor(len(t) * dt * fc + 1e-9) if fc > 0 else 0.0
+    n = min(int(round(revs / (fc * dt))), len(t)) if revs >= 1 else len(t)
+    return t[:n], {k: x[:n] for k, x in signals.items()}
+
+
+def _lines(f, amp, f_m, f_c, z_r: int, planets: int, sensor: str) -> list[dict]:
+    """f_m + k f_c, |k| <= SIDEBANDS: amplitude, over the band's median, what lets a sensor see it, and
+    whether a perfect machine shows it to this sensor (axis: phasing; housing: phasing or transfer path)."""
+    from components.geometry import sideband_origin
+
+    seen = {"axis": ("phasing",), "housing": ("phasing", "transfer path")}[sensor]
+    ks = range(-SIDEBANDS, SIDEBANDS + 1)
+    lab = {k: f"f_m{k:+d}f_c" if k else "f_m" for k in ks}
+    rows = line_table(f, amp, {lab[k]: f_m + k * f_c for k in ks},
+                      (f_m - (SIDEBANDS + 0.5) * f_c, f_m + (SIDEBANDS + 0.5) * f_c))
+    for k, r in zip(ks, rows):
+        r["k"] = k
+        r["origin"] = sideband_origin(k, z_r, planets)
+        r["perfect_machine_shows"] = r["origin"] in seen
+    return rows
+
+
+def _write_csv(path: Path, rows: list[dict]) -> None:
     buf = io.StringIO()
-    w = csv.writer(buf)
-    w.writerow(["frequency_hz", "amplitude", "amplitude_y"])
-    w.writerows(zip(f.tolist(), ax.tolist(), ay.tolist()))
-    atomic_write_text(out / "spectrum.csv", buf.getvalue())
-    buf = io.StringIO()
-    if peaks:
-        w = csv.DictWriter(buf, fieldnames=list(peaks[0]))
+    if rows:
+        w = csv.DictWriter(buf, fieldnames=list(rows[0]))
         w.writeheader()
-        w.writerows(peaks)
-    atomic_write_text(out / "peaks.csv", buf.getvalue())
-    summary = {"f_m_hz": f_m, "f_c_hz": f_c, "resolution_hz": df, "window_s": s["window_s"],
-               "carrier_rpm": s["carrier_rpm"], "sun_rpm": s["sun_rpm"], "power_W": s["power_W"],
-               "quantity": "carrier acceleration in the fixed frame, x component [m/s^2] (amplitude_y: y component)",
-               "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"], "error_estimate": s["error_estimate"]}
-    atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
+        w.writerows(rows)
+    atomic_write_text(path, buf.getvalue())
+
+
+def _plot(f, spectra, f_m, f_c, s, sensor, out):
     from viz import plots as vp
 
-    fig = vp.spectrum(f, {"x": ax, "y": ay}, marks, out / "spectrum.png", fmax=min(f[-1], 2.5 * f_m),
-                      quantity="carrier acceleration (fixed frame)", unit="m/s^2", logy=True,
-                      title=f"Carrier housing acceleration, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min")
+    names = {"amplitude": "housing sensor" if sensor == "housing" else "x", "amplitude_y": "y",
+             "amplitude_axis": "axis (carrier x)"}
+    marks = {"f_m": f_m, **{f"f_m{'+' if k > 0 else '−'}{abs(k)}f_c": f_m + k * f_c for k in (-3, -1, 1, 3)}}
+    where = "housing accelerometer" if sensor == "housing" else "carrier acceleration (fixed frame)"
+    return vp.spectrum(f, {names[k]: a[1] for k, a in spectra.items()}, marks, out / "spectrum.png",
+                       fmax=min(f[-1], 2.5 * f_m), quantity=where, unit="m/s^2", logy=True,
+                       title=f"{where.capitalize()}, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min")
+
+
+def _report(lines, peaks, f_m, f_c, df, t, sensor) -> None:
+    print(f"sensor: {SENSORS[sensor]}")
     print(f"f_c = {f_c:.2f} Hz, f_m = {f_m:.1f} Hz, resolution {df:.2f} Hz over {t[-1] - t[0]:.4g} s")
+    print("lines f_m + k f_c (origin: phasing = a perfect machine shows it at the axis; transfer path = "
+          "phasing allows it through a position-dependent path; errors = cancelled in a perfect machine):")
+    for r in lines:
+        print(f"  {r['line']:>9} {r['frequency_hz']:8.1f} Hz  amp {r['amplitude']:9.3g} m/s^2  "
+              f"{r['over_median']:8.1f} x median   {r['origin']:<13} "
+              f"{'expected' if r['perfect_machine_shows'] else '-'}")
     print("strongest peaks near f_m:")
     for r in peaks:
         print(f"  {r['frequency_hz']:9.1f} Hz  amp {r['amplitude']:.3g} m/s^2   nearest {r['nearest']:>8} "
               f"({r['expected_hz']:.1f} Hz, {r['distance_bins']:+.2f} bins)")
-    print(f"written: {out / 'spectrum.csv'}, {out / 'peaks.csv'}, {out / 'summary.json'}, {fig}")
-    return summary
 
 
 @command

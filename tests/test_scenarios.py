@@ -110,9 +110,11 @@ def test_spectrum_peaks_sit_on_mesh_sidebands(tmp_path):
     "Strongest" means within 30 dB of the largest peak: weaker local maxima sit at the Hann window's
     leakage floor of the dominant line (seen: 0.2 m/s² seven bins from a 144 m/s² line).
     Planet phasing (McFadden & Smith): with N equally spaced planets and the ring fixed, a fixed sensor
-    sees the sidebands k with (z_r + k) ≡ 0 mod N; for z_r = 82, N = 3 the dominant one must be such a k."""
+    sees the sidebands k with (z_r + k) ≡ 0 mod N; for z_r = 82, N = 3 the dominant one must be such a k.
+    A sensor at the axis carries k = ±1 only (geometry.sideband_origin): every other line stays below 1 %
+    of the dominant one (seen: 0.2 % at f_m + 2f_c, weak gravity/nonlinear orders; cancelled lines ~2e-4)."""
     s = spectrum.run(spectrum.parse_args(["--out", str(tmp_path), "--settle", "0.06", "--window", "0.09",
-                                          "--option", "bearings=linear", "--no-progress"]))
+                                          "--option", "bearings=linear", "--no-progress", "--sensor", "axis"]))
     assert s["f_c_hz"] == pytest.approx(2000 / 60) and s["f_m_hz"] == pytest.approx(82 * 2000 / 60)
     assert s["resolution_hz"] == pytest.approx(1 / 0.09, rel=0.01)
     big = s["peaks"][0]["amplitude"] if s["peaks"] else 0.0
@@ -127,6 +129,33 @@ def test_spectrum_peaks_sit_on_mesh_sidebands(tmp_path):
     rows = list(csv.DictReader((tmp_path / "spectrum.csv").open()))
     assert set(rows[0]) >= {"frequency_hz", "amplitude"}
     assert (tmp_path / "spectrum.png").exists()
+    lines = {r["k"]: r for r in s["lines"]}
+    strongest = max(r["amplitude"] for r in s["lines"])
+    assert lines[-1]["origin"] == "phasing" and lines[-1]["amplitude"] == strongest
+    assert all(r["amplitude"] < 0.01 * strongest for r in s["lines"] if r["origin"] != "phasing"), s["lines"]
+
+
+@pytest.mark.slow
+def test_spectrum_housing_sensor_on_a_perfect_machine(tmp_path):
+    """The windowed housing sensor (MODEL.md §3.10) on a perfect machine: a passing-planet window carries every
+    carrier order, so besides f_m − f_c the other lines planet phasing allows for z_r = 82, N = 3 appear —
+    f_m + 2f_c, f_m − 4f_c, f_m + 5f_c stand out of the band's median by ≥ 5× (seen: 2000–28000×) — while
+    the lines phasing cancels, f_m, f_m + f_c and f_m ± 3f_c among them, stay below 1 % of the strongest
+    (seen: ≤ 0.02 %): the window alone does not bring f_m or f_m + f_c (McFadden & Smith 1985: "complete
+    suppression of the component at the tooth meshing frequency"); errors (MODEL.md §3.9) must."""
+    s = spectrum.run(spectrum.parse_args(["--out", str(tmp_path), "--settle", "0.06", "--window", "0.09",
+                                          "--option", "bearings=linear", "--no-progress"]))
+    assert s["sensor"] == "housing" and s["resolution_hz"] == pytest.approx(s["f_c_hz"] / 3, rel=1e-3)
+    lines = {r["k"]: r for r in s["lines"]}
+    strongest = max(r["amplitude"] for r in s["lines"])
+    assert [k for k, r in lines.items() if r["perfect_machine_shows"] and abs(k) <= 5] == [-4, -1, 2, 5]
+    for k in (-4, -1, 2, 5):
+        assert lines[k]["over_median"] >= 5.0, lines[k]
+    for r in s["lines"]:
+        if r["origin"] == "errors":
+            assert r["amplitude"] < 0.01 * strongest, r
+    rows = list(csv.DictReader((tmp_path / "lines.csv").open()))
+    assert {r["origin"] for r in rows} == {"phasing", "transfer path", "errors"}
 
 
 def test_spectrum_rejects_inconsistent_sun_speed(tmp_path):
