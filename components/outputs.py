@@ -14,6 +14,10 @@ taken here, by :class:`WindowStatistics`, an observer of the one simulation loop
   carrier); *radial* is from the carrier axis through the planet's centre, *tangential* 90° ahead.
   Both are independent of where the planet sits and of the frame the model is integrated in.
 
+Bearing lives (:mod:`components.life` owns the laws): ISO 281's from the bearing load's equivalent
+(mean P^(10/3)), and the ISO/TS 16281-style one from every roller's raceway loads, accumulated here as
+(Q/Q_c)^4.5 on the pin (stationary relative to the load) and (Q/Q_c)^4 on the bore (rotating).
+
 Element family names come from :mod:`components.families` (re-exported here).
 """
 from __future__ import annotations
