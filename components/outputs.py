@@ -17,6 +17,10 @@ taken here, by :class:`WindowStatistics`, an observer of the one simulation loop
 The rig's accelerometer on the housing (MODEL.md §3.10) is :class:`HousingSensor`, recorded per sample
 through :meth:`HousingSensor.probe` when a run asks for it (it costs nothing otherwise).
 
+Bearing lives (:mod:`components.life` owns the laws): ISO 281's from the bearing load's equivalent
+(mean P^(10/3)), and the ISO/TS 16281-style one from every roller's raceway loads, accumulated here as
+(Q/Q_c)^4.5 on the pin (stationary relative to the load) and (Q/Q_c)^4 on the bore (rotating).
+
 Element family names come from :mod:`components.families` (re-exported here).
 """
 from __future__ import annotations
@@ -31,13 +35,14 @@ from mbd.ad import wrap_angle
 
 from .bearing import bearing_kinematics
 from .families import FAMILY, MESH_FAMILY
+from .life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
+                   iso281_rating, lundberg_palmgren_life, raceway_ratings, relative_life)
 from .lubrication import bearing_film
 
 __all__ = ["FAMILY", "MESH_FAMILY", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
            "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life",
            "contact_film", "SUMMARY_WORDS", "hann_window", "sensor_acceleration", "HousingSensor"]
 
-LIFE_EXPONENT = 10.0 / 3.0     # ISO 281, roller bearings: L10 ∝ P^(−10/3)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -131,6 +136,8 @@ SUMMARY_WORDS = {
     "bearing_load_mean_N": ("planet bearing load, mean", "N"),
     "equivalent_load_N": ("planet bearing equivalent load (ISO 281)", "N"),
     "life_L10_relative": ("L10 life relative to forward", "1"),
+    "life_iso281_h": ("L10 life, ISO 281 from the bearing load", "h"),
+    "life_iso16281_h": ("L10 life, ISO/TS 16281-style from the roller loads", "h"),
     "roller_inner_race_rms_N": ("roller–inner race load RMS", "N"),
     "roller_inner_race_max_N": ("roller–inner race load max", "N"),
     "roller_outer_race_rms_N": ("roller–outer race load RMS", "N"),
@@ -148,11 +155,6 @@ SUMMARY_WORDS = {
     "pocket_impact_speed_max": ("pocket impact speed max", "m/s"),
     "pocket_impact_peak_max_N": ("pocket impact peak force max", "N"),
 }
-
-
-def relative_life(P: float, P_ref: float) -> float | None:
-    """ISO 281 basic rating life ratio L10/L10_ref = (P_ref/P)^(10/3) for roller bearings (None for P ≤ 0)."""
-    return float((P_ref / P) ** LIFE_EXPONENT) if P > 0 else None
 
 
 def radial_tangential(vec, planet_xy, carrier_xy):
@@ -280,6 +282,9 @@ class WindowStatistics(mbd.Observer):
                 self.target = np.maximum(np.round(revs), 1.0)
         self.t_end = self.t1 + (self.MARGIN * (self.t1 - self.t0) if self.target is not None else 0.0)
         self._lubricant = scene.meta.get("lubricant")       # None: no film statistics (e.g. the bearing rig)
+        self._qc = raceway_ratings(scene.meta["bearing"])    # (pin, bore) roller contact ratings [N]
+        # the planet's speed relative to its pin, per bearing kind: the revolutions a life counts
+        self._w_rel = {k: float(sp[f"{k}_planet"]) - self.omega_c for k in ("inner", "outer")}
 
     # setup -------------------------------------------------------------------------------------
     def bind(self, model, system, state) -> None:
@@ -345,6 +350,9 @@ class WindowStatistics(mbd.Observer):
             pin = pin_reactions(ri, slice(None), p.roller_bearing, nb, p.rows)
             snap["roller_inner_load"] = np.asarray(ri["load"], float)
             snap["roller_outer_load"] = np.asarray(out[FAMILY["race_outer"]]["load"], float)
+            # Lundberg–Palmgren: (Q/Q_c)^p, the pin stationary and the bore rotating relative to the load
+            snap["roller_inner_fatigue"] = (snap["roller_inner_load"] / self._qc[0]) ** STATIONARY_EXPONENT
+            snap["roller_outer_fatigue"] = (snap["roller_outer_load"] / self._qc[1]) ** ROTATING_EXPONENT
             ro = out[FAMILY["race_outer"]]
             snap["heat_traction"], snap["traction_coefficient"] = self._traction_heat(ri, ro, nb)
             if self._lubricant is not None:
@@ -629,6 +637,7 @@ class WindowStatistics(mbd.Observer):
                 self._heat_summary(d, ref, sel)
                 if self._lubricant is not None:
                     self._film_summary(d, sel)
+            self._life_summary(d, kind, ref, sel)
             if p.cage is not None:
                 self._cage_summary(d, ref, sel)
             d["life_L10_relative"] = None     # filled by a study relative to its forward run
@@ -670,6 +679,30 @@ class WindowStatistics(mbd.Observer):
                 d["pocket_impact_peak_max_N"] = float(im["peak_max"][pk].max())
                 d["pocket_impact_peak_mean_N"] = float(im["peak_sum"][pk].sum() / count) if count else 0.0
         d["all_rollers"] = al
+
+    def _life_summary(self, d, kind, ref, sel):
+        """ISO 281 L10 from the bearing load and the ISO/TS 16281-style L10 from the roller loads
+        (:mod:`components.life`), in 10^6 revolutions of the planet relative to its pin and in hours at the
+        nominal relative speed: pair 1's bearing, and in ``all_rollers`` every bearing of this kind pooled."""
+        p, b, w = self.plan, self.scene.meta["bearing"], self._w_rel[kind]
+        d["dynamic_load_rating_N"] = iso281_rating(b)
+        cases = [(d, np.array([ref]))]
+        if p.rollers:
+            cases.append((d["all_rollers"], sel))
+        for out, bearings in cases:
+            P = float(np.mean(self.stats("load_life")["mean"][bearings]) ** (1.0 / LIFE_EXPONENT))
+            out["life_iso281_Mrev"] = iso281_life(P, b)
+            out["life_iso281_h"] = hours(out["life_iso281_Mrev"], w)
+            if not p.rollers:
+                continue
+            mine = np.isin(p.roller_bearing, bearings)
+            q_pin = self._qc[0] * float(equivalent_load(self.stats("roller_inner_fatigue")["mean"][mine].mean(),
+                                                        STATIONARY_EXPONENT))
+            q_bore = self._qc[1] * float(equivalent_load(self.stats("roller_outer_fatigue")["mean"][mine].mean(),
+                                                         ROTATING_EXPONENT))
+            out["roller_equivalent_load_pin_N"], out["roller_equivalent_load_bore_N"] = q_pin, q_bore
+            out["life_iso16281_Mrev"] = lundberg_palmgren_life(q_pin, q_bore, b)
+            out["life_iso16281_h"] = hours(out["life_iso16281_Mrev"], w)
 
     def _heat_summary(self, d, ref, sel):
         """Heat from traction and land friction (time means, W): the reference bearing's and the mean of its

@@ -51,10 +51,10 @@ from .units import ParameterError, Quantity, format_quantity, quantity, to_si
 
 __all__ = [
     "Source", "Sourced", "paper", "derived", "assumed", "SI", "Derived", "Params",
-    "GearParams", "GearSetParams", "CageParams", "SlideRollTractionParams", "BearingParams", "LubricantParams", "SupportParams",
-    "MeshParams", "OperatingPoint", "SensorParams", "RigParams", "DPGTParams", "BearingRigParams", "ErrorsParams",
-    "PinholeErrorParams", "RunoutParams", "RollerDiameterErrorParams", "SpallParams", "ToothFaultParams",
-    "GearSI", "GearSetSI", "CageSI", "SlideRollTractionSI", "BearingSI", "LubricantSI", "SupportSI", "MeshSI",
+    "GearParams", "GearSetParams", "CageParams", "SlideRollTractionParams", "LifeParams", "BearingParams", "LubricantParams",
+    "SupportParams", "MeshParams", "OperatingPoint", "SensorParams", "RigParams", "DPGTParams", "BearingRigParams",
+    "ErrorsParams", "PinholeErrorParams", "RunoutParams", "RollerDiameterErrorParams", "SpallParams", "ToothFaultParams",
+    "GearSI", "GearSetSI", "CageSI", "SlideRollTractionSI", "LifeSI", "BearingSI", "LubricantSI", "SupportSI", "MeshSI",
     "OperatingSI", "SensorSI", "RigSI", "DPGTSI", "DPGTOperatingSI", "DPGTSupportSI", "BearingRigSI",
     "with_overrides", "parameter_names", "flatten", "describe", "to_toml", "overrides_from_toml",
 ]
@@ -588,6 +588,22 @@ class SlideRollTractionParams(Params):
 SlideRollTractionSI = SlideRollTractionParams.SI
 
 
+@_with_si("LifeSI")
+@dataclass(frozen=True, kw_only=True)
+class LifeParams(Params):
+    """Rating factors of the planet bearing's fatigue life (:mod:`components.life`): ISO 281's basic
+    dynamic load rating C_r = b_m f_c (i l)^(7/9) Z^(3/4) D^(29/27), f_c ∝ λν, and the raceway ratings
+    of the ISO/TS 16281-style life, which keep b_m but not λν (that life sums the roller loads itself)."""
+
+    _prefix: ClassVar[str] = "bearing.life"
+    material_factor: Quantity = _pos("dimensionless", "rating factor b_m for contemporary material and "
+                                                      "manufacturing quality (ISO 281:2007 Table 1)")
+    reduction_factor: Quantity = _param("dimensionless", "ISO 281's reduction λν of the Lundberg-Palmgren line-"
+                                                         "contact rating (edge stresses, real stress distribution)",
+                                        lo=0.0, hi=1.0, lo_open=True, bound_text="in (0, 1]")
+LifeSI = LifeParams.SI
+
+
 @_with_si("BearingSI")
 @dataclass(frozen=True, kw_only=True)
 class BearingParams(Params):
@@ -626,6 +642,7 @@ class BearingParams(Params):
     poisson_ratio: Quantity = _param("dimensionless", "Poisson's ratio of rollers and raceways", lo=0.0, hi=0.5,
                                      hi_open=True, bound_text="in [0, 0.5)")
     cage: CageParams = _nested(CageParams, "cage")
+    life: LifeParams = _nested(LifeParams, "fatigue life rating factors")
 
     _si_derived: ClassVar[tuple] = (
         Derived("roller_mass", float, "mass of one physical roller [kg] (given, or the rule)"),

@@ -12,8 +12,8 @@ from types import MappingProxyType
 from pathlib import Path
 
 from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, ErrorsParams, GearParams, GearSetParams,
-                     LubricantParams, MeshParams, OperatingPoint, RigParams, SensorParams, SlideRollTractionParams,
-                     SupportParams, assumed, derived,
+                     LifeParams, LubricantParams, MeshParams, OperatingPoint, RigParams, SensorParams,
+                     SlideRollTractionParams, SupportParams, assumed, derived,
                      overrides_from_toml, paper, with_overrides)
 from .units import Q_, ParameterError
 
@@ -127,6 +127,10 @@ def reference_bearing() -> BearingParams:
         elastic_modulus=assumed("210 GPa", "bearing steel"),
         poisson_ratio=assumed(0.3, "bearing steel"),
         cage=cage,
+        life=LifeParams(
+            material_factor=derived(1.1, "ISO 281:2007 Table 1: b_m = 1.1 for cylindrical roller bearings"),
+            reduction_factor=derived(0.83, "ISO 281:2007 f_c = 207.9 λν ... with λν = 0.83 (ISO/TR 1281-1; "
+                                           "ISO/TS 16281:2008 undoes it for its raceway ratings)")),
     )
 
 

@@ -106,7 +106,8 @@ def discrete_load_distribution(b: BearingSI, radial_load: float, angles=None) ->
     # scaled unknowns (d / d0) and residuals (/ F): hybr's default tolerances then mean what they say
     sol = optimize.root(lambda x: [np.sum(loads(x * d0) * c) / F - 1.0, np.sum(loads(x * d0) * s) / F],
                         [1.0, 0.0], method="hybr", options={"xtol": 1e-13})
-    if not sol.success:
+    # hybr may stop "not making good progress" when it sits on the root to round-off: accept that
+    if not sol.success and np.max(np.abs(sol.fun)) > 1e-12:
         raise RuntimeError(f"discrete_load_distribution: no equilibrium found ({sol.message})")
     d = sol.x * d0
     return DiscreteDistribution(float(d[0]), float(d[1]), psi, loads(d), F_total, float(b.clearance), b.rows)

@@ -17,7 +17,8 @@ BEARING_KEYS = {"roller_cage_rms_N", "roller_cage_max_N", "cage_guide_rms_N", "c
                 "life_L10_relative", "all_rollers", "cage_acc_radial_rms", "cage_acc_tangential_rms",
                 "cage_acc_magnitude_rms", "cage_acc_rel_radial_rms", "cage_acc_rel_tangential_rms",
                 "cage_acc_rel_magnitude_rms", "pocket_impacts_per_rev", "pocket_impact_speed_max",
-                "pocket_impact_peak_max_N", "cage_slip_pct"}
+                "pocket_impact_peak_max_N", "cage_slip_pct", "life_iso281_h", "life_iso16281_h",
+                "roller_equivalent_load_pin_N", "roller_equivalent_load_bore_N", "dynamic_load_rating_N"}
 
 SIGNED = {"bearing_load_radial_mean_N", "bearing_load_tangential_mean_N", "cage_slip_pct", "cage_slip_pct_all"}
 
@@ -47,12 +48,37 @@ def test_study_writes_documented_outputs(zero_power_study):
                 if isinstance(v, float):        # magnitudes are >= 0; signed: mean load components, slip
                     assert np.isfinite(v) and (v >= 0 or k in SIGNED), (kind, k, v)
         assert s["inner"]["life_L10_relative"] > 0
+        for kind in ("inner", "outer"):       # both lives, pair 1's bearing and the kind pooled, consistent
+            _check_lives(s[kind])
         assert (out / f"c4_{d}" / "results.nc").exists()
     rows = list(csv.DictReader((out / "comparison.csv").open()))
-    assert {r["quantity"] for r in rows} >= {"bearing_load_mean_N", "roller_cage_rms_N", "life_L10_relative"}
+    assert {r["quantity"] for r in rows} >= {"bearing_load_mean_N", "roller_cage_rms_N", "life_L10_relative",
+                                             "life_iso281_h", "life_iso16281_h"}
     assert "| bearing | quantity | forward | reverse | difference % |" in (out / "comparison.md").read_text()
     assert (out / "c4_time_histories.png").stat().st_size > 10_000
     assert (out / "bars.png").stat().st_size > 10_000
+
+
+def _check_lives(d):
+    """The summary's lives follow from its own loads through components.life, in hours at the planet's
+    speed relative to the pin; the ISO/TS 16281-style life sees the roller loads, not only the bearing's."""
+    from components.life import iso281_life, lundberg_palmgren_life
+    from components.presets import reference_bearing
+
+    b = reference_bearing().replace(rollers=8).si()
+    for target in (d, d["all_rollers"]):
+        assert target["life_iso281_h"] > 0 and target["life_iso16281_h"] > 0
+        assert target["life_iso16281_Mrev"] == pytest.approx(
+            lundberg_palmgren_life(target["roller_equivalent_load_pin_N"], target["roller_equivalent_load_bore_N"], b),
+            rel=1e-12)
+        # one conversion to hours for both lives: the same relative speed
+        assert target["life_iso281_h"] / target["life_iso281_Mrev"] == pytest.approx(
+            target["life_iso16281_h"] / target["life_iso16281_Mrev"], rel=1e-12)
+    assert d["life_iso281_Mrev"] == pytest.approx(iso281_life(d["equivalent_load_N"], b), rel=1e-12)
+    # power means over the same rollers and windows: RMS (p = 2) < Q_e (p = 4, 4.5) < max
+    al = d["all_rollers"]
+    for race, key in (("inner", "pin"), ("outer", "bore")):
+        assert al[f"roller_{race}_race_rms_N"] < al[f"roller_equivalent_load_{key}_N"] < al[f"roller_{race}_race_max_N"]
 
 
 def test_zero_power_forward_and_reverse_agree(zero_power_study):
