@@ -18,7 +18,8 @@ from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, Er
 from .units import Q_, ParameterError
 
 __all__ = ["CONDITIONS", "DIRECTIONS", "OIL_GRADES", "oil_grade", "operating_point", "reference_gears", "reference_bearing",
-           "reference_dpgt", "reference_bearing_rig", "rig_accelerometer", "load_toml", "perfect_machine"]
+           "reference_dpgt", "reference_bearing_rig", "rig_accelerometer", "load_toml", "perfect_machine",
+           "typical_errors", "iso1328_runout"]
 
 # the study's four operating conditions: carrier speed n_c and output power P (ring fixed)
 CONDITIONS = MappingProxyType({
@@ -138,6 +139,50 @@ def perfect_machine() -> ErrorsParams:
     """No manufacturing errors or faults: the machine the source models (MODEL.md §3.9)."""
     return ErrorsParams(**{f: paper((), "the source models a perfect machine")
                            for f in ("pinhole", "runout", "roller_diameter", "spall", "tooth_fault")})
+
+
+def iso1328_runout(module: float, diameter: float, grade: int) -> float:
+    """Radial runout tolerance F_r [m] of a gear of ISO 1328 accuracy ``grade`` (module and reference
+    diameter in m): ISO 1328-2:1997 Annex B, F_r = 0.8 F_p, with ISO 1328-1:1995's cumulative pitch
+    tolerance F_p = (0.3 m + 1.25 √d + 7) µm at grade 5 (m, d in mm), × √2 per grade."""
+    if not (isinstance(grade, int) and 1 <= grade <= 12):
+        raise ParameterError.at("grade", f"ISO 1328 accuracy grade must be an integer 1..12, got {grade!r}")
+    m, d = 1e3 * module, 1e3 * diameter
+    F_p = (0.3 * m + 1.25 * d ** 0.5 + 7.0) * 2.0 ** (0.5 * (grade - 5))
+    return 0.8 * F_p * 1e-6
+
+
+def typical_errors(params: DPGTParams, grade: int) -> ErrorsParams:
+    """A modest, stated set of manufacturing errors for gears of ISO 1328 accuracy ``grade``: every gear
+    eccentric by half its grade's runout tolerance (:func:`iso1328_runout`) at an arbitrary but fixed phase,
+    and the carrier's pinholes off by up to 10 µm (a precision carrier's position tolerance, of the order
+    Bodas & Kahraman (2004) study). What the spectrum scenario puts on the rig by default (MODEL.md §3.10)."""
+    si = params.si()
+    G, N = si.gears, si.layout.planets
+    note = f"ISO 1328 grade {grade}: eccentricity = F_r/2 (ISO 1328-2 Annex B); phase arbitrary"
+
+    def runout(gear, g, phase_deg):
+        e = 0.5 * iso1328_runout(g.module, g.pitch_radius * 2.0, grade)
+        return {"gear": gear, "eccentricity": assumed(Q_(1e6 * e, "um"), note),
+                "phase": assumed(Q_(phase_deg, "deg"), "arbitrary assembly phase")}
+    runouts = [runout("sun", G.sun, 0.0), runout("ring", G.ring, 90.0)]
+    runouts += [runout(f"a{n + 1}", G.inner_planet, 60.0 + 110.0 * n) for n in range(N)]
+    runouts += [runout(f"b{n + 1}", G.outer_planet, 200.0 + 70.0 * n) for n in range(N)]
+    pin = "carrier pinhole position error within +-10 um (assumed precision carrier)"
+    pinholes = [{"planet": f"b{n + 1}", "radial": assumed(Q_(r, "um"), pin), "tangential": assumed(Q_(t, "um"), pin)}
+                for n, (r, t) in enumerate([(0.0, 10.0), (-6.0, 0.0), (4.0, -8.0)][:N])]
+    return ErrorsParams(runout=assumed([_sourced_entry(x) for x in runouts], note),
+                        pinhole=assumed([_sourced_entry(x) for x in pinholes], pin),
+                        roller_diameter=assumed((), "no roller errors"), spall=assumed((), "no damage"),
+                        tooth_fault=assumed((), "no damage"))
+
+
+def _sourced_entry(d: dict):
+    """An error entry from a dict of (possibly Sourced) values, keeping their tags."""
+    from .params import PinholeErrorParams, RunoutParams
+
+    cls = RunoutParams if "gear" in d else PinholeErrorParams
+    return cls(**d)
 
 
 def rig_accelerometer() -> SensorParams:

@@ -142,12 +142,12 @@ def _own_frequency(case: Case, si, fr: dict) -> float | None:
     return fr["f_c"] if e.pinhole else None
 
 
-def sensor_spectrum(run_dir: Path):
-    """(f, amplitude) of the recorded sensor signal of a run (scenarios.spectrum's definition)."""
+def sensor_spectrum(run_dir: Path, f_c: float):
+    """(f, amplitude) of the recorded housing sensor of a run (scenarios.spectrum's definition)."""
     from .spectrum import sensor_signal
     from .analysis import amplitude_spectrum
 
-    t, x = sensor_signal(run_dir / "results.nc")
+    t, x = sensor_signal(run_dir / "results.nc", f_c)
     f, amp, _ = amplitude_spectrum(t, x)
     return f, amp
 
@@ -167,7 +167,7 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
             continue
         si = build_params(case).si()
         fr = characteristic_frequencies(si)
-        f, amp = sensor_spectrum(Path(case.out_dir))
+        f, amp = sensor_spectrum(Path(case.out_dir), fr["f_c"])
         own = _own_frequency(case, si, fr)
         spectra[(case.tag, case.direction)] = (f, amp, fr, own)
         sensor = {f"sensor_f_m{k:+d}f_c" if k else "sensor_f_m": _amplitude_at(f, amp, fr["f_m"] + k * fr["f_c"])
@@ -229,7 +229,7 @@ def run(a) -> dict:
     out = Path(a.out)
     cases = make_cases(a, out)
     cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
-                    progress=not a.no_progress)
+                    progress=not a.no_progress, sensor=True)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # design warnings of the reference machine are known
         for c in cases:

@@ -58,6 +58,11 @@ def parse_args(argv):
     p.add_argument("--direction", default="forward", choices=["forward", "reverse"])
     p.add_argument("--sensor", default="housing", choices=list(SENSORS),
                    help="housing: the rig's windowed accelerometer (rig.sensor.*, default); axis: ideal, at the carrier axis")
+    p.add_argument("--perfect", action="store_true",
+                   help="a perfect machine: no manufacturing errors (default: the errors of --gear-grade)")
+    p.add_argument("--gear-grade", type=int, default=6,
+                   help="ISO 1328 accuracy grade of the gears behind the default manufacturing errors (default 6: "
+                        "runouts F_r/2 of that grade, carrier pinholes within ±10 µm; components.presets.typical_errors)")
     p.add_argument("--settle", type=float, default=0.06,
                    help="seconds discarded (default 0.06: a lightly damped ~2.6 kHz mode rings for ~50 ms after the start)")
     p.add_argument("--window", type=float, default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")
@@ -72,9 +77,10 @@ def parse_args(argv):
 
 def machine(a):
     """The machine on the rig: the reference DPGT at the operating point asked for, with ``--set``
-    overrides (a usage error names the parameter). Its manufacturing errors are part of it."""
+    overrides (a usage error names the parameter) and its manufacturing errors: those given (``--set
+    errors.X`` / a TOML file), else the typical errors of ``--gear-grade``, none with ``--perfect``."""
     from components.params import with_overrides
-    from components.presets import reference_dpgt
+    from components.presets import reference_dpgt, typical_errors
     from components.units import ParameterError
 
     from .paper_study import parse_sets
@@ -83,6 +89,8 @@ def machine(a):
                  "operating.direction": a.direction, **parse_sets(a.set)}
     try:
         params = with_overrides(reference_dpgt(2, a.direction), overrides)
+        if not a.perfect and params.errors.perfect:      # the rig's machine, unless errors were given
+            params = params.replace(errors=typical_errors(params, a.gear_grade))
         si = params.si()
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
@@ -134,6 +142,7 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path) -> dict:
     summary = {"f_m_hz": f_m, "f_c_hz": f_c, "resolution_hz": df, "window_s": s["window_s"],
                "carrier_rpm": s["carrier_rpm"], "sun_rpm": s["sun_rpm"], "power_W": s["power_W"],
                "sensor": sensor, "quantity": SENSORS[sensor],
+               "errors": {k: [e.to_dict() for e in v] for k, v in params.si().errors.to_dict().items()},
                "sensor_parameters": dataclasses.asdict(params.si().rig.sensor) if sensor == "housing" else None,
                "lines": lines, "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"],
                "error_estimate": s["error_estimate"]}
@@ -155,6 +164,13 @@ def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
         if sensor == "axis":
             return t, {"amplitude": acc[:, 0], "amplitude_y": acc[:, 1]}
         return t, {"amplitude": ds["sensor.acceleration"].values[:, 0], "amplitude_axis": acc[:, 0]}
+
+
+def sensor_signal(path: Path, f_c: float) -> tuple[np.ndarray, np.ndarray]:
+    """(t, a) of a run's recorded housing sensor (``results.nc`` of a run with ``RunConfig.sensor``), over
+    the first whole number of carrier revolutions: what every spectrum of the sensor is taken of."""
+    t, signals = _whole_revolutions(*_signals(Path(path), "housing"), f_c)
+    return t, signals["amplitude"]
 
 
 def _whole_revolutions(t, signals: dict, f_c: float):
