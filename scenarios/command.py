@@ -14,6 +14,7 @@ import sys
 from components.units import ParameterError
 from mbd.errors import IntegrationError, ModelError
 
+from .integrity import OtherResults
 from .lock import FolderLocked
 
 __all__ = ["command", "USAGE", "FAILED", "INTERRUPTED"]
@@ -41,7 +42,7 @@ def command(main):
                 print(exc.code if exc.code.startswith("error:") else f"error: {exc.code}", file=sys.stderr)
                 return USAGE
             return exc.code if isinstance(exc.code, int) else 0
-        except (ParameterError, ModelError) as exc:
+        except (ParameterError, ModelError, OtherResults) as exc:
             if debug:
                 raise
             print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)

@@ -36,7 +36,7 @@ from mbd.recorder import atomic_write_text
 
 from .paper_study import parse_sets
 from .runner import RunConfig
-from .sweep import Case, build_params, run_sweep
+from .sweep import Case, build_params, check_folders, run_sweep
 from .command import command
 from .lock import holds_out_folder
 
@@ -67,6 +67,8 @@ def parse_args(argv):
     p.add_argument("--workers", type=int, default=None, help="Dask local workers (default: one per core)")
     p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
     p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace finished results of other parameters or settings in --out (else refused)")
     p.add_argument("--out", default="results/lubricant", help="output directory")
     return p.parse_args(argv)
 
@@ -207,7 +209,9 @@ def run(a) -> dict:
             build_params(c).si()             # every parameter checked before any run starts
     cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
                     progress=not a.no_progress)
-    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress)
+    check_folders(cases, cfg, a.overwrite)      # never replace results of other parameters silently
+    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
+                        overwrite=a.overwrite)
     rows = rows_of(cases, results)
     files = write_outputs(rows, out) if rows else []
     failed = {k: v["error"] for k, v in results.items() if "error" in v}

@@ -24,7 +24,8 @@ from components.outputs import relative_life as iso_relative_life
 from mbd.recorder import atomic_write_text
 
 from .runner import RunConfig
-from .sweep import Case, build_params, run_sweep
+from .integrity import read_summary
+from .sweep import Case, build_params, check_folders, run_sweep
 from .command import command
 from .lock import holds_out_folder
 
@@ -63,6 +64,8 @@ def parse_args(argv):
     p.add_argument("--workers", type=int, default=None, help="Dask local workers (default: one per core)")
     p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
     p.add_argument("--animate", action="store_true", help="write a cage-orbit animation per condition")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace finished results of other parameters or settings in --out (else refused)")
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("--out", default="results/study", help="output directory")
     return p.parse_args(argv)
@@ -264,13 +267,9 @@ def _keep_finished_on_disk(results: dict, out: Path) -> None:
     """A run that failed this time but finished before keeps its summary in the tables: a re-run in which
     nothing succeeds never replaces good tables with empty ones (its failure is still reported)."""
     for label, s in list(results.items()):
-        done = out / label / "summary.json"
-        if "error" in s and done.exists():
-            try:
-                old = json.loads(done.read_text())
-            except (OSError, ValueError):
-                continue                      # damaged: not a valid summary
-            if "error" not in old and "inner" in old:
+        if "error" in s:
+            old = read_summary(out / label / "summary.json")      # a damaged one is moved aside, not used
+            if old is not None and "error" not in old and "inner" in old:
                 results[label] = {**old, "stale_after_failure": s["error"]}
 
 
@@ -294,7 +293,9 @@ def run(a) -> dict:
             print(f"design warning: {msg}")
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
-    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress)
+    check_folders(cases, cfg, a.overwrite)      # never replace results of other parameters silently
+    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
+                        overwrite=a.overwrite)
     _keep_finished_on_disk(results, out)
     relative_life(results)
     for label, s in results.items():   # store the relative life in each run's summary (atomic rewrite)

@@ -34,9 +34,10 @@ from mbd.recorder import BodyMotion, Recorder, atomic_write_text
 from components.outputs import WindowStatistics, bearing_map, cage_period, default_window
 from components.results_schema import drawing_geometry, element_probes
 
+from .integrity import checkpoint_usable, claim_folder
 from .lock import folder_lock
 
-__all__ = ["RunConfig", "run_case", "run_fingerprint", "statistics_window"]
+__all__ = ["RunConfig", "run_case", "run_fingerprint", "parameters_fingerprint", "statistics_window"]
 
 _ROOT = Path(__file__).resolve().parent.parent
 _CODE_DIGEST = None
@@ -56,11 +57,21 @@ def _code_digest() -> str:
     return _CODE_DIGEST
 
 
+def _digest(params: DPGTParams, cfg: "RunConfig", code: bool) -> str:
+    settings = asdict(replace(cfg, progress=False))
+    what = {"params": repr(params), "cfg": settings, **({"code": _code_digest()} if code else {})}
+    return hashlib.sha256(json.dumps(what, sort_keys=True, default=repr).encode()).hexdigest()[:16]
+
+
 def run_fingerprint(params: DPGTParams, cfg: "RunConfig") -> str:
     """Identifies a run: parameters, run settings (the progress display excluded) and code."""
-    settings = asdict(replace(cfg, progress=False))
-    blob = json.dumps({"params": repr(params), "cfg": settings, "code": _code_digest()}, sort_keys=True, default=repr)
-    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+    return _digest(params, cfg, code=True)
+
+
+def parameters_fingerprint(params: DPGTParams, cfg: "RunConfig") -> str:
+    """Identifies what a user asked for: parameters and run settings, not the code (a folder holding results
+    of another one is refused unless --overwrite, :func:`scenarios.integrity.claim_folder`)."""
+    return _digest(params, cfg, code=False)
 
 
 @dataclass(frozen=True)
@@ -103,11 +114,24 @@ def _probes(scene) -> list:
             *element_probes(scene)]
 
 
-def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None) -> dict:
+def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None, overwrite: bool = False) -> dict:
     """Run one operating point; write results.nc and summary.json atomically into out_dir.
-    An interrupted run resumes from out_dir/checkpoint.npz. One run at a time per folder (scenarios.lock)."""
+    An interrupted run resumes from out_dir/checkpoint.npz. One run at a time per folder (scenarios.lock).
+    A folder holding finished results of other parameters is refused unless ``overwrite``
+    (:func:`scenarios.integrity.claim_folder`); damaged files there are moved aside and recomputed."""
     with folder_lock(out_dir):
+        how = claim_folder(out_dir, parameters_fingerprint(params, cfg), run_fingerprint(params, cfg), overwrite)
+        if how == "recompute":
+            print(f"{out_dir}: recomputing, its results were made by other code")
         return _run_case(params, cfg, Path(out_dir), label)
+
+
+def _earlier_wall(out_dir: Path, resuming: bool) -> float:
+    """Wall time [s] of the earlier segments of a resumed run (progress.json keeps the running total)."""
+    try:
+        return float(json.loads((out_dir / "progress.json").read_text())["wall_s"]) if resuming else 0.0
+    except (OSError, ValueError, KeyError, TypeError):
+        return 0.0
 
 
 def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> dict:
@@ -126,14 +150,15 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     fp = run_fingerprint(params, cfg)
     fp_file = out_dir / "fingerprint"
     ckpt = out_dir / "checkpoint.npz"
-    if ckpt.exists() and (not fp_file.exists() or fp_file.read_text().strip() != fp):
+    if ckpt.exists() and (not fp_file.exists() or fp_file.read_text(errors="replace").strip() != fp):
         # a checkpoint of another run (other parameters, settings or code): start afresh, say so
         print(f"{out_dir}: the checkpoint there is from a different run (parameters, settings or code); starting afresh")
         ckpt.unlink()
+    resuming = checkpoint_usable(ckpt, rec.parts)     # a damaged checkpoint or chunk is moved aside
     atomic_write_text(fp_file, fp)
-    wall0 = time.perf_counter()
+    wall0 = time.perf_counter() - _earlier_wall(out_dir, resuming)   # wall_s counts every segment
 
-    def report(t, t_end, counters):   # read by a sweep's progress display (another process)
+    def report(t, t_end, counters):   # read by a sweep's progress display (another process) and a resume
         atomic_write_text(out_dir / "progress.json", json.dumps(
             {"t": t, "t_end": t_end, "wall_s": time.perf_counter() - wall0, "steps": counters.accepted}))
 
@@ -159,7 +184,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
             "max_local_displacement_error_m": res.error_max * integ.atol_pos,
         },
         "integration": asdict(integ),
-        "fingerprint": fp,
+        "fingerprint": fp, "parameters_fingerprint": parameters_fingerprint(params, cfg),
     })
     atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2, default=_json_default))
     return summary

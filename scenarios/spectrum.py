@@ -45,6 +45,8 @@ def parse_args(argv):
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", help="scene switch")
     p.add_argument("--h", type=float, default=5e-6)
     p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a finished run of other parameters or settings in --out (else refused)")
     p.add_argument("--out", default="results/spectrum")
     return p.parse_args(argv)
 
@@ -76,7 +78,7 @@ def run(a) -> dict:
                     integration=dataclasses.replace(mbd.PRODUCTION, h=a.h), progress=not a.no_progress)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        s = run_case(params, cfg, out / "run", label={"scenario": "spectrum"})
+        s = run_case(params, cfg, out / "run", label={"scenario": "spectrum"}, overwrite=a.overwrite)
     import xarray as xr
 
     with xr.open_dataset(out / "run" / "results.nc", engine="h5netcdf") as ds:

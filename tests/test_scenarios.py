@@ -171,7 +171,7 @@ def test_modal_scenario_single_planetary(tmp_path):
 
 def test_stale_results_are_recomputed_not_reused(zero_power_study, tmp_path):
     """A finished case is reused only when its parameters, settings and code are the same: the
-    fingerprint in summary.json decides (changing a parameter into the same folder recomputes)."""
+    fingerprint in summary.json decides (changing a parameter into the same folder recomputes, with --overwrite)."""
     from dataclasses import replace
 
     from scenarios.runner import run_fingerprint
@@ -191,9 +191,11 @@ def test_stale_results_are_recomputed_not_reused(zero_power_study, tmp_path):
     assert _finished(case, params, replace(cfg, window=2 * cfg.window)) is None
     other = replace(case, overrides={**case.overrides, "bearing.rollers": "10"})
     assert _finished(other, build_params(other), cfg) is None
-    # a checkpoint left by another run is not resumed: run_case starts afresh (and says so)
+    # a checkpoint left by another run is not resumed: run_case starts afresh (and says so); the finished
+    # results of other parameters are replaced only when asked (--overwrite, scenarios.integrity)
     a2 = paper_study.parse_args(["--conditions", "4", "--directions", "forward", "--out", str(out), "--settle", "0.002",
-                                 "--window", "0.001", "--set", "bearing.rollers=10", "--no-progress", "--workers", "1"])
+                                 "--window", "0.001", "--set", "bearing.rollers=10", "--no-progress", "--workers", "1",
+                                 "--overwrite"])
     (out / "c4_forward" / "checkpoint.npz").write_bytes(b"not this run's checkpoint")
     r = paper_study.run(a2)
     assert not r["failed"]

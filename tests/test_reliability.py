@@ -1,0 +1,99 @@
+"""Nothing a user does loses results (issue 17): folders of other parameters, damaged files, disk full,
+interrupted sweeps — one test per class, on a tiny window (8 rollers, 0.5 ms settle + 0.5 ms window)."""
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from scenarios import paper_study
+from scenarios.integrity import DAMAGED, OtherResults, checkpoint_usable
+from scenarios.runner import RunConfig
+from scenarios.sweep import Case, _finished, build_params, check_folders, run_sweep
+
+CFG = RunConfig(settle=0.0005, window=0.0005, progress=False)
+TINY = ["--conditions", "4", "--directions", "forward", "--settle", "0.0005", "--window", "0.0005",
+        "--no-progress", "--workers", "1"]
+
+
+def _case(folder, rollers=8):
+    return Case(4, "forward", str(folder), {"bearing.rollers": rollers})
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """A finished tiny run (its folder is copied by each test that changes it)."""
+    out = tmp_path_factory.mktemp("finished") / "c4_forward"
+    r = run_sweep([_case(out)], CFG, workers=1, progress=False)["c4_forward"]
+    assert "error" not in r
+    return out
+
+
+def _copy(finished, tmp_path):
+    dst = tmp_path / "c4_forward"
+    shutil.copytree(finished, dst)
+    return dst
+
+
+def _moved_aside(folder, name):
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith(name + DAMAGED))
+
+
+def test_other_parameters_are_refused_unless_overwrite(finished, tmp_path, capsys):
+    run = _copy(finished, tmp_path)
+    before = (run / "summary.json").read_bytes()
+    with pytest.raises(OtherResults, match="--overwrite"):
+        check_folders([_case(run, rollers=10)], CFG)
+    check_folders([_case(run, rollers=8)], CFG)                    # the same parameters: fine (resumes)
+    check_folders([_case(run, rollers=10)], CFG, overwrite=True)   # asked for
+    # through the command: a usage error in one line before anything runs, the finished results untouched
+    code = paper_study.main(TINY + ["--set", "bearing.rollers=10", "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith("error: ") and "--overwrite" in err and err.count("\n") == 1
+    assert (run / "summary.json").read_bytes() == before
+
+
+def test_a_damaged_summary_is_moved_aside_and_recomputed(finished, tmp_path, capsys):
+    run = _copy(finished, tmp_path)
+    (run / "summary.json").write_text('{"inner": {"bearing_load_mean_N": 1')      # cut off mid-write
+    assert _finished(_case(run), build_params(_case(run)), CFG) is None
+    assert len(_moved_aside(run, "summary.json")) == 1 and "summary.json" in capsys.readouterr().err
+    r = run_sweep([_case(run)], CFG, workers=1, progress=False)["c4_forward"]
+    assert "error" not in r and json.loads((run / "summary.json").read_text())["rollers"] == 8
+
+
+def test_a_finished_run_with_damaged_results_is_recomputed_not_skipped(finished, tmp_path, capsys):
+    run = _copy(finished, tmp_path)
+    data = (run / "results.nc").read_bytes()
+    (run / "results.nc").write_bytes(data[: len(data) // 3])                      # truncated
+    r = run_sweep([_case(run)], CFG, workers=1, progress=False)["c4_forward"]
+    assert "skipped" not in r and "error" not in r
+    assert len(_moved_aside(run, "results.nc")) == 1 and "results.nc is damaged" in capsys.readouterr().err
+    import h5py
+    with h5py.File(run / "results.nc", "r") as f:
+        assert f["time"].shape[0] == r["samples"]
+
+
+def test_a_damaged_checkpoint_or_chunk_is_moved_aside_and_the_run_starts_afresh(finished, tmp_path, capsys):
+    import mbd
+    from mbd.simulate import save_state
+
+    run = _copy(finished, tmp_path)
+    (run / "summary.json").unlink()                  # an unfinished run: the checkpoint is what it has
+    (run / "checkpoint.npz").write_bytes(b"PK\x03\x04 cut off")
+    assert not checkpoint_usable(run / "checkpoint.npz", run / "results.nc.parts")
+    assert len(_moved_aside(run, "checkpoint.npz")) == 1
+    # a loadable checkpoint whose recorder chunk is damaged cannot resume: both go aside
+    state = mbd.State(0.001, np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), {})
+    save_state(run / "checkpoint.npz", state, {"recorder": {"n_chunks": 1, "next_index": 5}})
+    (run / "results.nc.parts").mkdir()
+    (run / "results.nc.parts" / "chunk_000000.npz").write_bytes(b"garbage")
+    assert not checkpoint_usable(run / "checkpoint.npz", run / "results.nc.parts")
+    assert len(_moved_aside(run, "chunk_000000.npz")) == 1 and len(_moved_aside(run, "checkpoint.npz")) == 2
+    # end to end: a damaged checkpoint of this very run (same fingerprint) never blocks it
+    (run / "checkpoint.npz").write_bytes(b"not a zip file")
+    r = run_sweep([_case(run)], CFG, workers=1, progress=False)["c4_forward"]
+    assert "error" not in r and r["resumed_from_s"] is None
+    assert len(_moved_aside(run, "checkpoint.npz")) == 3 and "checkpoint.npz is damaged" in capsys.readouterr().err
