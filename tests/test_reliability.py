@@ -97,3 +97,65 @@ def test_a_damaged_checkpoint_or_chunk_is_moved_aside_and_the_run_starts_afresh(
     r = run_sweep([_case(run)], CFG, workers=1, progress=False)["c4_forward"]
     assert "error" not in r and r["resumed_from_s"] is None
     assert len(_moved_aside(run, "checkpoint.npz")) == 3 and "checkpoint.npz is damaged" in capsys.readouterr().err
+
+
+def _no_space_for(names, monkeypatch):
+    """os.replace fails with ENOSPC when it would put one of ``names`` in place (the write itself went to a
+    temporary file, as on a disk that fills up while a results file is written)."""
+    import errno
+    import os
+
+    real = os.replace
+
+    def replace(src, dst, *a, **k):
+        if os.path.basename(dst) in names:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(dst))
+        return real(src, dst, *a, **k)
+    monkeypatch.setattr(os, "replace", replace)
+
+
+def _leftovers(folder):
+    return [p for p in folder.rglob("*") if ".tmp" in p.name]
+
+
+def test_disk_full_keeps_earlier_results_and_leaves_no_temporary_files(finished, tmp_path, monkeypatch, capsys):
+    from scenarios.command import FAILED, command
+    from scenarios.runner import run_case
+
+    run = _copy(finished, tmp_path)
+    before = {n: (run / n).read_bytes() for n in ("results.nc", "summary.json")}
+    _no_space_for({"results.nc"}, monkeypatch)
+    code = paper_study.main(TINY + ["--set", "bearing.rollers=10", "--overwrite", "--out", str(tmp_path)])
+    assert code == FAILED and "No space left on device" in capsys.readouterr().out
+    assert {n: (run / n).read_bytes() for n in before} == before and not _leftovers(tmp_path)
+    # the same fault outside a sweep reaches the command: one line, exit 1, what to do
+    _no_space_for({"summary.json"}, monkeypatch)
+    main = command(lambda argv: run_case(build_params(_case(run, 10)), CFG, run, overwrite=True))
+    assert main([]) == FAILED
+    err = capsys.readouterr().err
+    assert err.startswith("error: No space left on device") and "run the same command again" in err
+    assert err.count("\n") == 1 and (run / "summary.json").read_bytes() == before["summary.json"]
+    assert not _leftovers(tmp_path)
+
+
+def test_an_unwritable_output_folder_is_one_line(tmp_path, monkeypatch, capsys):
+    import errno
+    import os
+
+    from scenarios.command import FAILED, command
+    from mbd.recorder import atomic_write_text
+
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    code = paper_study.main(TINY + ["--out", str(blocker / "out")])      # a folder that cannot exist
+    err = capsys.readouterr().err
+    assert code in (1, 2) and err.startswith("error: ") and "a_file" in err and err.count("\n") == 1
+    # a folder whose files cannot be replaced (read-only file system): the old file stays, no temporary left
+    (tmp_path / "summary.json").write_text("old")
+    real = os.replace
+    monkeypatch.setattr(os, "replace", lambda s, d: (_ for _ in ()).throw(
+        OSError(errno.EROFS, os.strerror(errno.EROFS), str(d))) if str(d).endswith("summary.json") else real(s, d))
+    assert command(lambda argv: atomic_write_text(tmp_path / "summary.json", "new"))([]) == FAILED
+    err = capsys.readouterr().err
+    assert "Read-only file system" in err and "--out" in err and err.count("\n") == 1
+    assert (tmp_path / "summary.json").read_text() == "old" and not _leftovers(tmp_path)
