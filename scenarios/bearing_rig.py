@@ -11,7 +11,6 @@ and the classical discrete-roller solution for comparison) and DIR/load_distribu
 """
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 import warnings
@@ -20,21 +19,22 @@ from pathlib import Path
 import numpy as np
 
 from mbd.recorder import atomic_write_text
+from . import args
 from .command import command
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(prog="python -m scenarios.bearing_rig", description=__doc__.split("\n\n")[0])
-    p.add_argument("--radial-load", default="10 kN", help='radial load on the outer ring (default "10 kN")')
-    p.add_argument("--clearance", default=None, help='diametral clearance P_d (default: preset, "20 um")')
-    p.add_argument("--rollers", type=int, default=None, help="number of rollers Z (default 12)")
-    p.add_argument("--roller-diameter", default=None, help='roller diameter D (default "7.5 mm")')
-    p.add_argument("--roller-length", default=None, help='roller effective length l (default "9 mm")')
-    p.add_argument("--pitch-diameter", default=None, help='pitch diameter d_m (default "39 mm")')
-    p.add_argument("--speed", default="0 rpm", help='outer ring speed (default "0 rpm": static)')
+    p = args.Parser(prog="python -m scenarios.bearing_rig", description=__doc__.split("\n\n")[0])
+    p.add_argument("--radial-load", default="10 kN", type=args.quantity_of("force", positive_only=True), help='radial load on the outer ring (default "10 kN")')
+    p.add_argument("--clearance", default=None, type=args.quantity_of("length"), help='diametral clearance P_d (default: preset, "20 um")')
+    p.add_argument("--rollers", type=args.count(3), default=None, help="number of rollers Z (default 12)")
+    p.add_argument("--roller-diameter", default=None, type=args.quantity_of("length", positive_only=True), help='roller diameter D (default "7.5 mm")')
+    p.add_argument("--roller-length", default=None, type=args.quantity_of("length", positive_only=True), help='roller effective length l (default "9 mm")')
+    p.add_argument("--pitch-diameter", default=None, type=args.quantity_of("length", positive_only=True), help='pitch diameter d_m (default "39 mm")')
+    p.add_argument("--speed", default="0 rpm", type=args.quantity_of("angular_velocity"), help='outer ring speed (default "0 rpm": static)')
     p.add_argument("--cage", default="held", choices=["held", "free", "none"], help="cage held (default), free or absent")
     p.add_argument("--no-drag", action="store_true", help="switch lubricant drag off")
-    p.add_argument("--out", default="results/bearing_rig")
+    p.add_argument("--out", default="results/bearing_rig", type=args.out_folder)
     return p.parse_args(argv)
 
 

@@ -11,7 +11,6 @@ window of several carrier periods (default 0.1 s → 10 Hz against f_c = 33.3 Hz
 """
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import csv
 import io
@@ -27,27 +26,28 @@ from mbd.recorder import atomic_write_text
 
 from .analysis import amplitude_spectrum, peak_table
 from .runner import RunConfig, run_case
+from . import args
 from .command import command
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(prog="python -m scenarios.spectrum", description=__doc__.split("\n\n")[0])
-    p.add_argument("--carrier-rpm", type=float, default=2000.0, help="carrier speed [r/min] (default 2000)")
-    p.add_argument("--sun-rpm", type=float, default=None,
+    p = args.Parser(prog="python -m scenarios.spectrum", description=__doc__.split("\n\n")[0])
+    p.add_argument("--carrier-rpm", type=args.positive("r/min"), default=2000.0, help="carrier speed [r/min] (default 2000)")
+    p.add_argument("--sun-rpm", type=args.positive("r/min"), default=None,
                    help="sun speed [r/min] magnitude; must match the ring-fixed ratio (3290 at 2000)")
-    p.add_argument("--power", default="200 kW", help='output power with unit (default "200 kW")')
+    p.add_argument("--power", default="200 kW", type=args.quantity_of("power"), help='output power with unit (default "200 kW")')
     p.add_argument("--direction", default="forward", choices=["forward", "reverse"])
-    p.add_argument("--settle", type=float, default=0.06,
+    p.add_argument("--settle", type=args.nonnegative("s"), default=0.06,
                    help="seconds discarded (default 0.06: a lightly damped ~2.6 kHz mode rings for ~50 ms after the start)")
-    p.add_argument("--window", type=float, default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")
-    p.add_argument("--sample-rate", type=float, default=20000.0, help="recording rate [Hz]")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="parameter override")
-    p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", help="scene switch")
-    p.add_argument("--h", type=float, default=5e-6)
+    p.add_argument("--window", type=args.positive("s"), default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")
+    p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz]")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="parameter override")
+    p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="scene switch")
+    p.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="initial step [s]")
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("--overwrite", action="store_true",
                    help="replace a finished run of other parameters or settings in --out (else refused)")
-    p.add_argument("--out", default="results/spectrum")
+    p.add_argument("--out", default="results/spectrum", type=args.out_folder)
     return p.parse_args(argv)
 
 

@@ -150,8 +150,8 @@ def test_bearing_rig_scenario(tmp_path):
     assert s["q_max_N"] == pytest.approx(s["discrete_theory"]["q_max_N"], rel=0.02)
     assert 0 < s["load_zone_deg"] < 180 and s["ring_deflection_m"] > 0
     assert (tmp_path / "load_distribution.png").exists()
-    with pytest.raises(SystemExit, match="radial_load"):
-        bearing_rig.run(bearing_rig.parse_args(["--radial-load", "5 m", "--out", str(tmp_path)]))
+    with pytest.raises(SystemExit, match="radial-load: expected a force"):
+        bearing_rig.parse_args(["--radial-load", "5 m", "--out", str(tmp_path)])
 
 
 def test_modal_scenario_single_planetary(tmp_path):
