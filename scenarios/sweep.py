@@ -4,7 +4,8 @@ Each case is plain data (condition, direction, parameter overrides as strings, r
 travels to any worker; the worker rebuilds the pint parameters itself. A case whose summary.json
 was made from the same parameters, settings and code (its fingerprint, :func:`runner.run_fingerprint`)
 is skipped, so a restarted sweep resumes; a stale one is recomputed. A failing case writes error.json
-with its traceback and does not stop the others; every file is written atomically.
+with its traceback and does not stop the others; every file is written atomically. An interrupted client
+(Ctrl-C) cancels its runs on the scheduler, and a local cluster's workers stop with it.
 """
 from __future__ import annotations
 
@@ -179,6 +180,7 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
         client = Client(cluster)
     else:
         client = Client(scheduler)
+    futs = {}
     try:
         futs = {client.submit(execute_case, c, wcfg, overwrite, pure=False, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
         bar = tqdm(total=len(futs), desc="runs", disable=not progress, position=0)
@@ -203,8 +205,11 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
                 bar.write(f"run {c.label} failed: {results[c.label]['error']}")
         runs.close()
         bar.close()
+    except BaseException:       # Ctrl-C or a failure of the client: take its runs off the scheduler
+        client.cancel(list(futs), force=True)
+        raise
     finally:
         client.close()
         if cluster is not None:
-            cluster.close()
+            cluster.close()     # a local cluster's workers stop with it
     return results

@@ -159,3 +159,60 @@ def test_an_unwritable_output_folder_is_one_line(tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err
     assert "Read-only file system" in err and "--out" in err and err.count("\n") == 1
     assert (tmp_path / "summary.json").read_text() == "old" and not _leftovers(tmp_path)
+
+
+class _FakeFuture:
+    def done(self):
+        return False
+
+
+class _FakeClient:
+    """Stands in for dask.distributed.Client: records what the sweep asks of the scheduler."""
+    made = []
+
+    def __init__(self, address=None):
+        self.address, self.submitted, self.cancelled, self.closed = address, [], [], False
+        _FakeClient.made.append(self)
+
+    def submit(self, fn, *a, **k):
+        self.submitted.append(_FakeFuture())
+        return self.submitted[-1]
+
+    def cancel(self, futures, force=False):
+        self.cancelled += list(futures)
+
+    def close(self):
+        self.closed = True
+
+
+class _FakeCluster:
+    made = []
+
+    def __init__(self, **k):
+        self.closed = False
+        _FakeCluster.made.append(self)
+
+    def close(self):
+        self.closed = True
+
+
+@pytest.mark.parametrize("scheduler", ["tcp://elsewhere:8786", None])
+def test_an_interrupted_sweep_cancels_its_runs_and_stops_local_workers(scheduler, tmp_path, monkeypatch):
+    import time
+
+    import dask.distributed
+
+    _FakeClient.made.clear()
+    _FakeCluster.made.clear()
+    monkeypatch.setattr(dask.distributed, "Client", _FakeClient)
+    monkeypatch.setattr(dask.distributed, "LocalCluster", _FakeCluster)
+
+    def ctrl_c(_):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(time, "sleep", ctrl_c)        # the user presses Ctrl-C while the runs are out
+    cases = [_case(tmp_path / "a"), Case(4, "reverse", str(tmp_path / "b"), {"bearing.rollers": 8})]
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(cases, CFG, workers=2, scheduler=scheduler, progress=False)
+    client, = _FakeClient.made
+    assert len(client.submitted) == 2 and client.cancelled == client.submitted and client.closed
+    assert [c.closed for c in _FakeCluster.made] == ([] if scheduler else [True])
