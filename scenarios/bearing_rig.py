@@ -18,9 +18,13 @@ from pathlib import Path
 
 import numpy as np
 
+import mbd
 from mbd.recorder import atomic_write_text
 from . import args
 from .command import command
+from .runner import accuracy_line
+
+ATOL = mbd.PRODUCTION.atol_pos     # the rig runs the production stepper (components.rig.rig_static_solution)
 
 
 def parse_args(argv):
@@ -77,7 +81,9 @@ def run(a) -> dict:
         "ring_deflection_m": sol.deflection,
         "load_vector_sum_N": sol.load_sum.tolist(),
         "load_balance_error": float(np.hypot(*(sol.load_sum - sol.load_vector)) / F),
-        "window_s": [sol.t0, sol.t1], "wall_s": sol.wall_s,
+        "window_s": [sol.t0, sol.t1], "wall_s": sol.wall_s, "steps": sol.steps,
+        "error_estimate": {"kind": "HHT local displacement error estimate, scaled by atol; RMS and max over "
+                                   "accepted steps", "rms": sol.error_rms, "max": sol.error_max, "atol_m": ATOL},
         "discrete_theory": {"q_max_N": theory.q_max, "stribeck_ratio": theory.stribeck,
                             "ring_deflection_m": theory.deflection, "load_zone_deg": float(np.degrees(theory.zone_angle)),
                             "roller_angle_deg": np.degrees(theory.angles).tolist(), "roller_load_N": theory.loads.tolist(),
@@ -94,6 +100,7 @@ def run(a) -> dict:
           f"ring deflection {sol.deflection * 1e6:.2f} um, Σ roller loads vs F_r: {summary['load_balance_error']:.2e}")
     print(f"discrete-roller theory: Q_max = {theory.q_max:.0f} N, Q_max·Z/F_r = {theory.stribeck:.2f}, "
           f"ring deflection {theory.deflection * 1e6:.2f} um")
+    print("run time and accuracy: " + accuracy_line(sol.wall_s, sol.steps, sol.error_rms, sol.error_max, ATOL))
     print(f"written: {out / 'summary.json'}, {fig}")
     return summary
 

@@ -23,7 +23,7 @@ from components.outputs import SUMMARY_WORDS
 from components.outputs import relative_life as iso_relative_life
 from mbd.recorder import atomic_write_text
 
-from .runner import RunConfig
+from .runner import RunConfig, run_report
 from .integrity import read_summary
 from .sweep import Case, build_params, check_folders, run_sweep
 from . import args
@@ -317,9 +317,8 @@ def run(a) -> dict:
     print("run time and accuracy per run:")
     for k, s in sorted(results.items()):
         if "error" not in s:
-            e = s["error_estimate"]
-            print(f"  {k}: {s['wall_s']:.1f} s wall, {s['steps']} steps, local error estimate rms {e['rms']:.2f} / "
-                  f"max {e['max']:.2f} × {e['atol_m']:.0e} m")
+            first, *warns = run_report(s)
+            print(f"  {k}: {first}", *(f"\n  {k}: {w}" for w in warns), sep="")
     print("\nwritten:")
     for p in [csv_p, md_p, *figs, *anims]:
         print(f"  {p}")

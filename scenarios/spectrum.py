@@ -25,7 +25,7 @@ import mbd
 from mbd.recorder import atomic_write_text
 
 from .analysis import amplitude_spectrum, peak_table
-from .runner import RunConfig, run_case
+from .runner import RunConfig, run_case, run_report
 from . import args
 from .command import command
 
@@ -105,7 +105,8 @@ def run(a) -> dict:
     summary = {"f_m_hz": f_m, "f_c_hz": f_c, "resolution_hz": df, "window_s": s["window_s"],
                "carrier_rpm": s["carrier_rpm"], "sun_rpm": s["sun_rpm"], "power_W": s["power_W"],
                "quantity": "carrier acceleration in the fixed frame, x component [m/s^2] (amplitude_y: y component)",
-               "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"], "error_estimate": s["error_estimate"]}
+               "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"], "error_estimate": s["error_estimate"],
+               "warnings": s["warnings"]}
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
     from viz import plots as vp
 
@@ -117,6 +118,7 @@ def run(a) -> dict:
     for r in peaks:
         print(f"  {r['frequency_hz']:9.1f} Hz  amp {r['amplitude']:.3g} m/s^2   nearest {r['nearest']:>8} "
               f"({r['expected_hz']:.1f} Hz, {r['distance_bins']:+.2f} bins)")
+    print("run time and accuracy: " + "\n".join(run_report(s)))
     print(f"written: {out / 'spectrum.csv'}, {out / 'peaks.csv'}, {out / 'summary.json'}, {fig}")
     return summary
 

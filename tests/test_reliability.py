@@ -216,3 +216,47 @@ def test_an_interrupted_sweep_cancels_its_runs_and_stops_local_workers(scheduler
     client, = _FakeClient.made
     assert len(client.submitted) == 2 and client.cancelled == client.submitted and client.closed
     assert [c.closed for c in _FakeCluster.made] == ([] if scheduler else [True])
+
+
+def test_a_fixed_step_run_beyond_its_tolerance_warns(finished, tmp_path, capsys):
+    from scenarios.runner import FIXED_STEP_ERROR_FACTOR
+
+    assert json.loads((finished / "summary.json").read_text())["warnings"] == []       # adaptive: none
+    code = paper_study.main(TINY + ["--method", "hht-fixed", "--h", "1e-5", "--out", str(tmp_path)])
+    s = json.loads((tmp_path / "c4_forward" / "summary.json").read_text())
+    assert code == 0 and s["error_estimate"]["rms"] > FIXED_STEP_ERROR_FACTOR      # 10 us from the start: ~30 x
+    assert len(s["warnings"]) == 1 and "fixed step h = 1e-05 s" in s["warnings"][0]
+    assert f"c4_forward: warning: {s['warnings'][0]}" in capsys.readouterr().out
+
+
+def test_wall_time_of_a_resumed_run_counts_every_segment(tmp_path, monkeypatch):
+    """Interrupted late in its run, resumed from the checkpoint: wall_s is the first segment's time plus
+    the second's, not the second's alone."""
+    import dataclasses
+    import time
+
+    import mbd
+    from scenarios import runner
+
+    real = mbd.simulate
+    calls = []
+
+    class CtrlC(mbd.Observer):
+        def step(self, s0, s1):
+            if s1.t > 0.8 * CFG.settle + 0.8 * CFG.window:
+                raise KeyboardInterrupt
+
+    def simulate(*a, observers=(), **k):
+        calls.append(1)
+        return real(*a, observers=[*observers, *([CtrlC()] if len(calls) == 1 else [])], **k)
+    monkeypatch.setattr(mbd, "simulate", simulate)
+    cfg = dataclasses.replace(CFG, checkpoint_every=20)
+    params = build_params(_case(tmp_path))
+    with pytest.raises(KeyboardInterrupt):
+        runner.run_case(params, cfg, tmp_path)
+    first = json.loads((tmp_path / "progress.json").read_text())["wall_s"]
+    t0 = time.perf_counter()
+    s = runner.run_case(params, cfg, tmp_path)
+    second = time.perf_counter() - t0
+    assert s["resumed_from_s"] is not None and s["resumed_from_s"] > 0.5 * (CFG.settle + CFG.window)
+    assert first < s["wall_s"] <= first + second

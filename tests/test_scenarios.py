@@ -135,7 +135,7 @@ def test_spectrum_rejects_inconsistent_sun_speed(tmp_path):
     assert "3290" in str(e.value)
 
 
-def test_bearing_rig_scenario(tmp_path):
+def test_bearing_rig_scenario(tmp_path, capsys):
     from scenarios import bearing_rig
 
     s = bearing_rig.run(bearing_rig.parse_args(["--radial-load", "5 kN", "--clearance", "20 um", "--out", str(tmp_path)]))
@@ -150,6 +150,10 @@ def test_bearing_rig_scenario(tmp_path):
     assert s["q_max_N"] == pytest.approx(s["discrete_theory"]["q_max_N"], rel=0.02)
     assert 0 < s["load_zone_deg"] < 180 and s["ring_deflection_m"] > 0
     assert (tmp_path / "load_distribution.png").exists()
+    # run time and accuracy, stored and printed like the study's (an adaptive run holds its tolerance)
+    e = s["error_estimate"]
+    assert s["steps"] > 0 and 0 < e["rms"] <= e["max"] <= 1.5 and e["atol_m"] == 1e-8
+    assert "run time and accuracy: " in capsys.readouterr().out
     with pytest.raises(SystemExit, match="radial-load: expected a force"):
         bearing_rig.parse_args(["--radial-load", "5 m", "--out", str(tmp_path)])
 
