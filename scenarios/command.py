@@ -16,6 +16,7 @@ from components.units import ParameterError
 from mbd.errors import IntegrationError, ModelError
 
 from .integrity import OtherResults
+from .plausibility import Implausible
 from .lock import FolderLocked
 
 __all__ = ["command", "USAGE", "FAILED", "INTERRUPTED"]
@@ -43,7 +44,7 @@ def command(main):
                 print(exc.code if exc.code.startswith("error:") else f"error: {exc.code}", file=sys.stderr)
                 return USAGE
             return exc.code if isinstance(exc.code, int) else 0
-        except (ParameterError, ModelError, OtherResults) as exc:
+        except (ParameterError, ModelError, OtherResults, Implausible) as exc:
             if debug:
                 raise
             print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)

@@ -35,7 +35,8 @@ from mbd.recorder import atomic_write_text
 
 from .paper_study import parse_sets
 from .runner import RunConfig
-from .sweep import Case, build_params, check_folders, run_sweep
+from .plausibility import check_runs
+from .sweep import Case, _case_cfg, build_params, check_folders, run_sweep
 from . import args
 from .command import command
 from .lock import holds_out_folder
@@ -66,6 +67,8 @@ def parse_args(argv):
     p.add_argument("--params", default=None, type=args.existing_file, help="TOML file of parameter overrides")
     p.add_argument("--workers", type=args.count(1), default=None, help="Dask local workers (default: one per core)")
     p.add_argument("--scheduler", default=None, type=args.scheduler, help="address of an existing Dask scheduler")
+    p.add_argument("--force", action="store_true",
+                   help="run although the gears collide or the recording is too large for the limit or the disk")
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("--overwrite", action="store_true",
                    help="replace finished results of other parameters or settings in --out (else refused)")
@@ -209,6 +212,8 @@ def run(a) -> dict:
             build_params(c).si()             # every parameter checked before any run starts
     cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
                     progress=not a.no_progress)
+    for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], out, a.force):
+        print(f"warning (--force): {w}")
     check_folders(cases, cfg, a.overwrite)      # never replace results of other parameters silently
     results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
                         overwrite=a.overwrite)

@@ -25,7 +25,8 @@ from mbd.recorder import atomic_write_text
 
 from .runner import RunConfig, run_report
 from .integrity import read_summary
-from .sweep import Case, build_params, check_folders, run_sweep
+from .plausibility import check_runs
+from .sweep import Case, _case_cfg, build_params, check_folders, run_sweep
 from . import args
 from .command import command
 from .lock import holds_out_folder
@@ -69,6 +70,8 @@ def parse_args(argv):
     p.add_argument("--animate", action="store_true", help="write a cage-orbit animation per condition")
     p.add_argument("--overwrite", action="store_true",
                    help="replace finished results of other parameters or settings in --out (else refused)")
+    p.add_argument("--force", action="store_true",
+                   help="run although the gears collide or the recording is too large for the limit or the disk")
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("--out", default="results/study", type=args.out_folder, help="output directory")
     return p.parse_args(argv)
@@ -296,6 +299,8 @@ def run(a) -> dict:
             print(f"design warning: {msg}")
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
+    for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], out, a.force):
+        print(f"warning (--force): {w}")
     check_folders(cases, cfg, a.overwrite)      # never replace results of other parameters silently
     results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
                         overwrite=a.overwrite)

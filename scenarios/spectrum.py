@@ -25,6 +25,7 @@ import mbd
 from mbd.recorder import atomic_write_text
 
 from .analysis import amplitude_spectrum, peak_table
+from .plausibility import check_runs
 from .runner import RunConfig, run_case, run_report
 from . import args
 from .command import command
@@ -44,6 +45,8 @@ def parse_args(argv):
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="parameter override")
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="scene switch")
     p.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="initial step [s]")
+    p.add_argument("--force", action="store_true",
+                   help="run although the gears collide or the recording is too large for the limit or the disk")
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("--overwrite", action="store_true",
                    help="replace a finished run of other parameters or settings in --out (else refused)")
@@ -76,6 +79,8 @@ def run(a) -> dict:
     opts = SceneOptions.from_dict({k: _bool(v) for k, v in parse_sets(a.option).items()})
     cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, options=opts,
                     integration=dataclasses.replace(mbd.PRODUCTION, h=a.h), progress=not a.no_progress)
+    for w in check_runs([("spectrum", params, cfg)], out, a.force):
+        print(f"warning (--force): {w}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         s = run_case(params, cfg, out / "run", label={"scenario": "spectrum"}, overwrite=a.overwrite)

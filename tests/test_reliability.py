@@ -260,3 +260,27 @@ def test_wall_time_of_a_resumed_run_counts_every_segment(tmp_path, monkeypatch):
     second = time.perf_counter() - t0
     assert s["resumed_from_s"] is not None and s["resumed_from_s"] > 0.5 * (CFG.settle + CFG.window)
     assert first < s["wall_s"] <= first + second
+
+
+def test_colliding_gears_are_refused_unless_forced(tmp_path, capsys):
+    from scenarios.plausibility import check_runs
+
+    code = paper_study.main(TINY + ["--planets", "4", "--out", str(tmp_path)])      # 4 pairs do not fit
+    err = capsys.readouterr().err
+    assert code == 2 and "would collide" in err and "--force" in err and err.count("\n") == 1
+    assert not (tmp_path / "c4_forward").exists()
+    params = build_params(Case(4, "forward", str(tmp_path), {"gears.planets": 4}))
+    forced = check_runs([("c4_forward", params, CFG)], tmp_path, force=True)
+    assert len(forced) == 1 and "gears.planets" in forced[0]
+
+
+def test_output_size_is_estimated_and_checked_before_starting(tmp_path, monkeypatch, capsys):
+    from scenarios import plausibility
+
+    # 1 GHz over 0.5 ms: 5e5 samples of 1632 values (12 rollers), 8 bytes, twice while joined: 13.0 GB
+    assert paper_study.main(TINY + ["--sample-rate", "1e9", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "the recording would take 13.0 GB" in err and "more than 5 GB" in err and "--sample-rate" in err
+    monkeypatch.setattr(plausibility, "_free", lambda folder: 1e3)                  # a nearly full disk
+    assert paper_study.main(TINY + ["--out", str(tmp_path)]) == 2
+    assert "GB free" in capsys.readouterr().err and not (tmp_path / "c4_forward").exists()
