@@ -529,6 +529,7 @@ class Finding:
     severity: str      # "error" | "warning"
     parameter: str     # dotted parameter name (or the group at fault, e.g. "gears")
     message: str
+    collides: bool = False   # gears overlap even at their pitch circles: the machine could not be built
 
     def __str__(self) -> str:
         return f"{self.parameter}: {self.message}"
@@ -548,12 +549,13 @@ def _overlap_findings(out, name_i, name_j, ci, cj, ri, rj, parameter, same=False
         who_j = f"{name_j} {j}" if len(cj) > 1 else name_j
         what = f"tip circles of {who_i} and {who_j} (not in mesh) overlap by {ov[k] * 1e3:.2f} mm " \
                f"(centre distance {d[k] * 1e3:.2f} mm < {(ri + rj) * 1e3:.2f} mm)"
-        if pitch is not None and d[k] < sum(pitch):
+        collides = bool(pitch is not None and d[k] < sum(pitch))
+        if collides:
             # the model has no contact between these bodies, so it still runs; the machine could not exist
             what += "; even their pitch circles overlap: the gears would collide"
         else:
             what += "; a real design needs profile shift, shorter addenda or an axial offset"
-        out.append(Finding("warning", parameter, what))
+        out.append(Finding("warning", parameter, what, collides))
 
 
 def design_findings(params) -> list[Finding]:
@@ -640,11 +642,12 @@ def _interference_findings(lay, G, out) -> None:
         what = f"tip circles of the inner planets and the ring (not in mesh) overlap by " \
                f"{(reach - ra['ring']) * 1e3:.2f} mm (r_ca + r_a,inner = {reach * 1e3:.2f} mm > ring tip radius " \
                f"{ra['ring'] * 1e3:.2f} mm)"
-        if lay.r_ca + G["inner_planet"].pitch_radius > G["ring"].pitch_radius:
+        collides = bool(lay.r_ca + G["inner_planet"].pitch_radius > G["ring"].pitch_radius)
+        if collides:
             what += "; even their pitch circles overlap: the gears would collide"
         else:
             what += "; a real design needs profile shift, shorter addenda or an axial offset"
-        out.append(Finding("warning", "gears.ring", what))
+        out.append(Finding("warning", "gears.ring", what, collides))
     ca, cb = lay.centres_a, lay.centres_b
     if lay.planets > 1:
         rp = {n: G[n].pitch_radius for n in _GEARS}

@@ -251,8 +251,10 @@ def _radial_stiffness(b: BearingSI, F: float, a: float) -> float:
 # running and post-processing
 # ----------------------------------------------------------------------------------------------
 def run_sampled(model: mbd.Model, q0, v0, times, *, controller, stepper: mbd.HHT | None = None,
-                system: mbd.System | None = None, t0: float = 0.0, state: mbd.State | None = None) -> list[mbd.State]:
-    """Integrate from (t0, q0, v0) (or ``state``) and return copies of the states at ``times`` (ascending).
+                system: mbd.System | None = None, t0: float = 0.0, state: mbd.State | None = None,
+                results: list | None = None) -> list[mbd.State]:
+    """Integrate from (t0, q0, v0) (or ``state``) and return copies of the states at ``times`` (ascending);
+    each piece's :class:`mbd.SimResult` is appended to ``results`` when given (run time, error estimate).
 
     The run is split at the sample times (steps end exactly on them, no interpolation); an
     :class:`mbd.Adaptive` controller continues each piece from the largest step of the previous one."""
@@ -266,6 +268,8 @@ def run_sampled(model: mbd.Model, q0, v0, times, *, controller, stepper: mbd.HHT
             res = mbd.simulate(model, t_end=float(t), state=state, stepper=stepper, controller=controller,
                                system=system, progress=False)
             state = res.state
+            if results is not None:
+                results.append(res)
             if isinstance(controller, mbd.Adaptive) and res.steps:
                 controller = dataclasses.replace(controller, h0=float(np.clip(res.h_max_used, controller.h_min,
                                                                                  controller.h_max)))
@@ -332,6 +336,9 @@ class RigSolution:
     load_vector: np.ndarray
     wall_s: float
     zone_tol: float = 1e-3
+    steps: int = 0
+    error_rms: float = float("nan")   # HHT local error estimate over the accepted steps, in units of atol
+    error_max: float = float("nan")
 
     def summary(self) -> dict:
         return {"radial_load_N": self.radial_load, "q_max_N": self.q_max, "stribeck": self.stribeck,
@@ -357,8 +364,12 @@ def rig_static_solution(built: BuiltScene, *, t_settle: float | None = None, win
     times = t_settle + window * np.arange(samples) / max(samples - 1, 1)
     system = mbd.System(built.model)
     w0 = time.perf_counter()
-    states = run_sampled(built.model, built.q0, built.v0, times, controller=controller, stepper=stepper, system=system)
+    pieces = []
+    states = run_sampled(built.model, built.q0, built.v0, times, controller=controller, stepper=stepper, system=system,
+                         results=pieces)
     wall = time.perf_counter() - w0
+    steps = sum(r.steps for r in pieces)
+    err_rms = float(np.sqrt(sum(r.error_rms ** 2 * r.steps for r in pieces) / max(steps, 1)))
     recs = [rig_loads(built, system, s) for s in states]
     # bin by angle from the load-zone centre (bin k centred on 2πk/Z)
     ang = np.array([r["angle"] for r in recs])                       # (samples, Z)
@@ -389,4 +400,5 @@ def rig_static_solution(built: BuiltScene, *, t_settle: float | None = None, win
                        zone_angle=zone, zone_angle_continuous=_zone_angle(defl, meta["bearing"].clearance),
                        deflection=defl, sideways=side, load_sum=mean("load_sum"), pin_force=mean("pin_force"),
                        ring_force=mean("ring_force"), radial_load=F, load_vector=F * u, wall_s=wall,
-                       zone_tol=zone_tol)
+                       zone_tol=zone_tol, steps=steps, error_rms=err_rms,
+                       error_max=max((r.error_max for r in pieces), default=0.0))

@@ -23,6 +23,7 @@ Layout of the file (every variable and coordinate carries CF-style ``units`` and
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
@@ -38,14 +39,32 @@ from .model import to_fixed
 __all__ = ["BodyMotion", "ElementOutput", "DerivedOutput", "Recorder", "atomic_write_bytes", "atomic_write_text", "hermite"]
 
 
+def _tmp_for(path: Path) -> Path:
+    return path.with_name(f".{path.name}.tmp{os.getpid()}")
+
+
+@contextlib.contextmanager
+def _discard_on_failure(tmp: Path):
+    """A failed write (disk full, unwritable folder, interrupt) leaves no temporary file behind; the file it
+    would have replaced stays as it was."""
+    try:
+        yield
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
 def atomic_write_bytes(path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file and os.replace: ``path`` is either the old or the
+    new content, never a part (a failed write raises and leaves no temporary file)."""
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    with open(tmp, "wb") as fh:
-        fh.write(data)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    tmp = _tmp_for(path)
+    with _discard_on_failure(tmp):
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
 
 
 def atomic_write_text(path, text: str) -> None:
@@ -299,15 +318,22 @@ class Recorder:
                 yield {nm: d[f"v{j}"] for j, nm in enumerate(names)}
 
     def finalize(self, attrs: dict | None = None) -> Path:
-        """Stream all chunks into the results file (netCDF4 via h5netcdf) atomically."""
-        import h5netcdf
-        import h5py
-
+        """Stream all chunks into the results file (netCDF4 via h5netcdf) atomically; the chunks are removed
+        only once the file is in place (a failed write keeps them and the checkpoint: the run can resume)."""
         self.flush()
         total = sum(c["time"].shape[0] for c in self._chunks())
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = self.path.with_name(f".{self.path.name}.tmp{os.getpid()}")
-        allattrs = {**self.attrs, **(attrs or {})}
+        tmp = _tmp_for(self.path)
+        with _discard_on_failure(tmp):
+            self._write(tmp, total, {**self.attrs, **(attrs or {})})
+            os.replace(tmp, self.path)
+        shutil.rmtree(self.parts, ignore_errors=True)
+        return self.path
+
+    def _write(self, tmp: Path, total: int, allattrs: dict) -> None:
+        import h5netcdf
+        import h5py
+
         with h5netcdf.File(tmp, "w") as f:
             f.dimensions["time"] = total
             for key, val in allattrs.items():
@@ -337,9 +363,6 @@ class Recorder:
                 for name in self.vars:
                     created[name][i0: i0 + n, ...] = c[name]
                 i0 += n
-        os.replace(tmp, self.path)
-        shutil.rmtree(self.parts, ignore_errors=True)
-        return self.path
 
 
 def _fixed_body_acceleration(m, fs, qf, vf, af) -> None:

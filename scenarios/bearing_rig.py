@@ -11,7 +11,6 @@ and the classical discrete-roller solution for comparison) and DIR/load_distribu
 """
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 import warnings
@@ -19,22 +18,27 @@ from pathlib import Path
 
 import numpy as np
 
+import mbd
 from mbd.recorder import atomic_write_text
+from . import args
 from .command import command
+from .runner import accuracy_line
+
+ATOL = mbd.PRODUCTION.atol_pos     # the rig runs the production stepper (components.rig.rig_static_solution)
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(prog="python -m scenarios.bearing_rig", description=__doc__.split("\n\n")[0])
-    p.add_argument("--radial-load", default="10 kN", help='radial load on the outer ring (default "10 kN")')
-    p.add_argument("--clearance", default=None, help='diametral clearance P_d (default: preset, "20 um")')
-    p.add_argument("--rollers", type=int, default=None, help="number of rollers Z (default 12)")
-    p.add_argument("--roller-diameter", default=None, help='roller diameter D (default "7.5 mm")')
-    p.add_argument("--roller-length", default=None, help='roller effective length l (default "9 mm")')
-    p.add_argument("--pitch-diameter", default=None, help='pitch diameter d_m (default "39 mm")')
-    p.add_argument("--speed", default="0 rpm", help='outer ring speed (default "0 rpm": static)')
+    p = args.Parser(prog="python -m scenarios.bearing_rig", description=__doc__.split("\n\n")[0])
+    p.add_argument("--radial-load", default="10 kN", type=args.quantity_of("force", positive_only=True), help='radial load on the outer ring (default "10 kN")')
+    p.add_argument("--clearance", default=None, type=args.quantity_of("length"), help='diametral clearance P_d (default: preset, "20 um")')
+    p.add_argument("--rollers", type=args.count(3), default=None, help="number of rollers Z (default 12)")
+    p.add_argument("--roller-diameter", default=None, type=args.quantity_of("length", positive_only=True), help='roller diameter D (default "7.5 mm")')
+    p.add_argument("--roller-length", default=None, type=args.quantity_of("length", positive_only=True), help='roller effective length l (default "9 mm")')
+    p.add_argument("--pitch-diameter", default=None, type=args.quantity_of("length", positive_only=True), help='pitch diameter d_m (default "39 mm")')
+    p.add_argument("--speed", default="0 rpm", type=args.quantity_of("angular_velocity"), help='outer ring speed (default "0 rpm": static)')
     p.add_argument("--cage", default="held", choices=["held", "free", "none"], help="cage held (default), free or absent")
     p.add_argument("--no-drag", action="store_true", help="switch lubricant drag off")
-    p.add_argument("--out", default="results/bearing_rig")
+    p.add_argument("--out", default="results/bearing_rig", type=args.out_folder)
     return p.parse_args(argv)
 
 
@@ -77,7 +81,9 @@ def run(a) -> dict:
         "ring_deflection_m": sol.deflection,
         "load_vector_sum_N": sol.load_sum.tolist(),
         "load_balance_error": float(np.hypot(*(sol.load_sum - sol.load_vector)) / F),
-        "window_s": [sol.t0, sol.t1], "wall_s": sol.wall_s,
+        "window_s": [sol.t0, sol.t1], "wall_s": sol.wall_s, "steps": sol.steps,
+        "error_estimate": {"kind": "HHT local displacement error estimate, scaled by atol; RMS and max over "
+                                   "accepted steps", "rms": sol.error_rms, "max": sol.error_max, "atol_m": ATOL},
         "discrete_theory": {"q_max_N": theory.q_max, "stribeck_ratio": theory.stribeck,
                             "ring_deflection_m": theory.deflection, "load_zone_deg": float(np.degrees(theory.zone_angle)),
                             "roller_angle_deg": np.degrees(theory.angles).tolist(), "roller_load_N": theory.loads.tolist(),
@@ -94,6 +100,7 @@ def run(a) -> dict:
           f"ring deflection {sol.deflection * 1e6:.2f} um, Σ roller loads vs F_r: {summary['load_balance_error']:.2e}")
     print(f"discrete-roller theory: Q_max = {theory.q_max:.0f} N, Q_max·Z/F_r = {theory.stribeck:.2f}, "
           f"ring deflection {theory.deflection * 1e6:.2f} um")
+    print("run time and accuracy: " + accuracy_line(sol.wall_s, sol.steps, sol.error_rms, sol.error_max, ATOL))
     print(f"written: {out / 'summary.json'}, {fig}")
     return summary
 

@@ -22,7 +22,6 @@ largest difference of the final positions relative to the largest displacement f
 """
 from __future__ import annotations
 
-import argparse
 import json
 import statistics
 import sys
@@ -32,6 +31,7 @@ import numpy as np
 
 import mbd
 from mbd.elements import BodySpring, ForceSource, GroundSupport, Ramp, TorqueSource, TorsionalSpring
+from . import args
 from .command import command
 
 ROLLER_D = 7.5e-3                      # m
@@ -172,12 +172,12 @@ def agreement(hht: dict, radau: dict, model: mbd.Model) -> float:
 
 @command
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--sizes", type=int, nargs="+", default=[10, 50, 100, 250], help="numbers of bodies M")
-    p.add_argument("--steps", type=int, default=2000, help="HHT steps of h = 5 µs")
-    p.add_argument("--repeats", type=int, default=3, help="HHT repeats (the median is reported)")
+    p = args.Parser(prog="python -m scenarios.bench_engine", description=__doc__.splitlines()[0])
+    p.add_argument("--sizes", type=args.count(1), nargs="+", default=[10, 50, 100, 250], help="numbers of bodies M")
+    p.add_argument("--steps", type=args.count(1), default=2000, help="HHT steps of h = 5 µs")
+    p.add_argument("--repeats", type=args.count(1), default=3, help="HHT repeats (the median is reported)")
     p.add_argument("--no-radau", action="store_true", help="skip the solve_ivp(Radau) comparison")
-    p.add_argument("--radau-max-wall", type=float, default=600.0, help="wall-time cap per Radau run [s]")
+    p.add_argument("--radau-max-wall", type=args.positive("s"), default=600.0, help="wall-time cap per Radau run [s]")
     p.add_argument("--json", help="write the results to this JSON file")
     p.add_argument("--chain", action="store_true", help="the Exudyn comparison chain on both engines")
     a = p.parse_args(argv)

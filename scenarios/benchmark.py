@@ -32,7 +32,6 @@ collide, are run anyway and labelled non-physical). With --json the LAST line pr
 """
 from __future__ import annotations
 
-import argparse
 import cProfile
 import io
 import json
@@ -49,6 +48,7 @@ from components.presets import reference_dpgt
 
 from .numerics_common import (design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note,
                               observables, peak_rss_mb, run_hht, run_scipy, settled_state, warm_up)
+from . import args
 from .command import command
 
 __all__ = ["main", "benchmark", "scaling", "profile_window"]
@@ -258,39 +258,44 @@ def scaling(configs=SCALING, steps: int = 200, h: float = 5e-6, log=print) -> li
     return rows
 
 
+def _factors(text: str) -> list[float]:
+    """Contact-stiffness factors > 0 ('' skips the stiff comparison)."""
+    return args.float_list("")(text) if text.strip() else []
+
+
 @command
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = args.Parser(prog="python -m scenarios.benchmark", description=__doc__.splitlines()[0])
     ap.add_argument("--json", action="store_true", help="print one JSON object on the last line")
-    ap.add_argument("--window", type=float, default=0.1, help="simulated window after settling [s]")
-    ap.add_argument("--ref-window", type=float, default=0.01, help="sub-window for the error and scipy [s]")
-    ap.add_argument("--h", type=float, default=5e-6, help="HHT fixed step [s]")
-    ap.add_argument("--alpha", type=float, default=-0.3)
-    ap.add_argument("--newton-tol", type=float, default=None, help="HHT Newton tolerance (default: the engine's, 1e-3)")
-    ap.add_argument("--scipy-cap", type=float, default=120.0, help="wall-time cap per scipy run [s]")
-    ap.add_argument("--scipy-tols", default="1e-3,1e-4",
+    ap.add_argument("--window", type=args.positive("s"), default=0.1, help="simulated window after settling [s]")
+    ap.add_argument("--ref-window", type=args.positive("s"), default=0.01, help="sub-window for the error and scipy [s]")
+    ap.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="HHT fixed step [s]")
+    ap.add_argument("--alpha", type=args.alpha, default=-0.3, help="HHT alpha in [-1/3, 0]")
+    ap.add_argument("--newton-tol", type=args.positive(""), default=None, help="HHT Newton tolerance (default: the engine's, 1e-3)")
+    ap.add_argument("--scipy-cap", type=args.positive("s"), default=120.0, help="wall-time cap per scipy run [s]")
+    ap.add_argument("--scipy-tols", default="1e-3,1e-4", type=args.float_list(""),
                     help="rtol ladder per scipy method, loosest first (stops at the first with <= 1 %% error)")
-    ap.add_argument("--scipy-methods", default="Radau,BDF,LSODA,RK45")
-    ap.add_argument("--repeats", type=int, default=3, help="interleaved repeats of each engine on the sub-window")
-    ap.add_argument("--stiff", default="10,100", help="contact-stiffness factors for the stiff comparison ('' skips)")
-    ap.add_argument("--stiff-window", type=float, default=2e-3, help="window of the stiff comparison [s]")
-    ap.add_argument("--stiff-settle", type=float, default=0.01, help="settling time of the stiff cases [s]")
+    ap.add_argument("--scipy-methods", default="Radau,BDF,LSODA,RK45",
+                    type=args.choice_list(("Radau", "BDF", "LSODA", "RK45", "RK23", "DOP853"), "scipy methods"))
+    ap.add_argument("--repeats", type=args.count(1), default=3, help="interleaved repeats of each engine on the sub-window")
+    ap.add_argument("--stiff", default="10,100", type=_factors, help="contact-stiffness factors for the stiff comparison ('' skips)")
+    ap.add_argument("--stiff-window", type=args.positive("s"), default=2e-3, help="window of the stiff comparison [s]")
+    ap.add_argument("--stiff-settle", type=args.nonnegative("s"), default=0.01, help="settling time of the stiff cases [s]")
     ap.add_argument("--profile", action="store_true", help="print the cProfile top entries (2 ms of the window)")
     ap.add_argument("--scaling", action="store_true", help="cost per step against N·Z")
-    ap.add_argument("--settle", type=float, default=0.03, help="settling time before the window [s]")
-    ap.add_argument("--out", default="results/numerics")
+    ap.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="settling time before the window [s]")
+    ap.add_argument("--out", default="results/numerics", type=args.out_folder)
     a = ap.parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     log = (lambda m: print(m, file=sys.stderr, flush=True)) if a.json else (lambda m: print(m, flush=True))
     log(machine_note())
     res = benchmark(out, a.window, a.ref_window, a.h, a.alpha, a.scipy_cap,
-                    [float(x) for x in a.scipy_tols.split(",")], log, a.settle,
+                    a.scipy_tols, log, a.settle,
                     [m.strip() for m in a.scipy_methods.split(",") if m.strip()], a.repeats, a.newton_tol)
-    factors = [float(x) for x in a.stiff.split(",") if x.strip()]
-    res["stiff"] = stiff_comparison(factors, a.stiff_settle, a.stiff_window,
+    res["stiff"] = stiff_comparison(a.stiff, a.stiff_settle, a.stiff_window,
                                     [m.strip() for m in a.scipy_methods.split(",") if m.strip()],
-                                    [float(x) for x in a.scipy_tols.split(",")], a.scipy_cap, log)
+                                    a.scipy_tols, a.scipy_cap, log)
     if a.profile:
         prof = profile_window(out, a.h, a.alpha, settle=a.settle)
         res["profile_top"] = prof

@@ -8,12 +8,15 @@ never a traceback unless ``--debug`` asks for it.
 """
 from __future__ import annotations
 
+import errno
 import functools
 import sys
 
 from components.units import ParameterError
 from mbd.errors import IntegrationError, ModelError
 
+from .integrity import OtherResults
+from .plausibility import Implausible
 from .lock import FolderLocked
 
 __all__ = ["command", "USAGE", "FAILED", "INTERRUPTED"]
@@ -41,7 +44,7 @@ def command(main):
                 print(exc.code if exc.code.startswith("error:") else f"error: {exc.code}", file=sys.stderr)
                 return USAGE
             return exc.code if isinstance(exc.code, int) else 0
-        except (ParameterError, ModelError) as exc:
+        except (ParameterError, ModelError, OtherResults, Implausible) as exc:
             if debug:
                 raise
             print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
@@ -54,6 +57,11 @@ def command(main):
         except FolderLocked as exc:
             print(f"error: {exc}", file=sys.stderr)
             return FAILED
+        except OSError as exc:               # disk full, unwritable folder: earlier results are intact
+            if debug:
+                raise
+            print(f"error: {_os_error(exc)}", file=sys.stderr)
+            return FAILED
         except Exception as exc:             # a defect: say what, keep the traceback for --debug
             if debug:
                 raise
@@ -62,3 +70,19 @@ def command(main):
             return FAILED
 
     return wrapped
+
+
+_FULL = {errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC)}
+_DENIED = {errno.EACCES, errno.EPERM, errno.EROFS}
+
+
+def _os_error(exc: OSError) -> str:
+    """One line for a failed file operation: what, where, and what the user can do."""
+    what = exc.strerror or " ".join(str(exc).split())
+    where = f": {exc.filename}" if exc.filename else ""
+    if exc.errno in _FULL:
+        return (f"{what}{where}; nothing was half-written (earlier results and checkpoints are intact): free some "
+                f"space and run the same command again to resume")
+    if exc.errno in _DENIED:
+        return f"{what}{where}; choose a folder you can write (--out)"
+    return f"{what}{where}"

@@ -19,7 +19,6 @@ each direction (from the film's η^0.694 scaling) — so whether reverse wants a
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import dataclasses
 import io
@@ -36,7 +35,9 @@ from mbd.recorder import atomic_write_text
 
 from .paper_study import parse_sets
 from .runner import RunConfig
-from .sweep import Case, build_params, run_sweep
+from .plausibility import check_runs
+from .sweep import Case, _case_cfg, build_params, check_folders, run_sweep
+from . import args
 from .command import command
 from .lock import holds_out_folder
 
@@ -52,22 +53,26 @@ _FROM_SUMMARY = {"h_min_m": "film_min_m", "h_mean_m": "film_mean_m"}
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(prog="python -m scenarios.lubricant_study", description=__doc__.split("\n\n")[0])
-    p.add_argument("--conditions", default="3", help="comma list of operating conditions 1-4 (default 3)")
-    p.add_argument("--directions", default="forward,reverse", help="comma list: forward, reverse")
+    p = args.Parser(prog="python -m scenarios.lubricant_study", description=__doc__.split("\n\n")[0])
+    p.add_argument("--conditions", default="3", type=args.conditions, help="comma list of operating conditions 1-4 (default 3)")
+    p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--grades", default=None, help=f"comma list of ISO VG grades ({', '.join(OIL_GRADES)})")
+    g.add_argument("--grades", default=None, type=args.choice_list(tuple(OIL_GRADES), "ISO VG grades"), help=f"comma list of ISO VG grades ({', '.join(OIL_GRADES)})")
     g.add_argument("--viscosities", default=None,
                    help='dynamic viscosities at the operating temperature, e.g. "10,30,100 mPa*s"')
-    p.add_argument("--settle", type=float, default=0.03, help="seconds discarded after the start (default 0.03)")
-    p.add_argument("--window", type=float, default=None, help="statistics window [s] (default: the study's rule)")
-    p.add_argument("--sample-rate", type=float, default=2000.0, help="recording rate [Hz] (statistics use every step)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a parameter (repeatable)")
-    p.add_argument("--params", default=None, help="TOML file of parameter overrides")
-    p.add_argument("--workers", type=int, default=None, help="Dask local workers (default: one per core)")
-    p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
+    p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded after the start (default 0.03)")
+    p.add_argument("--window", type=args.positive("s"), default=None, help="statistics window [s] (default: the study's rule)")
+    p.add_argument("--sample-rate", type=args.positive("Hz"), default=2000.0, help="recording rate [Hz] (statistics use every step)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="override a parameter (repeatable)")
+    p.add_argument("--params", default=None, type=args.existing_file, help="TOML file of parameter overrides")
+    p.add_argument("--workers", type=args.count(1), default=None, help="Dask local workers (default: one per core)")
+    p.add_argument("--scheduler", default=None, type=args.scheduler, help="address of an existing Dask scheduler")
+    p.add_argument("--force", action="store_true",
+                   help="run although the gears collide or the recording is too large for the limit or the disk")
     p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--out", default="results/lubricant", help="output directory")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace finished results of other parameters or settings in --out (else refused)")
+    p.add_argument("--out", default="results/lubricant", type=args.out_folder, help="output directory")
     return p.parse_args(argv)
 
 
@@ -207,7 +212,11 @@ def run(a) -> dict:
             build_params(c).si()             # every parameter checked before any run starts
     cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
                     progress=not a.no_progress)
-    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress)
+    for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], out, a.force):
+        print(f"warning (--force): {w}")
+    check_folders(cases, cfg, a.overwrite)      # never replace results of other parameters silently
+    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
+                        overwrite=a.overwrite)
     rows = rows_of(cases, results)
     files = write_outputs(rows, out) if rows else []
     failed = {k: v["error"] for k, v in results.items() if "error" in v}

@@ -13,7 +13,6 @@ as 0, mode_class, multiplicity), DIR/modes.csv and DIR/mode_shapes.png.
 """
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import csv
 import io
@@ -25,17 +24,18 @@ from pathlib import Path
 import numpy as np
 
 from mbd.recorder import atomic_write_text
+from . import args
 from .command import command
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(prog="python -m scenarios.modal", description=__doc__.split("\n\n")[0])
-    p.add_argument("--params", default=None, help="TOML file of the single planetary set (default: built-in example)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override, e.g. planets=4")
+    p = args.Parser(prog="python -m scenarios.modal", description=__doc__.split("\n\n")[0])
+    p.add_argument("--params", default=None, type=args.existing_file, help="TOML file of the single planetary set (default: built-in example)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="override, e.g. planets=4")
     p.add_argument("--dpgt", action="store_true", help="analyse the DPGT with linear bearings instead")
-    p.add_argument("--condition", type=int, default=3, help="DPGT operating condition (default 3)")
-    p.add_argument("--settle", type=float, default=0.03, help="DPGT: seconds to reach the loaded steady state")
-    p.add_argument("--out", default="results/modal")
+    p.add_argument("--condition", type=args.count(1, 4), default=3, help="DPGT operating condition (default 3)")
+    p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="DPGT: seconds to reach the loaded steady state")
+    p.add_argument("--out", default="results/modal", type=args.out_folder)
     return p.parse_args(argv)
 
 

@@ -23,8 +23,11 @@ from components.outputs import SUMMARY_WORDS
 from components.outputs import relative_life as iso_relative_life
 from mbd.recorder import atomic_write_text
 
-from .runner import RunConfig
-from .sweep import Case, build_params, run_sweep
+from .runner import RunConfig, run_report
+from .integrity import read_summary
+from .plausibility import check_runs
+from .sweep import Case, _case_cfg, build_params, check_folders, run_sweep
+from . import args
 from .command import command
 from .lock import holds_out_folder
 
@@ -42,29 +45,35 @@ BAR_QUANTITIES = ["roller_cage_rms_N", "cage_guide_rms_N", "roller_inner_race_rm
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(prog="python -m scenarios.paper_study", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--conditions", default="3", help="comma list of operating conditions 1-4 (default 3)")
-    p.add_argument("--directions", default="forward,reverse", help="comma list: forward, reverse")
-    p.add_argument("--planets", type=int, default=None, help="planet pairs N (default 3, the reference machine)")
-    p.add_argument("--settle", type=float, default=0.03, help="seconds discarded after the start (default 0.03)")
-    p.add_argument("--window", type=float, default=None,
+    p = args.Parser(prog="python -m scenarios.paper_study", description=__doc__.split("\n\n")[0],
+                    formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--conditions", default="3", type=args.conditions,
+                   help="comma list of operating conditions 1-4 (default 3)")
+    p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
+    p.add_argument("--planets", type=args.count(1), default=None, help="planet pairs N (default 3, the reference machine)")
+    p.add_argument("--settle", type=args.nonnegative("s"), default=0.03,
+                   help="seconds discarded after the start (default 0.03)")
+    p.add_argument("--window", type=args.positive("s"), default=None,
                    help="seconds recorded and analysed (default: max(0.02 s, one carrier revolution), rounded up "
                         "to whole revolutions of the slowest cage relative to the carrier)")
-    p.add_argument("--sample-rate", type=float, default=25000.0, help="recording rate [Hz]")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+    p.add_argument("--sample-rate", type=args.positive("Hz"), default=25000.0, help="recording rate [Hz]")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
                    help='override a parameter, e.g. --set bearing.clearance="30 um" (repeatable)')
-    p.add_argument("--params", default=None, help="TOML file of parameter overrides")
+    p.add_argument("--params", default=None, type=args.existing_file, help="TOML file of parameter overrides")
     p.add_argument("--method", default="hht-adaptive", choices=["hht-adaptive", "hht-fixed"])
-    p.add_argument("--h", type=float, default=5e-6, help="fixed step / initial step [s]")
-    p.add_argument("--alpha", type=float, default=-0.3, help="HHT alpha in [-1/3, 0]")
-    p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+    p.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="fixed step / initial step [s]")
+    p.add_argument("--alpha", type=args.alpha, default=-0.3, help="HHT alpha in [-1/3, 0]")
+    p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
                    help="scene switch, e.g. --option drag=false --option bearings=linear")
-    p.add_argument("--workers", type=int, default=None, help="Dask local workers (default: one per core)")
-    p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
+    p.add_argument("--workers", type=args.count(1), default=None, help="Dask local workers (default: one per core)")
+    p.add_argument("--scheduler", default=None, type=args.scheduler, help="address of an existing Dask scheduler")
     p.add_argument("--animate", action="store_true", help="write a cage-orbit animation per condition")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace finished results of other parameters or settings in --out (else refused)")
+    p.add_argument("--force", action="store_true",
+                   help="run although the gears collide or the recording is too large for the limit or the disk")
     p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--out", default="results/study", help="output directory")
+    p.add_argument("--out", default="results/study", type=args.out_folder, help="output directory")
     return p.parse_args(argv)
 
 
@@ -264,13 +273,9 @@ def _keep_finished_on_disk(results: dict, out: Path) -> None:
     """A run that failed this time but finished before keeps its summary in the tables: a re-run in which
     nothing succeeds never replaces good tables with empty ones (its failure is still reported)."""
     for label, s in list(results.items()):
-        done = out / label / "summary.json"
-        if "error" in s and done.exists():
-            try:
-                old = json.loads(done.read_text())
-            except (OSError, ValueError):
-                continue                      # damaged: not a valid summary
-            if "error" not in old and "inner" in old:
+        if "error" in s:
+            old = read_summary(out / label / "summary.json")      # a damaged one is moved aside, not used
+            if old is not None and "error" not in old and "inner" in old:
                 results[label] = {**old, "stale_after_failure": s["error"]}
 
 
@@ -294,7 +299,11 @@ def run(a) -> dict:
             print(f"design warning: {msg}")
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
-    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress)
+    for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], out, a.force):
+        print(f"warning (--force): {w}")
+    check_folders(cases, cfg, a.overwrite)      # never replace results of other parameters silently
+    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
+                        overwrite=a.overwrite)
     _keep_finished_on_disk(results, out)
     relative_life(results)
     for label, s in results.items():   # store the relative life in each run's summary (atomic rewrite)
@@ -313,9 +322,8 @@ def run(a) -> dict:
     print("run time and accuracy per run:")
     for k, s in sorted(results.items()):
         if "error" not in s:
-            e = s["error_estimate"]
-            print(f"  {k}: {s['wall_s']:.1f} s wall, {s['steps']} steps, local error estimate rms {e['rms']:.2f} / "
-                  f"max {e['max']:.2f} × {e['atol_m']:.0e} m")
+            first, *warns = run_report(s)
+            print(f"  {k}: {first}", *(f"\n  {k}: {w}" for w in warns), sep="")
     print("\nwritten:")
     for p in [csv_p, md_p, *figs, *anims]:
         print(f"  {p}")

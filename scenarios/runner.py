@@ -35,9 +35,16 @@ from mbd.recorder import BodyMotion, Recorder, atomic_write_text
 from components.outputs import HousingSensor, WindowStatistics, bearing_map, cage_period, default_window
 from components.results_schema import drawing_geometry, element_probes
 
+from .integrity import checkpoint_usable, claim_folder
 from .lock import folder_lock
 
-__all__ = ["RunConfig", "run_case", "run_fingerprint", "statistics_window"]
+__all__ = ["RunConfig", "run_case", "run_fingerprint", "parameters_fingerprint", "statistics_window", "run_report",
+           "accuracy_line", "FIXED_STEP_ERROR_FACTOR"]
+
+# A fixed-step run whose RMS local error estimate exceeds its tolerance (atol) by more than this factor ends
+# with a warning. Measured at condition 3 from the kinematic start: h = 5 us (the cheapest setting,
+# docs/numerics.md) 2.7-7.0 x atol; h = 2 us 0.85 x; h = 10 us ("do not use") 33 x.
+FIXED_STEP_ERROR_FACTOR = 10.0
 
 _ROOT = Path(__file__).resolve().parent.parent
 _CODE_DIGEST = None
@@ -57,11 +64,21 @@ def _code_digest() -> str:
     return _CODE_DIGEST
 
 
+def _digest(params: DPGTParams, cfg: "RunConfig", code: bool) -> str:
+    settings = asdict(replace(cfg, progress=False))
+    what = {"params": repr(params), "cfg": settings, **({"code": _code_digest()} if code else {})}
+    return hashlib.sha256(json.dumps(what, sort_keys=True, default=repr).encode()).hexdigest()[:16]
+
+
 def run_fingerprint(params: DPGTParams, cfg: "RunConfig") -> str:
     """Identifies a run: parameters, run settings (the progress display excluded) and code."""
-    settings = asdict(replace(cfg, progress=False))
-    blob = json.dumps({"params": repr(params), "cfg": settings, "code": _code_digest()}, sort_keys=True, default=repr)
-    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+    return _digest(params, cfg, code=True)
+
+
+def parameters_fingerprint(params: DPGTParams, cfg: "RunConfig") -> str:
+    """Identifies what a user asked for: parameters and run settings, not the code (a folder holding results
+    of another one is refused unless --overwrite, :func:`scenarios.integrity.claim_folder`)."""
+    return _digest(params, cfg, code=False)
 
 
 @dataclass(frozen=True)
@@ -107,11 +124,24 @@ def _probes(scene, sensor=None) -> list:
             *([HousingSensor(scene, sensor).probe()] if sensor is not None else [])]
 
 
-def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None) -> dict:
+def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None, overwrite: bool = False) -> dict:
     """Run one operating point; write results.nc and summary.json atomically into out_dir.
-    An interrupted run resumes from out_dir/checkpoint.npz. One run at a time per folder (scenarios.lock)."""
+    An interrupted run resumes from out_dir/checkpoint.npz. One run at a time per folder (scenarios.lock).
+    A folder holding finished results of other parameters is refused unless ``overwrite``
+    (:func:`scenarios.integrity.claim_folder`); damaged files there are moved aside and recomputed."""
     with folder_lock(out_dir):
+        how = claim_folder(out_dir, parameters_fingerprint(params, cfg), run_fingerprint(params, cfg), overwrite)
+        if how == "recompute":
+            print(f"{out_dir}: recomputing, its results were made by other code")
         return _run_case(params, cfg, Path(out_dir), label)
+
+
+def _earlier_wall(out_dir: Path, resuming: bool) -> float:
+    """Wall time [s] of the earlier segments of a resumed run (progress.json keeps the running total)."""
+    try:
+        return float(json.loads((out_dir / "progress.json").read_text())["wall_s"]) if resuming else 0.0
+    except (OSError, ValueError, KeyError, TypeError):
+        return 0.0
 
 
 def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> dict:
@@ -130,14 +160,15 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     fp = run_fingerprint(params, cfg)
     fp_file = out_dir / "fingerprint"
     ckpt = out_dir / "checkpoint.npz"
-    if ckpt.exists() and (not fp_file.exists() or fp_file.read_text().strip() != fp):
+    if ckpt.exists() and (not fp_file.exists() or fp_file.read_text(errors="replace").strip() != fp):
         # a checkpoint of another run (other parameters, settings or code): start afresh, say so
         print(f"{out_dir}: the checkpoint there is from a different run (parameters, settings or code); starting afresh")
         ckpt.unlink()
+    resuming = checkpoint_usable(ckpt, rec.parts)     # a damaged checkpoint or chunk is moved aside
     atomic_write_text(fp_file, fp)
-    wall0 = time.perf_counter()
+    wall0 = time.perf_counter() - _earlier_wall(out_dir, resuming)   # wall_s counts every segment
 
-    def report(t, t_end, counters):   # read by a sweep's progress display (another process)
+    def report(t, t_end, counters):   # read by a sweep's progress display (another process) and a resume
         atomic_write_text(out_dir / "progress.json", json.dumps(
             {"t": t, "t_end": t_end, "wall_s": time.perf_counter() - wall0, "steps": counters.accepted}))
 
@@ -153,6 +184,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     summary["samples"] = int(rec.next_index)      # recorded (for plots); the statistics use every step
     summary.update(label or {})
     summary.update({
+        "warnings": accuracy_warnings(integ, res.error_rms),
         "wall_s": wall, "steps": res.steps, "rejected_steps": res.counters["rejected"],
         "newton_per_step": res.counters["newton"] / max(res.steps, 1),
         "resumed_from_s": res.resumed_from,
@@ -163,10 +195,31 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
             "max_local_displacement_error_m": res.error_max * integ.atol_pos,
         },
         "integration": asdict(integ),
-        "fingerprint": fp,
+        "fingerprint": fp, "parameters_fingerprint": parameters_fingerprint(params, cfg),
     })
     atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2, default=_json_default))
     return summary
+
+
+def accuracy_warnings(integ: mbd.IntegratorSettings, error_rms: float) -> list[str]:
+    """Why a run's accuracy is doubtful (an adaptive run holds its tolerance; a fixed step may not)."""
+    if integ.method == "hht-fixed" and error_rms > FIXED_STEP_ERROR_FACTOR:
+        return [f"fixed step h = {integ.h:g} s: RMS local error estimate {error_rms:.1f} x the tolerance "
+                f"{integ.atol_pos:g} m (more than {FIXED_STEP_ERROR_FACTOR:g} x); use a smaller --h or hht-adaptive"]
+    return []
+
+
+def accuracy_line(wall_s: float, steps: int, error_rms: float, error_max: float, atol_m: float) -> str:
+    """Run time and error estimate, as every scenario prints them."""
+    return (f"{wall_s:.1f} s wall, {steps} steps, local error estimate rms {error_rms:.2f} / max {error_max:.2f} "
+            f"x {atol_m:.0e} m")
+
+
+def run_report(s: dict) -> list[str]:
+    """Lines for a finished run's summary: run time and error estimate, then any warning."""
+    e = s["error_estimate"]
+    return [accuracy_line(s["wall_s"], s["steps"], e["rms"], e["max"], e["atol_m"]),
+            *(f"warning: {w}" for w in s.get("warnings", []))]
 
 
 def _json_default(o):

@@ -22,7 +22,6 @@ The machine is one argument of :func:`measure` (a :class:`components.params.DPGT
 """
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import csv
 import io
@@ -37,7 +36,9 @@ import mbd
 from mbd.recorder import atomic_write_text
 
 from .analysis import amplitude_spectrum, line_table, peak_table
-from .runner import RunConfig, run_case
+from .plausibility import check_runs
+from .runner import RunConfig, run_case, run_report
+from . import args
 from .command import command
 
 SENSORS = {
@@ -50,28 +51,32 @@ SIDEBANDS = 6         # the line table covers f_m + k f_c, |k| <= SIDEBANDS
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(prog="python -m scenarios.spectrum", description=__doc__.split("\n\n")[0])
-    p.add_argument("--carrier-rpm", type=float, default=2000.0, help="carrier speed [r/min] (default 2000)")
-    p.add_argument("--sun-rpm", type=float, default=None,
+    p = args.Parser(prog="python -m scenarios.spectrum", description=__doc__.split("\n\n")[0])
+    p.add_argument("--carrier-rpm", type=args.positive("r/min"), default=2000.0, help="carrier speed [r/min] (default 2000)")
+    p.add_argument("--sun-rpm", type=args.positive("r/min"), default=None,
                    help="sun speed [r/min] magnitude; must match the ring-fixed ratio (3290 at 2000)")
-    p.add_argument("--power", default="200 kW", help='output power with unit (default "200 kW")')
+    p.add_argument("--power", default="200 kW", type=args.quantity_of("power"), help='output power with unit (default "200 kW")')
     p.add_argument("--direction", default="forward", choices=["forward", "reverse"])
     p.add_argument("--sensor", default="housing", choices=list(SENSORS),
                    help="housing: the rig's windowed accelerometer (rig.sensor.*, default); axis: ideal, at the carrier axis")
     p.add_argument("--perfect", action="store_true",
                    help="a perfect machine: no manufacturing errors (default: the errors of --gear-grade)")
-    p.add_argument("--gear-grade", type=int, default=6,
+    p.add_argument("--gear-grade", type=args.count(1, 12), default=6,
                    help="ISO 1328 accuracy grade of the gears behind the default manufacturing errors (default 6: "
                         "runouts F_r/2 of that grade, carrier pinholes within ±10 µm; components.presets.typical_errors)")
-    p.add_argument("--settle", type=float, default=0.06,
+    p.add_argument("--settle", type=args.nonnegative("s"), default=0.06,
                    help="seconds discarded (default 0.06: a lightly damped ~2.6 kHz mode rings for ~50 ms after the start)")
-    p.add_argument("--window", type=float, default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")
-    p.add_argument("--sample-rate", type=float, default=20000.0, help="recording rate [Hz]")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="parameter override")
-    p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", help="scene switch")
-    p.add_argument("--h", type=float, default=5e-6)
+    p.add_argument("--window", type=args.positive("s"), default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")
+    p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz]")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="parameter override")
+    p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="scene switch")
+    p.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="initial step [s]")
+    p.add_argument("--force", action="store_true",
+                   help="run although the gears collide or the recording is too large for the limit or the disk")
     p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--out", default="results/spectrum")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a finished run of other parameters or settings in --out (else refused)")
+    p.add_argument("--out", default="results/spectrum", type=args.out_folder)
     return p.parse_args(argv)
 
 
@@ -113,19 +118,22 @@ def run_config(a) -> RunConfig:
 
 
 def run(a) -> dict:
-    return measure(machine(a), a.sensor, run_config(a), Path(a.out))
+    return measure(machine(a), a.sensor, run_config(a), Path(a.out), force=a.force, overwrite=a.overwrite)
 
 
-def measure(params, sensor: str, cfg: RunConfig, out: Path) -> dict:
+def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = False, overwrite: bool = False) -> dict:
     """Run ``params`` (:class:`components.params.DPGTParams`) on the rig, read ``sensor`` ("housing" |
-    "axis"), and write its spectrum, line table and peaks into ``out`` (module docstring)."""
+    "axis"), and write its spectrum, line table and peaks into ``out`` (module docstring). ``force``: run
+    despite the plausibility checks; ``overwrite``: replace a finished run of other parameters in ``out``."""
     if sensor not in SENSORS:
         raise SystemExit(f"error: --sensor {sensor!r}: expected one of {list(SENSORS)}")
     out.mkdir(parents=True, exist_ok=True)
     cfg = dataclasses.replace(cfg, sensor=sensor == "housing")
+    for w in check_runs([("spectrum", params, cfg)], out, force):
+        print(f"warning (--force): {w}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        s = run_case(params, cfg, out / "run", label={"scenario": "spectrum", "sensor": sensor})
+        s = run_case(params, cfg, out / "run", label={"scenario": "spectrum", "sensor": sensor}, overwrite=overwrite)
     t, signals = _signals(out / "run" / "results.nc", sensor)
     t, signals = _whole_revolutions(t, signals, s["f_c_hz"])
     spectra = {k: amplitude_spectrum(t, x) for k, x in signals.items()}
@@ -145,10 +153,11 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path) -> dict:
                "errors": {k: [e.to_dict() for e in v] for k, v in params.si().errors.to_dict().items()},
                "sensor_parameters": dataclasses.asdict(params.si().rig.sensor) if sensor == "housing" else None,
                "lines": lines, "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"],
-               "error_estimate": s["error_estimate"]}
+               "error_estimate": s["error_estimate"], "warnings": s["warnings"]}
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
     fig = _plot(f, spectra, f_m, f_c, s, sensor, out)
     _report(lines, peaks, f_m, f_c, df, t, sensor)
+    print("run time and accuracy: " + "\n".join(run_report(s)))
     print(f"written: {out / 'spectrum.csv'}, {out / 'lines.csv'}, {out / 'peaks.csv'}, {out / 'summary.json'}, {fig}")
     return summary
 

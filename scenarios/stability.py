@@ -42,6 +42,7 @@ from components.units import Q_
 
 from .numerics_common import (Problem, StateSampler, design_verdict, dpgt_problem, machine_note, run_scipy,
                               warm_up)
+from . import args
 from .command import command
 
 __all__ = ["CASES", "case_overrides", "run_case_stability", "main", "FIELDS"]
@@ -209,16 +210,28 @@ def markdown(rows: list[dict], window: float, cap: float) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _scipy_runs(text: str) -> list[tuple[str, float]]:
+    """METHOD:RTOL,... -> [(method, rtol)] (a usage error names the bad item)."""
+    runs = []
+    for item in (x.strip() for x in text.split(",") if x.strip()):
+        method, _, tol = item.partition(":")
+        try:
+            runs.append((method, args.positive("")(tol)))
+        except argparse.ArgumentTypeError:
+            raise argparse.ArgumentTypeError(f"expects METHOD:RTOL with RTOL > 0, e.g. Radau:1e-5, got {item!r}") from None
+    return runs
+
+
 @command
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = args.Parser(prog="python -m scenarios.stability", description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer cases, 1.5 ms window")
-    ap.add_argument("--out", default="results/numerics", help="output directory")
-    ap.add_argument("--window", type=float, default=None, help="simulated time per case [s]")
-    ap.add_argument("--cap", type=float, default=None, help="wall-time cap of each Radau run [s]")
-    ap.add_argument("--cases", default=None, help=f"comma-separated subset of: {', '.join(CASES)}")
+    ap.add_argument("--out", default="results/numerics", type=args.out_folder, help="output directory")
+    ap.add_argument("--window", type=args.positive("s"), default=None, help="simulated time per case [s]")
+    ap.add_argument("--cap", type=args.positive("s"), default=None, help="wall-time cap of each Radau run [s]")
+    ap.add_argument("--cases", default=None, type=args.choice_list(tuple(CASES), "cases"), help=f"comma-separated subset of: {', '.join(CASES)}")
     ap.add_argument("--no-radau", action="store_true", help="skip the scipy comparison")
-    ap.add_argument("--scipy", default="Radau:1e-5", help="scipy runs per case, METHOD:RTOL,... (default Radau:1e-5)")
+    ap.add_argument("--scipy", default="Radau:1e-5", type=_scipy_runs, help="scipy runs per case, METHOD:RTOL,... (default Radau:1e-5)")
     ap.add_argument("--no-hht", action="store_true", help="scipy rows only (to --merge into an existing table)")
     ap.add_argument("--merge", default=None,
                     help="comma-separated directories of partial runs (same window and cap, e.g. run in parallel "
@@ -244,7 +257,7 @@ def main(argv=None) -> int:
     print(machine_note(), flush=True)
     rows = []
     for n in names:
-        runs = [(m.split(":")[0], float(m.split(":")[1])) for m in a.scipy.split(",") if m]
+        runs = a.scipy
         rs = run_case_stability(n, window, cap, radau=not a.no_radau, hht=not a.no_hht, scipy_runs=runs)
         for r in rs:
             print(f"{r['case']:20s} {r['integrator']:20s} {'ok ' if r.get('completed') else 'FAIL'} "

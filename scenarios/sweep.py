@@ -4,7 +4,8 @@ Each case is plain data (condition, direction, parameter overrides as strings, r
 travels to any worker; the worker rebuilds the pint parameters itself. A case whose summary.json
 was made from the same parameters, settings and code (its fingerprint, :func:`runner.run_fingerprint`)
 is skipped, so a restarted sweep resumes; a stale one is recomputed. A failing case writes error.json
-with its traceback and does not stop the others; every file is written atomically.
+with its traceback and does not stop the others; every file is written atomically. An interrupted client
+(Ctrl-C) cancels its runs on the scheduler, and a local cluster's workers stop with it.
 """
 from __future__ import annotations
 
@@ -17,7 +18,9 @@ from pathlib import Path
 
 from mbd.recorder import atomic_write_text
 
-__all__ = ["Case", "run_sweep", "execute_case"]
+from .integrity import OtherResults, claim_folder, read_summary, results_intact
+
+__all__ = ["Case", "run_sweep", "execute_case", "check_folders"]
 
 
 @dataclass(frozen=True)
@@ -52,15 +55,32 @@ def _case_cfg(case: Case, cfg):
 
 
 def _finished(case: Case, params, cfg) -> dict | None:
-    """The case's summary if it was finished from the same parameters, settings and code, else None
-    (a stale summary is then recomputed, not reused)."""
+    """The case's summary if it was finished from the same parameters, settings and code and its results.nc
+    is intact, else None (then recomputed, not reused; damaged files are moved aside, scenarios.integrity)."""
     from .runner import run_fingerprint
 
-    done = Path(case.out_dir) / "summary.json"
-    if not done.exists():
+    out = Path(case.out_dir)
+    s = read_summary(out / "summary.json")
+    if s is None or s.get("fingerprint") != run_fingerprint(params, cfg):
         return None
-    s = json.loads(done.read_text())
-    return s if s.get("fingerprint") == run_fingerprint(params, cfg) else None
+    return s if results_intact(out / "results.nc", s.get("samples")) else None
+
+
+def check_folders(cases: list[Case], cfg, overwrite: bool = False) -> None:
+    """Before any run starts: refuse (:class:`~scenarios.integrity.OtherResults`) when a case's folder holds
+    finished results of other parameters or settings and ``overwrite`` is not given; list every such folder."""
+    from .runner import parameters_fingerprint, run_fingerprint
+
+    others = []
+    for c in cases:
+        params, ccfg = build_params(c), _case_cfg(c, cfg)
+        try:
+            claim_folder(c.out_dir, parameters_fingerprint(params, ccfg), run_fingerprint(params, ccfg), overwrite)
+        except OtherResults:
+            others.append(c.out_dir)
+    if others:
+        raise OtherResults(f"{', '.join(others)} hold{'s' if len(others) == 1 else ''} finished results of other "
+                           f"parameters or settings; pass --overwrite to replace them, or choose another --out")
 
 
 def _is_finished(case: Case, cfg) -> bool:
@@ -70,7 +90,7 @@ def _is_finished(case: Case, cfg) -> bool:
         return False
 
 
-def execute_case(case: Case, cfg) -> dict:
+def execute_case(case: Case, cfg, overwrite: bool = False) -> dict:
     """Run one case (on whichever process). Returns its summary, or {"error": ...}; never raises."""
     from .runner import run_case
 
@@ -81,7 +101,8 @@ def execute_case(case: Case, cfg) -> dict:
         done = _finished(case, params, cfg)
         if done is not None:
             return {**done, "skipped": True}
-        s = run_case(params, cfg, out, label={"condition": case.condition, "direction": case.direction})
+        s = run_case(params, cfg, out, label={"condition": case.condition, "direction": case.direction},
+                     overwrite=overwrite)
         err = out / "error.json"
         if err.exists():
             err.unlink()
@@ -89,7 +110,10 @@ def execute_case(case: Case, cfg) -> dict:
     except Exception as exc:  # reported, never hidden; the sweep goes on
         out.mkdir(parents=True, exist_ok=True)
         info = {"case": case.label, "error": f"{type(exc).__name__}: {exc}", "traceback": traceback.format_exc()}
-        atomic_write_text(out / "error.json", json.dumps(info, indent=2))
+        try:
+            atomic_write_text(out / "error.json", json.dumps(info, indent=2))
+        except OSError:       # disk full or unwritable: the caller still gets the report
+            pass
         return info
 
 
@@ -130,8 +154,9 @@ class _RunBars:
 
 
 def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | None = None,
-              progress: bool = True) -> dict[str, dict]:
-    """Run every case; returns {label: summary or error}. One case runs in-process (no cluster)."""
+              progress: bool = True, overwrite: bool = False) -> dict[str, dict]:
+    """Run every case; returns {label: summary or error}. One case runs in-process (no cluster).
+    ``overwrite``: replace finished results of other parameters (else :func:`check_folders` refuses)."""
     from tqdm.auto import tqdm
 
     todo = [c for c in cases if not _is_finished(c, cfg)]
@@ -141,7 +166,7 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
     n_workers = workers or min(len(todo), os.cpu_count() or 1)
     if scheduler is None and n_workers <= 1:
         for c in tqdm(todo, desc="runs", disable=not progress or len(todo) == 1):
-            results[c.label] = execute_case(c, cfg)
+            results[c.label] = execute_case(c, cfg, overwrite)
         return results
     from dataclasses import replace
 
@@ -155,8 +180,9 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
         client = Client(cluster)
     else:
         client = Client(scheduler)
+    futs = {}
     try:
-        futs = {client.submit(execute_case, c, wcfg, pure=False, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
+        futs = {client.submit(execute_case, c, wcfg, overwrite, pure=False, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
         bar = tqdm(total=len(futs), desc="runs", disable=not progress, position=0)
         runs = _RunBars(todo, progress)
         while True:
@@ -179,8 +205,11 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
                 bar.write(f"run {c.label} failed: {results[c.label]['error']}")
         runs.close()
         bar.close()
+    except BaseException:       # Ctrl-C or a failure of the client: take its runs off the scheduler
+        client.cancel(list(futs), force=True)
+        raise
     finally:
         client.close()
         if cluster is not None:
-            cluster.close()
+            cluster.close()     # a local cluster's workers stop with it
     return results

@@ -31,7 +31,6 @@ fitted HHT orders, evaluation costs, the reference's pin-load range, and with --
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import shutil
@@ -46,6 +45,7 @@ from components.outputs import FAMILY
 
 from .numerics_common import (dpgt_problem, error_metrics, eval_costs, machine_note, observables, peak_rss_mb,
                               rig_problem, run_hht, run_scipy, settled_state, warm_up)
+from . import args
 from .command import command
 
 __all__ = ["main", "study", "FIELDS"]
@@ -290,16 +290,16 @@ def markdown(res: dict) -> str:
 
 @command
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--problems", default="rig,dpgt", help="comma-separated: rig, dpgt")
+    ap = args.Parser(prog="python -m scenarios.work_precision", description=__doc__.splitlines()[0])
+    ap.add_argument("--problems", default="rig,dpgt", type=args.choice_list(("rig", "dpgt"), "problems"), help="comma-separated: rig, dpgt")
     ap.add_argument("--quick", action="store_true", help="short window, fewer settings (minutes, not tens of minutes)")
-    ap.add_argument("--out", default="results/numerics", help="output directory")
-    ap.add_argument("--repeats", type=int, default=1, help="timing repeats per contender (median reported)")
-    ap.add_argument("--cap", type=float, default=None, help="wall-time cap per scipy run [s]")
-    ap.add_argument("--window", type=float, default=None, help="integration window after settling [s]")
+    ap.add_argument("--out", default="results/numerics", type=args.out_folder, help="output directory")
+    ap.add_argument("--repeats", type=args.count(1), default=1, help="timing repeats per contender (median reported)")
+    ap.add_argument("--cap", type=args.positive("s"), default=None, help="wall-time cap per scipy run [s]")
+    ap.add_argument("--window", type=args.positive("s"), default=None, help="integration window after settling [s]")
     ap.add_argument("--floor-check", action="store_true",
                     help="also rerun HHT alpha=0 at the three smallest h with Newton tolerances 0.03, 1e-3, 1e-5")
-    ap.add_argument("--figures", default=None, help="also copy the PNGs into this directory (e.g. docs/numerics)")
+    ap.add_argument("--figures", default=None, type=args.out_folder, help="also copy the PNGs into this directory (e.g. docs/numerics)")
     a = ap.parse_args(argv)
     probs = [p.strip() for p in a.problems.split(",") if p.strip()]
     bad = set(probs) - {"rig", "dpgt"}

@@ -38,7 +38,7 @@ def test_debug_shows_the_traceback():
 
 def test_a_bad_condition_through_the_dpgt_command(tmp_path, capsys):
     assert cli.main(["paper_study", "--conditions", "7", "--out", str(tmp_path)]) == USAGE
-    assert capsys.readouterr().err.strip() == "error: --conditions takes 1, 2, 3 and/or 4 (PARAMETERS.md), got 7"
+    assert capsys.readouterr().err.strip() == "error: argument --conditions: takes 1, 2, 3 and/or 4 (PARAMETERS.md), got '7'"
     assert paper_study.main(["--set", 'bearing.clearance=-1 um', "--out", str(tmp_path)]) == USAGE
     assert "bearing.clearance" in capsys.readouterr().err
 
@@ -55,3 +55,51 @@ def test_a_failed_rerun_keeps_the_finished_summaries_in_the_tables(tmp_path):
     assert results["c4_forward"]["inner"] == {"bearing_load_mean_N": 1.0}
     assert results["c4_forward"]["stale_after_failure"] == "boom"      # still reported as failed
     assert results["c4_reverse"] == {"error": "bang"}                 # a damaged summary is not used
+
+
+# every command checks all its arguments before anything runs: one line naming the argument, exit 2
+BAD_ARGUMENTS = [
+    ("paper_study", ["--conditions", ""], "--conditions: expected a comma list"),
+    ("paper_study", ["--conditions", "3,x"], "--conditions: takes 1, 2, 3"),
+    ("paper_study", ["--directions", " , "], "--directions: expected a comma list"),
+    ("paper_study", ["--directions", "backward"], "--directions: takes directions"),
+    ("paper_study", ["--window", "-0.01"], "--window: must be > 0 s"),
+    ("paper_study", ["--window", "nan"], "--window: expected a finite number"),
+    ("paper_study", ["--settle", "abc"], "--settle: expected a number >= 0 s"),
+    ("paper_study", ["--h", "0"], "--h: must be > 0 and <= 0.001 s"),
+    ("paper_study", ["--alpha", "0.2"], "--alpha: HHT alpha must be in [-1/3, 0]"),
+    ("paper_study", ["--sample-rate", "0"], "--sample-rate: must be > 0 Hz"),
+    ("paper_study", ["--workers", "0"], "--workers: must be a whole number in [1"),
+    ("paper_study", ["--planets", "two"], "--planets: expected a whole number"),
+    ("paper_study", ["--option", "drag"], "--option: expects KEY=VALUE"),
+    ("paper_study", ["--params", "/no/such.toml"], "--params: no such file"),
+    ("paper_study", ["--scheduler", "my laptop"], "--scheduler: expected a Dask scheduler address"),
+    ("paper_study", ["--method", "rk4"], "--method: invalid choice"),
+    ("paper_study", ["--frobnicate"], "unrecognized arguments: --frobnicate"),
+    ("lubricant_study", ["--grades", "VG1000"], "--grades: takes ISO VG grades"),
+    ("lubricant_study", ["--directions", ""], "--directions: expected a comma list"),
+    ("spectrum", ["--power", "200 kg"], "--power: expected a power"),
+    ("spectrum", ["--carrier-rpm", "-5"], "--carrier-rpm: must be > 0 r/min"),
+    ("bearing_rig", ["--radial-load", "0 N"], "--radial-load: must be > 0"),
+    ("bearing_rig", ["--rollers", "2"], "--rollers: must be a whole number in [3"),
+    ("modal", ["--condition", "5"], "--condition: must be a whole number in [1, 4]"),
+    ("stability", ["--scipy", "Radau:x"], "--scipy: expects METHOD:RTOL"),
+    ("stability", ["--cases", "nonsense"], "--cases: takes cases"),
+    ("work_precision", ["--problems", "ring"], "--problems: takes problems"),
+    ("benchmark", ["--scipy-methods", "Euler"], "--scipy-methods: takes scipy methods"),
+    ("bench_engine", ["--steps", "-1"], "--steps: must be a whole number"),
+]
+
+
+@pytest.mark.parametrize("name,argv,words", BAD_ARGUMENTS)
+def test_bad_arguments_are_one_line_usage_errors(name, argv, words, tmp_path, capsys):
+    assert cli.main([name, *argv, *(["--out", str(tmp_path)] if name != "bench_engine" else [])]) == USAGE
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and words in err and err.count("\n") == 1, err
+    assert list(tmp_path.iterdir()) == []        # nothing ran, nothing was written
+
+
+def test_an_output_folder_that_cannot_exist_is_a_usage_error(tmp_path, capsys):
+    (tmp_path / "a_file").write_text("")
+    assert cli.main(["paper_study", "--out", str(tmp_path / "a_file" / "out")]) == USAGE
+    assert "argument --out: cannot make the folder" in capsys.readouterr().err

@@ -39,4 +39,4 @@ def test_a_rerun_resumes_and_bad_oils_are_refused(study, capsys):
     assert lubricant_study.main(ARGS + ["--out", str(study)]) == 0    # every run finished: nothing recomputed
     assert (study / "summary.csv").read_text() == before
     assert lubricant_study.main(ARGS[:4] + ["--grades", "VG46", "--out", str(study)]) == 2
-    assert "error: lubricant grade" in capsys.readouterr().err
+    assert "error: argument --grades: takes ISO VG grades" in capsys.readouterr().err

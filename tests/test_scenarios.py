@@ -190,7 +190,7 @@ def test_spectrum_rejects_inconsistent_sun_speed(tmp_path):
     assert "3290" in str(e.value)
 
 
-def test_bearing_rig_scenario(tmp_path):
+def test_bearing_rig_scenario(tmp_path, capsys):
     from scenarios import bearing_rig
 
     s = bearing_rig.run(bearing_rig.parse_args(["--radial-load", "5 kN", "--clearance", "20 um", "--out", str(tmp_path)]))
@@ -205,8 +205,12 @@ def test_bearing_rig_scenario(tmp_path):
     assert s["q_max_N"] == pytest.approx(s["discrete_theory"]["q_max_N"], rel=0.02)
     assert 0 < s["load_zone_deg"] < 180 and s["ring_deflection_m"] > 0
     assert (tmp_path / "load_distribution.png").exists()
-    with pytest.raises(SystemExit, match="radial_load"):
-        bearing_rig.run(bearing_rig.parse_args(["--radial-load", "5 m", "--out", str(tmp_path)]))
+    # run time and accuracy, stored and printed like the study's (an adaptive run holds its tolerance)
+    e = s["error_estimate"]
+    assert s["steps"] > 0 and 0 < e["rms"] <= e["max"] <= 1.5 and e["atol_m"] == 1e-8
+    assert "run time and accuracy: " in capsys.readouterr().out
+    with pytest.raises(SystemExit, match="radial-load: expected a force"):
+        bearing_rig.parse_args(["--radial-load", "5 m", "--out", str(tmp_path)])
 
 
 def test_modal_scenario_single_planetary(tmp_path):
@@ -226,7 +230,7 @@ def test_modal_scenario_single_planetary(tmp_path):
 
 def test_stale_results_are_recomputed_not_reused(zero_power_study, tmp_path):
     """A finished case is reused only when its parameters, settings and code are the same: the
-    fingerprint in summary.json decides (changing a parameter into the same folder recomputes)."""
+    fingerprint in summary.json decides (changing a parameter into the same folder recomputes, with --overwrite)."""
     from dataclasses import replace
 
     from scenarios.runner import run_fingerprint
@@ -246,9 +250,11 @@ def test_stale_results_are_recomputed_not_reused(zero_power_study, tmp_path):
     assert _finished(case, params, replace(cfg, window=2 * cfg.window)) is None
     other = replace(case, overrides={**case.overrides, "bearing.rollers": "10"})
     assert _finished(other, build_params(other), cfg) is None
-    # a checkpoint left by another run is not resumed: run_case starts afresh (and says so)
+    # a checkpoint left by another run is not resumed: run_case starts afresh (and says so); the finished
+    # results of other parameters are replaced only when asked (--overwrite, scenarios.integrity)
     a2 = paper_study.parse_args(["--conditions", "4", "--directions", "forward", "--out", str(out), "--settle", "0.002",
-                                 "--window", "0.001", "--set", "bearing.rollers=10", "--no-progress", "--workers", "1"])
+                                 "--window", "0.001", "--set", "bearing.rollers=10", "--no-progress", "--workers", "1",
+                                 "--overwrite"])
     (out / "c4_forward" / "checkpoint.npz").write_bytes(b"not this run's checkpoint")
     r = paper_study.run(a2)
     assert not r["failed"]

@@ -1,0 +1,131 @@
+"""What a run folder holds is checked before it is used (README "What a user can expect").
+
+* A damaged file — a checkpoint or recorder chunk that does not load, a ``summary.json`` that is not a JSON
+  object, a ``results.nc`` that does not open or holds fewer samples than its summary says — is named in a
+  warning, moved aside (renamed ``NAME.damaged-YYYYmmdd-HHMMSS``, never deleted) and recomputed.
+* Finished results are never replaced silently by a run of other parameters: a folder whose ``summary.json``
+  was made from other parameters or settings is refused (:class:`OtherResults`, a usage error) unless the
+  user passes ``--overwrite``. The same parameters made by other code are recomputed (and said so).
+"""
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+__all__ = ["OtherResults", "move_aside", "read_summary", "results_intact", "checkpoint_usable", "claim_folder",
+           "DAMAGED"]
+
+DAMAGED = ".damaged-"
+
+
+class OtherResults(Exception):
+    """The folder holds finished results of other parameters (the message names them and the way out)."""
+
+
+def warn(msg: str) -> None:
+    print(f"warning: {msg}", file=sys.stderr, flush=True)
+
+
+def move_aside(path, why: str, into=None) -> Path:
+    """Rename a damaged ``path`` to NAME.damaged-STAMP (in ``into`` or beside it), say so, return the new path."""
+    path = Path(path)
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    dest = Path(into or path.parent) / f"{path.name}{DAMAGED}{stamp}"
+    n = 1
+    while dest.exists():
+        dest = dest.with_name(f"{path.name}{DAMAGED}{stamp}-{n}")
+        n += 1
+    os.replace(path, dest)
+    warn(f"{path} is damaged ({why}); moved aside to {dest.name}, recomputing")
+    return dest
+
+
+def read_summary(path) -> dict | None:
+    """The summary at ``path``; None when absent or damaged (a damaged one is moved aside)."""
+    path = Path(path)
+    if not path.exists():
+        return None
+    try:
+        s = json.loads(path.read_text())
+    except (OSError, ValueError, UnicodeDecodeError) as exc:
+        move_aside(path, f"not readable JSON: {type(exc).__name__}")
+        return None
+    if not isinstance(s, dict):
+        move_aside(path, "not a JSON object")
+        return None
+    return s
+
+
+def results_intact(path, samples: int | None = None) -> bool:
+    """Whether the results file opens and holds ``samples`` time samples; a damaged one is moved aside."""
+    path = Path(path)
+    if not path.exists():
+        return False
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            n = int(f["time"].shape[0])
+    except Exception as exc:        # h5py raises OSError, KeyError, ValueError... for a broken file
+        move_aside(path, f"does not open as netCDF4/HDF5: {type(exc).__name__}")
+        return False
+    if samples is not None and n != samples:
+        move_aside(path, f"{n} time samples where its summary says {samples}")
+        return False
+    return True
+
+
+def _npz_loads(path) -> bool:
+    import numpy as np
+
+    try:
+        with np.load(path) as d:
+            for k in d.files:
+                d[k]
+        return True
+    except Exception:               # zipfile.BadZipFile, EOFError, ValueError, OSError ...
+        return False
+
+
+def checkpoint_usable(ckpt, parts) -> bool:
+    """Whether the checkpoint and the recorder chunks it relies on load. A damaged checkpoint is moved
+    aside; a damaged chunk too, and with it the checkpoint (it cannot resume without the chunk's samples)."""
+    from mbd.simulate import load_state
+
+    ckpt, parts = Path(ckpt), Path(parts)
+    if not ckpt.exists():
+        return False
+    try:
+        _, extra = load_state(ckpt)
+        n_chunks = int(extra.get("recorder", {}).get("n_chunks", 0))
+    except Exception as exc:
+        move_aside(ckpt, f"does not load: {type(exc).__name__}")
+        return False
+    for i in range(n_chunks):
+        chunk = parts / f"chunk_{i:06d}.npz"
+        if not chunk.exists() or not _npz_loads(chunk):
+            if chunk.exists():
+                move_aside(chunk, "recorder chunk does not load", into=ckpt.parent)
+            move_aside(ckpt, f"its recorded samples ({chunk.name}) are {'damaged' if chunk.exists() else 'missing'}")
+            return False
+    return True
+
+
+def claim_folder(folder, parameters_fp: str, full_fp: str | None, overwrite: bool, what: str = "") -> str:
+    """Check that ``folder`` may take a run of these parameters: "new" (nothing finished there), "same"
+    (finished from the same parameters and code), "recompute" (same parameters, other code) or "overwrite"
+    (other parameters, ``overwrite`` given). Other parameters without ``overwrite``: :class:`OtherResults`."""
+    s = read_summary(Path(folder) / "summary.json")
+    if s is None:
+        return "new"
+    if full_fp is not None and s.get("fingerprint") == full_fp:
+        return "same"
+    if s.get("parameters_fingerprint") == parameters_fp:
+        return "recompute"
+    if overwrite:
+        return "overwrite"
+    raise OtherResults(f"{folder} holds finished results of other parameters or settings{what}; pass --overwrite "
+                       f"to replace them, or choose another --out")

@@ -1,0 +1,286 @@
+"""Nothing a user does loses results (issue 17): folders of other parameters, damaged files, disk full,
+interrupted sweeps — one test per class, on a tiny window (8 rollers, 0.5 ms settle + 0.5 ms window)."""
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from scenarios import paper_study
+from scenarios.integrity import DAMAGED, OtherResults, checkpoint_usable
+from scenarios.runner import RunConfig
+from scenarios.sweep import Case, _finished, build_params, check_folders, run_sweep
+
+CFG = RunConfig(settle=0.0005, window=0.0005, progress=False)
+TINY = ["--conditions", "4", "--directions", "forward", "--settle", "0.0005", "--window", "0.0005",
+        "--no-progress", "--workers", "1"]
+
+
+def _case(folder, rollers=8):
+    return Case(4, "forward", str(folder), {"bearing.rollers": rollers})
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """A finished tiny run (its folder is copied by each test that changes it)."""
+    out = tmp_path_factory.mktemp("finished") / "c4_forward"
+    r = run_sweep([_case(out)], CFG, workers=1, progress=False)["c4_forward"]
+    assert "error" not in r
+    return out
+
+
+def _copy(finished, tmp_path):
+    dst = tmp_path / "c4_forward"
+    shutil.copytree(finished, dst)
+    return dst
+
+
+def _moved_aside(folder, name):
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith(name + DAMAGED))
+
+
+def test_other_parameters_are_refused_unless_overwrite(finished, tmp_path, capsys):
+    run = _copy(finished, tmp_path)
+    before = (run / "summary.json").read_bytes()
+    with pytest.raises(OtherResults, match="--overwrite"):
+        check_folders([_case(run, rollers=10)], CFG)
+    check_folders([_case(run, rollers=8)], CFG)                    # the same parameters: fine (resumes)
+    check_folders([_case(run, rollers=10)], CFG, overwrite=True)   # asked for
+    # through the command: a usage error in one line before anything runs, the finished results untouched
+    code = paper_study.main(TINY + ["--set", "bearing.rollers=10", "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith("error: ") and "--overwrite" in err and err.count("\n") == 1
+    assert (run / "summary.json").read_bytes() == before
+
+
+def test_a_damaged_summary_is_moved_aside_and_recomputed(finished, tmp_path, capsys):
+    run = _copy(finished, tmp_path)
+    (run / "summary.json").write_text('{"inner": {"bearing_load_mean_N": 1')      # cut off mid-write
+    assert _finished(_case(run), build_params(_case(run)), CFG) is None
+    assert len(_moved_aside(run, "summary.json")) == 1 and "summary.json" in capsys.readouterr().err
+    r = run_sweep([_case(run)], CFG, workers=1, progress=False)["c4_forward"]
+    assert "error" not in r and json.loads((run / "summary.json").read_text())["rollers"] == 8
+
+
+def test_a_finished_run_with_damaged_results_is_recomputed_not_skipped(finished, tmp_path, capsys):
+    run = _copy(finished, tmp_path)
+    data = (run / "results.nc").read_bytes()
+    (run / "results.nc").write_bytes(data[: len(data) // 3])                      # truncated
+    r = run_sweep([_case(run)], CFG, workers=1, progress=False)["c4_forward"]
+    assert "skipped" not in r and "error" not in r
+    assert len(_moved_aside(run, "results.nc")) == 1 and "results.nc is damaged" in capsys.readouterr().err
+    import h5py
+    with h5py.File(run / "results.nc", "r") as f:
+        assert f["time"].shape[0] == r["samples"]
+
+
+def test_a_damaged_checkpoint_or_chunk_is_moved_aside_and_the_run_starts_afresh(finished, tmp_path, capsys):
+    import mbd
+    from mbd.simulate import save_state
+
+    run = _copy(finished, tmp_path)
+    (run / "summary.json").unlink()                  # an unfinished run: the checkpoint is what it has
+    (run / "checkpoint.npz").write_bytes(b"PK\x03\x04 cut off")
+    assert not checkpoint_usable(run / "checkpoint.npz", run / "results.nc.parts")
+    assert len(_moved_aside(run, "checkpoint.npz")) == 1
+    # a loadable checkpoint whose recorder chunk is damaged cannot resume: both go aside
+    state = mbd.State(0.001, np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), {})
+    save_state(run / "checkpoint.npz", state, {"recorder": {"n_chunks": 1, "next_index": 5}})
+    (run / "results.nc.parts").mkdir()
+    (run / "results.nc.parts" / "chunk_000000.npz").write_bytes(b"garbage")
+    assert not checkpoint_usable(run / "checkpoint.npz", run / "results.nc.parts")
+    assert len(_moved_aside(run, "chunk_000000.npz")) == 1 and len(_moved_aside(run, "checkpoint.npz")) == 2
+    # end to end: a damaged checkpoint of this very run (same fingerprint) never blocks it
+    (run / "checkpoint.npz").write_bytes(b"not a zip file")
+    r = run_sweep([_case(run)], CFG, workers=1, progress=False)["c4_forward"]
+    assert "error" not in r and r["resumed_from_s"] is None
+    assert len(_moved_aside(run, "checkpoint.npz")) == 3 and "checkpoint.npz is damaged" in capsys.readouterr().err
+
+
+def _no_space_for(names, monkeypatch):
+    """os.replace fails with ENOSPC when it would put one of ``names`` in place (the write itself went to a
+    temporary file, as on a disk that fills up while a results file is written)."""
+    import errno
+    import os
+
+    real = os.replace
+
+    def replace(src, dst, *a, **k):
+        if os.path.basename(dst) in names:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(dst))
+        return real(src, dst, *a, **k)
+    monkeypatch.setattr(os, "replace", replace)
+
+
+def _leftovers(folder):
+    return [p for p in folder.rglob("*") if ".tmp" in p.name]
+
+
+def test_disk_full_keeps_earlier_results_and_leaves_no_temporary_files(finished, tmp_path, monkeypatch, capsys):
+    from scenarios.command import FAILED, command
+    from scenarios.runner import run_case
+
+    run = _copy(finished, tmp_path)
+    before = {n: (run / n).read_bytes() for n in ("results.nc", "summary.json")}
+    _no_space_for({"results.nc"}, monkeypatch)
+    code = paper_study.main(TINY + ["--set", "bearing.rollers=10", "--overwrite", "--out", str(tmp_path)])
+    assert code == FAILED and "No space left on device" in capsys.readouterr().out
+    assert {n: (run / n).read_bytes() for n in before} == before and not _leftovers(tmp_path)
+    # the same fault outside a sweep reaches the command: one line, exit 1, what to do
+    _no_space_for({"summary.json"}, monkeypatch)
+    main = command(lambda argv: run_case(build_params(_case(run, 10)), CFG, run, overwrite=True))
+    assert main([]) == FAILED
+    err = capsys.readouterr().err
+    assert err.startswith("error: No space left on device") and "run the same command again" in err
+    assert err.count("\n") == 1 and (run / "summary.json").read_bytes() == before["summary.json"]
+    assert not _leftovers(tmp_path)
+
+
+def test_an_unwritable_output_folder_is_one_line(tmp_path, monkeypatch, capsys):
+    import errno
+    import os
+
+    from scenarios.command import FAILED, command
+    from mbd.recorder import atomic_write_text
+
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    code = paper_study.main(TINY + ["--out", str(blocker / "out")])      # a folder that cannot exist
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith("error: argument --out") and "a_file" in err and err.count("\n") == 1
+    # a folder whose files cannot be replaced (read-only file system): the old file stays, no temporary left
+    (tmp_path / "summary.json").write_text("old")
+    real = os.replace
+    monkeypatch.setattr(os, "replace", lambda s, d: (_ for _ in ()).throw(
+        OSError(errno.EROFS, os.strerror(errno.EROFS), str(d))) if str(d).endswith("summary.json") else real(s, d))
+    assert command(lambda argv: atomic_write_text(tmp_path / "summary.json", "new"))([]) == FAILED
+    err = capsys.readouterr().err
+    assert "Read-only file system" in err and "--out" in err and err.count("\n") == 1
+    assert (tmp_path / "summary.json").read_text() == "old" and not _leftovers(tmp_path)
+
+
+class _FakeFuture:
+    def done(self):
+        return False
+
+
+class _FakeClient:
+    """Stands in for dask.distributed.Client: records what the sweep asks of the scheduler."""
+    made = []
+
+    def __init__(self, address=None):
+        self.address, self.submitted, self.cancelled, self.closed = address, [], [], False
+        _FakeClient.made.append(self)
+
+    def submit(self, fn, *a, **k):
+        self.submitted.append(_FakeFuture())
+        return self.submitted[-1]
+
+    def cancel(self, futures, force=False):
+        self.cancelled += list(futures)
+
+    def close(self):
+        self.closed = True
+
+
+class _FakeCluster:
+    made = []
+
+    def __init__(self, **k):
+        self.closed = False
+        _FakeCluster.made.append(self)
+
+    def close(self):
+        self.closed = True
+
+
+@pytest.mark.parametrize("scheduler", ["tcp://elsewhere:8786", None])
+def test_an_interrupted_sweep_cancels_its_runs_and_stops_local_workers(scheduler, tmp_path, monkeypatch):
+    import time
+
+    import dask.distributed
+
+    _FakeClient.made.clear()
+    _FakeCluster.made.clear()
+    monkeypatch.setattr(dask.distributed, "Client", _FakeClient)
+    monkeypatch.setattr(dask.distributed, "LocalCluster", _FakeCluster)
+
+    def ctrl_c(_):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(time, "sleep", ctrl_c)        # the user presses Ctrl-C while the runs are out
+    cases = [_case(tmp_path / "a"), Case(4, "reverse", str(tmp_path / "b"), {"bearing.rollers": 8})]
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(cases, CFG, workers=2, scheduler=scheduler, progress=False)
+    client, = _FakeClient.made
+    assert len(client.submitted) == 2 and client.cancelled == client.submitted and client.closed
+    assert [c.closed for c in _FakeCluster.made] == ([] if scheduler else [True])
+
+
+def test_a_fixed_step_run_beyond_its_tolerance_warns(finished, tmp_path, capsys):
+    from scenarios.runner import FIXED_STEP_ERROR_FACTOR
+
+    assert json.loads((finished / "summary.json").read_text())["warnings"] == []       # adaptive: none
+    code = paper_study.main(TINY + ["--method", "hht-fixed", "--h", "1e-5", "--out", str(tmp_path)])
+    s = json.loads((tmp_path / "c4_forward" / "summary.json").read_text())
+    assert code == 0 and s["error_estimate"]["rms"] > FIXED_STEP_ERROR_FACTOR      # 10 us from the start: ~30 x
+    assert len(s["warnings"]) == 1 and "fixed step h = 1e-05 s" in s["warnings"][0]
+    assert f"c4_forward: warning: {s['warnings'][0]}" in capsys.readouterr().out
+
+
+def test_wall_time_of_a_resumed_run_counts_every_segment(tmp_path, monkeypatch):
+    """Interrupted late in its run, resumed from the checkpoint: wall_s is the first segment's time plus
+    the second's, not the second's alone."""
+    import dataclasses
+    import time
+
+    import mbd
+    from scenarios import runner
+
+    real = mbd.simulate
+    calls = []
+
+    class CtrlC(mbd.Observer):
+        def step(self, s0, s1):
+            if s1.t > 0.8 * CFG.settle + 0.8 * CFG.window:
+                raise KeyboardInterrupt
+
+    def simulate(*a, observers=(), **k):
+        calls.append(1)
+        return real(*a, observers=[*observers, *([CtrlC()] if len(calls) == 1 else [])], **k)
+    monkeypatch.setattr(mbd, "simulate", simulate)
+    cfg = dataclasses.replace(CFG, checkpoint_every=20)
+    params = build_params(_case(tmp_path))
+    with pytest.raises(KeyboardInterrupt):
+        runner.run_case(params, cfg, tmp_path)
+    first = json.loads((tmp_path / "progress.json").read_text())["wall_s"]
+    t0 = time.perf_counter()
+    s = runner.run_case(params, cfg, tmp_path)
+    second = time.perf_counter() - t0
+    assert s["resumed_from_s"] is not None and s["resumed_from_s"] > 0.5 * (CFG.settle + CFG.window)
+    assert first < s["wall_s"] <= first + second
+
+
+def test_colliding_gears_are_refused_unless_forced(tmp_path, capsys):
+    from scenarios.plausibility import check_runs
+
+    code = paper_study.main(TINY + ["--planets", "4", "--out", str(tmp_path)])      # 4 pairs do not fit
+    err = capsys.readouterr().err
+    assert code == 2 and "would collide" in err and "--force" in err and err.count("\n") == 1
+    assert not (tmp_path / "c4_forward").exists()
+    params = build_params(Case(4, "forward", str(tmp_path), {"gears.planets": 4}))
+    forced = check_runs([("c4_forward", params, CFG)], tmp_path, force=True)
+    assert len(forced) == 1 and "gears.planets" in forced[0]
+
+
+def test_output_size_is_estimated_and_checked_before_starting(tmp_path, monkeypatch, capsys):
+    from scenarios import plausibility
+
+    # 1 GHz over 0.5 ms: 5e5 samples of 1632 values (12 rollers), 8 bytes, twice while joined: 13.0 GB
+    assert paper_study.main(TINY + ["--sample-rate", "1e9", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "the recording would take 13.0 GB" in err and "more than 5 GB" in err and "--sample-rate" in err
+    monkeypatch.setattr(plausibility, "_free", lambda folder: 1e3)                  # a nearly full disk
+    assert paper_study.main(TINY + ["--out", str(tmp_path)]) == 2
+    assert "GB free" in capsys.readouterr().err and not (tmp_path / "c4_forward").exists()
