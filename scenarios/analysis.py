@@ -47,16 +47,17 @@ def peak_table(f: np.ndarray, amp: np.ndarray, centre: float, span: float, expec
 
 
 def line_table(f: np.ndarray, amp: np.ndarray, lines: dict[str, float], band: tuple[float, float]) -> list[dict]:
-    """Each expected line: its amplitude (the largest bin within one bin of it — a Hann window spreads a
-    line that falls between bins over two) and that amplitude over the median amplitude of the band
-    [lo, hi] (the spectrum's floor there: most of its bins hold no line)."""
+    """Each expected line: its amplitude (its bin; for a line between bins, the larger of the two that
+    bracket it — a Hann window spreads such a line over both) and that amplitude over the median amplitude
+    of the band [lo, hi] (the spectrum's floor there: most of its bins hold no line)."""
     f, amp = np.asarray(f, float), np.asarray(amp, float)
     df = f[1] - f[0]
     floor = float(np.median(amp[(f >= band[0]) & (f <= band[1])]))
     rows = []
     for label, fl in lines.items():
-        near = np.abs(f - fl) <= 1.0001 * df
-        a = float(amp[near].max()) if near.any() else float("nan")
+        x = (fl - f[0]) / df
+        lo, hi = (round(x),) * 2 if abs(x - round(x)) < 1e-6 else (int(np.floor(x)), int(np.ceil(x)))
+        a = float(max(amp[lo], amp[hi])) if 0 <= lo and hi < f.size else float("nan")
         rows.append({"line": label, "frequency_hz": float(fl), "amplitude": a,
                      "over_median": a / floor if floor > 0 else float("inf")})
     return rows

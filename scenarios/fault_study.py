@@ -3,15 +3,17 @@
     python -m scenarios.fault_study [--condition 2] [--directions forward,reverse]
         [--faults pinhole,runout,roller,spall_pin,spall_bore,cracked_tooth,missing_tooth]
         [--machine NAME=FILE.toml ...] [--settle S] [--window S] [--sample-rate HZ]
-        [--set KEY=VALUE ...] [--workers N | --scheduler ADDR] [--out DIR]
+        [--set KEY=VALUE ...] [--workers N | --scheduler ADDR] [--force] [--overwrite] [--out DIR]
 
 Every fault (the catalogue :data:`FAULTS`, each a stated size with its basis; or a damaged machine described
 in a TOML file, README "A damaged machine") runs beside the perfect machine in every direction, through the
 one runner (resumable, on Dask like the other studies). Per run and bearing type the table holds the
 planet-bearing loads (per planet and the load-sharing factor K_γ), the most loaded roller, cage slip,
-pocket impacts and cage acceleration, the bearing lives (ISO 281 relative to the perfect machine), and the
-sensor spectrum's amplitude at f_m, f_m ± f_c, f_m ± 3 f_c and at the fault's own frequencies (roller-pass
-frequencies over pin and bore, the rotation of the faulty gear, the cage's revolution).
+pocket impacts and cage acceleration, the bearing lives of pair 1 (whose planet b1 carries the catalogue's
+faults: ISO 281's and the roller-load ISO/TS 16281-style life in hours, and the latter relative to the perfect
+machine), and the housing sensor's lines f_m, f_m ± f_c, f_m ± 3 f_c and f_m ± the fault's own frequency
+(roller-pass frequencies over pin and bore, the rotation of the faulty gear, the cage's revolution), each as
+its amplitude over the band's median (the spectrum's floor).
 
 Writes ``summary.csv`` / ``summary.md``, ``spectra.png`` (each fault's sensor spectrum against the perfect
 machine's, its characteristic frequencies marked), ``loads.png`` and ``study.json``.
@@ -33,11 +35,14 @@ import mbd
 from components.units import ParameterError
 from mbd.recorder import atomic_write_text
 
+from . import args
 from .command import command
 from .lock import holds_out_folder
 from .paper_study import parse_sets
+from .plausibility import check_runs
 from .runner import RunConfig
-from .sweep import Case, build_params, run_sweep
+from .analysis import line_table
+from .sweep import Case, build_params, check_folders, run_sweep
 
 __all__ = ["FAULTS", "main", "run", "characteristic_frequencies", "COLUMNS"]
 
@@ -62,50 +67,61 @@ FAULTS = {
                       "the same tooth missing"),
 }
 COLUMNS = ["fault", "direction", "bearing", "load_sharing_factor", "bearing_load_mean_N", "bearing_load_max_N",
-           "roller_max_N", "life_relative", "cage_slip_pct", "pocket_impacts_per_rev", "cage_acc_rel_rms",
+           "roller_max_N", "life_iso281_h", "life_iso16281_h", "life_relative", "cage_slip_pct",
+           "pocket_impacts_per_rev", "cage_acc_rel_rms",
            "sensor_f_m", "sensor_f_m-1f_c", "sensor_f_m+1f_c", "sensor_f_m-3f_c", "sensor_f_m+3f_c",
            "sensor_own", "own_frequency"]
-LIFE_EXPONENT = 10.0 / 3.0
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(prog="python -m scenarios.fault_study", description=__doc__.split("\n\n")[0])
-    p.add_argument("--condition", type=int, default=2, choices=(1, 2, 3, 4),
-                   help="operating condition (default 2: carrier 2000 r/min, the source's rig speed)")
-    p.add_argument("--directions", default="forward,reverse", help="comma list: forward, reverse")
-    p.add_argument("--faults", default=",".join(FAULTS), help=f"comma list from {', '.join(FAULTS)} ('' for none)")
-    p.add_argument("--machine", action="append", default=[], metavar="NAME=FILE.toml",
+    p = args.Parser(prog="python -m scenarios.fault_study", description=__doc__.split("\n\n")[0])
+    p.add_argument("--condition", type=args.count(1, 4), default=2,
+                   help="operating condition 1-4 (default 2: carrier 2000 r/min, the source's rig speed)")
+    p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
+    p.add_argument("--faults", default=",".join(FAULTS), type=_fault_list,
+                   help=f"comma list from {', '.join(FAULTS)} ('' for none: only --machine)")
+    p.add_argument("--machine", action="append", default=[], metavar="NAME=FILE.toml", type=_machine,
                    help="a damaged machine described in a TOML file (repeatable)")
-    p.add_argument("--settle", type=float, default=0.03, help="seconds discarded after the start (default 0.03)")
-    p.add_argument("--window", type=float, default=0.1,
+    p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded after the start (default 0.03)")
+    p.add_argument("--window", type=args.positive("s"), default=0.1,
                    help="seconds analysed (default 0.1: 10 Hz resolution, the f_c sidebands at 2000 r/min)")
-    p.add_argument("--sample-rate", type=float, default=20000.0, help="recording rate [Hz] (> 2 f_m)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a parameter (repeatable)")
-    p.add_argument("--workers", type=int, default=None, help="Dask local workers (default: one per core)")
-    p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
+    p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz] (> 2 f_m)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
+                   help="override a parameter (repeatable)")
+    p.add_argument("--workers", type=args.count(1), default=None, help="Dask local workers (default: one per core)")
+    p.add_argument("--scheduler", default=None, type=args.scheduler, help="address of an existing Dask scheduler")
+    p.add_argument("--force", action="store_true",
+                   help="run although the gears collide or the recording is too large for the limit or the disk")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace finished results of other parameters or settings in --out (else refused)")
     p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--out", default="results/faults", help="output directory")
+    p.add_argument("--out", default="results/faults", type=args.out_folder, help="output directory")
     return p.parse_args(argv)
 
 
-def make_cases(a, out: Path) -> list[Case]:
-    dirs = [d.strip() for d in str(a.directions).split(",") if d.strip()]
-    if not dirs or any(d not in ("forward", "reverse") for d in dirs):
-        raise ParameterError.at("--directions", f"expected a comma list of forward, reverse; got {a.directions!r}")
-    names = [f.strip() for f in str(a.faults).split(",") if f.strip()]
+def _fault_list(text: str) -> list[str]:
+    names = [f.strip() for f in text.split(",") if f.strip()]
     unknown = [f for f in names if f not in FAULTS]
     if unknown:
-        raise ParameterError.at("--faults", f"unknown {unknown}; the catalogue has {', '.join(FAULTS)}")
+        raise argparse.ArgumentTypeError(f"unknown fault(s) {unknown}; the catalogue has {', '.join(FAULTS)}")
+    return names
+
+
+def _machine(text: str) -> tuple[str, str]:
+    name, _, path = text.partition("=")
+    if not name.strip() or not path.strip():
+        raise argparse.ArgumentTypeError(f"expected NAME=FILE.toml, got {text!r}")
+    return name.strip(), args.existing_file(path.strip())
+
+
+def make_cases(a, out: Path) -> list[Case]:
     machines: dict[str, tuple[dict, str | None]] = {"perfect": ({}, None)}
-    machines.update({f: (FAULTS[f][0], None) for f in names})
-    for m in a.machine:
-        name, _, path = m.partition("=")
-        if not name.strip() or not path.strip() or not Path(path.strip()).is_file():
-            raise ParameterError.at("--machine", f"expected NAME=FILE.toml with an existing file, got {m!r}")
-        machines[name.strip()] = ({}, path.strip())
+    machines.update({f: (FAULTS[f][0], None) for f in a.faults})
+    for name, path in a.machine:
+        machines[name] = ({}, str(path))
     user = parse_sets(a.set)
     return [Case(a.condition, d, str(out / f"{name}_{d}"), {**user, **ov}, path, tag=name)
-            for name, (ov, path) in machines.items() for d in dirs]
+            for name, (ov, path) in machines.items() for d in a.directions.split(",")]
 
 
 def characteristic_frequencies(si) -> dict[str, float]:
@@ -152,12 +168,6 @@ def sensor_spectrum(run_dir: Path, f_c: float):
     return f, amp
 
 
-def _amplitude_at(f, amp, f0: float) -> float:
-    """Largest amplitude within ±1 bin of f0 (a Hann-windowed line spreads over its neighbours)."""
-    i = int(np.argmin(np.abs(f - f0)))
-    return float(amp[max(i - 1, 0):i + 2].max())
-
-
 def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
     rows, spectra = [], {}
     perfect = {c.direction: results.get(c.label, {}) for c in cases if c.tag == "perfect"}
@@ -170,20 +180,25 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
         f, amp = sensor_spectrum(Path(case.out_dir), fr["f_c"])
         own = _own_frequency(case, si, fr)
         spectra[(case.tag, case.direction)] = (f, amp, fr, own)
-        sensor = {f"sensor_f_m{k:+d}f_c" if k else "sensor_f_m": _amplitude_at(f, amp, fr["f_m"] + k * fr["f_c"])
-                  for k in (-3, -1, 0, 1, 3)}
+        fm, fc = fr["f_m"], fr["f_c"]
+        marks = {f"sensor_f_m{k:+d}f_c" if k else "sensor_f_m": fm + k * fc for k in (-3, -1, 0, 1, 3)}
+        if own is not None:
+            marks.update({"own-": fm - own, "own+": fm + own})
+        band = (fm - 6.5 * max(fc, own or 0.0), fm + 6.5 * max(fc, own or 0.0))
+        sensor = {r["line"]: r["over_median"] for r in line_table(f, amp, marks, band)}
         for kind in ("inner", "outer"):
             d, p0 = s[kind], perfect.get(case.direction, {}).get(kind)
-            life = (d["equivalent_load_N"] / p0["equivalent_load_N"]) ** -LIFE_EXPONENT if p0 else None
+            life = d["life_iso16281_h"] / p0["life_iso16281_h"] if p0 else None
             row = {"fault": case.tag, "direction": case.direction, "bearing": kind,
                    "load_sharing_factor": d.get("load_sharing_factor"),
                    "bearing_load_mean_N": d["bearing_load_mean_all_N"], "bearing_load_max_N": d["bearing_load_max_N"],
-                   "roller_max_N": d.get("all_rollers", {}).get("roller_inner_race_max_N"),
+                   "roller_max_N": max(d["roller_inner_race_max_N"], d["roller_outer_race_max_N"]),
+                   "life_iso281_h": d["life_iso281_h"], "life_iso16281_h": d["life_iso16281_h"],
                    "life_relative": life, "cage_slip_pct": d.get("cage_slip_pct"),
                    "pocket_impacts_per_rev": d.get("pocket_impacts_per_rev"),
-                   "cage_acc_rel_rms": d.get("cage_acc_rel_magnitude_rms"), **sensor,
-                   "sensor_own": None if own is None else min(_amplitude_at(f, amp, fr["f_m"] - own),
-                                                              _amplitude_at(f, amp, fr["f_m"] + own)),
+                   "cage_acc_rel_rms": d.get("cage_acc_rel_magnitude_rms"),
+                   **{k: v for k, v in sensor.items() if k.startswith("sensor")},
+                   "sensor_own": min(sensor["own-"], sensor["own+"]) if own is not None else None,
                    "own_frequency": own}
             rows.append(row)
     return rows, spectra
@@ -235,7 +250,11 @@ def run(a) -> dict:
         for c in cases:
             _check_case(c, cfg)              # every parameter checked before any run starts
     out.mkdir(parents=True, exist_ok=True)
-    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress)
+    for w in check_runs([(c.label, build_params(c), cfg) for c in cases], out, a.force):
+        print(f"warning (--force): {w}")
+    check_folders(cases, cfg, a.overwrite)   # never replace results of other parameters silently
+    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
+                        overwrite=a.overwrite)
     rows, spectra = rows_of(cases, results)
     files = write_outputs(rows, spectra, out) if rows else []
     failed = {k: v["error"] for k, v in results.items() if "error" in v}
@@ -264,7 +283,7 @@ def main(argv=None) -> int:
         if row["bearing"] == "outer":
             print(f"{row['fault']:>14} {row['direction']:>8}: K_γ {row['load_sharing_factor']:.3f}, "
                   f"max bearing load {row['bearing_load_max_N']:.0f} N, life {row['life_relative'] or float('nan'):.2f}, "
-                  f"sensor at f_m {row['sensor_f_m']:.3g}")
+                  f"sensor f_m / floor {row['sensor_f_m']:.3g}")
     for k, v in r["failed"].items():
         print(f"FAILED {k}: {v}")
     print("\nwritten:\n" + "\n".join(f"  {p}" for p in r["files"]))
