@@ -60,13 +60,14 @@ def nominal(pair, n, rng, angle_span=50.0, spread=0.2):
     return p1, p2
 
 
-def make_mesh(pair, p1, p2, *, backlash=0.0, shape="constant", c_mesh=0.0, p0=0.0, name="mesh"):
+def make_mesh(pair, p1, p2, *, backlash=0.0, shape="constant", c_mesh=0.0, p0=0.0, name="mesh", **errors):
+    """A family of n meshes with u0 from the nominal poses p1, p2; ``errors``: GearMesh's error arguments."""
     internal, z1, z2 = PAIRS[pair]
     n = p1.shape[0]
     return GearMesh(name, np.arange(n), n + np.arange(n), internal=internal, rb1=rb(z1), rb2=rb(z2),
                     alpha=ALPHA, a0=a0_of(internal, z1, z2), teeth1=z1, k_mean=K_MEAN, c_mesh=c_mesh,
                     u0=mesh_u0(internal, rb(z1), rb(z2), p1, p2), p0=p0, backlash=backlash,
-                    stiffness=SHAPES[shape] if isinstance(shape, str) else shape)
+                    stiffness=SHAPES[shape] if isinstance(shape, str) else shape, **errors)
 
 
 def circ(x):
