@@ -36,7 +36,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..elements.gear_mesh import FAULT_ARGS, ConstantStiffness, FourierStiffness, GearMesh, RectangularStiffness
+from ..elements.gear_mesh import ConstantStiffness, FourierStiffness, GearMesh, RectangularStiffness
 
 __all__ = ["pack_gear_mesh", "evaluate_gear_mesh", "KERNELS"]
 
@@ -44,7 +44,7 @@ _TWO_PI = 2.0 * np.pi
 
 (P_SIGMA, P_RB1, P_RB2, P_A0, P_SIN_ALPHA, P_KAPPA0, P_PITCH, P_TEETH1, P_K_MEAN, P_C_MESH, P_U0, P_P0,
  P_BACKLASH, P_PHI_REF, P_RECT_H, P_RECT_S, P_RECT_SINGLE, P_RECT_RATIO) = range(18)
-# the fault block's columns, from G[G_FAULT], in the order of gear_mesh.FAULT_ARGS
+# the fault block's columns, from G[G_FAULT]
 F_COEF1, F_COEF2, F_OFFSET, F_PERIOD, F_FACTOR, F_EPS, F_SMOOTH = range(7)
 G_SHAPE, G_OFFSET, G_FAULT, G_FOURIER = 0, 1, 2, 3
 SHAPE_CONSTANT, SHAPE_RECTANGULAR, SHAPE_FOURIER = 0, 1, 2
@@ -71,7 +71,8 @@ def pack_gear_mesh(elem: GearMesh):
         cols += [elem.offset1[:, 0], elem.offset1[:, 1], elem.offset2[:, 0], elem.offset2[:, 1]]
     if elem.has_fault:
         flt = len(cols)
-        cols += [getattr(elem, k) for k in FAULT_ARGS]
+        cols += [elem.fault_coef1, elem.fault_coef2, elem.fault_offset, elem.fault_period, elem.fault_factor,
+                 elem.fault_contact_ratio, elem.fault_smoothing]          # the order of F_*
     G = np.array([kind, off, flt, *fourier], float)
     P = np.ascontiguousarray(np.column_stack([np.broadcast_to(np.asarray(c, float), (elem.n,)) for c in cols]))
     return P, G
