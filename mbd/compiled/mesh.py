@@ -85,11 +85,17 @@ def _wrap(x):
 
 
 @njit(cache=True)
-def _smooth_box(p, centre, half, s, period):
-    """(w, dw/dp) of the periodic smoothed window, as gear_mesh._smooth_box."""
+def _distance(p, centre, period):
+    """(|p − centre| on a circle of circumference ``period``, its derivative in p), as gear_mesh._distance."""
     u = _wrap(_TWO_PI / period * (p - centre)) * (period / _TWO_PI)
-    x = (half + 0.5 * s - abs(u)) * (1.0 / s)
-    dx = -np.sign(u) * (1.0 / s)               # du/dp = 1; d|u|/du = sign(u) (0 at 0, as ad.abs_)
+    return abs(u), np.sign(u)                  # d|u|/du = sign(u) (0 at 0, as ad.abs_)
+
+
+@njit(cache=True)
+def _box(dist, ddist, half, s):
+    """(w, dw/dp) of the smoothed window at distance dist (d dist/dp = ddist), as gear_mesh._box."""
+    x = (half + 0.5 * s - dist) * (1.0 / s)
+    dx = -ddist * (1.0 / s)
     if x > 1.0:
         x, dx = 1.0, 0.0
     elif x < 0.0:
@@ -101,7 +107,8 @@ def _smooth_box(p, centre, half, s, period):
 @njit(cache=True)
 def _rect_factor(p, h, s, single, ratio):
     """(factor, dfactor/dp) of the smoothed rectangular wave, as gear_mesh._rect_factor."""
-    w, dw = _smooth_box(p, h, h, s, 1.0)
+    dist, ddist = _distance(p, h, 1.0)
+    w, dw = _box(dist, ddist, h, s)
     return single * (1.0 + (ratio - 1.0) * w), single * (ratio - 1.0) * dw
 
 
@@ -150,62 +157,62 @@ def _put_row(Jq, Jv, i, r, scale, h, sig):
 @njit(cache=True)
 def evaluate_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     """Forces (and Jacobians) of n meshes; the mesh is frame-invariant, so phi/omega/domega are unused."""
-    shape, off, flt = int(G[G_SHAPE]), int(G[G_OFFSET]), int(G[G_FAULT])
-    W = np.zeros((10, 8))            # gradient scratch, allocated once (see _mesh)
+    off = int(G[G_OFFSET])
     if off < 0:                      # no eccentricity: the law on the body centres, written in place
-        for i in range(ql.shape[0]):
-            _mesh(ql[i], vl[i], P, i, shape, flt, G, F, Jq, Jv, i, jac, W)
+        _meshes(ql, vl, P, G, F, Jq, Jv, jac)
         return
-    qg, vg, r = np.empty(6), np.empty(6), np.empty(4)
-    Fg, Jqg, Jvg = np.empty((1, 6)), np.empty((1, 6, 6)), np.empty((1, 6, 6))
-    for i in range(ql.shape[0]):
-        _to_geometric(ql[i], vl[i], P, i, off, qg, vg, r)
-        _mesh(qg, vg, P, i, shape, flt, G, Fg, Jqg, Jvg, 0, jac, W)
-        _from_geometric(Fg[0], Jqg[0], Jvg[0], r, vl[i], F, Jq, Jv, i, jac)
+    n = ql.shape[0]
+    qg, vg, r, Fg = np.empty((n, 6)), np.empty((n, 6)), np.empty((n, 4)), np.empty((n, 6))
+    Jqg, Jvg = np.empty((n if jac else 0, 6, 6)), np.empty((n if jac else 0, 6, 6))
+    _to_geometric(ql, vl, P, off, qg, vg, r)
+    _meshes(qg, vg, P, G, Fg, Jqg, Jvg, jac)
+    _from_geometric(Fg, Jqg, Jvg, r, vl, F, Jq, Jv, jac)
 
 
 @njit(cache=True)
-def _to_geometric(q, v, P, i, off, qg, vg, r):
+def _to_geometric(ql, vl, P, off, qg, vg, r):
     """Local coordinates and rates of the geometric centres c + R(θ)·o (θ, ω unchanged); r ← (R(θ1)o1, R(θ2)o2)."""
-    for b in range(2):
-        k = 3 * b
-        th, w = q[k + 2], v[k + 2]
-        c, s = np.cos(th), np.sin(th)
-        ox, oy = P[i, off + 2 * b], P[i, off + 2 * b + 1]
-        rx = c * ox - s * oy
-        ry = s * ox + c * oy
-        qg[k], qg[k + 1], qg[k + 2] = q[k] + rx, q[k + 1] + ry, th
-        vg[k], vg[k + 1], vg[k + 2] = v[k] - w * ry, v[k + 1] + w * rx, w
-        r[2 * b], r[2 * b + 1] = rx, ry
+    for i in range(ql.shape[0]):
+        for b in range(2):
+            k = 3 * b
+            th, w = ql[i, k + 2], vl[i, k + 2]
+            c, s = np.cos(th), np.sin(th)
+            ox, oy = P[i, off + 2 * b], P[i, off + 2 * b + 1]
+            rx = c * ox - s * oy
+            ry = s * ox + c * oy
+            qg[i, k], qg[i, k + 1], qg[i, k + 2] = ql[i, k] + rx, ql[i, k + 1] + ry, th
+            vg[i, k], vg[i, k + 1], vg[i, k + 2] = vl[i, k] - w * ry, vl[i, k + 1] + w * rx, w
+            r[i, 2 * b], r[i, 2 * b + 1] = rx, ry
 
 
 @njit(cache=True)
-def _from_geometric(Fg, Jqg, Jvg, r, v, F, Jq, Jv, i, jac):
+def _from_geometric(Fg, Jqg, Jvg, r, vl, F, Jq, Jv, jac):
     """Body forces Q = Aᵀ F_g from the forces F_g on the geometric centres (A = ∂q_g/∂q), and
     ∂Q/∂q = Aᵀ(J_q A + J_v B) + (∂Aᵀ/∂θ) F_g, ∂Q/∂v = Aᵀ J_v A with B = ∂v_g/∂q.
     Per gear A = [[1, 0, −r_y], [0, 1, r_x], [0, 0, 1]] and B's only column, θ's, is −ω (r_x, r_y, 0)."""
-    for j in range(6):
-        F[i, j] = Fg[j]
-    for b in range(2):
-        k, rx, ry = 3 * b, r[2 * b], r[2 * b + 1]
-        F[i, k + 2] = Fg[k + 2] + (rx * Fg[k + 1] - ry * Fg[k])     # + the moment r × F_g
-    if not jac:
-        return
-    for row in range(6):             # columns: J_q A + J_v B and J_v A
-        for col in range(6):
-            Jq[i, row, col] = Jqg[row, col]
-            Jv[i, row, col] = Jvg[row, col]
+    for i in range(Fg.shape[0]):
+        for j in range(6):
+            F[i, j] = Fg[i, j]
         for b in range(2):
-            k, rx, ry, w = 3 * b, r[2 * b], r[2 * b + 1], v[3 * b + 2]
-            Jq[i, row, k + 2] += (-ry * Jqg[row, k] + rx * Jqg[row, k + 1]
-                                  - w * (rx * Jvg[row, k] + ry * Jvg[row, k + 1]))
-            Jv[i, row, k + 2] += -ry * Jvg[row, k] + rx * Jvg[row, k + 1]
-    for b in range(2):               # rows: Aᵀ (the θ rows gain r × the force rows), then (∂Aᵀ/∂θ) F_g
-        k, rx, ry = 3 * b, r[2 * b], r[2 * b + 1]
-        for col in range(6):
-            Jq[i, k + 2, col] += -ry * Jq[i, k, col] + rx * Jq[i, k + 1, col]
-            Jv[i, k + 2, col] += -ry * Jv[i, k, col] + rx * Jv[i, k + 1, col]
-        Jq[i, k + 2, k + 2] -= rx * Fg[k] + ry * Fg[k + 1]
+            k, rx, ry = 3 * b, r[i, 2 * b], r[i, 2 * b + 1]
+            F[i, k + 2] = Fg[i, k + 2] + (rx * Fg[i, k + 1] - ry * Fg[i, k])     # + the moment r × F_g
+        if not jac:
+            continue
+        for row in range(6):         # columns: J_q A + J_v B and J_v A
+            for col in range(6):
+                Jq[i, row, col] = Jqg[i, row, col]
+                Jv[i, row, col] = Jvg[i, row, col]
+            for b in range(2):
+                k, rx, ry, w = 3 * b, r[i, 2 * b], r[i, 2 * b + 1], vl[i, 3 * b + 2]
+                Jq[i, row, k + 2] += (-ry * Jqg[i, row, k] + rx * Jqg[i, row, k + 1]
+                                      - w * (rx * Jvg[i, row, k] + ry * Jvg[i, row, k + 1]))
+                Jv[i, row, k + 2] += -ry * Jvg[i, row, k] + rx * Jvg[i, row, k + 1]
+        for b in range(2):           # rows: Aᵀ (the θ rows gain r × the force rows), then (∂Aᵀ/∂θ) F_g
+            k, rx, ry = 3 * b, r[i, 2 * b], r[i, 2 * b + 1]
+            for col in range(6):
+                Jq[i, k + 2, col] += -ry * Jq[i, k, col] + rx * Jq[i, k + 1, col]
+                Jv[i, k + 2, col] += -ry * Jv[i, k, col] + rx * Jv[i, k + 1, col]
+            Jq[i, k + 2, k + 2] -= rx * Fg[i, k] + ry * Fg[i, k + 1]
 
 
 @njit(cache=True)
@@ -213,113 +220,116 @@ def _fault_multiplier(th1, th2, phi_e, P, i, flt):
     """(m, dm/dp_f, A1, A2) of the tooth fault, m = 1 − (1 − c)·share(u), as gear_mesh._fault_multiplier."""
     a1, a2 = P[i, flt + F_COEF1], P[i, flt + F_COEF2]
     pf = a1 * th1 + a2 * th2 - (a1 + a2) * phi_e + P[i, flt + F_OFFSET]
-    eps, s, zf = P[i, flt + F_EPS], P[i, flt + F_SMOOTH], P[i, flt + F_PERIOD]
-    c = 0.5 * eps
-    w1, dw1 = _smooth_box(pf, c, c, s, zf)
-    w2, dw2 = _smooth_box(pf, c, 1.0 - c, s, zf)
+    eps, s = P[i, flt + F_EPS], P[i, flt + F_SMOOTH]
+    dist, ddist = _distance(pf, 0.5 * eps, P[i, flt + F_PERIOD])
+    w1, dw1 = _box(dist, ddist, 0.5 * eps, s)
+    w2, dw2 = _box(dist, ddist, 1.0 - 0.5 * eps, s)
     share, dshare = 0.5 * (w1 + w2), 0.5 * (dw1 + dw2)
     loss = 1.0 - P[i, flt + F_FACTOR]
     return 1.0 - loss * share, -loss * dshare, a1, a2
 
 
 @njit(cache=True)
-def _mesh(q, v, P, i, shape, flt, G, F, Jq, Jv, o, jac, W):
-    """Mesh i (parameters P[i]) at local coordinates q, rates v: forces into F[o] and, when ``jac``,
-    Jacobians into Jq[o], Jv[o]. W: (10, 8) scratch for the gradients over (dx, dy, θ1, θ2, ḋx, ḋy, ω1, ω2)."""
-    ds, dsd, dr, drd, dkp, gp, gm, hx, hy, hnet = W[0], W[1], W[2], W[3], W[4], W[5], W[6], W[7], W[8], W[9]
-    sig, rb1, rb2 = P[i, P_SIGMA], P[i, P_RB1], P[i, P_RB2]
-    sa, kappa0, pb, z1 = P[i, P_SIN_ALPHA], P[i, P_KAPPA0], P[i, P_PITCH], P[i, P_TEETH1]
-    x1, y1, th1, x2, y2, th2 = q[0], q[1], q[2], q[3], q[4], q[5]
-    vx1, vy1, w1, vx2, vy2, w2 = v[0], v[1], v[2], v[3], v[4], v[5]
-    # --- values, in the reference kernel's order of operations
-    dx, dy, ddx, ddy = sig * (x2 - x1), sig * (y2 - y1), sig * (vx2 - vx1), sig * (vy2 - vy1)
-    r2 = dx * dx + dy * dy
-    a = np.sqrt(r2)
-    inv_a = 1.0 / a
-    ex, ey = dx * inv_a, dy * inv_a
-    tx, ty = -ey, ex
-    phi_ref = P[i, P_PHI_REF]
-    phi_e = phi_ref + _wrap(np.arctan2(dy, dx) - phi_ref)
-    raw = sig * rb1 * (th1 - phi_e) + rb2 * (th2 - phi_e) - P[i, P_U0]
-    roll = sig * rb1 * w1 + rb2 * w2
-    s = _wrap(raw * (_TWO_PI / pb)) * (pb / _TWO_PI)
-    kappa = kappa0 * inv_a
-    radial = sig * sa * (a - P[i, P_A0])
-    half_b = 0.5 * P[i, P_BACKLASH]
-    t_dd = tx * ddx + ty * ddy
-    e_dd = ex * ddx + ey * ddy
-    s_dot = roll - kappa * t_dd
-    radial_dot = sig * sa * e_dd
-    d_plus = s - radial - half_b
-    d_minus = -1.0 * s - radial - half_b
-    r_plus = s_dot - radial_dot
-    r_minus = -1.0 * s_dot - radial_dot
-    p = z1 * (th1 - phi_e) * (1.0 / _TWO_PI) + P[i, P_P0]
-    fac, dfac = _factor(shape, p, P, i, G)
-    k_mean, c = P[i, P_K_MEAN], P[i, P_C_MESH]
-    kp = k_mean * fac
-    m, dm, fa1, fa2 = 1.0, 0.0, 0.0, 0.0
-    if flt >= 0:
-        m, dm, fa1, fa2 = _fault_multiplier(th1, th2, phi_e, P, i, flt)
-        kp = kp * m
-    g_plus = kp * d_plus + c * r_plus
-    g_minus = kp * d_minus + c * r_minus
-    on_plus = d_plus > 0.0 and g_plus > 0.0          # flank in contact and not pulling
-    on_minus = d_minus > 0.0 and g_minus > 0.0
-    F_plus = g_plus if on_plus else 0.0
-    F_minus = g_minus if on_minus else 0.0
-    F_net = F_plus - F_minus
-    F_sum = F_plus + F_minus
-    Fx_head = F_net * kappa * tx + sig * sa * F_sum * ex
-    Fy_head = F_net * kappa * ty + sig * sa * F_sum * ey
-    F[o, 0] = -sig * Fx_head
-    F[o, 1] = -sig * Fy_head
-    F[o, 2] = -sig * rb1 * F_net
-    F[o, 3] = sig * Fx_head
-    F[o, 4] = sig * Fy_head
-    F[o, 5] = -1.0 * rb2 * F_net
-    if not jac:
-        return
-    # --- gradients of the scalars the flank forces are built from
-    phx, phy = -dy / r2, dx / r2                      # ∂φ_e/∂d
-    ds[0], ds[1], ds[2], ds[3] = -kappa0 * phx, -kappa0 * phy, sig * rb1, rb2
-    dr[0], dr[1] = sig * sa * ex, sig * sa * ey
-    ka = kappa * inv_a
-    dsd[0], dsd[1] = ka * (ex * t_dd + tx * e_dd), ka * (ey * t_dd + ty * e_dd)
-    dsd[4], dsd[5], dsd[6], dsd[7] = -kappa * tx, -kappa * ty, sig * rb1, rb2
-    drd[0], drd[1] = sig * sa * inv_a * tx * t_dd, sig * sa * inv_a * ty * t_dd
-    drd[4], drd[5] = sig * sa * ex, sig * sa * ey
-    dpdth = z1 * (1.0 / _TWO_PI)
-    dk = k_mean * dfac
-    if flt < 0:
-        dkp[0], dkp[1], dkp[2] = -dk * dpdth * phx, -dk * dpdth * phy, dk * dpdth
-    else:                            # k = k_mean·fac(p)·m(p_f): p_f = A1 θ1 + A2 θ2 − (A1 + A2) φ_e + c_f
-        g, asum = k_mean * fac * dm, fa1 + fa2
-        dkp[0] = -(dk * dpdth * m + g * asum) * phx
-        dkp[1] = -(dk * dpdth * m + g * asum) * phy
-        dkp[2], dkp[3] = dk * dpdth * m + g * fa1, g * fa2
-    for j in range(8):
-        gp[j] = (dkp[j] * d_plus + kp * (ds[j] - dr[j]) + c * (dsd[j] - drd[j])) if on_plus else 0.0
-        gm[j] = (dkp[j] * d_minus + kp * (-ds[j] - dr[j]) + c * (-dsd[j] - drd[j])) if on_minus else 0.0
-    # --- head force (F_net κ t + σ F_sum sin α e) and torques
-    for j in range(8):
-        dnet, dsum = gp[j] - gm[j], gp[j] + gm[j]
-        hnet[j] = dnet
-        hx[j] = dnet * kappa * tx + sig * sa * dsum * ex
-        hy[j] = dnet * kappa * ty + sig * sa * dsum * ey
-    # d-dependence of κ, t, e (only the two d components)
-    for j in range(2):
-        ej = ex if j == 0 else ey
-        tj = tx if j == 0 else ty
-        dkappa = -ka * ej
-        hx[j] += F_net * (dkappa * tx - kappa * ex * tj * inv_a) + sig * sa * F_sum * tx * tj * inv_a
-        hy[j] += F_net * (dkappa * ty - kappa * ey * tj * inv_a) + sig * sa * F_sum * ty * tj * inv_a
-    _put_row(Jq, Jv, o, 0, -sig, hx, sig)
-    _put_row(Jq, Jv, o, 1, -sig, hy, sig)
-    _put_row(Jq, Jv, o, 2, -sig * rb1, hnet, sig)
-    _put_row(Jq, Jv, o, 3, sig, hx, sig)
-    _put_row(Jq, Jv, o, 4, sig, hy, sig)
-    _put_row(Jq, Jv, o, 5, -1.0 * rb2, hnet, sig)
+def _meshes(ql, vl, P, G, F, Jq, Jv, jac):
+    """The mesh law at local coordinates ql, rates vl (the body centres, or the geometric centres)."""
+    shape, flt = int(G[G_SHAPE]), int(G[G_FAULT])
+    # gradients over (dx, dy, θ1, θ2, ḋx, ḋy, ω1, ω2), allocated once
+    ds, dsd, dr, drd, dkp = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
+    gp, gm, hx, hy, hnet = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
+    for i in range(ql.shape[0]):
+        sig, rb1, rb2 = P[i, P_SIGMA], P[i, P_RB1], P[i, P_RB2]
+        sa, kappa0, pb, z1 = P[i, P_SIN_ALPHA], P[i, P_KAPPA0], P[i, P_PITCH], P[i, P_TEETH1]
+        x1, y1, th1, x2, y2, th2 = ql[i, 0], ql[i, 1], ql[i, 2], ql[i, 3], ql[i, 4], ql[i, 5]
+        vx1, vy1, w1, vx2, vy2, w2 = vl[i, 0], vl[i, 1], vl[i, 2], vl[i, 3], vl[i, 4], vl[i, 5]
+        # --- values, in the reference kernel's order of operations
+        dx, dy, ddx, ddy = sig * (x2 - x1), sig * (y2 - y1), sig * (vx2 - vx1), sig * (vy2 - vy1)
+        r2 = dx * dx + dy * dy
+        a = np.sqrt(r2)
+        inv_a = 1.0 / a
+        ex, ey = dx * inv_a, dy * inv_a
+        tx, ty = -ey, ex
+        phi_ref = P[i, P_PHI_REF]
+        phi_e = phi_ref + _wrap(np.arctan2(dy, dx) - phi_ref)
+        raw = sig * rb1 * (th1 - phi_e) + rb2 * (th2 - phi_e) - P[i, P_U0]
+        roll = sig * rb1 * w1 + rb2 * w2
+        s = _wrap(raw * (_TWO_PI / pb)) * (pb / _TWO_PI)
+        kappa = kappa0 * inv_a
+        radial = sig * sa * (a - P[i, P_A0])
+        half_b = 0.5 * P[i, P_BACKLASH]
+        t_dd = tx * ddx + ty * ddy
+        e_dd = ex * ddx + ey * ddy
+        s_dot = roll - kappa * t_dd
+        radial_dot = sig * sa * e_dd
+        d_plus = s - radial - half_b
+        d_minus = -1.0 * s - radial - half_b
+        r_plus = s_dot - radial_dot
+        r_minus = -1.0 * s_dot - radial_dot
+        p = z1 * (th1 - phi_e) * (1.0 / _TWO_PI) + P[i, P_P0]
+        fac, dfac = _factor(shape, p, P, i, G)
+        k_mean, c = P[i, P_K_MEAN], P[i, P_C_MESH]
+        kp = k_mean * fac
+        m, dm, fa1, fa2 = 1.0, 0.0, 0.0, 0.0
+        if flt >= 0:
+            m, dm, fa1, fa2 = _fault_multiplier(th1, th2, phi_e, P, i, flt)
+            kp = kp * m
+        g_plus = kp * d_plus + c * r_plus
+        g_minus = kp * d_minus + c * r_minus
+        on_plus = d_plus > 0.0 and g_plus > 0.0          # flank in contact and not pulling
+        on_minus = d_minus > 0.0 and g_minus > 0.0
+        F_plus = g_plus if on_plus else 0.0
+        F_minus = g_minus if on_minus else 0.0
+        F_net = F_plus - F_minus
+        F_sum = F_plus + F_minus
+        Fx_head = F_net * kappa * tx + sig * sa * F_sum * ex
+        Fy_head = F_net * kappa * ty + sig * sa * F_sum * ey
+        F[i, 0] = -sig * Fx_head
+        F[i, 1] = -sig * Fy_head
+        F[i, 2] = -sig * rb1 * F_net
+        F[i, 3] = sig * Fx_head
+        F[i, 4] = sig * Fy_head
+        F[i, 5] = -1.0 * rb2 * F_net
+        if not jac:
+            continue
+        # --- gradients of the scalars the flank forces are built from
+        phx, phy = -dy / r2, dx / r2                      # ∂φ_e/∂d
+        ds[0], ds[1], ds[2], ds[3] = -kappa0 * phx, -kappa0 * phy, sig * rb1, rb2
+        dr[0], dr[1] = sig * sa * ex, sig * sa * ey
+        ka = kappa * inv_a
+        dsd[0], dsd[1] = ka * (ex * t_dd + tx * e_dd), ka * (ey * t_dd + ty * e_dd)
+        dsd[4], dsd[5], dsd[6], dsd[7] = -kappa * tx, -kappa * ty, sig * rb1, rb2
+        drd[0], drd[1] = sig * sa * inv_a * tx * t_dd, sig * sa * inv_a * ty * t_dd
+        drd[4], drd[5] = sig * sa * ex, sig * sa * ey
+        dpdth = z1 * (1.0 / _TWO_PI)
+        dk = k_mean * dfac
+        if flt < 0:
+            dkp[0], dkp[1], dkp[2] = -dk * dpdth * phx, -dk * dpdth * phy, dk * dpdth
+        else:                            # k = k_mean·fac(p)·m(p_f): p_f = A1 θ1 + A2 θ2 − (A1 + A2) φ_e + c_f
+            g, asum = k_mean * fac * dm, fa1 + fa2
+            dkp[0] = -(dk * dpdth * m + g * asum) * phx
+            dkp[1] = -(dk * dpdth * m + g * asum) * phy
+            dkp[2], dkp[3] = dk * dpdth * m + g * fa1, g * fa2
+        for j in range(8):
+            gp[j] = (dkp[j] * d_plus + kp * (ds[j] - dr[j]) + c * (dsd[j] - drd[j])) if on_plus else 0.0
+            gm[j] = (dkp[j] * d_minus + kp * (-ds[j] - dr[j]) + c * (-dsd[j] - drd[j])) if on_minus else 0.0
+        # --- head force (F_net κ t + σ F_sum sin α e) and torques
+        for j in range(8):
+            dnet, dsum = gp[j] - gm[j], gp[j] + gm[j]
+            hnet[j] = dnet
+            hx[j] = dnet * kappa * tx + sig * sa * dsum * ex
+            hy[j] = dnet * kappa * ty + sig * sa * dsum * ey
+        # d-dependence of κ, t, e (only the two d components)
+        for j in range(2):
+            ej = ex if j == 0 else ey
+            tj = tx if j == 0 else ty
+            dkappa = -ka * ej
+            hx[j] += F_net * (dkappa * tx - kappa * ex * tj * inv_a) + sig * sa * F_sum * tx * tj * inv_a
+            hy[j] += F_net * (dkappa * ty - kappa * ey * tj * inv_a) + sig * sa * F_sum * ty * tj * inv_a
+        _put_row(Jq, Jv, i, 0, -sig, hx, sig)
+        _put_row(Jq, Jv, i, 1, -sig, hy, sig)
+        _put_row(Jq, Jv, i, 2, -sig * rb1, hnet, sig)
+        _put_row(Jq, Jv, i, 3, sig, hx, sig)
+        _put_row(Jq, Jv, i, 4, sig, hy, sig)
+        _put_row(Jq, Jv, i, 5, -1.0 * rb2, hnet, sig)
 
 
 KERNELS = {GearMesh: (pack_gear_mesh, evaluate_gear_mesh, None)}

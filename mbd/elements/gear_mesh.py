@@ -204,11 +204,15 @@ STIFFNESS_SHAPES = MappingProxyType({"constant": ConstantStiffness, "rectangular
                                      "fourier": FourierStiffness})
 
 
-def _smooth_box(p, centre, half, s, period):
-    """Periodic window (period ``period``) of half width ``half`` centred at ``centre``: 1 inside, 0
-    outside, quintic-smoothstep edges (C², symmetric) of full width s centred on each edge."""
-    u = ad.wrap_angle(_TWO_PI / period * (p - centre)) * (period / _TWO_PI)   # from the centre, in [-period/2, period/2]
-    x = (half + 0.5 * s - ad.abs_(u)) * (1.0 / s)          # 1 inside, 0 outside, linear across an edge
+def _distance(p, centre, period):
+    """|p − centre| on a circle of circumference ``period``, in [0, period/2]."""
+    return ad.abs_(ad.wrap_angle(_TWO_PI / period * (p - centre)) * (period / _TWO_PI))
+
+
+def _box(dist, half, s):
+    """Window of half width ``half`` at distance ``dist`` from its centre: 1 inside, 0 outside,
+    quintic-smoothstep edges (C², symmetric) of full width s centred on each edge."""
+    x = (half + 0.5 * s - dist) * (1.0 / s)                # 1 inside, 0 outside, linear across an edge
     x = ad.where(x > 1.0, 1.0, ad.where(x < 0.0, 0.0, x))
     return x * x * x * (10.0 + x * (-15.0 + 6.0 * x))
 
@@ -216,14 +220,14 @@ def _smooth_box(p, centre, half, s, period):
 def _rect_factor(p, h, s, single, ratio):
     """Smoothed rectangular wave k/k_mean: double-contact window of half width h centred at p = h
     (period 1), quintic-smoothstep edges of width s. Parameters may be per-instance (n,) arrays."""
-    return single * (1.0 + (ratio - 1.0) * _smooth_box(p, h, h, s, 1.0))
+    return single * (1.0 + (ratio - 1.0) * _box(_distance(p, h, 1.0), h, s))
 
 
 def _fault_share(pf, eps, s, zf):
     """The faulty tooth pair's share of the mesh stiffness at fault position pf (module docstring):
-    ½ box over [0, ε) + ½ box over [ε − 1, 1) — both windows are centred at ε/2 — period z_f."""
-    c = 0.5 * eps
-    return 0.5 * (_smooth_box(pf, c, c, s, zf) + _smooth_box(pf, c, 1.0 - c, s, zf))
+    ½ window over [0, ε) + ½ window over [ε − 1, 1) — both centred at ε/2 — period z_f."""
+    dist = _distance(pf, 0.5 * eps, zf)
+    return 0.5 * (_box(dist, 0.5 * eps, s) + _box(dist, 1.0 - 0.5 * eps, s))
 
 
 FAULT_ARGS = ("fault_coef1", "fault_coef2", "fault_offset", "fault_period", "fault_factor", "fault_contact_ratio",
