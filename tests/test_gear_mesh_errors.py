@@ -353,3 +353,17 @@ def test_error_parameters_are_validated():
             GearMesh("bad", [0, 1], [2, 3], **kw, offset2=bad)
     # contact ratio 1: the two windows coincide and a ramp may take up to a whole cycle
     GearMesh("ok", [0, 1], [2, 3], **kw, **dict(good, fault_contact_ratio=1.0, fault_smoothing=1.0))
+
+
+def test_the_error_kernels_are_covered_by_the_compiled_cache_hash():
+    """mbd.compiled drops its numba cache when a file it hashes changes (mbd/compiled/*.py among them):
+    every compiled mesh function, the error ones included, must live in such a file."""
+    from pathlib import Path
+
+    from numba.core.registry import CPUDispatcher
+    import mbd.compiled as mc
+    here = Path(mc.__file__).resolve().parent
+    jitted = [f for f in vars(mesh).values() if isinstance(f, CPUDispatcher)]
+    assert {"_to_geometric", "_from_geometric", "_fault_multiplier", "_distance", "_box"} <= {f.__name__ for f in jitted}
+    for f in jitted:
+        assert Path(f.py_func.__code__.co_filename).resolve().parent == here, f.__name__
