@@ -352,17 +352,17 @@ class GearMesh(Element):
         for k in FAULT_ARGS:
             setattr(self, k, self._per_instance(k, vals[k]))
         c, eps, s, zf = self.fault_factor, self.fault_contact_ratio, self.fault_smoothing, self.fault_period
-        if np.any((c < 0.0) | (c > 1.0)):
-            raise ModelError(f"{self.name}: parameter 'fault_factor' must be in [0, 1] (1 healthy, 0 missing tooth), got {c!r}")
-        if np.any((eps < 1.0) | (eps >= 2.0)):
-            raise ModelError(f"{self.name}: parameter 'fault_contact_ratio' must be in [1, 2), got {eps!r}")
         s_max = fault_smoothing_max(eps)
-        if np.any((s <= 0.0) | (s > s_max)):
-            raise ModelError(f"{self.name}: parameter 'fault_smoothing' (ramp width) must be in (0, {s_max!r}] cycles "
-                             f"for fault_contact_ratio {eps!r} (ramps may not overlap), got {s!r}")
-        if np.any((zf < 2.0) | (zf != np.round(zf))):
-            raise ModelError(f"{self.name}: parameter 'fault_period' must be the faulty gear's tooth count "
-                             f"(whole, >= 2) [cycles], got {zf!r}")
+        for bad, what in (((c < 0.0) | (c > 1.0), "'fault_factor' must be in [0, 1] (1 healthy, 0 missing tooth)"),
+                          ((eps < 1.0) | (eps >= 2.0), "'fault_contact_ratio' must be in [1, 2)"),
+                          ((zf < 2.0) | (zf != np.round(zf)),
+                           "'fault_period' must be the faulty gear's tooth count (whole, >= 2) [cycles]"),
+                          ((s <= 0.0) | (s > s_max), "'fault_smoothing' (ramp width) must be in (0, min(ε − 1, 2 − ε)] "
+                                                     "cycles (1 for ε = 1) so that no two ramps overlap")):
+            if np.any(bad):
+                i = int(np.argmax(bad))
+                raise ModelError(f"{self.name}: parameter {what}; instance {i} has fault_factor {c[i]:g}, "
+                                 f"fault_contact_ratio {eps[i]:g}, fault_period {zf[i]:g}, fault_smoothing {s[i]:g}")
         self.has_fault = bool(np.any(c != 1.0))
 
     _FUSED = ("dofs", "rb1", "rb2", "alpha", "a0", "teeth1", "k_mean", "c_mesh", "u0", "p0", "backlash",
