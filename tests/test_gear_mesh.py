@@ -40,12 +40,12 @@ def a0_of(internal, z1, z2):
     return M_ * ((z2 - z1) if internal else (z1 + z2)) / 2.0
 
 
-def nominal(pair, n, rng, angle_span=50.0, spread=0.2):
-    """Nominal poses (n, 3) of gear 1 and gear 2: centres a0 apart in a random direction, anywhere
-    within ``spread`` of the origin, random (large) angles."""
+def nominal(pair, n, rng, angle_span=50.0, spread=0.2, psi=None):
+    """Nominal poses (n, 3) of gear 1 and gear 2: centres a0 apart in a random direction (or along the
+    angles ``psi`` of e), anywhere within ``spread`` of the origin, random (large) angles."""
     internal, z1, z2 = PAIRS[pair]
     a0 = a0_of(internal, z1, z2)
-    psi = rng.uniform(-np.pi, np.pi, n)
+    psi = rng.uniform(-np.pi, np.pi, n) if psi is None else np.broadcast_to(np.asarray(psi, float), (n,))
     e = np.column_stack([np.cos(psi), np.sin(psi)])
     base = rng.uniform(-spread, spread, (n, 2))
     p1, p2 = np.zeros((n, 3)), np.zeros((n, 3))
@@ -60,13 +60,14 @@ def nominal(pair, n, rng, angle_span=50.0, spread=0.2):
     return p1, p2
 
 
-def make_mesh(pair, p1, p2, *, backlash=0.0, shape="constant", c_mesh=0.0, p0=0.0, name="mesh"):
+def make_mesh(pair, p1, p2, *, backlash=0.0, shape="constant", c_mesh=0.0, p0=0.0, name="mesh", **errors):
+    """A family of n meshes with u0 from the nominal poses p1, p2; ``errors``: GearMesh's error arguments."""
     internal, z1, z2 = PAIRS[pair]
     n = p1.shape[0]
     return GearMesh(name, np.arange(n), n + np.arange(n), internal=internal, rb1=rb(z1), rb2=rb(z2),
                     alpha=ALPHA, a0=a0_of(internal, z1, z2), teeth1=z1, k_mean=K_MEAN, c_mesh=c_mesh,
                     u0=mesh_u0(internal, rb(z1), rb(z2), p1, p2), p0=p0, backlash=backlash,
-                    stiffness=SHAPES[shape] if isinstance(shape, str) else shape)
+                    stiffness=SHAPES[shape] if isinstance(shape, str) else shape, **errors)
 
 
 def circ(x):
@@ -97,10 +98,10 @@ def fd_jacobians(elem, q, v, hq=1e-8, hv=1e-4):
     return Jq, Jv
 
 
-def perturbed_state(pair, rng, n, du=2e-5):
+def perturbed_state(pair, rng, n, du=2e-5, psi=None):
     """Nominal poses plus displacements of ~du (so flanks open and close), rolling + random speeds."""
     internal, z1, z2 = PAIRS[pair]
-    p1, p2 = nominal(pair, n, rng)
+    p1, p2 = nominal(pair, n, rng, psi=psi)
     q = full(p1, p2)
     q1 = q.copy().reshape(-1, 3)
     q1[:, :2] += rng.normal(0.0, du, (2 * n, 2))

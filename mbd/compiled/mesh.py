@@ -4,18 +4,25 @@ The force law is the reference kernel's, operation for operation (so values agre
 of arctan2/cos/sin), with its Jacobians derived by hand. One family may mix external and internal
 meshes (σ per instance, as after System fusion).
 
-P, shape (n, 14) or (n, 18), one row per mesh (constants ``P_*`` below):
+P, shape (n, 14 [+ 4] [+ 4] [+ 7]), one row per mesh (constants ``P_*`` below):
 
     0 σ (+1 external, −1 internal)   1 r_b1     2 r_b2      3 a0     4 sin α    5 κ0 = σ r_b1 + r_b2
     6 p_b base pitch                 7 z1       8 k_mean    9 c_m   10 u0      11 p0
     12 b backlash                   13 φ_ref
     RectangularStiffness only: 14 h = (ε_α − 1)/2   15 s smoothing   16 k_single/k_mean   17 ratio
+    then, only in a family with eccentricity, from column G[1]: o1x, o1y, o2x, o2y [m]
+    then, only in a family with a tooth fault, from column G[2] (``F_*``): A1, A2, c_f, z_f, c, ε, s
 
-G, the family's stiffness shape (constants ``SHAPE_*``):
+G = [shape, offset column or −1, fault column or −1, shape coefficients] (constants ``G_*``, ``SHAPE_*``):
 
-    constant     [0]
-    rectangular  [1]                                   (its parameters are per instance, in P)
-    fourier      [2, na, nb, a_1 … a_na, b_1 … b_nb]
+    constant     [0, ., .]
+    rectangular  [1, ., .]                                   (its parameters are per instance, in P)
+    fourier      [2, ., ., na, nb, a_1 … a_na, b_1 … b_nb]
+
+A family without errors (G[1] = G[2] = −1) evaluates exactly as before they existed. With eccentricity,
+the law is evaluated on the geometric centres (:func:`_to_geometric`) and the forces and Jacobians are
+mapped back to the body coordinates by the chain rule (:func:`_from_geometric`); a tooth fault multiplies
+k by m(p_f) (:func:`_fault_multiplier`) with its gradient through θ1, θ2 and φ_e.
 
 Jacobians. With d the centre vector along e (σ(c2 − c1)), ḋ its rate, t = k × e, a = |d|, every
 quantity is a function of (d, θ1, θ2) and (ḋ, ω1, ω2); the kernel carries gradients over these
@@ -37,6 +44,9 @@ _TWO_PI = 2.0 * np.pi
 
 (P_SIGMA, P_RB1, P_RB2, P_A0, P_SIN_ALPHA, P_KAPPA0, P_PITCH, P_TEETH1, P_K_MEAN, P_C_MESH, P_U0, P_P0,
  P_BACKLASH, P_PHI_REF, P_RECT_H, P_RECT_S, P_RECT_SINGLE, P_RECT_RATIO) = range(18)
+# the fault block's columns, from G[G_FAULT]
+F_COEF1, F_COEF2, F_OFFSET, F_PERIOD, F_FACTOR, F_EPS, F_SMOOTH = range(7)
+G_SHAPE, G_OFFSET, G_FAULT, G_FOURIER = 0, 1, 2, 3
 SHAPE_CONSTANT, SHAPE_RECTANGULAR, SHAPE_FOURIER = 0, 1, 2
 
 
@@ -44,17 +54,26 @@ def pack_gear_mesh(elem: GearMesh):
     """(P, G) of a GearMesh family (layouts in the module docstring)."""
     cols = [elem.sigma, elem.rb1, elem.rb2, elem.a0, elem.sin_alpha, elem.kappa0, elem.pitch, elem.teeth1,
             elem.k_mean, elem.c_mesh, elem.u0, elem.p0, elem.backlash, elem.phi_ref]
-    shape = elem.stiffness
+    shape, fourier = elem.stiffness, []
     if type(shape) is ConstantStiffness:
-        G = np.array([SHAPE_CONSTANT], float)
+        kind = SHAPE_CONSTANT
     elif type(shape) is RectangularStiffness:
-        G = np.array([SHAPE_RECTANGULAR], float)
+        kind = SHAPE_RECTANGULAR
         cols += list(elem._shape_args)          # (h, s, single, ratio) per instance, concatenated when fused
     elif type(shape) is FourierStiffness:
-        G = np.array([SHAPE_FOURIER, len(shape.a), len(shape.b), *shape.a, *shape.b], float)
+        kind, fourier = SHAPE_FOURIER, [len(shape.a), len(shape.b), *shape.a, *shape.b]
     else:
         raise NotImplementedError(f"GearMesh {elem.name!r}: the compiled path has no stiffness shape "
                                   f"{type(shape).__name__} (only constant, rectangular, fourier)")
+    off = flt = -1                              # error blocks only when the family has them
+    if elem.has_offset:
+        off = len(cols)
+        cols += [elem.offset1[:, 0], elem.offset1[:, 1], elem.offset2[:, 0], elem.offset2[:, 1]]
+    if elem.has_fault:
+        flt = len(cols)
+        cols += [elem.fault_coef1, elem.fault_coef2, elem.fault_offset, elem.fault_period, elem.fault_factor,
+                 elem.fault_contact_ratio, elem.fault_smoothing]          # the order of F_*
+    G = np.array([kind, off, flt, *fourier], float)
     P = np.ascontiguousarray(np.column_stack([np.broadcast_to(np.asarray(c, float), (elem.n,)) for c in cols]))
     return P, G
 
@@ -66,33 +85,46 @@ def _wrap(x):
 
 
 @njit(cache=True)
-def _rect_factor(p, h, s, single, ratio):
-    """(factor, dfactor/dp) of the smoothed rectangular wave, as gear_mesh._rect_factor."""
-    u = _wrap(_TWO_PI * (p - h)) * (1.0 / _TWO_PI)
-    x = (h + 0.5 * s - abs(u)) * (1.0 / s)
-    dx = -np.sign(u) * (1.0 / s)               # du/dp = 1; d|u|/du = sign(u) (0 at 0, as ad.abs_)
+def _distance(p, centre, period):
+    """(|p − centre| on a circle of circumference ``period``, its derivative in p), as gear_mesh._distance."""
+    u = _wrap(_TWO_PI / period * (p - centre)) * (period / _TWO_PI)
+    return abs(u), np.sign(u)                  # d|u|/du = sign(u) (0 at 0, as ad.abs_)
+
+
+@njit(cache=True)
+def _box(dist, ddist, half, s):
+    """(w, dw/dp) of the smoothed window at distance dist (d dist/dp = ddist), as gear_mesh._box."""
+    x = (half + 0.5 * s - dist) * (1.0 / s)
+    dx = -ddist * (1.0 / s)
     if x > 1.0:
         x, dx = 1.0, 0.0
     elif x < 0.0:
         x, dx = 0.0, 0.0
     w = x * x * x * (10.0 + x * (-15.0 + 6.0 * x))
-    dw = 30.0 * x * x * (1.0 - x) * (1.0 - x) * dx
+    return w, 30.0 * x * x * (1.0 - x) * (1.0 - x) * dx
+
+
+@njit(cache=True)
+def _rect_factor(p, h, s, single, ratio):
+    """(factor, dfactor/dp) of the smoothed rectangular wave, as gear_mesh._rect_factor."""
+    dist, ddist = _distance(p, h, 1.0)
+    w, dw = _box(dist, ddist, h, s)
     return single * (1.0 + (ratio - 1.0) * w), single * (ratio - 1.0) * dw
 
 
 @njit(cache=True)
 def _fourier_factor(p, G):
     """(factor, dfactor/dp) of 1 + Σ a_j cos 2πjp + b_j sin 2πjp, coefficients from G."""
-    na, nb = int(G[1]), int(G[2])
+    na, nb, a0 = int(G[G_FOURIER]), int(G[G_FOURIER + 1]), G_FOURIER + 2
     f, df = 1.0, 0.0
     for j in range(na):
         w = _TWO_PI * (j + 1)
-        f = f + G[3 + j] * np.cos(w * p)
-        df -= G[3 + j] * w * np.sin(w * p)
+        f = f + G[a0 + j] * np.cos(w * p)
+        df -= G[a0 + j] * w * np.sin(w * p)
     for j in range(nb):
         w = _TWO_PI * (j + 1)
-        f = f + G[3 + na + j] * np.sin(w * p)
-        df += G[3 + na + j] * w * np.cos(w * p)
+        f = f + G[a0 + na + j] * np.sin(w * p)
+        df += G[a0 + na + j] * w * np.cos(w * p)
     return f, df
 
 
@@ -125,7 +157,82 @@ def _put_row(Jq, Jv, i, r, scale, h, sig):
 @njit(cache=True)
 def evaluate_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     """Forces (and Jacobians) of n meshes; the mesh is frame-invariant, so phi/omega/domega are unused."""
-    shape = int(G[0])
+    off = int(G[G_OFFSET])
+    if off < 0:                      # no eccentricity: the law on the body centres, written in place
+        _meshes(ql, vl, P, G, F, Jq, Jv, jac)
+        return
+    n = ql.shape[0]
+    qg, vg, r, Fg = np.empty((n, 6)), np.empty((n, 6)), np.empty((n, 4)), np.empty((n, 6))
+    Jqg, Jvg = np.empty((n if jac else 0, 6, 6)), np.empty((n if jac else 0, 6, 6))
+    _to_geometric(ql, vl, P, off, qg, vg, r)
+    _meshes(qg, vg, P, G, Fg, Jqg, Jvg, jac)
+    _from_geometric(Fg, Jqg, Jvg, r, vl, F, Jq, Jv, jac)
+
+
+@njit(cache=True)
+def _to_geometric(ql, vl, P, off, qg, vg, r):
+    """Local coordinates and rates of the geometric centres c + R(θ)·o (θ, ω unchanged); r ← (R(θ1)o1, R(θ2)o2)."""
+    for i in range(ql.shape[0]):
+        for b in range(2):
+            k = 3 * b
+            th, w = ql[i, k + 2], vl[i, k + 2]
+            c, s = np.cos(th), np.sin(th)
+            ox, oy = P[i, off + 2 * b], P[i, off + 2 * b + 1]
+            rx = c * ox - s * oy
+            ry = s * ox + c * oy
+            qg[i, k], qg[i, k + 1], qg[i, k + 2] = ql[i, k] + rx, ql[i, k + 1] + ry, th
+            vg[i, k], vg[i, k + 1], vg[i, k + 2] = vl[i, k] - w * ry, vl[i, k + 1] + w * rx, w
+            r[i, 2 * b], r[i, 2 * b + 1] = rx, ry
+
+
+@njit(cache=True)
+def _from_geometric(Fg, Jqg, Jvg, r, vl, F, Jq, Jv, jac):
+    """Body forces Q = Aᵀ F_g from the forces F_g on the geometric centres (A = ∂q_g/∂q), and
+    ∂Q/∂q = Aᵀ(J_q A + J_v B) + (∂Aᵀ/∂θ) F_g, ∂Q/∂v = Aᵀ J_v A with B = ∂v_g/∂q.
+    Per gear A = [[1, 0, −r_y], [0, 1, r_x], [0, 0, 1]] and B's only column, θ's, is −ω (r_x, r_y, 0)."""
+    for i in range(Fg.shape[0]):
+        for j in range(6):
+            F[i, j] = Fg[i, j]
+        for b in range(2):
+            k, rx, ry = 3 * b, r[i, 2 * b], r[i, 2 * b + 1]
+            F[i, k + 2] = Fg[i, k + 2] + (rx * Fg[i, k + 1] - ry * Fg[i, k])     # + the moment r × F_g
+        if not jac:
+            continue
+        for row in range(6):         # columns: J_q A + J_v B and J_v A
+            for col in range(6):
+                Jq[i, row, col] = Jqg[i, row, col]
+                Jv[i, row, col] = Jvg[i, row, col]
+            for b in range(2):
+                k, rx, ry, w = 3 * b, r[i, 2 * b], r[i, 2 * b + 1], vl[i, 3 * b + 2]
+                Jq[i, row, k + 2] += (-ry * Jqg[i, row, k] + rx * Jqg[i, row, k + 1]
+                                      - w * (rx * Jvg[i, row, k] + ry * Jvg[i, row, k + 1]))
+                Jv[i, row, k + 2] += -ry * Jvg[i, row, k] + rx * Jvg[i, row, k + 1]
+        for b in range(2):           # rows: Aᵀ (the θ rows gain r × the force rows), then (∂Aᵀ/∂θ) F_g
+            k, rx, ry = 3 * b, r[i, 2 * b], r[i, 2 * b + 1]
+            for col in range(6):
+                Jq[i, k + 2, col] += -ry * Jq[i, k, col] + rx * Jq[i, k + 1, col]
+                Jv[i, k + 2, col] += -ry * Jv[i, k, col] + rx * Jv[i, k + 1, col]
+            Jq[i, k + 2, k + 2] -= rx * Fg[i, k] + ry * Fg[i, k + 1]
+
+
+@njit(cache=True)
+def _fault_multiplier(th1, th2, phi_e, P, i, flt):
+    """(m, dm/dp_f, A1, A2) of the tooth fault, m = 1 − (1 − c)·share(u), as gear_mesh._fault_multiplier."""
+    a1, a2 = P[i, flt + F_COEF1], P[i, flt + F_COEF2]
+    pf = a1 * th1 + a2 * th2 - (a1 + a2) * phi_e + P[i, flt + F_OFFSET]
+    eps, s = P[i, flt + F_EPS], P[i, flt + F_SMOOTH]
+    dist, ddist = _distance(pf, 0.5 * eps, P[i, flt + F_PERIOD])
+    w1, dw1 = _box(dist, ddist, 0.5 * eps, s)
+    w2, dw2 = _box(dist, ddist, 1.0 - 0.5 * eps, s)
+    share, dshare = 0.5 * (w1 + w2), 0.5 * (dw1 + dw2)
+    loss = 1.0 - P[i, flt + F_FACTOR]
+    return 1.0 - loss * share, -loss * dshare, a1, a2
+
+
+@njit(cache=True)
+def _meshes(ql, vl, P, G, F, Jq, Jv, jac):
+    """The mesh law at local coordinates ql, rates vl (the body centres, or the geometric centres)."""
+    shape, flt = int(G[G_SHAPE]), int(G[G_FAULT])
     # gradients over (dx, dy, θ1, θ2, ḋx, ḋy, ω1, ω2), allocated once
     ds, dsd, dr, drd, dkp = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
     gp, gm, hx, hy, hnet = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
@@ -161,6 +268,10 @@ def evaluate_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         fac, dfac = _factor(shape, p, P, i, G)
         k_mean, c = P[i, P_K_MEAN], P[i, P_C_MESH]
         kp = k_mean * fac
+        m, dm, fa1, fa2 = 1.0, 0.0, 0.0, 0.0
+        if flt >= 0:
+            m, dm, fa1, fa2 = _fault_multiplier(th1, th2, phi_e, P, i, flt)
+            kp = kp * m
         g_plus = kp * d_plus + c * r_plus
         g_minus = kp * d_minus + c * r_minus
         on_plus = d_plus > 0.0 and g_plus > 0.0          # flank in contact and not pulling
@@ -190,7 +301,13 @@ def evaluate_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         drd[4], drd[5] = sig * sa * ex, sig * sa * ey
         dpdth = z1 * (1.0 / _TWO_PI)
         dk = k_mean * dfac
-        dkp[0], dkp[1], dkp[2] = -dk * dpdth * phx, -dk * dpdth * phy, dk * dpdth
+        if flt < 0:
+            dkp[0], dkp[1], dkp[2] = -dk * dpdth * phx, -dk * dpdth * phy, dk * dpdth
+        else:                            # k = k_mean·fac(p)·m(p_f): p_f = A1 θ1 + A2 θ2 − (A1 + A2) φ_e + c_f
+            g, asum = k_mean * fac * dm, fa1 + fa2
+            dkp[0] = -(dk * dpdth * m + g * asum) * phx
+            dkp[1] = -(dk * dpdth * m + g * asum) * phy
+            dkp[2], dkp[3] = dk * dpdth * m + g * fa1, g * fa2
         for j in range(8):
             gp[j] = (dkp[j] * d_plus + kp * (ds[j] - dr[j]) + c * (dsd[j] - drd[j])) if on_plus else 0.0
             gm[j] = (dkp[j] * d_minus + kp * (-ds[j] - dr[j]) + c * (-dsd[j] - drd[j])) if on_minus else 0.0
