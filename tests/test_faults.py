@@ -121,3 +121,94 @@ def test_pinhole_error_shifts_load_between_planets_and_turns_with_the_carrier():
     off0 = np.linalg.norm(sun0)
     assert np.linalg.norm(sun_p) > 10 * off0 and np.linalg.norm(sun_m) > 10 * off0
     assert np.dot(sun_p - sun0, sun_m - sun0) < 0                              # pushed the other way
+
+
+def _mesh_history(overrides, family_key, window=0.03):
+    """Condition 3, linear planet bearings: per accepted step of the window, pair 1's mesh of
+    ``family_key``: t, both flanks' force, stiffness over the healthy wave's, and the angles of gear 1, gear 2 and the line of
+    centres φ_e (internal: ring centre → planet centre) in R."""
+    from components.families import MESH_FAMILY
+
+    rec = []
+
+    def extra(bs, t0, t1):
+        fam = MESH_FAMILY[family_key]
+        el = bs.model.element(fam)
+        g1, g2 = bs.model.body_names.index(_GEARS[family_key][0]), bs.model.body_names.index(_GEARS[family_key][1])
+
+        class Obs(mbd.Observer):
+            def bind(self, model, system, state):
+                self.system, self.model = system, model
+
+            def step(self, s0, s1):
+                if s1.t < t0:
+                    return
+                o = self.system.outputs(s1.t, s1.q, s1.v, s1.z, families={fam})[fam]
+                X = self.model.full(s1.t, s1.q, s1.v)[0].reshape(-1, 3)
+                d = X[g1, :2] - X[g2, :2] if family_key == "outer_ring" else X[g2, :2] - X[g1, :2]
+                healthy = el.k_mean * el._factor(np.asarray(o["position"], float))   # the wave without the fault
+                rec.append((s1.t, o["force_drive"][0] + o["force_coast"][0], o["stiffness"][0] / healthy[0],
+                            X[g1, 2], X[g2, 2], np.arctan2(d[1], d[0])))
+        return [Obs()]
+    dpgt_runs.run(3, "forward", overrides, window=window, bearings="linear", extra=extra)
+    return np.array(rec).T
+
+
+_GEARS = {"sun_inner": ("sun", "a1"), "outer_ring": ("b1", "ring")}
+
+
+def _line(t, x, f0):
+    """Amplitude of x(t) (resampled uniformly, Hann window) at f0."""
+    from scenarios.analysis import amplitude_spectrum
+
+    tu = np.linspace(t[0], t[-1], 4096)
+    f, a, _ = amplitude_spectrum(tu, np.interp(tu, t, x))
+    return float(a[np.argmin(np.abs(f - f0))])
+
+
+def test_sun_runout_modulates_its_meshes_once_per_sun_revolution():
+    """A sun eccentric by 20 µm: the sun–planet mesh force gains a line at the sun's rotation relative to
+    the carrier (185 Hz at condition 3) that the perfect machine does not have (> 100× its level there)."""
+    from scenarios.fault_study import characteristic_frequencies
+
+    f_s = characteristic_frequencies(reference_dpgt(3).si())["sun_rel"]
+    t0, F0, *_ = _mesh_history({}, "sun_inner")
+    t1, F1, *_ = _mesh_history({"errors.runout": [{"gear": "sun", "eccentricity": "20 um", "phase": "0 deg"}]},
+                               "sun_inner")
+    a0, a1 = _line(t0, F0, f_s), _line(t1, F1, f_s)
+    assert a1 > 100 * a0 and a1 > 0.05 * F1.mean()
+
+
+@pytest.mark.parametrize("gear, tooth, factor, period_of", [("b1", 0, 0.0, "outer_planet_rel"),
+                                                             ("ring", 5, 0.5, "f_c")])
+def test_tooth_fault_weakens_its_mesh_once_per_revolution_of_its_gear(gear, tooth, factor, period_of):
+    """A missing tooth on outer planet b1 / a cracked ring tooth: the b1–ring mesh stiffness drops to the
+    fault's share exactly once per revolution of the faulty gear relative to the carrier (b1: 4.18 ms; the
+    ring, fixed, meets b1 once per carrier revolution: 14.3 ms) and nowhere else. The tooth index is the
+    real tooth: whenever that tooth's centre line crosses the pitch point its pair is in contact (on the
+    loaded flank it touches a quarter pitch from there, inside the path of contact), and the weak stretch
+    is ε_α pitches of the tooth's travel."""
+    from scenarios.fault_study import characteristic_frequencies
+
+    p = reference_dpgt(3)
+    period = 1.0 / characteristic_frequencies(p.si())[period_of]
+    t, F, k, th1, th2, phi = _mesh_history({"errors.tooth_fault": [{"gear": gear, "tooth": tooth,
+                                                                     "stiffness_factor": factor}]}, "outer_ring")
+    low = k < 1.0 - 1e-9
+    # the weak pair's share: down to the factor in single contact, (1 + c)/2 in double contact
+    assert k.min() == pytest.approx(factor, abs=1e-12) and k.max() == pytest.approx(1.0, abs=1e-12)
+    starts = t[1:][np.diff(low.astype(int)) == 1]
+    assert starts.size >= 2
+    np.testing.assert_allclose(np.diff(starts), period, atol=2e-5)         # one mesh-step resolution
+    mg = p.si().layout.meshes["outer_ring"]
+    z = mg.z1 if gear == "b1" else mg.z2
+    theta = th1 if gear == "b1" else th2
+    # the faulty tooth's centre line from the pitch point's direction (at angle φ_e from either gear of an
+    # internal mesh), in pitches
+    rel = np.angle(np.exp(1j * (theta + 2 * np.pi * tooth / z - phi))) * z / (2 * np.pi)
+    assert np.all(low[np.abs(rel) < 0.1]) and np.any(np.abs(rel) < 0.1)
+    smooth = p.si().mesh.smoothing_width
+    assert abs(np.ptp(rel[low]) - mg.contact_ratio) < smooth + 0.02
+    if gear == "b1":     # gear 1: the stretch is where geometry puts that tooth's pair, [−h, ε − h]
+        h = mg.entry_shift(dpgt_runs.build(p).handles["flanks"]["outer_ring"])
+        assert rel[low].min() > -h - smooth and rel[low].max() < mg.contact_ratio - h + smooth
