@@ -140,7 +140,8 @@ def test_spectrum_peaks_sit_on_mesh_sidebands(tmp_path):
     A sensor at the axis carries k = ±1 only (geometry.sideband_origin): every other line stays below 1 %
     of the dominant one (seen: 0.2 % at f_m + 2f_c, weak gravity/nonlinear orders; cancelled lines ~2e-4)."""
     s = spectrum.run(spectrum.parse_args(["--out", str(tmp_path), "--settle", "0.06", "--window", "0.09",
-                                          "--option", "bearings=linear", "--no-progress", "--sensor", "axis"]))
+                                          "--option", "bearings=linear", "--no-progress", "--sensor", "axis",
+                                          "--perfect"]))
     assert s["f_c_hz"] == pytest.approx(2000 / 60) and s["f_m_hz"] == pytest.approx(82 * 2000 / 60)
     assert s["resolution_hz"] == pytest.approx(1 / 0.09, rel=0.01)
     big = s["peaks"][0]["amplitude"] if s["peaks"] else 0.0
@@ -170,7 +171,7 @@ def test_spectrum_housing_sensor_on_a_perfect_machine(tmp_path):
     (seen: ≤ 0.02 %): the window alone does not bring f_m or f_m + f_c (McFadden & Smith 1985: "complete
     suppression of the component at the tooth meshing frequency"); errors (MODEL.md §3.9) must."""
     s = spectrum.run(spectrum.parse_args(["--out", str(tmp_path), "--settle", "0.06", "--window", "0.09",
-                                          "--option", "bearings=linear", "--no-progress"]))
+                                          "--option", "bearings=linear", "--no-progress", "--perfect"]))
     assert s["sensor"] == "housing" and s["resolution_hz"] == pytest.approx(s["f_c_hz"] / 3, rel=1e-3)
     lines = {r["k"]: r for r in s["lines"]}
     strongest = max(r["amplitude"] for r in s["lines"])
