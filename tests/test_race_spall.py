@@ -10,9 +10,12 @@ import numpy as np
 import pytest
 from hypothesis import given, strategies as st
 
+import mbd
 from mbd.assembly import _fused_families
 from mbd.compiled.contact import RACE_COLS, pack_race
+from mbd.compiled.system import CompiledSystem
 from mbd.element import evaluate
+from mbd.elements import GroundSupport, SpeedDrive
 from mbd.elements.contact import RaceContact
 from mbd.errors import ModelError
 from test_compiled_contact import assert_matches_reference, compiled
@@ -294,3 +297,79 @@ def test_spall_parameter_errors_name_the_parameter():
     for key, val, msg in bad:
         with pytest.raises(ModelError, match=msg):
             RaceContact("r", [1, 2], 0, **base, **{**ok, key: val, "spall_edge": val if key == "spall_edge" else 1e-4})
+
+
+# -------------------------------------------------------------------------------------- in the engine
+I_PINCH, W_SP, E_SP, H_SP = 8e-6, 2e-3, 0.5e-3, 3e-6     # interference; the pin spall's width, edge, depth
+
+
+def _pinched_scene(spall: bool):
+    """Three rollers pinched (8 µm) between a fixed pin and a bore on stiff supports, driven at 200 rad/s, the
+    rollers rolling; roller 0 starts at the outer edge of a pin spall (when ``spall``). Returns the model, the
+    free coordinates and the time roller 0 takes to reach the defect's centre."""
+    R_o, rho = R_IN + DR - I_PINCH, R_IN + DR / 2 - I_PINCH / 2
+    ang = np.array([0.3, 2.4, -1.9])
+    hi = 0.5 * (W_SP + E_SP)
+    mb = mbd.ModelBuilder()
+    mb.add_body("carrier", 1.0, 1e-3, fixed=True)
+    planet = mb.add_body("planet", 0.2, 5e-5)
+    rollers = [mb.add_body(f"roller{j}", M_ROLLER, M_ROLLER * DR ** 2 / 8) for j in range(3)]
+    mb.add(GroundSupport("support", [planet], kx=1e10, cx=1e4))
+    mb.add(SpeedDrive("drive", planet, omega_ref=200.0, k=50.0, c=0.5))
+    law = dict(D=DR, K=K_HZ, m_roller=M_ROLLER, **LAW)
+    defect = dict(spall_angle=ang[0] + hi / R_IN, spall_width=W_SP, spall_depth=H_SP, spall_edge=E_SP)
+    mb.add(RaceContact("race_inner", rollers, 0, kind="inner", race_marker=(0, 0), R_race=R_IN, **law,
+                       **(defect if spall else {})))
+    mb.add(RaceContact("race_outer", rollers, planet, kind="outer", race_marker=(0, 0), R_race=R_o, **law))
+    v_c = 200.0 * R_o / 2                            # pure rolling on the fixed pin: the centre at half the bore's speed
+    q0 = np.concatenate([[0, 0, 0]] + [[rho * np.cos(a), rho * np.sin(a), 0.0] for a in ang])
+    v0 = np.concatenate([[0, 0, 200.0]] + [[-v_c * np.sin(a), v_c * np.cos(a), 2 * v_c / DR] for a in ang])
+    return mb.build(), q0, v0, hi / (R_IN * v_c / rho)
+
+
+def test_a_spalled_family_runs_in_both_engines():
+    """Three rollers pinched between a pin and a stiffly held bore, roller 0 rolling into a pin spall. Assembled
+    with a plain outer family (kept apart by the fuse key), the compiled system equals the reference on the
+    defect's ramp; both engines take the same steps to the same state; over the deep part roller 0's pin load
+    is the no-spall run's times ((i − h + u)/(i + u'))^p (its two contacts share the interference i less the
+    depth h, plus u, u' the give of the bore's support in the two runs); the other rollers' loads move only by
+    that give (< 2 %)."""
+    model, q0, v0, t_c = _pinched_scene(True)
+    system = mbd.System(model)
+    assert sorted(len(parts) for e, parts in system._evals if isinstance(e, RaceContact)) == [1, 1]
+    z = system.init_internal()
+    q_ramp = q0.copy()
+    a_ramp = 0.3 + 0.25e-3 / R_IN                          # s = −1 mm: half way down the entry ramp
+    q_ramp[3:5] = np.hypot(*q0[3:5]) * np.array([np.cos(a_ramp), np.sin(a_ramp)])
+    ref = system.evaluate(0.0, q_ramp, v0, z, jac=True)
+    got = CompiledSystem(system).evaluate(0.0, q_ramp, v0, z, jac=True)
+    for name in ("F", "Jq", "Jv"):
+        a, b = getattr(got, name), getattr(ref, name)
+        assert np.abs(a - b).max() <= 1e-10 * np.abs(b).max(), name
+    H = 5e-6
+    n = int(round(t_c / H))
+
+    def run(m, q, v, engine):
+        return mbd.simulate(m, q, v, n * H, stepper=mbd.HHT(alpha=-0.1), controller=mbd.FixedStep(H), progress=False,
+                            engine=engine)
+
+    runs = [run(model, q0, v0, eng) for eng in ("compiled", "numpy")]
+    assert [r.engine for r in runs] == ["compiled", "numpy"] and runs[0].counters == runs[1].counters
+    np.testing.assert_allclose(runs[0].state.q, runs[1].state.q, rtol=0, atol=1e-12)
+    plain_model, _, _, _ = _pinched_scene(False)
+    plain = run(plain_model, q0, v0, "compiled").state
+    s = runs[0].state
+    out = system.outputs(s.t, s.q, s.v, s.z)["race_inner"]
+    inner = next(e for e in model.elements if e.name == "race_inner")
+    s_0 = R_IN * (out["angle"][0] - inner.spall_angle[0])
+    assert abs(s_0) < 0.1 * (W_SP - E_SP) / 2                # roller 0 is at the middle of the defect
+    load = out["load"]
+    load_plain = mbd.System(plain_model).outputs(plain.t, plain.q, plain.v, plain.z)["race_inner"]["load"]
+    # the bore's support gives way (ΔQ/k, here 1 % of the pinch): u = its shift away from roller 0
+    e0 = s.q[3:5] / np.hypot(*s.q[3:5])
+    u, u_plain = -s.q[:2] @ e0, -plain.q[:2] @ e0
+    law = ((I_PINCH - H_SP + u) / (I_PINCH + u_plain)) ** P
+    print(f"pin load over the spall / without: {load[0] / load_plain[0]:.5f}, law {law:.5f}, rigid bore "
+          f"{((I_PINCH - H_SP) / I_PINCH) ** P:.5f}")
+    assert load[0] / load_plain[0] == pytest.approx(law, rel=2e-3)
+    np.testing.assert_allclose(load[1:], load_plain[1:], rtol=0.02)
