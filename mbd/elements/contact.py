@@ -347,13 +347,14 @@ class RaceContact(Element):
     ramps in, and w + e < 2πR. With s = R·wrap(angle − spall_angle) the roller's arc position from the
     defect centre, the deflection loses d(s) = h·B(s): B = 1 for |s| ≤ (w − e)/2, 0 for |s| ≥ (w + e)/2 and
     the C² quintic smoothstep x³(10 − 15x + 6x²), x = ((w + e)/2 − |s|)/e, in between. δ_eff = δ − d(s)
-    replaces δ everywhere (contact gate, stiffness and damping terms), and its rate is the exact time
-    derivative δ̇_eff = δ̇ − h·B'(s)·ṡ, ṡ = R·(angle rate): the surface dropping away under a rolling roller
-    is an opening of the contact like any other, and a damping term without it would see a rate that is
-    not the rate of the deflection it damps (dissipation at a constant δ_eff). The contact point and the
-    traction geometry are unchanged. A family without a spall evaluates exactly as before (no extra work).
+    (= δ without a spall) replaces δ everywhere (contact gate, stiffness and damping terms), and its rate
+    is the exact time derivative δ̇_eff = δ̇ − h·B'(s)·ṡ, ṡ = R·(angle rate): the surface dropping away
+    under a rolling roller is an opening of the contact like any other, and a damping term without it
+    would see a rate that is not the rate of the deflection it damps (dissipation at a constant δ_eff).
+    The contact point and the traction geometry are unchanged. A family without a spall evaluates
+    exactly as before (no extra work).
 
-    Outputs, all per physical contact: "load" Q ≥ 0 [N]; "deflection" δ (δ_eff with a spall) [m] (negative: a gap); "traction"
+    Outputs, all per physical contact: "load" Q ≥ 0 [N]; "deflection" δ_eff [m] (negative: a gap); "traction"
     tangential force on the roller along t [N] (opposes v_s); "slip_velocity" v_s [m/s]; "rolling_speed"
     the entraining speed u_e = (u_roller + u_race)/2 relative to the contact point [m/s] (what builds an
     EHL film); "angle" the roller centre's angle about the raceway centre measured in the race body's
@@ -400,7 +401,8 @@ class RaceContact(Element):
         missing = [k for k, val in given.items() if val is None]
         self.has_spall = not missing
         if missing and len(missing) < 4:
-            raise ModelError(f"{self.name}: a spall needs all of {', '.join(self._SPALL)}; missing {', '.join(missing)}")
+            raise ModelError(f"{self.name}: a spall needs all of {', '.join(self._SPALL)}; "
+                             f"missing {', '.join(missing)}")
         if missing:
             return
         self.spall_angle = self._per_instance("spall_angle", angle)
