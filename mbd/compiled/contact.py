@@ -4,7 +4,9 @@ convention of :mod:`mbd.compiled` (pack / evaluate / update). The numpy kernels 
 Layouts (P: one row per instance, columns in this order; G: family-wide values):
 
 ``RaceContact``   P (n, 8): κ (+1 inner, −1 outer: per instance, so a fused inner + outer family packs
-                  as one), race_marker x, y [m], R_race [m], D [m], K, c₀ = 2ζ·sqrt(m_roller·p·K), multiplicity
+                  as one), race_marker x, y [m], R_race [m], D [m], K, c₀ = 2ζ·sqrt(m_roller·p·K), multiplicity;
+                  a family with a spall packs 4 more columns, so the kernel decides from P's width (a family
+                  without one pays nothing): spall_angle [rad], (w + e)/2 [m], depth h [m], edge e [m]
                   G (10,): exponent p, traction law id, then the law's coefficients (zero-padded):
                   law 0 (TanhTraction): mu_max, v0;  law 1 (SlideRollTraction): A, B, C, D, u_reg, s_eps;
                   law 2 (EHLTraction): eta0, alpha_p, E_red, length, tau_L0, gamma_L, G_e, u_reg
@@ -74,7 +76,10 @@ def pack_race(elem):
         raise NotImplementedError(f"{elem.name}: RaceContact with traction law {type(tr).__name__} has no "
                                   f"compiled kernel (compiled: {sorted(c.__name__ for c in TRACTION_IDS)})")
     mk = elem.race_marker
-    P = _rows(elem.kappa, mk[:, 0], mk[:, 1], elem.R_race, elem.D, elem.K, elem._c0, elem.multiplicity)
+    cols = [elem.kappa, mk[:, 0], mk[:, 1], elem.R_race, elem.D, elem.K, elem._c0, elem.multiplicity]
+    if elem.has_spall:
+        cols += [elem.spall_angle, elem._spall_hi, elem.spall_depth, elem.spall_edge]
+    P = _rows(*cols)
     G = np.zeros(10)
     G[:2 + len(coef)] = [elem.exponent, float(law), *coef]
     return P, G
@@ -258,10 +263,36 @@ def _impact_state(v0, x0, xd0, x1, xd1, v_min):
 
 
 # ----------------------------------------------------------------------------------- race contact
+RACE_COLS = 8                                   # P columns of a race family without a spall
+
+
+@njit(cache=True)
+def _spall(P, i, R, dx, dy, wx, wy, thb, vb2):
+    """The defect's loss of deflection d = h·B(s), its rate h·B'(s)·ṡ, and h·B', h·B'', ṡ for the
+    Jacobian (RaceContact._spalled, spall_profile: the reference's operations). s = R·wrap(angle − ψ),
+    angle = wrap(atan2(dy, dx) − θ_race)."""
+    psi, hi, h, e = P[i, RACE_COLS], P[i, RACE_COLS + 1], P[i, RACE_COLS + 2], P[i, RACE_COLS + 3]
+    s = R * _wrap(_wrap(np.arctan2(dy, dx) - thb) - psi)
+    s_dot = R * ((dx * wy - dy * wx) / (dx * dx + dy * dy + _ETA2) - vb2)
+    x = (hi - abs(s)) / e
+    B_ss = 0.0
+    if x >= 1.0:
+        x = 1.0
+    elif x > 0.0:
+        B_ss = 60.0 * x * (1.0 - x) * (1.0 - 2.0 * x) / (e * e)
+    else:
+        x = 0.0
+    B = x * x * x * (10.0 + x * (6.0 * x - 15.0))
+    u = 1.0 - x
+    B_s = (-30.0 * _sign(s) / e) * (x * x * u * u)
+    return h * B, h * B_s * s_dot, h * B_s, h * B_ss, s_dot
+
+
 @njit(cache=True)
 def evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     p, law = G[0], int(G[1])
     pe = 0.5 * (p - 1.0)                        # exponent of the damping's δ factor
+    spall = P.shape[1] > RACE_COLS              # decided at pack time (see the module docstring)
     for i in range(ql.shape[0]):
         kap, mx, my, R, D, K, c0, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6], P[i, 7]
         xr, yr = ql[i, 0], ql[i, 1]
@@ -279,6 +310,10 @@ def evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
         wx, wy = vr0 - Vcx, vr1 - Vcy
         delta_dot = -kap * (ex * wx + ey * wy)
+        hBs, hBss, s_dot = 0.0, 0.0, 0.0
+        if spall:                                # δ_eff = δ − d(s) and its exact rate
+            d_s, d_rate, hBs, hBss, s_dot = _spall(P, i, R, dx, dy, wx, wy, thb, vb2)
+            delta, delta_dot = delta - d_s, delta_dot - d_rate
         # Hertz load with contact damping, clipped at >= 0 (ad.where: zero derivative when clipped)
         if not delta > 0.0:
             _zero(F, Jq, Jv, i, jac)
@@ -323,8 +358,16 @@ def evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
             dtx, dty = -dey, dex
             dVcx, dVcy = dvb0 - dvb2 * rcy - vb2 * drcy, dvb1 + dvb2 * rcx + vb2 * drcx
             dwx, dwy = dvr0 - dVcx, dvr1 - dVcy
+            ddelta = -kap * drho
             ddelta_dot = -kap * (dex * wx + ex * dwx + dey * wy + ey * dwy)
-            dQ = Q_d * (-kap * drho) + Q_r * ddelta_dot
+            if spall:                            # chain rule through s (the marker turns with θ_race too)
+                ds = R * ((dx * ddy - dy * ddx) / (dx * dx + dy * dy) - dthb)     # ad.arctan2: no η
+                rho2 = dx * dx + dy * dy + _ETA2
+                dnum = ddx * wy + dx * dwy - ddy * wx - dy * dwx
+                ds_dot = R * ((dnum - (dx * wy - dy * wx) * 2.0 * (dx * ddx + dy * ddy) / rho2) / rho2 - dvb2)
+                ddelta -= hBs * ds
+                ddelta_dot -= hBss * ds * s_dot + hBs * ds_dot
+            dQ = Q_d * ddelta + Q_r * ddelta_dot
             drrx, drry = -drho * ex + rl * dex, -drho * ey + rl * dey
             drbx, drby = drcx + R * dex, drcy + R * dey
             dVrx, dVry = dvr0 - dvr2 * rry - vr2 * drry, dvr1 + dvr2 * rrx + vr2 * drrx

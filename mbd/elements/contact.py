@@ -31,7 +31,7 @@ from ..errors import ModelError
 __all__ = ["Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS", "ImpactLaw", "ExactRestitution",
            "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS", "RaceContact", "PocketContact",
            "GuideContact", "LubricantDrag", "restitution_lambda", "LandLaw", "DryLand", "HydrodynamicLand",
-           "LAND_LAWS"]
+           "LAND_LAWS", "spall_profile"]
 
 _ETA2 = 1e-24  # (1e-12 m)²: below round-off of any physical distance squared, keeps norms nonzero
 
@@ -310,6 +310,19 @@ TRACTION_LAWS = MappingProxyType({"tanh": TanhTraction, "slide_roll": SlideRollT
 
 
 # --------------------------------------------------------------------------------------------
+def spall_profile(s, hi, edge):
+    """(B(s), B'(s)) of a raceway defect: 1 for |s| ≤ hi − edge, 0 for |s| ≥ hi, and the C² quintic
+    smoothstep B = x³(10 − 15x + 6x²), x = (hi − |s|)/edge, in between; B' = −sign(s)·30x²(1 − x)²/edge.
+    Works on dual numbers (B' then carries B'' for the Jacobian of the rate term)."""
+    x_raw = (hi - ad.abs_(s)) / edge
+    xv = ad.value(x_raw)
+    x = ad.where(xv >= 1.0, 1.0, ad.where(xv > 0.0, x_raw, 0.0))
+    B = x * x * x * (10.0 + x * (6.0 * x - 15.0))
+    u = 1.0 - x
+    B_s = (-30.0 * ad.sign(s) / edge) * (x * x * u * u)
+    return B, B_s
+
+
 class RaceContact(Element):
     """Roller–raceway Hertz line contact (Palmgren) with damping and traction.
 
@@ -327,7 +340,21 @@ class RaceContact(Element):
     contacts (a double-row bearing modelled as one row): the law above is one physical contact's (K, and
     m_roller the mass of one physical roller), and the generalized forces are multiplied by it.
 
-    Outputs, all per physical contact: "load" Q ≥ 0 [N]; "deflection" δ [m] (negative: a gap); "traction"
+    Local raceway defect (spall, MODEL.md §3.9; all four per instance, or all None = no spall, the default):
+    ``spall_angle`` [rad] the defect's centre, an angle about the raceway centre in the race body's axes (as
+    the output "angle": the defect is fixed on the race body); ``spall_width`` w > 0 [m] its arc length along
+    the raceway; ``spall_depth`` h ≥ 0 [m]; ``spall_edge`` e in (0, w] [m] the length over which the depth
+    ramps in, and w + e < 2πR. With s = R·wrap(angle − spall_angle) the roller's arc position from the
+    defect centre, the deflection loses d(s) = h·B(s): B = 1 for |s| ≤ (w − e)/2, 0 for |s| ≥ (w + e)/2 and
+    the C² quintic smoothstep x³(10 − 15x + 6x²), x = ((w + e)/2 − |s|)/e, in between. δ_eff = δ − d(s)
+    (= δ without a spall) replaces δ everywhere (contact gate, stiffness and damping terms), and its rate
+    is the exact time derivative δ̇_eff = δ̇ − h·B'(s)·ṡ, ṡ = R·(angle rate): the surface dropping away
+    under a rolling roller is an opening of the contact like any other, and a damping term without it
+    would see a rate that is not the rate of the deflection it damps (dissipation at a constant δ_eff).
+    The contact point and the traction geometry are unchanged. A family without a spall evaluates
+    exactly as before (no extra work).
+
+    Outputs, all per physical contact: "load" Q ≥ 0 [N]; "deflection" δ_eff [m] (negative: a gap); "traction"
     tangential force on the roller along t [N] (opposes v_s); "slip_velocity" v_s [m/s]; "rolling_speed"
     the entraining speed u_e = (u_roller + u_race)/2 relative to the contact point [m/s] (what builds an
     EHL film); "angle" the roller centre's angle about the raceway centre measured in the race body's
@@ -337,7 +364,8 @@ class RaceContact(Element):
     n_local = 6
 
     def __init__(self, name, roller, race_body, *, kind, race_marker, R_race, D, K, exponent, zeta, m_roller,
-                 traction: Traction, multiplicity=1):
+                 traction: Traction, multiplicity=1, spall_angle=None, spall_width=None, spall_depth=None,
+                 spall_edge=None):
         self.name = name
         self.dofs = body_dofs(roller, race_body)
         if kind not in ("inner", "outer"):
@@ -362,19 +390,55 @@ class RaceContact(Element):
         self.R_red = 1.0 / (2.0 / self.D + self.kappa / self.R_race)   # reduced radius: convex inner, concave outer
         self.multiplicity = _multiplicity(self, multiplicity)
         self._multi = bool(np.any(self.multiplicity != 1.0))
+        self._spall_params(spall_angle, spall_width, spall_depth, spall_edge)
 
+    _SPALL = ("spall_angle", "spall_width", "spall_depth", "spall_edge")
     _FUSED = ("dofs", "race_marker", "R_race", "D", "K", "zeta", "m_roller", "_c0", "kappa", "R_red", "multiplicity")
 
+    def _spall_params(self, angle, width, depth, edge):
+        """The defect's per-instance arrays (``has_spall`` False: none given); ``_spall_hi`` = (w + e)/2."""
+        given = dict(zip(self._SPALL, (angle, width, depth, edge)))
+        missing = [k for k, val in given.items() if val is None]
+        self.has_spall = not missing
+        if missing and len(missing) < 4:
+            raise ModelError(f"{self.name}: a spall needs all of {', '.join(self._SPALL)}; "
+                             f"missing {', '.join(missing)}")
+        if missing:
+            return
+        self.spall_angle = self._per_instance("spall_angle", angle)
+        self.spall_width = self._per_instance("spall_width", width, positive=True)
+        self.spall_depth = self._per_instance("spall_depth", depth, nonneg=True)
+        self.spall_edge = self._per_instance("spall_edge", edge, positive=True)
+        if np.any(self.spall_edge > self.spall_width):
+            raise ModelError(f"{self.name}: parameter 'spall_edge' must lie in (0, spall_width] [m], got {edge!r} "
+                             f"with spall_width {width!r}")
+        if np.any(self.spall_width + self.spall_edge >= 2.0 * np.pi * self.R_race):
+            raise ModelError(f"{self.name}: parameter 'spall_width' plus spall_edge must be < 2π·R_race (the "
+                             f"raceway's circumference) [m], got {width!r} + {edge!r}")
+        self._spall_hi = 0.5 * self.spall_width + 0.5 * self.spall_edge
+
     def fuse_key(self):
-        return ("RaceContact", self.exponent, self.traction)
+        return ("RaceContact", self.exponent, self.traction, self.has_spall)
 
     @classmethod
     def fuse(cls, parts):
-        """One family holding the instances of several (inner and outer raceways alike)."""
+        """One family holding the instances of several (inner and outer raceways alike; with a spall or
+        without, as the fuse key keeps them apart)."""
         f = super().fuse(parts)
         f.kind, f.exponent, f.traction = None, parts[0].exponent, parts[0].traction
         f._multi = bool(np.any(f.multiplicity != 1.0))
+        f.has_spall = parts[0].has_spall
+        for a in cls._SPALL + ("_spall_hi",) if f.has_spall else ():
+            setattr(f, a, np.concatenate([getattr(p, a) for p in parts]))
         return f
+
+    def _spalled(self, delta, delta_dot, angle, dx, dy, wx, wy, w_race):
+        """(δ − d(s), its exact rate δ̇ − h·B'(s)·ṡ) over the defect (law in the class docstring)."""
+        R, h = self.R_race, self.spall_depth
+        s = R * ad.wrap_angle(angle - self.spall_angle)
+        s_dot = R * ((dx * wy - dy * wx) / (dx * dx + dy * dy + _ETA2) - w_race)
+        B, B_s = spall_profile(s, self._spall_hi, self.spall_edge)
+        return delta - h * B, delta_dot - h * B_s * s_dot
 
     def kernel(self, t, fs, q, v, z):
         qr, qb, vr, vb = q[:3], q[3:], v[:3], v[3:]
@@ -388,6 +452,9 @@ class RaceContact(Element):
         Vc = marker_velocity(vb, rc)
         wx, wy = vr[0] - Vc[0], vr[1] - Vc[1]            # roller centre relative to raceway centre
         delta_dot = -kap * (ex * wx + ey * wy)
+        angle = ad.wrap_angle(ad.arctan2(dy, dx) - qb[2])
+        if self.has_spall:
+            delta, delta_dot = self._spalled(delta, delta_dot, angle, dx, dy, wx, wy, vb[2])
         # normal load; powers are taken of a safe positive δ and selected afterwards (no 0^negative)
         touch = ad.value(delta) > 0.0
         ds = ad.where(touch, delta, 1.0)
@@ -415,7 +482,6 @@ class RaceContact(Element):
         Fy = kap * Q * ey + Ft * ty
         forces = point_force(r_roll, (Fx, Fy)) + point_force(r_race, (-1.0 * Fx, -1.0 * Fy))
         forces = _scaled(forces, self.multiplicity, self._multi)
-        angle = ad.wrap_angle(ad.arctan2(dy, dx) - qb[2])
         return forces, {"load": Q, "deflection": delta, "traction": Ft, "slip_velocity": v_s, "angle": angle,
                         "rolling_speed": u_e, "fx": Fx, "fy": Fy}   # fx, fy: force on one physical roller, in R
 
