@@ -113,8 +113,9 @@ def spall_args(si, planet: str, raceway: str, angle_of_planet: float) -> dict:
         return {}
     Z = si.bearing.rollers
     hit = [x for x in si.errors.spall if x.planet == planet and x.raceway == raceway]
-    if not hit:
-        return dict(spall_angle=np.zeros(Z), spall_width=np.ones(Z), spall_depth=np.zeros(Z), spall_edge=np.ones(Z))
+    if not hit:       # a healthy raceway in a family that has a spall: depth 0 (any valid width and edge)
+        w = 1e-3 * si.bearing.roller_diameter
+        return dict(spall_angle=np.zeros(Z), spall_width=np.full(Z, w), spall_depth=np.zeros(Z), spall_edge=np.full(Z, w))
     x = hit[0]
     angle = x.position + (angle_of_planet if raceway == "inner" else 0.0)
     return dict(spall_angle=np.full(Z, angle), spall_width=np.full(Z, x.width), spall_depth=np.full(Z, x.depth),

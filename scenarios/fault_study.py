@@ -55,9 +55,10 @@ FAULTS = {
                "sun eccentric by 16 µm (radial runout 32 µm: ISO 1328-2 grade 7 for m = 3 mm, d = 93 mm)"),
     "roller": ({"errors.roller_diameter": [{"planet": "b1", "roller": 0, "deviation": "5 um"}]},
                "one roller of b1's bearing 5 µm oversize (a mis-sorted roller)"),
-    "spall_pin": ({"errors.spall": [{"planet": "b1", "raceway": "inner", "position": "0 deg", "width": "2 mm",
+    "spall_pin": ({"errors.spall": [{"planet": "b1", "raceway": "inner", "position": "180 deg", "width": "2 mm",
                                      "depth": "20 um", "edge": "0.5 mm"}]},
-                  "2 mm spall, 20 µm deep, on b1's pin in its load zone (radially outwards)"),
+                  "2 mm spall, 20 µm deep, on b1's pin in its load zone (facing the carrier axis: the planet's "
+                  "centrifugal load draws the bore outwards, so the pin carries on its inner side)"),
     "spall_bore": ({"errors.spall": [{"planet": "b1", "raceway": "outer", "position": "0 deg", "width": "2 mm",
                                       "depth": "20 um", "edge": "0.5 mm"}]},
                    "the same spall on b1's bore (turning with the planet)"),
