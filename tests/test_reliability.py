@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import json
 import shutil
+import warnings
 
 import numpy as np
 import pytest
 
+from components.dpgt import build_dpgt
+from components.presets import reference_dpgt
 from scenarios import paper_study
 from scenarios.integrity import DAMAGED, OtherResults, checkpoint_usable
 from scenarios.runner import RunConfig
@@ -277,10 +280,15 @@ def test_colliding_gears_are_refused_unless_forced(tmp_path, capsys):
 def test_output_size_is_estimated_and_checked_before_starting(tmp_path, monkeypatch, capsys):
     from scenarios import plausibility
 
-    # 1 GHz over 0.5 ms: 5e5 samples of 1632 values (12 rollers), 8 bytes, twice while joined: 13.0 GB
+    # 1 GHz over 0.5 ms: 5e5 samples of every recorded value (12 rollers: ~2000), 8 bytes, twice while joined
     assert paper_study.main(TINY + ["--sample-rate", "1e9", "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
-    assert "the recording would take 13.0 GB" in err and "more than 5 GB" in err and "--sample-rate" in err
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = build_dpgt(reference_dpgt(4, "forward"))
+    expect = plausibility.output_bytes(scene, 0.0005, 1e9)          # the recorder's own layout
+    assert f"the recording would take {expect / 1e9:.1f} GB" in err and "more than 5 GB" in err
+    assert "--sample-rate" in err and expect > 1e10
     monkeypatch.setattr(plausibility, "_free", lambda folder: 1e3)                  # a nearly full disk
     assert paper_study.main(TINY + ["--out", str(tmp_path)]) == 2
     assert "GB free" in capsys.readouterr().err and not (tmp_path / "c4_forward").exists()
