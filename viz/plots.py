@@ -344,6 +344,15 @@ def fault_spectra(panels: Sequence[tuple], path, *, quantity: str = "sensor acce
         return _save(fig, path)
 
 
+def _zoom_if_clustered(ax, values) -> None:
+    """Bars of positive values within a few % of each other (e.g. load-sharing factors near 1) read better
+    on an axis that starts near them than at zero."""
+    v = np.asarray([x for x in values if np.isfinite(x)], float)
+    if v.size and v.min() > 0 and np.ptp(v) < 0.3 * v.max():
+        pad = 0.15 * (np.ptp(v) or 0.05 * v.max())
+        ax.set_ylim(v.min() - pad, v.max() + pad)
+
+
 def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = (
         ("load_sharing_factor", "load sharing K_γ", None), ("bearing_load_max_N", "largest bearing load", "N"),
         ("life_relative", "life / perfect machine's", None), ("cage_slip_pct", "cage slip", "%"),
@@ -359,11 +368,14 @@ def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = 
         for r, (key, words, unit) in enumerate(quantities):
             for c, b in enumerate(bearings):
                 ax = axes[r, c]
+                shown = []
                 for k, (d, st) in enumerate((("forward", FWD), ("reverse", REV))):
                     val = {row["fault"]: row.get(key) for row in rows if row["bearing"] == b and row["direction"] == d}
                     y = [np.nan if val.get(f) is None else float(val[f]) for f in faults]
                     ax.bar(x + (k - 0.5) * 0.38, y, width=0.38, color=st["color"], label=d,
                            hatch="//" if d == "reverse" else None, alpha=0.85)
+                    shown += y
+                _zoom_if_clustered(ax, shown)
                 ax.set_ylabel(_axis_label(words, unit))
                 if r == 0:
                     ax.set_title(f"{b} planet bearings")

@@ -1,0 +1,51 @@
+"""The fault study end to end on a tiny window, and its characteristic frequencies."""
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+
+from components.presets import reference_dpgt
+from scenarios import fault_study
+
+
+def test_characteristic_frequencies_follow_the_kinematics():
+    """Condition 2 (2000 r/min): f_m = z_r f_c; a gear's rotation relative to the carrier is f_m / z; the
+    roller-pass frequencies are Z × the cage's speed relative to the pin and to the bore."""
+    si = reference_dpgt(2).si()
+    fr = fault_study.characteristic_frequencies(si)
+    z = {g: si.gears[g].teeth for g in ("sun", "outer_planet", "ring")}
+    assert fr["f_c"] == pytest.approx(2000 / 60) and fr["f_m"] == pytest.approx(z["ring"] * fr["f_c"])
+    assert fr["sun_rel"] == pytest.approx(fr["f_m"] / z["sun"])
+    assert fr["outer_planet_rel"] == pytest.approx(fr["f_m"] / z["outer_planet"])
+    Z = si.bearing.rollers
+    assert fr["outer_roller_pass_pin"] == pytest.approx(Z * fr["outer_cage_rel"])
+    # the cage rolls between pin and bore: its speed relative to each is shared by the raceway radii
+    b = si.bearing
+    Ri, Ro = 0.5 * (b.pitch_diameter - b.roller_diameter), 0.5 * (b.pitch_diameter + b.roller_diameter)
+    assert fr["outer_roller_pass_pin"] / fr["outer_roller_pass_bore"] == pytest.approx(Ro / Ri)
+
+
+@pytest.mark.slow
+def test_fault_study_runs_end_to_end(tmp_path):
+    out = tmp_path / "faults"
+    code = fault_study.main(["--faults", "pinhole,cracked_tooth", "--directions", "forward", "--settle", "0.002",
+                             "--window", "0.006", "--workers", "1", "--no-progress", "--out", str(out)])
+    assert code == 0
+    rows = list(csv.DictReader((out / "summary.csv").open()))
+    assert {(r["fault"], r["bearing"]) for r in rows} == {(f, b) for f in ("perfect", "pinhole", "cracked_tooth")
+                                                          for b in ("inner", "outer")}
+    by = {(r["fault"], r["bearing"]): r for r in rows}
+    assert float(by[("perfect", "outer")]["life_relative"]) == 1.0
+    assert float(by[("pinhole", "outer")]["load_sharing_factor"]) > float(by[("perfect", "outer")]["load_sharing_factor"])
+    assert float(by[("cracked_tooth", "outer")]["own_frequency"]) == pytest.approx(
+        fault_study.characteristic_frequencies(reference_dpgt(2).si())["outer_planet_rel"])
+    assert all(np.isfinite(float(r["sensor_f_m-1f_c"])) for r in rows)
+    for f in ("summary.md", "loads.png", "spectra.png", "study.json"):
+        assert (out / f).exists(), f
+    # a second call finds every run finished (resumes, nothing recomputed) and refuses other parameters
+    assert fault_study.main(["--faults", "pinhole,cracked_tooth", "--directions", "forward", "--settle", "0.002",
+                             "--window", "0.006", "--workers", "1", "--no-progress", "--out", str(out)]) == 0
+    assert fault_study.main(["--faults", "pinhole", "--directions", "forward", "--settle", "0.003",
+                             "--window", "0.006", "--workers", "1", "--no-progress", "--out", str(out)]) == 2
