@@ -40,7 +40,7 @@ from .command import command
 from .lock import holds_out_folder
 from .paper_study import parse_sets
 from .plausibility import check_runs
-from .runner import RunConfig
+from .runner import RunConfig, sweep_report
 from .analysis import line_table
 from .sweep import Case, build_params, check_folders, run_sweep
 
@@ -262,7 +262,7 @@ def run(a) -> dict:
     atomic_write_text(out / "study.json", json.dumps({"cases": [dataclasses.asdict(c) for c in cases],
                                                       "faults": {k: v[1] for k, v in FAULTS.items()},
                                                       "failed": failed}, indent=2, default=str))
-    return {"rows": rows, "failed": failed, "files": files}
+    return {"rows": rows, "failed": failed, "files": files, "results": results}
 
 
 def _check_case(case: Case, cfg: RunConfig) -> None:
@@ -285,6 +285,7 @@ def main(argv=None) -> int:
             print(f"{row['fault']:>14} {row['direction']:>8}: K_γ {row['load_sharing_factor']:.3f}, "
                   f"max bearing load {row['bearing_load_max_N']:.0f} N, life {row['life_relative'] or float('nan'):.2f}, "
                   f"sensor f_m / floor {row['sensor_f_m']:.3g}")
+    print("\nrun time and accuracy per run:", *sweep_report(r["results"]), sep="\n")
     for k, v in r["failed"].items():
         print(f"FAILED {k}: {v}")
     print("\nwritten:\n" + "\n".join(f"  {p}" for p in r["files"]))

@@ -34,7 +34,7 @@ from components.units import ParameterError, quantity, to_si
 from mbd.recorder import atomic_write_text
 
 from .paper_study import parse_sets
-from .runner import RunConfig
+from .runner import RunConfig, sweep_report
 from .plausibility import check_runs
 from .sweep import Case, _case_cfg, build_params, check_folders, run_sweep
 from . import args
@@ -222,13 +222,14 @@ def run(a) -> dict:
     failed = {k: v["error"] for k, v in results.items() if "error" in v}
     atomic_write_text(out / "study.json", json.dumps({"cases": [dataclasses.asdict(c) for c in cases],
                                                       "failed": failed}, indent=2, default=str))
-    return {"rows": rows, "failed": failed, "files": files, "answer": answer(rows) if rows else ""}
+    return {"rows": rows, "failed": failed, "files": files, "answer": answer(rows) if rows else "", "results": results}
 
 
 @command
 def main(argv=None) -> int:
     r = run(parse_args(sys.argv[1:] if argv is None else argv))
     print(r["answer"])
+    print("\nrun time and accuracy per run:", *sweep_report(r["results"]), sep="\n")
     for k, v in r["failed"].items():
         print(f"FAILED {k}: {v}")
     print("\nwritten:\n" + "\n".join(f"  {p}" for p in r["files"]))

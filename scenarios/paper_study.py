@@ -23,7 +23,7 @@ from components.outputs import SUMMARY_WORDS
 from components.outputs import relative_life as iso_relative_life
 from mbd.recorder import atomic_write_text
 
-from .runner import RunConfig, run_report
+from .runner import RunConfig, sweep_report
 from .integrity import read_summary
 from .plausibility import check_runs
 from .sweep import Case, _case_cfg, build_params, check_folders, run_sweep
@@ -319,11 +319,7 @@ def run(a) -> dict:
               if "error" in v or "stale_after_failure" in v}
     for k, v in failed.items():
         print(f"FAILED {k}: {v}  (details in {out / k / 'error.json'})")
-    print("run time and accuracy per run:")
-    for k, s in sorted(results.items()):
-        if "error" not in s:
-            first, *warns = run_report(s)
-            print(f"  {k}: {first}", *(f"\n  {k}: {w}" for w in warns), sep="")
+    print("run time and accuracy per run:", *sweep_report(results), sep="\n")
     print("\nwritten:")
     for p in [csv_p, md_p, *figs, *anims]:
         print(f"  {p}")

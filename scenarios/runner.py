@@ -184,7 +184,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     summary["samples"] = int(rec.next_index)      # recorded (for plots); the statistics use every step
     summary.update(label or {})
     summary.update({
-        "warnings": accuracy_warnings(integ, res.error_rms),
+        "warnings": accuracy_warnings(integ, res.error_rms) + validity_warnings(params.si(), summary),
         "wall_s": wall, "steps": res.steps, "rejected_steps": res.counters["rejected"],
         "newton_per_step": res.counters["newton"] / max(res.steps, 1),
         "resumed_from_s": res.resumed_from,
@@ -209,6 +209,24 @@ def accuracy_warnings(integ: mbd.IntegratorSettings, error_rms: float) -> list[s
     return []
 
 
+FULL_FILM_LAMBDA = 1.0   # below Λ = h_min/σ ≈ 1 asperities touch: mixed or boundary lubrication (Hamrock)
+
+
+def validity_warnings(si, summary: dict) -> list[str]:
+    """Where a finished run left the model's range of validity. The EHL traction law is a law of a full film:
+    where the thinnest film falls below Λ ≈ 1 (too slow, or too thin an oil) asperities carry load and
+    friction that the model does not have, so its traction there is not to be trusted."""
+    out = []
+    if si.bearing.traction_law == "ehl":
+        for kind in ("inner", "outer"):
+            lam = summary.get(kind, {}).get("lambda_min")
+            if lam is not None and lam < FULL_FILM_LAMBDA:
+                out.append(f"{kind} planet bearings: thinnest film Λ_min = {lam:.2f} < {FULL_FILM_LAMBDA:g} "
+                           f"(h_min {summary[kind]['film_min_m'] * 1e6:.3g} µm): mixed lubrication at this speed and "
+                           f"oil, outside the EHL traction law's full-film validity (no asperity friction is modelled)")
+    return out
+
+
 def accuracy_line(wall_s: float, steps: int, error_rms: float, error_max: float, atol_m: float) -> str:
     """Run time and error estimate, as every scenario prints them."""
     return (f"{wall_s:.1f} s wall, {steps} steps, local error estimate rms {error_rms:.2f} / max {error_max:.2f} "
@@ -220,6 +238,16 @@ def run_report(s: dict) -> list[str]:
     e = s["error_estimate"]
     return [accuracy_line(s["wall_s"], s["steps"], e["rms"], e["max"], e["atol_m"]),
             *(f"warning: {w}" for w in s.get("warnings", []))]
+
+
+def sweep_report(results: dict) -> list[str]:
+    """Run time, error estimate and warnings of every finished run of a sweep ({label: summary}), a line each."""
+    lines = []
+    for k, s in sorted(results.items()):
+        if "error" not in s and "error_estimate" in s:
+            first, *warns = run_report(s)
+            lines += [f"  {k}: {first}", *(f"  {k}: {w}" for w in warns)]
+    return lines
 
 
 def _json_default(o):

@@ -40,3 +40,21 @@ def test_a_rerun_resumes_and_bad_oils_are_refused(study, capsys):
     assert (study / "summary.csv").read_text() == before
     assert lubricant_study.main(ARGS[:4] + ["--grades", "VG46", "--out", str(study)]) == 2
     assert "error: argument --grades: takes ISO VG grades" in capsys.readouterr().err
+
+
+def test_a_thin_film_is_flagged_outside_the_ehl_laws_validity(study, capsys):
+    """Λ_min < 1 with the EHL traction law: a warning names the bearing type and Λ; the dry laws, or a full
+    film, give none. The study's own runs (condition 3, 10 and 100 mPa·s: Λ ≈ 2–7) carry no such warning."""
+    import json
+
+    from components.params import with_overrides
+    from components.presets import reference_dpgt
+    from scenarios.runner import validity_warnings
+
+    ehl = with_overrides(reference_dpgt(1), {"bearing.traction_law": "ehl"}).si()
+    thin = {"inner": {"lambda_min": 0.32, "film_min_m": 4.8e-8}, "outer": {"lambda_min": 1.7, "film_min_m": 2.6e-7}}
+    w = validity_warnings(ehl, thin)
+    assert len(w) == 1 and w[0].startswith("inner planet bearings") and "0.32" in w[0]
+    assert validity_warnings(reference_dpgt(1).si(), thin) == []          # tanh law: not a film law
+    for f in study.glob("*/summary.json"):
+        assert not [x for x in json.loads(f.read_text())["warnings"] if "Λ_min" in x]
