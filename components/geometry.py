@@ -578,6 +578,7 @@ def design_findings(params) -> list[Finding]:
     _mesh_findings(lay, out)
     _interference_findings(lay, G, out)
     _bearing_findings(params.bearing.si(), G, out)
+    _clearance_findings(lay, params.bearing.si(), G, out)
     os_ = params.operating.si()
     try:
         kinematics(G["sun"].teeth, G["inner_planet"].teeth, G["outer_planet"].teeth, G["ring"].teeth,
@@ -687,6 +688,37 @@ def _bearing_findings(bs, G, out) -> None:
                                f"{n.replace('_', ' ')} rim under the teeth is {rim * 1e3:.2f} mm, less than "
                                f"{RIM_BACKUP_RATIO} x tooth height ({height * 1e3:.2f} mm): a thin rim is flexible, "
                                f"which the rigid planet model ignores"))
+
+
+def _tip_root_clearances(g1: GearGeometry, g2: GearGeometry, a: float, internal: bool) -> float:
+    """The smaller radial gap between a tooth tip and the mating gear's root circle at centre distance a
+    (c*·m = 0.25 m for standard teeth at the nominal distance)."""
+    if internal:   # gear 2 the ring: the planet's tip against the ring's root, the ring's tip against the planet's root
+        return min(g2.root_radius - (a + g1.tip_radius), g2.tip_radius - (a + g1.root_radius))
+    return min(a - g1.tip_radius - g2.root_radius, a - g2.tip_radius - g1.root_radius)
+
+
+def _clearance_findings(lay, bs, G, out) -> None:
+    """A bearing clearance bigger than the gears allow: a planet free to move c/2 on its pin (the inner–outer
+    mesh: both planets, c) changes its centre distances by that much; the teeth must then neither strike the
+    mating roots (tip–root gap > 0) nor lose continuous contact (ε_α ≥ 1), which the mesh model has neither of."""
+    play = 0.5 * bs.clearance
+    for key, mg in lay.meshes.items():
+        da = 2.0 * play if key == "inner_outer" else play
+        g1, g2 = G[mg.gear1], G[mg.gear2]
+        for a in (mg.centre_distance - da, mg.centre_distance + da):
+            gap = _tip_root_clearances(g1, g2, a, mg.internal)
+            try:
+                eps = contact_ratio(g1, g2, a, mg.internal)
+            except ParameterError:
+                eps = 0.0
+            if gap <= 0.0 or eps < 1.0:
+                what = (f"the teeth strike the mating roots (tip-root gap {gap * 1e3:.3f} mm)" if gap <= 0.0 else
+                        f"the contact ratio falls to {eps:.3f} < 1")
+                out.append(Finding("error", "bearing.clearance",
+                                   f"{bs.clearance * 1e3:g} mm lets the {key.replace('_', '-')} centre distance move by "
+                                   f"{da * 1e3:.3f} mm, at which {what}: the gears allow less"))
+                return
 
 
 def check_design(params, strict: bool = True) -> list[Finding]:

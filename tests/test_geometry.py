@@ -404,3 +404,19 @@ def test_random_gear_sets(values):
     assert lay.assembles == bool(np.all(np.abs(lay.phasing.ring_mismatch) < 1e-9))
     assert s.gears.sun.pitch_radius == pytest.approx(0.5 * s.gears.sun.module * values["gears.sun.teeth"])
     assert s.operating.sun_speed == pytest.approx(lay.sun_ratio * s.operating.carrier_speed)
+
+
+def test_a_bearing_clearance_bigger_than_the_gears_allow_is_a_design_error():
+    """A planet free to move c/2 on its pin moves its centre distances by that much (the inner-outer mesh by
+    c): past the tip-root gap c*·m = 0.75 mm the teeth would strike roots the mesh model does not have.
+    The inner-outer mesh reaches it first, at c = 0.75 mm; the reference 20 µm is far inside."""
+    from components.geometry import design_findings
+    from components.params import with_overrides
+    from components.presets import reference_dpgt
+
+    def errors(c):
+        return [f for f in design_findings(with_overrides(reference_dpgt(), {"bearing.clearance": c}))
+                if f.severity == "error" and f.parameter == "bearing.clearance"]
+    assert errors("20 um") == [] and errors("0.74 mm") == []
+    (f,) = errors("0.76 mm")
+    assert "inner-outer" in f.message and "tip-root gap -0.010 mm" in f.message
