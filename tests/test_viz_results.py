@@ -260,7 +260,7 @@ def test_bad_inputs_give_clear_errors(tmp_path, capsys, runs):
         vr.load_run(tmp_path)
 
     out = tmp_path / "a.gif"
-    cases = [([str(missing), "--out", str(out)], 1, "no such results file"),
+    cases = [([str(missing), "--out", str(out)], 2, "argument results: no such file"),
              ([str(text), "--out", str(out)], 1, "not a netCDF4/HDF5"),
              ([str(foreign), "--out", str(out)], 1, "not a DPGT results file"),
              ([str(runs["forward"]), "--out", str(tmp_path / "a.png")], 2, ".gif or .mp4"),
@@ -268,8 +268,8 @@ def test_bad_inputs_give_clear_errors(tmp_path, capsys, runs):
              ([str(runs["forward"]), "--out", str(out), "--fps", "0"], 2, "positive"),
              ([str(runs["forward"]), "--out", str(out), "--kind", "train", "--compare",
                str(runs["reverse"])], 2, "--compare applies to --kind cage"),
-             ([str(runs["forward"]), "--out", str(out), "--compare", str(missing)], 1,
-              "no such results file")]
+             ([str(runs["forward"]), "--out", str(out), "--compare", str(missing)], 2,
+              "argument --compare: no such file")]
     for argv, code, message in cases:
         assert animate_main(argv) == code, argv
         err = capsys.readouterr().err
@@ -292,8 +292,8 @@ def test_no_offscreen_rendering_is_a_message(runs, tmp_path, capsys, monkeypatch
 
 def test_dpgt_routes_animate(tmp_path, capsys):
     from scenarios.cli import main as dpgt_main
-    assert dpgt_main(["animate", str(tmp_path / "x.nc"), "--out", str(tmp_path / "x.gif")]) == 1
-    assert "no such results file" in capsys.readouterr().err
+    assert dpgt_main(["animate", str(tmp_path / "x.nc"), "--out", str(tmp_path / "x.gif")]) == 2   # usage error
+    assert "no such file" in capsys.readouterr().err
 
 
 def test_viz_reads_results_without_the_engine(runs):

@@ -90,6 +90,9 @@ def main(argv=None) -> int:
         return _fail(f"--out must end in .gif or .mp4, got {out.name!r}", 2)
     if args.kind == "train" and args.compare:
         return _fail("--compare applies to --kind cage only", 2)
+    for what, path in (("results", args.results), ("--compare", args.compare)):
+        if path is not None and not Path(path).exists():      # a usage error, before anything loads
+            return _fail(f"argument {what}: no such file or folder {path!r}", 2)
 
     # Inputs first (cheap, clear messages), then the offscreen probe, then VTK.
     try:
