@@ -30,9 +30,11 @@ def test_characteristic_frequencies_follow_the_kinematics():
 @pytest.mark.slow
 def test_fault_study_runs_end_to_end(tmp_path):
     out = tmp_path / "faults"
-    code = fault_study.main(["--faults", "pinhole,cracked_tooth", "--directions", "forward", "--settle", "0.002",
-                             "--window", "0.006", "--workers", "1", "--no-progress", "--out", str(out)])
-    assert code == 0
+    machine = tmp_path / "bent_carrier.toml"        # a damaged machine described in TOML (README)
+    machine.write_text('[[errors.pinhole]]\nplanet = "b1"\nradial = "0 um"\ntangential = "30 um"\n')
+    args = ["--faults", "cracked_tooth", "--machine", f"pinhole={machine}", "--directions", "forward",
+            "--settle", "0.002", "--window", "0.006", "--workers", "1", "--no-progress", "--out", str(out)]
+    assert fault_study.main(args) == 0
     rows = list(csv.DictReader((out / "summary.csv").open()))
     assert {(r["fault"], r["bearing"]) for r in rows} == {(f, b) for f in ("perfect", "pinhole", "cracked_tooth")
                                                           for b in ("inner", "outer")}
@@ -45,7 +47,6 @@ def test_fault_study_runs_end_to_end(tmp_path):
     for f in ("summary.md", "loads.png", "spectra.png", "study.json"):
         assert (out / f).exists(), f
     # a second call finds every run finished (resumes, nothing recomputed) and refuses other parameters
-    assert fault_study.main(["--faults", "pinhole,cracked_tooth", "--directions", "forward", "--settle", "0.002",
-                             "--window", "0.006", "--workers", "1", "--no-progress", "--out", str(out)]) == 0
-    assert fault_study.main(["--faults", "pinhole", "--directions", "forward", "--settle", "0.003",
+    assert fault_study.main(args) == 0
+    assert fault_study.main(["--faults", "cracked_tooth", "--directions", "forward", "--settle", "0.003",
                              "--window", "0.006", "--workers", "1", "--no-progress", "--out", str(out)]) == 2
