@@ -40,9 +40,9 @@ from .command import command
 from .lock import holds_out_folder
 from .paper_study import parse_sets
 from .plausibility import check_runs
-from .runner import RunConfig, sweep_report
+from .runner import RunConfig
 from .analysis import line_table
-from .sweep import Case, build_params, check_folders, run_sweep
+from .sweep import Case, build_params, check_folders, run_sweep, study_epilogue
 
 __all__ = ["FAULTS", "main", "run", "characteristic_frequencies", "COLUMNS"]
 
@@ -285,11 +285,7 @@ def main(argv=None) -> int:
             print(f"{row['fault']:>14} {row['direction']:>8}: K_γ {row['load_sharing_factor']:.3f}, "
                   f"max bearing load {row['bearing_load_max_N']:.0f} N, life {row['life_relative'] or float('nan'):.2f}, "
                   f"sensor f_m / floor {row['sensor_f_m']:.3g}")
-    print("\nrun time and accuracy per run:", *sweep_report(r["results"]), sep="\n")
-    for k, v in r["failed"].items():
-        print(f"FAILED {k}: {v}")
-    print("\nwritten:\n" + "\n".join(f"  {p}" for p in r["files"]))
-    return 1 if r["failed"] else 0
+    return study_epilogue(r)
 
 
 if __name__ == "__main__":

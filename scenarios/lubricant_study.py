@@ -34,9 +34,9 @@ from components.units import ParameterError, quantity, to_si
 from mbd.recorder import atomic_write_text
 
 from .paper_study import parse_sets
-from .runner import RunConfig, sweep_report
+from .runner import RunConfig
 from .plausibility import check_runs
-from .sweep import Case, _case_cfg, build_params, check_folders, run_sweep
+from .sweep import Case, _case_cfg, build_params, check_folders, run_sweep, study_epilogue
 from . import args
 from .command import command
 from .lock import holds_out_folder
@@ -229,11 +229,7 @@ def run(a) -> dict:
 def main(argv=None) -> int:
     r = run(parse_args(sys.argv[1:] if argv is None else argv))
     print(r["answer"])
-    print("\nrun time and accuracy per run:", *sweep_report(r["results"]), sep="\n")
-    for k, v in r["failed"].items():
-        print(f"FAILED {k}: {v}")
-    print("\nwritten:\n" + "\n".join(f"  {p}" for p in r["files"]))
-    return 1 if r["failed"] else 0
+    return study_epilogue(r)
 
 
 if __name__ == "__main__":

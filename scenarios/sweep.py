@@ -213,3 +213,15 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
         if cluster is not None:
             cluster.close()     # a local cluster's workers stop with it
     return results
+
+
+def study_epilogue(r: dict) -> int:
+    """What a study prints after its tables: every run's time, error estimate and warnings, the failed runs,
+    the files written. Returns the exit code (1 if any run failed). ``r``: results, failed, files."""
+    from .runner import sweep_report
+
+    print("\nrun time and accuracy per run:", *sweep_report(r["results"]), sep="\n")
+    for k, v in r["failed"].items():
+        print(f"FAILED {k}: {v}")
+    print("\nwritten:\n" + "\n".join(f"  {p}" for p in r["files"]))
+    return 1 if r["failed"] else 0
