@@ -179,3 +179,16 @@ def out_folder(text):
     if not os.access(parent, os.W_OK | os.X_OK):
         raise argparse.ArgumentTypeError(f"cannot write into {str(parent)!r} (permission denied)")
     return str(p)
+
+
+def add_sweep_options(p, out_default: str) -> None:
+    """The options every study shares: where its runs go (Dask local workers or a scheduler), what may be
+    replaced or forced, progress bars, and its output folder."""
+    p.add_argument("--workers", type=count(1), default=None, help="Dask local workers (default: one per core)")
+    p.add_argument("--scheduler", default=None, type=scheduler, help="address of an existing Dask scheduler")
+    p.add_argument("--force", action="store_true",
+                   help="run although the gears collide or the recording is too large for the limit or the disk")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace finished results of other parameters or settings in --out (else refused)")
+    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--out", default=out_default, type=out_folder, help="output directory")

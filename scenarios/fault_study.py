@@ -89,14 +89,7 @@ def parse_args(argv):
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz] (> 2 f_m)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
                    help="override a parameter (repeatable)")
-    p.add_argument("--workers", type=args.count(1), default=None, help="Dask local workers (default: one per core)")
-    p.add_argument("--scheduler", default=None, type=args.scheduler, help="address of an existing Dask scheduler")
-    p.add_argument("--force", action="store_true",
-                   help="run although the gears collide or the recording is too large for the limit or the disk")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace finished results of other parameters or settings in --out (else refused)")
-    p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--out", default="results/faults", type=args.out_folder, help="output directory")
+    args.add_sweep_options(p, "results/faults")
     return p.parse_args(argv)
 
 

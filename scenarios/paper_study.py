@@ -65,15 +65,8 @@ def parse_args(argv):
     p.add_argument("--alpha", type=args.alpha, default=-0.3, help="HHT alpha in [-1/3, 0]")
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
                    help="scene switch, e.g. --option drag=false --option bearings=linear")
-    p.add_argument("--workers", type=args.count(1), default=None, help="Dask local workers (default: one per core)")
-    p.add_argument("--scheduler", default=None, type=args.scheduler, help="address of an existing Dask scheduler")
     p.add_argument("--animate", action="store_true", help="write a cage-orbit animation per condition")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace finished results of other parameters or settings in --out (else refused)")
-    p.add_argument("--force", action="store_true",
-                   help="run although the gears collide or the recording is too large for the limit or the disk")
-    p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--out", default="results/study", type=args.out_folder, help="output directory")
+    args.add_sweep_options(p, "results/study")
     return p.parse_args(argv)
 
 
