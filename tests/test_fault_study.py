@@ -44,8 +44,10 @@ def test_fault_study_runs_end_to_end(tmp_path):
     assert float(by[("cracked_tooth", "outer")]["own_frequency"]) == pytest.approx(
         fault_study.characteristic_frequencies(reference_dpgt(2).si())["outer_planet_rel"])
     assert all(np.isfinite(float(r["sensor_f_m-1f_c"])) for r in rows)
-    for f in ("summary.md", "loads.png", "spectra.png", "study.json"):
+    for f in ("summary.md", "findings.md", "loads.png", "spectra.png", "study.json"):
         assert (out / f).exists(), f
+    text = (out / "findings.md").read_text()
+    assert "forward:" in text and "cracked_tooth: life ×" in text and "pinhole: life ×" in text
     # a second call finds every run finished (resumes, nothing recomputed) and refuses other parameters
     assert fault_study.main(args) == 0
     assert fault_study.main(["--faults", "cracked_tooth", "--directions", "forward", "--settle", "0.003",
