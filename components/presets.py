@@ -12,7 +12,8 @@ from types import MappingProxyType
 from pathlib import Path
 
 from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, ErrorsParams, GearParams, GearSetParams,
-                     LifeParams, LubricantParams, MeshParams, OperatingPoint, RigParams, SensorParams,
+                     LifeParams, LubricantParams, MeshParams, OperatingPoint, PinholeErrorParams, RigParams, RunoutParams,
+                     SensorParams,
                      SlideRollTractionParams, SupportParams, assumed, derived,
                      overrides_from_toml, paper, with_overrides)
 from .units import Q_, ParameterError
@@ -171,18 +172,10 @@ def typical_errors(params: DPGTParams, grade: int) -> ErrorsParams:
     pin = "carrier pinhole position error within +-10 um (assumed precision carrier)"
     pinholes = [{"planet": f"b{n + 1}", "radial": assumed(Q_(r, "um"), pin), "tangential": assumed(Q_(t, "um"), pin)}
                 for n, (r, t) in enumerate([(0.0, 10.0), (-6.0, 0.0), (4.0, -8.0)][:N])]
-    return ErrorsParams(runout=assumed([_sourced_entry(x) for x in runouts], note),
-                        pinhole=assumed([_sourced_entry(x) for x in pinholes], pin),
+    return ErrorsParams(runout=assumed([RunoutParams(**x) for x in runouts], note),
+                        pinhole=assumed([PinholeErrorParams(**x) for x in pinholes], pin),
                         roller_diameter=assumed((), "no roller errors"), spall=assumed((), "no damage"),
                         tooth_fault=assumed((), "no damage"))
-
-
-def _sourced_entry(d: dict):
-    """An error entry from a dict of (possibly Sourced) values, keeping their tags."""
-    from .params import PinholeErrorParams, RunoutParams
-
-    cls = RunoutParams if "gear" in d else PinholeErrorParams
-    return cls(**d)
 
 
 def rig_accelerometer() -> SensorParams:

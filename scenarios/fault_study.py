@@ -140,15 +140,15 @@ def characteristic_frequencies(si) -> dict[str, float]:
 def _own_frequency(case: Case, si, fr: dict) -> float | None:
     """The sideband spacing a fault of this case should bring in around f_m (None: none specific)."""
     e = si.errors
-    for x in e.tooth_fault + e.runout:
-        g = getattr(x, "gear")
-        return fr["f_c"] if g == "ring" else fr["sun_rel"] if g == "sun" else \
-            fr[f"{'inner' if g[0] == 'a' else 'outer'}_planet_rel"]
-    for x in e.spall:
-        kind = "inner" if x.planet[0] == "a" else "outer"
-        return fr[f"{kind}_roller_pass_{'pin' if x.raceway == 'inner' else 'bore'}"]
-    for x in e.roller_diameter:
-        return fr[f"{'inner' if x.planet[0] == 'a' else 'outer'}_cage_rel"]
+    kind = lambda planet: "inner" if planet[0] == "a" else "outer"
+    if e.tooth_fault or e.runout:          # the first faulty gear's rotation relative to the carrier
+        g = (e.tooth_fault + e.runout)[0].gear
+        return fr["f_c"] if g == "ring" else fr["sun_rel"] if g == "sun" else fr[f"{kind(g)}_planet_rel"]
+    if e.spall:
+        x = e.spall[0]
+        return fr[f"{kind(x.planet)}_roller_pass_{'pin' if x.raceway == 'inner' else 'bore'}"]
+    if e.roller_diameter:
+        return fr[f"{kind(e.roller_diameter[0].planet)}_cage_rel"]
     return fr["f_c"] if e.pinhole else None
 
 
@@ -301,10 +301,10 @@ def _check_case(case: Case, cfg: RunConfig) -> None:
 
     si = build_params(case).si()
     faults.check_errors(si)
-    f_m = si.operating.mesh_frequency
-    if cfg.sample_rate <= 2 * (f_m + 6 * si.operating.carrier_frequency):
+    need = 2 * (si.operating.mesh_frequency + 6 * abs(si.operating.carrier_frequency))   # f_m + 6 f_c, reverse too
+    if cfg.sample_rate <= need:
         raise ParameterError.at("--sample-rate", f"{cfg.sample_rate:g} Hz cannot resolve the mesh sidebands: needs "
-                                                 f"> {2 * (f_m + 6 * abs(si.operating.carrier_frequency)):.0f} Hz")
+                                                 f"> {need:.0f} Hz")
 
 
 @command

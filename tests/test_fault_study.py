@@ -52,3 +52,12 @@ def test_fault_study_runs_end_to_end(tmp_path):
     assert fault_study.main(args) == 0
     assert fault_study.main(["--faults", "cracked_tooth", "--directions", "forward", "--settle", "0.003",
                              "--window", "0.006", "--workers", "1", "--no-progress", "--out", str(out)]) == 2
+
+
+def test_a_sample_rate_that_cannot_resolve_the_sidebands_is_refused_in_either_direction(tmp_path, capsys):
+    """Condition 2: f_m + 6 f_c = 2933 Hz needs more than 5867 Hz; 5500 Hz is refused forward and reverse (the
+    reverse carrier frequency is negative, which must not lower the bound)."""
+    for d in ("forward", "reverse"):
+        assert fault_study.main(["--faults", "", "--directions", d, "--sample-rate", "5500", "--no-progress",
+                                 "--out", str(tmp_path / d)]) == 2
+        assert "--sample-rate: 5500 Hz cannot resolve" in capsys.readouterr().err
