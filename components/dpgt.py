@@ -14,7 +14,7 @@ import numpy as np
 
 from mbd.elements import GroundSupport, Ramp, SpeedDrive, TorqueSource
 
-from . import faults
+from . import faults, teeth
 from .bearing import BearingHandles, add_planet_bearing
 from .gears import add_mesh_family
 from .geometry import check_design, loaded_flanks
@@ -100,6 +100,7 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     # meshes, phased for the flank the torque path loads (reverse rotation loads the other flanks)
     T_s = op.sun_torque
     flanks = loaded_flanks(np.sign(T_s) if T_s != 0 else np.sign(speed["sun"]))
+    tooth_pairs = teeth.has_teeth(si)       # real teeth: the tooth-pair law (perfect ones: its exact reduction)
     common = dict(time_varying=opt.mesh_stiffness == "time_varying", smoothing=ms.smoothing_width,
                   ratio=ms.stiffness_ratio)
     M = lay.meshes
@@ -107,7 +108,8 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
                                   ("inner_outer", a_names, b_names, ph.gamma_inner, ph.gamma_outer),
                                   ("outer_ring", b_names, ["ring"] * N, ph.gamma_outer, np.full(N, ph.gamma_ring))):
         add_mesh_family(scene, MESH_FAMILY[key], M[key], gear1=g1, gear2=g2, theta1_0=th1, theta2_0=th2,
-                        flank=flanks[key], errors=faults.mesh_error_args(si, M[key], flanks[key], g1, g2), **common)
+                        flank=flanks[key], errors=faults.mesh_error_args(si, g1, g2),
+                        pairs=teeth.mesh_pairs(si, M[key], g1, g2) if tooth_pairs else None, **common)
 
     # drives: sun torque (driving motor), carrier speed drive (loading motor)
     f_m = op.mesh_frequency

@@ -8,8 +8,8 @@ families that feel them:
 * pinhole error → the pin's marker on the carrier (:func:`pin_position`);
 * roller diameter deviation → that roller's D in both raceway contacts (:func:`roller_diameters`);
 * spall → the raceway contacts' defect parameters (:func:`spall_args`);
-* runout and tooth faults → the mesh families' geometric-centre offsets and fault coordinates
-  (:func:`mesh_error_args`).
+* runout → the mesh families' geometric-centre offsets (:func:`mesh_error_args`);
+* tooth faults and deviations → the gears' tooth tables (:mod:`components.teeth`, checked here too).
 
 A machine without errors gets none of these parameters: its elements are evaluated exactly as before.
 A family that holds one damaged instance holds the "healthy" values (depth 0, factor 1, offset 0) for
@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import teeth
 from .units import ParameterError
 
 __all__ = ["check_errors", "pin_position", "roller_diameters", "spall_args", "mesh_error_args", "GEAR_OF"]
@@ -75,12 +76,10 @@ def check_errors(si) -> None:
         if x.tooth >= z:
             raise ParameterError.at(f"errors.tooth_fault[{i}].tooth", f"must be in 0..{z - 1} ({x.gear} has {z} teeth), "
                                                                       f"got {x.tooth}")
-    gears = [x.gear for x in e.tooth_fault]
-    if len(set(gears)) < len(gears):
-        raise ParameterError.at("errors.tooth_fault", "at most one faulty tooth per gear")
     runout = [x.gear for x in e.runout]
     if len(set(runout)) < len(runout):
         raise ParameterError.at("errors.runout", "at most one runout entry per gear")
+    teeth.check_teeth(si)
 
 
 def pin_position(si, planet: str, nominal) -> np.ndarray:
@@ -129,55 +128,9 @@ def _offset(si, gear: str) -> np.ndarray:
     return np.zeros(2)
 
 
-def _tooth_fault(si, gear: str):
-    return next((x for x in si.errors.tooth_fault if x.gear == gear), None)
-
-
-def _fault_coordinate(mg, flank: int, which: int, tooth: int) -> tuple[float, float, float]:
-    """(A1, A2, c_f) of the fault coordinate p_f = A1 θ1 + A2 θ2 − (A1 + A2) φ_e + c_f, which is 0 (mod the
-    faulty gear's tooth count) when the pair of tooth ``tooth`` of gear ``which`` (1 or 2) enters on ``flank``.
-
-    Gear 1 (body angle θ1 holds its tooth 0): tooth i is centred on the pitch point at
-    p_geo = z1(θ1 − φ_e)/2π ≡ −i, and its pair enters entry_shift = h earlier, so p_f = p_geo + i + h.
-    Gear 2: its tooth phase at the pitch point q = z2(θ2 − φ_e − π·[external])/2π is ≡ −k when tooth k is
-    centred there, and rolling gives q = −σ p_geo + const. The pair (i, k) on flank f has its contact at
-    s = (σ f (p − p_i) + 1/4) p_b, at −p_b/4 when tooth k is centred (symmetry), so tooth k is centred at
-    p_i − σf/2 and the pair enters σf/2 − h after that. With A2 = −σ z2/2π:
-    A2(θ2 − φ_e) = −σ q − σ (z2/2)·[external], hence c_f = −(σk − σ(z2/2)[external] + σf/2 − h)."""
-    h = mg.entry_shift(flank)
-    if which == 1:
-        return mg.z1 / TWO_PI, 0.0, tooth + h
-    sig = mg.sigma
-    ext = 0.0 if mg.internal else 1.0
-    return 0.0, -sig * mg.z2 / TWO_PI, -(sig * tooth - sig * 0.5 * mg.z2 * ext + 0.5 * sig * flank - h)
-
-
-def mesh_error_args(si, mg, flank: int, gear1: list[str], gear2: list[str]) -> dict:
-    """Runout offsets and tooth-fault parameters of one mesh family (``mg`` its
-    :class:`components.geometry.MeshGeometry`, ``gear1``/``gear2`` the gear names per instance); {} for a
-    machine with neither."""
-    e = si.errors
-    out = {}
-    if e.runout:
-        out["offset1"] = np.array([_offset(si, g) for g in gear1])
-        out["offset2"] = np.array([_offset(si, g) for g in gear2])
-    if e.tooth_fault:
-        n = len(gear1)
-        cols = {k: np.zeros(n) for k in ("fault_coef1", "fault_coef2", "fault_offset")}
-        cols["fault_period"] = np.full(n, float(mg.z1))
-        cols["fault_factor"] = np.ones(n)
-        for i, (g1, g2) in enumerate(zip(gear1, gear2)):
-            f1, f2 = _tooth_fault(si, g1), _tooth_fault(si, g2)
-            if f1 is not None and f2 is not None:
-                raise ParameterError.at("errors.tooth_fault", f"faulty teeth on both gears of the {g1}-{g2} mesh: "
-                                                              "one faulty gear per mesh is supported")
-            f, which = (f1, 1) if f1 is not None else (f2, 2)
-            if f is None:
-                continue
-            A1, A2, c = _fault_coordinate(mg, flank, which, f.tooth)
-            cols["fault_coef1"][i], cols["fault_coef2"][i], cols["fault_offset"][i] = A1, A2, c
-            cols["fault_period"][i] = float(mg.z1 if which == 1 else mg.z2)
-            cols["fault_factor"][i] = f.stiffness_factor
-        out.update(cols, fault_contact_ratio=np.full(n, mg.contact_ratio),
-                   fault_smoothing=np.full(n, si.mesh.smoothing_width))
-    return out
+def mesh_error_args(si, gear1: list[str], gear2: list[str]) -> dict:
+    """Runout offsets of one mesh family's gears (``gear1``/``gear2`` the gear names per instance); {} for a
+    machine without runout. (Tooth faults and deviations are the tooth-pair law's: :mod:`components.teeth`.)"""
+    if not si.errors.runout:
+        return {}
+    return {"offset1": np.array([_offset(si, g) for g in gear1]), "offset2": np.array([_offset(si, g) for g in gear2])}

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from mbd.elements.gear_mesh import GearMesh, StiffnessShape, mesh_offset
+from mbd.elements.tooth_pairs import ToothPairs
 
 from .scene import Scene
 from .units import ParameterError
@@ -20,16 +21,20 @@ __all__ = ["add_mesh_family"]
 
 
 def add_mesh_family(scene: Scene, family: str, mg, *, gear1: list[str], gear2: list[str], theta1_0, theta2_0,
-                    flank: int, time_varying: bool, smoothing: float, ratio: float, errors: dict) -> slice:
+                    flank: int, time_varying: bool, smoothing: float, ratio: float, errors: dict,
+                    pairs: ToothPairs | None = None) -> slice:
     """Add the N meshes of one type (``mg`` a :class:`components.geometry.MeshGeometry`).
     ``theta*_0`` are the gears' body angles at assembly (tooth 0 at the body angle); u0 makes both
-    flanks' compression zero there. ``errors``: per-instance runout and tooth-fault parameters
-    (:func:`components.faults.mesh_error_args`; {} for a perfect machine)."""
+    flanks' compression zero there. ``errors``: per-instance runout offsets
+    (:func:`components.faults.mesh_error_args`; {} for a perfect machine); ``pairs``: the tooth-pair law's
+    data (:func:`components.teeth.mesh_pairs`) of a machine whose teeth are not perfect, else None (the
+    rectangular law, which the pair law then equals). A constant stiffness with pairs splits a constant
+    over the pairs (k_double/k_single = 1)."""
     th1, th2 = np.asarray(theta1_0, float), np.asarray(theta2_0, float)
     phi = np.asarray(mg.line_angle, float)
     rb1, rb2 = mg.base_radius1, mg.base_radius2
     u0 = mesh_offset(mg.internal, rb1, rb2, th1, th2, phi)
-    if time_varying:
+    if time_varying or pairs is not None:
         # the single/double-contact wave needs 1 <= ε < 2 and non-overlapping ramps: refuse with the
         # parameter's name here (StiffnessShape would raise a bare ModelError from inside the build)
         eps = mg.contact_ratio
@@ -40,13 +45,13 @@ def add_mesh_family(scene: Scene, family: str, mg, *, gear1: list[str], gear2: l
         if smoothing > s_max:
             raise ParameterError.at("mesh.smoothing_width", f"{smoothing:g} is too wide for the {mg.name} mesh: its contact "
                                                             f"ratio {eps:.4f} allows at most {s_max:.4g} (ramps may not overlap)")
-        shape = StiffnessShape.rectangular(mg.contact_ratio, ratio=ratio, smoothing=smoothing)
+        shape = StiffnessShape.rectangular(mg.contact_ratio, ratio=ratio if time_varying else 1.0, smoothing=smoothing)
         # geometry's p0 assumes body angle 0 at assembly; here the body angle already holds γ₁
         p0 = np.mod(mg.wave_p0(flank) - mg.p0, 1.0)
     else:
         shape = StiffnessShape.constant()
         p0 = np.zeros_like(phi)
-    fam = scene.family(family, GearMesh, ("gear1", "gear2"), internal=mg.internal, stiffness=shape)
+    fam = scene.family(family, GearMesh, ("gear1", "gear2"), internal=mg.internal, stiffness=shape, pairs=pairs)
     n = phi.size
     return fam.add(n, gear1=gear1, gear2=gear2, rb1=rb1, rb2=rb2, alpha=mg.pressure_angle, a0=mg.centre_distance,
                    teeth1=mg.z1, k_mean=mg.k_mean, c_mesh=mg.damping, u0=u0, p0=p0, backlash=mg.backlash, phi_ref=phi,

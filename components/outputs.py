@@ -754,7 +754,10 @@ class WindowStatistics(mbd.Observer):
             d["all_cages"]["cage_guide_rms_N"] = d["all_rollers"]["cage_guide_rms_N"]
 
     def _mesh_summary(self) -> dict:
-        """Per mesh type, over all planet pairs: mean (average of the pairs) and max of each flank."""
+        """Per mesh type, over all planet pairs: mean (average of the pairs) and max of each flank; the loaded
+        transmission error's peak-to-peak (the drive flank's compression, max − min over the window) and the
+        dynamic factor K_v = max / mean of the drive flank's force (ISO 6336-1's notion, from the run), the
+        largest of the pairs and per pair."""
         out = {}
         for key in self.meshes:
             d = {"drive_flank": int(self.flanks.get(key, 1))}
@@ -765,5 +768,12 @@ class WindowStatistics(mbd.Observer):
                 d[f"{flank}_deflection_mean_m"] = float(x["mean"].mean())
                 d[f"{flank}_deflection_max_m"] = float(x["max"].max())
                 d[f"{flank}_force_mean_per_pair_N"] = [float(y) for y in f["mean"]]
+            f, x = self.stats(f"{key}_drive_force"), self.stats(f"{key}_drive_deflection")
+            te = x["max"] - x["min"]
+            kv = f["max"] / np.where(f["mean"] > 0, f["mean"], np.nan)
+            d["te_peak_to_peak_m"] = float(te.max())
+            d["te_peak_to_peak_per_pair_m"] = [float(y) for y in te]
+            d["dynamic_factor"] = float(np.nanmax(kv)) if np.any(np.isfinite(kv)) else None
+            d["dynamic_factor_per_pair"] = [float(y) if np.isfinite(y) else None for y in kv]
             out[key] = d
         return out

@@ -110,7 +110,7 @@ _USER = Source("user")
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class _Spec:
-    kind: str                      # a units kind, or "count" | "sign" | "flag" | "choice" | "name" | "nested" | "entries"
+    kind: str                      # a units kind, or "count" | "sign" | "flag" | "choice" | "name" | "tooth" | "nested" | "entries"
     lo: float | None = None        # bounds on the SI value
     hi: float | None = None
     lo_open: bool = False
@@ -228,6 +228,13 @@ def _convert(spec: _Spec, name: str, value):
         return value
     if k == "entries":
         return _convert_entries(spec, name, value)
+    if k == "tooth":
+        if value == "all":
+            return value
+        v = _as_int(name, value, 'a tooth index >= 0 or "all"')
+        if v < 0:
+            raise ParameterError.at(name, f'expected a tooth index >= 0 or "all", got {value!r}')
+        return v
     if k == "choice":
         if value not in spec.choices:
             raise ParameterError.at(name, f"expected one of {list(spec.choices)}, got {value!r}")
@@ -326,7 +333,8 @@ def _si_type(spec: "_Spec"):
         return spec.cls.SI
     if spec.kind == "entries":
         return tuple
-    t = {"count": int, "sign": int, "flag": bool, "choice": str, "name": str}.get(spec.kind, float)
+    t = {"count": int, "sign": int, "flag": bool, "choice": str, "name": str,
+         "tooth": int | str}.get(spec.kind, float)
     return t | None if spec.optional else t
 
 
@@ -484,6 +492,12 @@ class GearParams(Params):
     internal: bool = _param("flag", "internal gear (teeth inside, the ring)", default=False)
     addendum_coefficient: Quantity = _nonneg("dimensionless", "addendum h_a/m (standard 1)", default=1.0)
     dedendum_coefficient: Quantity = _nonneg("dimensionless", "dedendum h_f/m (standard 1.25)", default=1.25)
+    tip_relief: Quantity = _nonneg("length", "tip relief C_a: material removed at the tip, along the line of action "
+                                             "(a profile modification; 0: none)", default="0 um")
+    tip_relief_length: Quantity = _nonneg("length", "length L_a of the tip relief: roll length along the line of "
+                                                    "action from the tip", default="0 mm")
+    tip_relief_shape: str = _param("choice", "how the relief grows from its start to the tip", default="linear",
+                                   choices=("linear", "parabolic"))
 
     _si_derived: ClassVar[tuple] = (
         Derived("inertia", float, "polar moment of inertia [kg m^2] (given, or the rule)"),
@@ -916,6 +930,53 @@ class ToothFaultParams(Params):
 ToothFaultSI = ToothFaultParams.SI
 
 
+_TOOTH_GEAR_TEXT = "a gear name: 'sun', 'ring', 'a1'..'aN' or 'b1'..'bN'"
+
+
+@_with_si("ToothDeviationSI")
+@dataclass(frozen=True, kw_only=True)
+class ToothDeviationParams(Params):
+    """Deviations of one tooth's flank (or of every tooth) from the perfect involute, ISO 1328-1 quantities,
+    along the line of action. ``flank`` "ccw" is the tooth flank that faces the gear's counter-clockwise
+    (+θ, forward) side, "cw" the other; "both" sets both. Signs: ``pitch`` + = the flank sits ahead of its
+    theoretical position in the counter-clockwise sense (a tooth with "both" at +5 µm is turned 5 µm
+    forward: the single pitch deviations f_pt are the differences of neighbouring teeth's values);
+    ``slope`` f_Hα + = more material at the tip than at the start of the active profile; ``form`` f_fα:
+    the range of the deviation left after removing its straight line, + = more material mid-profile
+    ("barrel") or towards the tip ("s"). Entries for the same tooth and flank add up."""
+    _prefix: ClassVar[str] = "errors.tooth"
+    gear: str = _name(_GEAR, _TOOTH_GEAR_TEXT, "the gear whose tooth deviates")
+    tooth: Any = _param("tooth", 'tooth index 0..z-1 (tooth 0 on the gear\'s body x axis) or "all"')
+    flank: str = _param("choice", "which flank of the tooth", choices=("ccw", "cw", "both"))
+    pitch: Quantity = _param("length", "cumulative pitch deviation F_pk: where the flank sits, + ahead "
+                                       "counter-clockwise", default="0 um")
+    slope: Quantity = _param("length", "profile slope deviation f_Ha (+: material towards the tip)", default="0 um")
+    form: Quantity = _param("length", "profile form deviation f_fa, the range of the curved part (+: material "
+                                      "mid-profile for 'barrel', towards the tip for 's')", default="0 um")
+    form_shape: str = _param("choice", "shape of the form deviation: barrel (a parabola) or s (a cubic)",
+                             choices=("barrel", "s"), default="barrel")
+ToothDeviationSI = ToothDeviationParams.SI
+
+
+@_with_si("FlankClassSI")
+@dataclass(frozen=True, kw_only=True)
+class FlankClassParams(Params):
+    """Tooth deviations drawn for gears of an ISO 1328-1:2013 flank tolerance class (``components.tolerances``):
+    every tooth flank's cumulative pitch deviation, profile slope and profile form deviation, normal with
+    the class's tolerance at 3σ (per tooth), the profile deviations split into a part common to every tooth
+    of a gear flank (``systematic_share`` of their variance: one grinding set-up) and a tooth-to-tooth part.
+    Every gear draws its own teeth (reproducibly from ``seed`` and its name)."""
+    _prefix: ClassVar[str] = "errors.flank_class"
+    gear: str = _name(r"all|planets|" + _GEAR, "'all', 'planets' or " + _TOOTH_GEAR_TEXT, "the gears of this class")
+    grade: int = _param("count", "ISO 1328-1:2013 flank tolerance class 1 (finest) .. 11", lo=1, hi=11,
+                        bound_text="in 1..11")
+    seed: int = _param("count", "seed of the random draw", lo=0, bound_text=">= 0")
+    systematic_share: Quantity = _param("dimensionless", "share of the profile deviations' variance common to every "
+                                                         "tooth of a gear flank", lo=0.0, hi=1.0,
+                                        bound_text="in [0, 1]")
+FlankClassSI = FlankClassParams.SI
+
+
 @_with_si("ErrorsSI")
 @dataclass(frozen=True, kw_only=True)
 class ErrorsParams(Params):
@@ -928,6 +989,8 @@ class ErrorsParams(Params):
     roller_diameter: tuple = _entries(RollerDiameterErrorParams, "roller diameter deviations")
     spall: tuple = _entries(SpallParams, "raceway spalls")
     tooth_fault: tuple = _entries(ToothFaultParams, "cracked or missing teeth")
+    tooth: tuple = _entries(ToothDeviationParams, "tooth flank deviations, tooth by tooth")
+    flank_class: tuple = _entries(FlankClassParams, "tooth deviations drawn for an ISO 1328-1 flank tolerance class")
 
     @property
     def perfect(self) -> bool:

@@ -11,16 +11,20 @@ from types import MappingProxyType
 
 from pathlib import Path
 
-from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, ErrorsParams, GearParams, GearSetParams,
+import numpy as np
+
+from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, ErrorsParams, FlankClassParams,
+                     GearParams, GearSetParams,
                      LifeParams, LubricantParams, MeshParams, OperatingPoint, PinholeErrorParams, RigParams, RunoutParams,
                      SensorParams,
                      SlideRollTractionParams, SupportParams, assumed, derived,
                      overrides_from_toml, paper, with_overrides)
+from .tolerances import radial_runout
 from .units import Q_, ParameterError
 
 __all__ = ["CONDITIONS", "DIRECTIONS", "OIL_GRADES", "oil_grade", "operating_point", "reference_gears", "reference_bearing",
            "reference_dpgt", "reference_bearing_rig", "rig_accelerometer", "load_toml", "perfect_machine",
-           "typical_errors", "iso1328_runout"]
+           "typical_errors"]
 
 # the study's four operating conditions: carrier speed n_c and output power P (ring fixed)
 CONDITIONS = MappingProxyType({
@@ -49,7 +53,10 @@ def _gear(teeth, face_width, mass, internal=False) -> GearParams:
     return GearParams(teeth=paper(teeth), module=paper("3 mm"), pressure_angle=paper("20 deg"),
                       face_width=paper(face_width), mass=paper(mass),
                       internal=paper(internal, "internal gear" if internal else "external gear"),
-                      addendum_coefficient=assumed(1.0, profile), dedendum_coefficient=assumed(1.25, profile))
+                      addendum_coefficient=assumed(1.0, profile), dedendum_coefficient=assumed(1.25, profile),
+                      tip_relief=paper("0 um", "the source states no profile modification"),
+                      tip_relief_length=paper("0 mm", "no profile modification"),
+                      tip_relief_shape=paper("linear", "no profile modification"))
 
 
 def reference_gears() -> GearSetParams:
@@ -139,43 +146,43 @@ def reference_bearing() -> BearingParams:
 def perfect_machine() -> ErrorsParams:
     """No manufacturing errors or faults: the machine the source models (MODEL.md §3.9)."""
     return ErrorsParams(**{f: paper((), "the source models a perfect machine")
-                           for f in ("pinhole", "runout", "roller_diameter", "spall", "tooth_fault")})
-
-
-def iso1328_runout(module: float, diameter: float, grade: int) -> float:
-    """Radial runout tolerance F_r [m] of a gear of ISO 1328 accuracy ``grade`` (module and reference
-    diameter in m): ISO 1328-2:1997 Annex B, F_r = 0.8 F_p, with ISO 1328-1:1995's cumulative pitch
-    tolerance F_p = (0.3 m + 1.25 √d + 7) µm at grade 5 (m, d in mm), × √2 per grade."""
-    if not (isinstance(grade, int) and 1 <= grade <= 12):
-        raise ParameterError.at("grade", f"ISO 1328 accuracy grade must be an integer 1..12, got {grade!r}")
-    m, d = 1e3 * module, 1e3 * diameter
-    F_p = (0.3 * m + 1.25 * d ** 0.5 + 7.0) * 2.0 ** (0.5 * (grade - 5))
-    return 0.8 * F_p * 1e-6
+                           for f in ("pinhole", "runout", "roller_diameter", "spall", "tooth_fault", "tooth",
+                                     "flank_class")})
 
 
 def typical_errors(params: DPGTParams, grade: int) -> ErrorsParams:
-    """A modest, stated set of manufacturing errors for gears of ISO 1328 accuracy ``grade``: every gear
-    eccentric by half its grade's runout tolerance (:func:`iso1328_runout`) at an arbitrary but fixed phase,
-    and the carrier's pinholes off by up to 10 µm (a precision carrier's position tolerance, of the order
-    Bodas & Kahraman (2004) study). What the spectrum scenario puts on the rig by default (MODEL.md §3.10)."""
+    """A modest, stated set of manufacturing errors for gears of ISO 1328 accuracy ``grade`` (1..11): every
+    gear's teeth drawn for ISO 1328-1:2013 flank tolerance class ``grade`` (seed 1, each gear its own teeth,
+    half the profile deviations' variance systematic: :mod:`components.tolerances`), every gear eccentric by
+    half its grade's runout tolerance (:func:`components.tolerances.radial_runout`) at an arbitrary but fixed
+    phase, and all 2N carrier pinholes off by up to 10 µm (a precision carrier's position tolerance, of the
+    order Bodas & Kahraman (2004) study; drawn uniformly, seed 2). What the spectrum scenario puts on the rig
+    by default (MODEL.md §3.10)."""
     si = params.si()
     G, N = si.gears, si.layout.planets
     note = f"ISO 1328 grade {grade}: eccentricity = F_r/2 (ISO 1328-2 Annex B); phase arbitrary"
 
     def runout(gear, g, phase_deg):
-        e = 0.5 * iso1328_runout(g.module, g.pitch_radius * 2.0, grade)
+        e = 0.5 * radial_runout(g.module, g.pitch_radius * 2.0, grade)
         return {"gear": gear, "eccentricity": assumed(Q_(1e6 * e, "um"), note),
                 "phase": assumed(Q_(phase_deg, "deg"), "arbitrary assembly phase")}
     runouts = [runout("sun", G.sun, 0.0), runout("ring", G.ring, 90.0)]
     runouts += [runout(f"a{n + 1}", G.inner_planet, 60.0 + 110.0 * n) for n in range(N)]
     runouts += [runout(f"b{n + 1}", G.outer_planet, 200.0 + 70.0 * n) for n in range(N)]
-    pin = "carrier pinhole position error within +-10 um (assumed precision carrier)"
-    pinholes = [{"planet": f"b{n + 1}", "radial": assumed(Q_(r, "um"), pin), "tangential": assumed(Q_(t, "um"), pin)}
-                for n, (r, t) in enumerate([(0.0, 10.0), (-6.0, 0.0), (4.0, -8.0)][:N])]
+    pin = "carrier pinhole position error within +-10 um (assumed precision carrier), uniform, seed 2"
+    rt = np.round(np.random.default_rng(2).uniform(-10.0, 10.0, (2 * N, 2)), 1)
+    planets = [f"a{n + 1}" for n in range(N)] + [f"b{n + 1}" for n in range(N)]
+    pinholes = [{"planet": p, "radial": assumed(Q_(float(r), "um"), pin), "tangential": assumed(Q_(float(t), "um"), pin)}
+                for p, (r, t) in zip(planets, rt)]
+    teeth = "ISO 1328-1:2013 flank tolerance class, normal with the tolerance at 3 sigma (components.tolerances)"
+    flank = {"gear": "all", "grade": assumed(grade, teeth), "seed": assumed(1, "a fixed draw"),
+             "systematic_share": assumed(0.5, "ground gears: the profile deviations of a flank are largely common "
+                                              "to its teeth (one grinding set-up); half their variance assumed")}
     return ErrorsParams(runout=assumed([RunoutParams(**x) for x in runouts], note),
                         pinhole=assumed([PinholeErrorParams(**x) for x in pinholes], pin),
+                        flank_class=assumed([FlankClassParams(**flank)], teeth),
                         roller_diameter=assumed((), "no roller errors"), spall=assumed((), "no damage"),
-                        tooth_fault=assumed((), "no damage"))
+                        tooth_fault=assumed((), "no damage"), tooth=assumed((), "the class's draw only"))
 
 
 def rig_accelerometer() -> SensorParams:

@@ -26,7 +26,8 @@ from mbd.recorder import ElementOutput
 from .families import FAMILY, MESH_FAMILY
 from .outputs import bearing_map, contact_film
 
-__all__ = ["OUTPUTS", "FILM_OUTPUTS", "MESH_WORDS", "instance_coords", "element_probes", "drawing_geometry"]
+__all__ = ["OUTPUTS", "FILM_OUTPUTS", "MESH_WORDS", "instance_coords", "element_probes", "drawing_geometry",
+           "loaded_transmission_error"]
 
 MESH_WORDS = {MESH_FAMILY["sun_inner"]: "sun–inner planet mesh",
               MESH_FAMILY["inner_outer"]: "inner planet–outer planet mesh",
@@ -136,13 +137,22 @@ def instance_coords(scene) -> dict[str, dict[str, tuple[str, list]]]:
     return out
 
 
+def loaded_transmission_error(outputs, flank: int) -> dict:
+    """The loaded transmission error of a mesh family's instances: the compression of the flank the torque
+    path loads (``flank`` = ±1) along its line of action [m] — 0 where perfect rigid teeth touch, the
+    elastic deflection plus the teeth's deviations under load, < 0 while that flank is open."""
+    return {"transmission_error": np.asarray(outputs["deflection" if flank > 0 else "deflection_coast"], float)}
+
+
 def element_probes(scene) -> list[ElementOutput]:
     """The element outputs the runner records: every family of :data:`OUTPUTS` the scene has, with
     units, long names and instance coordinates; with a lubricant (``scene.meta["lubricant"]``), the
-    raceway families' film (:data:`FILM_OUTPUTS`) as well."""
+    raceway families' film (:data:`FILM_OUTPUTS`) as well; for every mesh its loaded transmission error
+    (:func:`loaded_transmission_error`, from the flank ``scene.handles["flanks"]`` says the torque loads)."""
     fams = {e.name for e in scene.model.elements}
     coords = instance_coords(scene)
     lub = scene.meta.get("lubricant")
+    flanks = {MESH_FAMILY[k]: f for k, f in scene.handles.get("flanks", {}).items()}
     probes = []
     for f, meta in OUTPUTS.items():
         if f not in fams:
@@ -152,6 +162,12 @@ def element_probes(scene) -> list[ElementOutput]:
             inner, film = FILM_OUTPUTS[f]
             meta = {**meta, **film}
             derived = partial(contact_film, bearing=scene.meta["bearing"], lubricant=lub, inner=inner)
+        if f in flanks:
+            meta = {**meta, "transmission_error": (
+                "m", f"{MESH_WORDS[f]} loaded transmission error: compression of the drive flank (flank "
+                     f"{flanks[f]:+d}, the one the torque path loads) along its line of action (0: perfect rigid "
+                     "teeth touching; < 0: that flank open)")}
+            derived = partial(loaded_transmission_error, flank=flanks[f])
         probes.append(ElementOutput(f, list(meta), meta=meta, instances=coords.get(f), derived=derived))
     return probes
 

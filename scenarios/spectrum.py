@@ -61,9 +61,10 @@ def parse_args(argv):
                    help="housing: the rig's windowed accelerometer (rig.sensor.*, default); axis: ideal, at the carrier axis")
     p.add_argument("--perfect", action="store_true",
                    help="a perfect machine: no manufacturing errors (default: the errors of --gear-grade)")
-    p.add_argument("--gear-grade", type=args.count(1, 12), default=6,
-                   help="ISO 1328 accuracy grade of the gears behind the default manufacturing errors (default 6: "
-                        "runouts F_r/2 of that grade, carrier pinholes within ±10 µm; components.presets.typical_errors)")
+    p.add_argument("--gear-grade", type=args.count(1, 11), default=6,
+                   help="ISO 1328-1 flank tolerance class of the gears behind the default manufacturing errors "
+                        "(default 6: every gear's teeth drawn for that class, runouts F_r/2 of that grade, all "
+                        "carrier pinholes within ±10 µm; components.presets.typical_errors)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.06,
                    help="seconds discarded (default 0.06: a lightly damped ~2.6 kHz mode rings for ~50 ms after the start)")
     p.add_argument("--window", type=args.positive("s"), default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")

@@ -1,14 +1,12 @@
-"""Gear-mesh manufacturing errors (MODEL.md §3.9): eccentricity of the geometric centres and a tooth
-fault, in the numpy reference and the compiled kernel.
+"""Gear-mesh eccentricity (MODEL.md §3.9): the law on the geometric centres, in the numpy reference and
+the compiled kernel. (Tooth faults and deviations: the tooth-pair law, tests/test_tooth_pairs.py.)
 
-(a) reference vs compiled forces and Jacobians, and Jacobians vs finite differences, with offsets and
-    faults, across the fault window's edges and with the line of centres near ±π;
-(b) no error (the default, explicit zero offsets, a fault factor of 1) is bit-for-bit the error-free
-    evaluation, also inside a fused family that mixes plain and faulted/eccentric meshes;
+(a) reference vs compiled forces and Jacobians, and Jacobians vs finite differences, with offsets, also
+    with the line of centres near ±π;
+(b) no error (the default, explicit zero offsets) is bit-for-bit the error-free evaluation, also inside a
+    fused family that mixes plain and eccentric meshes;
 (c) eccentricity: the static deflection of a rigidly rolling pair follows the first-order law
-    Δδ_f = ∂δ_f/∂d · Δd once per revolution of the eccentric gear; forces and moments balance exactly;
-(d) tooth fault: over a rigid rotation the stiffness drops to c·k_single in the faulty pair's single
-    contact and to k_double (1 + c)/2 in its double contact, once per z_f mesh cycles, unchanged elsewhere.
+    Δδ_f = ∂δ_f/∂d · Δd once per revolution of the eccentric gear; forces and moments balance exactly.
 """
 from __future__ import annotations
 
@@ -25,20 +23,12 @@ from test_gear_mesh import (ALPHA, FS0, K_MEAN, PAIRS, a0_of, far_from_kinks, fu
 from strategies import assert_third_law
 
 ECC = 2e-5               # eccentricity [m] (20 µm)
-EPS, SMOOTH = 1.6, 0.05  # contact ratio and ramp width of the mesh (and of the fault window)
+EPS, SMOOTH = 1.6, 0.05  # contact ratio and ramp width of the mesh
 RECT = StiffnessShape.rectangular(EPS, ratio=1.5, smoothing=SMOOTH)
 
 
 def sigma(pair):
     return -1.0 if PAIRS[pair][0] else 1.0
-
-
-def fault(pair, n, gear, c, c_f=0.0, eps=EPS, s=SMOOTH):
-    """The fault arguments for a tooth of gear 1 or gear 2 (A1 = z1/2π, or A2 = −σ z2/2π)."""
-    internal, z1, z2 = PAIRS[pair]
-    a1, a2, zf = (z1 / (2 * np.pi), 0.0, z1) if gear == 1 else (0.0, -sigma(pair) * z2 / (2 * np.pi), z2)
-    return dict(fault_coef1=np.full(n, a1), fault_coef2=np.full(n, a2), fault_offset=c_f, fault_period=zf,
-                fault_factor=c, fault_contact_ratio=eps, fault_smoothing=s)
 
 
 def rotated(o, th):
@@ -47,33 +37,12 @@ def rotated(o, th):
     return np.column_stack([c * o[:, 0] - s * o[:, 1], s * o[:, 0] + c * o[:, 1]])
 
 
-def fault_position(elem, q, c_f=0.0):
-    """p_f = A1 θ1 + A2 θ2 − (A1 + A2) φ_e + c_f, φ_e of the geometric centres on the element's branch."""
-    ql = q[elem.dofs]
-    g1 = ql[:, 0:2] + rotated(elem.offset1, ql[:, 2])
-    g2 = ql[:, 3:5] + rotated(elem.offset2, ql[:, 5])
-    d = elem.sigma[:, None] * (g2 - g1)
-    phi = elem.phi_ref + np.angle(np.exp(1j * (np.arctan2(d[:, 1], d[:, 0]) - elem.phi_ref)))
-    a1, a2 = elem.fault_coef1, elem.fault_coef2
-    return a1 * ql[:, 2] + a2 * ql[:, 5] - (a1 + a2) * phi + c_f
-
-
-def error_case(pair, errors, seed, near_pi=False, n=8):
-    """(family, q, v) with random offsets and/or a fault whose window edges (0, ε − 1, 1, ε, cycled over
-    the instances) lie within ±s of each instance's fault position."""
+def error_case(pair, seed, near_pi=False, n=8):
+    """(family, q, v) with random offsets on both gears, in perturbed states."""
     rng = np.random.default_rng(seed)
     psi = np.pi + rng.uniform(-3e-4, 3e-4, n) if near_pi else None
     p1, p2, q, v = perturbed_state(pair, rng, n, psi=psi)
-    kw = {}
-    if errors in ("offset", "both"):
-        kw.update(offset1=rng.normal(0.0, ECC, (n, 2)), offset2=rng.normal(0.0, ECC, (n, 2)))
-    if errors in ("fault1", "fault2", "both"):
-        c = rng.uniform(0.0, 1.0, n)
-        c[0] = 0.0                                             # a missing tooth among them
-        probe = make_mesh(pair, p1, p2, **kw, **fault(pair, n, 2 if errors == "fault2" else 1, c))
-        edges = np.array([0.0, EPS - 1.0, 1.0, EPS])[np.arange(n) % 4]
-        kw.update(fault(pair, n, 2 if errors == "fault2" else 1, c,
-                        c_f=edges + rng.uniform(-SMOOTH, SMOOTH, n) - fault_position(probe, q)))
+    kw = dict(offset1=rng.normal(0.0, ECC, (n, 2)), offset2=rng.normal(0.0, ECC, (n, 2)))
     elem = make_mesh(pair, p1, p2, shape=RECT, c_mesh=2e3, p0=rng.uniform(), **kw)
     return elem, q, v
 
@@ -82,14 +51,12 @@ def error_case(pair, errors, seed, near_pi=False, n=8):
 # (a) reference vs compiled, and finite differences
 # ----------------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("near_pi", [False, True])
-@pytest.mark.parametrize("errors", ["offset", "fault1", "fault2", "both"])
 @pytest.mark.parametrize("pair", sorted(PAIRS))
-def test_errors_match_reference_and_finite_differences(pair, errors, near_pi):
+def test_errors_match_reference_and_finite_differences(pair, near_pi):
     checked, sides = 0, set()
     for seed in range(4):
-        elem, q, v = error_case(pair, errors, seed, near_pi)
-        assert elem.has_offset == (errors in ("offset", "both"))
-        assert elem.has_fault == (errors != "offset")
+        elem, q, v = error_case(pair, seed, near_pi)
+        assert elem.has_offset
         if near_pi:        # the line of centres on both sides of the branch cut
             ql = q[elem.dofs]
             d = elem.sigma[:, None] * (ql[:, 3:5] - ql[:, 0:2])
@@ -106,7 +73,7 @@ def test_errors_match_reference_and_finite_differences(pair, errors, near_pi):
 
 
 def test_fused_error_family_matches_reference():
-    """A fused family (plain external + eccentric, faulted internal) in the compiled kernel."""
+    """A fused family (plain external + eccentric internal) in the compiled kernel."""
     parts, qs, vs = [], [], []
     for pair, errors in (("sun_planet", None), ("planet_ring", "both")):
         if errors is None:
@@ -114,13 +81,13 @@ def test_fused_error_family_matches_reference():
             p1, p2, q, v = perturbed_state(pair, rng, 3)
             e = make_mesh(pair, p1, p2, shape=RECT, c_mesh=2e3, p0=0.3, name=pair)
         else:
-            e, q, v = error_case(pair, errors, 6, n=4)
+            e, q, v = error_case(pair, 6, n=4)
         e.dofs = e.dofs + sum(x.size for x in qs)
         parts.append(e)
         qs.append(q)
         vs.append(v)
     fused = GearMesh.fuse(parts)
-    assert fused.has_offset and fused.has_fault
+    assert fused.has_offset
     with libm_arctan2():
         assert_matches_reference(fused, 0.0, FS0, np.concatenate(qs), np.concatenate(vs))
 
@@ -135,16 +102,15 @@ def _all_outputs(elem, q, v):
 
 
 @pytest.mark.parametrize("pair", sorted(PAIRS))
-def test_zero_offsets_and_healthy_fault_are_bit_for_bit(pair):
+def test_zero_offsets_are_bit_for_bit(pair):
     rng = np.random.default_rng(11)
     n = 6
     p1, p2, q, v = perturbed_state(pair, rng, n)
     plain = make_mesh(pair, p1, p2, shape=RECT, c_mesh=2e3, p0=0.4)
-    quiet = make_mesh(pair, p1, p2, shape=RECT, c_mesh=2e3, p0=0.4, offset1=np.zeros((n, 2)), offset2=(0.0, 0.0),
-                      **fault(pair, n, 1, 1.0, c_f=rng.uniform(0, 30, n)))
-    assert not (quiet.has_offset or quiet.has_fault)
+    quiet = make_mesh(pair, p1, p2, shape=RECT, c_mesh=2e3, p0=0.4, offset1=np.zeros((n, 2)), offset2=(0.0, 0.0))
+    assert not quiet.has_offset
     (P, G), (Pq, Gq) = mesh.pack_gear_mesh(plain), mesh.pack_gear_mesh(quiet)
-    assert P.shape == (n, 18) and list(G) == [mesh.SHAPE_RECTANGULAR, -1, -1]     # no error columns
+    assert P.shape == (n, 18) and list(G) == [mesh.SHAPE_RECTANGULAR, -1, -1, 4]  # no error columns or tables
     np.testing.assert_array_equal(Pq, P)
     np.testing.assert_array_equal(Gq, G)
     (ref, out), (got, out_q) = _all_outputs(plain, q, v), _all_outputs(quiet, q, v)
@@ -155,16 +121,16 @@ def test_zero_offsets_and_healthy_fault_are_bit_for_bit(pair):
 
 
 def test_fusing_plain_and_error_families_keeps_each_instance_exact():
-    """The fused family evaluates the errors for all its instances; the plain ones (zero offsets, c = 1)
-    still get exactly their own values, the erroneous ones exactly theirs (numpy and compiled)."""
+    """The fused family evaluates the offsets for all its instances; the plain ones (zero offsets) still get
+    exactly their own values, the eccentric ones exactly theirs (numpy and compiled)."""
     rng = np.random.default_rng(12)
     p1, p2, qa, va = perturbed_state("sun_planet", rng, 3)
     plain = make_mesh("sun_planet", p1, p2, shape=RECT, c_mesh=2e3, p0=0.2, name="plain")
-    err, qb, vb = error_case("planet_ring", "both", 13, n=5)
+    err, qb, vb = error_case("planet_ring", 13, n=5)
     shifted = GearMesh.fuse([err])            # the same family with its bodies after the plain one's
     shifted.dofs = err.dofs + qa.size
     fused = GearMesh.fuse([plain, shifted])
-    assert fused.has_offset and fused.has_fault and mesh.pack_gear_mesh(fused)[0].shape == (8, 18 + 4 + 7)
+    assert fused.has_offset and mesh.pack_gear_mesh(fused)[0].shape == (8, 18 + 4)
     q, v = np.concatenate([qa, qb]), np.concatenate([va, vb])
     (got, _), (ref_a, _), (ref_b, _) = _all_outputs(fused, q, v), _all_outputs(plain, qa, va), _all_outputs(err, qb, vb)
     for g, a, b in zip(got, ref_a, ref_b):
@@ -226,7 +192,7 @@ def test_eccentric_mesh_forces_and_moments_balance(pair):
     at the geometric centre: T_b = (mesh torque) + (R(θ_b) o_b) × F_b."""
     internal, z1, z2 = PAIRS[pair]
     sig = sigma(pair)
-    elem, q, v = error_case(pair, "both", 31, n=8)
+    elem, q, v = error_case(pair, 31, n=8)
     elem.offset1 *= 50.0                         # 1 mm: the offset moments are not negligible
     elem.offset2 *= 50.0
     F, out, _, _ = evaluate(elem, 0.0, FS0, q, v, None, False)
@@ -249,121 +215,27 @@ def test_eccentric_mesh_forces_and_moments_balance(pair):
                                atol=tol * rb(z2))
 
 
-# ----------------------------------------------------------------------------------------------------
-# (d) tooth fault
-# ----------------------------------------------------------------------------------------------------
-@pytest.mark.parametrize("c", [0.3, 0.0])
-@pytest.mark.parametrize("gear", [1, 2])
-@pytest.mark.parametrize("pair", sorted(PAIRS))
-def test_tooth_fault_stiffness_over_a_rigid_rotation(pair, gear, c):
-    """Fixed centres, rigid rolling over two revolutions of the faulty gear, 40 samples per mesh cycle.
-    Mesh cycles are counted from the rotation (P = z1 Δθ1/2π + p(0), unwrapped); the faulty tooth enters
-    at mesh cycle 5 (its fault offset aligned with the mesh phase) and then every z_f cycles."""
-    internal, z1, z2 = PAIRS[pair]
-    sig, r1, r2 = sigma(pair), rb(z1), rb(z2)
-    zf = z1 if gear == 1 else z2
-    per = 40
-    P_rel = np.arange(2 * zf * per) / per + 0.5 / per             # mesh cycles from the start
-    dth1 = 2 * np.pi * P_rel / z1
-    P1, P2 = nominal(pair, 1, np.random.default_rng(41), angle_span=3.0)
-    m = dth1.size
-    p1, p2 = np.repeat(P1, m, axis=0), np.repeat(P2, m, axis=0)
-    p1[:, 2] += dth1
-    p2[:, 2] += -sig * (r1 / r2) * dth1
-    q, v = full(p1, p2), np.zeros(6 * m)
-    N1, N2 = np.repeat(P1, m, axis=0), np.repeat(P2, m, axis=0)    # u0 from the nominal poses
-    healthy = make_mesh(pair, N1, N2, shape=RECT, p0=0.0)
-    out_h = evaluate(healthy, 0.0, FS0, q, v, None, False)[1]
-    p_start = out_h["position"][0] - P_rel[0]                      # p at zero rotation
-    P = P_rel + p_start                                            # unwrapped mesh position
-    enter = 5.0
-    probe = make_mesh(pair, P1, P2, shape=RECT, **fault(pair, 1, gear, c))
-    c_f = p_start - enter - fault_position(probe, full(P1, P2))[0]  # p_f = P − enter at every sample
-    faulty = make_mesh(pair, N1, N2, shape=RECT, p0=0.0, **fault(pair, m, gear, c, c_f=c_f))
-    k = evaluate(faulty, 0.0, FS0, q, v, None, False)[1]["stiffness"]
-    k_h = out_h["stiffness"]
-    u = np.mod(P - enter, zf)
-    h = SMOOTH / 2
-    single = (u >= EPS - 1 + h) & (u <= 1 - h)
-    double = ((u >= h) & (u <= EPS - 1 - h)) | ((u >= 1 + h) & (u <= EPS - h))
-    outside = (u >= EPS + h) & (u <= zf - h)
-    assert single.sum() >= 2 * 10 and double.sum() >= 2 * 10
-    np.testing.assert_allclose(k_h[single], K_MEAN * RECT.single, rtol=1e-12)
-    np.testing.assert_allclose(k[single], c * K_MEAN * RECT.single, rtol=1e-12, atol=1e-3)
-    np.testing.assert_allclose(k_h[double], K_MEAN * RECT.double, rtol=1e-12)
-    np.testing.assert_allclose(k[double], K_MEAN * RECT.double * (1 + c) / 2, rtol=1e-12)
-    np.testing.assert_array_equal(k[outside], k_h[outside])
-    # exactly one fault window per z_f mesh cycles: runs of changed stiffness start z_f cycles apart
-    changed = k != k_h
-    starts = np.flatnonzero(changed & ~np.roll(changed, 1))
-    assert starts.size == 2
-    np.testing.assert_allclose(np.diff(P[starts]), zf, atol=1.0 / per)
-    np.testing.assert_allclose(np.mod(P[starts] - enter + 0.5, zf) - 0.5, -h, atol=1.0 / per)
-
-
-@pytest.mark.parametrize("pair", sorted(PAIRS))
-def test_tooth_fault_is_immune_to_the_branch_of_the_line_of_centres(pair):
-    """A rigid rotation of the whole pair (centres and gears, eccentric) through φ_e = ±π changes
-    nothing: the stiffness and the deflections stay put, although φ_e jumps by 2π (phi_ref = 0)."""
-    internal, z1, z2 = PAIRS[pair]
-    rng = np.random.default_rng(51)
-    n = 4
-    P1, P2 = nominal(pair, n, rng, psi=np.pi - 0.01)
-    c_f = rng.uniform(0.0, EPS, n)
-    base = fault_position(make_mesh(pair, P1, P2, **fault(pair, n, 1, 0.3)), full(P1, P2))
-    o1, o2 = rng.normal(0.0, ECC, (n, 2)), rng.normal(0.0, ECC, (n, 2))
-    elem = make_mesh(pair, P1, P2, shape=RECT, offset1=o1, offset2=o2, **fault(pair, n, 1, 0.3, c_f=c_f - base))
-    ref = None
-    for beta in (0.0, 0.005, 0.015, 0.03):                         # φ_e: π − 0.01 → −π + 0.02
-        R = np.array([[np.cos(beta), -np.sin(beta)], [np.sin(beta), np.cos(beta)]])
-        q1, q2 = P1.copy(), P2.copy()
-        q1[:, :2], q2[:, :2] = P1[:, :2] @ R.T, P2[:, :2] @ R.T
-        q1[:, 2] += beta
-        q2[:, 2] += beta
-        out = evaluate(elem, 0.0, FS0, full(q1, q2), np.zeros(6 * n), None, False)[1]
-        got = np.array([out["stiffness"], out["deflection"], out["deflection_coast"]])
-        if ref is None:
-            ref = got
-            assert np.all(out["stiffness"] < K_MEAN * RECT.double)  # the fault is active here
-        np.testing.assert_allclose(got[0], ref[0], rtol=1e-9)
-        np.testing.assert_allclose(got[1:], ref[1:], atol=1e-12)
-
-
 def test_error_parameters_are_validated():
     internal, z1, z2 = PAIRS["sun_planet"]
     kw = dict(internal=False, rb1=rb(z1), rb2=rb(z2), alpha=ALPHA, a0=a0_of(False, z1, z2), teeth1=z1,
               k_mean=K_MEAN)
-    good = fault("sun_planet", 2, 1, 0.5)
-    GearMesh("ok", [0, 1], [2, 3], **kw, **good, offset1=(1e-5, 0.0))
-    for key, bad, msg in (("fault_factor", 1.5, "fault_factor.*\\[0, 1\\]"),
-                          ("fault_factor", -0.1, "fault_factor"),
-                          ("fault_contact_ratio", 2.0, "fault_contact_ratio.*\\[1, 2\\)"),
-                          ("fault_smoothing", 0.45, "fault_smoothing.*overlap"),
-                          ("fault_smoothing", 0.0, "fault_smoothing"),
-                          ("fault_period", 31.5, "fault_period.*whole"),
-                          ("fault_period", 1.0, "fault_period"),
-                          ("fault_offset", np.nan, "fault_offset"),
-                          ("fault_coef1", [1.0, 2.0, 3.0], "fault_coef1")):
-        with pytest.raises(ModelError, match=msg):
-            GearMesh("bad", [0, 1], [2, 3], **kw, **dict(good, **{key: bad}))
-    with pytest.raises(ModelError, match="missing fault_coef1.*fault_smoothing"):
-        GearMesh("bad", [0, 1], [2, 3], **kw, fault_factor=0.5, fault_period=z1)
+    GearMesh("ok", [0, 1], [2, 3], **kw, offset1=(1e-5, 0.0))
     for bad in (np.zeros(3), np.full((2, 2), np.inf)):
         with pytest.raises(ModelError, match="offset2"):
             GearMesh("bad", [0, 1], [2, 3], **kw, offset2=bad)
-    # contact ratio 1: the two windows coincide and a ramp may take up to a whole cycle
-    GearMesh("ok", [0, 1], [2, 3], **kw, **dict(good, fault_contact_ratio=1.0, fault_smoothing=1.0))
 
 
 def test_the_error_kernels_are_covered_by_the_compiled_cache_hash():
     """mbd.compiled drops its numba cache when a file it hashes changes (mbd/compiled/*.py among them):
-    every compiled mesh function, the error ones included, must live in such a file."""
+    every compiled mesh function, the error and tooth-pair ones included, must live in such a file."""
     from pathlib import Path
 
     from numba.core.registry import CPUDispatcher
     import mbd.compiled as mc
     here = Path(mc.__file__).resolve().parent
-    jitted = [f for f in vars(mesh).values() if isinstance(f, CPUDispatcher)]
-    assert {"_to_geometric", "_from_geometric", "_fault_multiplier", "_distance", "_box"} <= {f.__name__ for f in jitted}
+    from mbd.compiled import tooth_pairs
+    jitted = [f for m in (mesh, tooth_pairs) for f in vars(m).values() if isinstance(f, CPUDispatcher)]
+    assert {"_to_geometric", "_from_geometric", "_distance", "_box", "flank_force", "_relief", "_cubic"} <= \
+        {f.__name__ for f in jitted}
     for f in jitted:
         assert Path(f.py_func.__code__.co_filename).resolve().parent == here, f.__name__

@@ -4,25 +4,29 @@ The force law is the reference kernel's, operation for operation (so values agre
 of arctan2/cos/sin), with its Jacobians derived by hand. One family may mix external and internal
 meshes (σ per instance, as after System fusion).
 
-P, shape (n, 14 [+ 4] [+ 4] [+ 7]), one row per mesh (constants ``P_*`` below):
+P, shape (n, 14 [+ 4] [+ 4] [+ 13]), one row per mesh (constants ``P_*`` below):
 
     0 σ (+1 external, −1 internal)   1 r_b1     2 r_b2      3 a0     4 sin α    5 κ0 = σ r_b1 + r_b2
     6 p_b base pitch                 7 z1       8 k_mean    9 c_m   10 u0      11 p0
     12 b backlash                   13 φ_ref
     RectangularStiffness only: 14 h = (ε_α − 1)/2   15 s smoothing   16 k_single/k_mean   17 ratio
     then, only in a family with eccentricity, from column G[1]: o1x, o1y, o2x, o2y [m]
-    then, only in a family with a tooth fault, from column G[2] (``F_*``): A1, A2, c_f, z_f, c, ε, s
+    then, only in a family with the tooth-pair law, from column G[2]: its block (:mod:`.tooth_pairs`)
 
-G = [shape, offset column or −1, fault column or −1, shape coefficients] (constants ``G_*``, ``SHAPE_*``):
+G = [shape, offset column or −1, pair column or −1, table start, shape coefficients, tooth tables]
+(constants ``G_*``, ``SHAPE_*``):
 
-    constant     [0, ., .]
-    rectangular  [1, ., .]                                   (its parameters are per instance, in P)
-    fourier      [2, ., ., na, nb, a_1 … a_na, b_1 … b_nb]
+    constant     [0, ., ., .]
+    rectangular  [1, ., ., .]                                (its parameters are per instance, in P)
+    fourier      [2, ., ., ., na, nb, a_1 … a_na, b_1 … b_nb]
+
+and, with the tooth-pair law, the family's tooth tables from G[G[3]] on (:mod:`.tooth_pairs`).
 
 A family without errors (G[1] = G[2] = −1) evaluates exactly as before they existed. With eccentricity,
 the law is evaluated on the geometric centres (:func:`_to_geometric`) and the forces and Jacobians are
-mapped back to the body coordinates by the chain rule (:func:`_from_geometric`); a tooth fault multiplies
-k by m(p_f) (:func:`_fault_multiplier`) with its gradient through θ1, θ2 and φ_e.
+mapped back to the body coordinates by the chain rule (:func:`_from_geometric`). The tooth-pair law
+(tooth deviations, relief, tooth faults) replaces the flank force and its gradient
+(:func:`.tooth_pairs.flank_force`); the rest is shared.
 
 Jacobians. With d the centre vector along e (σ(c2 − c1)), ḋ its rate, t = k × e, a = |d|, every
 quantity is a function of (d, θ1, θ2) and (ḋ, ω1, ω2); the kernel carries gradients over these
@@ -37,6 +41,7 @@ import numpy as np
 from numba import njit
 
 from ..elements.gear_mesh import ConstantStiffness, FourierStiffness, GearMesh, RectangularStiffness
+from . import tooth_pairs
 
 __all__ = ["pack_gear_mesh", "evaluate_gear_mesh", "KERNELS"]
 
@@ -44,9 +49,7 @@ _TWO_PI = 2.0 * np.pi
 
 (P_SIGMA, P_RB1, P_RB2, P_A0, P_SIN_ALPHA, P_KAPPA0, P_PITCH, P_TEETH1, P_K_MEAN, P_C_MESH, P_U0, P_P0,
  P_BACKLASH, P_PHI_REF, P_RECT_H, P_RECT_S, P_RECT_SINGLE, P_RECT_RATIO) = range(18)
-# the fault block's columns, from G[G_FAULT]
-F_COEF1, F_COEF2, F_OFFSET, F_PERIOD, F_FACTOR, F_EPS, F_SMOOTH = range(7)
-G_SHAPE, G_OFFSET, G_FAULT, G_FOURIER = 0, 1, 2, 3
+G_SHAPE, G_OFFSET, G_PAIRS, G_TABLE, G_FOURIER = 0, 1, 2, 3, 4
 SHAPE_CONSTANT, SHAPE_RECTANGULAR, SHAPE_FOURIER = 0, 1, 2
 
 
@@ -65,15 +68,21 @@ def pack_gear_mesh(elem: GearMesh):
     else:
         raise NotImplementedError(f"GearMesh {elem.name!r}: the compiled path has no stiffness shape "
                                   f"{type(shape).__name__} (only constant, rectangular, fourier)")
-    off = flt = -1                              # error blocks only when the family has them
+    off = pcol = -1                             # error blocks only when the family has them
     if elem.has_offset:
         off = len(cols)
         cols += [elem.offset1[:, 0], elem.offset1[:, 1], elem.offset2[:, 0], elem.offset2[:, 1]]
-    if elem.has_fault:
-        flt = len(cols)
-        cols += [elem.fault_coef1, elem.fault_coef2, elem.fault_offset, elem.fault_period, elem.fault_factor,
-                 elem.fault_contact_ratio, elem.fault_smoothing]          # the order of F_*
-    G = np.array([kind, off, flt, *fourier], float)
+    table = []
+    if elem.pairs is not None:
+        pcol, pp = len(cols), elem.pairs
+        h, s = elem._shape_args[0], elem._shape_args[1]
+        reach = 1.0 + 2.0 * float(np.max(s / (2.0 * h + 1.0)))        # |x| of any pair with stiffness
+        cols += [*pp.entry.T, *pp.phase2.T, *pp.relief1.T, *pp.relief2.T, pp.start1, pp.start2,
+                 pp.excess_bound(elem.teeth1, elem.teeth2, reach)]      # the order of tooth_pairs.Q_*
+        table = list(pp.table)
+    head = [kind, off, pcol, 0.0, *fourier]
+    head[G_TABLE] = len(head)
+    G = np.array(head + table, float)
     P = np.ascontiguousarray(np.column_stack([np.broadcast_to(np.asarray(c, float), (elem.n,)) for c in cols]))
     return P, G
 
@@ -216,26 +225,34 @@ def _from_geometric(Fg, Jqg, Jvg, r, vl, F, Jq, Jv, jac):
 
 
 @njit(cache=True)
-def _fault_multiplier(th1, th2, phi_e, P, i, flt):
-    """(m, dm/dp_f, A1, A2) of the tooth fault, m = 1 − (1 − c)·share(u), as gear_mesh._fault_multiplier."""
-    a1, a2 = P[i, flt + F_COEF1], P[i, flt + F_COEF2]
-    pf = a1 * th1 + a2 * th2 - (a1 + a2) * phi_e + P[i, flt + F_OFFSET]
-    eps, s = P[i, flt + F_EPS], P[i, flt + F_SMOOTH]
-    dist, ddist = _distance(pf, 0.5 * eps, P[i, flt + F_PERIOD])
-    w1, dw1 = _box(dist, ddist, 0.5 * eps, s)
-    w2, dw2 = _box(dist, ddist, 1.0 - 0.5 * eps, s)
-    share, dshare = 0.5 * (w1 + w2), 0.5 * (dw1 + dw2)
-    loss = 1.0 - P[i, flt + F_FACTOR]
-    return 1.0 - loss * share, -loss * dshare, a1, a2
+def _lumped_flanks(shape, P, i, G, p_geo, z1, k_mean, c, phx, phy, d_plus, d_minus, r_plus, r_minus, ds, dr, dsd,
+                   drd, dkp, gp, gm, jac):
+    """(F_+, F_−) of the lumped law k(p) δ_f + c_m δ̇_f (gated, no pull) and, with ``jac``, their gradients
+    into gp, gm from those of s, the radial term and their rates."""
+    fac, dfac = _factor(shape, p_geo + P[i, P_P0], P, i, G)
+    kp = k_mean * fac
+    g_plus = kp * d_plus + c * r_plus
+    g_minus = kp * d_minus + c * r_minus
+    on_plus = d_plus > 0.0 and g_plus > 0.0          # flank in contact and not pulling
+    on_minus = d_minus > 0.0 and g_minus > 0.0
+    if jac:
+        dpdth = z1 * (1.0 / _TWO_PI)
+        dk = k_mean * dfac
+        dkp[0], dkp[1], dkp[2] = -dk * dpdth * phx, -dk * dpdth * phy, dk * dpdth
+        for j in range(8):
+            gp[j] = (dkp[j] * d_plus + kp * (ds[j] - dr[j]) + c * (dsd[j] - drd[j])) if on_plus else 0.0
+            gm[j] = (dkp[j] * d_minus + kp * (-ds[j] - dr[j]) + c * (-dsd[j] - drd[j])) if on_minus else 0.0
+    return (g_plus if on_plus else 0.0), (g_minus if on_minus else 0.0)
 
 
 @njit(cache=True)
 def _meshes(ql, vl, P, G, F, Jq, Jv, jac):
     """The mesh law at local coordinates ql, rates vl (the body centres, or the geometric centres)."""
-    shape, flt = int(G[G_SHAPE]), int(G[G_FAULT])
+    shape, pcol, tstart = int(G[G_SHAPE]), int(G[G_PAIRS]), int(G[G_TABLE])
     # gradients over (dx, dy, θ1, θ2, ḋx, ḋy, ω1, ω2), allocated once
     ds, dsd, dr, drd, dkp = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
     gp, gm, hx, hy, hnet = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
+    dd_p, dd_m, dv_p, dv_m = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
     for i in range(ql.shape[0]):
         sig, rb1, rb2 = P[i, P_SIGMA], P[i, P_RB1], P[i, P_RB2]
         sa, kappa0, pb, z1 = P[i, P_SIN_ALPHA], P[i, P_KAPPA0], P[i, P_PITCH], P[i, P_TEETH1]
@@ -264,20 +281,32 @@ def _meshes(ql, vl, P, G, F, Jq, Jv, jac):
         d_minus = -1.0 * s - radial - half_b
         r_plus = s_dot - radial_dot
         r_minus = -1.0 * s_dot - radial_dot
-        p = z1 * (th1 - phi_e) * (1.0 / _TWO_PI) + P[i, P_P0]
-        fac, dfac = _factor(shape, p, P, i, G)
+        phx, phy = -dy / r2, dx / r2                      # ∂φ_e/∂d
+        if jac:                  # gradients of s, the radial term and their rates
+            ds[0], ds[1], ds[2], ds[3] = -kappa0 * phx, -kappa0 * phy, sig * rb1, rb2
+            dr[0], dr[1] = sig * sa * ex, sig * sa * ey
+            ka = kappa * inv_a
+            dsd[0], dsd[1] = ka * (ex * t_dd + tx * e_dd), ka * (ey * t_dd + ty * e_dd)
+            dsd[4], dsd[5], dsd[6], dsd[7] = -kappa * tx, -kappa * ty, sig * rb1, rb2
+            drd[0], drd[1] = sig * sa * inv_a * tx * t_dd, sig * sa * inv_a * ty * t_dd
+            drd[4], drd[5] = sig * sa * ex, sig * sa * ey
         k_mean, c = P[i, P_K_MEAN], P[i, P_C_MESH]
-        kp = k_mean * fac
-        m, dm, fa1, fa2 = 1.0, 0.0, 0.0, 0.0
-        if flt >= 0:
-            m, dm, fa1, fa2 = _fault_multiplier(th1, th2, phi_e, P, i, flt)
-            kp = kp * m
-        g_plus = kp * d_plus + c * r_plus
-        g_minus = kp * d_minus + c * r_minus
-        on_plus = d_plus > 0.0 and g_plus > 0.0          # flank in contact and not pulling
-        on_minus = d_minus > 0.0 and g_minus > 0.0
-        F_plus = g_plus if on_plus else 0.0
-        F_minus = g_minus if on_minus else 0.0
+        if pcol >= 0:            # the tooth-pair law, flank by flank
+            for j in range(8):
+                dd_p[j], dd_m[j] = ds[j] - dr[j], -ds[j] - dr[j]
+                dv_p[j], dv_m[j] = dsd[j] - drd[j], -dsd[j] - drd[j]
+            h, sw, single, ratio = P[i, P_RECT_H], P[i, P_RECT_S], P[i, P_RECT_SINGLE], P[i, P_RECT_RATIO]
+            z2 = np.rint(rb2 / rb1 * z1)
+            F_plus = tooth_pairs.flank_force(1.0, P, i, pcol, G, tstart, sig, z1, z2, k_mean, c, h, sw, single,
+                                             ratio, th1, th2, phi_e, w1, d_plus, r_plus, ex, ey, tx, ty, inv_a,
+                                             t_dd, e_dd, dd_p, dv_p, gp, jac)
+            F_minus = tooth_pairs.flank_force(-1.0, P, i, pcol, G, tstart, sig, z1, z2, k_mean, c, h, sw, single,
+                                              ratio, th1, th2, phi_e, w1, d_minus, r_minus, ex, ey, tx, ty, inv_a,
+                                              t_dd, e_dd, dd_m, dv_m, gm, jac)
+        else:
+            F_plus, F_minus = _lumped_flanks(shape, P, i, G, z1 * (th1 - phi_e) * (1.0 / _TWO_PI), z1, k_mean, c,
+                                             phx, phy, d_plus, d_minus, r_plus, r_minus, ds, dr, dsd, drd, dkp,
+                                             gp, gm, jac)
         F_net = F_plus - F_minus
         F_sum = F_plus + F_minus
         Fx_head = F_net * kappa * tx + sig * sa * F_sum * ex
@@ -290,27 +319,6 @@ def _meshes(ql, vl, P, G, F, Jq, Jv, jac):
         F[i, 5] = -1.0 * rb2 * F_net
         if not jac:
             continue
-        # --- gradients of the scalars the flank forces are built from
-        phx, phy = -dy / r2, dx / r2                      # ∂φ_e/∂d
-        ds[0], ds[1], ds[2], ds[3] = -kappa0 * phx, -kappa0 * phy, sig * rb1, rb2
-        dr[0], dr[1] = sig * sa * ex, sig * sa * ey
-        ka = kappa * inv_a
-        dsd[0], dsd[1] = ka * (ex * t_dd + tx * e_dd), ka * (ey * t_dd + ty * e_dd)
-        dsd[4], dsd[5], dsd[6], dsd[7] = -kappa * tx, -kappa * ty, sig * rb1, rb2
-        drd[0], drd[1] = sig * sa * inv_a * tx * t_dd, sig * sa * inv_a * ty * t_dd
-        drd[4], drd[5] = sig * sa * ex, sig * sa * ey
-        dpdth = z1 * (1.0 / _TWO_PI)
-        dk = k_mean * dfac
-        if flt < 0:
-            dkp[0], dkp[1], dkp[2] = -dk * dpdth * phx, -dk * dpdth * phy, dk * dpdth
-        else:                            # k = k_mean·fac(p)·m(p_f): p_f = A1 θ1 + A2 θ2 − (A1 + A2) φ_e + c_f
-            g, asum = k_mean * fac * dm, fa1 + fa2
-            dkp[0] = -(dk * dpdth * m + g * asum) * phx
-            dkp[1] = -(dk * dpdth * m + g * asum) * phy
-            dkp[2], dkp[3] = dk * dpdth * m + g * fa1, g * fa2
-        for j in range(8):
-            gp[j] = (dkp[j] * d_plus + kp * (ds[j] - dr[j]) + c * (dsd[j] - drd[j])) if on_plus else 0.0
-            gm[j] = (dkp[j] * d_minus + kp * (-ds[j] - dr[j]) + c * (-dsd[j] - drd[j])) if on_minus else 0.0
         # --- head force (F_net κ t + σ F_sum sin α e) and torques
         for j in range(8):
             dnet, dsum = gp[j] - gm[j], gp[j] + gm[j]

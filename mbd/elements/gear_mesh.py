@@ -34,25 +34,17 @@ Mesh-cycle convention of :class:`RectangularStiffness`: double-tooth contact is 
 on p = (ε_α − 1)/2, i.e. it spans p ∈ [0, ε_α − 1) (a new tooth pair enters at p = 0) and single
 contact spans [ε_α − 1, 1). Components choose p0 from the real tooth positions accordingly.
 
-Manufacturing errors (MODEL.md §3.9; both default to none, and then the evaluation is exactly the
-error-free one — the family skips them):
+Manufacturing errors (MODEL.md §3.9; default none, and then the evaluation is exactly the error-free
+one — the family skips them):
 
 - Eccentricity / runout: gear b's geometric (tooth) centre sits at c_geo = c + R(θ_b)·o_b, o_b
   (``offset1``, ``offset2``) fixed in the gear's body axes. The law above is evaluated with the
   geometric centres in place of the body centres (their velocities v + ω k × R(θ)o), and the mesh force
   acts at the geometric centre: the body gets the force and the moment (R(θ)o) × F. Rigid-motion
   invariance, and so the exact force and moment balance, is kept.
-- Tooth fault: one tooth pair's stiffness scaled by c (``fault_factor``; 1 healthy, 0 missing tooth)
-  while it is in mesh, located from the states through the fault position
-  p_f = A1·θ1 + A2·θ2 − (A1 + A2)·φ_e + c_f [cycles] (A1 = z1/2π, A2 = 0 for a tooth of gear 1;
-  A1 = 0, A2 = −σ z2/2π for a tooth of gear 2: p_f advances one cycle per tooth pitch, and a 2π jump
-  of φ_e moves it by whole periods z_f). With u = p_f mod z_f the faulty pair enters at u = 0 and
-  leaves at u = ε (the contact ratio); its share of the mesh stiffness is ½ in double contact
-  (u ∈ [0, ε − 1) and [1, ε)), 1 in single contact [ε − 1, 1), 0 elsewhere:
-      share(u) = ½·box(u; 0, ε) + ½·box(u; ε − 1, 1),    k = k_mean·factor(p)·(1 − (1 − c)·share)
-  box a smoothed window of period z_f with quintic-smoothstep edges of full width s centred on each
-  edge (as the rectangular stiffness). With the rectangular shape the faulty pair's own stiffness is
-  then c times a healthy pair's: c·k_single in single contact, k_double·(1 + c)/2 in double contact.
+- Tooth deviations, profile modification and tooth faults: the tooth-pair law (``pairs``,
+  :mod:`mbd.elements.tooth_pairs`) replaces the flank forces F_f = k(p)·δ_f + c_m·δ̇_f by sums over the
+  tooth pairs, each with its own gap; with every gap zero and no fault it is exactly the rectangular law.
 """
 from __future__ import annotations
 
@@ -65,10 +57,10 @@ import numpy as np
 from .. import ad
 from ..element import Element, body_dofs, marker, marker_velocity
 from ..errors import ModelError
+from .tooth_pairs import ToothPairs, flank_force, smooth_box
 
 __all__ = ["StiffnessShape", "ConstantStiffness", "RectangularStiffness", "FourierStiffness", "STIFFNESS_SHAPES",
-           "GearMesh", "mesh_offset", "mesh_u0", "contact_ratio_to_fraction",
-           "FAULT_ARGS", "fault_smoothing_max"]
+           "GearMesh", "mesh_offset", "mesh_u0", "contact_ratio_to_fraction"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -209,39 +201,13 @@ def _distance(p, centre, period):
     return ad.abs_(ad.wrap_angle(_TWO_PI / period * (p - centre)) * (period / _TWO_PI))
 
 
-def _box(dist, half, s):
-    """Window of half width ``half`` at distance ``dist`` from its centre: 1 inside, 0 outside,
-    quintic-smoothstep edges (C², symmetric) of full width s centred on each edge."""
-    x = (half + 0.5 * s - dist) * (1.0 / s)                # 1 inside, 0 outside, linear across an edge
-    x = ad.where(x > 1.0, 1.0, ad.where(x < 0.0, 0.0, x))
-    return x * x * x * (10.0 + x * (-15.0 + 6.0 * x))
+_box = smooth_box
 
 
 def _rect_factor(p, h, s, single, ratio):
     """Smoothed rectangular wave k/k_mean: double-contact window of half width h centred at p = h
     (period 1), quintic-smoothstep edges of width s. Parameters may be per-instance (n,) arrays."""
     return single * (1.0 + (ratio - 1.0) * _box(_distance(p, h, 1.0), h, s))
-
-
-def _fault_share(pf, eps, s, zf):
-    """The faulty tooth pair's share of the mesh stiffness at fault position pf (module docstring):
-    ½ window over [0, ε) + ½ window over [ε − 1, 1) — both centred at ε/2 — period z_f."""
-    dist = _distance(pf, 0.5 * eps, zf)
-    return 0.5 * (_box(dist, 0.5 * eps, s) + _box(dist, 1.0 - 0.5 * eps, s))
-
-
-FAULT_ARGS = ("fault_coef1", "fault_coef2", "fault_offset", "fault_period", "fault_factor", "fault_contact_ratio",
-              "fault_smoothing")
-# the values of a healthy instance (a family without a fault, or fused with a faulted one): factor 1
-_NO_FAULT = dict(fault_coef1=0.0, fault_coef2=0.0, fault_offset=0.0, fault_period=2.0, fault_factor=1.0,
-                 fault_contact_ratio=1.5, fault_smoothing=0.5)
-
-
-def fault_smoothing_max(contact_ratio):
-    """Largest fault-window ramp width [cycles] for which no two ramps overlap: min(ε − 1, 2 − ε), or 1
-    when ε = 1 (the two windows then coincide)."""
-    eps = np.asarray(contact_ratio, float)
-    return np.where(eps > 1.0, np.minimum(eps - 1.0, 2.0 - eps), 1.0)
 
 
 def mesh_offset(internal: bool, rb1, rb2, theta1, theta2, phi):
@@ -277,12 +243,9 @@ class GearMesh(Element):
     which the pitch wrap removes anyway).
 
     Errors (module docstring; default none): ``offset1``, ``offset2`` (2,) or (n, 2) [m] the geometric
-    centre of gear 1 / gear 2 in its body axes (eccentricity / runout). Tooth fault, all seven (n,) or
-    none: ``fault_coef1`` A1, ``fault_coef2`` A2 [cycles/rad], ``fault_offset`` c_f [cycles],
-    ``fault_period`` z_f (the faulty gear's tooth count, whole, ≥ 2), ``fault_factor`` c ∈ [0, 1],
-    ``fault_contact_ratio`` ε ∈ [1, 2), ``fault_smoothing`` s ∈ (0, :func:`fault_smoothing_max`] [cycles].
-    An instance with c = 1 is healthy; a family whose offsets are all zero and whose c are all 1 is
-    evaluated exactly as one without errors.
+    centre of gear 1 / gear 2 in its body axes (eccentricity / runout); a family whose offsets are all zero
+    is evaluated exactly as one without them. ``pairs``: a :class:`~mbd.elements.tooth_pairs.ToothPairs`
+    (tooth deviations, relief, tooth faults) for the tooth-pair law, which needs the rectangular stiffness.
 
     Outputs: ``force`` = F_drive − F_coast [N] (signed: > 0 when flank f = +1 carries the load);
     ``force_drive``, ``force_coast`` ≥ 0 (flanks f = +1, −1); ``deflection`` δ_+ and
@@ -293,8 +256,7 @@ class GearMesh(Element):
 
     def __init__(self, name, gear1, gear2, *, internal: bool, rb1, rb2, alpha, a0, teeth1, k_mean,
                  c_mesh=0.0, u0=0.0, p0=0.0, backlash=0.0, stiffness: StiffnessShape | None = None,
-                 phi_ref=0.0, offset1=None, offset2=None, fault_coef1=None, fault_coef2=None, fault_offset=None,
-                 fault_period=None, fault_factor=None, fault_contact_ratio=None, fault_smoothing=None):
+                 phi_ref=0.0, offset1=None, offset2=None, pairs: ToothPairs | None = None):
         self.name = name
         self.dofs = body_dofs(gear1, gear2)
         self.internal = bool(internal)
@@ -338,38 +300,24 @@ class GearMesh(Element):
         self.offset1, self.offset2 = (np.zeros((self.n, 2)) if o is None else self._per_instance_xy(k, o)
                                       for k, o in (("offset1", offset1), ("offset2", offset2)))
         self.has_offset = bool(np.any(self.offset1 != 0.0) or np.any(self.offset2 != 0.0))
-        self._init_fault(dict(fault_coef1=fault_coef1, fault_coef2=fault_coef2, fault_offset=fault_offset,
-                              fault_period=fault_period, fault_factor=fault_factor,
-                              fault_contact_ratio=fault_contact_ratio, fault_smoothing=fault_smoothing))
+        self.teeth2 = np.round(z2)
+        self._init_pairs(pairs)
 
-    def _init_fault(self, args):
-        """Per-instance tooth-fault arrays (healthy values when no fault is given), validated."""
-        given = [k for k, v in args.items() if v is not None]
-        if given and len(given) < len(FAULT_ARGS):
-            missing = [k for k in FAULT_ARGS if args[k] is None]
-            raise ModelError(f"{self.name}: a tooth fault needs all of {', '.join(FAULT_ARGS)}; missing {', '.join(missing)}")
-        vals = args if given else _NO_FAULT
-        for k in FAULT_ARGS:
-            setattr(self, k, self._per_instance(k, vals[k]))
-        c, eps, s, zf = self.fault_factor, self.fault_contact_ratio, self.fault_smoothing, self.fault_period
-        s_max = fault_smoothing_max(eps)
-        for bad, what in (((c < 0.0) | (c > 1.0), "'fault_factor' must be in [0, 1] (1 healthy, 0 missing tooth)"),
-                          ((eps < 1.0) | (eps >= 2.0), "'fault_contact_ratio' must be in [1, 2)"),
-                          ((zf < 2.0) | (zf != np.round(zf)),
-                           "'fault_period' must be the faulty gear's tooth count (whole, >= 2) [cycles]"),
-                          ((s <= 0.0) | (s > s_max), "'fault_smoothing' (ramp width) must be in (0, min(ε − 1, 2 − ε)] "
-                                                     "cycles (1 for ε = 1) so that no two ramps overlap")):
-            if np.any(bad):
-                i = int(np.argmax(bad))
-                raise ModelError(f"{self.name}: parameter {what}; instance {i} has fault_factor {c[i]:g}, "
-                                 f"fault_contact_ratio {eps[i]:g}, fault_period {zf[i]:g}, fault_smoothing {s[i]:g}")
-        self.has_fault = bool(np.any(c != 1.0))
+    def _init_pairs(self, pairs):
+        """The tooth-pair law's data (None: the lumped law), validated."""
+        self.pairs = None
+        if pairs is None:
+            return
+        if not isinstance(self.stiffness, RectangularStiffness):
+            raise ModelError(f"{self.name}: the tooth-pair law splits the rectangular stiffness over the pairs; "
+                             f"parameter 'stiffness' must be rectangular, got {type(self.stiffness).__name__}")
+        self.pairs = pairs.checked(self.name, self.n, self.teeth1, self.teeth2)
 
-    _FUSED = ("dofs", "rb1", "rb2", "alpha", "a0", "teeth1", "k_mean", "c_mesh", "u0", "p0", "backlash",
-              "phi_ref", "pitch", "kappa0", "sigma", "sin_alpha", "offset1", "offset2", *FAULT_ARGS)
+    _FUSED = ("dofs", "rb1", "rb2", "alpha", "a0", "teeth1", "teeth2", "k_mean", "c_mesh", "u0", "p0", "backlash",
+              "phi_ref", "pitch", "kappa0", "sigma", "sin_alpha", "offset1", "offset2")
 
     def fuse_key(self):
-        return ("GearMesh", *self.stiffness.fuse_key())
+        return ("GearMesh", *self.stiffness.fuse_key(), self.pairs is not None)
 
     @classmethod
     def fuse(cls, parts):
@@ -377,22 +325,15 @@ class GearMesh(Element):
         f = super().fuse(parts)
         f.internal = None
         f.stiffness = parts[0].stiffness
-        # the errors are evaluated for the whole fused family when any part has them (error-free
-        # instances then carry zero offsets and c = 1, which give the same values)
+        # the offsets are evaluated for the whole fused family when any part has them (the others' are
+        # zero, which gives the same values)
         f.has_offset = any(p.has_offset for p in parts)
-        f.has_fault = any(p.has_fault for p in parts)
         f._shape_args = tuple(np.concatenate(cols) for cols in zip(*(p._shape_args for p in parts)))
+        f.pairs = ToothPairs.fuse([p.pairs for p in parts]) if parts[0].pairs is not None else None
         return f
 
     def _factor(self, p):
         return self.stiffness.family_factor(p, self._shape_args)
-
-    def _fault_multiplier(self, th1, th2, phi_e):
-        """1 − (1 − c)·share(u) of the tooth fault (module docstring)."""
-        a1, a2 = self.fault_coef1, self.fault_coef2
-        pf = a1 * th1 + a2 * th2 - (a1 + a2) * phi_e + self.fault_offset
-        share = _fault_share(pf, self.fault_contact_ratio, self.fault_smoothing, self.fault_period)
-        return 1.0 - (1.0 - self.fault_factor) * share
 
     def kernel(self, t, fs, q, v, z):
         x1, y1, th1, x2, y2, th2 = q
@@ -428,12 +369,16 @@ class GearMesh(Element):
         r_plus = s_dot - radial_dot
         r_minus = -1.0 * s_dot - radial_dot
         p = self.teeth1 * (th1 - phi_e) * (1.0 / _TWO_PI) + self.p0
-        kp = self.k_mean * self._factor(p)
-        if self.has_fault:
-            kp = kp * self._fault_multiplier(th1, th2, phi_e)
-        c = self.c_mesh
-        F_plus = ad.where(d_plus > 0.0, ad.pos(kp * d_plus + c * r_plus), 0.0)
-        F_minus = ad.where(d_minus > 0.0, ad.pos(kp * d_minus + c * r_minus), 0.0)
+        if self.pairs is not None:     # tooth by tooth (tooth_pairs), each flank over its own pairs
+            pair_args = (self.pairs, sig, self.teeth1, self.teeth2, self.k_mean, self.c_mesh, self._shape_args,
+                         th1, th2, phi_e, t_dd * inv_a, w1)
+            F_plus, kp = flank_force(pair_args[0], 1, *pair_args[1:], d_plus, r_plus)
+            F_minus, _ = flank_force(pair_args[0], -1, *pair_args[1:], d_minus, r_minus)
+        else:
+            kp = self.k_mean * self._factor(p)
+            c = self.c_mesh
+            F_plus = ad.where(d_plus > 0.0, ad.pos(kp * d_plus + c * r_plus), 0.0)
+            F_minus = ad.where(d_minus > 0.0, ad.pos(kp * d_minus + c * r_minus), 0.0)
         # Q = −Σ F_f ∇δ_f; on the body at the head of d: (F+ − F−) κ t + σ (F+ + F−) sin α e
         F_net = F_plus - F_minus
         F_sum = F_plus + F_minus
