@@ -19,7 +19,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
 __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution", "against_viscosity",
-           "mode_shapes", "fault_spectra", "fault_loads", "FWD", "REV", "STYLE"]
+           "mode_shapes", "fault_spectra", "fault_loads", "gear_quality", "FWD", "REV", "STYLE"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
 STYLE = {
@@ -382,4 +382,65 @@ def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = 
                     ax.legend(loc="best")
         for ax in axes[-1]:
             ax.set_xticks(x, faults, rotation=30, ha="right")
+        return _save(fig, path)
+
+
+def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple] = (
+        ("bearing_load_mean_N", "mean bearing load", "kN", 1e-3), ("bearing_load_max_N", "largest bearing load", "kN", 1e-3),
+        ("roller_max_N", "largest roller load", "kN", 1e-3), ("life_iso16281_h", "roller-load life, pair 1", "h", 1.0)),
+        meshes: Sequence[str] = ("sun_inner", "inner_outer", "outer_ring")) -> Path:
+    """Per condition, perfect teeth against each tooth class (markers: the seeds' mean, bars: their range),
+    forward filled and reverse open; one row per quantity and a column per bearing type, and a last row with
+    the largest dynamic factor K_v and loaded transmission error p2p of the meshes. ``groups``: rows of
+    :func:`scenarios.gear_quality.by_grade`."""
+    grades = [None] + sorted({g["grade"] for g in groups if g["grade"] is not None})
+    conds = sorted({g["condition"] for g in groups})
+    at = {(g["condition"], g["direction"], g["grade"], g["bearing"]): g for g in groups}
+    colors = ["#222222", "#2b8a3e", "#1f5fa8", "#c2255c", "#e07b00", "#7a1f7a"]
+    width = 0.8 / len(grades)
+
+    def series(ax, key, bearing, scale, direction, k, g):
+        x, y, lo, hi = [], [], [], []
+        for i, c in enumerate(conds):
+            r = at.get((c, direction, g, bearing))
+            if r is None or r.get(key) is None:
+                continue
+            x.append(i + (k - (len(grades) - 1) / 2) * width + (0.2 if direction == "reverse" else -0.2) * width)
+            y.append(scale * r[key])
+            lo.append(scale * (r[key] - r[f"{key}_min"]))
+            hi.append(scale * (r[f"{key}_max"] - r[key]))
+        if not x:
+            return
+        label = ("perfect" if g is None else f"class {g}") if direction == "forward" else None
+        ax.errorbar(x, y, yerr=[lo, hi], fmt="o" if direction == "forward" else "s", ms=4.5, capsize=2,
+                    color=colors[k % len(colors)], mfc=colors[k % len(colors)] if direction == "forward" else "white",
+                    label=label, lw=1.0)
+
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(9.0, 2.2 * (len(quantities) + 1) + 0.8), layout="constrained")
+        axes = fig.subplots(len(quantities) + 1, 2, squeeze=False, sharex=True)
+        for r, (key, words, unit, scale) in enumerate(quantities):
+            for col, b in enumerate(("inner", "outer")):
+                ax = axes[r, col]
+                for k, g in enumerate(grades):
+                    for d in ("forward", "reverse"):
+                        series(ax, key, b, scale, d, k, g)
+                ax.set_ylabel(_axis_label(words, unit))
+                if r == 0:
+                    ax.set_title(f"{b} planet bearings")
+        for col, (prefix, words, unit, scale) in enumerate((("dynamic_factor", "K_v", None, 1.0),
+                                                            ("te_p2p_um", "loaded TE p2p", "µm", 1.0))):
+            ax = axes[-1, col]
+            for k, g in enumerate(grades):
+                for d in ("forward", "reverse"):
+                    for key in meshes[-1:]:           # the ring mesh: the one the rig's sensor hears
+                        series(ax, f"{prefix}_{key}", "outer", scale, d, k, g)
+            ax.set_ylabel(_axis_label(words + ", ring mesh", unit))
+        for ax in axes[-1]:
+            ax.set_xticks(range(len(conds)), [f"condition {c}" for c in conds])
+            ax.set_xlim(-0.55, len(conds) - 0.45)
+        axes[0, 0].legend(loc="best", title="filled: forward, open: reverse", title_fontsize=7)
+        for ax in axes.ravel():
+            if ax.get_ylim()[0] > 0:
+                ax.set_ylim(bottom=0)
         return _save(fig, path)

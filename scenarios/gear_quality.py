@@ -1,0 +1,269 @@
+"""What real gears do to the planet bearings: the forward/reverse study with ISO 1328-1 tooth classes.
+
+    python -m scenarios.gear_quality [--conditions 1,2,3,4] [--directions forward,reverse] [--grades 5,6,8]
+        [--seeds 1,2,3] [--systematic-share 0.5] [--settle S] [--window S] [--set KEY=VALUE ...]
+        [--workers N | --scheduler ADDR] [--force] [--overwrite] [--out DIR]
+
+Every operating point runs with perfect teeth and with the teeth of every gear drawn for each flank
+tolerance class and seed (``errors.flank_class``: ISO 1328-1:2013, normal with the tolerance at 3σ, each
+gear its own teeth; components.tolerances) — teeth only: no runout, no pinhole error, so that the change is
+the teeth's. All runs use the tooth-pair mesh law where teeth are real (the perfect machine's law is its exact
+reduction), the same window and the same runner as the paper study (resumable, on Dask).
+
+Writes ``runs.csv`` (a row per run and bearing type: mean and largest bearing load, largest roller load, cage
+guide and pocket-impact maxima, both lives, and per mesh type the dynamic factor K_v and the loaded
+transmission error's peak-to-peak), ``by_grade.csv`` (per condition, direction, class and bearing type the
+mean over the seeds with their smallest and largest value, and the forward/reverse change of the mean load and
+the life), ``findings.md`` (the answer in words) and ``quality.png``.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import dataclasses
+import io
+import json
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import mbd
+from mbd.recorder import atomic_write_text
+
+from . import args
+from .command import command
+from .lock import holds_out_folder
+from .paper_study import parse_sets
+from .plausibility import check_runs
+from .runner import RunConfig
+from .sweep import Case, build_params, check_folders, run_sweep, study_epilogue
+
+__all__ = ["main", "run", "make_cases", "rows_of", "by_grade", "findings", "QUANTITIES", "MESHES"]
+
+MESHES = ("sun_inner", "inner_outer", "outer_ring")
+# per bearing type: column -> (summary.json key, words, unit)
+QUANTITIES = {
+    "bearing_load_mean_N": ("bearing_load_mean_all_N", "mean bearing load", "N"),
+    "bearing_load_max_N": ("bearing_load_max_N", "largest bearing load", "N"),
+    "roller_max_N": (None, "largest roller load", "N"),
+    "cage_guide_max_N": ("cage_guide_max_N", "largest cage-guide force", "N"),
+    "pocket_impact_peak_max_N": ("pocket_impact_peak_max_N", "largest pocket impact", "N"),
+    "pocket_impact_speed_max": ("pocket_impact_speed_max", "fastest pocket impact", "m/s"),
+    "load_sharing_factor": ("load_sharing_factor", "load sharing K_γ", None),
+    "life_iso281_h": ("life_iso281_h", "ISO 281 life (pair 1)", "h"),
+    "life_iso16281_h": ("life_iso16281_h", "roller-load life (pair 1)", "h"),
+}
+COLUMNS = (["condition", "direction", "grade", "seed", "bearing", *QUANTITIES]
+           + [f"{k}_{m}" for m in MESHES for k in ("dynamic_factor", "te_p2p_um")])
+
+
+def parse_args(argv):
+    p = args.Parser(prog="python -m scenarios.gear_quality", description=__doc__.split("\n\n")[0])
+    p.add_argument("--conditions", default="1,2,3,4", type=args.conditions, help="comma list of conditions 1-4")
+    p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
+    p.add_argument("--grades", default="5,6,8", type=_int_list(1, 11, "flank tolerance classes"),
+                   help="ISO 1328-1:2013 flank tolerance classes 1..11 (default 5,6,8)")
+    p.add_argument("--seeds", default="1,2,3", type=_int_list(0, None, "seeds"), help="seeds of the draws (default 1,2,3)")
+    p.add_argument("--systematic-share", type=_share, default=0.5,
+                   help="share of the profile deviations' variance common to a gear flank's teeth (default 0.5)")
+    p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded (default 0.03)")
+    p.add_argument("--window", type=args.positive("s"), default=None,
+                   help="seconds analysed (default: the paper study's, whole cage revolutions)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
+                   help="override a parameter (repeatable)")
+    args.add_sweep_options(p, "results/gear_quality")
+    return p.parse_args(argv)
+
+
+def _int_list(lo: int, hi: int | None, what: str):
+    conv = args.count(lo, hi)
+
+    def parse(text: str) -> list[int]:
+        items = [x.strip() for x in text.split(",") if x.strip()]
+        if not items:
+            raise argparse.ArgumentTypeError(f"expected a comma list of {what}, got {text!r}")
+        out = [conv(x) for x in items]
+        if len(set(out)) < len(out):
+            raise argparse.ArgumentTypeError(f"{what} repeat in {text!r}")
+        return out
+    parse.__name__ = f"comma list of {what}"
+    return parse
+
+
+def _share(text: str) -> float:
+    x = args.nonnegative("")(text)
+    if x > 1.0:
+        raise argparse.ArgumentTypeError(f"must be in [0, 1], got {text!r}")
+    return x
+
+
+def _tag(grade, seed) -> str:
+    return "perfect" if grade is None else f"class{grade}_seed{seed}"
+
+
+def make_cases(a, out: Path) -> list[Case]:
+    """Perfect teeth, and every class × seed, at every condition and direction."""
+    user = parse_sets(a.set)
+    machines = [(None, None)] + [(g, s) for g in a.grades for s in a.seeds]
+    cases = []
+    for c in (int(x) for x in a.conditions.split(",")):
+        for d in a.directions.split(","):
+            for g, s in machines:
+                ov = dict(user)
+                if g is not None:
+                    ov["errors.flank_class"] = [{"gear": "all", "grade": g, "seed": s,
+                                                 "systematic_share": a.systematic_share}]
+                cases.append(Case(c, d, str(out / f"c{c}_{d}_{_tag(g, s)}"), ov, tag=_tag(g, s)))
+    return cases
+
+
+def _grade_seed(case: Case):
+    fc = case.overrides.get("errors.flank_class")
+    return (None, None) if not fc else (fc[0]["grade"], fc[0]["seed"])
+
+
+def rows_of(cases: list[Case], results: dict) -> list[dict]:
+    """A row per finished run and bearing type (module docstring)."""
+    rows = []
+    for case in cases:
+        s = results.get(case.label, {})
+        if not s or "error" in s:
+            continue
+        g, seed = _grade_seed(case)
+        mesh = {}
+        for m in MESHES:
+            d = s["meshes"][m]
+            mesh[f"dynamic_factor_{m}"] = d.get("dynamic_factor")
+            mesh[f"te_p2p_um_{m}"] = 1e6 * d["te_peak_to_peak_m"]
+        for kind in ("inner", "outer"):
+            b = s[kind]
+            row = {"condition": case.condition, "direction": case.direction, "grade": g, "seed": seed, "bearing": kind}
+            for col, (key, _, _) in QUANTITIES.items():
+                row[col] = max(b["roller_inner_race_max_N"], b["roller_outer_race_max_N"]) if key is None else b.get(key)
+            rows.append({**row, **mesh})
+    return rows
+
+
+def by_grade(rows: list[dict]) -> list[dict]:
+    """Per condition, direction, class (None: perfect) and bearing: mean, min and max over the seeds of every
+    quantity, and the reverse/forward change (in %) of the mean bearing load and the roller-load life."""
+    groups: dict[tuple, list[dict]] = {}
+    for r in rows:
+        groups.setdefault((r["condition"], r["direction"], r["grade"], r["bearing"]), []).append(r)
+    cols = [c for c in COLUMNS if c not in ("condition", "direction", "grade", "seed", "bearing")]
+    out = []
+    for (c, d, g, b), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1], kv[0][2] or 0, kv[0][3])):
+        row = {"condition": c, "direction": d, "grade": g, "bearing": b, "seeds": len(rs)}
+        for col in cols:
+            v = np.array([np.nan if r[col] is None else float(r[col]) for r in rs])
+            row[col] = float(np.nanmean(v)) if np.any(np.isfinite(v)) else None
+            row[f"{col}_min"] = float(np.nanmin(v)) if np.any(np.isfinite(v)) else None
+            row[f"{col}_max"] = float(np.nanmax(v)) if np.any(np.isfinite(v)) else None
+        out.append(row)
+    index = {(r["condition"], r["direction"], r["grade"], r["bearing"]): r for r in out}
+    for r in out:
+        f = index.get((r["condition"], "forward", r["grade"], r["bearing"]))
+        rev = index.get((r["condition"], "reverse", r["grade"], r["bearing"]))
+        for col in ("bearing_load_mean_N", "life_iso16281_h"):
+            ok = f and rev and f[col] and rev[col] is not None
+            r[f"{col}_reverse_change_pct"] = 100.0 * (rev[col] / f[col] - 1.0) if ok else None
+    return out
+
+
+def findings(groups: list[dict]) -> str:
+    """The answer in words: per condition and bearing type, what each class does against perfect teeth
+    (mean and largest bearing load, largest roller load, life, K_v), the spread between seeds, and whether the
+    forward/reverse change of the mean load keeps its sign and size."""
+    at = {(g["condition"], g["direction"], g["grade"], g["bearing"]): g for g in groups}
+    grades = sorted({g["grade"] for g in groups if g["grade"] is not None})
+    lines = ["What real teeth do (ISO 1328-1:2013 flank tolerance class, every gear its own teeth; mean of the "
+             "seeds, their range in brackets; against perfect teeth at the same operating point).", ""]
+    pct = lambda x, y: 100.0 * (x / y - 1.0)
+    for c in sorted({g["condition"] for g in groups}):
+        lines.append(f"condition {c}:")
+        for d in ("forward", "reverse"):
+            for b in ("inner", "outer"):
+                p = at.get((c, d, None, b))
+                if p is None:
+                    continue
+                parts = []
+                for g in grades:
+                    q = at.get((c, d, g, b))
+                    if q is None:
+                        continue
+                    kv = max(q[f"dynamic_factor_{m}"] or 0.0 for m in MESHES)
+                    parts.append(
+                        f"class {g}: mean load {pct(q['bearing_load_mean_N'], p['bearing_load_mean_N']):+.1f} %, "
+                        f"largest {pct(q['bearing_load_max_N'], p['bearing_load_max_N']):+.0f} % "
+                        f"[{pct(q['bearing_load_max_N_min'], p['bearing_load_max_N']):+.0f}, "
+                        f"{pct(q['bearing_load_max_N_max'], p['bearing_load_max_N']):+.0f}], roller "
+                        f"{pct(q['roller_max_N'], p['roller_max_N']):+.0f} %, life "
+                        f"{pct(q['life_iso16281_h'], p['life_iso16281_h']):+.1f} %, K_v {kv:.2f}")
+                lines.append(f"  {d:>7} {b} bearings ({p['bearing_load_mean_N'] / 1e3:.1f} kN mean, "
+                             f"{p['bearing_load_max_N'] / 1e3:.1f} kN largest with perfect teeth): " + "; ".join(parts))
+        for b in ("inner", "outer"):
+            ch = [(g, at.get((c, "forward", g, b))) for g in [None, *grades]]
+            ch = [(g, r["bearing_load_mean_N_reverse_change_pct"]) for g, r in ch if r and
+                  r.get("bearing_load_mean_N_reverse_change_pct") is not None]
+            if ch:
+                lines.append(f"  reverse vs forward, {b} bearings' mean load: "
+                             + ", ".join(f"{'perfect' if g is None else f'class {g}'} {v:+.1f} %" for g, v in ch))
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _write_csv(path: Path, rows: list[dict], columns=None) -> None:
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=list(columns or rows[0]))
+    w.writeheader()
+    w.writerows(rows)
+    atomic_write_text(path, buf.getvalue())
+
+
+def write_outputs(rows: list[dict], out: Path) -> list[Path]:
+    from viz.plots import gear_quality
+
+    groups = by_grade(rows)
+    _write_csv(out / "runs.csv", rows, COLUMNS)
+    _write_csv(out / "by_grade.csv", groups)
+    atomic_write_text(out / "findings.md", findings(groups) + "\n")
+    return [out / "runs.csv", out / "by_grade.csv", out / "findings.md", gear_quality(groups, out / "quality.png")]
+
+
+@holds_out_folder
+def run(a) -> dict:
+    out = Path(a.out)
+    cases = make_cases(a, out)
+    cfg = RunConfig(settle=a.settle, window=a.window, integration=mbd.PRODUCTION, progress=not a.no_progress)
+    from components import faults
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")      # the reference machine's known design warnings
+        for c in cases:
+            faults.check_errors(build_params(c).si())   # every parameter checked before any run starts
+    out.mkdir(parents=True, exist_ok=True)
+    for w in check_runs([(c.label, build_params(c), cfg) for c in cases], out, a.force):
+        print(f"warning (--force): {w}")
+    check_folders(cases, cfg, a.overwrite)
+    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
+                        overwrite=a.overwrite)
+    rows = rows_of(cases, results)
+    files = write_outputs(rows, out) if rows else []
+    failed = {k: v["error"] for k, v in results.items() if "error" in v}
+    atomic_write_text(out / "study.json", json.dumps({"cases": [dataclasses.asdict(c) for c in cases],
+                                                      "failed": failed}, indent=2, default=str))
+    return {"rows": rows, "failed": failed, "files": files, "results": results}
+
+
+@command
+def main(argv=None) -> int:
+    r = run(parse_args(sys.argv[1:] if argv is None else argv))
+    if r["files"]:
+        print((Path(r["files"][2])).read_text())
+    return study_epilogue(r)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
