@@ -32,8 +32,9 @@ recorded loads (:class:`HousingLoads`, recorded with ``RunConfig(sensor=True)``)
 exactly for loads linear between samples (first-order hold, :func:`scipy.signal.lsim`), starting at rest
 at the static deflection of the first sample's load: a constant load reads zero from the first sample,
 and only the dynamic part at the first sample starts a free vibration, which decays as e^(−ζ ω_n t)
-(3.2 ms at the rocking mode, 5 ms at the translation: ζ = 0.05, 1 kHz / 630 Hz) and sits under the
-spectrum's Hann taper (w ≤ 0.03 over the first 5 ms of a 90 ms window).
+(time constants 5 ms for the rocking at 630 Hz, 3.2 ms for the translation at 1 kHz, ζ = 0.05) and sits
+under the spectrum's Hann taper (w ≤ 0.03 over the first 5 ms of a 90 ms window): starting instead from the
+load's mean over the mode's first period changes the rig machine's lines by < 1e-10 (measured).
 """
 from __future__ import annotations
 

@@ -358,7 +358,14 @@ def test_a_perfect_machine_keeps_the_cancelled_lines_on_every_path(perfect_linea
     at 30°), so around f_m the path holds nothing but the integrator's broadband noise (2.7e-6 m/s², 1e-7 of
     the sum's f_m − f_c): its cancelled lines stay within 3× its band median and below 1e-6 of the sum's
     f_m − f_c. At the rig's sensor (radial, on the vertical through the rocking centre) the torque path's
-    lever is 0, and so is the path."""
+    lever is 0, and so is the path.
+
+    The full model (gravity, roller bearings) takes 45–90 s (`python -m scenarios.spectrum --perfect`), too long
+    for the suite; measured there: the sum's cancelled lines at 1.0–1.9× the band's median (f_m 1.3×, f_m + f_c
+    1.9×, f_m ± 3f_c 1.0× / 1.3×), the mesh path's at 1.0–1.7× its own; but the bearing path's f_m + f_c at 8.1×
+    its own (far lower) floor and, read tangentially, the torque path's f_m at 16×: the roller bearings leave the
+    planets' load shares 2.5e-4 apart (K_γ = 1.00025), which a net force shows at f_m + f_c and a net torque at
+    f_m — at 0.09 and 0.66 m/s², under the sum's floor."""
     path, fc, fm = perfect_linear_run
     s = dataclasses.replace(reference_dpgt(2).si().rig.sensor, **where)
     t, paths = _whole_revolutions(*sensor_paths(path, s), fc)
