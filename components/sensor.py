@@ -47,6 +47,7 @@ import mbd
 from mbd.ad import wrap_angle
 
 from .families import FAMILY
+from .params import HousingSI, SensorSI
 
 __all__ = ["PATHS", "hann_window", "sensor_axis", "rocking_lever", "mesh_path", "mode_acceleration",
            "housing_paths", "paths", "HousingLoads", "sensor_from_dict"]
@@ -127,7 +128,6 @@ def paths(t, psi_planets, ring_force, force, torque, sensor) -> dict[str, np.nda
 
 def sensor_from_dict(d: dict):
     """A :class:`components.params.SensorSI` from its ``to_dict()`` (as a run stores it in results.nc)."""
-    from .params import HousingSI, SensorSI
     return SensorSI(**{**d, "housing": HousingSI(**d["housing"])})
 
 

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.sensor import PATHS as SENSOR_PATHS
 from mbd.recorder import atomic_write_text
 
 from .analysis import amplitude_spectrum, line_table, peak_table
@@ -55,7 +56,7 @@ SENSORS = {
                "carrier's bearing forces and the ring's seat force [m/s^2]",
     "axis": "ideal sensor at the carrier axis: carrier acceleration in the fixed frame, x component [m/s^2]",
 }
-PATHS = ("mesh", "torque", "bearing", "housing")   # the housing sensor's paths and their sum, in lines.csv
+PATHS = (*SENSOR_PATHS, "housing")   # the housing sensor's paths and their sum, in lines.csv
 # the lines planet phasing lets each sensor see on a perfect machine (components.geometry.sideband_origin):
 # a window carries every allowed carrier order; the forces at the axis only k = ±1 (the torque path too, once
 # gravity modulates each planet's force once per revolution: without it a net torque keeps only orders l z_r)
@@ -156,7 +157,7 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     gears = params.si().gears
     lines = _lines(f, spectra, f_m, f_c, int(gears.ring.teeth), int(gears.planets), sensor)
     expected = {r["line"]: r["frequency_hz"] for r in lines}
-    peaks = peak_table(f, amp, f_m, (SIDEBANDS + 0.5) * f_c, expected, n=8)
+    peaks = peak_table(f, amp, f_m, (SIDEBANDS + 0.5) * f_c, expected, n=8) if amp.any() else []   # a path at 0
     _write_csv(out / "spectrum.csv", [{"frequency_hz": fi, **{k: a[1][i] for k, a in spectra.items()}}
                                       for i, fi in enumerate(f.tolist())])
     _write_csv(out / "lines.csv", lines)
@@ -254,7 +255,7 @@ def _lines(f, spectra, f_m, f_c, z_r: int, planets: int, sensor: str) -> list[di
         for name in PATHS:
             r[f"{name}_amplitude"] = table[name][i]["amplitude"]
             r[f"{name}_over_floor"] = table[name][i]["over_median"]
-        r["carried_by"] = max(PATHS[:-1], key=lambda name: r[f"{name}_amplitude"])
+        r["carried_by"] = max(SENSOR_PATHS, key=lambda name: r[f"{name}_amplitude"])
     return rows
 
 
@@ -270,7 +271,7 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
 def _plot(f, spectra, f_m, f_c, s, sensor, out):
     from viz import plots as vp
 
-    shown = {"housing": ["housing", *PATHS[:-1]], "axis": ["axis_x", "axis_y"]}.get(sensor, [sensor, "housing"])
+    shown = {"housing": ["housing", *SENSOR_PATHS], "axis": ["axis_x", "axis_y"]}.get(sensor, [sensor, "housing"])
     names = {"housing": "housing sensor", "mesh": "mesh path", "torque": "torque path", "bearing": "bearing path",
              "axis_x": "x", "axis_y": "y"}
     marks = {"f_m": f_m, **{f"f_m{'+' if k > 0 else '−'}{abs(k)}f_c": f_m + k * f_c for k in (-3, -1, 1, 3)}}
