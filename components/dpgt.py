@@ -18,12 +18,12 @@ from . import faults, teeth
 from .bearing import BearingHandles, add_planet_bearing
 from .gears import add_mesh_family
 from .geometry import check_design, loaded_flanks
-from .families import MESH_FAMILY
-from .params import DPGTParams
+from .families import FAMILY, MESH_FAMILY
+from .params import CarrierRippleParams, DPGTParams
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError
 
-__all__ = ["build_dpgt", "PairHandles"]
+__all__ = ["build_dpgt", "PairHandles", "carrier_ripple"]
 
 
 @dataclass(frozen=True)
@@ -53,6 +53,16 @@ def _bearing_damage(si, planet: str, psi: float) -> dict:
                 outer=faults.spall_args(si, planet, "outer", psi))
 
 
+def carrier_ripple(ripple, wc: float) -> list[tuple[float, float, float]] | None:
+    """The carrier drive's speed-ripple harmonics (k ω_c, A_k, φ_k) of the orders with A_k > 0 (None without
+    any: the drive then runs its constant-speed reference unchanged). ``ripple``: a CarrierRippleSI."""
+    orders = [k for k in CarrierRippleParams.ORDERS if getattr(ripple, f"amplitude_{k}") > 0.0]
+    if orders and wc == 0.0:
+        raise ParameterError.at(f"rig.carrier_ripple.amplitude_{orders[0]}",
+                                "must be 0 rad/s with the carrier at rest (its orders of f_c = 0 Hz)")
+    return [(k * wc, getattr(ripple, f"amplitude_{k}"), getattr(ripple, f"phase_{k}")) for k in orders] or None
+
+
 def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: bool = True) -> BuiltScene:
     """Build the DPGT scene. Design errors raise ParameterError; design warnings are issued."""
     opt = (options or SceneOptions()).resolved()
@@ -73,7 +83,7 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     scene.body("sun", G.sun.mass, G.sun.inertia, vel=(0, 0, speed["sun"]))
     scene.body("ring", G.ring.mass, G.ring.inertia, pose=(0, 0, ph.gamma_ring))
     scene.body("carrier", G.carrier_mass, G.carrier_inertia, vel=(0, 0, wc))
-    sup_f = scene.family("support", GroundSupport, ("bodies",))
+    sup_f = scene.family(FAMILY["support"], GroundSupport, ("bodies",))
     for name, k, m, J in (("sun", sup.sun_stiffness, G.sun.mass, G.sun.inertia),
                           ("ring", sup.ring_stiffness, G.ring.mass, G.ring.inertia),
                           ("carrier", sup.carrier_stiffness, G.carrier_mass, G.carrier_inertia)):
@@ -126,7 +136,8 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
         J_eff = G.carrier_inertia + N * (G.inner_planet.mass * lay.r_ca**2 + G.outer_planet.mass * lay.r_cb**2)
     wd = 2 * np.pi * rig.carrier_drive_bandwidth
     scene.add_element(SpeedDrive("carrier_drive", scene.index["carrier"], wc, k=J_eff * wd**2,
-                                 c=2 * rig.carrier_drive_damping_ratio * J_eff * wd, k_i=J_eff * wd**3 / 5))
+                                 c=2 * rig.carrier_drive_damping_ratio * J_eff * wd, k_i=J_eff * wd**3 / 5,
+                                 ripple=carrier_ripple(rig.carrier_ripple, wc)))
     scene.handles.update({"pairs": tuple(pairs), "flanks": flanks})
     scene.meta.update({
         "speeds_rad_s": {"sun": speed["sun"], "inner_planet": speed["a"], "outer_planet": speed["b"], "carrier": wc},

@@ -14,8 +14,7 @@ taken here, by :class:`WindowStatistics`, an observer of the one simulation loop
   carrier); *radial* is from the carrier axis through the planet's centre, *tangential* 90° ahead.
   Both are independent of where the planet sits and of the frame the model is integrated in.
 
-The rig's accelerometer on the housing (MODEL.md §3.10) is :class:`HousingSensor`, recorded per sample
-through :meth:`HousingSensor.probe` when a run asks for it (it costs nothing otherwise).
+The rig's accelerometer on the housing (MODEL.md §3.10) and its transfer paths are in :mod:`components.sensor`.
 
 Bearing lives (:mod:`components.life` owns the laws): ISO 281's from the bearing load's equivalent
 (mean P^(10/3)), and the ISO/TS 16281-style one from every roller's raceway loads, accumulated here as
@@ -41,7 +40,7 @@ from .lubrication import bearing_film
 
 __all__ = ["FAMILY", "MESH_FAMILY", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
            "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life",
-           "contact_film", "SUMMARY_WORDS", "hann_window", "sensor_acceleration", "HousingSensor"]
+           "contact_film", "SUMMARY_WORDS"]
 
 
 
@@ -165,65 +164,6 @@ def radial_tangential(vec, planet_xy, carrier_xy):
     vec = np.asarray(vec, float)
     return (vec[..., 0] * er[..., 0] + vec[..., 1] * er[..., 1],
             -vec[..., 0] * er[..., 1] + vec[..., 1] * er[..., 0])
-
-
-# ----------------------------------------------------------------------------------------------
-# the rig's accelerometer (MODEL.md §3.10)
-# ----------------------------------------------------------------------------------------------
-def hann_window(dpsi, width: float) -> np.ndarray:
-    """Weight of a planet at angular distance ``dpsi`` [rad] from the sensor: cos²(π Δ/width) for
-    |Δ| < width/2 (Δ wrapped to (−π, π]), 0 beyond. 1 at the sensor; value and slope are continuous
-    everywhere (a Hann window of full width ``width``, McFadden 1994), so a passing planet fades in and out."""
-    d = wrap_angle(np.asarray(dpsi, float))
-    return np.where(np.abs(d) < 0.5 * width, np.cos(np.pi * d / width) ** 2, 0.0)
-
-
-def sensor_acceleration(psi_planets, force_along_axis, housing_along_axis, sensor) -> np.ndarray:
-    """a = Σ_n w(ψ_n − ψ_s)·F_n/m_eq + a_h (MODEL.md §3.10), broadcasting over leading (sample) axes.
-
-    ``psi_planets`` (..., N): outer planets' angles in the fixed frame [rad]; ``force_along_axis`` (..., N):
-    each one's ring-mesh force on the ring along the sensor's axis [N]; ``housing_along_axis`` (...): the
-    housing's acceleration along it [m/s²]; ``sensor``: :class:`components.params.SensorSI`."""
-    w = hann_window(np.asarray(psi_planets, float) - sensor.angle, sensor.window_width)
-    return (w * np.asarray(force_along_axis, float)).sum(axis=-1) / sensor.equivalent_mass + housing_along_axis
-
-
-class HousingSensor:
-    """The accelerometer on the housing at ψ_s (MODEL.md §3.10), evaluated at a recorded sample.
-
-    Its axis e is fixed in the housing: radial (cos ψ_s, sin ψ_s) or tangential (−sin ψ_s, cos ψ_s).
-    F_n is the outer-ring mesh family's force on the ring (both flanks: drive minus coast along the line
-    of action), the housing's acceleration is the carrier's in the fixed frame (the carrier-housing
-    acceleration, MODEL.md §5). Dot products are taken in R (lengths do not depend on the frame)."""
-
-    def __init__(self, scene, sensor):
-        model = scene.model
-        self.sensor, self.frame = sensor, model.frame
-        self.planets = np.array([model.body(p.outer).index for p in scene.handles["pairs"]])
-        self.carrier = model.body("carrier").index
-        self.family = MESH_FAMILY["outer_ring"]
-        self.axis_angle = sensor.angle + (0.0 if sensor.direction == "radial" else 0.5 * math.pi)
-
-    def __call__(self, t, X, V, A, outputs) -> np.ndarray:
-        fs = self.frame.at(t)
-        e = np.array([math.cos(self.axis_angle - fs.phi), math.sin(self.axis_angle - fs.phi)])   # axis in R
-        P = X[self.planets]
-        psi = np.arctan2(P[:, 1], P[:, 0]) + fs.phi
-        o = outputs[self.family]
-        force = np.asarray(o["fx"], float) * e[0] + np.asarray(o["fy"], float) * e[1]
-        _, _, a_c = mbd.to_fixed(X[self.carrier], V[self.carrier], fs, A[self.carrier])
-        e_fixed = (math.cos(self.axis_angle), math.sin(self.axis_angle))
-        housing = a_c[0] * e_fixed[0] + a_c[1] * e_fixed[1]
-        return np.atleast_1d(sensor_acceleration(psi, force, housing, self.sensor))
-
-    def probe(self) -> mbd.DerivedOutput:
-        """The recorder probe: ``sensor.acceleration`` [m/s^2] along ``sensor.acceleration.instance``."""
-        s = self.sensor
-        where = f"{math.degrees(s.angle):.4g} deg, {s.direction}"
-        return mbd.DerivedOutput("sensor.acceleration", self, "m/s^2",
-                                 f"housing accelerometer at {where}: Hann-windowed ring-mesh forces / "
-                                 f"{s.equivalent_mass:.4g} kg + carrier-housing acceleration (MODEL.md 3.10)",
-                                 instances=(f"housing {where}",))
 
 
 # ----------------------------------------------------------------------------------------------

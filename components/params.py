@@ -52,10 +52,12 @@ from .units import ParameterError, Quantity, format_quantity, quantity, to_si
 __all__ = [
     "Source", "Sourced", "paper", "derived", "assumed", "SI", "Derived", "Params",
     "GearParams", "GearSetParams", "CageParams", "SlideRollTractionParams", "LifeParams", "BearingParams", "LubricantParams",
-    "SupportParams", "MeshParams", "OperatingPoint", "SensorParams", "RigParams", "DPGTParams", "BearingRigParams",
+    "SupportParams", "MeshParams", "OperatingPoint", "HousingParams", "SensorParams", "CarrierRippleParams", "RigParams",
+    "DPGTParams", "BearingRigParams",
     "ErrorsParams", "PinholeErrorParams", "RunoutParams", "RollerDiameterErrorParams", "SpallParams", "ToothFaultParams",
     "GearSI", "GearSetSI", "CageSI", "SlideRollTractionSI", "LifeSI", "BearingSI", "LubricantSI", "SupportSI", "MeshSI",
-    "OperatingSI", "SensorSI", "RigSI", "DPGTSI", "DPGTOperatingSI", "DPGTSupportSI", "BearingRigSI",
+    "OperatingSI", "HousingSI", "SensorSI", "CarrierRippleSI", "RigSI", "DPGTSI", "DPGTOperatingSI", "DPGTSupportSI",
+    "BearingRigSI",
     "with_overrides", "parameter_names", "flatten", "describe", "to_toml", "overrides_from_toml",
 ]
 
@@ -801,26 +803,78 @@ class OperatingPoint(Params):
 OperatingSI = OperatingPoint.SI
 
 
+@_with_si("HousingSI")
+@dataclass(frozen=True, kw_only=True)
+class HousingParams(Params):
+    """The housing the rig's accelerometer sits on, as two rigid-body modes on its mounting (MODEL.md §3.10),
+    each a linear mass–spring–damper driven one way by what the train puts on the housing
+    (:mod:`components.sensor`): a translation (modal mass m_h, the same in x and y) and a rocking about the
+    mounting's elastic centre O, ``rocking_centre_depth`` below the gear axis (a gearbox on feet rocks about
+    its foot plane), with modal inertia J_O about O. Each mode: natural frequency and damping ratio."""
+
+    _prefix: ClassVar[str] = "housing"
+    mass: Quantity = _pos("mass", "modal mass m_h of the housing's translation (the housing's mass)")
+    translation_frequency: Quantity = _pos("frequency", "natural frequency of the housing's translation on its mounting")
+    translation_damping_ratio: Quantity = _pos("dimensionless", "damping ratio of the housing's translation")
+    rocking_inertia: Quantity = _pos("inertia", "modal inertia J_O of the housing's rocking about its mounting's "
+                                                "elastic centre O")
+    rocking_frequency: Quantity = _pos("frequency", "natural frequency of the housing's rocking on its mounting")
+    rocking_damping_ratio: Quantity = _pos("dimensionless", "damping ratio of the housing's rocking")
+    rocking_centre_depth: Quantity = _nonneg("length", "depth h of the rocking centre O below the gear axis "
+                                                       "(along -Y of the fixed frame, the foot plane)")
+HousingSI = HousingParams.SI
+
+
 @_with_si("SensorSI")
 @dataclass(frozen=True, kw_only=True)
 class SensorParams(Params):
-    """The rig's accelerometer on the housing (MODEL.md §3.10): at angle ``angle`` ψ_s of the fixed frame it
-    reads a(t) = Σ_n w(ψ_n(t) − ψ_s)·(F_n(t)·e)/m_eq + a_h(t)·e along its axis e (radial at ψ_s, or
-    tangential 90° ahead), w a Hann window of full angular width ``window_width`` of the outer planet's
-    distance from the sensor (McFadden & Smith 1985; Inalpolat & Kahraman 2009), F_n the outer planet n's
-    ring-mesh force on the ring, m_eq = ``equivalent_mass``, a_h the carrier housing's acceleration
-    (:class:`components.outputs.HousingSensor`)."""
+    """The rig's accelerometer on the housing (MODEL.md §3.10) at angle ``angle`` ψ_s of the fixed frame and
+    distance ``radius`` from the gear axis, along its axis e (radial at ψ_s, or tangential 90° ahead). It reads
+    the sum of three paths (:mod:`components.sensor`):
+
+    * mesh: Σ_n w(ψ_n − ψ_s)·(F_n·e)/m_eq — each outer planet's ring-mesh force on the ring F_n weighted by a
+      Hann window w of full angular width ``window_width`` of the planet's distance from the sensor (McFadden &
+      Smith 1985; Inalpolat & Kahraman 2009), m_eq = ``equivalent_mass``;
+    * torque: the housing's rocking (``housing``) driven by the ring's torsional support torque;
+    * bearing: the housing's translation and rocking driven by the sun's and carrier's bearing forces and the
+      ring's seat force."""
 
     _prefix: ClassVar[str] = "sensor"
     angle: Quantity = _param("angle", "angle psi_s of the sensor on the housing, in the fixed frame")
+    radius: Quantity = _pos("length", "distance of the sensor from the gear axis")
     window_width: Quantity = _param("angle", "full angular width of the Hann window over which a passing "
                                              "planet's ring-mesh force reaches the sensor",
                                     lo=0.0, hi=2.0 * math.pi, lo_open=True, bound_text="in (0, 360 deg]")
-    equivalent_mass: Quantity = _pos("mass", "equivalent mass m_eq of the path: mesh force / m_eq is the "
+    equivalent_mass: Quantity = _pos("mass", "equivalent mass m_eq of the mesh path: mesh force / m_eq is the "
                                              "acceleration the sensor reads")
     direction: str = _param("choice", "sensor axis: radial (through the ring's axis) or tangential",
                             choices=("radial", "tangential"))
+    housing: HousingParams = _nested(HousingParams, "the housing's translation and rocking (torque and bearing paths)")
 SensorSI = SensorParams.SI
+
+
+def _ripple_amplitude(order: int):
+    return _param("angular_velocity", f"amplitude A_{order} of the carrier speed reference's ripple at {order} x f_c",
+                  lo=0.0, bound_text=">= 0 rad/s (the phase gives its sign)")
+
+
+@_with_si("CarrierRippleSI")
+@dataclass(frozen=True, kw_only=True)
+class CarrierRippleParams(Params):
+    """Carrier-synchronous speed ripple of the rig's carrier speed drive (MODEL.md §3.10: the loading motor and
+    its coupling). The drive's speed reference becomes ω_c + Σ_k A_k cos(k ω_c t + φ_k) over the orders
+    k = 1, 2, 4 of the carrier frequency, its angle reference the exact integral
+    (:class:`mbd.elements.SpeedDrive` ``ripple``). Every amplitude 0: an ideal drive."""
+
+    _prefix: ClassVar[str] = "carrier_ripple"
+    ORDERS: ClassVar[tuple] = (1, 2, 4)
+    amplitude_1: Quantity = _ripple_amplitude(1)
+    phase_1: Quantity = _param("angle", "phase of the order-1 ripple at t = 0")
+    amplitude_2: Quantity = _ripple_amplitude(2)
+    phase_2: Quantity = _param("angle", "phase of the order-2 ripple at t = 0")
+    amplitude_4: Quantity = _ripple_amplitude(4)
+    phase_4: Quantity = _param("angle", "phase of the order-4 ripple at t = 0")
+CarrierRippleSI = CarrierRippleParams.SI
 
 
 @_with_si("RigSI")
@@ -828,11 +882,14 @@ SensorSI = SensorParams.SI
 class RigParams(Params):
     """The source's test rig around the train (MODEL.md §3.7): the loading motor holds the carrier at its
     speed through a PI speed drive (stiffness, damping and integral gain from the bandwidth and damping
-    ratio on the train's kinetic inertia), and the driving motor's sun torque is ramped in."""
+    ratio on the train's kinetic inertia), with its carrier-synchronous speed ripple, and the driving
+    motor's sun torque is ramped in."""
 
     _prefix: ClassVar[str] = "rig"
     carrier_drive_bandwidth: Quantity = _pos("frequency", "bandwidth of the carrier speed drive")
     carrier_drive_damping_ratio: Quantity = _nonneg("dimensionless", "damping ratio of the carrier speed drive")
+    carrier_ripple: CarrierRippleParams = _nested(CarrierRippleParams, "speed ripple of the carrier drive at "
+                                                                       "orders 1, 2, 4 of f_c")
     load_ramp_mesh_periods: Quantity = _nonneg("dimensionless", "length of the sun-torque ramp in mesh periods "
                                                                 "(0: the full torque at t = 0)")
     load_ramp_max: Quantity = _nonneg("time", "longest sun-torque ramp (near-zero speeds have no mesh period)")

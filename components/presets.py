@@ -13,18 +13,17 @@ from pathlib import Path
 
 import numpy as np
 
-from .params import (BearingParams, BearingRigParams, CageParams, DPGTParams, ErrorsParams, FlankClassParams,
-                     GearParams, GearSetParams,
-                     LifeParams, LubricantParams, MeshParams, OperatingPoint, PinholeErrorParams, RigParams, RunoutParams,
-                     SensorParams,
+from .params import (BearingParams, BearingRigParams, CageParams, CarrierRippleParams, DPGTParams, ErrorsParams,
+                     FlankClassParams, GearParams, GearSetParams, HousingParams, LifeParams, LubricantParams, MeshParams,
+                     OperatingPoint, PinholeErrorParams, RigParams, RunoutParams, SensorParams,
                      SlideRollTractionParams, SupportParams, assumed, derived,
                      overrides_from_toml, paper, with_overrides)
 from .tolerances import radial_runout
 from .units import Q_, ParameterError
 
 __all__ = ["CONDITIONS", "DIRECTIONS", "OIL_GRADES", "oil_grade", "operating_point", "reference_gears", "reference_bearing",
-           "reference_dpgt", "reference_bearing_rig", "rig_accelerometer", "load_toml", "perfect_machine",
-           "typical_errors"]
+           "reference_dpgt", "reference_bearing_rig", "rig_accelerometer", "rig_housing", "ideal_carrier_drive", "load_toml",
+           "perfect_machine", "typical_errors"]
 
 # the study's four operating conditions: carrier speed n_c and output power P (ring fixed)
 CONDITIONS = MappingProxyType({
@@ -185,18 +184,51 @@ def typical_errors(params: DPGTParams, grade: int) -> ErrorsParams:
                         tooth_fault=assumed((), "no damage"), tooth=assumed((), "the class's draw only"))
 
 
+def rig_housing() -> HousingParams:
+    """The housing under the accelerometer (MODEL.md §3.10), as two rigid-body modes on its feet. The source
+    describes neither housing nor mounting: a cast-iron housing around the 246 mm ring, bolted by four feet
+    to a stiff bed, sized here from the gears."""
+    feet = "four bolted feet of ~5e8 N/m each on a stiff bed"
+    return HousingParams(
+        mass=assumed("50 kg", "cast-iron housing around the ring: ~320 mm outside diameter, 160 mm long, 15 mm "
+                              "walls, two 20 mm end covers with the bearing seats, feet (~6.6 dm^3 of cast iron)"),
+        translation_frequency=assumed("1.0 kHz", f"{feet}: sqrt(2e9 N/m / 50 kg)/2 pi; gearbox housings' first "
+                                                 "modes lie in the low kHz"),
+        translation_damping_ratio=assumed(0.05, "bolted joints and a cast housing: a few percent of critical"),
+        rocking_inertia=assumed("2.9 kg*m^2", "about the foot plane: J_cm + m h^2 = 50 kg x (0.13 m)^2 + "
+                                              "50 kg x (0.2 m)^2"),
+        rocking_frequency=assumed("630 Hz", f"{feet} at +-150 mm: k_theta = 4 x 5e8 N/m x (0.15 m)^2 = 4.5e7 "
+                                            "N m/rad, sqrt(k_theta / J_O)/2 pi"),
+        rocking_damping_ratio=assumed(0.05, "bolted joints and a cast housing: a few percent of critical"),
+        rocking_centre_depth=assumed("0.2 m", "a foot-mounted housing rocks about its foot plane's elastic "
+                                              "centre, below the axis by the housing's centre height"),
+    )
+
+
 def rig_accelerometer() -> SensorParams:
     """The housing accelerometer of MODEL.md §3.10. The source gives only "on the carrier bearing housing near
-    the carrier axis"; where on the housing, how wide a planet is heard and through what mass are assumed."""
+    the carrier axis"; where on the housing, how wide a planet is heard and through what mass, and the
+    housing's modes (:func:`rig_housing`) are assumed."""
     return SensorParams(
         angle=assumed("90 deg", "top of the housing (+Y of the fixed frame), where a rig's accelerometer is "
                                 "usually mounted; the source does not say"),
+        radius=assumed("0.1 m", "on the carrier bearing housing near the carrier axis (the source): the boss "
+                                "around the carrier's bearing"),
         window_width=assumed("120 deg", "Hann window (McFadden & Smith 1985; Inalpolat & Kahraman 2009) as wide "
                                         "as the spacing of N = 3 planets: the sensor hears one planet at a time"),
         equivalent_mass=assumed("6.07 kg", "the ring gear's mass (Table 1): the mass a ring-mesh force "
                                            "accelerates before it reaches the housing"),
         direction=assumed("radial", "an accelerometer screwed onto the housing's outer surface"),
+        housing=rig_housing(),
     )
+
+
+def ideal_carrier_drive() -> CarrierRippleParams:
+    """No speed ripple: the reference machine's carrier drive (MODEL.md §3.10: 0 for the reference machine)."""
+    ideal = "an ideal drive (MODEL.md 3.10: no ripple on the reference machine)"
+    return CarrierRippleParams(**{f"amplitude_{k}": assumed("0 rad/s", ideal) for k in CarrierRippleParams.ORDERS},
+                               **{f"phase_{k}": assumed("0 deg", "immaterial without ripple")
+                                  for k in CarrierRippleParams.ORDERS})
 
 
 def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams:
@@ -240,6 +272,7 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
             carrier_drive_bandwidth=assumed("80 Hz", "carrier speed error < 0.1 rad/s by 30 ms (measured; at 30 Hz "
                                                      "it still swung 8 rad/s), far below the mesh frequency"),
             carrier_drive_damping_ratio=assumed(0.7),
+            carrier_ripple=ideal_carrier_drive(),
             load_ramp_mesh_periods=assumed(20.0, "no impulse at the start (MODEL.md 4)"),
             load_ramp_max=assumed("0.05 s", "near-zero speeds have no mesh period"),
             sensor=rig_accelerometer()),

@@ -7,7 +7,9 @@ Results layout of a run directory:
                    "<family>.<key>" (e.g. race_inner.load, pocket.force, guide.force, mesh_sa.force) along
                    "<family>.instance", whose coordinates name each instance ("a1.pb.roller3", "sun-a1")
                    with its bearing, planet, pair, bearing_kind, roller (components.results_schema);
-                   with RunConfig.sensor the housing accelerometer "sensor.acceleration" (MODEL.md §3.10);
+                   with RunConfig.sensor what the supports put on the housing ("housing.force_x/force_y/torque",
+                   fixed frame) and the sensor's parameters (attrs "sensor"), from which the housing
+                   accelerometer's paths are computed (MODEL.md §3.10, scenarios.spectrum.sensor_paths);
                    attrs hold the run summary and, as JSON, the bearing map, meta, label and geometry
     summary.json   the statistics users read, taken on every accepted step over the window
                    (:class:`components.outputs.WindowStatistics`; the recording is for plots only)
@@ -32,7 +34,8 @@ from components.params import DPGTParams
 from components.scene import SceneOptions
 from mbd.recorder import BodyMotion, Recorder, atomic_write_text
 
-from components.outputs import HousingSensor, WindowStatistics, bearing_map, cage_period, default_window
+from components.outputs import WindowStatistics, bearing_map, cage_period, default_window
+from components.sensor import HousingLoads
 from components.results_schema import drawing_geometry, element_probes
 
 from .integrity import checkpoint_usable, claim_folder
@@ -90,7 +93,7 @@ class RunConfig:
     options: SceneOptions = field(default_factory=SceneOptions)
     progress: bool = True
     checkpoint_every: int = 2000
-    sensor: bool = False          # record the housing accelerometer (rig.sensor, MODEL.md §3.10) per sample
+    sensor: bool = False          # record what the housing accelerometer needs (rig.sensor, MODEL.md §3.10)
 
     def __post_init__(self):
         for k in ("settle", "window"):
@@ -114,14 +117,14 @@ def statistics_window(scene, base: float = 0.02) -> float:
     return default_window(base, [cage_period(b, wc, sp[k]) for k in ("inner_planet", "outer_planet")])
 
 
-def _probes(scene, sensor=None) -> list:
+def _probes(scene, sensor: bool = False) -> list:
     """Body motion in R (all bodies) and in the fixed frame (sun, carrier, ring), the element outputs of
-    :mod:`components.results_schema` (units, long names, instance coordinates), and the housing
-    accelerometer when ``sensor`` (:class:`components.params.SensorSI`) is given."""
+    :mod:`components.results_schema` (units, long names, instance coordinates), and with ``sensor`` the
+    loads on the housing (:class:`components.sensor.HousingLoads`)."""
     return [BodyMotion("motion", frame="reference"),
             BodyMotion("fixed", bodies=["sun", "carrier", "ring"], frame="fixed"),
             *element_probes(scene),
-            *([HousingSensor(scene, sensor).probe()] if sensor is not None else [])]
+            *(HousingLoads(scene).probes() if sensor else [])]
 
 
 def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None, overwrite: bool = False) -> dict:
@@ -152,9 +155,10 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     meta = {k: v for k, v in scene.meta.items() if k not in ("bearing", "lubricant")}   # SI objects, not JSON
     window = cfg.window if cfg.window is not None else statistics_window(scene)
     stats = WindowStatistics(scene, cfg.settle, cfg.settle + window)
-    rec = Recorder(out_dir / "results.nc", dt=1.0 / cfg.sample_rate, probes=_probes(scene, params.si().rig.sensor if cfg.sensor else None), t_start=cfg.settle,
+    sensor = {"sensor": params.si().rig.sensor.to_dict()} if cfg.sensor else {}
+    rec = Recorder(out_dir / "results.nc", dt=1.0 / cfg.sample_rate, probes=_probes(scene, cfg.sensor), t_start=cfg.settle,
                    attrs={"bearings": bmap, "meta": meta, "label": label or {},
-                          "geometry": drawing_geometry(params)})
+                          "geometry": drawing_geometry(params), **sensor})
     integ = cfg.integration
     t_end = stats.t_end          # the window plus a margin for slipping cages (WindowStatistics)
     fp = run_fingerprint(params, cfg)

@@ -1,18 +1,23 @@
 """Spectrum check (the source's test rig): what an accelerometer on the housing reads.
 
-    python -m scenarios.spectrum --out results/spectrum [--sensor housing|axis] [--carrier-rpm 2000] [--power "200 kW"]
+    python -m scenarios.spectrum --out results/spectrum [--sensor housing|mesh|torque|bearing|axis]
+                                 [--carrier-rpm 2000] [--power "200 kW"]
 
 ``--sensor housing`` (default): the rig's accelerometer on the housing at ψ_s (MODEL.md §3.10,
-``rig.sensor.*``): each outer planet's ring-mesh force weighted by a Hann window of its angular distance
-from the sensor, over m_eq, plus the carrier-housing acceleration, along the sensor's axis.
-``--sensor axis``: an ideal sensor at the carrier axis (w ≡ 1): the carrier's acceleration in the fixed frame,
-x component (amplitude_y: y).
+``rig.sensor.*``, :mod:`components.sensor`), the sum of its three paths along the sensor's axis: ``mesh``
+(each outer planet's ring-mesh force weighted by a Hann window of its angular distance from the sensor, over
+m_eq), ``torque`` (the housing's rocking under the ring's support torque) and ``bearing`` (the housing's
+translation and rocking under the sun's and carrier's bearing forces and the ring's seat force); each path
+alone with ``--sensor mesh|torque|bearing``. ``--sensor axis``: an ideal sensor at the carrier axis (w ≡ 1):
+the carrier's acceleration in the fixed frame, x component.
 
 Writes the one-sided amplitude spectrum (Hann window) to DIR/spectrum.csv (frequency_hz, amplitude = the
-sensor; amplitude_y or amplitude_axis for comparison), DIR/spectrum.png with f_m = z_r f_c and f_m ± f_c,
-f_m ± 3 f_c marked, DIR/lines.csv (f_m + k f_c, |k| ≤ 6: amplitude, over the band's median, and what lets the
-sensor see the line: planet phasing, the transfer path, or errors — :func:`components.geometry.sideband_origin`),
-the strongest peaks near f_m in DIR/peaks.csv, and DIR/summary.json. The spectrum covers the first whole number
+chosen sensor, then every path, their sum and the axis sensor's x and y), DIR/spectrum.png with f_m = z_r f_c
+and f_m ± f_c, f_m ± 3 f_c marked, DIR/lines.csv (f_m + k f_c, |k| ≤ 6: the sensor's amplitude, over the
+band's median, what lets a sensor see the line — planet phasing, the transfer path, or errors,
+:func:`components.geometry.sideband_origin` — and every path's amplitude and amplitude over its own band
+median, with the path that carries the most of it), the strongest peaks near f_m in DIR/peaks.csv, and
+DIR/summary.json. The spectrum covers the first whole number
 of carrier revolutions of the window (the lines then fall on bins); its resolution is f_c/revolutions: resolve
 f_c sidebands with a window of several carrier periods (default 0.1 s: 3 revolutions at 2000 r/min, 11.1 Hz
 against f_c = 33.3 Hz).
@@ -33,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.sensor import PATHS as SENSOR_PATHS
 from mbd.recorder import atomic_write_text
 
 from .analysis import amplitude_spectrum, line_table, peak_table
@@ -42,11 +48,20 @@ from . import args
 from .command import command
 
 SENSORS = {
-    "housing": "housing accelerometer (MODEL.md 3.10): Hann-windowed ring-mesh forces / m_eq + carrier-housing "
-               "acceleration, along the sensor's axis [m/s^2]",
-    "axis": "ideal sensor at the carrier axis: carrier acceleration in the fixed frame, x component [m/s^2] "
-            "(amplitude_y: y component)",
+    "housing": "housing accelerometer (MODEL.md 3.10): the sum of its mesh, torque and bearing paths, along the "
+               "sensor's axis [m/s^2]",
+    "mesh": "the housing accelerometer's local ring-mesh path: Hann-windowed ring-mesh forces / m_eq [m/s^2]",
+    "torque": "the housing accelerometer's torque path: the housing's rocking under the ring's support torque [m/s^2]",
+    "bearing": "the housing accelerometer's bearing path: the housing's translation and rocking under the sun's and "
+               "carrier's bearing forces and the ring's seat force [m/s^2]",
+    "axis": "ideal sensor at the carrier axis: carrier acceleration in the fixed frame, x component [m/s^2]",
 }
+PATHS = (*SENSOR_PATHS, "housing")   # the housing sensor's paths and their sum, in lines.csv
+# the lines planet phasing lets each sensor see on a perfect machine (components.geometry.sideband_origin):
+# a window carries every allowed carrier order; the forces at the axis only k = ±1 (the torque path too, once
+# gravity modulates each planet's force once per revolution: without it a net torque keeps only orders l z_r)
+SEEN = {"housing": ("phasing", "transfer path"), "mesh": ("phasing", "transfer path"), "torque": ("phasing",),
+        "bearing": ("phasing",), "axis": ("phasing",)}
 SIDEBANDS = 6         # the line table covers f_m + k f_c, |k| <= SIDEBANDS
 
 
@@ -58,7 +73,8 @@ def parse_args(argv):
     p.add_argument("--power", default="200 kW", type=args.quantity_of("power"), help='output power with unit (default "200 kW")')
     p.add_argument("--direction", default="forward", choices=["forward", "reverse"])
     p.add_argument("--sensor", default="housing", choices=list(SENSORS),
-                   help="housing: the rig's windowed accelerometer (rig.sensor.*, default); axis: ideal, at the carrier axis")
+                   help="housing: the rig's accelerometer (rig.sensor.*, default), the sum of its paths mesh, torque "
+                        "and bearing (each alone by name); axis: ideal, at the carrier axis")
     p.add_argument("--perfect", action="store_true",
                    help="a perfect machine: no manufacturing errors (default: the errors of --gear-grade)")
     p.add_argument("--gear-grade", type=args.count(1, 11), default=6,
@@ -69,6 +85,9 @@ def parse_args(argv):
                    help="seconds discarded (default 0.06: a lightly damped ~2.6 kHz mode rings for ~50 ms after the start)")
     p.add_argument("--window", type=args.positive("s"), default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz]")
+    p.add_argument("--params", default=None, type=args.existing_file,
+                   help="TOML file of parameter overrides: a user's machine on the rig (its errors replace the "
+                        "--gear-grade ones; the operating point is this command's options)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="parameter override")
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="scene switch")
     p.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="initial step [s]")
@@ -82,19 +101,34 @@ def parse_args(argv):
 
 
 def machine(a):
-    """The machine on the rig: the reference DPGT at the operating point asked for, with ``--set``
-    overrides (a usage error names the parameter) and its manufacturing errors: those given (``--set
-    errors.X`` / a TOML file), else the typical errors of ``--gear-grade``, none with ``--perfect``."""
-    from components.params import with_overrides
+    """The machine on the rig: the reference DPGT (or ``--params FILE.toml`` on it) at the operating point
+    asked for, with ``--set`` overrides (a usage error names the parameter) and its manufacturing errors: those
+    given (``--set errors.X`` / the TOML file), else the typical errors of ``--gear-grade``, none with
+    ``--perfect``. The operating point belongs to this command's options: a file or ``--set`` that sets it is
+    refused, as is ``--perfect`` with errors given."""
+    from components.params import overrides_from_toml, with_overrides
     from components.presets import reference_dpgt, typical_errors
     from components.units import ParameterError
 
     from .paper_study import parse_sets
 
+    try:
+        from_file = overrides_from_toml(Path(a.params).read_text(encoding="utf-8")) if a.params else {}
+    except (ParameterError, ValueError) as exc:          # not TOML, not UTF-8, or a bad value
+        raise SystemExit(f"error: --params {a.params}: {exc}".splitlines()[0]) from None
+    given = {**from_file, **parse_sets(a.set)}
+    options = {"operating.carrier_speed": "--carrier-rpm", "operating.output_power": "--power",
+               "operating.direction": "--direction"}
+    for key in given:
+        if key.startswith("operating."):
+            raise SystemExit(f"error: {key} is set by this command's {options.get(key, 'options')}, not by "
+                             f"{'--params' if key in from_file else '--set'}")
     overrides = {"operating.carrier_speed": f"{a.carrier_rpm} rpm", "operating.output_power": a.power,
-                 "operating.direction": a.direction, **parse_sets(a.set)}
+                 "operating.direction": a.direction, **given}
     try:
         params = with_overrides(reference_dpgt(2, a.direction), overrides)
+        if a.perfect and not params.errors.perfect:
+            raise SystemExit("error: --perfect contradicts the manufacturing errors given (--params / --set errors.*)")
         if not a.perfect and params.errors.perfect:      # the rig's machine, unless errors were given
             params = params.replace(errors=typical_errors(params, a.gear_grade))
         si = params.si()
@@ -123,27 +157,26 @@ def run(a) -> dict:
 
 
 def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = False, overwrite: bool = False) -> dict:
-    """Run ``params`` (:class:`components.params.DPGTParams`) on the rig, read ``sensor`` ("housing" |
-    "axis"), and write its spectrum, line table and peaks into ``out`` (module docstring). ``force``: run
+    """Run ``params`` (:class:`components.params.DPGTParams`) on the rig, read ``sensor`` (a key of
+    :data:`SENSORS`), and write its spectrum, line table and peaks into ``out`` (module docstring). ``force``: run
     despite the plausibility checks; ``overwrite``: replace a finished run of other parameters in ``out``."""
     if sensor not in SENSORS:
         raise SystemExit(f"error: --sensor {sensor!r}: expected one of {list(SENSORS)}")
     out.mkdir(parents=True, exist_ok=True)
-    cfg = dataclasses.replace(cfg, sensor=sensor == "housing")
+    cfg = dataclasses.replace(cfg, sensor=True)          # every path is written, whichever sensor is read
     for w in check_runs([("spectrum", params, cfg)], out, force):
         print(f"warning (--force): {w}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         s = run_case(params, cfg, out / "run", label={"scenario": "spectrum", "sensor": sensor}, overwrite=overwrite)
-    t, signals = _signals(out / "run" / "results.nc", sensor)
-    t, signals = _whole_revolutions(t, signals, s["f_c_hz"])
+    t, signals = _whole_revolutions(*_signals(out / "run" / "results.nc", sensor), s["f_c_hz"])
     spectra = {k: amplitude_spectrum(t, x) for k, x in signals.items()}
     f, amp, df = spectra["amplitude"]
     f_c, f_m = s["f_c_hz"], s["f_m_hz"]
     gears = params.si().gears
-    lines = _lines(f, amp, f_m, f_c, int(gears.ring.teeth), int(gears.planets), sensor)
+    lines = _lines(f, spectra, f_m, f_c, int(gears.ring.teeth), int(gears.planets), sensor)
     expected = {r["line"]: r["frequency_hz"] for r in lines}
-    peaks = peak_table(f, amp, f_m, (SIDEBANDS + 0.5) * f_c, expected, n=8)
+    peaks = peak_table(f, amp, f_m, (SIDEBANDS + 0.5) * f_c, expected, n=8) if amp.any() else []   # a path at 0
     _write_csv(out / "spectrum.csv", [{"frequency_hz": fi, **{k: a[1][i] for k, a in spectra.items()}}
                                       for i, fi in enumerate(f.tolist())])
     _write_csv(out / "lines.csv", lines)
@@ -152,7 +185,8 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
                "carrier_rpm": s["carrier_rpm"], "sun_rpm": s["sun_rpm"], "power_W": s["power_W"],
                "sensor": sensor, "quantity": SENSORS[sensor],
                "errors": {k: [e.to_dict() for e in v] for k, v in params.si().errors.to_dict().items()},
-               "sensor_parameters": dataclasses.asdict(params.si().rig.sensor) if sensor == "housing" else None,
+               "sensor_parameters": params.si().rig.sensor.to_dict(),
+               "carrier_ripple": params.si().rig.carrier_ripple.to_dict(),
                "lines": lines, "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"],
                "error_estimate": s["error_estimate"], "warnings": s["warnings"]}
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
@@ -163,24 +197,53 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     return summary
 
 
-def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
-    """Sample times and the sensor's signal ("amplitude") with its comparison signal."""
+def sensor_paths(path: Path, sensor=None) -> tuple[np.ndarray, dict]:
+    """(t, {"mesh", "torque", "bearing", "housing"}): the housing accelerometer's paths and their sum [m/s^2] at
+    every sample of a run's ``results.nc`` (recorded with ``RunConfig(sensor=True)``), by
+    :func:`components.sensor.paths` from the recorded outer planets' angles and ring-mesh forces and the loads on
+    the housing. ``sensor`` (:class:`components.params.SensorSI`): the run's own (stored with it) unless given.
+    The one place a run's file becomes the sensor's signals: the spectrum and the fault study read through it."""
     import xarray as xr
 
+    from components.families import MESH_FAMILY
+    from components.sensor import paths, sensor_from_dict
+
     with xr.open_dataset(path, engine="h5netcdf") as ds:
+        if "housing.force_x" not in ds:
+            raise ValueError(f"{path}: the run recorded no loads on the housing (run it with RunConfig(sensor=True))")
+        sensor = sensor if sensor is not None else sensor_from_dict(json.loads(ds.attrs["sensor"]))
         t = ds["time"].values
-        ic = list(ds["fixed.body"].values).index("carrier")
-        acc = ds["fixed.acceleration"].values[:, ic]
-        if sensor == "axis":
-            return t, {"amplitude": acc[:, 0], "amplitude_y": acc[:, 1]}
-        return t, {"amplitude": ds["sensor.acceleration"].values[:, 0], "amplitude_axis": acc[:, 0]}
+        bodies = list(ds["motion.body"].values)
+        phi = (ds["fixed.angle"].values[:, list(ds["fixed.body"].values).index("carrier")]
+               - ds["motion.angle"].values[:, bodies.index("carrier")])           # the frame's angle
+        fam = MESH_FAMILY["outer_ring"]
+        P = ds["motion.position"].values[:, [bodies.index(g) for g in ds[f"{fam}.gear1"].values]]
+        psi = np.arctan2(P[..., 1], P[..., 0]) + phi[:, None]
+        c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
+        fx, fy = ds[f"{fam}.fx"].values, ds[f"{fam}.fy"].values                 # on the ring, in R
+        ring = np.stack([c * fx - s * fy, s * fx + c * fy], axis=-1)
+        force = np.column_stack([ds["housing.force_x"].values.sum(axis=1), ds["housing.force_y"].values.sum(axis=1)])
+        torque = ds["housing.torque"].values.sum(axis=1)
+        return t, paths(t, psi, ring, force, torque, sensor)
 
 
-def sensor_signal(path: Path, f_c: float) -> tuple[np.ndarray, np.ndarray]:
-    """(t, a) of a run's recorded housing sensor (``results.nc`` of a run with ``RunConfig.sensor``), over
-    the first whole number of carrier revolutions: what every spectrum of the sensor is taken of."""
-    t, signals = _whole_revolutions(*_signals(Path(path), "housing"), f_c)
-    return t, signals["amplitude"]
+def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
+    """Sample times and the signals of a run: "amplitude" (the sensor read), every path of the housing sensor
+    and their sum, and the axis sensor's x and y."""
+    import xarray as xr
+
+    t, signals = sensor_paths(path)
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
+        acc = ds["fixed.acceleration"].values[:, list(ds["fixed.body"].values).index("carrier")]
+    signals.update({"axis_x": acc[:, 0], "axis_y": acc[:, 1]})
+    return t, {"amplitude": signals["axis_x" if sensor == "axis" else sensor], **signals}
+
+
+def sensor_signal(path: Path, f_c: float, sensor: str = "housing") -> tuple[np.ndarray, np.ndarray]:
+    """(t, a) of a run's housing sensor (or one of its paths, :func:`sensor_paths`) over the first whole number
+    of carrier revolutions: what every spectrum of the sensor is taken of."""
+    t, signals = _whole_revolutions(*sensor_paths(Path(path)), f_c)
+    return t, signals[sensor]
 
 
 def _whole_revolutions(t, signals: dict, f_c: float):
@@ -192,20 +255,26 @@ def _whole_revolutions(t, signals: dict, f_c: float):
     return t[:n], {k: x[:n] for k, x in signals.items()}
 
 
-def _lines(f, amp, f_m, f_c, z_r: int, planets: int, sensor: str) -> list[dict]:
-    """f_m + k f_c, |k| <= SIDEBANDS: amplitude, over the band's median, what lets a sensor see it, and
-    whether a perfect machine shows it to this sensor (axis: phasing; housing: phasing or transfer path)."""
+def _lines(f, spectra, f_m, f_c, z_r: int, planets: int, sensor: str) -> list[dict]:
+    """f_m + k f_c, |k| <= SIDEBANDS: the sensor's amplitude, over the band's median, what lets a sensor see it,
+    whether a perfect machine shows it to this sensor (:data:`SEEN`), and per path of the housing sensor (and
+    their sum) its amplitude and amplitude over its own band median; ``carried_by``: the path with the largest
+    amplitude at the line. ``spectra``: name -> (f, amplitude, df) with "amplitude" the sensor read."""
     from components.geometry import sideband_origin
 
-    seen = {"axis": ("phasing",), "housing": ("phasing", "transfer path")}[sensor]
     ks = range(-SIDEBANDS, SIDEBANDS + 1)
-    lab = {k: f"f_m{k:+d}f_c" if k else "f_m" for k in ks}
-    rows = line_table(f, amp, {lab[k]: f_m + k * f_c for k in ks},
-                      (f_m - (SIDEBANDS + 0.5) * f_c, f_m + (SIDEBANDS + 0.5) * f_c))
-    for k, r in zip(ks, rows):
+    marks = {f"f_m{k:+d}f_c" if k else "f_m": f_m + k * f_c for k in ks}
+    band = (f_m - (SIDEBANDS + 0.5) * f_c, f_m + (SIDEBANDS + 0.5) * f_c)
+    table = {name: line_table(f, spectra[name][1], marks, band) for name in ("amplitude", *PATHS)}
+    rows = table["amplitude"]
+    for i, (k, r) in enumerate(zip(ks, rows)):
         r["k"] = k
         r["origin"] = sideband_origin(k, z_r, planets)
-        r["perfect_machine_shows"] = r["origin"] in seen
+        r["perfect_machine_shows"] = r["origin"] in SEEN[sensor]
+        for name in PATHS:
+            r[f"{name}_amplitude"] = table[name][i]["amplitude"]
+            r[f"{name}_over_floor"] = table[name][i]["over_median"]
+        r["carried_by"] = max(SENSOR_PATHS, key=lambda name: r[f"{name}_amplitude"])
     return rows
 
 
@@ -221,11 +290,12 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
 def _plot(f, spectra, f_m, f_c, s, sensor, out):
     from viz import plots as vp
 
-    names = {"amplitude": "housing sensor" if sensor == "housing" else "x", "amplitude_y": "y",
-             "amplitude_axis": "axis (carrier x)"}
+    shown = {"housing": ["housing", *SENSOR_PATHS], "axis": ["axis_x", "axis_y"]}.get(sensor, [sensor, "housing"])
+    names = {"housing": "housing sensor", "mesh": "mesh path", "torque": "torque path", "bearing": "bearing path",
+             "axis_x": "x", "axis_y": "y"}
     marks = {"f_m": f_m, **{f"f_m{'+' if k > 0 else '−'}{abs(k)}f_c": f_m + k * f_c for k in (-3, -1, 1, 3)}}
-    where = "housing accelerometer" if sensor == "housing" else "carrier acceleration (fixed frame)"
-    return vp.spectrum(f, {names[k]: a[1] for k, a in spectra.items()}, marks, out / "spectrum.png",
+    where = "carrier acceleration (fixed frame)" if sensor == "axis" else "housing accelerometer"
+    return vp.spectrum(f, {names[k]: spectra[k][1] for k in shown}, marks, out / "spectrum.png",
                        fmax=min(f[-1], 2.5 * f_m), quantity=where, unit="m/s^2", logy=True,
                        title=f"{where.capitalize()}, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min")
 
@@ -234,11 +304,14 @@ def _report(lines, peaks, f_m, f_c, df, t, sensor) -> None:
     print(f"sensor: {SENSORS[sensor]}")
     print(f"f_c = {f_c:.2f} Hz, f_m = {f_m:.1f} Hz, resolution {df:.2f} Hz over {t[-1] - t[0]:.4g} s")
     print("lines f_m + k f_c (origin: phasing = a perfect machine shows it at the axis; transfer path = "
-          "phasing allows it through a position-dependent path; errors = cancelled in a perfect machine):")
+          "phasing allows it through a position-dependent path; errors = cancelled in a perfect machine); "
+          "each path's amplitude over its own band median, and the path that carries the line:")
+    print(f"  {'line':>9} {'freq':>9}    {'amp':>9}  {'x median':>8}   {'origin':<13} {'':8} "
+          + " ".join(f"{p:>8}" for p in PATHS) + "  carried by")
     for r in lines:
-        print(f"  {r['line']:>9} {r['frequency_hz']:8.1f} Hz  amp {r['amplitude']:9.3g} m/s^2  "
-              f"{r['over_median']:8.1f} x median   {r['origin']:<13} "
-              f"{'expected' if r['perfect_machine_shows'] else '-'}")
+        print(f"  {r['line']:>9} {r['frequency_hz']:6.1f} Hz  {r['amplitude']:9.3g}  {r['over_median']:8.1f}   "
+              f"{r['origin']:<13} {'expected' if r['perfect_machine_shows'] else '-':8} "
+              + " ".join(f"{r[f'{p}_over_floor']:8.2f}" for p in PATHS) + f"  {r['carried_by']}")
     print("strongest peaks near f_m:")
     for r in peaks:
         print(f"  {r['frequency_hz']:9.1f} Hz  amp {r['amplitude']:.3g} m/s^2   nearest {r['nearest']:>8} "

@@ -262,10 +262,15 @@ def test_force_source_matches_reference(fs, state, ramp, t, force):
 
 @st.composite
 def speed_drives(draw):
+    """A drive with or without an integral term, with no ripple or one to three harmonics (a rig's orders
+    1, 2, 4 of its speed; Ω may be negative for a reverse-turning drive)."""
     integral = draw(st.booleans())
-    e = SpeedDrive("drive", [1, 2], omega_ref=draw(st.floats(-400, 400)), k=draw(stiffnesses(1, 1e5)),
+    w = draw(st.floats(-400, 400))
+    orders = draw(st.sampled_from([(), (1,), (2, 4), (1, 2, 4)]))
+    ripple = [(k * (w if abs(w) > 1.0 else 100.0), draw(st.floats(0, 20)), draw(st.floats(-4, 4))) for k in orders]
+    e = SpeedDrive("drive", [1, 2], omega_ref=w, k=draw(stiffnesses(1, 1e5)),
                    c=draw(dampings()), k_i=draw(stiffnesses(1, 1e3)) if integral else 0.0,
-                   theta0=[draw(st.floats(-1, 1)), draw(st.floats(-1, 1))])
+                   theta0=[draw(st.floats(-1, 1)), draw(st.floats(-1, 1))], ripple=ripple or None)
     z = np.array([draw(st.floats(-1e-2, 1e-2)) for _ in range(2)]) if integral else None
     assert (e.init_internal() is None) == (not integral)
     return e, z

@@ -201,6 +201,40 @@ def test_speed_drive_profile_and_integral_update():
     assert SpeedDrive("p", 0, omega_ref=1.0, k=1.0).init_internal() is None   # no integral term, no state
 
 
+def test_speed_drive_ripple_reference_by_hand():
+    """A body exactly on the constant-speed line θ0 + ω t sees the ripple's whole reference as its error:
+    e = Σ (A/Ω) sin(Ω t + φ), ė = Σ A cos(Ω t + φ) (hand values), so T = k e + c ė; the ripple does not
+    enter the Jacobians (it is a function of time only). ω_ref is dθ_ref/dt: a central difference agrees."""
+    w, t = 200.0, 0.0137
+    rip = [(w, 3.0, 0.4), (4 * w, 0.5, -1.1)]
+    e = SpeedDrive("d", 0, omega_ref=w, k=40.0, c=0.3, theta0=0.2, ripple=rip)
+    fs = FrameState(0.0, 0.0, 0.0)
+    q, v = np.array([0.0, 0.0, 0.2 + w * t]), np.array([0.0, 0.0, w])
+    F, out, Jq, Jv = evaluate(e, t, fs, q, v, None, jac=True)
+    err = 3.0 / w * np.sin(w * t + 0.4) + 0.5 / (4 * w) * np.sin(4 * w * t - 1.1)
+    derr = 3.0 * np.cos(w * t + 0.4) + 0.5 * np.cos(4 * w * t - 1.1)
+    np.testing.assert_allclose(out["angle_error"], err, rtol=1e-12)
+    np.testing.assert_allclose(F[0, 2], 40.0 * err + 0.3 * derr, rtol=1e-12)
+    assert Jq[0, 2, 2] == -40.0 and Jv[0, 2, 2] == -0.3
+    th = lambda t: e.profile(t)[0][0]
+    h = 1e-6
+    np.testing.assert_allclose((th(t + h) - th(t - h)) / (2 * h), e.profile(t)[1][0], rtol=1e-8)
+    with pytest.raises(mbd.ModelError, match="ripple"):
+        SpeedDrive("d", 0, omega_ref=w, k=1.0, ripple=[(0.0, 1.0, 0.0)])
+    with pytest.raises(mbd.ModelError, match="ripple"):
+        SpeedDrive("d", 0, omega_ref=lambda t: (np.array([t]), np.array([1.0])), k=1.0, ripple=rip)
+
+
+@given(data=st.data(), fs=frame_states(), state=full_states(NB))
+def test_speed_drive_with_ripple_jacobians(data, fs, state):
+    q, v = state
+    e = SpeedDrive("drive", [1, 2], omega_ref=data.draw(st.floats(-400, 400)), k=data.draw(stiffnesses(1, 1e5)),
+                   c=data.draw(dampings()), k_i=data.draw(stiffnesses(1, 1e3)), theta0=0.1,
+                   ripple=[(150.0, data.draw(st.floats(0, 20)), 0.3), (-600.0, data.draw(st.floats(0, 5)), 1.0)])
+    z = np.array([data.draw(st.floats(-1e-2, 1e-2)) for _ in range(2)])
+    assert_jacobians_match(e, 0.02, fs, q, v, z)
+
+
 # ---------------------------------------------------------------------------------- assembly
 def _assembly_model(frame):
     b = mbd.ModelBuilder(frame=frame, gravity=(0.3, -9.81))

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import assume, given, strategies as st
 
 import mbd
 from mbd.assembly import _fused_families
@@ -115,6 +115,9 @@ def test_the_smoothstep_is_c2_with_flat_ends():
 @given(data=st.data(), zeta=st.sampled_from([0.0, 0.05, 0.3]))
 def test_spall_compiled_matches_reference(kind, law, data, zeta):
     state, spall, _ = data.draw(spall_states(kind))
+    # a roller whose interference equals the defect's depth sits exactly on the contact's onset, where round-off
+    # picks the branch (found by hypothesis: depth drawn equal to δ): both engines are right on either side
+    assume(np.all(np.abs(np.abs(np.asarray(state[4])) - spall["depth"]) > 1e-12))
     qf, vf, mk, R = race_scene(kind, *state)
     elem = spalled(kind, mk, R, LAWS[law], zeta=zeta, **spall)
     assert pack_race(elem)[0].shape == (N, RACE_COLS + 4)

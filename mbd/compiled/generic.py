@@ -8,7 +8,7 @@ BodySpring       P = [k, c, marker_a x, marker_a y, marker_b x, marker_b y]   G 
 TorsionalSpring  P = [k, c, θ0]                                               G = []
 TorqueSource     P = [torque]                                                 G = RAMP
 ForceSource      P = [F_X, F_Y] (fixed frame)                                 G = RAMP
-SpeedDrive       P = [k, c, k_i, θ0, ω_ref]                                   G = []
+SpeedDrive       P = [k, c, k_i, θ0, ω_ref]                                   G = [Ω_j, A_j, φ_j per ripple harmonic]
 
 RAMP = [has_ramp (1/0), t0, t1]: a :class:`~mbd.elements.drives.Ramp` (or none). A load or speed
 profile given as an arbitrary Python callable of t cannot be compiled: ``pack`` raises
@@ -252,20 +252,35 @@ def pack_speed_drive(elem: SpeedDrive):
         raise NotImplementedError(f"SpeedDrive {elem.name!r}: speed profile {elem.profile!r} is a Python callable "
                                   "of time, which the compiled path cannot evaluate (use a constant omega_ref, or "
                                   "the numpy path)")
-    return _columns(elem.n, elem.stiffness, elem.damping, elem.k_i, elem.theta0, elem.omega_ref), _NO_G
+    P = _columns(elem.n, elem.stiffness, elem.damping, elem.k_i, elem.theta0, elem.omega_ref)
+    return P, np.ascontiguousarray(elem.ripple.ravel())
 
 
 @njit(cache=True)
-def _angle_error(t, phi, P, i, theta):
-    return (P[i, 3] + P[i, 4] * t) - (theta + phi)
+def _ripple(t, G):
+    """(Δθ_ref, Δω_ref) of the ripple harmonics in G, summed in SpeedDrive._rippled's order."""
+    dth, dw = 0.0, 0.0
+    for j in range(G.shape[0] // 3):
+        Om, A, ph = G[3 * j], G[3 * j + 1], G[3 * j + 2]
+        dth = dth + A / Om * np.sin(Om * t + ph)
+        dw = dw + A * np.cos(Om * t + ph)
+    return dth, dw
+
+
+@njit(cache=True)
+def _angle_error(t, phi, P, G, i, theta):
+    if G.shape[0] == 0:                       # no ripple: the constant-speed reference, term for term
+        return (P[i, 3] + P[i, 4] * t) - (theta + phi)
+    return ((P[i, 3] + P[i, 4] * t) + _ripple(t, G)[0]) - (theta + phi)
 
 
 @njit(cache=True)
 def evaluate_speed_drive(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     has_z = z.shape[1] > 0
+    dw = _ripple(t, G)[1]
     for i in range(ql.shape[0]):
-        e = _angle_error(t, phi, P, i, ql[i, 2])
-        de = P[i, 4] - (vl[i, 2] + omega)
+        e = _angle_error(t, phi, P, G, i, ql[i, 2])
+        de = (P[i, 4] + dw if G.shape[0] else P[i, 4]) - (vl[i, 2] + omega)
         T = P[i, 0] * e + P[i, 1] * de
         if has_z:
             T = T + P[i, 2] * z[i, 0]
@@ -285,8 +300,8 @@ def update_speed_drive(z, t0, t1, ql0, vl0, ql1, vl1, P, G, phi0, phi1):
     if z.shape[1] == 0:
         return z1
     for i in range(z.shape[0]):
-        e0 = _angle_error(t0, phi0, P, i, ql0[i, 2])
-        e1 = _angle_error(t1, phi1, P, i, ql1[i, 2])
+        e0 = _angle_error(t0, phi0, P, G, i, ql0[i, 2])
+        e1 = _angle_error(t1, phi1, P, G, i, ql1[i, 2])
         z1[i, 0] = z[i, 0] + 0.5 * (t1 - t0) * (e0 + e1)
     return z1
 

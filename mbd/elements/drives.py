@@ -60,14 +60,21 @@ class SpeedDrive(Element):
     T = k (θ_ref − θ) + c (ω_ref − θ̇) + k_i ∫(θ_ref − θ) dt. The integral is an internal state,
     advanced (trapezoidal rule) after each accepted step and held constant within a step.
     ``omega_ref`` may be a callable t -> (θ_ref, ω_ref) for speed profiles.
+
+    ``ripple``: harmonics (Ω_j [rad/s], A_j [rad/s], φ_j [rad]) added to a constant speed (a motor's
+    speed ripple): ω_ref(t) = ω + Σ_j A_j cos(Ω_j t + φ_j) and θ_ref(t) = θ0 + ω t + Σ_j (A_j/Ω_j)
+    sin(Ω_j t + φ_j), its exact integral. Without ripple the reference is evaluated as without the term.
     """
     n_local = 3
 
-    def __init__(self, name, body, omega_ref, k, c=0.0, k_i=0.0, theta0=0.0):
+    def __init__(self, name, body, omega_ref, k, c=0.0, k_i=0.0, theta0=0.0, ripple=None):
         self.name = name
         self.dofs = body_dofs(body)
         self.theta0 = self.omega_ref = None        # constant speed: θ0 (n,) and ω_ref [rad/s]
+        self.ripple = self._ripple(ripple)
         if callable(omega_ref):
+            if self.ripple.size:
+                raise ModelError(f"{name}: ripple needs a constant omega_ref (a profile carries its own)")
             self.profile = omega_ref
         else:
             w = float(omega_ref)
@@ -75,10 +82,28 @@ class SpeedDrive(Element):
                 raise ModelError(f"{name}: omega_ref must be a finite speed in rad/s, got {omega_ref!r}")
             th0 = self._per_instance("theta0", theta0)
             self.theta0, self.omega_ref = th0, w
-            self.profile = lambda t: (th0 + w * t, np.full(self.n, w))
+            if self.ripple.size:
+                self.profile = lambda t: self._rippled(t, th0, w)
+            else:
+                self.profile = lambda t: (th0 + w * t, np.full(self.n, w))
         self.stiffness = self._per_instance("k", k, positive=True)
         self.damping = self._per_instance("c", c, nonneg=True)
         self.k_i = self._per_instance("k_i", k_i, nonneg=True)
+
+    def _ripple(self, ripple) -> np.ndarray:
+        """(m, 3) harmonics [Ω, A, φ]: finite, Ω ≠ 0 (θ_ref holds A/Ω)."""
+        h = np.zeros((0, 3)) if ripple is None else np.asarray(ripple, dtype=float)
+        if h.size % 3 or not np.all(np.isfinite(h)) or np.any(h.reshape(-1, 3)[:, 0] == 0.0):
+            raise ModelError(f"{self.name}: ripple must be finite (Ω [rad/s], A [rad/s], φ [rad]) rows with "
+                             f"Ω != 0, got {ripple!r}")
+        return h.reshape(-1, 3)
+
+    def _rippled(self, t, th0, w):
+        dth, dw = 0.0, 0.0
+        for Om, A, ph in self.ripple:          # the compiled kernel sums in the same order
+            dth = dth + A / Om * np.sin(Om * t + ph)
+            dw = dw + A * np.cos(Om * t + ph)
+        return (th0 + w * t) + dth, np.full(self.n, w + dw)
 
     def init_internal(self):
         return np.zeros(self.n) if np.any(self.k_i > 0) else None
