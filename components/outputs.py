@@ -696,8 +696,8 @@ class WindowStatistics(mbd.Observer):
     def _mesh_summary(self) -> dict:
         """Per mesh type, over all planet pairs: mean (average of the pairs) and max of each flank; the loaded
         transmission error's peak-to-peak (the drive flank's compression, max − min over the window) and the
-        dynamic factor K_v = max / mean of the drive flank's force (ISO 6336-1's notion, from the run), the
-        largest of the pairs and per pair."""
+        dynamic factor K_v = max / mean of the drive flank's force (ISO 6336-1's notion, from the run; None when
+        the train transmits no torque), the largest of the pairs and per pair."""
         out = {}
         for key in self.meshes:
             d = {"drive_flank": int(self.flanks.get(key, 1))}
@@ -710,7 +710,9 @@ class WindowStatistics(mbd.Observer):
                 d[f"{flank}_force_mean_per_pair_N"] = [float(y) for y in f["mean"]]
             f, x = self.stats(f"{key}_drive_force"), self.stats(f"{key}_drive_deflection")
             te = x["max"] - x["min"]
-            kv = f["max"] / np.where(f["mean"] > 0, f["mean"], np.nan)
+            # K_v has no meaning where the train transmits no torque (condition 4): no nominal load to scale
+            loaded = self.scene.meta.get("sun_torque_Nm", 1.0) != 0.0
+            kv = f["max"] / np.where(loaded & (f["mean"] > 0), f["mean"], np.nan)
             d["te_peak_to_peak_m"] = float(te.max())
             d["te_peak_to_peak_per_pair_m"] = [float(y) for y in te]
             d["dynamic_factor"] = float(np.nanmax(kv)) if np.any(np.isfinite(kv)) else None

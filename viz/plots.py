@@ -426,6 +426,8 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
                     for d in ("forward", "reverse"):
                         series(ax, key, b, scale, d, k, g)
                 ax.set_ylabel(_axis_label(words, unit))
+                if key.startswith("life"):            # lives span decades between conditions
+                    ax.set_yscale("log")
                 if r == 0:
                     ax.set_title(f"{b} planet bearings")
         for col, (prefix, words, unit, scale) in enumerate((("dynamic_factor", "K_v", None, 1.0),
@@ -441,6 +443,6 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
             ax.set_xlim(-0.55, len(conds) - 0.45)
         axes[0, 0].legend(loc="best", title="filled: forward, open: reverse", title_fontsize=7)
         for ax in axes.ravel():
-            if ax.get_ylim()[0] > 0:
+            if ax.get_yscale() == "linear" and ax.get_ylim()[0] > 0:
                 ax.set_ylim(bottom=0)
         return _save(fig, path)
