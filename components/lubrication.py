@@ -18,7 +18,9 @@
       h_min / R = 1.714 W'^(−0.128) U^0.694 G^0.568,    h_c / R = 2.922 W'^(−0.166) U^0.692 G^0.470.
   Dowson & Higginson's classic h_min/R = 2.65 U^0.70 G^0.54 W'^(−0.13) is :func:`dowson_higginson_film`
   (a cross-check: the two agree within ≈ 15 % over bearing conditions).
-* The film parameter Λ = h_min / σ, σ the composite roughness of the two surfaces.
+* The film parameter Λ = h_min / σ, σ the composite roughness of the two surfaces, and its regime as the
+  literature names it (:func:`regime`): Λ ≥ 3 full film; 1 ≤ Λ < 3 partial EHL (mixed: asperities carry part
+  of the load); Λ < 1 boundary-dominated.
 
 Scalars or numpy arrays (broadcast); SI units throughout.
 """
@@ -30,7 +32,9 @@ from mbd.elements.ehl import film_central, film_min, thermal_factor, thermal_loa
 
 __all__ = ["walther_viscosity", "walther_slope", "oil_density", "dynamic_viscosity", "temperature_viscosity",
            "reduced_modulus", "roller_contact_radius", "line_contact_film", "dowson_higginson_film",
-           "bearing_film"]
+           "bearing_film", "regime", "FULL_FILM_LAMBDA", "BOUNDARY_LAMBDA"]
+
+FULL_FILM_LAMBDA, BOUNDARY_LAMBDA = 3.0, 1.0     # Λ bounds of full film and of boundary-dominated contact
 
 T_DENSITY = 288.15     # 15 °C: the reference temperature of an oil's density (ISO 3675, ASTM D1298)
 
@@ -121,3 +125,9 @@ def bearing_film(load, rolling_speed, bearing, lubricant, inner: bool) -> dict[s
     out = {"film_min": phi * h_min, "film_central": phi * h_c, "film_min_isothermal": h_min,
            "film_thermal_loading": L, "film_thermal_factor": phi, "film_load_parameter": w / (E_red * R)}
     return {k: np.where(loaded, v, np.nan) for k, v in out.items()}
+
+
+def regime(lam: float) -> str:
+    """The lubrication regime of a film parameter Λ, as the literature names it."""
+    return ("full film" if lam >= FULL_FILM_LAMBDA else "partial EHL (mixed)" if lam >= BOUNDARY_LAMBDA
+            else "boundary-dominated")

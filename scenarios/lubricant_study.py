@@ -33,6 +33,7 @@ from pathlib import Path
 from scipy.optimize import brentq
 
 import mbd
+from components.lubrication import FULL_FILM_LAMBDA, regime
 from components.presets import OIL_GRADES, oil_grade
 from components.units import ParameterError, quantity, to_si
 from mbd.elements.ehl import FILM_MIN_U_EXPONENT, thermal_factor
@@ -48,7 +49,7 @@ from .lock import holds_out_folder
 
 __all__ = ["main", "run", "LAMBDA_LEVELS", "SKID_PCT", "COLUMNS", "regime", "least_viscosity"]
 
-LAMBDA_LEVELS = (1.5, 3.0)   # the least viscosity is reported for each: Λ ≥ 1.5, and full film (Λ ≥ 3)
+LAMBDA_LEVELS = (1.5, FULL_FILM_LAMBDA)   # the least viscosity is reported for each: Λ ≥ 1.5, and full film
 SKID_PCT = 5.0               # cage slip beyond this: skidding
 COLUMNS = ["condition", "direction", "lubricant", "viscosity_Pa_s", "bearing", "h_min_m", "h_min_isothermal_m",
            "h_mean_m", "thermal_factor_min", "thermal_loading_max", "lambda_min", "lambda_mean", "regime",
@@ -57,11 +58,6 @@ COLUMNS = ["condition", "direction", "lubricant", "viscosity_Pa_s", "bearing", "
            "pocket_impacts_per_rev", "heat_traction_W", "heat_land_W"]
 _FROM_SUMMARY = {"h_min_m": "film_min_m", "h_mean_m": "film_mean_m", "h_min_isothermal_m": "film_min_isothermal_m",
                  "thermal_factor_min": "film_thermal_factor_min", "thermal_loading_max": "film_thermal_loading_max"}
-
-
-def regime(lam: float) -> str:
-    """The lubrication regime of a film parameter Λ, as the literature names it."""
-    return "full film" if lam >= 3.0 else "partial EHL (mixed)" if lam >= 1.0 else "boundary-dominated"
 
 
 def parse_args(argv):
