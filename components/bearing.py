@@ -48,7 +48,8 @@ def _ehl(b, lub):
     E_red = reduced_modulus(b.elastic_modulus, b.poisson_ratio, b.elastic_modulus, b.poisson_ratio)
     return EHLTraction(eta0=lub.oil_viscosity, alpha_p=lub.pressure_viscosity, E_red=E_red, length=b.roller_length,
                        tau_L0=lub.limiting_shear_stress, gamma_L=lub.limiting_shear_slope,
-                       G_e=lub.film_shear_modulus, u_reg=lub.film_speed_reg)
+                       G_e=lub.film_shear_modulus, u_reg=lub.film_speed_reg, beta=lub.temperature_viscosity,
+                       k_oil=lub.thermal_conductivity)
 
 
 _TRACTION_FROM = {

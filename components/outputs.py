@@ -31,6 +31,7 @@ import numpy as np
 
 import mbd
 from mbd.ad import wrap_angle
+from mbd.elements.ehl import thermal_factor
 
 from .bearing import bearing_kinematics
 from .families import FAMILY, MESH_FAMILY
@@ -123,11 +124,13 @@ def pin_reactions(race_inner: dict, rollers, bearing_of_roller, n_bearings: int,
 
 def contact_film(race: dict, bearing, lubricant, inner: bool) -> dict[str, np.ndarray]:
     """The EHL film of every contact of one raceway family, from its outputs ``race`` ("load" [N] per
-    physical roller, "rolling_speed" [m/s]): "film_min" h_min and "film_central" h_c [m] (Pan & Hamrock,
-    :func:`components.lubrication.bearing_film`) and "film_lambda" Λ = h_min/σ; NaN where a roller carries
-    no load. ``bearing``, ``lubricant``: the SI parameter objects; ``inner``: the pin's raceway."""
-    h_min, h_c = bearing_film(race["load"], race["rolling_speed"], bearing, lubricant, inner)
-    return {"film_min": h_min, "film_central": h_c, "film_lambda": h_min / lubricant.roughness}
+    physical roller, "rolling_speed" [m/s]): :func:`components.lubrication.bearing_film`'s "film_min" h_min
+    and "film_central" h_c [m] (Pan & Hamrock, thinned by Murch & Wilson's φ_T), "film_min_isothermal",
+    "film_thermal_loading", "film_thermal_factor" and "film_load_parameter", and "film_lambda" Λ = h_min/σ;
+    NaN where a roller carries no load. ``bearing``, ``lubricant``: the SI parameter objects; ``inner``:
+    the pin's raceway."""
+    film = bearing_film(race["load"], race["rolling_speed"], bearing, lubricant, inner)
+    return {**film, "film_lambda": film["film_min"] / lubricant.roughness}
 
 
 # what each summary key means, in words and units (for tables and plot axes)
@@ -296,7 +299,7 @@ class WindowStatistics(mbd.Observer):
             ro = out[FAMILY["race_outer"]]
             snap["heat_traction"], snap["traction_coefficient"] = self._traction_heat(ri, ro, nb)
             if self._lubricant is not None:
-                snap["film_thinnest"] = self._thinnest_film(ri, ro, nb)
+                snap.update(self._film(ri, ro, nb))
                 snap["film_lambda"] = snap["film_thinnest"] / self._lubricant.roughness
             if p.pocket_bearing is not None:
                 snap["pocket_force"] = np.asarray(out[FAMILY["pocket"]]["force"], float)
@@ -344,14 +347,31 @@ class WindowStatistics(mbd.Observer):
             np.maximum.at(mu, owner, np.where(Q > 0.0, np.abs(Ft) / np.where(Q > 0.0, Q, 1.0), 0.0))
         return heat, mu
 
-    def _thinnest_film(self, race_inner, race_outer, nb) -> np.ndarray:
-        """Per bearing, the thinnest EHL film h_min [m] over its loaded roller contacts, both raceways."""
+    def _film(self, race_inner, race_outer, nb) -> dict[str, np.ndarray]:
+        """Per bearing, over its loaded roller contacts (both raceways): the thinnest EHL film h_min [m] with
+        and without the thermal reduction, the thermal loading L of the contact with the thinnest film, the
+        largest L and load parameter W' of any, and the smallest h_c/h_min (< 1: Pan & Hamrock's fit beyond
+        its range); NaN where no roller is loaded."""
         b, lub, owner = self.scene.meta["bearing"], self._lubricant, self.plan.roller_bearing
-        thinnest = np.full(nb, np.inf)
-        for race, inner in ((race_inner, True), (race_outer, False)):
-            h_min = contact_film(race, b, lub, inner)["film_min"]
-            np.minimum.at(thinnest, owner, np.where(np.isnan(h_min), np.inf, h_min))
-        return np.where(np.isfinite(thinnest), thinnest, np.nan)      # NaN: no roller loaded at this instant
+        films = [contact_film(race, b, lub, inner) for race, inner in ((race_inner, True), (race_outer, False))]
+        f = {k: np.concatenate([x[k] for x in films]) for k in films[0]}
+        own = np.concatenate([owner, owner])
+        loaded = ~np.isnan(f["film_min"])
+
+        def extreme(x, low):
+            out = np.full(nb, np.inf if low else -np.inf)
+            (np.minimum if low else np.maximum).at(out, own[loaded], x[loaded])
+            return np.where(np.isfinite(out), out, np.nan)
+
+        h = np.where(loaded, f["film_min"], np.inf)
+        order = np.lexsort((h, own))                                   # by bearing, thinnest first
+        first = order[np.searchsorted(own[order], np.arange(nb))]
+        return {"film_thinnest": extreme(f["film_min"], True),
+                "film_thinnest_isothermal": extreme(f["film_min_isothermal"], True),
+                "film_thinnest_loading": np.where(loaded[first], f["film_thermal_loading"][first], np.nan),
+                "film_thermal_loading": extreme(f["film_thermal_loading"], False),
+                "film_load_parameter": extreme(f["film_load_parameter"], False),
+                "film_central_ratio": extreme(f["film_central"] / f["film_min"], True)}
 
     def _to_carrier(self, vec, t):
         """A vector given in the model's frame R, in the carrier frame C."""
@@ -656,12 +676,22 @@ class WindowStatistics(mbd.Observer):
 
     def _film_summary(self, d, sel):
         """The thinnest EHL film of the bearings ``sel`` (every bearing of this kind): its smallest value in
-        the window and its time mean (the worst bearing's), in metres and as Λ = h_min/σ."""
+        the window and its time mean (the worst bearing's), in metres and as Λ = h_min/σ; the smallest
+        isothermal film; the largest thermal loading L at the thinnest film's contact, and of any loaded
+        contact with its factor φ_T(L) (the smallest); the largest load parameter W' and the smallest h_c/h_min
+        of Pan & Hamrock's fit."""
         h, lam = self.stats("film_thinnest"), self.stats("film_lambda")
         d["film_min_m"] = float(h["min"][sel].min())
         d["film_mean_m"] = float(h["mean"][sel].min())
         d["lambda_min"] = float(lam["min"][sel].min())
         d["lambda_mean"] = float(lam["mean"][sel].min())
+        d["film_min_isothermal_m"] = float(self.stats("film_thinnest_isothermal")["min"][sel].min())
+        d["film_min_thermal_loading"] = float(self.stats("film_thinnest_loading")["max"][sel].max())
+        L = float(self.stats("film_thermal_loading")["max"][sel].max())
+        d["film_thermal_loading_max"] = L
+        d["film_thermal_factor_min"] = float(thermal_factor(L))      # φ_T falls as L grows
+        d["film_load_parameter_max"] = float(self.stats("film_load_parameter")["max"][sel].max())
+        d["film_central_ratio_min"] = float(self.stats("film_central_ratio")["min"][sel].min())
 
     def _cage_revolutions(self, sel) -> float:
         """Cage revolutions relative to the carrier in the windows of the bearings ``sel``, summed."""

@@ -693,19 +693,27 @@ class LubricantParams(Params):
 
     Drag: F = C_d ρ D l (d_m Ω_m)^2 / 8 with the mixture density. Film: the oil's kinematic viscosity at
     40 °C and 100 °C (an ISO VG grade's data sheet) gives its viscosity at the operating temperature by
-    Walther's equation (ASTM D341); with the pressure–viscosity coefficient and the surfaces' composite
-    roughness it sets the EHL film of every roller contact (:mod:`components.lubrication`).
-    ``oil_viscosity`` (the dynamic viscosity at the operating temperature [Pa·s]) follows from these unless
-    given (a study of viscosity sets it directly)."""
+    Walther's equation (ASTM D341), times its density at that temperature (from the density at 15 °C and
+    the thermal expansion); with the pressure–viscosity coefficient and the surfaces' composite roughness
+    it sets the EHL film of every roller contact, thinned by inlet shear heating through the oil's thermal
+    conductivity and its temperature–viscosity coefficient β (:mod:`components.lubrication`).
+    ``oil_viscosity`` (the dynamic viscosity at the operating temperature [Pa·s]) and
+    ``temperature_viscosity`` (β [1/K]) follow from these unless given; a viscosity given directly (a study
+    of viscosity) keeps β of the grade's line at the operating temperature."""
 
     _prefix: ClassVar[str] = "lubricant"
     drag_coefficient: Quantity = _nonneg("dimensionless", "drag coefficient C_d")
     density: Quantity = _nonneg("density", "oil-air mixture density")
-    oil_density: Quantity = _pos("density", "density of the oil itself")
+    oil_density: Quantity = _pos("density", "density of the oil itself at 15 degC")
+    thermal_expansion: Quantity = _param("per_temperature", "volumetric thermal expansion alpha_rho of the oil: "
+                                                            "rho(T) = rho_15 (1 - alpha_rho (T - 15 degC))",
+                                         lo=0.0, hi=0.01, hi_open=True, bound_text="in [0, 0.01) 1/K")
     viscosity_40: Quantity = _pos("kinematic_viscosity", "kinematic viscosity at 40 degC (ISO VG: the grade)")
     viscosity_100: Quantity = _pos("kinematic_viscosity", "kinematic viscosity at 100 degC")
     temperature: Quantity = _pos("temperature", "oil temperature in the bearing")
     pressure_viscosity: Quantity = _pos("pressure_viscosity", "pressure-viscosity coefficient alpha_p (Barus)")
+    thermal_conductivity: Quantity = _pos("thermal_conductivity", "thermal conductivity k of the oil (the film's "
+                                                                  "thermal reduction, Murch-Wilson)")
     roughness: Quantity = _pos("length", "composite roughness sigma = sqrt(Rq1^2 + Rq2^2) of roller and raceway")
     limiting_shear_stress: Quantity = _pos("pressure", "limiting shear stress at zero pressure tau_L0 (EHL traction)")
     limiting_shear_slope: Quantity = _nonneg("dimensionless", "pressure slope gamma_L of the limiting shear stress "
@@ -715,21 +723,33 @@ class LubricantParams(Params):
                                                     "traction's linear region, Johnson-Tevaarwerk)")
 
     oil_viscosity: Quantity | None = _rule("dynamic_viscosity", "derived", "Walther (ASTM D341) at the temperature, "
-                                                                          "times the oil density")
+                                                                          "times the oil density there")
+    temperature_viscosity: Quantity | None = _rule("per_temperature", "derived",
+                                                   "beta = -(1/eta) d(eta)/dT of Walther's line and the density "
+                                                   "at the temperature")
 
     _si_derived: ClassVar[tuple] = (
         Derived("oil_viscosity", float, "dynamic viscosity at the operating temperature [Pa s] (given, or Walther)"),
+        Derived("temperature_viscosity", float, "temperature-viscosity coefficient beta at the operating "
+                                                "temperature [1/K] (given, or Walther)"),
     )
 
     def _si_values(self, v):
+        from .lubrication import dynamic_viscosity, oil_density, temperature_viscosity
         if not v["viscosity_100"] < v["viscosity_40"]:
             raise ParameterError.at("lubricant.viscosity_100", "must be below lubricant.viscosity_40 "
                                                                  "(an oil thins as it warms)")
-        if v["oil_viscosity"] is not None:
-            return dict(oil_viscosity=v["oil_viscosity"])
-        from .lubrication import walther_viscosity
-        return dict(oil_viscosity=v["oil_density"] * walther_viscosity(v["viscosity_40"], v["viscosity_100"],
-                                                                       v["temperature"]))
+        line = (v["viscosity_40"], v["viscosity_100"])
+        if not oil_density(v["oil_density"], v["thermal_expansion"], v["temperature"]) > 0.0:
+            raise ParameterError.at("lubricant.temperature", "the oil's density at this temperature would be <= 0 "
+                                                             "with lubricant.thermal_expansion")
+        eta = v["oil_viscosity"]
+        beta = v["temperature_viscosity"]
+        return dict(
+            oil_viscosity=eta if eta is not None else dynamic_viscosity(*line, v["oil_density"],
+                                                                        v["thermal_expansion"], v["temperature"]),
+            temperature_viscosity=beta if beta is not None else temperature_viscosity(*line, v["thermal_expansion"],
+                                                                                      v["temperature"]))
 LubricantSI = LubricantParams.SI
 
 

@@ -240,11 +240,17 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
             drag_coefficient=assumed(1.0),
             density=assumed("45 kg/m^3", "oil-air mixture: 5 % oil of 870 kg/m^3"),
             oil_density=assumed("870 kg/m^3", "mineral oil at 15 degC"),
+            thermal_expansion=assumed("7.2e-4 1/K", "lubricating oils, API MPMS 11.1 (ASTM D1250-04): "
+                                                    "alpha_60 = K1/rho_60 per degF, K1 = 0.34878 kg/m^3: "
+                                                    "1.8 x 0.34878/870 per K"),
             viscosity_40=OIL_GRADES["VG68"]["viscosity_40"],
             viscosity_100=OIL_GRADES["VG68"]["viscosity_100"],
             temperature=assumed("60 degC", "oil in the bearings of a running gearbox; not stated by the source"),
             pressure_viscosity=assumed("2.2e-8 1/Pa", "mineral oil (Hamrock, Fundamentals of Fluid Film "
                                                       "Lubrication: 1.5-2.5e-8 1/Pa)"),
+            thermal_conductivity=assumed("0.13 W/(m*K)", "mineral oils: 0.12-0.15 W/(m K) in handbooks, "
+                                                         "slowly falling with temperature; not measured for "
+                                                         "this oil"),
             roughness=assumed("0.15 um", "composite Rq of a ground raceway (~0.1 um) and a roller (~0.1 um)"),
             limiting_shear_stress=assumed("2 MPa", "Bair and Winer (1979): small at zero pressure"),
             limiting_shear_slope=assumed(0.07, "Bair and Winer (1979), mineral oils: tau_L/p ~ 0.05-0.1; with "

@@ -76,9 +76,11 @@ OUTPUTS = {
 
 def _film(race: str) -> dict:
     where = f"roller–{race} race contact"
-    return {"film_min": ("m", f"EHL minimum film thickness h_min of the {where} (Pan–Hamrock; NaN: no load)"),
-            "film_central": ("m", f"EHL central film thickness h_c of the {where} (Pan–Hamrock; NaN: no load)"),
-            "film_lambda": ("1", f"film parameter Λ = h_min/σ of the {where} (NaN: no load)")}
+    return {"film_min": ("m", f"EHL minimum film thickness h_min of the {where} (Pan–Hamrock × φ_T; NaN: no load)"),
+            "film_central": ("m", f"EHL central film thickness h_c of the {where} (Pan–Hamrock × φ_T; NaN: no load)"),
+            "film_lambda": ("1", f"film parameter Λ = h_min/σ of the {where} (NaN: no load)"),
+            "film_thermal_factor": ("1", f"thermal reduction φ_T (Murch–Wilson) in h_min and h_c of the {where}: "
+                                         "isothermal film = film / φ_T (NaN: no load)")}
 
 
 # the film of each raceway family (recorded when the scene has a lubricant): family -> (inner raceway?, keys)

@@ -91,6 +91,8 @@ KINDS: dict[str, Kind] = {
     "dynamic_viscosity": Kind("a dynamic viscosity", "Pa*s", "0.03 Pa*s"),
     "pressure_viscosity": Kind("a pressure-viscosity coefficient", "1/Pa", "2e-8 1/Pa"),
     "pressure": Kind("a pressure or elastic modulus", "Pa", "210 GPa"),
+    "per_temperature": Kind("a coefficient per kelvin", "1/K", "7.2e-4 1/K"),
+    "thermal_conductivity": Kind("a thermal conductivity", "W/(m*K)", "0.13 W/(m*K)"),
 }
 
 _TOL = 1e-9  # tolerance on dimension exponents (pint stores 10/9 as a float)

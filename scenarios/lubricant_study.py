@@ -10,12 +10,14 @@ roller–raceway traction as well as the film; ``--set bearing.traction_law=tanh
 A grade sets the oil's viscosity at 40 and 100 °C (ISO VG, viscosity at the operating temperature by
 Walther); a viscosity sets the dynamic viscosity at the operating temperature directly.
 
-Writes ``summary.csv`` / ``summary.md`` (one row per run and bearing type: film, Λ, traction, loads, cage
-guide, cage slip, pocket impacts, heat), ``film_and_slip.png`` and the answer in words (``answer.md``,
-printed): per direction the oils that keep the thinnest film at Λ ≥ 1.5 (the customary bound of full film
-separation: below it asperities carry load) with the cage at most 5 % below its epicyclic speed (beyond
-that the cage skids: the rollers slide instead of rolling), and the least viscosity for a full film in
-each direction (from the film's η^0.694 scaling) — so whether reverse wants a stronger oil, and by how much.
+Writes ``summary.csv`` / ``summary.md`` (one row per run and bearing type: film with and without the thermal
+reduction, Λ and its regime, traction, loads, cage guide, cage slip, pocket impacts, heat),
+``film_and_slip.png`` and the answer in words (``answer.md``, printed): per condition and direction each oil's
+thinnest film as Λ = h_min/σ and its regime as the literature names them (Λ ≥ 3 full film; 1 ≤ Λ < 3 partial
+EHL, i.e. mixed; Λ < 1 boundary-dominated), whether a cage skids (more than 5 % below its epicyclic speed:
+the rollers slide instead of rolling), and the least viscosity for Λ ≥ 1.5 and for a full film (Λ ≥ 3) in
+each direction (from the film's η^0.694 growth and its thermal reduction, at the oil nearest the bound) —
+so whether reverse wants a stronger oil, and by how much.
 """
 from __future__ import annotations
 
@@ -28,9 +30,13 @@ import sys
 import warnings
 from pathlib import Path
 
+from scipy.optimize import brentq
+
 import mbd
+from components.lubrication import FULL_FILM_LAMBDA, regime
 from components.presets import OIL_GRADES, oil_grade
 from components.units import ParameterError, quantity, to_si
+from mbd.elements.ehl import FILM_MIN_U_EXPONENT, thermal_factor
 from mbd.recorder import atomic_write_text
 
 from .paper_study import parse_sets
@@ -41,15 +47,17 @@ from . import args
 from .command import command
 from .lock import holds_out_folder
 
-__all__ = ["main", "run", "LAMBDA_MIN", "SKID_PCT", "COLUMNS"]
+__all__ = ["main", "run", "LAMBDA_LEVELS", "SKID_PCT", "COLUMNS", "regime", "least_viscosity"]
 
-LAMBDA_MIN = 1.5      # full film: the thinnest film at least 1.5 composite roughnesses
-SKID_PCT = 5.0        # cage slip beyond this: skidding
-COLUMNS = ["condition", "direction", "lubricant", "viscosity_Pa_s", "bearing", "h_min_m", "h_mean_m", "lambda_min",
-           "lambda_mean", "traction_coefficient_max", "roller_inner_race_rms_N", "roller_inner_race_max_N",
+LAMBDA_LEVELS = (1.5, FULL_FILM_LAMBDA)   # the least viscosity is reported for each: Λ ≥ 1.5, and full film
+SKID_PCT = 5.0               # cage slip beyond this: skidding
+COLUMNS = ["condition", "direction", "lubricant", "viscosity_Pa_s", "bearing", "h_min_m", "h_min_isothermal_m",
+           "h_mean_m", "thermal_factor_min", "thermal_loading_max", "lambda_min", "lambda_mean", "regime",
+           "traction_coefficient_max", "roller_inner_race_rms_N", "roller_inner_race_max_N",
            "roller_outer_race_rms_N", "roller_outer_race_max_N", "cage_guide_rms_N", "cage_slip_pct",
            "pocket_impacts_per_rev", "heat_traction_W", "heat_land_W"]
-_FROM_SUMMARY = {"h_min_m": "film_min_m", "h_mean_m": "film_mean_m"}
+_FROM_SUMMARY = {"h_min_m": "film_min_m", "h_mean_m": "film_mean_m", "h_min_isothermal_m": "film_min_isothermal_m",
+                 "thermal_factor_min": "film_thermal_factor_min", "thermal_loading_max": "film_thermal_loading_max"}
 
 
 def parse_args(argv):
@@ -112,55 +120,61 @@ def rows_of(cases: list[Case], results: dict) -> list[dict]:
             for col in COLUMNS[5:]:
                 v = d.get(_FROM_SUMMARY.get(col, col))
                 row[col] = v if v is not None else d.get("all_rollers", {}).get(col)
+            row["regime"] = regime(row["lambda_min"])
             rows.append(row)
     return rows
 
 
 def answer(rows: list[dict]) -> str:
-    """The source's question in plain words: per condition and direction, the oils that keep Λ ≥ 1.5 in both
-    bearing types with neither cage skidding."""
-    lines = [f"Which oil? Full film: the thinnest film over every loaded roller contact at Λ ≥ {LAMBDA_MIN:g}; "
-             f"no skid: cage slip ≤ {SKID_PCT:g} %. Per oil: Λ_min inner/outer, cage slip inner/outer.", ""]
-    ok_by, need = {}, {}
+    """The source's question in plain words: per condition and direction, each oil's thinnest film (Λ) and
+    its regime, cage skid, and the least viscosity for Λ ≥ 1.5 and for a full film; reverse against forward."""
+    lo, hi = LAMBDA_LEVELS
+    lines = ["Which oil? Λ = thinnest film (with its thermal reduction) / composite roughness over every loaded "
+             "roller contact of both bearing types. Regimes: Λ ≥ 3 full film; 1 ≤ Λ < 3 partial EHL (mixed); "
+             f"Λ < 1 boundary-dominated. Skid: cage slip > {SKID_PCT:g} %. Per oil: Λ_min inner/outer, cage slip "
+             "inner/outer.", ""]
+    need = {}
     for (c, d) in sorted({(r["condition"], r["direction"]) for r in rows}):
         lines.append(f"condition {c}, {d}:")
-        good = []
         for lab in sorted({r["lubricant"] for r in rows}, key=lambda x: _eta(rows, x)):
             rr = {r["bearing"]: r for r in rows if (r["condition"], r["direction"], r["lubricant"]) == (c, d, lab)}
             if set(rr) != {"inner", "outer"}:
                 continue
             lam = min(rr[k]["lambda_min"] for k in rr)
-            slip = max(abs(rr[k]["cage_slip_pct"]) for k in rr)
-            fine = lam >= LAMBDA_MIN and slip <= SKID_PCT
-            good += [lab] if fine else []
+            skid = max(abs(rr[k]["cage_slip_pct"]) for k in rr) > SKID_PCT
             lines.append(f"  {lab:>12} ({1e3 * _eta(rows, lab):.3g} mPa·s): Λ_min {rr['inner']['lambda_min']:.2f} / "
                          f"{rr['outer']['lambda_min']:.2f}, slip {rr['inner']['cage_slip_pct']:.2f} / "
-                         f"{rr['outer']['cage_slip_pct']:.2f} % -> {'suits' if fine else 'does not suit'}")
-        ok_by[(c, d)] = good
-        need[(c, d)] = _needed_viscosity([r for r in rows if (r["condition"], r["direction"]) == (c, d)])
-        lines.append(f"  suits: {', '.join(good) if good else 'none of the oils studied'}; full film from "
-                     f"{1e3 * need[(c, d)]:.3g} mPa·s")
-    for c in sorted({k[0] for k in ok_by}):
-        f, r = ok_by.get((c, "forward")), ok_by.get((c, "reverse"))
+                         f"{rr['outer']['cage_slip_pct']:.2f} % -> {regime(lam)}{', a cage skids' if skid else ''}")
+        here = [r for r in rows if (r["condition"], r["direction"]) == (c, d)]
+        need[(c, d)] = {level: _needed_viscosity(here, level) for level in LAMBDA_LEVELS}
+        lines.append(f"  least viscosity: Λ ≥ {lo:g} from {1e3 * need[(c, d)][lo]:.3g} mPa·s; full film (Λ ≥ {hi:g}) "
+                     f"from {1e3 * need[(c, d)][hi]:.3g} mPa·s")
+    for c in sorted({k[0] for k in need}):
+        f, r = need.get((c, "forward")), need.get((c, "reverse"))
         if f is not None and r is not None:
-            same = "the same oils suit both directions" if f == r else \
-                f"forward and reverse want different oils (forward: {', '.join(f) or 'none'}; reverse: " \
-                f"{', '.join(r) or 'none'})"
-            ratio = need[(c, "reverse")] / need[(c, "forward")]
-            lines.append(f"condition {c}: {same}; for a full film reverse needs {100 * (ratio - 1):+.1f} % "
-                         f"viscosity against forward ({1e3 * need[(c, 'forward')]:.3g} vs "
-                         f"{1e3 * need[(c, 'reverse')]:.3g} mPa·s).")
+            parts = [f"Λ ≥ {x:g} {100 * (r[x] / f[x] - 1):+.1f} % ({1e3 * f[x]:.3g} vs {1e3 * r[x]:.3g} mPa·s)"
+                     for x in LAMBDA_LEVELS]
+            lines.append(f"condition {c}: reverse needs against forward: {'; '.join(parts)}.")
     return "\n".join(lines)
 
 
-def _needed_viscosity(rows: list[dict]) -> float:
-    """The least viscosity for Λ_min = LAMBDA_MIN in both bearing types, from the oil whose Λ is nearest
-    the bound: the film scales as η^0.694 at fixed load and speed (Pan & Hamrock), so
-    η_needed = η (LAMBDA_MIN / Λ)^(1/0.694)."""
-    best = min(rows, key=lambda r: abs(math.log(r["lambda_min"] / LAMBDA_MIN)))
-    same = [r for r in rows if r["lubricant"] == best["lubricant"]]
-    worst = min(r["lambda_min"] for r in same)
-    return best["viscosity_Pa_s"] * (LAMBDA_MIN / worst) ** (1.0 / 0.694)
+def least_viscosity(eta: float, lam: float, L: float, target: float) -> float:
+    """The viscosity η' at which an oil of viscosity ``eta`` with thinnest film ``lam`` (Λ) and thermal loading
+    ``L`` there reaches Λ = ``target``, at the same loads and speeds: the isothermal film grows as η^0.694
+    (Pan & Hamrock) and L as η, so Λ(η') = lam (η'/eta)^0.694 φ_T(L η'/eta) / φ_T(L) (Murch & Wilson),
+    rising in η' (d ln Λ / d ln η = 0.694 − 0.62 x/(3.94 + x) > 0.07, x = L^0.62). β is held at the oil's."""
+    def gap(s):      # ln Λ(η' = eta e^s) − ln target
+        return (math.log(lam / target) + FILM_MIN_U_EXPONENT * s
+                + math.log(thermal_factor(L * math.exp(s)) / thermal_factor(L)))
+    return eta * math.exp(brentq(gap, -60.0, 60.0, xtol=1e-12, rtol=1e-12))
+
+
+def _needed_viscosity(rows: list[dict], target: float) -> float:
+    """The least viscosity for Λ_min = ``target`` in both bearing types, from the oil whose Λ is nearest the
+    bound (its worse bearing type), by :func:`least_viscosity`."""
+    best = min(rows, key=lambda r: abs(math.log(r["lambda_min"] / target)))
+    worst = min((r for r in rows if r["lubricant"] == best["lubricant"]), key=lambda r: r["lambda_min"])
+    return least_viscosity(worst["viscosity_Pa_s"], worst["lambda_min"], worst["thermal_loading_max"], target)
 
 
 def _eta(rows, lab) -> float:

@@ -30,6 +30,7 @@ import numpy as np
 
 import mbd
 from components.dpgt import build_dpgt
+from components.lubrication import BOUNDARY_LAMBDA
 from components.params import DPGTParams
 from components.scene import SceneOptions
 from mbd.recorder import BodyMotion, Recorder, atomic_write_text
@@ -213,21 +214,28 @@ def accuracy_warnings(integ: mbd.IntegratorSettings, error_rms: float) -> list[s
     return []
 
 
-FULL_FILM_LAMBDA = 1.0   # below Λ = h_min/σ ≈ 1 asperities touch: mixed or boundary lubrication (Hamrock)
-
-
 def validity_warnings(si, summary: dict) -> list[str]:
-    """Where a finished run left the model's range of validity. The EHL traction law is a law of a full film:
-    where the thinnest film falls below Λ ≈ 1 (too slow, or too thin an oil) asperities carry load and
-    friction that the model does not have, so its traction there is not to be trusted."""
+    """Where a finished run left the model's range of validity. The EHL traction law is a law of the film alone:
+    where the thinnest film falls below Λ ≈ 1 (too slow, or too thin an oil: boundary-dominated) asperities
+    carry much of the load and friction, which the model does not have, so its traction there is not to be
+    trusted (between Λ = 1 and 3, partial EHL, they carry some). Pan & Hamrock's film
+    fit is a regression: where it gives h_c < h_min (the heaviest loaded contacts) it is outside its range
+    (one warning per run, naming the bearing types)."""
     out = []
     if si.bearing.traction_law == "ehl":
         for kind in ("inner", "outer"):
             lam = summary.get(kind, {}).get("lambda_min")
-            if lam is not None and lam < FULL_FILM_LAMBDA:
-                out.append(f"{kind} planet bearings: thinnest film Λ_min = {lam:.2f} < {FULL_FILM_LAMBDA:g} "
-                           f"(h_min {summary[kind]['film_min_m'] * 1e6:.3g} µm): mixed lubrication at this speed and "
-                           f"oil, outside the EHL traction law's full-film validity (no asperity friction is modelled)")
+            if lam is not None and lam < BOUNDARY_LAMBDA:
+                out.append(f"{kind} planet bearings: thinnest film Λ_min = {lam:.2f} < {BOUNDARY_LAMBDA:g} "
+                           f"(h_min {summary[kind]['film_min_m'] * 1e6:.3g} µm): boundary-dominated at this speed and "
+                           f"oil, outside the EHL traction law's validity (no asperity friction is modelled)")
+    beyond = {k: summary[k] for k in ("inner", "outer")
+              if summary.get(k, {}).get("film_central_ratio_min", 1.0) < 1.0}
+    if beyond:
+        where = "; ".join(f"{k} planet bearings: W' up to {d['film_load_parameter_max']:.3g}, h_c/h_min down to "
+                          f"{d['film_central_ratio_min']:.4f}" for k, d in beyond.items())
+        out.append(f"Pan & Hamrock's film fit used beyond its range (it gives h_c < h_min at the most loaded "
+                   f"contacts) — {where}: the films there are extrapolated")
     return out
 
 

@@ -139,8 +139,10 @@ def test_race_pack_layout_and_unknown_traction():
     P, G = pack_race(race("inner", mk, R, EHL, multiplicity=2, bodies=([1], 0)))
     assert P.shape == (1, 8) and P.flags.c_contiguous and P[0, 0] == 1.0 and P[0, 7] == 2.0
     np.testing.assert_array_equal(G, [10.0 / 9.0, TRACTION_IDS[SlideRollTraction], EHL.A, EHL.B, EHL.C, EHL.D,
-                                      EHL.u_reg, EHL.s_eps, 0.0, 0.0])
+                                      EHL.u_reg, EHL.s_eps, 0.0, 0.0, 0.0])
     assert TRACTION_IDS[TanhTraction] == 0 and pack_race(race("inner", mk, R, TANH, bodies=([1], 0)))[1][1] == 0
+    # the EHL law's last column: L / u² = β η₀ / k of its thermal reduction
+    assert pack_race(race("inner", mk, R, FILM, bodies=([1], 0)))[1][10] == FILM.beta * FILM.eta0 / FILM.k_oil
 
     class Linear(Traction):
         def coefficient(self, v_s, u_roll=None):

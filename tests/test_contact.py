@@ -191,7 +191,7 @@ def race_scene(kind, pose, vel, psi, angles, deltas, v_normal, v_orbit, slips):
 TANH = TanhTraction(mu_max=0.08, v0=0.3)
 EHL = SlideRollTraction(A=-0.04, B=5.0, C=40.0, D=0.04, u_reg=0.1, s_eps=1e-4)
 FILM = EHLTraction(eta0=0.025, alpha_p=2.2e-8, E_red=2.31e11, length=LR, tau_L0=2e6, gamma_L=0.07, G_e=1e9,
-                   u_reg=0.1)
+                   u_reg=0.1, beta=0.038, k_oil=0.13)
 LAW = dict(exponent=10.0 / 9.0, zeta=0.05, traction=TANH)
 
 
@@ -401,7 +401,7 @@ def test_ehl_traction_is_the_tanh_law_without_pressure_effects():
     the tanh law with μ_max = τ_L0/p̄ and v0 = h_c τ_L0/η₀ (MODEL.md §3.8's limit), to α_p·p_max."""
     from mbd.elements import ehl
     law = EHLTraction(eta0=0.025, alpha_p=1e-13, E_red=2.31e11, length=LR, tau_L0=2e6, gamma_L=0.0, G_e=1e300,
-                      u_reg=0.1)
+                      u_reg=0.1, beta=0.0, k_oil=0.13)
     u, Q, R = 5.0, 2000.0, 3e-3
     w = Q / LR
     p_max = ehl.hertz_peak_pressure(w, R, law.E_red)
@@ -452,13 +452,19 @@ def test_ehl_traction_curve_shape():
     mu = _film_mu(FILM, v)
     np.testing.assert_allclose(_film_mu(FILM, -v), -mu, rtol=1e-14)
     assert mu[1] / mu[0] == pytest.approx(2.0, rel=1e-6)                  # linear at low slip
-    # its slope: the Maxwell film's Newtonian shear, Σ w_k η_eff(p_k) / (h_c p̄), 1/η_eff = e^(−α p)/η₀ + u/(G_e b)
+    # its slope: the Maxwell film's Newtonian shear, Σ w_k η_eff(p_k) / (h_c p̄), 1/η_eff = e^(−α p)/η₀ + u/(G_e b),
+    # h_c the thermal film: Pan & Hamrock's times Murch & Wilson's 3.94/(3.94 + L^0.62), L = β η₀ u²/k
     u, w, R = np.hypot(5.0, FILM.u_reg), 2000.0 / LR, 3e-3
     p_max, b = ehl.hertz_peak_pressure(w, R, FILM.E_red), ehl.hertz_half_width(w, R, FILM.E_red)
     eta_eff = 1.0 / (np.exp(-FILM.alpha_p * p_max * ehl.STRIP_NODES) / FILM.eta0 + u / (FILM.G_e * b))
-    h_c = ehl.film_central(u, w, R, FILM.eta0, FILM.alpha_p, FILM.E_red)
+    phi = 3.94 / (3.94 + (FILM.beta * FILM.eta0 * u ** 2 / FILM.k_oil) ** 0.62)
+    assert 0.91 < phi < 0.93                                              # L ≈ 0.18 at 5 m/s
+    h_c = phi * ehl.film_central(u, w, R, FILM.eta0, FILM.alpha_p, FILM.E_red)
     slope = np.sum(ehl.STRIP_WEIGHTS * eta_eff) / (h_c * 0.25 * np.pi * p_max)
     assert mu[0] / v[0] == pytest.approx(slope, rel=1e-6)
+    # the isothermal law (β = 0) shears the thicker film: its low-slip slope is φ_T times the thermal one's
+    iso = dataclasses.replace(FILM, beta=0.0)
+    assert _film_mu(iso, 1e-6) == pytest.approx(phi * mu[0], rel=1e-9)
     assert np.all(np.diff(mu) >= 0) and np.all(np.diff(mu[:8]) > 0)    # rises, then saturates (tanh = 1)
     w = 2000.0 / LR
     p_max = ehl.hertz_peak_pressure(w, 3e-3, FILM.E_red)

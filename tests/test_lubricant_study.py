@@ -24,13 +24,22 @@ def test_the_study_writes_its_table_answer_and_plot(study, capsys):
     assert len(rows) == 2 * 2 * 2                               # 2 oils × 2 directions × 2 bearing types
     assert set(rows[0]) == set(lubricant_study.COLUMNS)
     assert all(float(r["h_min_m"]) > 0 and float(r["lambda_min"]) > 0 and r["cage_slip_pct"] for r in rows)
-    # the film thickens with the oil as Pan–Hamrock's η^0.694 (10× the viscosity: ≈ 4.9×; loads differ a little)
+    # the isothermal film thickens with the oil as Pan–Hamrock's η^0.694 (10×: ≈ 4.9×; loads differ a little);
+    # the thermal one less, L growing with η (10 mPa·s: L ≈ 0.6, φ_T ≈ 0.85; 100: L ≈ 6, φ_T ≈ 0.55)
     for d in ("forward", "reverse"):
         for b in ("inner", "outer"):
-            h = {r["lubricant"]: float(r["h_min_m"]) for r in rows if (r["direction"], r["bearing"]) == (d, b)}
-            assert 4.0 < h["100mPas"] / h["10mPas"] < 6.0
+            sel = [r for r in rows if (r["direction"], r["bearing"]) == (d, b)]
+            h_iso = {r["lubricant"]: float(r["h_min_isothermal_m"]) for r in sel}
+            h = {r["lubricant"]: float(r["h_min_m"]) for r in sel}
+            phi = {r["lubricant"]: float(r["thermal_factor_min"]) for r in sel}
+            assert 4.0 < h_iso["100mPas"] / h_iso["10mPas"] < 6.0
+            assert 0.8 < phi["10mPas"] < 0.9 and 0.5 < phi["100mPas"] < 0.6
+            assert 2.5 < h["100mPas"] / h["10mPas"] < 4.0
+            for r in sel:
+                assert r["regime"] == lubricant_study.regime(float(r["lambda_min"]))
     text = (study / "answer.md").read_text()
     assert "condition 3, forward" in text and "condition 3, reverse" in text and "Λ" in text
+    assert "Λ ≥ 1.5 from" in text and "full film (Λ ≥ 3) from" in text and "reverse needs against forward" in text
     assert (study / "film_and_slip.png").stat().st_size > 10_000
 
 
@@ -43,8 +52,8 @@ def test_a_rerun_resumes_and_bad_oils_are_refused(study, capsys):
 
 
 def test_a_thin_film_is_flagged_outside_the_ehl_laws_validity(study, capsys):
-    """Λ_min < 1 with the EHL traction law: a warning names the bearing type and Λ; the dry laws, or a full
-    film, give none. The study's own runs (condition 3, 10 and 100 mPa·s: Λ ≈ 2–7) carry no such warning."""
+    """Λ_min < 1 with the EHL traction law: a warning names the bearing type and Λ; the dry laws, or a thicker
+    film, give none. The study's own runs (condition 3, 10 and 100 mPa·s: Λ ≈ 1.5–4) carry no such warning."""
     import json
 
     from components.params import with_overrides
@@ -58,3 +67,33 @@ def test_a_thin_film_is_flagged_outside_the_ehl_laws_validity(study, capsys):
     assert validity_warnings(reference_dpgt(1).si(), thin) == []          # tanh law: not a film law
     for f in study.glob("*/summary.json"):
         assert not [x for x in json.loads(f.read_text())["warnings"] if "Λ_min" in x]
+
+
+def test_regimes_are_named_as_the_literature_names_them():
+    """Λ ≥ 3 full film; 1 ≤ Λ < 3 partial EHL (mixed); Λ < 1 boundary-dominated."""
+    r = lubricant_study.regime
+    assert (r(3.0), r(2.999), r(1.0), r(0.999)) == ("full film", "partial EHL (mixed)", "partial EHL (mixed)",
+                                                     "boundary-dominated")
+    assert lubricant_study.LAMBDA_LEVELS == (1.5, 3.0)
+
+
+def test_the_least_viscosity_reaches_its_film():
+    """Without thermal loading the least viscosity is the closed form η (Λ_target/Λ)^(1/0.694); with it, the
+    film of that viscosity — Pan & Hamrock's film of a contact times Murch & Wilson's φ_T(L η'/η), computed
+    from the film functions at η' — has exactly the target Λ."""
+    from components.lubrication import line_contact_film, reduced_modulus
+    from mbd.elements.ehl import thermal_factor, thermal_loading
+    least = lubricant_study.least_viscosity
+    assert least(0.02, 1.2, 0.0, 3.0) == pytest.approx(0.02 * (3.0 / 1.2) ** (1 / 0.694), rel=1e-10)
+    E, R, u, w, sigma, beta, k = reduced_modulus(210e9, 0.3, 210e9, 0.3), 3e-3, 14.0, 5e5, 1.5e-7, 0.038, 0.13
+
+    def lam(eta):
+        return (line_contact_film(u, w, R, eta, 2.2e-8, E)[0]
+                * thermal_factor(thermal_loading(u, eta, beta, k)) / sigma)
+    eta0 = 0.024
+    L0 = thermal_loading(u, eta0, beta, k)
+    for target in (1.5, 3.0, 6.0):
+        eta = least(eta0, lam(eta0), L0, target)
+        assert lam(eta) == pytest.approx(target, rel=1e-9)
+        # scaling up, the thicker oil also heats its inlet more (L ∝ η): more than η^0.694 alone asks; down, less
+        assert (eta > least(eta0, lam(eta0), 0.0, target)) == (target > lam(eta0))

@@ -6,8 +6,10 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 import mbd
-from components.lubrication import (dowson_higginson_film, line_contact_film, reduced_modulus,
-                                    roller_contact_radius, walther_viscosity)
+from components.lubrication import (dowson_higginson_film, dynamic_viscosity, line_contact_film, oil_density,
+                                    reduced_modulus, roller_contact_radius, temperature_viscosity, walther_slope,
+                                    walther_viscosity)
+from mbd.elements.ehl import thermal_factor, thermal_loading
 from components.outputs import WindowStatistics
 from components.params import with_overrides
 from components.presets import OIL_GRADES, oil_grade, reference_dpgt
@@ -82,14 +84,17 @@ def _snapshot(scene, state, lubricant):
 
 
 def test_the_thinnest_film_of_each_bearing_scales_with_the_oil(loaded_state):
-    """Same state, two oils: every bearing's thinnest film scales as η^0.694 (Pan–Hamrock), Λ = h/σ."""
+    """Same state, two oils: every bearing's thinnest isothermal film scales as η^0.694 (Pan–Hamrock); the
+    thermal one is thinner, the more so for the thicker oil (L ∝ β η); Λ = h/σ."""
     sc, s = loaded_state
     base = reference_dpgt(3, "forward")
     thin, thick = (with_overrides(base, oil_grade(g)).si().lubricant for g in ("VG32", "VG150"))
     a, b = _snapshot(sc, s, thin), _snapshot(sc, s, thick)
     assert np.all(np.isfinite(a["film_thinnest"])) and np.all(a["film_thinnest"] > 0)
-    np.testing.assert_allclose(b["film_thinnest"] / a["film_thinnest"],
+    np.testing.assert_allclose(b["film_thinnest_isothermal"] / a["film_thinnest_isothermal"],
                                (thick.oil_viscosity / thin.oil_viscosity) ** 0.694, rtol=1e-12)
+    assert np.all(a["film_thinnest"] < a["film_thinnest_isothermal"])
+    assert np.all(b["film_thinnest"] / b["film_thinnest_isothermal"] < a["film_thinnest"] / a["film_thinnest_isothermal"])
     np.testing.assert_allclose(a["film_lambda"], a["film_thinnest"] / thin.roughness, rtol=1e-15)
     # the film of one contact by hand: the most loaded roller of bearing 0 on its pin
     out = mbd.System(sc.model).outputs(s.t, s.q, s.v, s.z)["race_inner"]
@@ -100,7 +105,7 @@ def test_the_thinnest_film_of_each_bearing_scales_with_the_oil(loaded_state):
     E = reduced_modulus(b0.elastic_modulus, b0.poisson_ratio, b0.elastic_modulus, b0.poisson_ratio)
     h_j, _ = line_contact_film(out["rolling_speed"][j], out["load"][j] / b0.roller_length, R, thin.oil_viscosity,
                                thin.pressure_viscosity, E)
-    assert a["film_thinnest"][0] <= h_j * (1 + 1e-12)
+    assert a["film_thinnest_isothermal"][0] <= h_j * (1 + 1e-12)
 
 
 def test_ehl_traction_is_selectable_and_runs_on_the_rig():
@@ -197,7 +202,11 @@ def test_the_film_of_every_contact_agrees_with_the_bearing_statistics(loaded_sta
     E = reduced_modulus(b0.elastic_modulus, b0.poisson_ratio, b0.elastic_modulus, b0.poisson_ratio)
     h, hc = line_contact_film(o["rolling_speed"][j], o["load"][j] / b0.roller_length, R, lub.oil_viscosity,
                               lub.pressure_viscosity, E)
-    assert (o["film_min"][j], o["film_central"][j]) == (h, hc)
+    # the thermal reduction by hand: Murch & Wilson's 3.94/(3.94 + L^0.62), L = β η₀ u²/k
+    phi = 3.94 / (3.94 + (lub.temperature_viscosity * lub.oil_viscosity * o["rolling_speed"][j] ** 2
+                          / lub.thermal_conductivity) ** 0.62)
+    assert o["film_min_isothermal"][j] == h and o["film_thermal_factor"][j] == pytest.approx(phi, rel=1e-14)
+    assert (o["film_min"][j], o["film_central"][j]) == pytest.approx((phi * h, phi * hc), rel=1e-14)
 
 
 def test_no_film_is_recorded_without_a_lubricant(loaded_state):
@@ -235,8 +244,144 @@ def test_results_file_records_the_film_of_every_contact(short_run):
             assert h.attrs["units"] == ds[f"{race}.film_central"].attrs["units"] == "m" and lam.attrs["units"] == "1"
             np.testing.assert_array_equal(np.isnan(h.values), ds[f"{race}.load"].values <= 0.0)
             np.testing.assert_allclose(lam.values, h.values / sigma, rtol=1e-15)
+            phi = ds[f"{race}.film_thermal_factor"].values
+            assert ds[f"{race}.film_thermal_factor"].attrs["units"] == "1"
+            np.testing.assert_array_equal(np.isnan(phi), np.isnan(h.values))
+            assert np.all((phi[~np.isnan(phi)] > 0.5) & (phi[~np.isnan(phi)] < 1.0))
         for kind in ("inner", "outer"):
             thinnest = min(float(ds[f"{r}.film_min"].where(ds[f"{r}.bearing_kind"] == kind).min())
                            for r in ("race_inner", "race_outer"))
             # 25 kHz samples against every step (≈ 1e-5 s) of a thinning film: measured 0.03 % and 0.6 % here
             assert thinnest == pytest.approx(summary[kind]["film_min_m"], rel=0.02)
+
+
+def test_summary_has_the_isothermal_film_and_the_thermal_factor(short_run):
+    """summary.json per bearing type: the isothermal film beside the thermal one, the largest thermal loading
+    L and its factor φ_T(L) = 3.94/(3.94 + L^0.62); the thinnest film's L from the rollers' pure-rolling
+    entraining speed at condition 3, ū = ω_rel R_i R_o'/(R_i + R_o') = 14.1 m/s (ω_rel the planet's speed on
+    its pin: the loaded rollers roll; lightly loaded ones that slide have up to ≈ 15.5 m/s, so the largest L
+    is higher); W' and h_c/h_min of Pan & Hamrock's fit, and its warning exactly when h_c < h_min."""
+    _, summary = short_run
+    si = reference_dpgt(3, "forward").si()
+    lub, b, op = si.lubricant, si.bearing, si.operating
+    Ri, Ro = 0.5 * (b.pitch_diameter - b.roller_diameter), 0.5 * (b.pitch_diameter + b.roller_diameter)
+    for kind in ("inner", "outer"):
+        d = summary[kind]
+        w_rel = abs(getattr(op, f"{kind}_planet_speed") - op.carrier_speed)
+        u = w_rel * Ri * Ro / (Ri + Ro)
+        assert 13.5 < u < 14.5
+        L = lub.temperature_viscosity * lub.oil_viscosity * u ** 2 / lub.thermal_conductivity
+        assert d["film_min_thermal_loading"] == pytest.approx(L, rel=0.05)         # loaded rollers slip a little
+        assert d["film_min_thermal_loading"] <= d["film_thermal_loading_max"] < 1.3 * L
+        assert d["film_thermal_factor_min"] == pytest.approx(3.94 / (3.94 + d["film_thermal_loading_max"] ** 0.62),
+                                                             rel=1e-14)
+        assert 0.7 < d["film_thermal_factor_min"] < 0.78
+        # the thinnest thermal film: each contact's isothermal film times its φ_T ≥ φ_T,min
+        h, h_iso, phi = d["film_min_m"], d["film_min_isothermal_m"], d["film_thermal_factor_min"]
+        assert phi * h_iso * (1 - 1e-12) <= h < h_iso
+        # at the run's start the most loaded rollers carry ≈ 6–8 kN: W' ≈ 1.2–1.3e-3, where the fit crosses
+        assert 0.95 < d["film_central_ratio_min"] < 1.2 and 5e-4 < d["film_load_parameter_max"] < 2e-3
+    crossed = [k for k in ("inner", "outer") if summary[k]["film_central_ratio_min"] < 1.0]
+    fit = [w for w in summary["warnings"] if "Pan & Hamrock" in w]
+    assert len(fit) == (1 if crossed else 0) and all(f"{k} planet bearings" in fit[0] for k in crossed)
+
+
+def test_murch_wilson_thermal_factor_against_the_formulas_own_numbers():
+    """φ_T = 3.94/(3.94 + L^0.62) (Murch & Wilson 1975): 1 at L = 0; at L = 1 the exponent drops out,
+    3.94/4.94; 3.94/(3.94 + 10^0.62) = 0.485898 at L = 10; ½ where L^0.62 = 3.94, L = 9.13015; and
+    φ_T L^0.62 → 3.94 at large L. A slip of the coefficient (×2: 0.887 at L = 1) or of the exponent
+    (0.64: 0.4744 at L = 10) fails here."""
+    assert thermal_factor(0.0) == 1.0
+    assert thermal_factor(1.0) == pytest.approx(0.797571, rel=1e-6)
+    assert thermal_factor(10.0) == pytest.approx(0.485898, rel=1e-6)
+    assert thermal_factor(9.13015) == pytest.approx(0.5, rel=1e-6)
+    big = 1e12
+    assert thermal_factor(big) * big ** 0.62 == pytest.approx(3.94, rel=1e-6)
+    L = np.logspace(-4, 3, 50)
+    assert np.all(np.diff(thermal_factor(L)) < 0)
+    # L = β η₀ u²/k by hand: VG 68 at 60 °C, 14.1 m/s, 0.13 W/(m K)
+    assert thermal_loading(14.1, 0.0241, 0.0384, 0.13) == pytest.approx(0.0384 * 0.0241 * 14.1 ** 2 / 0.13, rel=1e-15)
+    assert thermal_loading(14.1, 0.0241, 0.0384, 0.13) == pytest.approx(1.41528, rel=1e-5)
+
+
+def test_the_temperature_viscosity_coefficient_is_the_walther_lines_slope():
+    """β = −(1/η) dη/dT of η = ρ(T) ν(T) against a central difference of the viscosity–temperature law
+    itself (Walther's ν and the density), for every grade and several temperatures."""
+    alpha = 7.2e-4
+    for grade in OIL_GRADES.values():
+        nu40, nu100 = (float(grade[k].value.split()[0]) * 1e-6 for k in ("viscosity_40", "viscosity_100"))
+        for T in (293.15, 333.15, 363.15, 393.15):
+            dT = 1e-3
+            fd = -(np.log(walther_viscosity(nu40, nu100, T + dT)) - np.log(walther_viscosity(nu40, nu100, T - dT))) / (2 * dT)
+            assert walther_slope(nu40, nu100, T) == pytest.approx(fd, rel=1e-7)
+            eta = lambda t: dynamic_viscosity(nu40, nu100, 870.0, alpha, t)          # noqa: E731
+            fd = -(np.log(eta(T + dT)) - np.log(eta(T - dT))) / (2 * dT)
+            assert temperature_viscosity(nu40, nu100, alpha, T) == pytest.approx(fd, rel=1e-7)
+    # VG 68 at 60 °C: β ≈ 0.038 1/K, of which the density's expansion is 7.4e-4
+    b = temperature_viscosity(68e-6, 8.7e-6, alpha, 333.15)
+    assert 0.037 < b < 0.040 and b - walther_slope(68e-6, 8.7e-6, 333.15) == pytest.approx(alpha / (1 - alpha * 45), rel=1e-12)
+
+
+def test_the_oil_density_and_viscosity_are_taken_at_the_operating_temperature():
+    """ρ(60 °C) = 870 (1 − 7.2e-4 × 45) = 841.812 kg/m³ by hand; the preset's α_ρ is API MPMS 11.1's for
+    lubricating oils (α₆₀ = K₁/ρ₆₀ per °F, K₁ = 0.34878 kg/m³) at 870 kg/m³; the linear law stays within
+    0.05 % of that standard's exp(−α ΔT (1 + 0.8 α ΔT)) at 60 °C; η = ρ(T) ν(T), 3.2 % below the value
+    with the density at 15 °C."""
+    lub_p = reference_dpgt(3, "forward").lubricant
+    lub = lub_p.si()
+    assert oil_density(870.0, 7.2e-4, 333.15) == pytest.approx(841.812, rel=1e-12)
+    assert lub.thermal_expansion == pytest.approx(1.8 * 0.34878 / 870.0, rel=3e-3)
+    a60, dF = 0.34878 / 870.0, 45.0 * 1.8
+    api = 870.0 * np.exp(-a60 * dF * (1 + 0.8 * a60 * dF))
+    assert oil_density(870.0, lub.thermal_expansion, 333.15) == pytest.approx(api, rel=5e-4)
+    nu = walther_viscosity(lub.viscosity_40, lub.viscosity_100, lub.temperature)
+    assert lub.oil_viscosity == pytest.approx(841.812 * nu, rel=1e-12)
+    assert lub.oil_viscosity / (870.0 * nu) == pytest.approx(0.9676, rel=1e-12)
+    for key in ("thermal_expansion", "thermal_conductivity", "oil_density"):
+        assert lub_p.source(key).tag == "assumed" and lub_p.source(key).note
+    assert lub_p.source("temperature_viscosity").tag == "derived"
+
+
+@pytest.mark.parametrize("key, value, match", [
+    ("lubricant.thermal_conductivity", "-0.1 W/(m*K)", r"lubricant.thermal_conductivity: .*> 0"),
+    ("lubricant.thermal_conductivity", "0.13 W/m", r"lubricant.thermal_conductivity: expected a thermal conductivity"),
+    ("lubricant.thermal_expansion", "0.02 1/K", r"lubricant.thermal_expansion: .*\[0, 0.01\) 1/K"),
+    ("lubricant.thermal_expansion", "7e-4 1/Pa", r"lubricant.thermal_expansion: expected a coefficient per kelvin"),
+    ("lubricant.temperature_viscosity", "0 1/K", r"lubricant.temperature_viscosity: .*> 0"),
+])
+def test_bad_thermal_oil_parameters_are_refused(key, value, match):
+    with pytest.raises(ParameterError, match=match):
+        with_overrides(reference_dpgt(3, "forward"), {key: value}).si()
+
+
+def test_a_given_temperature_viscosity_coefficient_replaces_walther():
+    """β given directly (1/K) is used as is; with a viscosity given directly β stays the grade's at the
+    operating temperature, so L grows as η."""
+    base = reference_dpgt(3, "forward")
+    p = with_overrides(base, {"lubricant.temperature_viscosity": "0.02 1/K"})
+    assert p.si().lubricant.temperature_viscosity == pytest.approx(0.02, rel=1e-15)
+    assert p.lubricant.source("temperature_viscosity").tag == "user"
+    q = with_overrides(base, {"lubricant.oil_viscosity": "50 mPa*s"}).si().lubricant
+    assert q.temperature_viscosity == base.si().lubricant.temperature_viscosity
+
+
+def test_pan_hamrock_crosses_its_own_films_at_heavy_load():
+    """h_c/h_min = 1.705 G^(−0.098) W'^(−0.038) U^(−0.002) from the published exponents falls below 1 at
+    W' = (1.705 G^(−0.098) U^(−0.002))^(1/0.038): ≈ 1.15e-3 for the reference oil (G = 5077) at U = 1.2e-10
+    (condition 1). The run warns once, naming the bearing types, when its contacts get there."""
+    from scenarios.runner import validity_warnings
+    R, eta, alpha = 3e-3, 0.0241, 2.2e-8
+    G, U = alpha * E_STEEL, 1.2e-10
+    u = U * E_STEEL * R / eta
+    W_cross = ((2.922 / 1.714) * G ** -0.098 * U ** -0.002) ** (1 / 0.038)
+    assert 1.0e-3 < W_cross < 1.3e-3
+    for W, above in ((0.99 * W_cross, True), (1.01 * W_cross, False)):
+        h_min, h_c = line_contact_film(u, W * E_STEEL * R, R, eta, alpha, E_STEEL)
+        assert (h_c > h_min) == above
+    si = reference_dpgt(1, "reverse").si()
+    ok = {"film_central_ratio_min": 1.02, "film_load_parameter_max": 8e-4}
+    bad = {"film_central_ratio_min": 0.995, "film_load_parameter_max": 1.2e-3}
+    assert validity_warnings(si, {"inner": ok, "outer": ok}) == []
+    w = validity_warnings(si, {"inner": bad, "outer": {**bad, "film_central_ratio_min": 0.99}})
+    assert len(w) == 1 and "Pan & Hamrock" in w[0] and "inner planet bearings" in w[0] and "outer" in w[0]
+    assert "0.995" in w[0] and "0.0012" in w[0]

@@ -224,12 +224,14 @@ def test_an_interrupted_sweep_cancels_its_runs_and_stops_local_workers(scheduler
 def test_a_fixed_step_run_beyond_its_tolerance_warns(finished, tmp_path, capsys):
     from scenarios.runner import FIXED_STEP_ERROR_FACTOR
 
-    assert json.loads((finished / "summary.json").read_text())["warnings"] == []       # adaptive: none
+    # (the tiny run's start-up impacts also take Pan & Hamrock's film fit beyond its range: a validity warning)
+    accuracy = lambda s: [w for w in s["warnings"] if "fixed step" in w]        # noqa: E731
+    assert accuracy(json.loads((finished / "summary.json").read_text())) == []      # adaptive: none
     code = paper_study.main(TINY + ["--method", "hht-fixed", "--h", "1e-5", "--out", str(tmp_path)])
     s = json.loads((tmp_path / "c4_forward" / "summary.json").read_text())
     assert code == 0 and s["error_estimate"]["rms"] > FIXED_STEP_ERROR_FACTOR      # 10 us from the start: ~30 x
-    assert len(s["warnings"]) == 1 and "fixed step h = 1e-05 s" in s["warnings"][0]
-    assert f"c4_forward: warning: {s['warnings'][0]}" in capsys.readouterr().out
+    assert len(accuracy(s)) == 1 and "fixed step h = 1e-05 s" in accuracy(s)[0]
+    assert f"c4_forward: warning: {accuracy(s)[0]}" in capsys.readouterr().out
 
 
 def test_wall_time_of_a_resumed_run_counts_every_segment(tmp_path, monkeypatch):

@@ -7,9 +7,10 @@ Layouts (P: one row per instance, columns in this order; G: family-wide values):
                   as one), race_marker x, y [m], R_race [m], D [m], K, c₀ = 2ζ·sqrt(m_roller·p·K), multiplicity;
                   a family with a spall packs 4 more columns, so the kernel decides from P's width (a family
                   without one pays nothing): spall_angle [rad], (w + e)/2 [m], depth h [m], edge e [m]
-                  G (10,): exponent p, traction law id, then the law's coefficients (zero-padded):
+                  G (11,): exponent p, traction law id, then the law's coefficients (zero-padded):
                   law 0 (TanhTraction): mu_max, v0;  law 1 (SlideRollTraction): A, B, C, D, u_reg, s_eps;
-                  law 2 (EHLTraction): eta0, alpha_p, E_red, length, tau_L0, gamma_L, G_e, u_reg
+                  law 2 (EHLTraction): eta0, alpha_p, E_red, length, tau_L0, gamma_L, G_e, u_reg,
+                  beta·eta0/k_oil (L = that × u², the thermal loading number)
 ``PocketContact`` P (n, 10): pocket_angle ψ, pitch_radius, clearance, K_p, λ (impact law damping), v_min, mu,
                   v_mu, D, multiplicity;  G (0,)
 ``GuideContact``  P (n, 7): clearance, K_g, λ, v_min, mu, v_mu, land_radius;  G (4,): land law (0 dry,
@@ -49,6 +50,7 @@ _TWO_PI = 2.0 * np.pi
 TANH, SLIDE_ROLL, EHL = 0, 1, 2
 TRACTION_IDS = {TanhTraction: TANH, SlideRollTraction: SLIDE_ROLL, EHLTraction: EHL}
 _STRIP_A, _STRIP_W = ehl.STRIP_NODES.copy(), ehl.STRIP_WEIGHTS.copy()
+_THERMAL_A, _THERMAL_M = ehl.THERMAL_A, ehl.THERMAL_EXPONENT
 
 
 # ------------------------------------------------------------------------------------------ pack
@@ -71,7 +73,8 @@ def pack_race(elem):
     elif law == SLIDE_ROLL:
         coef = [tr.A, tr.B, tr.C, tr.D, tr.u_reg, tr.s_eps]
     elif law == EHL:
-        coef = [tr.eta0, tr.alpha_p, tr.E_red, tr.length, tr.tau_L0, tr.gamma_L, tr.G_e, tr.u_reg]
+        coef = [tr.eta0, tr.alpha_p, tr.E_red, tr.length, tr.tau_L0, tr.gamma_L, tr.G_e, tr.u_reg,
+                tr.beta * tr.eta0 / tr.k_oil]
     else:
         raise NotImplementedError(f"{elem.name}: RaceContact with traction law {type(tr).__name__} has no "
                                   f"compiled kernel (compiled: {sorted(c.__name__ for c in TRACTION_IDS)})")
@@ -80,7 +83,7 @@ def pack_race(elem):
     if elem.has_spall:
         cols += [elem.spall_angle, elem._spall_hi, elem.spall_depth, elem.spall_edge]
     P = _rows(*cols)
-    G = np.zeros(10)
+    G = np.zeros(11)
     G[:2 + len(coef)] = [elem.exponent, float(law), *coef]
     return P, G
 
@@ -192,13 +195,19 @@ def _traction(law, G, v_s, u):
 @njit(cache=True)
 def _ehl_traction(G, v_s, u, Q, Rr):
     """EHLTraction.coefficient (the reference's operations) and ∂μ/∂v_s, ∂μ/∂u, ∂μ/∂Q for a contact of
-    reduced radius Rr. Film h_c = C w^−0.166 ũ^0.692, p_max, b ∝ √w, so each scales as a power of Q."""
-    eta0, alpha, E, length, tauL0, gam, G_e, u_reg = G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9]
+    reduced radius Rr. Film h_c = C w^−0.166 ũ^0.692 φ_T(c ũ²), p_max, b ∝ √w, so each scales as a power
+    of Q; φ_T = a/(a + x), x = (c ũ²)^m: d ln φ_T / d ln ũ = −2m x/(a + x)."""
+    eta0, alpha, E, length, tauL0, gam, G_e, u_reg, c_T = G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9], G[10]
     w = Q * (1.0 / length)
     ut = np.sqrt(u * u + u_reg ** 2)
     U, W, Gm = eta0 * ut / (E * Rr), w * (1.0 / (E * Rr)), alpha * E
     h_c = Rr * 2.922 * Gm ** 0.470 * W ** -0.166 * U ** 0.692
-    hc_u, hc_Q = 0.692 * h_c * u / (ut * ut), -0.166 * h_c / Q
+    n_u = 0.692                                        # d ln h_c / d ln ũ
+    if c_T > 0.0:
+        x = (ut * ut * c_T) ** _THERMAL_M
+        h_c *= _THERMAL_A / (_THERMAL_A + x)
+        n_u -= 2.0 * _THERMAL_M * x / (_THERMAL_A + x)
+    hc_u, hc_Q = n_u * h_c * u / (ut * ut), -0.166 * h_c / Q
     p_max = np.sqrt(w * (E / (2.0 * np.pi * Rr)))
     b = np.sqrt(w * (8.0 * Rr / (np.pi * E)))
     el = ut / (G_e * b)

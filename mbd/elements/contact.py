@@ -269,8 +269,10 @@ class EHLTraction(Traction):
     b the Hertz half-width, u the entraining speed: a film element is sheared only for the transit time
     b/u, Johnson & Tevaarwerk 1977), limited by the limiting shear stress τ_L = tau_L0 + gamma_L·p
     (Bair & Winer 1979): τ = τ_L·tanh(η_eff v_s /(h_c τ_L)), smooth and odd in v_s; μ = mean τ / mean p.
-    h_c is Pan & Hamrock's central film (:mod:`mbd.elements.ehl`) with the entraining speed regularised to
-    √(u² + u_reg²); the load per unit length is Q/length, E_red the reduced modulus E'. Without the
+    h_c is Pan & Hamrock's central film times Murch & Wilson's thermal reduction φ_T(L), L = beta·eta0·u²/k_oil
+    (:mod:`mbd.elements.ehl`; beta = −(1/η)dη/dT [1/K], k_oil the oil's thermal conductivity [W/(m·K)];
+    beta = 0: isothermal), with the entraining speed regularised to √(u² + u_reg²); the load per unit length
+    is Q/length, E_red the reduced modulus E'. Without the
     elastic limit (G_e → ∞) Barus makes the low-slip slope astronomically steep (η e^(α p) ~ 1e12 Pa·s
     at 1.5 GPa); with alpha_p = gamma_L = 0 and G_e → ∞ it is the tanh law with μ_max = tau_L0/p̄ and
     v0 = h_c·tau_L0/eta0 (p̄ the mean Hertz pressure)."""
@@ -282,16 +284,21 @@ class EHLTraction(Traction):
     gamma_L: float
     G_e: float
     u_reg: float
+    beta: float
+    k_oil: float
     needs_rolling_speed = True
     needs_load = True
 
     def __post_init__(self):
-        self._check(positive=("eta0", "E_red", "length", "tau_L0", "G_e", "u_reg"), nonneg=("alpha_p", "gamma_L"))
+        self._check(positive=("eta0", "E_red", "length", "tau_L0", "G_e", "u_reg", "k_oil"),
+                    nonneg=("alpha_p", "gamma_L", "beta"))
 
     def coefficient(self, v_s, u_roll=None, load=None, radius=None):
         w = load * (1.0 / self.length)
         u = ad.sqrt(u_roll * u_roll + self.u_reg ** 2)
         h_c = ehl.film_central(u, w, radius, self.eta0, self.alpha_p, self.E_red)
+        if self.beta > 0.0:
+            h_c = h_c * ehl.thermal_factor(ehl.thermal_loading(u, self.eta0, self.beta, self.k_oil))
         p_max = ehl.hertz_peak_pressure(w, radius, self.E_red)
         elastic = u / (self.G_e * ehl.hertz_half_width(w, radius, self.E_red))   # transit-time compliance
         shear_rate = v_s / h_c
