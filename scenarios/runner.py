@@ -192,6 +192,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
         "warnings": accuracy_warnings(integ, res.error_rms) + validity_warnings(params.si(), summary),
         "wall_s": wall, "steps": res.steps, "rejected_steps": res.counters["rejected"],
         "newton_per_step": res.counters["newton"] / max(res.steps, 1),
+        "engine": res.engine, "engine_note": res.engine_note,    # which path ran, and why it fell back
         "resumed_from_s": res.resumed_from,
         "error_estimate": {
             "kind": "HHT local displacement error estimate (Zienkiewicz-Xie, (beta-1/6) h^2 (a1-a0)), "

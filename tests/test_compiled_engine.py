@@ -90,14 +90,23 @@ def test_a_planetary_scene_runs_identically_on_both_engines():
     assert np.all(np.abs(c.state.q - r.state.q) <= 0.05 * tol)       # Newton-tolerance round-off, 905 steps
 
 
-def test_what_cannot_be_compiled_falls_back_or_says_why():
+def test_what_cannot_be_compiled_falls_back_or_says_why(capsys):
+    """"auto" falls back to the numpy path and says so in one line on stderr, with the reason, which the result
+    (and so summary.json) keeps; "compiled" refuses; a compiled run has no note."""
     mb = mbd.ModelBuilder()
     mb.add_body("wheel", 1.0, 0.01)
     mb.add(mbd.elements.TorqueSource("motor", [0], torque=lambda t: np.array([np.sin(t)])))
     model = mb.build()
     kw = dict(stepper=mbd.PRODUCTION.stepper(), controller=mbd.FixedStep(1e-3), progress=False)
     res = mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="auto", **kw)
-    assert res.engine == "numpy"
+    assert res.engine == "numpy" and "motor" in res.engine_note and res.summary()["engine_note"] == res.engine_note
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("mbd: running the numpy engine path") and "motor" in err[0]
+    mb2 = mbd.ModelBuilder()
+    mb2.add_body("wheel", 1.0, 0.01)
+    mb2.add(mbd.elements.TorqueSource("motor", [0], torque=1.0))
+    ok = mbd.simulate(mb2.build(), np.zeros(3), np.zeros(3), 0.01, engine="auto", **kw)
+    assert ok.engine == "compiled" and ok.engine_note is None
     with pytest.raises(mbd.ModelError, match="compiled engine cannot run.*motor.*callable"):
         mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="compiled", **kw)
     with pytest.raises(mbd.ModelError, match="engine must be one of"):
@@ -123,3 +132,26 @@ def test_the_kernel_cache_is_dropped_when_any_compiled_source_changes(tmp_path, 
     stale.write_text("fresh")                  # same sources: nothing is dropped
     importlib.reload(mc)
     assert stale.exists() and (tmp_path / "compiled_sources.sha256").read_text() == stamp
+
+
+def test_a_run_that_must_compile_says_so_before_its_first_step(capsys, monkeypatch):
+    """When numba's cache does not hold the step loop, building the compiled runner says so in one line, compiles
+    before any step (a progress bar's ETA then leaves it out) and gives the time; with the cache warm it is
+    silent. (The compile is faked cold: the cache answers, so the test stays fast.)"""
+    import mbd.compiled as mc
+    from mbd.compiled.runner import CompiledRunner
+
+    mb = mbd.ModelBuilder()
+    mb.add_body("wheel", 1.0, 0.01)
+    mb.add(mbd.elements.TorqueSource("motor", [0], torque=1.0))
+    system = mbd.System(mb.build())
+    args = (system, mbd.PRODUCTION.stepper(), mbd.FixedStep(1e-3))
+    CompiledRunner(*args)
+    assert mc.kernels_cached()
+    capsys.readouterr()
+    CompiledRunner(*args)
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(mc, "kernels_cached", lambda: False)
+    CompiledRunner(*args)
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("mbd: compiling the engine's kernels") and err[1].startswith("mbd: kernels compiled in ")

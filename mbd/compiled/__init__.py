@@ -51,4 +51,15 @@ def _drop_stale_kernels() -> None:
         pass
 
 
+
+def kernels_cached() -> bool:
+    """Does numba's disk cache hold the compiled step loop of this code (so a run loads it in about a second
+    instead of compiling for about a minute)? Checked by its index file (:func:`_drop_stale_kernels` removes
+    stale ones)."""
+    from numba import config
+    here = _Path(__file__).resolve().parent
+    root = _Path(config.CACHE_DIR) if config.CACHE_DIR else here / "__pycache__"
+    return any(root.rglob("stepper.advance-*.nbi")) if root.is_dir() else False
+
+
 _drop_stale_kernels()

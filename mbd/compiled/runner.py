@@ -3,6 +3,8 @@ accepted steps in compiled code and hands each block back as states, so that the
 observers, checkpoints and the progress bar work unchanged."""
 from __future__ import annotations
 
+import sys
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -69,6 +71,25 @@ class CompiledRunner:
         self.out = tuple(np.zeros(n) for _ in range(4))
         self.z_shapes = list(zip(self.cs.state_names, self.cs.state_shapes))
         self.n_z = sum(int(np.prod(s)) for _, s in self.z_shapes)
+        self._compile()
+
+    def _compile(self) -> None:
+        """Compile (or load) the step loop now, before any step: a progress bar's ETA then leaves the compile
+        out, and a first run on a machine says what it is doing instead of looking stuck."""
+        from . import kernels_cached
+
+        cold = not kernels_cached()
+        if cold:
+            print("mbd: compiling the engine's kernels (the first run of this code on this machine; about a "
+                  "minute, then cached)", file=sys.stderr, flush=True)
+        t0 = time.perf_counter()
+        n = self.n
+        z = np.zeros(n)
+        advance(0.0, z.copy(), z.copy(), z.copy(), z.copy(), 1e-6, 0.0, 0, self.prm, self.ctrl, self.atol, self.rtol,
+                self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu, self.cache, self.work,
+                np.zeros(6, np.int64), self.out, np.empty((1, 3 + 4 * n + self.n_z)))
+        if cold:
+            print(f"mbd: kernels compiled in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
 
     def drop_lu(self) -> None:
         """Forget the LU (the numpy path drops it at checkpoints: both refactorise at the same step)."""
