@@ -365,7 +365,10 @@ def _fail(system: System, state: State, h: float, info, path) -> None:
 
 
 class _Progress:
-    """tqdm bar over simulated time: shows the simulated time, steps per second and time left."""
+    """tqdm bar over simulated time: shows the simulated time, steps per second and time left. When stderr is
+    not a terminal (a log file, a pipe, CI) it writes a plain line every ``PLAIN_EVERY`` seconds instead of a
+    bar's escape codes."""
+    PLAIN_EVERY = 10.0
 
     def __init__(self, t0, t1, show, callback=None):
         self.callback = callback
@@ -390,6 +393,13 @@ class _Progress:
             return
         if self.bar is None:
             if now - self._start < 2.0:   # short runs stay silent
+                return
+            if not sys.stderr.isatty():
+                if now - self._last_post >= self.PLAIN_EVERY:
+                    self._last_post = now
+                    left = (self.t_end - t) / max(t - self.t0, 1e-300) * (now - self._start)
+                    print(f"simulating: t = {t:.4g} of {self.t_end:.4g} s, {self._steps / (now - self._start):.0f} "
+                          f"steps/s, about {left:.0f} s left", file=sys.stderr, flush=True)
                 return
             from tqdm.auto import tqdm
             self.bar = tqdm(total=self.total, unit="s", unit_scale=True, desc="simulating",

@@ -26,7 +26,6 @@ import dataclasses
 import io
 import json
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -42,7 +41,7 @@ from .paper_study import parse_sets
 from .plausibility import check_runs
 from .runner import RunConfig
 from .analysis import line_table
-from .sweep import Case, build_params, check_folders, run_sweep, study_epilogue
+from .sweep import Case, build_params, check_folders, run_sweep, study_epilogue, user_overrides, validate_cases
 
 __all__ = ["FAULTS", "main", "run", "characteristic_frequencies", "COLUMNS"]
 
@@ -109,11 +108,20 @@ def _machine(text: str) -> tuple[str, str]:
 
 
 def make_cases(a, out: Path) -> list[Case]:
+    """The perfect machine, each catalogue fault and each ``--machine`` in every direction. The sweep owns the
+    operating point and the errors: ``--set`` may not touch either, a machine's file not the operating point,
+    and a machine may not take the name of the perfect machine or of a catalogue fault."""
+    operating = {"operating.carrier_speed": "--condition", "operating.output_power": "--condition",
+                 "operating.direction": "--directions"}
     machines: dict[str, tuple[dict, str | None]] = {"perfect": ({}, None)}
     machines.update({f: (FAULTS[f][0], None) for f in a.faults})
     for name, path in a.machine:
+        if name in machines or name in FAULTS:
+            what = "the perfect machine" if name == "perfect" else "a catalogue fault"
+            raise SystemExit(f"error: --machine {name}={path}: the name {name!r} is {what}'s; choose another")
+        user_overrides({}, str(path), operating)
         machines[name] = ({}, str(path))
-    user = parse_sets(a.set)
+    user = user_overrides(parse_sets(a.set), None, {**operating, "errors": "--faults or --machine NAME=FILE.toml"})
     return [Case(a.condition, d, str(out / f"{name}_{d}"), {**user, **ov}, path, tag=name)
             for name, (ov, path) in machines.items() for d in a.directions.split(",")]
 
@@ -276,10 +284,7 @@ def run(a) -> dict:
     cases = make_cases(a, out)
     cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
                     progress=not a.no_progress, sensor=True)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")      # design warnings of the reference machine are known
-        for c in cases:
-            _check_case(c, cfg)              # every parameter checked before any run starts
+    validate_cases(cases, lambda c: _check_case(c, cfg))     # every parameter checked before any run starts
     out.mkdir(parents=True, exist_ok=True)
     for w in check_runs([(c.label, build_params(c), cfg) for c in cases], out, a.force):
         print(f"warning (--force): {w}")
@@ -296,11 +301,8 @@ def run(a) -> dict:
 
 
 def _check_case(case: Case, cfg: RunConfig) -> None:
-    """The parameters and the named planets, rollers and teeth of a case exist (fails before any run)."""
-    from components import faults
-
+    """The recording resolves the mesh sidebands of the case (fails before any run)."""
     si = build_params(case).si()
-    faults.check_errors(si)
     need = 2 * (si.operating.mesh_frequency + 6 * abs(si.operating.carrier_frequency))   # f_m + 6 f_c, reverse too
     if cfg.sample_rate <= need:
         raise ParameterError.at("--sample-rate", f"{cfg.sample_rate:g} Hz cannot resolve the mesh sidebands: needs "

@@ -24,7 +24,6 @@ import dataclasses
 import io
 import json
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -38,7 +37,7 @@ from .lock import holds_out_folder
 from .paper_study import parse_sets
 from .plausibility import check_runs
 from .runner import RunConfig
-from .sweep import Case, build_params, check_folders, run_sweep, study_epilogue
+from .sweep import OPERATING_AXES, Case, build_params, check_folders, run_sweep, study_epilogue, user_overrides, validate_cases
 
 __all__ = ["main", "run", "make_cases", "rows_of", "by_grade", "findings", "QUANTITIES", "MESHES"]
 
@@ -105,7 +104,7 @@ def _tag(grade, seed) -> str:
 
 def make_cases(a, out: Path) -> list[Case]:
     """Perfect teeth, and every class × seed, at every condition and direction."""
-    user = parse_sets(a.set)
+    user = user_overrides(parse_sets(a.set), None, {**OPERATING_AXES, "errors.flank_class": "--grades and --seeds"})
     machines = [(None, None)] + [(g, s) for g in a.grades for s in a.seeds]
     cases = []
     for c in (int(x) for x in a.conditions.split(",")):
@@ -238,12 +237,7 @@ def run(a) -> dict:
     out = Path(a.out)
     cases = make_cases(a, out)
     cfg = RunConfig(settle=a.settle, window=a.window, integration=mbd.PRODUCTION, progress=not a.no_progress)
-    from components import faults
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")      # the reference machine's known design warnings
-        for c in cases:
-            faults.check_errors(build_params(c).si())   # every parameter checked before any run starts
+    validate_cases(cases)                    # every parameter checked before any run starts
     out.mkdir(parents=True, exist_ok=True)
     for w in check_runs([(c.label, build_params(c), cfg) for c in cases], out, a.force):
         print(f"warning (--force): {w}")

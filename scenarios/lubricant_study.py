@@ -27,7 +27,6 @@ import io
 import json
 import math
 import sys
-import warnings
 from pathlib import Path
 
 from scipy.optimize import brentq
@@ -42,7 +41,7 @@ from mbd.recorder import atomic_write_text
 from .paper_study import parse_sets
 from .runner import RunConfig
 from .plausibility import check_runs
-from .sweep import Case, _case_cfg, build_params, check_folders, run_sweep, study_epilogue
+from .sweep import OPERATING_AXES, Case, _case_cfg, build_params, check_folders, run_sweep, study_epilogue, user_overrides, validate_cases
 from . import args
 from .command import command
 from .lock import holds_out_folder
@@ -82,9 +81,11 @@ def lubricants(a) -> dict[str, dict]:
     if a.viscosities:
         text = a.viscosities.strip()
         nums, _, unit = text.partition(" ")
+        if not unit.strip():        # a bare number would silently be Pa·s
+            raise ParameterError.at("--viscosities", f"give the unit, e.g. \"10,30,100 mPa*s\", got {text!r}")
         out = {}
         for x in nums.split(","):
-            q = f"{x.strip()} {unit.strip() or 'Pa*s'}"
+            q = f"{x.strip()} {unit.strip()}"
             eta = to_si(quantity("--viscosities", q, "dynamic_viscosity"))
             if not eta > 0:
                 raise ParameterError.at("--viscosities", f"expected positive viscosities, got {q!r}")
@@ -101,7 +102,10 @@ def make_cases(a, out: Path) -> list[Case]:
             or any(d not in ("forward", "reverse") for d in dirs):
         raise ParameterError.at("--conditions/--directions", f"expected conditions 1-4 and forward/reverse, got "
                                                               f"{a.conditions!r}, {a.directions!r}")
-    user = {"bearing.traction_law": "ehl", **parse_sets(a.set)}
+    oils = "--grades or --viscosities"
+    owned = {**OPERATING_AXES, "lubricant.viscosity_40": oils, "lubricant.viscosity_100": oils,
+             "lubricant.oil_viscosity": oils}
+    user = {"bearing.traction_law": "ehl", **user_overrides(parse_sets(a.set), a.params, owned)}
     return [Case(c, d, str(out / f"c{c}_{d}_{lab}"), {**user, **ov}, a.params, tag=lab)
             for lab, ov in lubricants(a).items() for c in conds for d in dirs]
 
@@ -213,10 +217,7 @@ def run(a) -> dict:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     cases = make_cases(a, out)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")      # design warnings of the reference machine are known
-        for c in cases:
-            build_params(c).si()             # every parameter checked before any run starts
+    validate_cases(cases)                    # every parameter checked before any run starts
     cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
                     progress=not a.no_progress)
     for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], out, a.force):

@@ -70,10 +70,21 @@ def dpgt(a):
     from components.presets import reference_dpgt
     from components.scene import SceneOptions
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        built = build_dpgt(reference_dpgt(a.condition, "forward"),
-                           SceneOptions(bearings="linear", mesh_stiffness="constant", gravity=False))
+    from components.params import with_overrides
+    from components.units import ParameterError
+
+    from .paper_study import parse_sets
+
+    if a.params:      # the file is a single planetary set's; the DPGT takes its own parameters through --set
+        raise SystemExit(f"error: --params {a.params} describes a single planetary set; with --dpgt give DPGT "
+                         "parameters with --set KEY=VALUE")
+    try:
+        params = with_overrides(reference_dpgt(a.condition, "forward"), parse_sets(a.set))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            built = build_dpgt(params, SceneOptions(bearings="linear", mesh_stiffness="constant", gravity=False))
+    except ParameterError as exc:
+        raise SystemExit(f"error: {exc}") from None
     setting = dataclasses.replace(mbd.PRODUCTION, h_max=2e-5)     # linear bearings: larger steps are fine
     r = mbd.simulate(built.model, built.q0, built.v0, a.settle, stepper=setting.stepper(),
                      controller=setting.controller(), progress=False, engine=setting.engine)

@@ -15,7 +15,6 @@ import csv
 import io
 import json
 import sys
-import warnings
 from pathlib import Path
 
 import mbd
@@ -26,7 +25,7 @@ from mbd.recorder import atomic_write_text
 from .runner import RunConfig, sweep_report
 from .integrity import read_summary
 from .plausibility import check_runs
-from .sweep import Case, _case_cfg, build_params, check_folders, run_sweep
+from .sweep import OPERATING_AXES, Case, _case_cfg, build_params, check_folders, run_sweep, user_overrides, validate_cases
 from . import args
 from .command import command
 from .lock import holds_out_folder
@@ -105,7 +104,7 @@ def make_cases(a, out: Path) -> list[Case]:
     for d in dirs:
         if d not in ("forward", "reverse"):
             raise SystemExit(f"error: --directions takes forward and/or reverse, got {d!r}")
-    overrides = parse_sets(a.set)
+    overrides = user_overrides(parse_sets(a.set), a.params, OPERATING_AXES)
     if a.planets is not None:
         overrides["gears.planets"] = a.planets
     for c in conds:
@@ -278,20 +277,7 @@ def run(a) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     cfg = build_config(a)
     cases = make_cases(a, out)
-    # validate every case's parameters here, before any run starts (clear errors, design warnings once)
-    from components.units import ParameterError
-
-    try:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            for c in cases:
-                build_params(c)
-                from components.geometry import check_design
-                check_design(build_params(c))
-        for msg in sorted({str(w.message) for w in caught}):
-            print(f"design warning: {msg}")
-    except ParameterError as exc:
-        raise SystemExit(f"error: {exc}") from None
+    validate_cases(cases)         # before any run starts: clear errors, design warnings once
     for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], out, a.force):
         print(f"warning (--force): {w}")
     check_folders(cases, cfg, a.overwrite)      # never replace results of other parameters silently

@@ -77,7 +77,7 @@ def parse_args(argv):
                         "and bearing (each alone by name); axis: ideal, at the carrier axis")
     p.add_argument("--perfect", action="store_true",
                    help="a perfect machine: no manufacturing errors (default: the errors of --gear-grade)")
-    p.add_argument("--gear-grade", type=args.count(1, 11), default=6,
+    p.add_argument("--gear-grade", type=args.count(1, 11), default=None,
                    help="ISO 1328-1 flank tolerance class of the gears behind the default manufacturing errors "
                         "(default 6: every gear's teeth drawn for that class, runouts F_r/2 of that grade, all "
                         "carrier pinholes within ±10 µm; components.presets.typical_errors)")
@@ -129,8 +129,11 @@ def machine(a):
         params = with_overrides(reference_dpgt(2, a.direction), overrides)
         if a.perfect and not params.errors.perfect:
             raise SystemExit("error: --perfect contradicts the manufacturing errors given (--params / --set errors.*)")
+        if a.gear_grade is not None and (a.perfect or not params.errors.perfect):
+            raise SystemExit(f"error: --gear-grade {a.gear_grade} contradicts "
+                             f"{'--perfect' if a.perfect else 'the manufacturing errors given (--params / --set errors.*)'}")
         if not a.perfect and params.errors.perfect:      # the rig's machine, unless errors were given
-            params = params.replace(errors=typical_errors(params, a.gear_grade))
+            params = params.replace(errors=typical_errors(params, 6 if a.gear_grade is None else a.gear_grade))
         si = params.si()
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None

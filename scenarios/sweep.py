@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -20,7 +21,7 @@ from mbd.recorder import atomic_write_text
 
 from .integrity import OtherResults, claim_folder, read_summary, results_intact
 
-__all__ = ["Case", "run_sweep", "execute_case", "check_folders"]
+__all__ = ["Case", "run_sweep", "execute_case", "check_folders", "user_overrides", "validate_cases", "OPERATING_AXES"]
 
 
 @dataclass(frozen=True)
@@ -36,6 +37,60 @@ class Case:
     @property
     def label(self) -> str:
         return f"c{self.condition}_{self.direction}" + (f"_{self.tag}" if self.tag else "")
+
+
+# the parameters every study's sweep sets itself (its axes), and the option that sets them
+OPERATING_AXES = {"operating.carrier_speed": "--conditions", "operating.output_power": "--conditions",
+                  "operating.direction": "--directions"}
+
+
+def user_overrides(sets: dict, params_file: str | None, owned: dict[str, str]) -> dict:
+    """The ``--set`` overrides of a study, after checking that neither they nor the ``--params`` file touch a
+    parameter the study's sweep owns (``owned``: dotted key or prefix → the option that sets it). Such an override
+    would silently relabel runs — a folder ``c3_forward`` holding a reverse run — so it is refused in one line
+    naming the key, where it came from and the option to use. A file that is not UTF-8 TOML is a usage error
+    naming the file."""
+    from components.params import overrides_from_toml
+    from components.units import ParameterError
+
+    from_file = {}
+    if params_file:
+        try:
+            from_file = overrides_from_toml(Path(params_file).read_text(encoding="utf-8"))
+        except (ParameterError, ValueError) as exc:          # not UTF-8, not TOML, a bad value
+            raise SystemExit(f"error: --params {params_file}: {exc}".splitlines()[0]) from None
+    for where, given in (("--set", sets), (f"--params {params_file}", from_file)):
+        for key in given:
+            for axis, option in owned.items():
+                if key == axis or key.startswith(axis + ".") or axis.startswith(key + "."):
+                    raise SystemExit(f"error: {key} is set by this study's {option}, not by {where}")
+    return dict(sets)
+
+
+def validate_cases(cases: list[Case], check=None) -> None:
+    """Before any run starts: every case's parameters convert, its errors name what the machine has and its design
+    is checked (``check(case)``, optional, adds a study's own checks). A ParameterError ends the study with its
+    one line; each distinct design warning (the reference machine's known tip-circle overlaps) is said once for
+    the whole study, not once per run."""
+    import warnings
+
+    from components import faults
+    from components.geometry import check_design
+    from components.units import ParameterError
+
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            for c in cases:
+                params = build_params(c)
+                check_design(params)
+                faults.check_errors(params.si())
+                if check is not None:
+                    check(c)
+    except ParameterError as exc:
+        raise SystemExit(f"error: {exc}") from None
+    for msg in sorted({str(w.message) for w in caught if issubclass(w.category, UserWarning)}):
+        print(f"design {msg}" if msg.startswith("warning: ") else f"design warning: {msg}")
 
 
 def build_params(case: Case):
@@ -164,9 +219,14 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
     if not todo:
         return results
     n_workers = workers or min(len(todo), os.cpu_count() or 1)
+    # bars on a terminal; a log file or a pipe gets one plain line per finished run instead of escape codes
+    plain = progress and not sys.stderr.isatty()
+    bars = progress and not plain
     if scheduler is None and n_workers <= 1:
-        for c in tqdm(todo, desc="runs", disable=not progress or len(todo) == 1):
+        for i, c in enumerate(tqdm(todo, desc="runs", disable=not bars or len(todo) == 1)):
             results[c.label] = execute_case(c, cfg, overwrite)
+            if plain:
+                print(f"runs: {i + 1}/{len(todo)} done ({c.label})", file=sys.stderr, flush=True)
         return results
     from dataclasses import replace
 
@@ -183,8 +243,8 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
     futs = {}
     try:
         futs = {client.submit(execute_case, c, wcfg, overwrite, pure=False, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
-        bar = tqdm(total=len(futs), desc="runs", disable=not progress, position=0)
-        runs = _RunBars(todo, progress)
+        bar = tqdm(total=len(futs), desc="runs", disable=not bars, position=0)
+        runs = _RunBars(todo, bars)
         while True:
             done = [f for f in futs if f.done() and futs[f].label not in results]
             if not done:
@@ -201,6 +261,9 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
                 results[c.label] = {"case": c.label, "error": f"worker failure: {exc}"}
             bar.update(1)
             runs.finish(c)
+            if plain:
+                n_done = sum(futs[f].label in results for f in futs)
+                print(f"runs: {n_done}/{len(futs)} done ({c.label})", file=sys.stderr, flush=True)
             if "error" in results[c.label]:
                 bar.write(f"run {c.label} failed: {results[c.label]['error']}")
         runs.close()

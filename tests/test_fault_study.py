@@ -32,22 +32,22 @@ def test_fault_study_runs_end_to_end(tmp_path):
     out = tmp_path / "faults"
     machine = tmp_path / "bent_carrier.toml"        # a damaged machine described in TOML (README)
     machine.write_text('[[errors.pinhole]]\nplanet = "b1"\nradial = "0 um"\ntangential = "30 um"\n')
-    args = ["--faults", "cracked_tooth", "--machine", f"pinhole={machine}", "--directions", "forward",
+    args = ["--faults", "cracked_tooth", "--machine", f"bent={machine}", "--directions", "forward",
             "--settle", "0.002", "--window", "0.006", "--workers", "1", "--no-progress", "--out", str(out)]
     assert fault_study.main(args) == 0
     rows = list(csv.DictReader((out / "summary.csv").open()))
-    assert {(r["fault"], r["bearing"]) for r in rows} == {(f, b) for f in ("perfect", "pinhole", "cracked_tooth")
+    assert {(r["fault"], r["bearing"]) for r in rows} == {(f, b) for f in ("perfect", "bent", "cracked_tooth")
                                                           for b in ("inner", "outer")}
     by = {(r["fault"], r["bearing"]): r for r in rows}
     assert float(by[("perfect", "outer")]["life_relative"]) == 1.0
-    assert float(by[("pinhole", "outer")]["load_sharing_factor"]) > float(by[("perfect", "outer")]["load_sharing_factor"])
+    assert float(by[("bent", "outer")]["load_sharing_factor"]) > float(by[("perfect", "outer")]["load_sharing_factor"])
     assert float(by[("cracked_tooth", "outer")]["own_frequency"]) == pytest.approx(
         fault_study.characteristic_frequencies(reference_dpgt(2).si())["outer_planet_rel"])
     assert all(np.isfinite(float(r["sensor_f_m-1f_c"])) for r in rows)
     for f in ("summary.md", "findings.md", "loads.png", "spectra.png", "study.json"):
         assert (out / f).exists(), f
     text = (out / "findings.md").read_text()
-    assert "forward:" in text and "cracked_tooth: life ×" in text and "pinhole: life ×" in text
+    assert "forward:" in text and "cracked_tooth: life ×" in text and "bent: life ×" in text
     # a second call finds every run finished (resumes, nothing recomputed) and refuses other parameters
     assert fault_study.main(args) == 0
     assert fault_study.main(["--faults", "cracked_tooth", "--directions", "forward", "--settle", "0.003",
