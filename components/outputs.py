@@ -311,6 +311,8 @@ class WindowStatistics(mbd.Observer):
         snap["load_magnitude"] = np.hypot(pin[:, 0], pin[:, 1])
         snap["load_life"] = snap["load_magnitude"] ** LIFE_EXPONENT
         snap["load_x"], snap["load_y"] = pin[:, 0], pin[:, 1]
+        if self.omega_c != 0.0:      # the carrier's speed against its reference: has the drive settled?
+            snap["carrier_speed_error"] = np.array([V[p.carrier, 2] / self.omega_c])
         if p.cage is not None:
             a_own = A[p.cage, :2]
             a_rel = a_own - A[p.planet, :2]
@@ -575,6 +577,9 @@ class WindowStatistics(mbd.Observer):
         self._close_impacts()
         p = self.plan
         out: dict = {"window_s": [self.t0, self.t1], "window_duration_s": self.duration}
+        if "carrier_speed_error" in self._acc:
+            # the time mean: a settled drive oscillates about its reference (mesh dynamics), an unsettled one is off
+            out["carrier_speed_error_mean_pct"] = float(100.0 * self.stats("carrier_speed_error")["mean"][0])
         for kind in ("inner", "outer"):
             sel = np.flatnonzero(p.kinds == kind)
             ref = int(sel[0])

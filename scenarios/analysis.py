@@ -3,7 +3,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["amplitude_spectrum", "peak_table", "line_table"]
+__all__ = ["amplitude_spectrum", "peak_table", "line_table", "sideband_resolution", "MIN_REVOLUTIONS"]
+
+MIN_REVOLUTIONS = 3     # carrier revolutions a spectrum needs to tell the f_c sidebands from the band's floor
 
 
 def amplitude_spectrum(t: np.ndarray, x: np.ndarray, detrend: bool = True):
@@ -65,3 +67,18 @@ def line_table(f: np.ndarray, amp: np.ndarray, lines: dict[str, float], band: tu
         over = a / floor if floor > 0 else float("inf") if a > 0 else float("nan")     # nan: a signal that is 0
         rows.append({"line": label, "frequency_hz": float(fl), "amplitude": a, "over_median": over})
     return rows
+
+
+def sideband_resolution(t: np.ndarray, f_c: float) -> str | None:
+    """Why a spectrum of the samples ``t`` cannot show the carrier sidebands f_m + k f_c, or None when it can. Over
+    fewer than :data:`MIN_REVOLUTIONS` carrier revolutions its bins are f_c/3 wide or wider: a line fills its own bin
+    and its Hann neighbours, no bin between two lines is left for the floor, and "over the floor" reads the lines'
+    own leakage (at one revolution every bin is a line)."""
+    t = np.asarray(t, float)
+    span = float(t[-1] - t[0] + np.median(np.diff(t))) if t.size > 1 else 0.0
+    revs = span * abs(f_c)
+    if revs >= MIN_REVOLUTIONS - 1e-9:
+        return None
+    return (f"the spectrum covers {revs:.2g} carrier revolutions (< {MIN_REVOLUTIONS}): its resolution "
+            f"{1.0 / span if span > 0 else float('inf'):.3g} Hz cannot tell the f_c = {abs(f_c):.3g} Hz sidebands from "
+            f"the floor; its lines mean nothing (a window of at least {MIN_REVOLUTIONS / abs(f_c):.3g} s)")

@@ -70,7 +70,7 @@ COLUMNS = ["fault", "direction", "bearing", "load_sharing_factor", "bearing_load
            "roller_max_N", "life_iso281_h", "life_iso16281_h", "life_relative", "cage_slip_pct",
            "pocket_impacts_per_rev", "cage_acc_rel_rms",
            "sensor_f_m", "sensor_f_m-1f_c", "sensor_f_m+1f_c", "sensor_f_m-3f_c", "sensor_f_m+3f_c",
-           "sensor_own", "own_frequency"]
+           "sensor_own", "own_frequency", "notes"]
 
 
 def parse_args(argv):
@@ -161,13 +161,14 @@ def _own_frequency(case: Case, si, fr: dict) -> float | None:
 
 
 def sensor_spectrum(run_dir: Path, f_c: float):
-    """(f, amplitude) of the recorded housing sensor of a run (scenarios.spectrum's definition)."""
+    """(f, amplitude, why) of the recorded housing sensor of a run (scenarios.spectrum's definition); ``why`` says
+    why its lines mean nothing (too few carrier revolutions), None when they do."""
     from .spectrum import sensor_signal
-    from .analysis import amplitude_spectrum
+    from .analysis import amplitude_spectrum, sideband_resolution
 
     t, x = sensor_signal(run_dir / "results.nc", f_c)
     f, amp, _ = amplitude_spectrum(t, x)
-    return f, amp
+    return f, amp, sideband_resolution(t, f_c)
 
 
 def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
@@ -179,7 +180,7 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
             continue
         si = build_params(case).si()
         fr = characteristic_frequencies(si)
-        f, amp = sensor_spectrum(Path(case.out_dir), fr["f_c"])
+        f, amp, coarse = sensor_spectrum(Path(case.out_dir), fr["f_c"])
         own = _own_frequency(case, si, fr)
         spectra[(case.tag, case.direction)] = (f, amp, fr, own)
         fm, fc = fr["f_m"], fr["f_c"]
@@ -187,7 +188,8 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
         if own is not None:
             marks.update({"own-": fm - own, "own+": fm + own})
         band = (fm - 6.5 * max(fc, own or 0.0), fm + 6.5 * max(fc, own or 0.0))
-        sensor = {r["line"]: r["over_median"] for r in line_table(f, amp, marks, band)}
+        # lines that cannot mean anything are left out, not interpreted (the note says why)
+        sensor = {r["line"]: None if coarse else r["over_median"] for r in line_table(f, amp, marks, band)}
         for kind in ("inner", "outer"):
             d, p0 = s[kind], perfect.get(case.direction, {}).get(kind)
             life = d["life_iso16281_h"] / p0["life_iso16281_h"] if p0 else None
@@ -200,8 +202,10 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
                    "pocket_impacts_per_rev": d.get("pocket_impacts_per_rev"),
                    "cage_acc_rel_rms": d.get("cage_acc_rel_magnitude_rms"),
                    **{k: v for k, v in sensor.items() if k.startswith("sensor")},
-                   "sensor_own": min(sensor["own-"], sensor["own+"]) if own is not None else None,
-                   "own_frequency": own}
+                   "sensor_own": min(sensor["own-"], sensor["own+"]) if own is not None and not coarse else None,
+                   "own_frequency": own,
+                   "notes": "; ".join([w for w in s.get("warnings", []) if kind in w or "carrier drive" in w
+                                       or "ramp" in w] + ([coarse] if coarse else []))}
             rows.append(row)
     return rows, spectra
 
@@ -254,11 +258,14 @@ def findings(rows: list[dict]) -> str:
             loud = max(rise, key=rise.get) if rise else None
             heard = (f"the sensor hears it ({loud} × {rise[loud]:.1f} over the perfect machine's)"
                      if loud and rise[loud] >= 3.0 else "the sensor does not hear it")
+            if w["sensor_f_m"] is None or ref["sensor_f_m"] is None:      # too short a window: no verdict
+                heard = "the sensor's lines mean nothing here (too few carrier revolutions)"
             own = w.get("sensor_own")
             lines.append(f"  {fault:>14}: life × {w['life_iso16281_h'] / p['life_iso16281_h']:.2f} ({w['bearing']} planet "
                          f"bearing {w['life_iso16281_h']:.0f} h), K_γ {max(r['load_sharing_factor'] for r in by[fault].values()):.3f}, "
                          f"largest bearing load × {w['bearing_load_max_N'] / ref['bearing_load_max_N']:.2f}; {heard}"
-                         + (f"; its own sidebands f_m ± {w['own_frequency']:.0f} Hz at {own:.1f}× the floor" if own else ""))
+                         + (f"; its own sidebands f_m ± {w['own_frequency']:.0f} Hz at {own:.1f}× the floor" if own else "")
+                         + (f" [not meaningful: {w['notes']}]" if w.get("notes") else ""))
     return "\n".join(lines)
 
 

@@ -41,7 +41,7 @@ import mbd
 from components.sensor import PATHS as SENSOR_PATHS
 from mbd.recorder import atomic_write_text
 
-from .analysis import amplitude_spectrum, line_table, peak_table
+from .analysis import amplitude_spectrum, line_table, peak_table, sideband_resolution
 from .plausibility import check_runs
 from .runner import RunConfig, run_case, run_report
 from . import args
@@ -178,6 +178,9 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     f_c, f_m = s["f_c_hz"], s["f_m_hz"]
     gears = params.si().gears
     lines = _lines(f, spectra, f_m, f_c, int(gears.ring.teeth), int(gears.planets), sensor)
+    coarse = sideband_resolution(t, f_c)        # too few carrier revolutions: say so, mark every line
+    for r in lines:
+        r["meaningful"] = coarse is None
     expected = {r["line"]: r["frequency_hz"] for r in lines}
     peaks = peak_table(f, amp, f_m, (SIDEBANDS + 0.5) * f_c, expected, n=8) if amp.any() else []   # a path at 0
     _write_csv(out / "spectrum.csv", [{"frequency_hz": fi, **{k: a[1][i] for k, a in spectra.items()}}
@@ -191,10 +194,12 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
                "sensor_parameters": params.si().rig.sensor.to_dict(),
                "carrier_ripple": params.si().rig.carrier_ripple.to_dict(),
                "lines": lines, "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"],
-               "error_estimate": s["error_estimate"], "warnings": s["warnings"]}
+               "error_estimate": s["error_estimate"], "warnings": s["warnings"] + ([coarse] if coarse else [])}
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
     fig = _plot(f, spectra, f_m, f_c, s, sensor, out)
     _report(lines, peaks, f_m, f_c, df, t, sensor)
+    if coarse:
+        print(f"warning: {coarse}")
     print("run time and accuracy: " + "\n".join(run_report(s)))
     print(f"written: {out / 'spectrum.csv'}, {out / 'lines.csv'}, {out / 'peaks.csv'}, {out / 'summary.json'}, {fig}")
     return summary
