@@ -323,7 +323,8 @@ def main(argv=None) -> int:
         if row["bearing"] == "outer":
             print(f"{row['fault']:>14} {row['direction']:>8}: K_γ {row['load_sharing_factor']:.3f}, "
                   f"max bearing load {row['bearing_load_max_N']:.0f} N, life {row['life_relative'] or float('nan'):.2f}, "
-                  f"sensor f_m / floor {row['sensor_f_m']:.3g}")
+                  + (f"sensor f_m / floor {row['sensor_f_m']:.3g}" if row["sensor_f_m"] is not None
+                     else "sensor lines not meaningful (too short a window)"))
     return study_epilogue(r)
 
 
