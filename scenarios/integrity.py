@@ -15,7 +15,7 @@ import sys
 import time
 from pathlib import Path
 
-__all__ = ["OtherResults", "move_aside", "read_summary", "results_intact", "checkpoint_usable", "claim_folder",
+__all__ = ["OtherResults", "move_aside", "read_summary", "results_intact", "checkpoint_usable", "claim_folder", "differences",
            "DAMAGED"]
 
 DAMAGED = ".damaged-"
@@ -114,10 +114,13 @@ def checkpoint_usable(ckpt, parts) -> bool:
     return True
 
 
-def claim_folder(folder, parameters_fp: str, full_fp: str | None, overwrite: bool, what: str = "") -> str:
+def claim_folder(folder, parameters_fp: str, full_fp: str | None, overwrite: bool, what: str = "",
+                 description: dict | None = None) -> str:
     """Check that ``folder`` may take a run of these parameters: "new" (nothing finished there), "same"
     (finished from the same parameters and code), "recompute" (same parameters, other code) or "overwrite"
-    (other parameters, ``overwrite`` given). Other parameters without ``overwrite``: :class:`OtherResults`."""
+    (other parameters, ``overwrite`` given). Other parameters without ``overwrite``: :class:`OtherResults`,
+    naming what differs (``description``: the run's :func:`scenarios.runner.run_description`, against the one
+    the finished summary keeps)."""
     s = read_summary(Path(folder) / "summary.json")
     if s is None:
         return "new"
@@ -127,5 +130,17 @@ def claim_folder(folder, parameters_fp: str, full_fp: str | None, overwrite: boo
         return "recompute"
     if overwrite:
         return "overwrite"
-    raise OtherResults(f"{folder} holds finished results of other parameters or settings{what}; pass --overwrite "
-                       f"to replace them, or choose another --out")
+    raise OtherResults(f"{folder} holds finished results of other parameters or settings{what}"
+                       f"{differences(s.get('run_description'), description)}; pass --overwrite to replace them, "
+                       f"or choose another --out")
+
+
+def differences(old: dict | None, new: dict | None, most: int = 4) -> str:
+    """' (key: old → new, ...)' for the first ``most`` keys whose values differ, '' when unknown."""
+    if not old or not new:
+        return ""
+    keys = [k for k in sorted(set(old) | set(new)) if old.get(k) != new.get(k)]
+    if not keys:
+        return ""
+    shown = ", ".join(f"{k}: {old.get(k, '(none)')} → {new.get(k, '(none)')}" for k in keys[:most])
+    return f" ({shown}{f' and {len(keys) - most} more' if len(keys) > most else ''})"

@@ -42,7 +42,7 @@ from components.results_schema import drawing_geometry, element_probes
 from .integrity import checkpoint_usable, claim_folder
 from .lock import folder_lock
 
-__all__ = ["RunConfig", "run_case", "run_fingerprint", "parameters_fingerprint", "statistics_window", "run_report",
+__all__ = ["RunConfig", "run_case", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
            "accuracy_line", "FIXED_STEP_ERROR_FACTOR"]
 
 # A fixed-step run whose RMS local error estimate exceeds its tolerance (atol) by more than this factor ends
@@ -77,6 +77,16 @@ def _digest(params: DPGTParams, cfg: "RunConfig", code: bool) -> str:
 def run_fingerprint(params: DPGTParams, cfg: "RunConfig") -> str:
     """Identifies a run: parameters, run settings (the progress display excluded) and code."""
     return _digest(params, cfg, code=True)
+
+
+def run_description(params: DPGTParams, cfg: "RunConfig") -> dict[str, str]:
+    """Every parameter (dotted key) and run setting as text: what summary.json keeps so that a refusal to replace
+    a folder's results can name what differs."""
+    from components.params import flatten
+
+    out = {k: str(v) for k, v in flatten(params).items()}
+    out.update({f"settings.{k}": repr(v) for k, v in asdict(replace(cfg, progress=False)).items()})
+    return out
 
 
 def parameters_fingerprint(params: DPGTParams, cfg: "RunConfig") -> str:
@@ -134,7 +144,8 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
     A folder holding finished results of other parameters is refused unless ``overwrite``
     (:func:`scenarios.integrity.claim_folder`); damaged files there are moved aside and recomputed."""
     with folder_lock(out_dir):
-        how = claim_folder(out_dir, parameters_fingerprint(params, cfg), run_fingerprint(params, cfg), overwrite)
+        how = claim_folder(out_dir, parameters_fingerprint(params, cfg), run_fingerprint(params, cfg), overwrite,
+                           description=run_description(params, cfg))
         if how == "recompute":
             print(f"{out_dir}: recomputing, its results were made by other code")
         return _run_case(params, cfg, Path(out_dir), label)
@@ -203,6 +214,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
         },
         "integration": asdict(integ),
         "fingerprint": fp, "parameters_fingerprint": parameters_fingerprint(params, cfg),
+        "run_description": run_description(params, cfg),
     })
     atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2, default=_json_default))
     return summary

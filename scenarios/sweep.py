@@ -19,7 +19,7 @@ from pathlib import Path
 
 from mbd.recorder import atomic_write_text
 
-from .integrity import OtherResults, claim_folder, read_summary, results_intact
+from .integrity import OtherResults, claim_folder, differences, read_summary, results_intact
 
 __all__ = ["Case", "run_sweep", "execute_case", "check_folders", "user_overrides", "validate_cases", "OPERATING_AXES"]
 
@@ -124,7 +124,7 @@ def _finished(case: Case, params, cfg) -> dict | None:
 def check_folders(cases: list[Case], cfg, overwrite: bool = False) -> None:
     """Before any run starts: refuse (:class:`~scenarios.integrity.OtherResults`) when a case's folder holds
     finished results of other parameters or settings and ``overwrite`` is not given; list every such folder."""
-    from .runner import parameters_fingerprint, run_fingerprint
+    from .runner import parameters_fingerprint, run_description, run_fingerprint
 
     others = []
     for c in cases:
@@ -132,7 +132,8 @@ def check_folders(cases: list[Case], cfg, overwrite: bool = False) -> None:
         try:
             claim_folder(c.out_dir, parameters_fingerprint(params, ccfg), run_fingerprint(params, ccfg), overwrite)
         except OtherResults:
-            others.append(c.out_dir)
+            s = read_summary(Path(c.out_dir) / "summary.json") or {}
+            others.append(c.out_dir + differences(s.get("run_description"), run_description(params, ccfg), most=2))
     if others:
         raise OtherResults(f"{', '.join(others)} hold{'s' if len(others) == 1 else ''} finished results of other "
                            f"parameters or settings; pass --overwrite to replace them, or choose another --out")
