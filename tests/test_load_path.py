@@ -108,7 +108,8 @@ def _relative_angles(bs):
     carrier = m.body("carrier").index
 
     class Angles(mbd.Observer):
-        t, cage_rel, planet_rel = [], [], []
+        def __init__(self):
+            self.t, self.cage_rel, self.planet_rel = [], [], []
 
         def step(self, s0, s1):
             th = m.full(s1.t, s1.q, s1.v)[0][2::3]
