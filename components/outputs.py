@@ -416,7 +416,7 @@ class WindowStatistics(mbd.Observer):
         np.copyto(acc[3], np.minimum(acc[3], np.minimum(va, vb)), where=inside)
         self._T["global"] += max(wg - wa, 0.0) * h
         self._T["bearing"] += np.maximum(wb - wa, 0.0) * h
-        self._impacts(s0, s1, x1, s0.t + wb * h)
+        self._impacts(s0, s1, x0, x1, wb, s0.t + wb * h)
         self._prev = x1
 
     def _layout(self, x) -> None:
@@ -481,10 +481,12 @@ class WindowStatistics(mbd.Observer):
             ref.append(int(mine[np.argmin(np.abs(off))]))
         self.ref_roller = tuple(ref)
 
-    def _impacts(self, s0, s1, x1, t_end_bearing) -> None:
+    def _impacts(self, s0, s1, x0, x1, wb, t_end_bearing) -> None:
         """Pocket impacts: contact onsets faster than the element's approach-speed floor (the pocket element
         stores the approach speed v0 > 0 in column 0 of its internal state from the step in which contact
-        begins), their speeds and peak forces; onsets at the floor count as touches."""
+        begins), their speeds and peak forces; onsets at the floor count as touches. ``wb``: where each
+        bearing's window ends in this step (1: after it); a peak is taken up to that end (the force there
+        linear in the step, as every window end is), never past it."""
         fam = FAMILY["pocket"]
         pb = self.plan.pocket_bearing
         if pb is None or fam not in s1.z:
@@ -504,7 +506,8 @@ class WindowStatistics(mbd.Observer):
         onset = contact & ~touch
         im["touches"] += touch
         ended = (im["active"] > 0) & ((z1 <= 0.0) | ~in_window)
-        force = np.abs(x1["pocket_force"])
+        w = wb[pb]
+        force = np.abs(x0["pocket_force"] + w * (x1["pocket_force"] - x0["pocket_force"]))
         np.maximum(im["peak_now"], np.where(im["active"] > 0, force, 0.0), out=im["peak_now"])
         im["peak_sum"] += np.where(ended, im["peak_now"], 0.0)
         np.maximum(im["peak_max"], np.where(ended, im["peak_now"], 0.0), out=im["peak_max"])

@@ -274,12 +274,14 @@ def test_quasi_static_force_polygon(polygons, direction):
     internal to S; from outside it gets the mesh forces on the planet, the inner-raceway contacts and the
     lubricant drag from the carrier, and (in R) the frame forces m Ω² x + 2 m Ω k×v (gravity is off). So
         pin load P = −Σ inner contact forces = Σ mesh + Σ drag + Σ frame forces − d(Σ m v)/dt,
-    exact in the mean; at steady state the frame forces are m r Ω² of planet + rollers + cage at the
-    pin radius, the drag cancels around the pin and the momentum stays bounded: P ≈ mesh + m r Ω² (§6.3)."""
+    exact in the mean (measured ≤ 5.7e-6 of P: what the integrator conserves; tolerance 2e-5); at steady state
+    the frame forces are m r Ω² of planet + rollers + cage at the pin radius, the drag cancels around the pin
+    and the momentum stays bounded: P ≈ mesh + m r Ω² (§6.3; measured ≤ 1.8e-3 of P over this 3 ms window,
+    where the mesh is 11–43 % of P; tolerance 3e-3). The carrier runs 3.4e-4 below its reference speed."""
     bs, rows, mean, dmom, w_c = polygons[direction]
     b = bs.meta["bearing"]
     W = bs.model.frame.omega
-    assert w_c == pytest.approx(W, rel=3e-3)                  # the carrier runs at the reference speed
+    assert w_c == pytest.approx(W, rel=1e-3)                  # the carrier runs at the reference speed
     m_s = bs.model.mass[bs.model.body("a1").index] + b.rollers * b.roller_mass + b.cage.mass
     radius = {"inner": 0.0825, "outer": 0.087}
     for k, (n, key, h, bodies, on) in enumerate(rows):
@@ -290,11 +292,11 @@ def test_quasi_static_force_polygon(polygons, direction):
         centrifugal = m_s * radius[key] * W * W * np.array([math.cos(psi), math.sin(psi)])
         P = np.linalg.norm(pin)
         assert P > 5e3                                         # a real load: ≈ 7–13 kN at condition 3
-        # the exact balance (what the integrator conserves): 1e-4 of the load
-        assert np.linalg.norm(pin - (mesh + drag + frame - dmom[k, 8:10])) < 1e-4 * P
+        # the exact balance (what the integrator conserves)
+        assert np.linalg.norm(pin - (mesh + drag + frame - dmom[k, 8:10])) < 2e-5 * P
         assert np.linalg.norm(drag) < 1.0                      # drag is a couple about the pin
-        # §6.3: the quasi-static polygon with the nominal centrifugal force, within 2 %
-        assert np.linalg.norm(pin - (mesh + centrifugal)) < 0.02 * P, (n, key)
+        # §6.3: the quasi-static polygon with the nominal centrifugal force
+        assert np.linalg.norm(pin - (mesh + centrifugal)) < 3e-3 * P, (n, key)
         assert np.linalg.norm(mesh) > 0.05 * P                 # both terms matter (mesh: 11–87 % of P)
 
 

@@ -38,7 +38,11 @@ def test_fault_study_runs_end_to_end(tmp_path):
     assert {(r["fault"], r["bearing"]) for r in rows} == {(f, b) for f in ("perfect", "bent", "cracked_tooth")
                                                           for b in ("inner", "outer")}
     by = {(r["fault"], r["bearing"]): r for r in rows}
-    assert float(by[("perfect", "outer")]["life_relative"]) == 1.0
+    # each fault's life relative to the perfect machine's, bearing kind by bearing kind (not to its own run)
+    for (fault, kind), r in by.items():
+        ratio = float(r["life_iso16281_h"]) / float(by[("perfect", kind)]["life_iso16281_h"])
+        assert float(r["life_relative"]) == pytest.approx(ratio, rel=1e-12), (fault, kind)
+        assert (abs(ratio - 1.0) > 1e-6) == (fault != "perfect"), (fault, kind, ratio)
     assert float(by[("bent", "outer")]["load_sharing_factor"]) > float(by[("perfect", "outer")]["load_sharing_factor"])
     assert float(by[("cracked_tooth", "outer")]["own_frequency"]) == pytest.approx(
         fault_study.characteristic_frequencies(reference_dpgt(2).si())["outer_planet_rel"])

@@ -4,10 +4,14 @@ hold the planets' centrifugal load. Statistics come from components.outputs.Wind
 accepted step, a window of one whole cage revolution relative to the carrier)."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
-from components.outputs import MESH_FAMILY
+import mbd
+from components.bearing import bearing_kinematics
+from components.outputs import MESH_FAMILY, bearing_map
 from components.presets import reference_dpgt
 
 from dpgt_runs import line_of_action, run
@@ -42,46 +46,127 @@ def test_coast_flanks_stay_open_and_the_sun_flank_carries_the_torque(runs, direc
     np.testing.assert_allclose(drive["sun_inner"], share, rtol=0.02)
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("case", CASES)
-def test_bearing_load_is_the_drive_flank_polygon_plus_centrifugal_force(runs, case):
-    """§6.3 with backlash: the time-mean load of every planet bearing (pin reaction, radial and
-    tangential in the carrier frame) equals the vector sum of the mean drive-flank forces on its planet,
-    each along its nominal line of action, and the centrifugal force m r Ω² of everything the bearing
-    carries (planet + rollers + cage), within 2 % — at full load and at no load, both directions."""
-    bs, stats, _, _ = runs[case]
-    si = reference_dpgt(*case).si()
+def force_polygon(bs, stats, si):
+    """Per bearing (bearing-map order): the time-mean pin reaction (radial and tangential in the carrier frame,
+    back in the carrier-fixed axes of the nominal layout) and the force polygon that should hold it — the mean
+    flank forces on its planet, each along its nominal line of action (drive and coast flank: the coast flanks
+    carry the loss torque at no load), plus m r Ω² of planet, rollers and cage — the mesh part alone, and the
+    radial unit vector."""
     lay, m, b = si.layout, bs.model, bs.meta["bearing"]
     W = si.operating.carrier_speed
-    flanks = bs.handles["flanks"]
-    F = {key: stats.stats(f"{key}_drive_force")["mean"] for key in MESH_FAMILY}
+    drive = bs.handles["flanks"]
     lr, lt = stats.stats("load_radial")["mean"], stats.stats("load_tangential")["mean"]
     carried = b.rollers * b.rows * b.roller_mass + b.cage.mass
-    i = 0
+    M = lay.meshes
+    out = []
     for n, pair in enumerate(bs.handles["pairs"]):
         ca, cb = lay.centres_a[n], lay.centres_b[n]
-        e_sa = ca / np.linalg.norm(ca)
-        e_ab = (cb - ca) / np.linalg.norm(cb - ca)
-        e_br = cb / np.linalg.norm(cb)
-        M = lay.meshes
-        on = {  # drive-flank forces on each planet: gear 2 of an external mesh gets +n, gear 1 −n
-            "inner": F["sun_inner"][n] * line_of_action(e_sa, flanks["sun_inner"], M["sun_inner"].pressure_angle, False)
-            - F["inner_outer"][n] * line_of_action(e_ab, flanks["inner_outer"], M["inner_outer"].pressure_angle, False),
-            "outer": F["inner_outer"][n] * line_of_action(e_ab, flanks["inner_outer"], M["inner_outer"].pressure_angle, False)
-            + F["outer_ring"][n] * line_of_action(e_br, flanks["outer_ring"], M["outer_ring"].pressure_angle, True),
-        }
+        e = {"sun_inner": ca / np.linalg.norm(ca), "inner_outer": (cb - ca) / np.linalg.norm(cb - ca),
+             "outer_ring": cb / np.linalg.norm(cb)}
+
+        def force(key):    # the mesh force on gear 2 (external) or on the planet (internal), both flanks
+            return sum(stats.stats(f"{key}_{flank}_force")["mean"][n]
+                       * line_of_action(e[key], sign * drive[key], M[key].pressure_angle, key == "outer_ring")
+                       for flank, sign in (("drive", 1), ("coast", -1)))
+
+        # gear 2 of an external mesh gets +F, gear 1 −F
+        on = {"inner": force("sun_inner") - force("inner_outer"), "outer": force("inner_outer") + force("outer_ring")}
         for kind, c in (("inner", ca), ("outer", cb)):
+            i = len(out)
             assert stats.bmap[i]["kind"] == kind and stats.bmap[i]["pair"] == n
             r = np.linalg.norm(c)
             er = c / r
             et = np.array([-er[1], er[0]])
             mass = m.mass[m.body(pair.planet(kind)).index] + carried
-            poly = on[kind] + mass * r * W * W * er
-            pin = lr[i] * er + lt[i] * et
-            P = np.linalg.norm(pin)
-            assert P > 5e3                                        # a real load: centrifugal ≈ 10 kN
-            assert np.linalg.norm(pin - poly) < 0.02 * P, (case, n, kind, pin, poly)
-            i += 1
+            out.append((lr[i] * er + lt[i] * et, on[kind] + mass * r * W * W * er, on[kind], er))
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", CASES)
+def test_bearing_load_is_the_flank_force_polygon_plus_centrifugal_force(runs, case):
+    """§6.3 with backlash: the time-mean load of every planet bearing (pin reaction, radial and
+    tangential in the carrier frame) equals the vector sum of the mean flank forces on its planet, each along
+    its nominal line of action, and the centrifugal force m r Ω² of everything the bearing carries (planet +
+    rollers + cage): measured ≤ 1.3e-3 of the load at full load (the coast flanks open), ≤ 1.0e-3 at no load,
+    where the coast flanks carry the bearings' loss torque (with the drive flanks alone: up to 1.1e-2);
+    tolerance 2e-3, both directions."""
+    bs, stats, _, _ = runs[case]
+    for pin, poly, _, _ in force_polygon(bs, stats, reference_dpgt(*case).si()):
+        P = np.linalg.norm(pin)
+        assert P > 5e3                                        # a real load: centrifugal ≈ 10 kN
+        assert np.linalg.norm(pin - poly) < 2e-3 * P, (case, pin, poly)
+
+
+def _relative_angles(bs):
+    """An observer recording, on every step, the angles of each bearing's cage and planet relative to the
+    carrier (bearing-map order) — what the statistics integrate as speeds, taken here from the positions."""
+    m = bs.model
+    bm = bearing_map(bs)
+    cage = np.array([m.body(x["cage"]).index for x in bm])
+    planet = np.array([m.body(x["planet"]).index for x in bm])
+    carrier = m.body("carrier").index
+
+    class Angles(mbd.Observer):
+        def __init__(self):
+            self.t, self.cage_rel, self.planet_rel = [], [], []
+
+        def step(self, s0, s1):
+            th = m.full(s1.t, s1.q, s1.v)[0][2::3]
+            self.t.append(s1.t)
+            self.cage_rel.append(th[cage] - th[carrier])
+            self.planet_rel.append(th[planet] - th[carrier])
+
+    return Angles()
+
+
+@pytest.fixture(scope="module")
+def full_load_reverse():
+    """Condition 3 reverse (the largest mesh share: 26–43 % of the bearing loads): settled 8 ms, one cage
+    revolution relative to the carrier, with the relative angles of every cage and planet recorded."""
+    return run(3, "reverse", extra=lambda bs, t0, t1: [_relative_angles(bs)])
+
+
+def test_pin_reaction_vector_is_the_flank_force_polygon_at_full_load(full_load_reverse):
+    """The fast version of the polygon test above, on one run: every bearing's mean pin reaction, as a vector
+    in the carrier frame, is the flank force polygon plus m r Ω² (measured ≤ 8.1e-4 of the load; tolerance 2e-3),
+    where the mesh part is 26–43 % of it; so are the radial and tangential means the summary reports for
+    pair 1's bearings."""
+    bs, stats, _, _ = full_load_reverse
+    s = stats.summary()
+    poly = force_polygon(bs, stats, reference_dpgt(3, "reverse").si())
+    for i, (pin, pol, mesh, _) in enumerate(poly):
+        P = np.linalg.norm(pin)
+        assert np.linalg.norm(mesh) > 0.25 * P
+        assert np.linalg.norm(pin - pol) < 2e-3 * P, (i, pin, pol)
+    for kind, (pin, pol, _, er) in zip(("inner", "outer"), poly[:2]):
+        d, P = s[kind], np.linalg.norm(pin)
+        radial, tangential = pol @ er, pol[1] * er[0] - pol[0] * er[1]
+        assert d["bearing_load_radial_mean_N"] == pytest.approx(radial, abs=2e-3 * P)
+        assert d["bearing_load_tangential_mean_N"] == pytest.approx(tangential, abs=2e-3 * P)
+
+
+def test_cage_slip_is_the_lag_behind_the_epicyclic_speed(full_load_reverse):
+    """Pair 1's cages at full load: over each bearing's window (whole cage revolutions relative to the
+    carrier) the cage turned 2π n relative to the carrier (the recorded positions, not the statistics'
+    speeds: measured 3e-7 rad), and cage_slip_pct is 100 (1 − ω_cage/ω_m) with the mean speeds from those
+    positions and ω_m the epicyclic cage speed of bearing_kinematics, relative to the carrier (measured
+    6e-6 points at slips of 0.71 and 0.57 %; tolerance 1e-4). Inverted it would read ≈ −0.7 %."""
+    bs, stats, (angles,), _ = full_load_reverse
+    s = stats.summary()
+    b = bs.meta["bearing"]
+    t = np.array(angles.t)
+    for kind, i in (("inner", 0), ("outer", 1)):
+        d = s[kind]
+        ta, tb = d["window_s"]
+        at = lambda x, tt: float(np.interp(tt, t, np.array(x)[:, i]))
+        d_cage = at(angles.cage_rel, tb) - at(angles.cage_rel, ta)
+        d_planet = at(angles.planet_rel, tb) - at(angles.planet_rel, ta)
+        assert abs(d_cage) == pytest.approx(2 * math.pi * d["cage_revolutions"], abs=1e-6)
+        w_m = bearing_kinematics(b, 0.0, d_planet / (tb - ta))[0]
+        slip = 100 * (1 - d_cage / (tb - ta) / w_m)
+        assert d["cage_slip_pct"] == pytest.approx(slip, abs=1e-4)
+        assert 0.2 < slip < 2.0
 
 
 @pytest.mark.slow
@@ -115,21 +200,21 @@ def test_no_load_reverse_is_the_mirror_image_of_forward(runs):
     """Condition 4 (no load, 4200 r/min): the forward machine (h = −1) and its mirror image (h = +1) run in
     reverse give the same statistics (gravity, 9.81 against ≈ 17 000 m/s² of centrifugal acceleration, is
     the only part the mirror does not map — and the roller and cage impacts amplify any difference, so
-    after 15 ms the two runs are different realisations of the same motion). Compared over every bearing
-    of a type: within 2 %, or, for the chaotic cage motion, within the scatter between the N identical
-    bearings of one run over the same window (one cage revolution: up to ±3 % for a tangential RMS)."""
+    after 15 ms the two runs are different realisations of the same motion). Compared as the RMS over the
+    three bearings of a type: the loads within 1 % (measured ≤ 0.35 %, the pocket forces; ≤ 0.01 % the
+    others), the chaotic cage accelerations within 5 % (measured 0.4–2.6 %; 0.1–1.7 % with gravity off:
+    the realisations differ by about that much whatever breaks the mirror, the bound is ≈ 3 of their
+    ≈ 1.6 % RMS deviation). A fixed bound: one that grew with the scatter between the bearings would grow
+    with the differences it is meant to catch."""
     f = runs[4, "forward"][1]
     m = run(4, "reverse", {"gears.handedness": 1})[1]
     for kind in ("inner", "outer"):
         sel = np.flatnonzero(f.plan.kinds == kind)
         for key in ("roller_inner_load", "roller_outer_load", "pocket_force", "guide_force", "load_magnitude"):
-            assert m.aggregate_rms(key, sel) == pytest.approx(f.aggregate_rms(key, sel), rel=0.02), (kind, key)
+            assert m.aggregate_rms(key, sel) == pytest.approx(f.aggregate_rms(key, sel), rel=0.01), (kind, key)
         for key in ("cage_acc_magnitude", "cage_acc_rel_magnitude", "cage_acc_radial", "cage_acc_tangential",
                     "cage_acc_rel_radial", "cage_acc_rel_tangential"):
-            a, b = f.aggregate_rms(key, sel), m.aggregate_rms(key, sel)
-            per = f.stats(key)["rms"][sel]
-            scatter = (per.max() - per.min()) / per.mean()
-            assert abs(b / a - 1.0) <= max(0.02, scatter), (kind, key, a, b, scatter)
+            assert m.aggregate_rms(key, sel) == pytest.approx(f.aggregate_rms(key, sel), rel=0.05), (kind, key)
 
 
 @pytest.mark.slow

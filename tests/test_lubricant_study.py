@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import json
 
 import pytest
 
@@ -23,7 +24,12 @@ def test_the_study_writes_its_table_answer_and_plot(study, capsys):
         rows = list(csv.DictReader(fh))
     assert len(rows) == 2 * 2 * 2                               # 2 oils × 2 directions × 2 bearing types
     assert set(rows[0]) == set(lubricant_study.COLUMNS)
-    assert all(float(r["h_min_m"]) > 0 and float(r["lambda_min"]) > 0 and r["cage_slip_pct"] for r in rows)
+    assert all(float(r["h_min_m"]) > 0 and float(r["lambda_min"]) > 0 for r in rows)
+    # every row is its run's summary (the column a number, the bearing kind's, not a string that merely exists)
+    for r in rows:
+        s = json.loads((study / f"c{r['condition']}_{r['direction']}_{r['lubricant']}" / "summary.json").read_text())
+        for col in ("cage_slip_pct", "lambda_min", "roller_inner_race_rms_N", "heat_traction_W"):
+            assert float(r[col]) == pytest.approx(s[r["bearing"]][col], rel=1e-12), (r["lubricant"], r["bearing"], col)
     # the isothermal film thickens with the oil as Pan–Hamrock's η^0.694 (10×: ≈ 4.9×; loads differ a little);
     # the thermal one less, L growing with η (10 mPa·s: L ≈ 0.6, φ_T ≈ 0.85; 100: L ≈ 6, φ_T ≈ 0.55)
     for d in ("forward", "reverse"):
