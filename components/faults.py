@@ -66,6 +66,13 @@ def check_errors(si) -> None:
         if x.width + x.edge >= np.pi * R:
             raise ParameterError.at(f"errors.spall[{i}].width", f"must be shorter than half the raceway "
                                                                 f"({np.pi * R:.3g} m), got {x.width:.3g} m")
+        # a defect cannot be deeper than the ring it is in: the solid pin, or the planet's rim under its bore
+        planet_gear = si.gears["inner_planet" if x.planet[0] == "a" else "outer_planet"]
+        ring, what = ((b.inner_raceway_radius, "the pin's radius") if x.raceway == "inner" else
+                      (planet_gear.root_radius - b.outer_raceway_radius, "the planet's rim under the bore"))
+        if x.depth >= ring:
+            raise ParameterError.at(f"errors.spall[{i}].depth", f"must be smaller than the ring it is in ({what}, "
+                                                                f"{ring * 1e3:.3g} mm), got {x.depth * 1e3:.3g} mm")
     keys = [(x.planet, x.raceway) for x in e.spall]
     if len(set(keys)) < len(keys):
         raise ParameterError.at("errors.spall", "at most one spall per raceway (two entries name the same "
@@ -79,7 +86,35 @@ def check_errors(si) -> None:
     runout = [x.gear for x in e.runout]
     if len(set(runout)) < len(runout):
         raise ParameterError.at("errors.runout", "at most one runout entry per gear")
+    _check_pinholes(si)
     teeth.check_teeth(si)
+
+
+def _check_pinholes(si) -> None:
+    """A pinhole error moves its planet, and so its centre distances, by its size (plus the bearing's play c/2):
+    the gears must take that (no tip striking a root, ε_α ≥ 1; :func:`geometry.centre_distance_limit`), as the
+    clearance check asks of the play alone."""
+    from .geometry import centre_distance_limit
+
+    e, lay = si.errors, si.layout
+    play = 0.5 * si.bearing.clearance
+    moved: dict[str, float] = {}
+    first: dict[str, int] = {}
+    for i, x in enumerate(e.pinhole):
+        moved[x.planet] = moved.get(x.planet, 0.0) + float(np.hypot(x.radial, x.tangential))
+        first.setdefault(x.planet, i)
+    for planet, d in moved.items():
+        n = _planet_index(planet)
+        other = moved.get(("b" if planet[0] == "a" else "a") + planet[1:], 0.0)     # the pair's other planet
+        meshes = (("sun_inner", d + play), ("inner_outer", d + other + 2 * play)) if planet[0] == "a" else \
+                 (("inner_outer", d + other + 2 * play), ("outer_ring", d + play))
+        for key, da in meshes:
+            what = centre_distance_limit(lay.meshes[key], lay.gears, da)
+            if what:
+                raise ParameterError.at(f"errors.pinhole[{first[planet]}]",
+                                        f"moves {planet} by {d * 1e6:.4g} um, its {key.replace('_', '-')} centre distance "
+                                        f"(with the bearing's play) by up to {da * 1e3:.3f} mm, at which {what}: the "
+                                        f"gears allow less (pair {n + 1})")
 
 
 def pin_position(si, planet: str, nominal) -> np.ndarray:

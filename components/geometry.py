@@ -58,7 +58,7 @@ __all__ = [
     "centre_distances", "pair_angle", "planet_angles", "speed_ratio", "planet_speed_ratios", "iso_minimum_backlash",
     "mesh_frequency", "SIDEBAND_ORIGINS", "sideband_origin", "contact_path", "contact_ratio", "assembly_number", "mesh_phases",
     "mesh_stiffness_levels", "mesh_damping", "mesh_equivalent_mass", "palmgren_stiffness", "kinematics", "layout", "loaded_flanks",
-    "design_findings", "check_design",
+    "design_findings", "check_design", "centre_distance_limit",
 ]
 
 TWO_PI = 2.0 * math.pi
@@ -698,27 +698,35 @@ def _tip_root_clearances(g1: GearGeometry, g2: GearGeometry, a: float, internal:
     return min(a - g1.tip_radius - g2.root_radius, a - g2.tip_radius - g1.root_radius)
 
 
+def centre_distance_limit(mg, G, da: float) -> str | None:
+    """Why mesh ``mg``'s gears cannot take their centre distance moved by ±da, or None: the teeth must neither
+    strike the mating roots (tip–root gap > 0) nor lose continuous contact (ε_α ≥ 1), which the mesh model has
+    neither of."""
+    g1, g2 = G[mg.gear1], G[mg.gear2]
+    for a in (mg.centre_distance - da, mg.centre_distance + da):
+        gap = _tip_root_clearances(g1, g2, a, mg.internal)
+        try:
+            eps = contact_ratio(g1, g2, a, mg.internal)
+        except ParameterError:
+            eps = 0.0
+        if gap <= 0.0 or eps < 1.0:
+            return (f"the teeth strike the mating roots (tip-root gap {gap * 1e3:.3f} mm)" if gap <= 0.0 else
+                    f"the contact ratio falls to {eps:.3f} < 1")
+    return None
+
+
 def _clearance_findings(lay, bs, G, out) -> None:
     """A bearing clearance bigger than the gears allow: a planet free to move c/2 on its pin (the inner–outer
-    mesh: both planets, c) changes its centre distances by that much; the teeth must then neither strike the
-    mating roots (tip–root gap > 0) nor lose continuous contact (ε_α ≥ 1), which the mesh model has neither of."""
+    mesh: both planets, c) changes its centre distances by that much (:func:`centre_distance_limit`)."""
     play = 0.5 * bs.clearance
     for key, mg in lay.meshes.items():
         da = 2.0 * play if key == "inner_outer" else play
-        g1, g2 = G[mg.gear1], G[mg.gear2]
-        for a in (mg.centre_distance - da, mg.centre_distance + da):
-            gap = _tip_root_clearances(g1, g2, a, mg.internal)
-            try:
-                eps = contact_ratio(g1, g2, a, mg.internal)
-            except ParameterError:
-                eps = 0.0
-            if gap <= 0.0 or eps < 1.0:
-                what = (f"the teeth strike the mating roots (tip-root gap {gap * 1e3:.3f} mm)" if gap <= 0.0 else
-                        f"the contact ratio falls to {eps:.3f} < 1")
-                out.append(Finding("error", "bearing.clearance",
-                                   f"{bs.clearance * 1e3:g} mm lets the {key.replace('_', '-')} centre distance move by "
-                                   f"{da * 1e3:.3f} mm, at which {what}: the gears allow less"))
-                return
+        what = centre_distance_limit(mg, G, da)
+        if what:
+            out.append(Finding("error", "bearing.clearance",
+                               f"{bs.clearance * 1e3:g} mm lets the {key.replace('_', '-')} centre distance move by "
+                               f"{da * 1e3:.3f} mm, at which {what}: the gears allow less"))
+            return
 
 
 def check_design(params, strict: bool = True) -> list[Finding]:
