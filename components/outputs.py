@@ -39,7 +39,7 @@ from .life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equiva
                    iso281_rating, lundberg_palmgren_life, raceway_ratings, relative_life)
 from .lubrication import bearing_film
 
-__all__ = ["FAMILY", "MESH_FAMILY", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
+__all__ = ["FAMILY", "MESH_FAMILY", "BearingSeries", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
            "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life",
            "contact_film", "SUMMARY_WORDS"]
 
@@ -167,6 +167,59 @@ def radial_tangential(vec, planet_xy, carrier_xy):
     vec = np.asarray(vec, float)
     return (vec[..., 0] * er[..., 0] + vec[..., 1] * er[..., 1],
             -vec[..., 0] * er[..., 1] + vec[..., 1] * er[..., 0])
+
+
+class BearingSeries:
+    """Each planet bearing's load (the pin reaction) and its cage's slip at every recorded sample, for results.nc
+    (the statistics take every step; these are the histories to plot). The load is split as the statistics split
+    it — radial from the carrier axis through the planet, tangential 90° ahead — and the slip is the cage's speed
+    below its epicyclic speed, both relative to the carrier, as ``cage_slip_pct``."""
+
+    def __init__(self, scene):
+        model = scene.model
+        self.bmap = bearing_map(scene)
+        idx = lambda name: model.body(name).index
+        self.planet = np.array([idx(b["planet"]) for b in self.bmap])
+        self.carrier = idx("carrier")
+        self.rows = int(getattr(scene.meta["bearing"], "rows", 1))
+        self.rollers = self.bmap[0]["type"] == "rollers"
+        if self.rollers:
+            self.roller_bearing = np.concatenate([np.full(b["race_inner"][1] - b["race_inner"][0], i)
+                                                  for i, b in enumerate(self.bmap)])
+        else:
+            self.spring = np.array([b["spring"] for b in self.bmap])
+        self.cage = np.array([idx(b["cage"]) for b in self.bmap]) if self.rollers and "cage" in self.bmap[0] else None
+        bs = scene.meta["bearing"]
+        Ri, Ro = 0.5 * (bs.pitch_diameter - bs.roller_diameter), 0.5 * (bs.pitch_diameter + bs.roller_diameter)
+        self.pitch_ratio = Ro / (Ri + Ro)
+        self.names = tuple(b["name"] for b in self.bmap)
+
+    def load(self, t, X, V, A, outputs) -> np.ndarray:
+        """(radial, tangential) pin reaction per bearing [N], (2, nb)."""
+        if self.rollers:
+            pin = pin_reactions(outputs[FAMILY["race_inner"]], slice(None), self.roller_bearing, len(self.bmap), self.rows)
+        else:
+            lin = outputs[FAMILY["linear"]]
+            pin = -np.column_stack([lin["fx"][self.spring], lin["fy"][self.spring]])
+        return np.array(radial_tangential(pin, X[self.planet, :2], X[self.carrier, :2]))
+
+    def slip(self, t, X, V, A, outputs) -> np.ndarray:
+        w_cage = V[self.cage, 2] - V[self.carrier, 2]
+        w_epi = self.pitch_ratio * (V[self.planet, 2] - V[self.carrier, 2])
+        return 100.0 * (1.0 - w_cage / np.where(w_epi != 0.0, w_epi, np.nan))
+
+    def probes(self) -> list:
+        where = "radial: from the carrier axis through the planet; tangential 90 deg ahead"
+        out = [mbd.DerivedOutput("bearing.load_radial", lambda *a: self.load(*a)[0], "N",
+                                 f"planet bearing load (pin reaction), radial component ({where})", instances=self.names),
+               mbd.DerivedOutput("bearing.load_tangential", lambda *a: self.load(*a)[1], "N",
+                                 f"planet bearing load (pin reaction), tangential component ({where})",
+                                 instances=self.names)]
+        if self.cage is not None:
+            out.append(mbd.DerivedOutput("bearing.cage_slip", self.slip, "percent",
+                                         "cage speed below its epicyclic speed, relative to the carrier",
+                                         instances=self.names))
+        return out
 
 
 # ----------------------------------------------------------------------------------------------

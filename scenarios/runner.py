@@ -35,7 +35,7 @@ from components.params import DPGTParams
 from components.scene import SceneOptions
 from mbd.recorder import BodyMotion, Recorder, atomic_write_text
 
-from components.outputs import WindowStatistics, bearing_map, cage_period, default_window
+from components.outputs import BearingSeries, WindowStatistics, bearing_map, cage_period, default_window
 from components.sensor import HousingLoads
 from components.results_schema import drawing_geometry, element_probes
 
@@ -134,7 +134,7 @@ def _probes(scene, sensor: bool = False) -> list:
     loads on the housing (:class:`components.sensor.HousingLoads`)."""
     return [BodyMotion("motion", frame="reference"),
             BodyMotion("fixed", bodies=["sun", "carrier", "ring"], frame="fixed"),
-            *element_probes(scene),
+            *element_probes(scene), *BearingSeries(scene).probes(),
             *(HousingLoads(scene).probes() if sensor else [])]
 
 
@@ -169,7 +169,10 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     stats = WindowStatistics(scene, cfg.settle, cfg.settle + window)
     sensor = {"sensor": params.si().rig.sensor.to_dict()} if cfg.sensor else {}
     rec = Recorder(out_dir / "results.nc", dt=1.0 / cfg.sample_rate, probes=_probes(scene, cfg.sensor), t_start=cfg.settle,
-                   attrs={"bearings": bmap, "meta": meta, "label": label or {},
+                   attrs={"Conventions": "CF-1.10",
+                          "title": f"DPGT run: carrier {params.si().operating.carrier_speed * 30 / np.pi:.0f} r/min, "
+                                   f"{params.si().operating.output_power / 1e3:.0f} kW, {params.si().operating.direction}",
+                          "bearings": bmap, "meta": meta, "label": label or {},
                           "geometry": drawing_geometry(params), **sensor})
     integ = cfg.integration
     t_end = stats.t_end          # the window plus a margin for slipping cages (WindowStatistics)
