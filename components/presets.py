@@ -74,7 +74,11 @@ def reference_gears() -> GearSetParams:
 
 
 # ISO VG grades (ISO 3448: the grade is the kinematic viscosity at 40 degC, mm^2/s) of mineral oils with a
-# viscosity index near 100; the 100 degC values are typical of such oils' data sheets
+# viscosity index near 100; the 100 degC values are typical of such oils' data sheets (VG 32, 68, 150, the lubricant
+# study's) or of a reference table of typical values per grade (lubesolut.com "ISO VG reference table": the others)
+_TABLE = "typical 100 degC value of a VI ~ 100 mineral oil (ISO VG reference table, lubesolut.com)"
+_TYPICAL_100 = {"VG10": 2.5, "VG15": 3.5, "VG22": 4.5, "VG46": 6.5, "VG100": 11.4, "VG220": 19.0, "VG320": 24.5,
+                "VG460": 32.0, "VG680": 42.0, "VG1000": 55.0, "VG1500": 74.0}
 OIL_GRADES = {
     "VG32": {"viscosity_40": assumed("32 mm^2/s", "ISO 3448 grade VG 32"),
              "viscosity_100": assumed("5.4 mm^2/s", "mineral oil, VI ~ 100")},
@@ -82,7 +86,10 @@ OIL_GRADES = {
              "viscosity_100": assumed("8.7 mm^2/s", "mineral oil, VI ~ 100")},
     "VG150": {"viscosity_40": assumed("150 mm^2/s", "ISO 3448 grade VG 150"),
               "viscosity_100": assumed("14.7 mm^2/s", "mineral oil, VI ~ 100")},
+    **{g: {"viscosity_40": assumed(f"{g[2:]} mm^2/s", f"ISO 3448 grade VG {g[2:]}"),
+           "viscosity_100": assumed(f"{v} mm^2/s", _TABLE)} for g, v in _TYPICAL_100.items()},
 }
+OIL_GRADES = dict(sorted(OIL_GRADES.items(), key=lambda kv: int(kv[0][2:])))
 
 
 def oil_grade(name: str) -> dict:

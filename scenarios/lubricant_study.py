@@ -34,6 +34,8 @@ from scipy.optimize import brentq
 import mbd
 from components.lubrication import FULL_FILM_LAMBDA, regime
 from components.presets import OIL_GRADES, oil_grade
+
+DEFAULT_GRADES = ("VG32", "VG68", "VG150")     # thin, the reference oil, thick: the study's default span
 from components.units import ParameterError, quantity, to_si
 from mbd.elements.ehl import FILM_MIN_U_EXPONENT, thermal_factor
 from mbd.recorder import atomic_write_text
@@ -64,7 +66,8 @@ def parse_args(argv):
     p.add_argument("--conditions", default="3", type=args.conditions, help="comma list of operating conditions 1-4 (default 3)")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--grades", default=None, type=args.choice_list(tuple(OIL_GRADES), "ISO VG grades"), help=f"comma list of ISO VG grades ({', '.join(OIL_GRADES)})")
+    g.add_argument("--grades", default=None, type=args.choice_list(tuple(OIL_GRADES), "ISO VG grades"),
+                   help=f"comma list of ISO VG grades ({', '.join(OIL_GRADES)}; default {','.join(DEFAULT_GRADES)})")
     g.add_argument("--viscosities", default=None,
                    help='dynamic viscosities at the operating temperature, e.g. "10,30,100 mPa*s"')
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded after the start (default 0.03)")
@@ -91,7 +94,7 @@ def lubricants(a) -> dict[str, dict]:
                 raise ParameterError.at("--viscosities", f"expected positive viscosities, got {q!r}")
             out[q.replace(" ", "").replace("*", "")] = {"lubricant.oil_viscosity": q}   # a file-name-safe label
         return out
-    grades = [s.strip() for s in (a.grades or ",".join(OIL_GRADES)).split(",") if s.strip()]
+    grades = [s.strip() for s in (a.grades or ",".join(DEFAULT_GRADES)).split(",") if s.strip()]
     return {g: {k: v.value for k, v in oil_grade(g).items()} for g in grades}
 
 
