@@ -76,7 +76,7 @@ BAD_ARGUMENTS = [
     ("paper_study", ["--scheduler", "my laptop"], "--scheduler: expected a Dask scheduler address"),
     ("paper_study", ["--method", "rk4"], "--method: invalid choice"),
     ("paper_study", ["--frobnicate"], "unrecognized arguments: --frobnicate"),
-    ("lubricant_study", ["--grades", "VG1000"], "--grades: takes ISO VG grades"),
+    ("lubricant_study", ["--grades", "VG999"], "--grades: takes ISO VG grades"),
     ("lubricant_study", ["--directions", ""], "--directions: expected a comma list"),
     ("spectrum", ["--power", "200 kg"], "--power: expected a power"),
     ("spectrum", ["--carrier-rpm", "-5"], "--carrier-rpm: must be > 0 r/min"),

@@ -53,7 +53,7 @@ def test_a_rerun_resumes_and_bad_oils_are_refused(study, capsys):
     before = (study / "summary.csv").read_text()
     assert lubricant_study.main(ARGS + ["--out", str(study)]) == 0    # every run finished: nothing recomputed
     assert (study / "summary.csv").read_text() == before
-    assert lubricant_study.main(ARGS[:4] + ["--grades", "VG46", "--out", str(study)]) == 2
+    assert lubricant_study.main(ARGS[:4] + ["--grades", "VG47", "--out", str(study)]) == 2
     assert "error: argument --grades: takes ISO VG grades" in capsys.readouterr().err
 
 

@@ -66,7 +66,7 @@ def test_oil_grades_and_bad_viscosities():
     with pytest.raises(ParameterError, match="viscosity_100.*below"):
         with_overrides(base, {"lubricant.viscosity_100": "80 mm^2/s"}).si()
     with pytest.raises(ParameterError, match="lubricant grade"):
-        oil_grade("VG46")
+        oil_grade("VG47")
     assert with_overrides(base, {"lubricant.temperature": "80 degC"}).si().lubricant.oil_viscosity < eta[1]
 
 
