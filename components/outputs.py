@@ -33,6 +33,7 @@ import mbd
 from mbd.ad import wrap_angle
 from mbd.elements.ehl import thermal_factor
 
+from .accumulate import IMPACT_ROWS, accumulate_steps
 from .bearing import bearing_kinematics
 from .families import FAMILY, MESH_FAMILY
 from .life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
@@ -90,36 +91,42 @@ def default_window(base: float, periods) -> float:
 # kinematics in the carrier frame
 # ----------------------------------------------------------------------------------------------
 def carrier_frame_motion(model, t, q, v, a, omega_c: float):
-    """(x, v, a) of every body, (nb, 3) each, in the frame turning at the nominal carrier speed
-    ``omega_c`` (its orientation at t is immaterial: only lengths and projections are read)."""
-    qf, vf = model.full(t, q, v)
+    """(x, v, a) of every body, (K, nb, 3) each, at K states (``t`` (K,), ``q``, ``v``, ``a`` (K, n_free)), in the
+    frame turning at the nominal carrier speed ``omega_c`` (its orientation at t is immaterial: only lengths
+    and projections are read)."""
+    t = np.asarray(t, float)
+    K = t.size
+    qf, vf = model.full_batch(t, q, v)
     af = np.zeros_like(qf)
-    af[model.free] = a
-    X, V, A = qf.reshape(-1, 3), vf.reshape(-1, 3), af.reshape(-1, 3)
+    af[:, model.free] = a
+    X, V, A = (x.reshape(K, -1, 3) for x in (qf, vf, af))
     fr = model.frame
     if fr.profile is None and fr.omega == omega_c:
         return X, V, A
-    Xi, Vi, Ai = mbd.to_fixed(X, V, model.frame.at(t), A)
-    c, s = math.cos(omega_c * t), math.sin(omega_c * t)
+    Xi, Vi, Ai = mbd.to_fixed(X, V, model.frame_batch(t), A)
+    phi = omega_c * t[:, None]
+    c, s = np.cos(phi), np.sin(phi)
     rot = lambda x, y: (c * x + s * y, -s * x + c * y)          # Rot(−φ)
     Om = omega_c
-    x, y = rot(Xi[:, 0], Xi[:, 1])
-    vx, vy = rot(Vi[:, 0], Vi[:, 1])
+    x, y = rot(Xi[..., 0], Xi[..., 1])
+    vx, vy = rot(Vi[..., 0], Vi[..., 1])
     vx, vy = vx + Om * y, vy - Om * x                               # v_C = Rot(−φ) v_I − Ω k × x_C
-    ax, ay = rot(Ai[:, 0], Ai[:, 1])
+    ax, ay = rot(Ai[..., 0], Ai[..., 1])
     ax, ay = ax + 2 * Om * vy + Om * Om * x, ay - 2 * Om * vx + Om * Om * y   # a_C = Rot(−φ) a_I − 2Ω k × v_C + Ω² x_C
-    return (np.column_stack([x, y, Xi[:, 2] - Om * t]), np.column_stack([vx, vy, Vi[:, 2] - Om]),
-            np.column_stack([ax, ay, Ai[:, 2]]))
+    return (np.stack([x, y, Xi[..., 2] - phi], axis=-1), np.stack([vx, vy, Vi[..., 2] - Om], axis=-1),
+            np.stack([ax, ay, Ai[..., 2]], axis=-1))
 
 
 def pin_reactions(race_inner: dict, rollers, bearing_of_roller, n_bearings: int, rows: int = 1) -> np.ndarray:
-    """(n_bearings, 2) force each bearing's rollers exert on its pin, in the model's frame: minus the sum
+    """(..., n_bearings, 2) force each bearing's rollers exert on its pin, in the model's frame: minus the sum
     of the inner-raceway contact forces on the rollers ``rollers`` (instance indices of the race_inner
-    family; its ``fx``, ``fy`` are per physical roller, so × ``rows``), grouped by ``bearing_of_roller``."""
-    fx = np.asarray(race_inner["fx"], float)[rollers]
-    fy = np.asarray(race_inner["fy"], float)[rollers]
-    return -rows * np.column_stack([np.bincount(bearing_of_roller, fx, n_bearings),
-                                    np.bincount(bearing_of_roller, fy, n_bearings)])
+    family; its ``fx``, ``fy`` (..., n) are per physical roller, so × ``rows``), grouped by ``bearing_of_roller``."""
+    fx = np.asarray(race_inner["fx"], float)[..., rollers]
+    fy = np.asarray(race_inner["fy"], float)[..., rollers]
+    owner = np.asarray(bearing_of_roller)
+    S = np.zeros((owner.size, n_bearings))
+    S[np.arange(owner.size), owner] = 1.0
+    return -rows * np.stack([fx @ S, fy @ S], axis=-1)
 
 
 def contact_film(race: dict, bearing, lubricant, inner: bool) -> dict[str, np.ndarray]:
@@ -306,20 +313,28 @@ class WindowStatistics(mbd.Observer):
         self.meshes = {k: f for k, f in MESH_FAMILY.items() if f in fams}
         self._families = {FAMILY[k] for k in ("race_inner", "race_outer", "pocket", "guide", "linear")} \
             | set(self.meshes.values())
-        if pb is not None:      # approach-speed floor of the impact law: slower onsets are touches
-            self._v_floor = model.element(FAMILY["pocket"]).v_min * (1.0 + 1e-9)
+        # approach-speed floor of the impact law: slower onsets are touches
+        self._floor = model.element(FAMILY["pocket"]).v_min * (1.0 + 1e-9) if pb is not None else np.zeros(0)
+        self._pocket_owner = pb.astype(np.int64) if pb is not None else np.zeros(0, np.int64)
+        if rollers:    # each bearing's roller contacts in [race_inner..., race_outer...] order (a sentinel pads)
+            nr = rb.size
+            mine = [np.concatenate([np.flatnonzero(rb == i), nr + np.flatnonzero(rb == i)]) for i in range(len(bm))]
+            L = max(x.size for x in mine)
+            self._contacts = np.array([np.concatenate([x, np.full(L - x.size, 2 * nr)]) for x in mine], np.int64)
+        self._target = np.asarray(self.target if self.target is not None else np.zeros(len(bm)), float)
         self.reset()
 
     def reset(self) -> None:
         nb = self.plan.planet.size
         self._acc, self._flat = {}, None
-        self._T = {"global": 0.0, "bearing": np.zeros(nb)}     # time covered by each window
+        self._Tw = np.zeros(nb + 1)                             # time covered by each bearing's window, the global one
         self._angle = np.zeros(nb)                              # cage angle relative to the carrier since t0
         self._open = np.ones(nb, bool)                          # bearing windows still open
         self._t_close = np.full(nb, np.nan)
         self._prev = None
         self.ref_roller = None       # (inner, outer) race_inner instance of the reference rollers
-        self._impact = None
+        self._imp = np.zeros((len(IMPACT_ROWS), self._pocket_owner.size))
+        self._impact = dict(zip(IMPACT_ROWS, self._imp)) if self._imp.size else None   # row views
 
     def _owner(self, key: str):
         """Bearing index of each instance of a snapshot quantity, or None for the global window."""
@@ -332,54 +347,60 @@ class WindowStatistics(mbd.Observer):
             return np.arange(p.planet.size)
         return None
 
-    # one state -> derived quantities -------------------------------------------------------------
+    # states -> derived quantities ----------------------------------------------------------------
     def snapshot(self, s) -> dict[str, np.ndarray]:
-        """Every derived quantity at state ``s`` (arrays per bearing / roller / mesh)."""
+        """Every derived quantity at state ``s`` (arrays per bearing / roller / mesh): :meth:`snapshots` of one."""
+        z = {k: np.asarray(v)[None] for k, v in s.z.items()}
+        rows = self.snapshots(np.array([s.t]), s.q[None], s.v[None], s.a[None], z)
+        return {k: v[0] for k, v in rows.items()}
+
+    def snapshots(self, t, q, v, a, z) -> dict[str, np.ndarray]:
+        """Every derived quantity at K states (``t`` (K,), ``q``, ``v``, ``a`` (K, n), ``z`` {family: (K, ...)}):
+        arrays (K, per bearing / roller / mesh), each from vectorised expressions over the K states."""
         p, m = self.plan, self.model
-        out = self.system.outputs(s.t, s.q, s.v, s.z, families=self._families)
-        X, V, A = carrier_frame_motion(m, s.t, s.q, s.v, s.a, self.omega_c)
-        radial = lambda vec: radial_tangential(vec, X[p.planet, :2], X[p.carrier, :2])
-        nb = p.planet.size
+        out = self.system.outputs_batch(t, q, v, z, families=self._families)
+        X, V, A = carrier_frame_motion(m, t, q, v, a, self.omega_c)
+        radial = lambda vec: radial_tangential(vec, X[:, p.planet, :2], X[:, p.carrier, :2][:, None, :])
+        K, nb = t.size, p.planet.size
         snap: dict[str, np.ndarray] = {}
         if p.rollers:
-            ri = out[FAMILY["race_inner"]]
+            ri, ro = out[FAMILY["race_inner"]], out[FAMILY["race_outer"]]
             pin = pin_reactions(ri, slice(None), p.roller_bearing, nb, p.rows)
             snap["roller_inner_load"] = np.asarray(ri["load"], float)
-            snap["roller_outer_load"] = np.asarray(out[FAMILY["race_outer"]]["load"], float)
+            snap["roller_outer_load"] = np.asarray(ro["load"], float)
             # Lundberg–Palmgren: (Q/Q_c)^p, the pin stationary and the bore rotating relative to the load
             snap["roller_inner_fatigue"] = (snap["roller_inner_load"] / self._qc[0]) ** STATIONARY_EXPONENT
             snap["roller_outer_fatigue"] = (snap["roller_outer_load"] / self._qc[1]) ** ROTATING_EXPONENT
-            ro = out[FAMILY["race_outer"]]
-            snap["heat_traction"], snap["traction_coefficient"] = self._traction_heat(ri, ro, nb)
+            snap["heat_traction"], snap["traction_coefficient"] = self._traction_heat(ri, ro)
             if self._lubricant is not None:
-                snap.update(self._film(ri, ro, nb))
+                snap.update(self._film(ri, ro))
                 snap["film_lambda"] = snap["film_thinnest"] / self._lubricant.roughness
             if p.pocket_bearing is not None:
                 snap["pocket_force"] = np.asarray(out[FAMILY["pocket"]]["force"], float)
         else:
             lin = out[FAMILY["linear"]]
-            pin = -np.column_stack([lin["fx"][p.spring], lin["fy"][p.spring]])   # fx, fy act on the planet
-        pin = self._to_carrier(pin, s.t)
+            pin = -np.stack([lin["fx"][:, p.spring], lin["fy"][:, p.spring]], axis=-1)   # fx, fy act on the planet
+        pin = self._to_carrier(pin, t)
         snap["load_radial"], snap["load_tangential"] = radial(pin)
-        snap["load_magnitude"] = np.hypot(pin[:, 0], pin[:, 1])
+        snap["load_magnitude"] = np.hypot(pin[..., 0], pin[..., 1])
         snap["load_life"] = snap["load_magnitude"] ** LIFE_EXPONENT
-        snap["load_x"], snap["load_y"] = pin[:, 0], pin[:, 1]
+        snap["load_x"], snap["load_y"] = pin[..., 0], pin[..., 1]
         if self.omega_c != 0.0:      # the carrier's speed against its reference: has the drive settled?
-            snap["carrier_speed_error"] = np.array([V[p.carrier, 2] / self.omega_c])
+            snap["carrier_speed_error"] = (V[:, p.carrier, 2] / self.omega_c)[:, None]
         if p.cage is not None:
-            a_own = A[p.cage, :2]
-            a_rel = a_own - A[p.planet, :2]
+            a_own = A[:, p.cage, :2]
+            a_rel = a_own - A[:, p.planet, :2]
             snap["cage_acc_radial"], snap["cage_acc_tangential"] = radial(a_own)
-            snap["cage_acc_magnitude"] = np.hypot(a_own[:, 0], a_own[:, 1])
+            snap["cage_acc_magnitude"] = np.hypot(a_own[..., 0], a_own[..., 1])
             snap["cage_acc_rel_radial"], snap["cage_acc_rel_tangential"] = radial(a_rel)
-            snap["cage_acc_rel_magnitude"] = np.hypot(a_rel[:, 0], a_rel[:, 1])
-            snap["cage_acc_x"], snap["cage_acc_y"] = a_rel[:, 0], a_rel[:, 1]
-            snap["cage_speed_rel"] = V[p.cage, 2] - V[p.carrier, 2]
-            snap["planet_speed_rel"] = V[p.planet, 2] - V[p.carrier, 2]
+            snap["cage_acc_rel_magnitude"] = np.hypot(a_rel[..., 0], a_rel[..., 1])
+            snap["cage_acc_x"], snap["cage_acc_y"] = a_rel[..., 0], a_rel[..., 1]
+            snap["cage_speed_rel"] = V[:, p.cage, 2] - V[:, p.carrier, 2][:, None]
+            snap["planet_speed_rel"] = V[:, p.planet, 2] - V[:, p.carrier, 2][:, None]
             if p.guide is not None:
                 g = out[FAMILY["guide"]]
-                snap["guide_force"] = np.asarray(g["force"], float)[p.guide]
-                snap["heat_land"] = np.abs(np.asarray(g["friction"], float) * g["sliding_speed"])[p.guide]
+                snap["guide_force"] = np.asarray(g["force"], float)[:, p.guide]
+                snap["heat_land"] = np.abs(np.asarray(g["friction"], float) * g["sliding_speed"])[:, p.guide]
         for key, fam in self.meshes.items():
             o, f = out[fam], self.flanks.get(key, 1)
             drive, coast = ("", "_coast") if f > 0 else ("_coast", "")
@@ -388,134 +409,125 @@ class WindowStatistics(mbd.Observer):
             snap[f"{key}_drive_deflection"] = np.asarray(o["deflection" + drive], float)
             snap[f"{key}_coast_deflection"] = np.asarray(o["deflection" + coast], float)
         if p.rollers:
-            snap["_roller_angle"] = self._roller_angles(X)
+            d = X[:, p.roller_body, :2] - X[:, p.planet[p.roller_bearing], :2]
+            snap["_roller_angle"] = np.arctan2(d[..., 1], d[..., 0])
         return snap
 
-    def _traction_heat(self, race_inner, race_outer, nb) -> tuple[np.ndarray, np.ndarray]:
+    def _per_bearing(self, x, reduce, fill):
+        """(K, n_b) ``reduce`` (np.min / np.max / np.sum) over each bearing's contacts of ``x`` (K, 2·n_r): the
+        inner-raceway contacts, then the outer ones (race_inner order); ``fill`` where a bearing has none."""
+        return reduce(np.concatenate([x, np.full((x.shape[0], 1), fill)], axis=1)[:, self._contacts], axis=-1)
+
+    def _traction_heat(self, race_inner, race_outer) -> tuple[np.ndarray, np.ndarray]:
         """Per bearing: the power the roller–raceway traction dissipates, Σ |F_t v_s| over every physical
         roller and both raceways [W], and the largest traction coefficient |F_t|/Q of a loaded contact."""
-        owner, rows = self.plan.roller_bearing, self.plan.rows
-        heat, mu = np.zeros(nb), np.zeros(nb)
-        for race in (race_inner, race_outer):
-            Ft, Q = np.asarray(race["traction"], float), np.asarray(race["load"], float)
-            heat += np.bincount(owner, weights=rows * np.abs(Ft * race["slip_velocity"]), minlength=nb)
-            np.maximum.at(mu, owner, np.where(Q > 0.0, np.abs(Ft) / np.where(Q > 0.0, Q, 1.0), 0.0))
+        races = (race_inner, race_outer)
+        Ft = np.concatenate([np.asarray(r["traction"], float) for r in races], axis=-1)
+        Q = np.concatenate([np.asarray(r["load"], float) for r in races], axis=-1)
+        vs = np.concatenate([np.asarray(r["slip_velocity"], float) for r in races], axis=-1)
+        heat = self._per_bearing(self.plan.rows * np.abs(Ft * vs), np.sum, 0.0)
+        mu = self._per_bearing(np.where(Q > 0.0, np.abs(Ft) / np.where(Q > 0.0, Q, 1.0), 0.0), np.max, 0.0)
         return heat, mu
 
-    def _film(self, race_inner, race_outer, nb) -> dict[str, np.ndarray]:
+    def _film(self, race_inner, race_outer) -> dict[str, np.ndarray]:
         """Per bearing, over its loaded roller contacts (both raceways): the thinnest EHL film h_min [m] with
         and without the thermal reduction, the thermal loading L of the contact with the thinnest film, the
         largest L and load parameter W' of any, and the smallest h_c/h_min (< 1: Pan & Hamrock's fit beyond
         its range); NaN where no roller is loaded."""
-        b, lub, owner = self.scene.meta["bearing"], self._lubricant, self.plan.roller_bearing
+        b, lub = self.scene.meta["bearing"], self._lubricant
         films = [contact_film(race, b, lub, inner) for race, inner in ((race_inner, True), (race_outer, False))]
-        f = {k: np.concatenate([x[k] for x in films]) for k in films[0]}
-        own = np.concatenate([owner, owner])
+        f = {k: np.concatenate([x[k] for x in films], axis=-1) for k in films[0]}
         loaded = ~np.isnan(f["film_min"])
 
         def extreme(x, low):
-            out = np.full(nb, np.inf if low else -np.inf)
-            (np.minimum if low else np.maximum).at(out, own[loaded], x[loaded])
-            return np.where(np.isfinite(out), out, np.nan)
+            e = self._per_bearing(np.where(loaded, x, np.inf if low else -np.inf), np.min if low else np.max,
+                                  np.inf if low else -np.inf)
+            return np.where(np.isfinite(e), e, np.nan)
 
-        h = np.where(loaded, f["film_min"], np.inf)
-        order = np.lexsort((h, own))                                   # by bearing, thinnest first
-        first = order[np.searchsorted(own[order], np.arange(nb))]
+        h = np.concatenate([np.where(loaded, f["film_min"], np.inf), np.full((loaded.shape[0], 1), np.inf)], axis=1)
+        first = self._contacts[np.arange(self._contacts.shape[0]),
+                               np.argmin(h[:, self._contacts], axis=-1)]            # (K, n_b): thinnest first
+        pick = lambda x: np.take_along_axis(x, np.minimum(first, x.shape[1] - 1), axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = f["film_central"] / f["film_min"]
         return {"film_thinnest": extreme(f["film_min"], True),
                 "film_thinnest_isothermal": extreme(f["film_min_isothermal"], True),
-                "film_thinnest_loading": np.where(loaded[first], f["film_thermal_loading"][first], np.nan),
+                "film_thinnest_loading": np.where(pick(loaded), pick(f["film_thermal_loading"]), np.nan),
                 "film_thermal_loading": extreme(f["film_thermal_loading"], False),
                 "film_load_parameter": extreme(f["film_load_parameter"], False),
-                "film_central_ratio": extreme(f["film_central"] / f["film_min"], True)}
+                "film_central_ratio": extreme(ratio, True)}
 
     def _to_carrier(self, vec, t):
-        """A vector given in the model's frame R, in the carrier frame C."""
+        """Vectors (K, n, 2) given in the model's frame R at times ``t`` (K,), in the carrier frame C."""
         fr = self.model.frame
         if fr.profile is None and fr.omega == self.omega_c:
             return vec
-        d = self.model.frame.at(t).phi - self.omega_c * t
-        c, s = math.cos(d), math.sin(d)
-        return np.column_stack([c * vec[:, 0] - s * vec[:, 1], s * vec[:, 0] + c * vec[:, 1]])
-
-    def _roller_angles(self, X):
-        p = self.plan
-        d = X[p.roller_body, :2] - X[p.planet[p.roller_bearing], :2]
-        return np.arctan2(d[:, 1], d[:, 0])
+        d = self.model.frame_batch(t).phi - self.omega_c * t[:, None]
+        c, s = np.cos(d), np.sin(d)
+        return np.stack([c * vec[..., 0] - s * vec[..., 1], s * vec[..., 0] + c * vec[..., 1]], axis=-1)
 
     # accumulation --------------------------------------------------------------------------------
+    def _closed(self, t_start) -> bool:
+        return t_start >= self.t1 and not self._open.any()
+
     def step(self, s0, s1) -> None:
-        if s1.t <= self.t0 or (s0.t >= self.t1 and not self._open.any()):
+        """One accepted step (the numpy engine's path; the compiled engine hands blocks to :meth:`on_block`)."""
+        if s1.t <= self.t0 or self._closed(s0.t):
             return
         x0 = self._prev if self._prev is not None else self.snapshot(s0)
         x1 = self.snapshot(s1)
-        h = s1.t - s0.t
-        ta = max(s0.t, self.t0)
-        wa = (ta - s0.t) / h                                  # linear interpolation inside a straddling step
-        wg = (min(s1.t, self.t1) - s0.t) / h                  # end of the global window in this step
-        wb = self._bearing_ends(x0, x1, wa, s0.t, h)          # end of each bearing's window in this step
+        fam = FAMILY["pocket"]
+        zs = [np.asarray(s.z[fam])[:, 0] if fam in s.z else np.zeros(0) for s in (s0, s1)]
+        self._accumulate(np.array([s0.t, s1.t]), {k: np.stack([x0[k], x1[k]]) for k in x1}, np.stack(zs))
+
+    def on_block(self, block) -> None:
+        """A compiled block of steps: the quantities of all its states from the first step that reaches the
+        window on, in one vectorised pass, then the compiled accumulators."""
+        t = np.concatenate([[block.start.t], block.log[:, 0]])
+        if t[-1] <= self.t0 or self._closed(t[0]):
+            return
+        i0 = max(int(np.searchsorted(t, self.t0, side="right")) - 1, 0)     # the step that reaches t0 starts here
+        t, q, v, a, z = block.arrays()
+        rows = self.snapshots(t[i0:], q[i0:], v[i0:], a[i0:], {k: x[i0:] for k, x in z.items()})
+        fam = FAMILY["pocket"]
+        self._accumulate(t[i0:], rows, z[fam][i0:, :, 0] if fam in z else np.zeros((t.size - i0, 0)))
+
+    def _accumulate(self, t, rows, Z) -> None:
+        """Hand K steps (``rows``: each quantity at their K+1 ends; ``Z``: the pockets' stored approach speeds)
+        to the accumulators; the first call chooses the reference rollers and lays the accumulators out."""
         if self.ref_roller is None and self.plan.rollers:
-            self._choose_reference(x0, x1, wa)
+            i = int(np.searchsorted(t, self.t0, side="right")) - 1 if t[0] < self.t0 else 0
+            i = min(max(i, 0), t.size - 2)
+            wa = (max(t[i], self.t0) - t[i]) / (t[i + 1] - t[i])
+            self._choose_reference({k: rows[k][i] for k in ("_roller_angle", "load_x", "load_y")},
+                                   {k: rows[k][i + 1] for k in ("_roller_angle", "load_x", "load_y")}, wa)
         if self._flat is None:
-            self._layout(x1)
-        v0, v1 = self._flatten(x0), self._flatten(x1)
-        own = self._own_flat
-        w1 = np.where(own >= 0, wb[np.maximum(own, 0)], wg)       # window end of every quantity in this step
-        va, vb = v0 + wa * (v1 - v0), v0 + w1 * (v1 - v0)
-        dt = np.maximum(w1 - wa, 0.0) * h
-        acc, inside = self._flat, dt > 0
-        acc[0] += 0.5 * (va + vb) * dt
-        acc[1] += 0.5 * (va * va + vb * vb) * dt
-        np.copyto(acc[2], np.maximum(acc[2], np.maximum(va, vb)), where=inside)
-        np.copyto(acc[3], np.minimum(acc[3], np.minimum(va, vb)), where=inside)
-        self._T["global"] += max(wg - wa, 0.0) * h
-        self._T["bearing"] += np.maximum(wb - wa, 0.0) * h
-        self._impacts(s0, s1, x0, x1, wb, s0.t + wb * h)
-        self._prev = x1
+            self._layout({k: x[-1] for k, x in rows.items()})
+        V = np.concatenate([np.asarray(rows[k], float).reshape(t.size, -1) for k in self._keys], axis=1)
+        Zf = np.ascontiguousarray(Z, float) if self._imp.size else np.zeros((t.size, 0))
+        accumulate_steps(t, V, self._own_flat, self._flat, self._Tw, self._angle, self._open, self._t_close,
+                         self._target, self.target is not None, self.t0, self.t1, self._cage_cols,
+                         self._pocket_cols, self._pocket_owner, Zf, self._floor, self._imp)
+        self._prev = {k: x[-1].copy() for k, x in rows.items()}
 
     def _layout(self, x) -> None:
         """One flat accumulator (sum, sum of squares, max, min) for every quantity of a snapshot, each
         instance tagged with its bearing (or −1: the global window); ``_acc[key]`` are views into it."""
         keys = [k for k in x if not k.startswith("_")]
         sizes = [np.size(x[k]) for k in keys]
-        edges = np.concatenate([[0], np.cumsum(sizes)])
+        edges = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
         self._keys = keys
         self._own_flat = np.concatenate([self._owner(k) if self._owner(k) is not None else np.full(n, -1)
-                                         for k, n in zip(keys, sizes)]).astype(int)
+                                         for k, n in zip(keys, sizes)]).astype(np.int64)
         if self._flat is None:
             n = int(edges[-1])
             self._flat = np.stack([np.zeros(n), np.zeros(n), np.full(n, -np.inf), np.full(n, np.inf)])
         self._acc = {k: self._flat[:, a:b] for k, a, b in zip(keys, edges[:-1], edges[1:])}
-
-    def _flatten(self, x) -> np.ndarray:
-        return np.concatenate([np.asarray(x[k], float).ravel() for k in self._keys])
-
-    def _bearing_ends(self, x0, x1, wa, t_start, h) -> np.ndarray:
-        """Fraction of this step at which each bearing's window ends (1: still open after it; wa: closed
-        before it). A bearing closes when its cage has turned its whole number of revolutions."""
-        open_ = self._open
-        if self.target is None:            # no whole revolutions asked: the nominal window for every bearing
-            w = min(1.0, (self.t1 - t_start) / h)
-            end = np.where(open_, max(w, wa), wa)
-            if "cage_speed_rel" in x1:     # still count the cage's revolutions (impacts per revolution)
-                w0, w1 = x0["cage_speed_rel"], x1["cage_speed_rel"]
-                wa_s = w0 + wa * (w1 - w0)
-                wb_s = w0 + end * (w1 - w0)
-                self._angle = self._angle + 0.5 * (wa_s + wb_s) * (end - wa) * h
-            if w < 1.0:
-                self._open[:] = False
-            return end
-        w0, w1 = x0["cage_speed_rel"], x1["cage_speed_rel"]
-        wa_speed = w0 + wa * (w1 - w0)
-        new = self._angle + 0.5 * (wa_speed + w1) * (1.0 - wa) * h
-        phi_a, phi_b = np.abs(self._angle), np.abs(new)
-        goal = 2.0 * math.pi * self.target
-        closing = open_ & (phi_b >= goal)
-        frac = np.where(closing, (goal - phi_a) / np.where(phi_b > phi_a, phi_b - phi_a, 1.0), 1.0)
-        end = np.where(open_, wa + np.clip(frac, 0.0, 1.0) * (1.0 - wa), wa)
-        self._angle = np.where(open_, np.where(closing, np.sign(new) * goal, new), self._angle)
-        self._t_close = np.where(closing, t_start + end * h, self._t_close)
-        self._open = open_ & ~closing
-        return end
+        col = dict(zip(keys, edges[:-1]))
+        self._cage_cols = (col["cage_speed_rel"] + np.arange(self.plan.planet.size)).astype(np.int64) \
+            if "cage_speed_rel" in col else np.zeros(0, np.int64)
+        npk = self._imp.shape[1]
+        self._pocket_cols = (col["pocket_force"] + np.arange(npk)).astype(np.int64) if npk else np.zeros(0, np.int64)
 
     def _choose_reference(self, x0, x1, w):
         """Reference roller of each bearing kind: the roller of pair 0's bearing nearest its load-zone
@@ -534,44 +546,6 @@ class WindowStatistics(mbd.Observer):
             ref.append(int(mine[np.argmin(np.abs(off))]))
         self.ref_roller = tuple(ref)
 
-    def _impacts(self, s0, s1, x0, x1, wb, t_end_bearing) -> None:
-        """Pocket impacts: contact onsets faster than the element's approach-speed floor (the pocket element
-        stores the approach speed v0 > 0 in column 0 of its internal state from the step in which contact
-        begins), their speeds and peak forces; onsets at the floor count as touches. ``wb``: where each
-        bearing's window ends in this step (1: after it); a peak is taken up to that end (the force there
-        linear in the step, as every window end is), never past it."""
-        fam = FAMILY["pocket"]
-        pb = self.plan.pocket_bearing
-        if pb is None or fam not in s1.z:
-            return
-        z0 = np.asarray(s0.z[fam])[:, 0] if fam in s0.z else np.zeros(pb.size)
-        z1 = np.asarray(s1.z[fam])[:, 0]
-        n = z1.size
-        if self._impact is None:
-            self._impact = {k: np.zeros(n) for k in ("count", "touches", "speed_sum", "speed_max", "peak_sum",
-                                                     "peak_max", "peak_now", "active")}
-        im = self._impact
-        in_window = (s1.t > self.t0) & (s1.t <= t_end_bearing[pb])      # onset within this bearing's window
-        contact = (z0 <= 0.0) & (z1 > 0.0) & in_window
-        # an approach at the element's speed floor is a quasi-static touch (a roller settling against a
-        # wall, the last bounces of a rattle), not a collision: counted apart
-        touch = contact & (z1 <= self._v_floor)
-        onset = contact & ~touch
-        im["touches"] += touch
-        ended = (im["active"] > 0) & ((z1 <= 0.0) | ~in_window)
-        w = wb[pb]
-        force = np.abs(x0["pocket_force"] + w * (x1["pocket_force"] - x0["pocket_force"]))
-        np.maximum(im["peak_now"], np.where(im["active"] > 0, force, 0.0), out=im["peak_now"])
-        im["peak_sum"] += np.where(ended, im["peak_now"], 0.0)
-        np.maximum(im["peak_max"], np.where(ended, im["peak_now"], 0.0), out=im["peak_max"])
-        im["active"][ended] = 0.0
-        im["peak_now"][ended] = 0.0
-        im["count"] += onset
-        im["speed_sum"] += np.where(onset, z1, 0.0)
-        np.maximum(im["speed_max"], np.where(onset, z1, 0.0), out=im["speed_max"])
-        im["active"][onset] = 1.0
-        im["peak_now"][onset] = force[onset]
-
     def _close_impacts(self) -> None:
         """Impacts still in progress when their window ended count with the peak they reached."""
         im = self._impact
@@ -588,20 +562,22 @@ class WindowStatistics(mbd.Observer):
         d = {"acc": self._flat} if self._flat is not None else {}
         d.update({f"imp__{k}": v for k, v in (self._impact or {}).items()})
         d.update({f"prev__{k}": v for k, v in (self._prev or {}).items()})
-        d.update({"T_global": np.array(self._T["global"]), "T_bearing": self._T["bearing"], "angle": self._angle,
+        d.update({"T_global": np.array(self._Tw[-1]), "T_bearing": self._Tw[:-1], "angle": self._angle,
                   "open": self._open, "t_close": self._t_close,
                   "ref": np.array(self.ref_roller if self.ref_roller is not None else (-1, -1))})
         return d
 
     def load_state_dict(self, d: dict) -> None:
         self._acc, self._flat = {}, (d["acc"].copy() if "acc" in d else None)
-        self._impact = {k[5:]: v.copy() for k, v in d.items() if k.startswith("imp__")} or None
+        for k in IMPACT_ROWS:
+            if f"imp__{k}" in d:
+                self._impact[k][:] = d[f"imp__{k}"]
         self._prev = {k[6:]: v.copy() for k, v in d.items() if k.startswith("prev__")} or None
         if self._flat is not None and self._prev is not None:
             self._layout(self._prev)
         if "T_global" in d:
-            self._T = {"global": float(d["T_global"]), "bearing": d["T_bearing"].copy()}
-            self._angle, self._open, self._t_close = d["angle"].copy(), d["open"].astype(bool), d["t_close"].copy()
+            self._Tw[:-1], self._Tw[-1] = d["T_bearing"], float(d["T_global"])
+            self._angle[:], self._open[:], self._t_close[:] = d["angle"], d["open"].astype(bool), d["t_close"]
         ref = tuple(int(x) for x in d.get("ref", (-1, -1)))
         self.ref_roller = None if ref[0] < 0 else ref
 
@@ -610,7 +586,7 @@ class WindowStatistics(mbd.Observer):
         """mean, rms, max, min of a snapshot quantity over its window (arrays per instance)."""
         acc = self._acc[key]
         own = self._owner(key)
-        T = self._T["bearing"][own] if own is not None else self._T["global"]
+        T = self._Tw[:-1][own] if own is not None else self._Tw[-1]
         T = np.where(np.asarray(T) > 0, T, np.nan)
         return {"mean": acc[0] / T, "rms": np.sqrt(np.maximum(acc[1], 0.0) / T), "max": acc[2], "min": acc[3]}
 
@@ -618,13 +594,13 @@ class WindowStatistics(mbd.Observer):
         """RMS of a quantity over every instance that belongs to ``bearings`` (time-weighted, all windows)."""
         own = self._owner(key)
         mine = np.isin(own, bearings)
-        T = self._T["bearing"][own[mine]]
+        T = self._Tw[:-1][own[mine]]
         return float(np.sqrt(self._acc[key][1][mine].sum() / T.sum()))
 
     @property
     def duration(self) -> float:
         """Length of the global (mesh) window covered so far [s]."""
-        return self._T["global"]
+        return self._Tw[-1]
 
     def summary(self) -> dict:
         """The statistics users read, per bearing kind (see README: summary.json)."""
@@ -639,7 +615,7 @@ class WindowStatistics(mbd.Observer):
         for kind in ("inner", "outer"):
             sel = np.flatnonzero(p.kinds == kind)
             ref = int(sel[0])
-            d: dict = {"window_s": [self.t0, float(self.t0 + self._T["bearing"][ref])]}
+            d: dict = {"window_s": [self.t0, float(self.t0 + self._Tw[:-1][ref])]}
             if self.target is not None:
                 d["whole_revolutions"] = bool(not self._open[sel].any())
             lr, lt, lm = self.stats("load_radial"), self.stats("load_tangential"), self.stats("load_magnitude")

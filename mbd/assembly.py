@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from . import ad
 from .element import evaluate
 from .errors import IntegrationError, ModelError
 from .model import Model
@@ -209,6 +210,34 @@ class System:
             F, out, _, _ = evaluate(e, t, fs, qf, vf, z.get(parts[0][0]) if len(parts) == 1 else None, False)
             for name, sl in parts:
                 res[name] = out if len(parts) == 1 else {k: np.asarray(v)[sl] for k, v in out.items()}
+        return res
+
+    def outputs_batch(self, t, q, v, z, families=None) -> dict[str, dict[str, np.ndarray]]:
+        """:meth:`outputs` at K states at once: ``t`` (K,), ``q``, ``v`` (K, n_free), ``z`` {family: (K, ...)}
+        give arrays (K, n). A family whose kernel is elementwise over its instances (``Element.batched``:
+        parameters (n,), internal states read as ``z[..., j]``) takes (K, n) columns and evaluates the K
+        states in one call; the others (drives with a time profile) are evaluated state by state."""
+        m = self.model
+        t = np.asarray(t, float)
+        K = t.size
+        qf, vf = m.full_batch(t, q, v)
+        fs = m.frame_batch(t)
+        res = {}
+        for e, parts in self._evals:
+            if families is not None and not any(name in families for name, _ in parts):
+                continue
+            zi = z.get(parts[0][0]) if len(parts) == 1 else None
+            if e.batched:
+                ql, vl = qf[:, e.dofs], vf[:, e.dofs]            # (K, n, k)
+                _, out = e.kernel(t[:, None], fs, list(np.moveaxis(ql, 2, 0)), list(np.moveaxis(vl, 2, 0)), zi)
+                out = {key: np.broadcast_to(np.asarray(ad.value(val), float), (K, e.n)) for key, val in out.items()}
+            else:
+                rows = [evaluate(e, t[k], m.frame.at(t[k]), qf[k], vf[k], None if zi is None else zi[k], False)[1]
+                        for k in range(K)]
+                out = {key: np.stack([np.broadcast_to(np.asarray(r[key], float), (e.n,)) for r in rows])
+                       for key in rows[0]}
+            for name, sl in parts:
+                res[name] = out if len(parts) == 1 else {k: val[:, sl] for k, val in out.items()}
         return res
 
     def check_finite(self, t, F, q, v, z):

@@ -50,6 +50,9 @@ class Element:
     n_local: int = 0
     name: str = "element"
     dofs: np.ndarray
+    # the kernel is elementwise over its instances: (K, n) columns evaluate K states at once
+    # (System.outputs_batch); False for kernels that call arbitrary functions of t
+    batched: bool = False
 
     @property
     def n(self) -> int:

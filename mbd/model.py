@@ -208,6 +208,31 @@ class Model:
         vf[self.free] = v
         return qf, vf
 
+    def full_batch(self, t, q, v) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`full` at K states: ``t`` (K,), ``q``, ``v`` (K, n_free) → (K, 3·n_bodies) each."""
+        t = np.asarray(t, float)
+        qf, vf = np.zeros((t.size, 3 * self.n_bodies)), np.zeros((t.size, 3 * self.n_bodies))
+        if self.fixed.any():          # at rest in I: seen from R (as fixed_body_motion, K times at once)
+            idx = np.flatnonzero(self.fixed)
+            p = self.pose0[idx]
+            fs = self.frame_batch(t)
+            c, s = np.cos(fs.phi), np.sin(fs.phi)
+            xr, yr = c * p[:, 0] + s * p[:, 1], -s * p[:, 0] + c * p[:, 1]
+            qf[:, 3 * idx], qf[:, 3 * idx + 1], qf[:, 3 * idx + 2] = xr, yr, p[:, 2] - fs.phi
+            vf[:, 3 * idx], vf[:, 3 * idx + 1], vf[:, 3 * idx + 2] = fs.omega * yr, -fs.omega * xr, -fs.omega
+        qf[:, self.free] = q
+        vf[:, self.free] = v
+        return qf, vf
+
+    def frame_batch(self, t) -> FrameState:
+        """The frame's state at K times as one FrameState of (K, 1) columns (they broadcast over instances)."""
+        t = np.asarray(t, float)[:, None]
+        if self.frame.profile is None:
+            return FrameState(self.frame.omega * t, np.full_like(t, self.frame.omega), np.zeros_like(t))
+        fs = [self.frame.at(float(tk)) for tk in t[:, 0]]
+        col = lambda key: np.array([getattr(f, key) for f in fs], float)[:, None]
+        return FrameState(col("phi"), col("omega"), col("domega"))
+
     def poses(self, q_full: np.ndarray) -> np.ndarray:
         return q_full.reshape(-1, 3)
 

@@ -211,6 +211,10 @@ class Recorder:
         self.coords[name] = (dim, values, {"units": units, "long_name": long_name})
 
     # sampling ----------------------------------------------------------------------------------
+    def due(self, t1: float) -> bool:
+        """Whether a sample falls due at or before t1 (a step ending at t1 needs recording)."""
+        return self.t_start + self.next_index * self.dt <= t1 + 1e-12 * max(1.0, abs(t1))
+
     def sample_times(self, t0: float, t1: float, include_start: bool) -> np.ndarray:
         """Sample times in (t0, t1] (and t0 itself if include_start)."""
         k0 = self.next_index

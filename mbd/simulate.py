@@ -116,6 +116,13 @@ class Observer:
     def step(self, s0: State, s1: State) -> None:
         raise TypeError(f"{type(self).__name__} must define step(s0, s1)")
 
+    def on_block(self, block) -> None:
+        """Every accepted step of a compiled block (:class:`mbd.compiled.runner.Block`) in one call; by default
+        :meth:`step` on each. An observer that overrides it reads the block's stacked states
+        (``block.arrays()``) and skips building a State per step."""
+        for s0, s1, _, _ in block.steps:
+            self.step(s0, s1)
+
     def state_dict(self) -> dict:
         return {}
 
@@ -259,6 +266,30 @@ class _Loop:
             self.recorder.record(s0, s1)
         for ob in self.observers:
             ob.step(s0, s1)
+        return self._count(s1, error, h_try, h_next)
+
+    def accepted_block(self, blk) -> bool:
+        """The same for a compiled block of steps: each observer takes the block in one call, the recorder
+        the steps a sample falls due in; a checkpoint can only fall on the block's last step (the runner ends
+        blocks there)."""
+        for ob in self.observers:
+            ob.on_block(blk)
+        last = len(blk) - 1
+        s0 = blk.start
+        for i in range(last + 1):
+            t1, h_try, err = (float(x) for x in blk.log[i, :3])
+            s1 = None
+            if self.recorder is not None and self.recorder.due(t1):
+                s1 = blk.state_at(i)
+                self.recorder.record(s0 if s0 is not None else blk.state_at(i - 1), s1)
+            if i == last:
+                return self._count(blk.state, err, h_try, blk.h)
+            _add_step(self.stats, err, h_try)
+            self.bar.update(t1, self.counters)
+            s0 = s1
+        return False
+
+    def _count(self, s1: State, error: float, h_try: float, h_next: float) -> bool:
         _add_step(self.stats, error, h_try)
         self.bar.update(s1.t, self.counters)
         if self.checkpoint is not None and self.stats["steps"] % self.checkpoint.every == 0:
@@ -299,11 +330,8 @@ def _compiled_steps(loop: _Loop, system, runner, state, h, t_end, failed_state_p
         blk = runner.advance(state, h, t_end, BLOCK if todo is None else min(BLOCK, todo))
         for k, val in blk.counters.items():
             setattr(loop.counters, k, getattr(loop.counters, k) + val)
-        last = len(blk.steps) - 1
-        for i, (s0, s1, h_try, err) in enumerate(blk.steps):
-            h_next = blk.h if i == last else blk.steps[i + 1][2]
-            if loop.accepted(s0, s1, err, h_try, h_next):
-                runner.drop_lu()
+        if len(blk) and loop.accepted_block(blk):
+            runner.drop_lu()
         state, h = blk.state, blk.h
         if blk.failed is not None:
             _fail(system, state, h, blk.failed, failed_state_path)

@@ -22,14 +22,56 @@ __all__ = ["CompiledRunner", "Block"]
 
 @dataclass
 class Block:
-    """What one compiled call did: the accepted steps (start state, end state, h, error), the work
-    (counter increments), the state and h it ended with, and — when the step size fell below the
-    controller's floor — the last failed step's StepInfo."""
-    steps: list
+    """What one compiled call did: the accepted steps as arrays (``log``: per step t₁, h, error, q₁, v₁, a₁,
+    f₁, internal states), the state it started from, the work (counter increments), the state and h it
+    ended with, and — when the step size fell below the controller's floor — the last failed step's
+    StepInfo. :attr:`steps` gives (start state, end state, h, error) per step; :meth:`arrays` the states
+    stacked, start first (for observers that take a block at once)."""
+    log: np.ndarray
+    start: State
+    z_shapes: list
     counters: dict
     state: State
     h: float
     failed: StepInfo | None = None
+
+    def __len__(self) -> int:
+        return self.log.shape[0]
+
+    def state_at(self, i: int) -> State:
+        """End state of accepted step i."""
+        row, n = self.log[i], self.start.q.size
+        z, off = {}, 3 + 4 * n
+        for name, shape in self.z_shapes:
+            size = int(np.prod(shape))
+            z[name] = row[off:off + size].reshape(shape).copy()
+            off += size
+        return State(float(row[0]), row[3:3 + n].copy(), row[3 + n:3 + 2 * n].copy(),
+                     row[3 + 2 * n:3 + 3 * n].copy(), row[3 + 3 * n:3 + 4 * n].copy(), z)
+
+    @property
+    def steps(self) -> list:
+        out, s0 = [], self.start
+        for i in range(len(self)):
+            s1 = self.state_at(i)
+            out.append((s0, s1, float(self.log[i, 1]), float(self.log[i, 2])))
+            s0 = s1
+        return out
+
+    def arrays(self):
+        """(t, q, v, a, z) of the start state and every step's end, stacked: t (K+1,), q, v, a (K+1, n),
+        z {family: (K+1, ...)} (no copies beyond the stacking)."""
+        n, s = self.start.q.size, self.start
+        L = self.log
+        t = np.concatenate([[s.t], L[:, 0]])
+        q, v, a = (np.vstack([x[None], L[:, 3 + j * n:3 + (j + 1) * n]]) for j, x in enumerate((s.q, s.v, s.a)))
+        z, off = {}, 3 + 4 * n
+        for name, shape in self.z_shapes:
+            size = int(np.prod(shape))
+            z[name] = np.concatenate([np.asarray(s.z[name], float).reshape(1, *shape),
+                                      L[:, off:off + size].reshape(-1, *shape)])
+            off += size
+        return t, q, v, a, z
 
 
 def _controller_array(controller) -> np.ndarray:
@@ -97,16 +139,6 @@ class CompiledRunner:
         """Forget the LU (the numpy path drops it at checkpoints: both refactorise at the same step)."""
         self.cache[0] = 0.0
 
-    def _state(self, row) -> State:
-        n = self.n
-        z, off = {}, 3 + 4 * n
-        for name, shape in self.z_shapes:
-            size = int(np.prod(shape))
-            z[name] = row[off:off + size].reshape(shape).copy()
-            off += size
-        return State(float(row[0]), row[3:3 + n].copy(), row[3 + n:3 + 2 * n].copy(),
-                     row[3 + 2 * n:3 + 3 * n].copy(), row[3 + 3 * n:3 + 4 * n].copy(), z)
-
     def advance(self, state: State, h: float, t_end: float, max_steps: int) -> Block:
         """Up to ``max_steps`` accepted steps from ``state`` (not modified) towards t_end."""
         self.cs.set_internal(state.z)
@@ -117,11 +149,10 @@ class CompiledRunner:
             float(state.t), q, v, a, f, float(h), float(t_end), int(max_steps), self.prm, self.ctrl, self.atol,
             self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu, self.cache,
             self.work, counters, self.out, log)
-        steps, s0 = [], state
-        for i in range(acc):
-            s1 = self._state(log[i])
-            steps.append((s0, s1, float(log[i, 1]), float(log[i, 2])))
-            s0 = s1
         keys = ("residual", "jacobian", "factor", "newton", "accepted", "rejected")
         failed = StepInfo(False, int(it), float(rate), reason=FAIL_REASONS[reason]) if status == 2 else None
-        return Block(steps, dict(zip(keys, (int(c) for c in counters))), s0, float(h), failed)
+        blk = Block(log[:acc], state, self.z_shapes, dict(zip(keys, (int(c) for c in counters))), state, float(h),
+                    failed)
+        if acc:
+            blk.state = blk.state_at(acc - 1)
+        return blk

@@ -191,7 +191,7 @@ class _Impact(Element):
         v_min = self.v_min
         v_app = ad.where(ad.value(xd) > v_min, xd, v_min)  # contact beginning in this step
         if z is not None:
-            v_app = ad.where(z[:, 0] > 0.0, z[:, 0], v_app)
+            v_app = ad.where(z[..., 0] > 0.0, z[..., 0], v_app)   # [..., 0]: also for K states at once
         F = K * x * (1.0 + self.lam * xd / v_app)
         touch = ad.value(x) > 0.0
         active = touch & (ad.value(F) > 0.0)
@@ -368,6 +368,7 @@ class RaceContact(Element):
     axes [rad] (wrapped to (−π, π]);
     "fx", "fy" the contact force on one physical roller, in R [N].
     """
+    batched = True
     n_local = 6
 
     def __init__(self, name, roller, race_body, *, kind, race_marker, R_race, D, K, exponent, zeta, m_roller,
@@ -518,6 +519,7 @@ class PocketContact(_Impact):
     the cage forward); "offset" s [m]; "penetration" max(d, 0) [m]; "penetration_rate" ḋ [m/s] (+ when
     closing); "approach_speed" v₀ in use [m/s] (0 out of contact).
     """
+    batched = True
     n_local = 6
 
     def __init__(self, name, roller, cage, *, pocket_angle, pitch_radius, clearance, K_p, restitution,
@@ -664,6 +666,7 @@ class GuideContact(_Impact):
     "fx", "fy" force on the cage, in R [N]; "penetration_rate" ε̇ [m/s]; "approach_speed" v₀ in use [m/s]
     (0 out of contact).
     """
+    batched = True
     n_local = 6
 
     def __init__(self, name, cage, planet, *, clearance, K_g, restitution, impact_law, v_min, mu, v_mu,
@@ -736,6 +739,7 @@ class LubricantDrag(Element):
 
     Output: "force" signed F_d [N] on one physical roller (the drag on it is −force·t).
     """
+    batched = True
     n_local = 6
 
     def __init__(self, name, roller, race_body, *, race_marker, C_d, rho, D, l, d_m, multiplicity=1):

@@ -252,6 +252,7 @@ class GearMesh(Element):
     ``deflection_coast`` δ_− [m]; ``deflection_rate``, ``deflection_rate_coast`` δ̇_± [m/s]; ``stiffness`` k(p) [N/m];
     ``position`` p in [0, 1); ``fx``, ``fy`` the mesh force on gear 2 in R [N] (gear 1 gets minus it).
     """
+    batched = True
     n_local = 6
 
     def __init__(self, name, gear1, gear2, *, internal: bool, rb1, rb2, alpha, a0, teeth1, k_mean,
@@ -395,7 +396,7 @@ class GearMesh(Element):
             "force": F_net, "force_drive": F_plus, "force_coast": F_minus,
             "deflection": d_plus, "deflection_coast": d_minus,
             "deflection_rate": r_plus, "deflection_rate_coast": r_minus,
-            "stiffness": np.broadcast_to(ad.value(kp), (self.n,)).astype(float),
+            "stiffness": np.broadcast_to(ad.value(kp), np.shape(ad.value(p))).astype(float),
             "position": np.mod(ad.value(p), 1.0),
             "fx": f2x, "fy": f2y,
         }

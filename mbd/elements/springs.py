@@ -15,6 +15,7 @@ class GroundSupport(Element):
     torsional spring ``k_theta``/``c_theta`` to the fixed angle ``theta0``. Damping acts on the
     velocity relative to ground, so a support in a rotating frame does not drag the body along R.
     """
+    batched = True
     n_local = 3
 
     def __init__(self, name, bodies, kx, cx=0.0, ky=None, cy=None, anchor=(0.0, 0.0),
@@ -63,6 +64,7 @@ class BodySpring(Element):
     produces a damping force (the R-frame rate Ṗ_B − Ṗ_A alone would make the damper depend on Ω).
     Typical use: a planet (B, marker at its centre) on a linear bearing to its pin (A, the carrier).
     """
+    batched = True
     n_local = 6
 
     def __init__(self, name, body_a, body_b, k, c=0.0, marker_a=(0.0, 0.0), marker_b=(0.0, 0.0)):
@@ -91,6 +93,7 @@ class BodySpring(Element):
 
 class TorsionalSpring(Element):
     """Torsional spring-damper on the relative angle θ_B − θ_A − θ0 of two bodies."""
+    batched = True
     n_local = 6
 
     def __init__(self, name, body_a, body_b, k, c=0.0, theta0=0.0):

@@ -159,15 +159,15 @@ def _relief(xi, r):
 
 def _cubic(c, x):
     """(E, dE/dx) of the cubic with (n, 4) coefficients c at x."""
-    E = c[:, 0] + x * (c[:, 1] + x * (c[:, 2] + x * c[:, 3]))
-    dE = c[:, 1] + x * (2.0 * c[:, 2] + x * (3.0 * c[:, 3]))
+    E = c[..., 0] + x * (c[..., 1] + x * (c[..., 2] + x * c[..., 3]))
+    dE = c[..., 1] + x * (2.0 * c[..., 2] + x * (3.0 * c[..., 3]))
     return E, dE
 
 
 def _lookup(table, start, tooth, face):
-    """(n, 5) table rows of tooth ``tooth`` (n,) int, face index ``face`` (n,) int."""
+    """(..., n, 5) table rows of tooth ``tooth`` (..., n) int, face index ``face`` (..., n) int."""
     base = start.astype(np.int64) + (tooth * FACES + face) * TABLE_STRIDE
-    return table[base[:, None] + np.arange(TABLE_STRIDE)]
+    return table[base[..., None] + np.arange(TABLE_STRIDE)]
 
 
 def flank_force(pp: ToothPairs, f: int, sig, z1, z2, k_mean, c_mesh, shape_args, th1, th2, phi_e, phi_dot, w1,
@@ -208,7 +208,7 @@ def flank_force(pp: ToothPairs, f: int, sig, z1, z2, k_mean, c_mesh, shape_args,
         dist = ad.abs_(u - 0.5 * eps)
         share = 0.5 * ratio * smooth_box(dist, 0.5 * eps, s) + (1.0 - 0.5 * ratio) * smooth_box(dist, half_b, s)
         k0 = kmax * share
-        pairs.append((k0 * (row1[:, 4] * row2[:, 4]), gap, dgap))
+        pairs.append((k0 * (row1[..., 4] * row2[..., 4]), gap, dgap))
         K0 = K0 + k0
     for k, gap, dgap in pairs:
         comp = delta - gap
