@@ -19,7 +19,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
 __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution", "against_viscosity",
-           "mode_shapes", "fault_spectra", "fault_loads", "gear_quality", "forward_reverse_headline",
+           "mode_shapes", "fault_spectra", "fault_loads", "FAULT_QUANTITIES", "gear_quality", "forward_reverse_headline",
            "time_history_group", "cage_orbit_picture", "display_unit", "format_pct", "HEADLINE_QUANTITIES", "FWD", "REV",
            "STYLE"]
 
@@ -93,9 +93,11 @@ def time_histories(t, series: Mapping[str, tuple], units: Mapping[str, str], pat
 def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]],
               units: Mapping[str, str], path, *, title: str | None = None,
               ylabels: Mapping[str, str] | None = None) -> Path:
-    """Grouped bars: one subplot per quantity (units differ), a forward/reverse pair per condition.
+    """Grouped bars: one subplot per quantity (units differ), a forward/reverse pair per condition, the change of
+    reverse against forward written over each pair; bars start at zero, forces in kN from 1 kN on.
 
-    table: quantity -> {condition: (fwd, rev)}; a missing condition or a None value leaves a gap.
+    table: quantity -> {condition: (fwd, rev)}; a missing condition or a None value leaves a gap, and a
+    direction with no value anywhere gets no legend entry.
     ylabels: optional quantity -> words for the y axis (default: the quantity, which is the panel title).
     """
     conditions = list(conditions)
@@ -106,8 +108,9 @@ def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]
     n = len(table)
     ncols = min(n, 3)
     nrows = -(-n // ncols)
+    present = set()
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(3.2 * ncols + 0.6, 2.8 * nrows + 0.4), layout="constrained")
+        fig = Figure(figsize=(3.2 * ncols + 0.6, 2.8 * nrows + 0.6), layout="constrained")
         axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
         for ax, (quantity, by_cond) in zip(axes, table.items()):
             vals = np.full((len(conditions), 2), np.nan)
@@ -115,17 +118,29 @@ def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]
                 pair = by_cond.get(c)
                 if pair is not None:
                     vals[i] = [np.nan if v is None else float(v) for v in pair]
-            ax.bar(x - w / 2, vals[:, 0], w, color=FWD["color"], label="forward")
-            ax.bar(x + w / 2, vals[:, 1], w, color=REV["color"], label="reverse", hatch="//",
-                   edgecolor="white", linewidth=0)
+            scale, shown = display_unit(units.get(quantity), vals)
+            for k, (d, st) in enumerate((("forward", FWD), ("reverse", REV))):
+                if np.all(np.isnan(vals[:, k])):
+                    continue
+                present.add(d)
+                ax.bar(x + (k - 0.5) * w, vals[:, k] * scale, w, color=st["color"], label=d,
+                       hatch="//" if d == "reverse" else None, edgecolor="white", linewidth=0)
+            top = float(np.nanmax(np.abs(vals))) * scale if np.any(np.isfinite(vals)) else 1.0
+            for i in range(len(conditions)):
+                p = _pct(*(None if np.isnan(v) else float(v) for v in vals[i]))
+                if p is not None:
+                    ax.text(x[i], 1.06 * float(np.nanmax(vals[i])) * scale, format_pct(p), ha="center", va="bottom",
+                            fontsize=8, fontweight="bold", color="#333333", gid="pct_change")
+            lo = min(0.0, float(np.nanmin(vals)) * scale) if np.any(np.isfinite(vals)) else 0.0
+            ax.set_ylim(lo * 1.2, 1.25 * top if top > 0 else 1.0)
             ax.set_xticks(x, conditions, rotation=20 if len(conditions) > 3 else 0)
-            ax.set_ylabel(_axis_label((ylabels or {}).get(quantity, quantity), units.get(quantity)))
-            ax.set_xlabel(_axis_label("condition", "–"))
+            ax.set_xlim(-0.7, len(conditions) - 0.3)
+            ax.set_ylabel(_axis_label(_wrap((ylabels or {}).get(quantity, quantity), 26), shown))
             ax.set_title(quantity)
             ax.grid(axis="x", visible=False)
         for ax in axes[n:]:
             ax.set_visible(False)
-        axes[0].legend(loc="best")
+        _direction_legend(fig, [d for d in ("forward", "reverse") if d in present], hatch=True)
         if title:
             fig.suptitle(title)
         return _save(fig, path)
@@ -294,30 +309,58 @@ def mode_shapes(freqs_hz, shapes, labels: Sequence[str], path, *, max_modes: int
         return _save(fig, path)
 
 
-def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple], path, *,
-                      title: str | None = None) -> Path:
-    """Quantities against the oil's viscosity, forward vs reverse, one column per bearing type.
+def _plain_log(axis) -> None:
+    """Tick labels of a log axis as plain numbers (0.3, 2, 40), not powers of ten: these axes span a decade or two."""
+    from matplotlib.ticker import LogLocator
+    axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 3.0, 5.0)))
+    axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
 
-    series: (quantity key, bearing, direction) -> (viscosities [Pa·s], values);  quantities: (key, words,
-    unit, log scale) — one row each;  bearings and directions are read from the series' keys."""
+
+def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple], path, *,
+                      title: str | None = None, levels: Mapping[str, Mapping[float, str]] | None = None,
+                      names: Mapping[str, float] | None = None) -> Path:
+    """Quantities against the oil's viscosity, forward vs reverse, one column per bearing type, one legend.
+
+    series: (quantity key, bearing, direction) -> (viscosities [Pa·s], values [SI]);  quantities: (key, words,
+    SI unit, log scale) — one row each, shown in a unit that suits the range (a film in µm); levels: quantity
+    key -> {value: words}, dotted horizontal lines (e.g. the film regimes' bounds of Λ); names: oil name ->
+    its viscosity [Pa·s], written under the bottom row's ticks at the oils. Bearings and directions are read from
+    the series' keys."""
     bearings = sorted({b for _, b, _ in series})
+    present = sorted({d for _, _, d in series}, key=lambda d: {"forward": 0, "reverse": 1}.get(d, 2))
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(3.4 * len(bearings) + 0.6, 2.6 * len(quantities) + 0.6), layout="constrained")
-        axes = fig.subplots(len(quantities), len(bearings), squeeze=False)
+        fig = Figure(figsize=(3.4 * len(bearings) + 0.6, 2.5 * len(quantities) + 0.8), layout="constrained")
+        axes = fig.subplots(len(quantities), len(bearings), squeeze=False, sharex=True)
         for r, (key, words, unit, log) in enumerate(quantities):
+            ys = [v for (k, _, _), (_, y) in series.items() if k == key for v in y if v is not None]
+            scale, shown = display_unit(unit, ys)
             for c, b in enumerate(bearings):
                 ax = axes[r, c]
                 for d, style in (("forward", FWD), ("reverse", REV)):
                     if (key, b, d) in series:
                         x, y = series[(key, b, d)]
-                        ax.plot(np.asarray(x) * 1e3, y, marker="o", **style)
+                        y = np.array([np.nan if v is None else v for v in y], float)
+                        ax.plot(np.asarray(x) * 1e3, y * scale, marker="o", **style)
                 ax.set_xscale("log")
+                _plain_log(ax.xaxis)
                 if log:
                     ax.set_yscale("log")
-                ax.set_title(f"{b} planet bearings")
-                ax.set_ylabel(_axis_label(words, unit))
-                ax.set_xlabel(_axis_label("oil viscosity", "mPa·s"))
-                ax.legend(loc="best")
+                    _plain_log(ax.yaxis)
+                for value, label in (levels or {}).get(key, {}).items():
+                    ax.axhline(value * scale, color=_MARK_COLOR, lw=0.8, ls=":")
+                    ax.text(0.02, value * scale, label, transform=ax.get_yaxis_transform(), fontsize=7,
+                            color=_MARK_COLOR, va="bottom")
+                if r == 0:
+                    ax.set_title(f"{b} planet bearings")
+                ax.set_ylabel(_axis_label(_wrap(words, 24), shown))
+                if r == len(quantities) - 1:
+                    ax.set_xlabel(_axis_label("oil viscosity η", "mPa·s"))
+                    if names:
+                        ax.set_xticks([1e3 * v for v in names.values()],
+                                      [f"{1e3 * v:.3g}\n{n}" for n, v in names.items()])
+                        ax.xaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
+        _direction_legend(fig, present)
         if title:
             fig.suptitle(title)
         return _save(fig, path)
@@ -346,44 +389,52 @@ def fault_spectra(panels: Sequence[tuple], path, *, quantity: str = "sensor acce
         return _save(fig, path)
 
 
-def _zoom_if_clustered(ax, values) -> None:
-    """Bars of positive values within a few % of each other (e.g. load-sharing factors near 1) read better
-    on an axis that starts near them than at zero."""
-    v = np.asarray([x for x in values if np.isfinite(x)], float)
-    if v.size and v.min() > 0 and np.ptp(v) < 0.3 * v.max():
-        pad = 0.15 * (np.ptp(v) or 0.05 * v.max())
-        ax.set_ylim(v.min() - pad, v.max() + pad)
+FAULT_QUANTITIES = (
+    ("load_sharing_factor", "load sharing K_γ − 1: most loaded over the mean", "%", "excess"),
+    ("bearing_load_max_N", "largest bearing load", "N", None),
+    ("life_relative", "life change against the perfect machine", "%", "excess"),
+    ("cage_slip_pct", "cage slip", "%", None),
+    ("pocket_impacts_per_rev", "pocket impacts", "per cage rev.", None))
 
 
-def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = (
-        ("load_sharing_factor", "load sharing K_γ", None), ("bearing_load_max_N", "largest bearing load", "N"),
-        ("life_relative", "life / perfect machine's", None), ("cage_slip_pct", "cage slip", "%"),
-        ("pocket_impacts_per_rev", "pocket impacts per cage rev.", None))) -> Path:
-    """Bars per fault (forward solid, reverse hatched), one row per quantity, one column per bearing type.
-    rows: dicts with "fault", "direction", "bearing" and the quantities' keys (None: not available)."""
+def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = FAULT_QUANTITIES) -> Path:
+    """Bars per fault (forward solid, reverse hatched), one row per quantity, one column per bearing type, one
+    legend naming the directions that ran. rows: dicts with "fault", "direction", "bearing" and the quantities'
+    keys (None: not available). quantities: (key, words, unit, how); how "excess" shows a ratio r (K_γ, a life
+    against the perfect machine's) as its excess over 1 in %, 100 (r − 1) — bars from zero then read as the
+    change, where bars of ratios near 1 would all look alike."""
     faults = list(dict.fromkeys(r["fault"] for r in rows))
     bearings = sorted({r["bearing"] for r in rows})
+    present = [d for d in ("forward", "reverse") if any(r["direction"] == d for r in rows)]
     x = np.arange(len(faults))
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(3.8 * len(bearings) + 0.6, 2.0 * len(quantities) + 0.8), layout="constrained")
+        fig = Figure(figsize=(3.8 * len(bearings) + 0.6, 2.0 * len(quantities) + 1.2), layout="constrained")
         axes = fig.subplots(len(quantities), len(bearings), squeeze=False, sharex=True)
-        for r, (key, words, unit) in enumerate(quantities):
+        for r, spec in enumerate(quantities):
+            key, words, unit = spec[:3]
+            how = spec[3] if len(spec) > 3 else None
+            raw = [row.get(key) for row in rows if row.get(key) is not None]
+            scale, shown = (100.0, "%") if how == "excess" else display_unit(unit, raw)
             for c, b in enumerate(bearings):
                 ax = axes[r, c]
-                shown = []
                 for k, (d, st) in enumerate((("forward", FWD), ("reverse", REV))):
+                    if d not in present:
+                        continue
                     val = {row["fault"]: row.get(key) for row in rows if row["bearing"] == b and row["direction"] == d}
-                    y = [np.nan if val.get(f) is None else float(val[f]) for f in faults]
+                    y = np.array([np.nan if val.get(f) is None else float(val[f]) for f in faults])
+                    y = (y - 1.0) * scale if how == "excess" else y * scale
                     ax.bar(x + (k - 0.5) * 0.38, y, width=0.38, color=st["color"], label=d,
-                           hatch="//" if d == "reverse" else None, alpha=0.85)
-                    shown += y
-                _zoom_if_clustered(ax, shown)
-                ax.set_ylabel(_axis_label(words, unit))
+                           hatch="//" if d == "reverse" else None, edgecolor="white", linewidth=0)
+                ax.axhline(0.0, color="k", lw=0.6)
+                lo, hi = ax.get_ylim()
+                ax.set_ylim(min(lo, 0.0), max(hi, 0.0))
+                ax.set_ylabel(_axis_label(_wrap(words, 26), shown))
+                ax.grid(axis="x", visible=False)
                 if r == 0:
                     ax.set_title(f"{b} planet bearings")
-                    ax.legend(loc="best")
         for ax in axes[-1]:
             ax.set_xticks(x, faults, rotation=30, ha="right")
+        _direction_legend(fig, present, hatch=True)
         return _save(fig, path)
 
 
