@@ -300,7 +300,7 @@ def plots(results: dict, out: Path) -> list[Path]:
     if conds and table:
         paths.append(vp.bar_chart([f"condition {c}" for c in conds], {k: {f"condition {c}": v for c, v in by.items()}
                                                                        for k, by in table.items()},
-                                  bar_units, out / "bars.png", ylabels=ylabels,
+                                  bar_units, out / "bars.png", ylabels=ylabels, ncols=2,
                                   title="RMS across conditions: forward vs reverse"))
     return paths
 

@@ -92,13 +92,14 @@ def time_histories(t, series: Mapping[str, tuple], units: Mapping[str, str], pat
 
 def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]],
               units: Mapping[str, str], path, *, title: str | None = None,
-              ylabels: Mapping[str, str] | None = None) -> Path:
+              ylabels: Mapping[str, str] | None = None, ncols: int = 3) -> Path:
     """Grouped bars: one subplot per quantity (units differ), a forward/reverse pair per condition, the change of
     reverse against forward written over each pair; bars start at zero, forces in kN from 1 kN on.
 
     table: quantity -> {condition: (fwd, rev)}; a missing condition or a None value leaves a gap, and a
     direction with no value anywhere gets no legend entry.
     ylabels: optional quantity -> words for the y axis (default: the quantity, which is the panel title).
+    ncols: panels per row (2 puts the inner and outer planet bearings of a quantity side by side).
     """
     conditions = list(conditions)
     if not table:
@@ -106,7 +107,7 @@ def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]
     x = np.arange(len(conditions))
     w = 0.38
     n = len(table)
-    ncols = min(n, 3)
+    ncols = min(n, ncols)
     nrows = -(-n // ncols)
     present = set()
     with mpl.rc_context(STYLE):
@@ -367,25 +368,33 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
 
 
 def fault_spectra(panels: Sequence[tuple], path, *, quantity: str = "sensor acceleration",
-                  unit: str = "m/s^2") -> Path:
-    """One panel per damaged machine: its spectrum against the perfect machine's, on a band around the mesh
-    frequency, with its characteristic frequencies marked.
+                  unit: str = "m/s^2", title: str | None = None) -> Path:
+    """One panel per damaged machine (its title): its spectrum against the perfect machine's, on a band around
+    the mesh frequency, with its characteristic frequencies marked; one legend for the figure.
 
     panels: (title, freq_hz, amplitude, reference amplitude, marks {label: Hz}, (f_lo, f_hi))."""
+    from matplotlib.lines import Line2D
+    shown = display_unit(unit)[1]
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(7.5, 2.4 * len(panels) + 0.4), layout="constrained")
+        fig = Figure(figsize=(7.5, 2.4 * len(panels) + 0.9), layout="constrained")
         axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
-        for ax, (title, f, amp, ref, marks, (lo, hi)) in zip(axes, panels):
+        for ax, (name, f, amp, ref, marks, (lo, hi)) in zip(axes, panels):
             f = np.asarray(f, float)
             keep = (f >= lo) & (f <= hi)
-            ax.plot(f[keep], np.asarray(ref, float)[keep], color="0.6", lw=1.0, label="perfect machine")
-            ax.plot(f[keep], np.asarray(amp, float)[keep], color=FWD["color"], lw=1.0, label=title)
+            ax.plot(f[keep], np.asarray(ref, float)[keep], color="0.6", lw=1.0)
+            ax.plot(f[keep], np.asarray(amp, float)[keep], color=FWD["color"], lw=1.0)
             ax.set_yscale("log")
+            _plain_log(ax.yaxis)
             ax.set_xlim(lo, hi)
-            ax.set_ylabel(_axis_label(quantity, unit))
-            ax.legend(loc="lower right")
+            ax.set_ylabel(_axis_label(_wrap(quantity, 22), shown))
+            ax.set_title(name, loc="left", fontsize=9)
             _mark_frequencies(fig, ax, {k: v for k, v in marks.items() if lo <= v <= hi}, hi)
         axes[-1].set_xlabel(_axis_label("frequency", "Hz"))
+        fig.legend(handles=[Line2D([], [], color="0.6", lw=1.0, label="perfect machine"),
+                            Line2D([], [], color=FWD["color"], lw=1.0, label="damaged machine (panel title)")],
+                   loc="outside lower center", ncols=2, frameon=False)
+        if title:
+            fig.suptitle(title)
         return _save(fig, path)
 
 
@@ -397,7 +406,8 @@ FAULT_QUANTITIES = (
     ("pocket_impacts_per_rev", "pocket impacts", "per cage rev.", None))
 
 
-def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = FAULT_QUANTITIES) -> Path:
+def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = FAULT_QUANTITIES,
+                title: str | None = None) -> Path:
     """Bars per fault (forward solid, reverse hatched), one row per quantity, one column per bearing type, one
     legend naming the directions that ran. rows: dicts with "fault", "direction", "bearing" and the quantities'
     keys (None: not available). quantities: (key, words, unit, how); how "excess" shows a ratio r (K_γ, a life
@@ -435,6 +445,8 @@ def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = 
         for ax in axes[-1]:
             ax.set_xticks(x, faults, rotation=30, ha="right")
         _direction_legend(fig, present, hatch=True)
+        if title:
+            fig.suptitle(title)
         return _save(fig, path)
 
 
