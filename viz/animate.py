@@ -306,12 +306,12 @@ def _orbit_inputs(t, orbits, clearance_m, rollers):
     return t, labels, orb, clr, rol
 
 
-def _panels_with_title(W, H, n, title, legend: bool = False):
+def _panels_with_title(W, H, n, title, legend: float = 0.0):
     """An offscreen plotter with n panels side by side under an optional title strip and over an optional
-    legend strip: (plotter, row of the panels, height fraction of the title strip, row of the legend or None,
-    height fraction of the legend strip)."""
+    legend strip of height fraction ``legend``: (plotter, row of the panels, height fraction of the title strip,
+    row of the legend or None, height fraction of the legend strip)."""
     strip = 0.13 if title else 0.0
-    leg = min(0.16, max(0.08, 34.0 / H)) if legend else 0.0
+    leg = float(legend)
     weights = ([strip] if title else []) + [1 - strip - leg] + ([leg] if legend else [])
     rows = len(weights)
     row = 1 if title else 0
@@ -333,51 +333,74 @@ def _panels_with_title(W, H, n, title, legend: bool = False):
 
 
 def _legend_strip(p, row: int, px: tuple[int, int], entries: Sequence[tuple], fs: int) -> None:
-    """A one-line legend across the strip ``row``: entries (glyph, colour, words), glyph "line", "dot" or
-    "ring"; the glyphs are drawn as geometry (VTK's font has no symbols), the words as text whose widths are
-    measured on the rendered strip. The font shrinks until every entry fits the width: nothing is clipped."""
+    """A legend across the strip ``row``: entries (glyph, colour, words), glyph "line", "dot" or "ring"; the
+    glyphs are drawn as geometry (VTK's font has no symbols), the words as text whose widths are measured on the
+    rendered strip. The font shrinks to fit the width, down to a legible minimum; below it the entries go on
+    as many lines as they need — nothing is clipped."""
     W, H = px
     p.subplot(row, 0)
-    glyph_w, pad, gap = 28.0, 6.0, 18.0          # [px]
+    glyph_w, pad, gap = 24.0, 5.0, 16.0          # [px]
     texts = [p.add_text(words, position=(0.0, 0.5), viewport=True, font_size=fs, color=_INK) for _, _, words in entries]
     for t in texts:
         t.prop.justification_horizontal = "left"
         t.prop.justification_vertical = "center"
-    p.render()
     bb = [0.0] * 4
 
-    def width(t):
-        t.GetBoundingBox(p.renderer, bb)
-        return bb[1] - bb[0]
-
-    while True:
-        widths = [glyph_w + pad + width(t) + gap for t in texts]
-        if sum(widths) - gap <= 0.97 * W or fs <= 6:
-            break
-        fs -= 1
-        for t in texts:
-            t.prop.font_size = fs
+    def widths():
         p.render()
-    x = 0.5 * (W - sum(widths) + gap)
-    y = 0.5 * H
+        out = []
+        for t in texts:
+            t.GetBoundingBox(p.renderer, bb)
+            out.append(glyph_w + pad + (bb[1] - bb[0]) + gap)
+        return out
+
+    def lines(ws):
+        """Entries split into consecutive lines, each at most 0.97 W wide."""
+        out, cur, width = [], [], 0.0
+        for i, w in enumerate(ws):
+            if cur and width + w - gap > 0.97 * W:
+                out.append(cur)
+                cur, width = [], 0.0
+            cur.append(i)
+            width += w
+        return out + [cur]
+
+    size = int(texts[0].prop.font_size)          # VTK's own units (pyvista scales font_size)
+    ws = widths()
+    while len(lines(ws)) > 1 and size > 12:      # shrink first, down to a legible size
+        size -= 1
+        for t in texts:
+            t.prop.font_size = size
+        ws = widths()
+    rows = lines(ws)
     # the strip's camera: one world unit per pixel, origin at the lower left
     p.camera_position = [(W / 2, H / 2, 10.0 * W), (W / 2, H / 2, 0.0), (0.0, 1.0, 0.0)]
     p.enable_parallel_projection()
     p.camera.parallel_scale = H / 2
     p.camera.clipping_range = (1.0, 100.0 * W)
-    for (glyph, color, _), t, w in zip(entries, texts, widths):
-        if glyph == "line":
-            pts = np.array([[x, y, 0.0], [x + glyph_w, y, 0.0]])
-            p.add_mesh(pv.PolyData(pts, lines=_lines_cells([[0, 1]])), color=color, line_width=2, lighting=False)
-        elif glyph == "dot":
-            p.add_mesh(pv.PolyData(np.array([[x + glyph_w / 2, y, 0.0]])), color=color, point_size=max(6, fs // 2),
-                       render_points_as_spheres=True, lighting=False)
-        else:   # ring
-            c = _circle(32) * 0.3 * glyph_w + [x + glyph_w / 2, y]
-            p.add_mesh(pv.PolyData(_xyz(c, 0.0), lines=_lines_cells([list(range(32)) + [0]])), color=color,
-                       line_width=1.5, lighting=False)
-        t.position = ((x + glyph_w + pad) / W, 0.5)
-        x += w
+    for k, members in enumerate(rows):
+        y = H * (1.0 - (k + 0.5) / len(rows))
+        x = 0.5 * (W - sum(ws[i] for i in members) + gap)
+        for i in members:
+            glyph, color, _ = entries[i]
+            if glyph == "line":
+                pts = np.array([[x, y, 0.0], [x + glyph_w, y, 0.0]])
+                p.add_mesh(pv.PolyData(pts, lines=_lines_cells([[0, 1]])), color=color, line_width=2, lighting=False)
+            elif glyph == "dot":
+                p.add_mesh(pv.PolyData(np.array([[x + glyph_w / 2, y, 0.0]])), color=color, point_size=max(5, size // 3),
+                           render_points_as_spheres=True, lighting=False)
+            else:   # ring
+                c = _circle(32) * 0.3 * glyph_w + [x + glyph_w / 2, y]
+                p.add_mesh(pv.PolyData(_xyz(c, 0.0), lines=_lines_cells([list(range(32)) + [0]])), color=color,
+                           line_width=1.5, lighting=False)
+            texts[i].position = ((x + glyph_w + pad) / W, y / H)
+            x += ws[i]
+
+
+def _legend_height(W: int, H: int, n_entries: int) -> float:
+    """Height fraction of the legend strip: one line of text (≈ 30 px), two where the frame is narrow."""
+    lines = 1 if W >= 1100 or n_entries <= 3 else (2 if W >= 560 else 3)
+    return min(0.3, max(0.07, lines * 26.0 / H))
 
 
 def _orbit_panel(p, view, orbit, clearance, extent, col, panel_px):
@@ -458,7 +481,8 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
     tfmt = _time_formatter(t[idx])
 
     n = len(labels)
-    p, row, strip, leg_row, leg = _panels_with_title(W, H, n, title, legend)
+    n_entries = 5 if rol else 3
+    p, row, strip, leg_row, leg = _panels_with_title(W, H, n, title, _legend_height(W, H, n_entries) if legend else 0.0)
     try:
         panel_px = (W // n, int(round(H * (1 - strip - leg))))
         longest = max(labels, key=len)
