@@ -281,8 +281,10 @@ def plots(results: dict, out: Path) -> list[Path]:
                                      title=f"Condition {c}: cage orbits in the guide clearance")
     vals = headline_values(results)
     if vals:
+        one = f", condition {conds[0]}" if len(conds) == 1 else ""
         paths.append(vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
-                                                 title="Planet bearings: mean load and L10 life, forward vs reverse"))
+                                                 title=f"Planet bearings (pair 1): mean load and L10 life, forward vs "
+                                                       f"reverse{one}"))
     table, bar_units, ylabels = {}, {}, {}
     for q, unit in QUANTITIES:
         if q not in BAR_QUANTITIES:

@@ -652,7 +652,10 @@ def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], t
                     if run not in styles:
                         styles[run] = {"color": next(extra, "#555555"), "linestyle": "-", "label": run}
                     st = {**styles[run], "label": run}
-                    (ln,) = ax.plot(np.asarray(t, float) * tscale, np.asarray(y, float) * scale, **st)
+                    t = np.asarray(t, float)
+                    # many samples: thinner lines, so that two overlaid runs stay apart
+                    lw = 1.2 if t.size < 200 else 0.9 if t.size < 1000 else 0.6
+                    (ln,) = ax.plot(t * tscale, np.asarray(y, float) * scale, lw=lw, **st)
                     handles.setdefault(run, ln)
                 if r == 0:
                     ax.set_title((column_titles or {}).get(col, col))
@@ -694,7 +697,8 @@ def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = Non
     cmap = mpl.colormaps["viridis"]
     circle = np.linspace(0, 2 * np.pi, 3601)
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(3.3 * len(panels) + 1.2, 7.4), layout="constrained")
+        fig = Figure(figsize=(3.3 * len(panels) + 1.2, 7.6), layout="constrained")
+        fig.get_layout_engine().set(hspace=0.06)          # the zoom row's titles clear the x labels above
         axes = fig.subplots(2, len(panels), squeeze=False)
         lc = None
         for k, ((label, t, _, clearance), e) in enumerate(zip(panels, es)):
