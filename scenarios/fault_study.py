@@ -223,10 +223,12 @@ def write_outputs(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
     atomic_write_text(out / "findings.md", findings(rows) + "\n")
     from viz.plots import fault_loads, fault_spectra
 
-    files = [out / "summary.csv", out / "summary.md", out / "findings.md", fault_loads(rows, out / "loads.png")]
+    files = [out / "summary.csv", out / "summary.md", out / "findings.md",
+             fault_loads(rows, out / "loads.png", title="What each fault does to the planet bearings (pair 1)")]
     panels = _spectrum_panels(spectra)
     if panels:
-        files.append(fault_spectra(panels, out / "spectra.png"))
+        files.append(fault_spectra(panels, out / "spectra.png",
+                                   title="The housing sensor around the mesh frequency: each fault against the perfect machine"))
     return files
 
 

@@ -12,7 +12,8 @@ Walther); a viscosity sets the dynamic viscosity at the operating temperature di
 
 Writes ``summary.csv`` / ``summary.md`` (one row per run and bearing type: film with and without the thermal
 reduction, Λ and its regime, traction, loads, cage guide, cage slip, pocket impacts, heat),
-``film_and_slip.png`` and the answer in words (``answer.md``, printed): per condition and direction each oil's
+``film_and_slip.png`` (Λ with the regimes' bounds, film, cage slip, traction heat against the viscosity) and
+the answer in words (``answer.md``, printed): per condition and direction each oil's
 thinnest film as Λ = h_min/σ and its regime as the literature names them (Λ ≥ 3 full film; 1 ≤ Λ < 3 partial
 EHL, i.e. mixed; Λ < 1 boundary-dominated), whether a cage skids (more than 5 % below its epicyclic speed:
 the rollers slide instead of rolling), and the least viscosity for Λ ≥ 1.5 and for a full film (Λ ≥ 3) in
@@ -203,15 +204,20 @@ def write_outputs(rows: list[dict], out: Path) -> list[Path]:
     from viz.plots import against_viscosity
 
     series = {}
-    for key in ("h_min_m", "cage_slip_pct", "heat_traction_W"):
+    for key in ("lambda_min", "h_min_m", "cage_slip_pct", "heat_traction_W"):
         for r in sorted(rows, key=lambda r: r["viscosity_Pa_s"]):
             x, y = series.setdefault((key, r["bearing"], r["direction"]), ([], []))
             x.append(r["viscosity_Pa_s"])
             y.append(r[key])
-    fig = against_viscosity(series, [("h_min_m", "thinnest film h_min", "m", True),
+    fig = against_viscosity(series, [("lambda_min", "film parameter Λ_min = h_min/σ", "1", True),
+                                     ("h_min_m", "thinnest film h_min", "m", True),
                                      ("cage_slip_pct", "cage slip", "%", False),
                                      ("heat_traction_W", "traction heat", "W", False)],
-                            out / "film_and_slip.png", title="Film and cage against the oil's viscosity")
+                            out / "film_and_slip.png",
+                            title="Film and cage against the oil's viscosity (at the operating temperature)",
+                            names={r["lubricant"]: r["viscosity_Pa_s"] for r in rows},
+                            levels={"lambda_min": {1.0: "Λ = 1: below, boundary-dominated",
+                                                   FULL_FILM_LAMBDA: f"Λ = {FULL_FILM_LAMBDA:g}: full film above"}})
     return [out / "summary.csv", out / "summary.md", out / "answer.md", fig]
 
 

@@ -5,7 +5,9 @@
         --set bearing.clearance="30 um" --out results/study
 
 Writes DIR/c{condition}_{direction}/{results.nc, summary.json}, DIR/comparison.csv, DIR/comparison.md,
-DIR/c{condition}_time_histories.png, DIR/bars.png, and (with --animate) DIR/c{condition}_cage_orbits.gif.
+DIR/bearing_load_life.png (the headline: mean load and L10 life per bearing type, forward vs reverse, the change
+in %), DIR/bars.png, per condition the time histories DIR/c{condition}_{bearing_loads,roller_contacts,cage,mesh}.png
+and the cage orbits DIR/c{condition}_cage_orbit_{inner,outer}.png, and (with --animate) DIR/c{condition}_cage_orbits.gif.
 """
 from __future__ import annotations
 
@@ -16,6 +18,8 @@ import io
 import json
 import sys
 from pathlib import Path
+
+import numpy as np
 
 import mbd
 from components.outputs import SUMMARY_WORDS
@@ -164,63 +168,123 @@ def write_tables(rows: list[dict], out: Path) -> tuple[Path, Path, str]:
     return out / "comparison.csv", out / "comparison.md", text
 
 
-def plots(results: dict, out: Path) -> list[Path]:
+def _runs_of(results: dict, out: Path, c: int) -> dict[str, Path]:
+    """direction -> results.nc of condition ``c``'s runs that finished (a missing run is left out, not faked)."""
+    runs = {}
+    for d in ("forward", "reverse"):
+        p = out / f"c{c}_{d}" / "results.nc"
+        if p.exists() and "error" not in results.get(f"c{c}_{d}", {"error": 1}):
+            runs[d] = p
+    return runs
+
+
+# the groups of time histories, each its own figure: file stem -> (title, columns)
+HISTORY_GROUPS = {"bearing_loads": "planet bearing loads (pin reaction, pair 1)",
+                  "roller_contacts": "roller contacts (reference roller 0, pair 1)",
+                  "cage": "cages (pair 1)",
+                  "mesh": "gear meshes (pair 1)"}
+MESH_COLUMNS = {"sun_inner": "sun – inner planet", "inner_outer": "inner – outer planet",
+                "outer_ring": "outer planet – ring"}
+
+
+def history_groups(runs: dict[str, Path]) -> dict[str, tuple[list, list[str]]]:
+    """The time histories of one condition's runs in readable groups (:data:`HISTORY_GROUPS`): group -> (rows of
+    :func:`viz.plots.time_history_group`, its columns). SI values from results.nc; the cage accelerations
+    relative to the planet are split radial/tangential here (physics stays out of viz)."""
     import xarray as xr
 
+    from components.families import MESH_FAMILY
     from components.outputs import FAMILY, radial_tangential
+
+    rows: dict[str, dict[tuple, dict]] = {g: {} for g in HISTORY_GROUPS}   # group -> (words, unit) -> col -> run
+
+    def put(group, words, unit, col, run, t, y):
+        rows[group].setdefault((words, unit), {}).setdefault(col, {})[run] = (t, np.asarray(y, float))
+
+    for d, p in runs.items():
+        with xr.open_dataset(p, engine="h5netcdf") as ds:
+            bmap = json.loads(ds.attrs["bearings"])
+            t = np.asarray(ds["time"].values, float)
+            bodies = list(ds["motion.body"].values)
+            for i, b in enumerate(bmap):
+                if b["pair"] != 0:
+                    continue
+                col = b["kind"]
+                if "bearing.load_radial" in ds:
+                    put("bearing_loads", "bearing load, radial (+ outward)", "N", col, d, t,
+                        ds["bearing.load_radial"].values[:, i])
+                    put("bearing_loads", "bearing load, tangential", "N", col, d, t,
+                        ds["bearing.load_tangential"].values[:, i])
+                if b["type"] != "rollers":
+                    continue
+                put("roller_contacts", "roller–inner race load", "N", col, d, t,
+                    ds[f"{FAMILY['race_inner']}.load"].values[:, b["race_inner"][0]])
+                put("roller_contacts", "roller–outer race load", "N", col, d, t,
+                    ds[f"{FAMILY['race_outer']}.load"].values[:, b["race_outer"][0]])
+                if "pocket" in b:
+                    put("roller_contacts", "roller–cage pocket force", "N", col, d, t,
+                        ds[f"{FAMILY['pocket']}.force"].values[:, b["pocket"][0]])
+                if "guide" in b:
+                    put("cage", "cage–guide force", "N", col, d, t, ds[f"{FAMILY['guide']}.force"].values[:, b["guide"]])
+                    a, pos = ds["motion.acceleration"].values, ds["motion.position"].values
+                    ic, ip, ik = (bodies.index(x) for x in (b["cage"], b["planet"], "carrier"))
+                    rad, tan = radial_tangential(a[:, ic] - a[:, ip], pos[:, ip], pos[:, ik])
+                    put("cage", "cage acc. rel. planet, radial", "m/s^2", col, d, t, rad)
+                    put("cage", "cage acc. rel. planet, tangential", "m/s^2", col, d, t, tan)
+                if "bearing.cage_slip" in ds:
+                    put("cage", "cage slip", "%", col, d, t, ds["bearing.cage_slip"].values[:, i])
+            for key in MESH_COLUMNS:
+                fam = MESH_FAMILY[key]
+                if f"{fam}.force" in ds:
+                    put("mesh", "mesh force, flank +1 − flank −1", "N", key, d, t, ds[f"{fam}.force"].values[:, 0])
+                if f"{fam}.transmission_error" in ds:
+                    put("mesh", "loaded transmission error", "m", key, d, t,
+                        ds[f"{fam}.transmission_error"].values[:, 0])
+    out = {}
+    for g, by_row in rows.items():
+        if by_row:
+            cols = list(MESH_COLUMNS) if g == "mesh" else ["inner", "outer"]
+            out[g] = ([(w, u, by_col) for (w, u), by_col in by_row.items()], cols)
+    return out
+
+
+def headline_values(results: dict) -> dict[tuple, float | None]:
+    """(quantity, condition, bearing, direction) -> value of :data:`viz.plots.HEADLINE_QUANTITIES`, from the runs
+    that finished (a failed or missing run has no entry)."""
+    from viz.plots import HEADLINE_QUANTITIES
+
+    vals = {}
+    for s in results.values():
+        if "error" in s or "inner" not in s:
+            continue
+        for kind in ("inner", "outer"):
+            for key, _, _ in HEADLINE_QUANTITIES:
+                vals[(key, s["condition"], kind, s["direction"])] = s[kind].get(key)
+    return vals
+
+
+def plots(results: dict, out: Path) -> list[Path]:
     from viz import plots as vp
+    from viz.results import study_cage_pictures
 
     paths = []
     conds = sorted({s["condition"] for s in results.values() if "error" not in s})
     for c in conds:
-        series, units = {}, {}
-        runs = {}
-        for d in ("forward", "reverse"):
-            p = out / f"c{c}_{d}" / "results.nc"
-            if p.exists() and "error" not in results.get(f"c{c}_{d}", {"error": 1}):
-                runs[d] = p
+        runs = _runs_of(results, out, c)
         if not runs:
             continue
-        data = {}
-        for d, p in runs.items():
-            with xr.open_dataset(p, engine="h5netcdf") as ds:
-                bmap = json.loads(ds.attrs["bearings"])
-                t = ds["time"].values
-                bodies = list(ds["motion.body"].values)
-                cols = {}       # label -> (values, units from the file's schema)
-
-                def col(var, i):
-                    return ds[var].values[:, i], ds[var].attrs.get("units", "")
-
-                for kind in ("inner", "outer"):
-                    b = next(x for x in bmap if x["kind"] == kind)
-                    if b["type"] != "rollers":
-                        continue
-                    cols[f"{kind}: roller–inner race"] = col(f"{FAMILY['race_inner']}.load", b["race_inner"][0])
-                    cols[f"{kind}: roller–outer race"] = col(f"{FAMILY['race_outer']}.load", b["race_outer"][0])
-                    if "pocket" in b:
-                        cols[f"{kind}: roller–cage"] = col(f"{FAMILY['pocket']}.force", b["pocket"][0])
-                    if "guide" in b:
-                        cols[f"{kind}: cage–guide"] = col(f"{FAMILY['guide']}.force", b["guide"])
-                        a, pos = ds["motion.acceleration"].values, ds["motion.position"].values
-                        ic, ip, ik = (bodies.index(x) for x in (b["cage"], b["planet"], "carrier"))
-                        rad, tan = radial_tangential(a[:, ic] - a[:, ip], pos[:, ip], pos[:, ik])
-                        u = ds["motion.acceleration"].attrs.get("units", "")
-                        cols[f"{kind}: cage acc. rel. radial"] = (rad, u)
-                        cols[f"{kind}: cage acc. rel. tangential"] = (tan, u)
-                data[d] = (t, cols)
-        labels = list(next(iter(data.values()))[1])
-        t = next(iter(data.values()))[0]
-        for lab in labels:
-            fw, fu = data.get("forward", (None, {}))[1].get(lab, (None, None))
-            rv, ru = data.get("reverse", (None, {}))[1].get(lab, (None, None))
-            n = min(x.size for x in (fw, rv) if x is not None)
-            series[lab] = (fw[:n] if fw is not None else None, rv[:n] if rv is not None else None)
-            units[lab] = fu or ru
-        t = t[:n]
-        if series:
-            paths.append(vp.time_histories(t, series, units, out / f"c{c}_time_histories.png",
-                                           title=f"Condition {c}: forward vs reverse (reference roller, pair 1)"))
+        for g, (rows, cols) in history_groups(runs).items():
+            titles = {"inner": "inner planet bearing", "outer": "outer planet bearing", **MESH_COLUMNS}
+            paths.append(vp.time_history_group(rows, out / f"c{c}_{g}.png", columns=cols, column_titles=titles,
+                                               title=f"Condition {c}: {HISTORY_GROUPS[g]}"))
+        paths += study_cage_pictures(runs, out, prefix=f"c{c}_",
+                                     title=f"Condition {c}: cage orbits in the guide clearance")
+    vals = headline_values(results)
+    if vals:
+        one = f", condition {conds[0]}" if len(conds) == 1 else ""
+        paths.append(vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
+                                                 title=f"Planet bearings (pair 1): mean load and L10 life, forward vs "
+                                                       f"reverse{one}"))
     table, bar_units, ylabels = {}, {}, {}
     for q, unit in QUANTITIES:
         if q not in BAR_QUANTITIES:
@@ -236,7 +300,9 @@ def plots(results: dict, out: Path) -> list[Path]:
                 rv = r.get(kind, {}).get(q) if "error" not in r else None
                 table[key][c] = (fv, rv)
     if conds and table:
-        paths.append(vp.bar_chart(conds, table, bar_units, out / "bars.png", ylabels=ylabels,
+        paths.append(vp.bar_chart([f"condition {c}" for c in conds], {k: {f"condition {c}": v for c, v in by.items()}
+                                                                       for k, by in table.items()},
+                                  bar_units, out / "bars.png", ylabels=ylabels, ncols=2,
                                   title="RMS across conditions: forward vs reverse"))
     return paths
 

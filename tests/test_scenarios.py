@@ -54,8 +54,36 @@ def test_study_writes_documented_outputs(zero_power_study):
     assert {r["quantity"] for r in rows} >= {"bearing_load_mean_N", "roller_cage_rms_N", "life_L10_relative",
                                              "life_iso281_h", "life_iso16281_h"}
     assert "| bearing | quantity | forward | reverse | difference % |" in (out / "comparison.md").read_text()
-    assert (out / "c4_time_histories.png").stat().st_size > 10_000
-    assert (out / "bars.png").stat().st_size > 10_000
+    for name in ("bars.png", "bearing_load_life.png", "c4_bearing_loads.png", "c4_roller_contacts.png", "c4_cage.png",
+                 "c4_mesh.png", "c4_cage_orbit_inner.png", "c4_cage_orbit_outer.png"):
+        assert (out / name).stat().st_size > 10_000, name
+    assert {p.name for p in r["figures"]} >= {"bars.png", "bearing_load_life.png", "c4_cage_orbit_inner.png"}
+
+
+def test_study_figures_show_the_runs_data(zero_power_study):
+    """The time-history groups carry results.nc's series of pair 1 unchanged (SI; the figure converts), and the
+    headline's values are the summaries' numbers."""
+    import xarray as xr
+
+    out, r = zero_power_study
+    runs = {d: out / f"c4_{d}" / "results.nc" for d in ("forward", "reverse")}
+    groups = paper_study.history_groups(runs)
+    assert set(groups) == set(paper_study.HISTORY_GROUPS)
+    assert groups["mesh"][1] == list(paper_study.MESH_COLUMNS)
+    rows = {w: (u, by) for w, u, by in groups["bearing_loads"][0]}
+    unit, by_col = rows["bearing load, radial (+ outward)"]
+    assert unit == "N" and set(by_col) == {"inner", "outer"} and set(by_col["outer"]) == {"forward", "reverse"}
+    with xr.open_dataset(runs["reverse"], engine="h5netcdf") as ds:
+        names = list(ds["bearing.load_radial.instance"].values)
+        t, y = by_col["outer"]["reverse"]
+        np.testing.assert_array_equal(t, ds["time"].values)
+        np.testing.assert_array_equal(y, ds["bearing.load_radial"].values[:, names.index("b1.pb")])
+    vals = paper_study.headline_values(r["results"])
+    for d in ("forward", "reverse"):
+        s = json.loads((out / f"c4_{d}" / "summary.json").read_text())
+        for kind in ("inner", "outer"):
+            assert vals[("bearing_load_mean_N", 4, kind, d)] == s[kind]["bearing_load_mean_N"]
+            assert vals[("life_iso16281_h", 4, kind, d)] == s[kind]["life_iso16281_h"]
 
 
 def _check_lives(d):

@@ -51,6 +51,11 @@ def _assert_animation(path: Path, n_frames: int, size: tuple[int, int]) -> np.nd
     return frames
 
 
+def _red_pixels(img: np.ndarray) -> int:
+    r, g, b = (img[..., c].astype(int) for c in range(3))
+    return int(((r > 170) & (g < 90) & (b < 90)).sum())
+
+
 def _red_centroid(img: np.ndarray) -> np.ndarray:
     r, g, b = (img[..., c].astype(int) for c in range(3))
     mask = (r > 170) & (g < 90) & (b < 90)
@@ -190,6 +195,26 @@ def test_cage_orbit_animation(animate, tmp_path, ext):
     half = SIZE[0] // 2
     moved = _red_centroid(frames[2][:, :half]) - _red_centroid(frames[0][:, :half])
     assert np.linalg.norm(moved) > 5.0
+
+
+def test_cage_orbit_animation_legend_and_progress(animate, tmp_path, capsys):
+    """The legend strip under the panels carries ink (its glyphs and words) where the frame without it has none;
+    progress goes to stderr as plain lines when stderr is not a terminal: the frame count at the start and end."""
+    t, orbits, C, rollers = _orbit_data(N_FRAMES)
+    size = (480, 240)
+    with_legend = animate.cage_orbit_animation(tmp_path / "a.gif", t, orbits, C, rollers=rollers, size=size)
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == f"animating a.gif: {N_FRAMES} frames"
+    assert err[-1].startswith(f"animating a.gif: {N_FRAMES} frames in ") and err[-1].endswith(" s")
+    without = animate.cage_orbit_animation(tmp_path / "b.gif", t, orbits, C, rollers=rollers, size=size,
+                                           legend=False, progress=False)
+    assert capsys.readouterr().err == ""
+    # the legend's red dot (the cage centre's mark) sits in the bottom strip; without a legend the only red is the
+    # markers on the orbits, higher up
+    a, b = _read_frames(with_legend)[-1], _read_frames(without)[-1]
+    low = slice(int(0.7 * size[1]), size[1])       # the strip: 30 % of this frame (three lines)
+    assert _red_pixels(a[low]) > 0 and _red_pixels(b[low]) == 0
+    assert np.mean(a[low].min(axis=-1) < 160) > 0.01                 # and words
 
 
 def test_cage_orbit_max_frames_subsamples(animate, tmp_path):

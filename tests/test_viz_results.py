@@ -342,6 +342,32 @@ def test_study_cage_animation(offscreen, runs, tmp_path):
         assert np.mean(quarter.min(axis=-1) < 200) > 0.01, f"panel {k} is empty"
 
 
+def test_study_cage_pictures(runs, tmp_path, monkeypatch):
+    """One PNG per bearing type, a panel per run: the trail drawn is cage_orbits' offset in µm, the circle the
+    file's guide clearance, the colours the run's times in ms."""
+    from viz import plots
+
+    figs = []
+    save = plots._save
+    monkeypatch.setattr(plots, "_save", lambda fig, path: (figs.append(fig), save(fig, path))[1])
+    paths = vr.study_cage_pictures({"forward": runs["forward"], "reverse": runs["reverse"]}, tmp_path, prefix="c3_")
+    assert [p.name for p in paths] == ["c3_cage_orbit_inner.png", "c3_cage_orbit_outer.png"]
+    assert all(p.stat().st_size > 10_000 for p in paths)
+    for fig, kind in zip(figs, ("inner", "outer")):
+        assert f"{kind} planet bearing" in fig._suptitle.get_text()
+        top = [ax for ax in fig.axes if ax.get_label() != "<colorbar>"][:2]
+        assert [ax.get_title() for ax in top] == ["forward", "reverse"]
+        for ax, d in zip(top, ("forward", "reverse")):
+            run = vr.load_run(runs[d])
+            e = vr.cage_orbits(run, 0)[kind] * 1e6
+            segs = ax.collections[0].get_segments()
+            np.testing.assert_allclose(np.array([s[1] for s in segs]), e[1:])
+            np.testing.assert_allclose(ax.collections[0].get_array(), 0.5e3 * (run.t[:-1] + run.t[1:]))
+            circle = next(ln for ln in ax.get_lines() if ln.get_linestyle() == "--")
+            np.testing.assert_allclose(np.hypot(circle.get_xdata(), circle.get_ydata()),
+                                       run.geometry["bearing"]["guide_clearance"] * 1e6)
+
+
 # ----------------------------------------------------------------------------------- schema
 _LENGTHS = {"m", "m/s", "m/s^2"}
 _ANGLES = {"rad", "rad/s", "rad/s^2"}

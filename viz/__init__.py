@@ -5,13 +5,13 @@ imported eagerly; the pyvista animations load VTK, so they are imported on first
 """
 from __future__ import annotations
 
-from .plots import (bar_chart, load_distribution, mode_shapes, spectrum, time_histories,
-                    work_precision)
+from .plots import (bar_chart, cage_orbit_picture, forward_reverse_headline, load_distribution, mode_shapes,
+                    spectrum, time_histories, time_history_group, work_precision)
 from .render_check import check_offscreen, require_offscreen
 
-__all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution",
-           "mode_shapes", "cage_orbit_animation", "train_animation", "check_offscreen",
-           "require_offscreen"]
+__all__ = ["time_histories", "time_history_group", "bar_chart", "forward_reverse_headline", "cage_orbit_picture",
+           "spectrum", "work_precision", "load_distribution", "mode_shapes", "cage_orbit_animation", "train_animation",
+           "check_offscreen", "require_offscreen"]
 
 _LAZY = {"cage_orbit_animation", "train_animation"}
 

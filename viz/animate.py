@@ -232,6 +232,51 @@ def _screenshot(plotter: pv.Plotter, size: tuple[int, int]) -> np.ndarray:
     return img
 
 
+class _Progress:
+    """Progress of a frame loop on stderr: a tqdm bar on a terminal, otherwise plain lines (one at the start, one
+    every ``PLAIN_EVERY`` seconds, one at the end) — a log file or a pipe gets no escape codes."""
+    PLAIN_EVERY = 10.0
+
+    def __init__(self, total: int, path: Path, show: bool = True):
+        import sys
+        import time
+        self.total, self.path, self.show, self.n = int(total), path, bool(show), 0
+        self._time = time.perf_counter
+        self._start = self._last = self._time()
+        self.bar = None
+        if not self.show:
+            return
+        if sys.stderr.isatty():
+            from tqdm.auto import tqdm
+            self.bar = tqdm(total=self.total, desc=f"animating {path.name}", unit="frame", leave=False)
+        else:
+            print(f"animating {path.name}: {self.total} frames", file=sys.stderr, flush=True)
+
+    def update(self) -> None:
+        self.n += 1
+        if not self.show:
+            return
+        if self.bar is not None:
+            self.bar.update(1)
+            return
+        now = self._time()
+        if now - self._last >= self.PLAIN_EVERY and self.n < self.total:
+            import sys
+            self._last = now
+            left = (self.total - self.n) * (now - self._start) / self.n
+            print(f"animating {self.path.name}: frame {self.n} of {self.total}, about {left:.0f} s left",
+                  file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        if not self.show:
+            return
+        import sys
+        if self.bar is not None:
+            self.bar.close()
+        print(f"animating {self.path.name}: {self.n} frames in {self._time() - self._start:.1f} s",
+              file=sys.stderr, flush=True)
+
+
 # ----------------------------------------------------------------------------------------------
 # cage orbits
 
@@ -261,13 +306,20 @@ def _orbit_inputs(t, orbits, clearance_m, rollers):
     return t, labels, orb, clr, rol
 
 
-def _panels_with_title(W, H, n, title):
-    """An offscreen plotter with n panels side by side under an optional title strip:
-    (plotter, row of the panels, height fraction of the strip)."""
+def _panels_with_title(W, H, n, title, legend: float = 0.0):
+    """An offscreen plotter with n panels side by side under an optional title strip and over an optional
+    legend strip of height fraction ``legend``: (plotter, row of the panels, height fraction of the title strip,
+    row of the legend or None, height fraction of the legend strip)."""
     strip = 0.13 if title else 0.0
-    if title:
-        p = pv.Plotter(off_screen=True, window_size=(W, H), shape=(2, n), row_weights=[strip, 1 - strip],
-                       groups=[(0, np.s_[:])], border=False)
+    leg = float(legend)
+    weights = ([strip] if title else []) + [1 - strip - leg] + ([leg] if legend else [])
+    rows = len(weights)
+    row = 1 if title else 0
+    leg_row = row + 1 if legend else None
+    groups = ([(0, np.s_[:])] if title else []) + ([(leg_row, np.s_[:])] if legend else [])
+    if rows > 1:
+        p = pv.Plotter(off_screen=True, window_size=(W, H), shape=(rows, n), row_weights=weights,
+                       groups=groups, border=False)
     else:
         p = pv.Plotter(off_screen=True, window_size=(W, H), shape=(1, n), border=False)
     p.set_background(_BG, all_renderers=True)
@@ -277,7 +329,78 @@ def _panels_with_title(W, H, n, title):
         tt.prop.justification_horizontal = "center"
         tt.prop.justification_vertical = "center"
         tt.prop.bold = True
-    return p, (1 if title else 0), strip
+    return p, row, strip, leg_row, leg
+
+
+def _legend_strip(p, row: int, px: tuple[int, int], entries: Sequence[tuple], fs: int) -> None:
+    """A legend across the strip ``row``: entries (glyph, colour, words), glyph "line", "dot" or "ring"; the
+    glyphs are drawn as geometry (VTK's font has no symbols), the words as text whose widths are measured on the
+    rendered strip. The font shrinks to fit the width, down to a legible minimum; below it the entries go on
+    as many lines as they need — nothing is clipped."""
+    W, H = px
+    p.subplot(row, 0)
+    glyph_w, pad, gap = 24.0, 5.0, 16.0          # [px]
+    texts = [p.add_text(words, position=(0.0, 0.5), viewport=True, font_size=fs, color=_INK) for _, _, words in entries]
+    for t in texts:
+        t.prop.justification_horizontal = "left"
+        t.prop.justification_vertical = "center"
+    bb = [0.0] * 4
+
+    def widths():
+        p.render()
+        out = []
+        for t in texts:
+            t.GetBoundingBox(p.renderer, bb)
+            out.append(glyph_w + pad + (bb[1] - bb[0]) + gap)
+        return out
+
+    def lines(ws):
+        """Entries split into consecutive lines, each at most 0.97 W wide."""
+        out, cur, width = [], [], 0.0
+        for i, w in enumerate(ws):
+            if cur and width + w - gap > 0.97 * W:
+                out.append(cur)
+                cur, width = [], 0.0
+            cur.append(i)
+            width += w
+        return out + [cur]
+
+    size = int(texts[0].prop.font_size)          # VTK's own units (pyvista scales font_size)
+    ws = widths()
+    while len(lines(ws)) > 1 and size > 12:      # shrink first, down to a legible size
+        size -= 1
+        for t in texts:
+            t.prop.font_size = size
+        ws = widths()
+    rows = lines(ws)
+    # the strip's camera: one world unit per pixel, origin at the lower left
+    p.camera_position = [(W / 2, H / 2, 10.0 * W), (W / 2, H / 2, 0.0), (0.0, 1.0, 0.0)]
+    p.enable_parallel_projection()
+    p.camera.parallel_scale = H / 2
+    p.camera.clipping_range = (1.0, 100.0 * W)
+    for k, members in enumerate(rows):
+        y = H * (1.0 - (k + 0.5) / len(rows))
+        x = 0.5 * (W - sum(ws[i] for i in members) + gap)
+        for i in members:
+            glyph, color, _ = entries[i]
+            if glyph == "line":
+                pts = np.array([[x, y, 0.0], [x + glyph_w, y, 0.0]])
+                p.add_mesh(pv.PolyData(pts, lines=_lines_cells([[0, 1]])), color=color, line_width=2, lighting=False)
+            elif glyph == "dot":
+                p.add_mesh(pv.PolyData(np.array([[x + glyph_w / 2, y, 0.0]])), color=color, point_size=max(5, size // 3),
+                           render_points_as_spheres=True, lighting=False)
+            else:   # ring
+                c = _circle(32) * 0.3 * glyph_w + [x + glyph_w / 2, y]
+                p.add_mesh(pv.PolyData(_xyz(c, 0.0), lines=_lines_cells([list(range(32)) + [0]])), color=color,
+                           line_width=1.5, lighting=False)
+            texts[i].position = ((x + glyph_w + pad) / W, y / H)
+            x += ws[i]
+
+
+def _legend_height(W: int, H: int, n_entries: int) -> float:
+    """Height fraction of the legend strip: one line of text (≈ 30 px), two where the frame is narrow."""
+    lines = 1 if W >= 1100 or n_entries <= 3 else (2 if W >= 560 else 3)
+    return min(0.3, max(0.07, lines * 26.0 / H))
 
 
 def _orbit_panel(p, view, orbit, clearance, extent, col, panel_px):
@@ -334,7 +457,7 @@ def _orbit_scales(orb, clr, rol, magnify):
 def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
                          magnify: float | None = None, rollers: Mapping[str, np.ndarray] | None = None,
                          fps: float = 20, size: Sequence[int] = (800, 400), title: str | None = None,
-                         max_frames: int | None = None) -> Path:
+                         max_frames: int | None = None, legend: bool = True, progress: bool = True) -> Path:
     """Cage-centre orbits inside the guiding clearance, one panel per label, side by side.
 
     t: (n_t,) s.  orbits: label -> (n_t, 2) cage-centre offset from the bore centre, m.
@@ -344,7 +467,10 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
     rollers: optional label -> (n_t, Z, 2) roller-centre offsets from their ideal pocket positions, m.
     They are drawn schematically as Z small circles on a ring around the clearance circle (grey:
     ideal position, coloured: displaced position); the offsets are multiplied by `magnify` (None:
-    chosen so the largest offset is about half a roller-circle radius; the factor is printed).
+    chosen so the largest offset is about half a roller-circle radius; the factor is written in the legend).
+    legend: a strip under the panels saying what each mark is (the clearance circle, the cage centre and its
+    trail, the rollers), with the guide clearance and the rollers' magnification. progress: frames rendered, on
+    stderr (:class:`_Progress`).
     """
     path = _output_path(path, fps)
     t, labels, orb, clr, rol = _orbit_inputs(t, orbits, clearance_m, rollers)
@@ -355,9 +481,10 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
     tfmt = _time_formatter(t[idx])
 
     n = len(labels)
-    p, row, strip = _panels_with_title(W, H, n, title)
+    n_entries = 5 if rol else 3
+    p, row, strip, leg_row, leg = _panels_with_title(W, H, n, title, _legend_height(W, H, n_entries) if legend else 0.0)
     try:
-        panel_px = (W // n, int(round(H * (1 - strip))))
+        panel_px = (W // n, int(round(H * (1 - strip - leg))))
         longest = max(labels, key=len)
         fs = _font(panel_px[1], 0.04, longest, panel_px[0])
         fs_small = _font(panel_px[1], 0.03, "t = 00.00 ms", 0.6 * panel_px[0])
@@ -370,8 +497,9 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
             extent = E[lab]
             if lab in rol:
                 extent = ring_r[lab] + r_roll[lab] + mag * max_off[lab]
-            # text rows: label (and the magnification note) on top; scale bar and time below
-            top = 0.98 - 1.5 * (fs + (fs_small if lab == first_rol else 0)) / panel_px[1] - 0.02
+            # text rows: label (and the magnification note, without a legend) on top; scale bar and time below
+            note = lab == first_rol and not legend
+            top = 0.98 - 1.5 * (fs + (fs_small if note else 0)) / panel_px[1] - 0.02
             bottom = 0.085 + 1.5 * fs_small / panel_px[1] + 0.02
             view = _View(p, (row, j), panel_px, (0.0, 0.0), extent, extent,
                          band=(0.03, 0.97, bottom, top))
@@ -383,13 +511,23 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
             if lab in rol:
                 moving, ideal, ring_pts = _roller_ring(p, view, rol[lab].shape[1], ring_r[lab], r_roll[lab], col)
                 roller_meshes.append((moving, ideal, ring_pts, lab))
-                if lab == first_rol:  # one factor for all panels: say it once
+                if note:  # one factor for all panels: say it once
                     view.text(f"roller offsets ×{mag:.3g}", (0.5, 0.98 - view.line_height(fs)),
                               fs_small, justify="center", color="#666666", valign="top")
             view.text(lab, (0.5, 0.98), fs, justify="center", bold=True, valign="top")
             view.scale_bar(frac=0.25, size=fs_small)
             time_actors.append(view.text(tfmt(t[idx[0]]), (0.97, 0.05), fs_small, justify="right"))
 
+        if legend:
+            Cs = sorted({round(c * 1e6, 1) for c in clr.values()})
+            entries = [("line", "#888888", "guide clearance C_g = " + " / ".join(f"{c:g}" for c in Cs) + " µm"),
+                       ("dot", "#d50000", "cage centre"), ("line", _PANEL_COLORS[0], "its trail (panel colour)")]
+            if rol:
+                entries += [("ring", "#bbbbbb", "roller, centred in its pocket"),
+                            ("ring", _PANEL_COLORS[0], f"roller, offset ×{mag:.3g}")]
+            _legend_strip(p, leg_row, (W, int(round(H * leg))), entries, fs_small)
+
+        bar = _Progress(idx.size, path, progress)
         with _Writer(path, fps) as writer:
             for i in idx:
                 for j, lab in enumerate(labels):
@@ -402,6 +540,8 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
                     moving.points = _xyz((c[:, None, :] + ring_pts[None]).reshape(-1, 2),
                                          2 * views[labels.index(lab)].z_step)
                 writer.append(_screenshot(p, (W, H)))
+                bar.update()
+        bar.close()
     finally:
         p.close()
     return path

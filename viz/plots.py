@@ -19,7 +19,9 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
 __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution", "against_viscosity",
-           "mode_shapes", "fault_spectra", "fault_loads", "gear_quality", "FWD", "REV", "STYLE"]
+           "mode_shapes", "fault_spectra", "fault_loads", "FAULT_QUANTITIES", "gear_quality", "forward_reverse_headline",
+           "time_history_group", "cage_orbit_picture", "display_unit", "format_pct", "HEADLINE_QUANTITIES", "FWD", "REV",
+           "STYLE"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
 STYLE = {
@@ -90,11 +92,14 @@ def time_histories(t, series: Mapping[str, tuple], units: Mapping[str, str], pat
 
 def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]],
               units: Mapping[str, str], path, *, title: str | None = None,
-              ylabels: Mapping[str, str] | None = None) -> Path:
-    """Grouped bars: one subplot per quantity (units differ), a forward/reverse pair per condition.
+              ylabels: Mapping[str, str] | None = None, ncols: int = 3) -> Path:
+    """Grouped bars: one subplot per quantity (units differ), a forward/reverse pair per condition, the change of
+    reverse against forward written over each pair; bars start at zero, forces in kN from 1 kN on.
 
-    table: quantity -> {condition: (fwd, rev)}; a missing condition or a None value leaves a gap.
+    table: quantity -> {condition: (fwd, rev)}; a missing condition or a None value leaves a gap, and a
+    direction with no value anywhere gets no legend entry.
     ylabels: optional quantity -> words for the y axis (default: the quantity, which is the panel title).
+    ncols: panels per row (2 puts the inner and outer planet bearings of a quantity side by side).
     """
     conditions = list(conditions)
     if not table:
@@ -102,10 +107,11 @@ def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]
     x = np.arange(len(conditions))
     w = 0.38
     n = len(table)
-    ncols = min(n, 3)
+    ncols = min(n, ncols)
     nrows = -(-n // ncols)
+    present = set()
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(3.2 * ncols + 0.6, 2.8 * nrows + 0.4), layout="constrained")
+        fig = Figure(figsize=(3.2 * ncols + 0.6, 2.8 * nrows + 0.6), layout="constrained")
         axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
         for ax, (quantity, by_cond) in zip(axes, table.items()):
             vals = np.full((len(conditions), 2), np.nan)
@@ -113,17 +119,29 @@ def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]
                 pair = by_cond.get(c)
                 if pair is not None:
                     vals[i] = [np.nan if v is None else float(v) for v in pair]
-            ax.bar(x - w / 2, vals[:, 0], w, color=FWD["color"], label="forward")
-            ax.bar(x + w / 2, vals[:, 1], w, color=REV["color"], label="reverse", hatch="//",
-                   edgecolor="white", linewidth=0)
+            scale, shown = display_unit(units.get(quantity), vals)
+            for k, (d, st) in enumerate((("forward", FWD), ("reverse", REV))):
+                if np.all(np.isnan(vals[:, k])):
+                    continue
+                present.add(d)
+                ax.bar(x + (k - 0.5) * w, vals[:, k] * scale, w, color=st["color"], label=d,
+                       hatch="//" if d == "reverse" else None, edgecolor="white", linewidth=0)
+            top = float(np.nanmax(np.abs(vals))) * scale if np.any(np.isfinite(vals)) else 1.0
+            for i in range(len(conditions)):
+                p = _pct(*(None if np.isnan(v) else float(v) for v in vals[i]))
+                if p is not None:
+                    ax.text(x[i], 1.06 * float(np.nanmax(vals[i])) * scale, format_pct(p), ha="center", va="bottom",
+                            fontsize=8, fontweight="bold", color="#333333", gid="pct_change")
+            lo = min(0.0, float(np.nanmin(vals)) * scale) if np.any(np.isfinite(vals)) else 0.0
+            ax.set_ylim(lo * 1.2, 1.25 * top if top > 0 else 1.0)
             ax.set_xticks(x, conditions, rotation=20 if len(conditions) > 3 else 0)
-            ax.set_ylabel(_axis_label((ylabels or {}).get(quantity, quantity), units.get(quantity)))
-            ax.set_xlabel(_axis_label("condition", "–"))
+            ax.set_xlim(-0.7, len(conditions) - 0.3)
+            ax.set_ylabel(_axis_label(_wrap((ylabels or {}).get(quantity, quantity), 26), shown))
             ax.set_title(quantity)
             ax.grid(axis="x", visible=False)
         for ax in axes[n:]:
             ax.set_visible(False)
-        axes[0].legend(loc="best")
+        _direction_legend(fig, [d for d in ("forward", "reverse") if d in present], hatch=True)
         if title:
             fig.suptitle(title)
         return _save(fig, path)
@@ -292,96 +310,143 @@ def mode_shapes(freqs_hz, shapes, labels: Sequence[str], path, *, max_modes: int
         return _save(fig, path)
 
 
-def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple], path, *,
-                      title: str | None = None) -> Path:
-    """Quantities against the oil's viscosity, forward vs reverse, one column per bearing type.
+def _plain_log(axis) -> None:
+    """Tick labels of a log axis as plain numbers (0.3, 2, 40), not powers of ten: these axes span a decade or two."""
+    from matplotlib.ticker import LogLocator
+    axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 3.0, 5.0)))
+    axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
 
-    series: (quantity key, bearing, direction) -> (viscosities [Pa·s], values);  quantities: (key, words,
-    unit, log scale) — one row each;  bearings and directions are read from the series' keys."""
+
+def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple], path, *,
+                      title: str | None = None, levels: Mapping[str, Mapping[float, str]] | None = None,
+                      names: Mapping[str, float] | None = None) -> Path:
+    """Quantities against the oil's viscosity, forward vs reverse, one column per bearing type, one legend.
+
+    series: (quantity key, bearing, direction) -> (viscosities [Pa·s], values [SI]);  quantities: (key, words,
+    SI unit, log scale) — one row each, shown in a unit that suits the range (a film in µm); levels: quantity
+    key -> {value: words}, dotted horizontal lines (e.g. the film regimes' bounds of Λ); names: oil name ->
+    its viscosity [Pa·s], written under the bottom row's ticks at the oils. Bearings and directions are read from
+    the series' keys."""
     bearings = sorted({b for _, b, _ in series})
+    present = sorted({d for _, _, d in series}, key=lambda d: {"forward": 0, "reverse": 1}.get(d, 2))
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(3.4 * len(bearings) + 0.6, 2.6 * len(quantities) + 0.6), layout="constrained")
-        axes = fig.subplots(len(quantities), len(bearings), squeeze=False)
+        fig = Figure(figsize=(3.4 * len(bearings) + 0.6, 2.5 * len(quantities) + 0.8), layout="constrained")
+        axes = fig.subplots(len(quantities), len(bearings), squeeze=False, sharex=True)
         for r, (key, words, unit, log) in enumerate(quantities):
+            ys = [v for (k, _, _), (_, y) in series.items() if k == key for v in y if v is not None]
+            scale, shown = display_unit(unit, ys)
             for c, b in enumerate(bearings):
                 ax = axes[r, c]
                 for d, style in (("forward", FWD), ("reverse", REV)):
                     if (key, b, d) in series:
                         x, y = series[(key, b, d)]
-                        ax.plot(np.asarray(x) * 1e3, y, marker="o", **style)
+                        y = np.array([np.nan if v is None else v for v in y], float)
+                        ax.plot(np.asarray(x) * 1e3, y * scale, marker="o", **style)
                 ax.set_xscale("log")
+                _plain_log(ax.xaxis)
                 if log:
                     ax.set_yscale("log")
-                ax.set_title(f"{b} planet bearings")
-                ax.set_ylabel(_axis_label(words, unit))
-                ax.set_xlabel(_axis_label("oil viscosity", "mPa·s"))
-                ax.legend(loc="best")
+                    _plain_log(ax.yaxis)
+                for value, label in (levels or {}).get(key, {}).items():
+                    ax.axhline(value * scale, color=_MARK_COLOR, lw=0.8, ls=":")
+                    ax.text(0.02, value * scale, label, transform=ax.get_yaxis_transform(), fontsize=7,
+                            color=_MARK_COLOR, va="bottom")
+                if r == 0:
+                    ax.set_title(f"{b} planet bearings")
+                ax.set_ylabel(_axis_label(_wrap(words, 24), shown))
+                if r == len(quantities) - 1:
+                    ax.set_xlabel(_axis_label("oil viscosity η", "mPa·s"))
+                    if names:
+                        ax.set_xticks([1e3 * v for v in names.values()],
+                                      [f"{1e3 * v:.3g}\n{n}" for n, v in names.items()])
+                        ax.xaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
+        _direction_legend(fig, present)
         if title:
             fig.suptitle(title)
         return _save(fig, path)
 
 
 def fault_spectra(panels: Sequence[tuple], path, *, quantity: str = "sensor acceleration",
-                  unit: str = "m/s^2") -> Path:
-    """One panel per damaged machine: its spectrum against the perfect machine's, on a band around the mesh
-    frequency, with its characteristic frequencies marked.
+                  unit: str = "m/s^2", title: str | None = None) -> Path:
+    """One panel per damaged machine (its title): its spectrum against the perfect machine's, on a band around
+    the mesh frequency, with its characteristic frequencies marked; one legend for the figure.
 
     panels: (title, freq_hz, amplitude, reference amplitude, marks {label: Hz}, (f_lo, f_hi))."""
+    from matplotlib.lines import Line2D
+    shown = display_unit(unit)[1]
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(7.5, 2.4 * len(panels) + 0.4), layout="constrained")
+        fig = Figure(figsize=(7.5, 2.4 * len(panels) + 0.9), layout="constrained")
         axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
-        for ax, (title, f, amp, ref, marks, (lo, hi)) in zip(axes, panels):
+        for ax, (name, f, amp, ref, marks, (lo, hi)) in zip(axes, panels):
             f = np.asarray(f, float)
             keep = (f >= lo) & (f <= hi)
-            ax.plot(f[keep], np.asarray(ref, float)[keep], color="0.6", lw=1.0, label="perfect machine")
-            ax.plot(f[keep], np.asarray(amp, float)[keep], color=FWD["color"], lw=1.0, label=title)
+            ax.plot(f[keep], np.asarray(ref, float)[keep], color="0.6", lw=1.0)
+            ax.plot(f[keep], np.asarray(amp, float)[keep], color=FWD["color"], lw=1.0)
             ax.set_yscale("log")
+            _plain_log(ax.yaxis)
             ax.set_xlim(lo, hi)
-            ax.set_ylabel(_axis_label(quantity, unit))
-            ax.legend(loc="lower right")
+            ax.set_ylabel(_axis_label(_wrap(quantity, 22), shown))
+            ax.set_title(name, loc="left", fontsize=9)
             _mark_frequencies(fig, ax, {k: v for k, v in marks.items() if lo <= v <= hi}, hi)
         axes[-1].set_xlabel(_axis_label("frequency", "Hz"))
+        fig.legend(handles=[Line2D([], [], color="0.6", lw=1.0, label="perfect machine"),
+                            Line2D([], [], color=FWD["color"], lw=1.0, label="damaged machine (panel title)")],
+                   loc="outside lower center", ncols=2, frameon=False)
+        if title:
+            fig.suptitle(title)
         return _save(fig, path)
 
 
-def _zoom_if_clustered(ax, values) -> None:
-    """Bars of positive values within a few % of each other (e.g. load-sharing factors near 1) read better
-    on an axis that starts near them than at zero."""
-    v = np.asarray([x for x in values if np.isfinite(x)], float)
-    if v.size and v.min() > 0 and np.ptp(v) < 0.3 * v.max():
-        pad = 0.15 * (np.ptp(v) or 0.05 * v.max())
-        ax.set_ylim(v.min() - pad, v.max() + pad)
+FAULT_QUANTITIES = (
+    ("load_sharing_factor", "load sharing K_γ − 1: most loaded over the mean", "%", "excess"),
+    ("bearing_load_max_N", "largest bearing load", "N", None),
+    ("life_relative", "life change against the perfect machine", "%", "excess"),
+    ("cage_slip_pct", "cage slip", "%", None),
+    ("pocket_impacts_per_rev", "pocket impacts", "per cage rev.", None))
 
 
-def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = (
-        ("load_sharing_factor", "load sharing K_γ", None), ("bearing_load_max_N", "largest bearing load", "N"),
-        ("life_relative", "life / perfect machine's", None), ("cage_slip_pct", "cage slip", "%"),
-        ("pocket_impacts_per_rev", "pocket impacts per cage rev.", None))) -> Path:
-    """Bars per fault (forward solid, reverse hatched), one row per quantity, one column per bearing type.
-    rows: dicts with "fault", "direction", "bearing" and the quantities' keys (None: not available)."""
+def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = FAULT_QUANTITIES,
+                title: str | None = None) -> Path:
+    """Bars per fault (forward solid, reverse hatched), one row per quantity, one column per bearing type, one
+    legend naming the directions that ran. rows: dicts with "fault", "direction", "bearing" and the quantities'
+    keys (None: not available). quantities: (key, words, unit, how); how "excess" shows a ratio r (K_γ, a life
+    against the perfect machine's) as its excess over 1 in %, 100 (r − 1) — bars from zero then read as the
+    change, where bars of ratios near 1 would all look alike."""
     faults = list(dict.fromkeys(r["fault"] for r in rows))
     bearings = sorted({r["bearing"] for r in rows})
+    present = [d for d in ("forward", "reverse") if any(r["direction"] == d for r in rows)]
     x = np.arange(len(faults))
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(3.8 * len(bearings) + 0.6, 2.0 * len(quantities) + 0.8), layout="constrained")
+        fig = Figure(figsize=(3.8 * len(bearings) + 0.6, 2.0 * len(quantities) + 1.2), layout="constrained")
         axes = fig.subplots(len(quantities), len(bearings), squeeze=False, sharex=True)
-        for r, (key, words, unit) in enumerate(quantities):
+        for r, spec in enumerate(quantities):
+            key, words, unit = spec[:3]
+            how = spec[3] if len(spec) > 3 else None
+            raw = [row.get(key) for row in rows if row.get(key) is not None]
+            scale, shown = (100.0, "%") if how == "excess" else display_unit(unit, raw)
             for c, b in enumerate(bearings):
                 ax = axes[r, c]
-                shown = []
                 for k, (d, st) in enumerate((("forward", FWD), ("reverse", REV))):
+                    if d not in present:
+                        continue
                     val = {row["fault"]: row.get(key) for row in rows if row["bearing"] == b and row["direction"] == d}
-                    y = [np.nan if val.get(f) is None else float(val[f]) for f in faults]
+                    y = np.array([np.nan if val.get(f) is None else float(val[f]) for f in faults])
+                    y = (y - 1.0) * scale if how == "excess" else y * scale
                     ax.bar(x + (k - 0.5) * 0.38, y, width=0.38, color=st["color"], label=d,
-                           hatch="//" if d == "reverse" else None, alpha=0.85)
-                    shown += y
-                _zoom_if_clustered(ax, shown)
-                ax.set_ylabel(_axis_label(words, unit))
+                           hatch="//" if d == "reverse" else None, edgecolor="white", linewidth=0)
+                ax.axhline(0.0, color="k", lw=0.6)
+                lo, hi = ax.get_ylim()
+                ax.set_ylim(min(lo, 0.0), max(hi, 0.0))
+                ax.set_ylabel(_axis_label(_wrap(words, 26), shown))
+                ax.grid(axis="x", visible=False)
                 if r == 0:
                     ax.set_title(f"{b} planet bearings")
-                    ax.legend(loc="best")
         for ax in axes[-1]:
             ax.set_xticks(x, faults, rotation=30, ha="right")
+        _direction_legend(fig, present, hatch=True)
+        if title:
+            fig.suptitle(title)
         return _save(fig, path)
 
 
@@ -445,4 +510,234 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
         for ax in axes.ravel():
             if ax.get_yscale() == "linear" and ax.get_ylim()[0] > 0:
                 ax.set_ylim(bottom=0)
+        return _save(fig, path)
+
+
+# ----------------------------------------------------------------------------------------------
+# display units: data stay SI, figures show a unit that suits the range
+
+_PRETTY = {"m/s^2": "m/s²", "rad/s^2": "rad/s²", "percent": "%", "1": "–", "": "–", "N m": "N·m"}
+
+
+def display_unit(unit: str | None, values=()) -> tuple[float, str]:
+    """(factor, unit) to show SI ``values`` of ``unit`` with: forces in kN from 1 kN on, lengths in µm or mm,
+    times in ms below 2 s, exponents written as superscripts. Multiply the data by the factor."""
+    unit = unit or ""
+    v = np.asarray([x for x in np.ravel(np.asarray(values, dtype=float)) if np.isfinite(x)], float)
+    big = float(np.max(np.abs(v))) if v.size else 0.0
+    if unit == "N":
+        return (1e-3, "kN") if big >= 1e3 else (1.0, "N")
+    if unit == "m":
+        if big < 1e-3:
+            return 1e6, "µm"
+        return (1e3, "mm") if big < 1.0 else (1.0, "m")
+    if unit == "s":
+        return (1e3, "ms") if big < 2.0 else (1.0, "s")
+    return 1.0, _PRETTY.get(unit, unit)
+
+
+def _wrap(text: str, width: int) -> str:
+    import textwrap
+    return "\n".join(textwrap.wrap(text, width, break_long_words=False)) or text
+
+
+def _pct(fwd, rev) -> float | None:
+    """The change of reverse against forward in % (None when either is missing or forward is 0)."""
+    if fwd is None or rev is None or not np.isfinite(fwd) or not np.isfinite(rev) or fwd == 0:
+        return None
+    return (rev - fwd) / fwd * 100.0
+
+
+def format_pct(p: float) -> str:
+    """'+40 %', '−24 %', '+3.2 %' (one decimal below 10 %; a true minus sign)."""
+    s = f"{p:+.1f}" if abs(p) < 9.95 else f"{p:+.0f}"
+    return s.replace("-", "\u2212") + " %"
+
+
+def _direction_legend(fig: Figure, present: Sequence[str], *, hatch: bool = False) -> None:
+    """One legend for the whole figure, above the panels, naming only the directions that were drawn."""
+    from matplotlib.patches import Patch
+    from matplotlib.lines import Line2D
+    handles = []
+    for d, st in (("forward", FWD), ("reverse", REV)):
+        if d in present:
+            handles.append(Patch(facecolor=st["color"], hatch="//" if (hatch and d == "reverse") else None,
+                                 edgecolor="white" if hatch else st["color"], label=d) if hatch
+                           else Line2D([], [], color=st["color"], ls=st["linestyle"], label=d))
+    if handles:      # below the panels: above them it would collide with a suptitle
+        fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), frameon=False)
+
+
+HEADLINE_QUANTITIES = (("bearing_load_mean_N", "mean bearing load", "N"),
+                       ("life_iso281_h", "L10 life, ISO 281", "h"),
+                       ("life_iso16281_h", "L10 life, from the roller loads", "h"))
+
+
+def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
+                             quantities: Sequence[tuple] = HEADLINE_QUANTITIES, bearings: Sequence[str] = ("inner", "outer"),
+                             title: str | None = None) -> Path:
+    """The study's headline: per condition (a row) and quantity (a column), each bearing type's forward and
+    reverse bar with the change of reverse against forward written above the pair.
+
+    values: (quantity key, condition, bearing, direction) -> value in SI units (None or absent: no such run).
+    quantities: (key, words, SI unit). Bars start at zero; forces are shown in kN from 1 kN on."""
+    conds = sorted({k[1] for k in values})
+    if not conds:
+        raise ValueError("values is empty")
+    present = [d for d in ("forward", "reverse")
+               if any(k[3] == d and v is not None and np.isfinite(v) for k, v in values.items())]
+    x = np.arange(len(bearings))
+    w = 0.36
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(2.9 * len(quantities) + 0.4, 2.5 * len(conds) + 0.7), layout="constrained")
+        axes = fig.subplots(len(conds), len(quantities), squeeze=False)
+        for c_i, c in enumerate(conds):
+            for q_i, (key, words, unit) in enumerate(quantities):
+                ax = axes[c_i, q_i]
+                scale, shown = display_unit(unit, [v for k, v in values.items() if k[0] == key and v is not None])
+                top = 0.0
+                for k, (d, st) in enumerate((("forward", FWD), ("reverse", REV))):
+                    y = np.array([np.nan if values.get((key, c, b, d)) is None else float(values[(key, c, b, d)])
+                                  for b in bearings]) * scale
+                    if np.all(np.isnan(y)):
+                        continue
+                    bars = ax.bar(x + (k - 0.5) * w, y, w, color=st["color"], label=d,
+                                  hatch="//" if d == "reverse" else None, edgecolor="white", linewidth=0)
+                    ax.bar_label(bars, labels=["" if np.isnan(v) else f"{v:.3g}" for v in y], fontsize=7,
+                                 padding=1.5)
+                    top = max(top, float(np.nanmax(y)))
+                for i, b in enumerate(bearings):
+                    p = _pct(values.get((key, c, b, "forward")), values.get((key, c, b, "reverse")))
+                    if p is not None:
+                        ax.text(x[i], 1.16 * top, format_pct(p), ha="center", va="bottom", fontsize=8.5,
+                                fontweight="bold", color="#333333", gid="pct_change")
+                ax.set_ylim(0.0, 1.38 * top if top > 0 else 1.0)
+                ax.set_xticks(x, [f"{b} planet\nbearing" for b in bearings])
+                ax.set_xlim(-0.6, len(bearings) - 0.4)
+                ax.grid(axis="x", visible=False)
+                ax.set_ylabel(_axis_label(_wrap(words, 24), shown))
+                ax.set_title(f"condition {c}" if len(conds) > 1 else words, fontsize=9)
+        _direction_legend(fig, present, hatch=True)
+        if title:
+            fig.suptitle(title)
+        return _save(fig, path)
+
+
+def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], title: str | None = None,
+                       column_titles: Mapping[str, str] | None = None) -> Path:
+    """A readable group of time histories: one row per quantity, one column per part (e.g. the inner and the
+    outer planet bearing), every panel on one time axis in ms, rows sharing their y scale, one legend.
+
+    rows: (words, SI unit, {column: {run: (t [s], y [SI])}}); a run named "forward"/"reverse" gets the
+    study's styles, any other name the next colour. Forces are shown in kN from 1 kN on."""
+    if not rows:
+        raise ValueError("rows is empty")
+    columns = list(columns)
+    ts = [np.asarray(t, float) for _, _, by_col in rows for runs in by_col.values() for t, _ in runs.values()]
+    if not ts:
+        raise ValueError("rows hold no series")
+    tscale, tunit = display_unit("s", np.concatenate(ts))
+    styles: dict[str, dict] = {"forward": FWD, "reverse": REV}
+    extra = iter(["#2e7d32", "#8e24aa", "#c62828", "#00838f", "#555555"])
+    handles: dict[str, object] = {}
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(3.3 * len(columns) + 0.9, 1.75 * len(rows) + 0.9), layout="constrained")
+        axes = fig.subplots(len(rows), len(columns), squeeze=False, sharex=True, sharey="row")
+        for r, (words, unit, by_col) in enumerate(rows):
+            ys = [np.asarray(y, float) for runs in by_col.values() for _, y in runs.values()]
+            scale, shown = display_unit(unit, np.concatenate(ys) if ys else [])
+            for c, col in enumerate(columns):
+                ax = axes[r, c]
+                for run, (t, y) in by_col.get(col, {}).items():
+                    if run not in styles:
+                        styles[run] = {"color": next(extra, "#555555"), "linestyle": "-", "label": run}
+                    st = {**styles[run], "label": run}
+                    t = np.asarray(t, float)
+                    # many samples: thinner lines, so that two overlaid runs stay apart
+                    lw = 1.2 if t.size < 200 else 0.9 if t.size < 1000 else 0.6
+                    (ln,) = ax.plot(t * tscale, np.asarray(y, float) * scale, lw=lw, **st)
+                    handles.setdefault(run, ln)
+                if r == 0:
+                    ax.set_title((column_titles or {}).get(col, col))
+                if c == 0:
+                    ax.set_ylabel(_axis_label(_wrap(words, 22), shown))
+                if r == len(rows) - 1:
+                    ax.set_xlabel(_axis_label("time", tunit))
+        if handles:
+            order = sorted(handles, key=lambda k: {"forward": 0, "reverse": 1}.get(k, 2))
+            fig.legend([handles[k] for k in order], order, loc="outside lower center", ncols=len(order),
+                       frameon=False)
+        if title:
+            fig.suptitle(title)
+        return _save(fig, path)
+
+
+def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = None) -> Path:
+    """Static cage orbits, one column per run side by side: the guide clearance circle, the cage centre's trail
+    coloured by time (one colour bar, in ms), its start and end, the bore centre; the top row shows the whole
+    clearance on one scale in µm for all runs, the bottom row zooms onto each trail (one span for all, so the
+    orbits' sizes compare).
+
+    panels: (label, t [s] (n,), offset of the cage centre from the bore centre [m] (n, 2), guide clearance
+    C_g [m]) — the offset as :func:`viz.results.cage_orbits` gives it (carrier axes). A cage pressed into its
+    land sits beyond the circle by the land contact's deflection."""
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import Normalize
+    from matplotlib.lines import Line2D
+
+    if not panels:
+        raise ValueError("panels is empty")
+    t_all = np.concatenate([np.asarray(p[1], float) for p in panels])
+    tscale, tunit = display_unit("s", t_all)
+    norm = Normalize(float(np.min(t_all)) * tscale, float(np.max(t_all)) * tscale)
+    um = 1e6
+    es = [np.asarray(p[2], float) * um for p in panels]
+    reach = max(max(float(p[3]) * um, float(np.nanmax(np.hypot(*e.T)))) for p, e in zip(panels, es)) * 1.12
+    half = 0.6 * max(max(float(np.nanmax(np.ptp(e, axis=0))), 1e-3) for e in es)     # zoom: one span for all
+    cmap = mpl.colormaps["viridis"]
+    circle = np.linspace(0, 2 * np.pi, 3601)
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(3.3 * len(panels) + 1.2, 7.6), layout="constrained")
+        fig.get_layout_engine().set(hspace=0.06)          # the zoom row's titles clear the x labels above
+        axes = fig.subplots(2, len(panels), squeeze=False)
+        lc = None
+        for k, ((label, t, _, clearance), e) in enumerate(zip(panels, es)):
+            t = np.asarray(t, float) * tscale
+            C = float(clearance) * um
+            seg = np.stack([e[:-1], e[1:]], axis=1)
+            mid = np.nanmean(e, axis=0)
+            for row, ax in enumerate(axes[:, k]):
+                ax.plot(C * np.cos(circle), C * np.sin(circle), color="0.45", lw=1.4, ls="--")
+                ax.plot([0], [0], marker="+", color="0.35", ms=9, mew=1.2, ls="none")
+                lc = LineCollection(seg, cmap=cmap, norm=norm, linewidths=1.3 if row == 0 else 1.6)
+                lc.set_array(0.5 * (t[:-1] + t[1:]))
+                ax.add_collection(lc)
+                ax.plot(*e[0], marker="o", mfc="white", mec="k", ms=6, ls="none")
+                ax.plot(*e[-1], marker="s", color="#d50000", ms=6, ls="none")
+                if row == 0:
+                    ax.set_xlim(-reach, reach)
+                    ax.set_ylim(-reach, reach)
+                    ax.set_title(label)
+                    zoom = (mid[0] - half, mid[0] + half, mid[1] - half, mid[1] + half)
+                    ax.plot([zoom[0], zoom[1], zoom[1], zoom[0], zoom[0]], [zoom[2], zoom[2], zoom[3], zoom[3], zoom[2]],
+                            color="k", lw=0.7)
+                else:
+                    ax.set_xlim(mid[0] - half, mid[0] + half)
+                    ax.set_ylim(mid[1] - half, mid[1] + half)
+                    ax.set_title(f"{label}: zoom on the trail", fontsize=8.5)
+                ax.set_aspect("equal")
+                ax.set_xlabel(_axis_label("cage centre offset x", "µm"))
+                if k == 0:
+                    ax.set_ylabel(_axis_label("cage centre offset y", "µm"))
+        cb = fig.colorbar(lc, ax=axes.ravel().tolist(), shrink=0.6, pad=0.02)
+        cb.set_label(_axis_label("time", tunit))
+        handles = [Line2D([], [], color="0.45", lw=1.4, ls="--", label="guide clearance circle"),
+                   Line2D([], [], color=cmap(0.6), lw=1.3, label="cage centre (colour: time)"),
+                   Line2D([], [], marker="o", mfc="white", mec="k", ls="none", label="start"),
+                   Line2D([], [], marker="s", color="#d50000", ls="none", label="end"),
+                   Line2D([], [], marker="+", color="0.35", mew=1.2, ls="none", label="bore centre"),
+                   Line2D([], [], color="k", lw=0.7, label="zoomed area")]
+        fig.legend(handles=handles, loc="outside lower center", ncols=3, frameon=False, fontsize=7.5)
+        if title:
+            fig.suptitle(title)
         return _save(fig, path)

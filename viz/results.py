@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["ResultsError", "GeometryWarning", "Run", "load_run", "cage_orbits", "roller_offsets", "train_bodies", "study_cage_animation",
+           "study_cage_pictures",
            "cage_panels", "view_angle"]
 
 _REQUIRED_VARS = ("time", "motion.position", "motion.angle")
@@ -541,3 +542,29 @@ def study_cage_animation(run_fwd_path, run_rev_path, out_path, *, pair: int = 0,
     return cage_orbit_animation(out_path, args["t"], args["orbits"], args["clearance_m"],
                                 magnify=magnify, rollers=args["rollers"], fps=fps, size=size,
                                 title=title, max_frames=max_frames)
+
+
+def study_cage_pictures(runs: Mapping[str, object], out_dir, *, pair: int = 0, prefix: str = "",
+                        title: str | None = None) -> list[Path]:
+    """Static cage-orbit pictures of a study, one PNG per bearing type (``{prefix}cage_orbit_{inner,outer}.png``
+    in ``out_dir``): a panel per run (label -> results file, run directory or :class:`Run`, e.g. forward and
+    reverse) with the guide clearance circle and the cage centre's trail coloured by time
+    (:func:`viz.plots.cage_orbit_picture`). Runs without a cage are left out; no runs with one: no picture."""
+    from .plots import cage_orbit_picture
+
+    loaded = {label: _as_run(r) for label, r in runs.items()}
+    paths = []
+    for kind in ("inner", "outer"):
+        panels = []
+        for label, run in loaded.items():
+            try:
+                e = cage_orbits(run, pair)[kind]
+            except ResultsError:              # bearings without a cage: nothing to draw
+                continue
+            panels.append((label, run.t, e, float(run.geometry["bearing"]["guide_clearance"])))
+        if not panels:
+            continue
+        rpm = _rpm(next(iter(loaded.values())))
+        head = (title + "\n" if title else "") + f"{kind} planet bearing, planet pair {pair + 1}" + (f", carrier {rpm}" if rpm else "")
+        paths.append(cage_orbit_picture(panels, Path(out_dir) / f"{prefix}cage_orbit_{kind}.png", title=head))
+    return paths

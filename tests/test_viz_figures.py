@@ -1,0 +1,288 @@
+"""The report figures of viz.plots read as figures: every axis says its unit, bars start at zero, legends name
+only runs that exist, the % change written on a bar pair is (reverse − forward)/forward of the numbers given.
+
+Each test captures the matplotlib Figure a plot function saves (``plots._save`` wrapped) and inspects its
+objects; the PNG is still written and checked not to be blank. The truths are computed here from the inputs,
+not taken from the plotting code. Synthetic data only: every test runs in well under a second or two.
+"""
+from __future__ import annotations
+
+import re
+
+import matplotlib.image as mpimg
+import numpy as np
+import pytest
+
+from viz import plots
+
+UNIT = re.compile(r"[\[(][^\])]+[\])]\s*$")          # "... [kN]" or "... (kN)" at the end of a label
+
+
+@pytest.fixture
+def captured(monkeypatch):
+    """The Figures the plot functions save, in order."""
+    figs = []
+    save = plots._save
+
+    def keep(fig, path):
+        figs.append(fig)
+        return save(fig, path)
+
+    monkeypatch.setattr(plots, "_save", keep)
+    return figs
+
+
+def _visible_axes(fig):
+    return [ax for ax in fig.axes if ax.get_visible() and ax.get_label() != "<colorbar>"]
+
+
+def _legend_labels(fig) -> list[str]:
+    labels = [t.get_text() for lg in fig.legends for t in lg.get_texts()]
+    labels += [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
+    return labels
+
+
+def _pct_texts(ax) -> list:
+    return [t for t in ax.texts if t.get_gid() == "pct_change"]
+
+
+def _parse_pct(text: str) -> tuple[float, float]:
+    """(value, half of the last written digit) of '+40 %', '−3.2 %'."""
+    m = re.fullmatch(r"([+\-−])(\d+(?:\.(\d+))?) %", text)
+    assert m, f"not a % change: {text!r}"
+    value = float(m.group(2)) * (-1 if m.group(1) in "-−" else 1)
+    decimals = len(m.group(3) or "")
+    return value, 0.5 * 10.0 ** -decimals
+
+
+def _not_blank(path):
+    img = mpimg.imread(path)[..., :3]
+    assert img.std() > 0.03 and np.mean(img.min(axis=-1) < 0.8) > 0.005
+
+
+# ------------------------------------------------------------------------------ headline
+def _headline_values():
+    """Two conditions, both bearing types; condition 1's reverse run does not exist."""
+    v = {}
+    data = {3: {"inner": (9300.0, 13100.0, 58.0, 19.0), "outer": (12200.0, 9300.0, 23.0, 58.0)},
+            1: {"inner": (14300.0, None, 78.0, None), "outer": (18300.0, None, 34.0, None)}}
+    for c, by in data.items():
+        for b, (lf, lr, hf, hr) in by.items():
+            v[("bearing_load_mean_N", c, b, "forward")] = lf
+            v[("life_iso281_h", c, b, "forward")] = hf
+            if lr is not None:
+                v[("bearing_load_mean_N", c, b, "reverse")] = lr
+                v[("life_iso281_h", c, b, "reverse")] = hr
+    return v
+
+
+QUANT = (("bearing_load_mean_N", "mean bearing load", "N"), ("life_iso281_h", "L10 life, ISO 281", "h"))
+
+
+def test_headline_writes_the_change_of_every_pair(tmp_path, captured):
+    values = _headline_values()
+    path = plots.forward_reverse_headline(values, tmp_path / "h.png", quantities=QUANT, title="headline")
+    _not_blank(path)
+    fig = captured[-1]
+    axes = fig.axes
+    assert len(axes) == 2 * 2                            # conditions 1 and 3 × two quantities
+    for ax in axes:
+        assert UNIT.search(ax.get_ylabel()), ax.get_ylabel()
+        lo, hi = ax.get_ylim()
+        assert lo <= 0.0 < hi                            # bars start at zero
+    # loads over 1 kN are shown in kN: the tallest bar of condition 3's load panel is 13.1
+    load3 = axes[1 * 2 + 0]
+    assert "[kN]" in load3.get_ylabel()
+    assert max(p.get_height() for p in load3.patches) == pytest.approx(13.1)
+    # the % change: one per pair where both runs exist, equal to (rev − fwd)/fwd of the inputs
+    for row, c in enumerate((1, 3)):
+        for col, (key, _, _) in enumerate(QUANT):
+            ax = axes[row * 2 + col]
+            texts = sorted(_pct_texts(ax), key=lambda t: t.get_position()[0])
+            if c == 1:
+                assert texts == []                       # no reverse run: no change written
+                continue
+            assert len(texts) == 2
+            for t, b in zip(texts, ("inner", "outer")):
+                f, r = values[(key, c, b, "forward")], values[(key, c, b, "reverse")]
+                truth = (r - f) / f * 100.0
+                shown, tol = _parse_pct(t.get_text())
+                assert abs(shown - truth) <= tol + 1e-9, (c, key, b, t.get_text(), truth)
+    assert sorted(_legend_labels(fig)) == ["forward", "reverse"]
+
+
+def test_headline_legend_names_only_runs_that_exist(tmp_path, captured):
+    values = {k: v for k, v in _headline_values().items() if k[3] == "forward"}
+    plots.forward_reverse_headline(values, tmp_path / "h.png", quantities=QUANT)
+    fig = captured[-1]
+    assert _legend_labels(fig) == ["forward"]
+    assert not any(_pct_texts(ax) for ax in fig.axes)
+    # forward bars only: two per panel (inner, outer), none for the missing reverse runs
+    for ax in fig.axes:
+        assert len([p for p in ax.patches if np.isfinite(p.get_height())]) == 2
+
+
+# ------------------------------------------------------------------------------ bar chart
+def test_bar_chart_from_zero_with_the_change_and_only_existing_runs(tmp_path, captured):
+    table = {"roller load RMS": {"c3": (1400.0, 2600.0), "c4": (1300.0, 2500.0)},
+             "cage slip": {"c3": (0.74, 0.71), "c4": (-0.2, 0.3)}}
+    plots.bar_chart(["c3", "c4"], table, {"roller load RMS": "N", "cage slip": "%"}, tmp_path / "b.png")
+    fig = captured[-1]
+    axes = _visible_axes(fig)
+    assert len(axes) == 2
+    for ax, (q, by) in zip(axes, table.items()):
+        assert UNIT.search(ax.get_ylabel())
+        lo, hi = ax.get_ylim()
+        assert lo <= 0.0 <= hi and lo <= min(min(p) for p in by.values())  # the negative slip is inside
+        texts = sorted(_pct_texts(ax), key=lambda t: t.get_position()[0])
+        for t, c in zip(texts, ("c3", "c4")):
+            f, r = by[c]
+            shown, tol = _parse_pct(t.get_text())
+            assert abs(shown - (r - f) / f * 100.0) <= tol + 1e-9
+        assert len(texts) == 2
+    assert "[kN]" in axes[0].get_ylabel()
+    assert sorted(_legend_labels(fig)) == ["forward", "reverse"]
+
+    only_fwd = {q: {c: (p[0], None) for c, p in by.items()} for q, by in table.items()}
+    plots.bar_chart(["c3", "c4"], only_fwd, {"roller load RMS": "N", "cage slip": "%"}, tmp_path / "b2.png")
+    fig = captured[-1]
+    assert _legend_labels(fig) == ["forward"]
+    assert not any(_pct_texts(ax) for ax in fig.axes)
+
+
+# ------------------------------------------------------------------------------ time histories
+def test_time_history_group_units_one_legend_shared_time(tmp_path, captured):
+    t = np.linspace(0.030, 0.051, 300)
+    load = 9000.0 + 800.0 * np.sin(2 * np.pi * 700 * t)
+    rows = [("bearing load, radial", "N", {"inner": {"forward": (t, load), "reverse": (t, 1.4 * load)},
+                                            "outer": {"forward": (t, 0.8 * load)}}),
+            ("cage–guide force", "N", {"inner": {"forward": (t, 0.1 * load)}, "outer": {"forward": (t, 0.09 * load)}}),
+            ("cage acc. rel. planet, radial", "m/s^2", {"inner": {"forward": (t, 3e3 * np.sin(9e3 * t))}}),
+            ("transmission error", "m", {"outer": {"forward": (t, 3e-6 + 1e-6 * np.sin(6e3 * t))}})]
+    path = plots.time_history_group(rows, tmp_path / "g.png", columns=["inner", "outer"], title="group")
+    _not_blank(path)
+    fig = captured[-1]
+    axes = np.array(fig.axes).reshape(len(rows), 2)
+    # one legend for the figure, naming the runs drawn; none on the panels
+    assert len(fig.legends) == 1 and all(ax.get_legend() is None for ax in fig.axes)
+    assert sorted(_legend_labels(fig)) == ["forward", "reverse"]
+    # y labels on the first column, with their display units; the time axis in ms on the bottom row
+    assert [ax.get_ylabel().split("[")[-1] for ax in axes[:, 0]] == ["kN]", "N]", "m/s²]", "µm]"]
+    assert all(UNIT.search(ax.get_xlabel()) and "[ms]" in ax.get_xlabel() for ax in axes[-1])
+    # the data: kN and ms, the rows' panels on one y scale, all panels on one time axis
+    line = axes[0, 0].get_lines()[0]
+    np.testing.assert_allclose(line.get_xdata(), t * 1e3)
+    np.testing.assert_allclose(line.get_ydata(), load / 1e3)
+    np.testing.assert_allclose(axes[1, 1].get_lines()[0].get_ydata(), 0.09 * load)        # under 1 kN: N
+    np.testing.assert_allclose(axes[3, 1].get_lines()[0].get_ydata(), (3e-6 + 1e-6 * np.sin(6e3 * t)) * 1e6)
+    assert axes[0, 0].get_ylim() == axes[0, 1].get_ylim()
+    assert len({ax.get_xlim() for ax in fig.axes}) == 1
+    # the reverse run drawn with the study's style (only where it exists)
+    assert [ln.get_label() for ln in axes[0, 0].get_lines()] == ["forward", "reverse"]
+    assert [ln.get_label() for ln in axes[0, 1].get_lines()] == ["forward"]
+
+
+def test_time_history_group_rejects_empty(tmp_path):
+    with pytest.raises(ValueError, match="empty"):
+        plots.time_history_group([], tmp_path / "x.png", columns=["inner"])
+
+
+# ------------------------------------------------------------------------------ cage orbit picture
+def test_cage_orbit_picture(tmp_path, captured):
+    t = np.linspace(0.030, 0.040, 400)
+    C = 150e-6
+    w = 2 * np.pi * 300
+    fwd = np.column_stack([190e-6 + 8e-6 * np.cos(w * t), 50e-6 + 8e-6 * np.sin(w * t)])
+    rev = np.column_stack([180e-6 + 4e-6 * np.cos(-w * t), -50e-6 + 4e-6 * np.sin(-w * t)])
+    path = plots.cage_orbit_picture([("forward", t, fwd, C), ("reverse", t, rev, C)], tmp_path / "o.png",
+                                    title="orbits")
+    _not_blank(path)
+    fig = captured[-1]
+    cbar = [ax for ax in fig.axes if ax.get_label() == "<colorbar>"]
+    assert len(cbar) == 1 and cbar[0].get_ylabel() == "time [ms]"
+    axes = _visible_axes(fig)
+    assert len(axes) == 4                                   # whole clearance and zoom, per run
+    for ax in axes:
+        assert "[µm]" in ax.get_xlabel()
+        assert ax.get_aspect() == 1.0                       # a circle is round
+    assert all("[µm]" in ax.get_ylabel() for ax in axes[::2][:1])
+    top = axes[:2]
+    for ax, e in zip(top, (fwd, rev)):
+        # the clearance circle in µm, centred on the bore centre
+        circle = next(ln for ln in ax.get_lines() if ln.get_linestyle() == "--")
+        r = np.hypot(circle.get_xdata(), circle.get_ydata())
+        np.testing.assert_allclose(r, C * 1e6, rtol=1e-12)
+        # the trail coloured by time: its segments are the offsets in µm, its colours the times in ms
+        lc = ax.collections[0]
+        segs = lc.get_segments()
+        np.testing.assert_allclose(np.array([s[0] for s in segs]), e[:-1] * 1e6)
+        np.testing.assert_allclose(lc.get_array(), 0.5 * (t[:-1] + t[1:]) * 1e3)
+        # the whole clearance is in view
+        assert ax.get_xlim()[1] > C * 1e6 and ax.get_ylim()[0] < -C * 1e6
+    assert lc.norm.vmin == pytest.approx(t[0] * 1e3) and lc.norm.vmax == pytest.approx(t[-1] * 1e3)
+    labels = _legend_labels(fig)
+    assert {"guide clearance circle", "start", "end", "bore centre"} <= set(labels)
+    # the zoom row shows the trails: each trail lies inside its zoom panel
+    for ax, e in zip(axes[2:], (fwd, rev)):
+        (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+        assert x0 < e[:, 0].min() * 1e6 and e[:, 0].max() * 1e6 < x1
+        assert y0 < e[:, 1].min() * 1e6 and e[:, 1].max() * 1e6 < y1
+
+
+# ------------------------------------------------------------------------------ fault and oil figures
+def test_fault_loads_bars_from_zero_as_changes(tmp_path, captured):
+    rows = []
+    for fault, k_gamma, life in (("perfect", 1.0, 1.0), ("pinhole", 1.12, 0.7), ("runout", 1.03, 0.95)):
+        for b in ("inner", "outer"):
+            rows.append({"fault": fault, "direction": "forward", "bearing": b, "load_sharing_factor": k_gamma,
+                         "bearing_load_max_N": 15000.0, "life_relative": life, "cage_slip_pct": 0.7,
+                         "pocket_impacts_per_rev": 150.0})
+    plots.fault_loads(rows, tmp_path / "f.png")
+    fig = captured[-1]
+    assert _legend_labels(fig) == ["forward"]               # no reverse run: no reverse entry
+    axes = np.array(fig.axes).reshape(len(plots.FAULT_QUANTITIES), 2)
+    for ax in axes.ravel():
+        lo, hi = ax.get_ylim()
+        assert lo <= 0.0 <= hi
+        assert UNIT.search(ax.get_ylabel()), ax.get_ylabel()
+    # K_γ and the life ratio as their change in %: 100 (r − 1) of the inputs
+    heights = [p.get_height() for p in axes[0, 0].patches]
+    np.testing.assert_allclose(heights, [0.0, 12.0, 3.0], atol=1e-9)
+    heights = [p.get_height() for p in axes[2, 1].patches]
+    np.testing.assert_allclose(heights, [0.0, -30.0, -5.0], atol=1e-9)
+    assert "[kN]" in axes[1, 0].get_ylabel()
+
+
+def test_against_viscosity_one_legend_film_in_micrometres(tmp_path, captured):
+    eta = [0.012, 0.024, 0.05]
+    series = {}
+    for d, f in (("forward", 1.0), ("reverse", 1.05)):
+        for b in ("inner", "outer"):
+            series[("h_min_m", b, d)] = (eta, [f * 0.3e-6, f * 0.5e-6, f * 0.8e-6])
+            series[("lambda_min", b, d)] = (eta, [f * 1.5, f * 2.5, f * 4.0])
+    plots.against_viscosity(series, [("lambda_min", "Λ_min", "1", True), ("h_min_m", "h_min", "m", True)],
+                            tmp_path / "v.png", levels={"lambda_min": {1.0: "boundary", 3.0: "full film"}})
+    fig = captured[-1]
+    assert len(fig.legends) == 1 and all(ax.get_legend() is None for ax in fig.axes)
+    assert sorted(_legend_labels(fig)) == ["forward", "reverse"]
+    axes = np.array(fig.axes).reshape(2, 2)
+    assert "[µm]" in axes[1, 0].get_ylabel() and "[–]" in axes[0, 0].get_ylabel()
+    np.testing.assert_allclose(axes[1, 0].get_lines()[0].get_ydata(), [0.3, 0.5, 0.8])
+    assert "[mPa·s]" in axes[1, 0].get_xlabel()
+    levels = [ln.get_ydata()[0] for ln in axes[0, 1].get_lines() if ln.get_linestyle() == ":"]
+    assert sorted(levels) == [1.0, 3.0]
+
+
+# ------------------------------------------------------------------------------ helpers
+@pytest.mark.parametrize("unit, values, factor, shown", [
+    ("N", [900.0, -950.0], 1.0, "N"), ("N", [999.0, 1000.0], 1e-3, "kN"), ("m", [2e-6], 1e6, "µm"),
+    ("m", [2e-3], 1e3, "mm"), ("s", [0.03], 1e3, "ms"), ("s", [5.0], 1.0, "s"), ("m/s^2", [1.0], 1.0, "m/s²"),
+    ("percent", [1.0], 1.0, "%"), ("1", [1.0], 1.0, "–")])
+def test_display_unit(unit, values, factor, shown):
+    assert plots.display_unit(unit, values) == (factor, shown)
+
+
+@pytest.mark.parametrize("p, text", [(40.0, "+40 %"), (-24.4, "−24 %"), (3.21, "+3.2 %"), (-0.04, "−0.0 %"),
+                                     (159.4, "+159 %")])
+def test_format_pct(p, text):
+    assert plots.format_pct(p) == text
