@@ -70,7 +70,7 @@ def test_outputs_of_k_states_at_once_equal_one_state_at_a_time(frame):
                 seen.append(s1)
 
     mbd.simulate(bs.model, bs.q0, bs.v0, 3e-3, stepper=mbd.PRODUCTION.stepper(),
-                 controller=mbd.PRODUCTION.controller(), progress=False, observers=[Keep()], engine="numpy")
+                 controller=mbd.PRODUCTION.controller(), progress=False, observers=[Keep()])
     assert len(seen) == 4 and any(np.any(s.z[k][:, 0] > 0) for s in seen for k in s.z if "pocket" in k)
     assert _compare_outputs(mbd.System(bs.model), seen) > 100
 

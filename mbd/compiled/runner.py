@@ -120,8 +120,6 @@ class CompiledRunner:
         out, and a first run on a machine says what it is doing instead of looking stuck."""
         from . import kernels_cached
 
-        if len(self.cs.fams) == 0:      # numba cannot type an empty list of families: nothing to compile for
-            raise NotImplementedError("compiled path: the model has no element families")
         cold = not kernels_cached()
         if cold:
             print("mbd: compiling the engine's kernels (the first run of this code on this machine; about a "

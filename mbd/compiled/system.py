@@ -37,6 +37,20 @@ def _full(t, q, v, free, fixed_idx, fixed_q_I, omega, n_full):
 
 
 @njit(cache=True)
+def _list_of(item):
+    """A typed list holding ``item``. Built here (cached on disk) rather than by numba.typed.List from Python,
+    whose methods compile afresh in every process (≈ 1 s per worker)."""
+    out = List()
+    out.append(item)
+    return out
+
+
+@njit(cache=True)
+def _push(items, item):
+    items.append(item)
+
+
+@njit(cache=True)
 def assemble(t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
     """Generalized forces F on the free DOFs and, with ``jac``, J_q, J_v on the pattern (in place)."""
     (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full) = sysd
@@ -114,8 +128,7 @@ class CompiledSystem:
         self.system, self.model, self.ndof, self.nnz = system, m, system.ndof, system.nnz
         self.state_names: list[str] = []
         self.state_shapes: list[tuple] = []
-        fams, zs = List(), List()
-        zs.append(np.zeros((0, 0)))                    # slot 0: families without internal state
+        fams, zs = [], _list_of(np.zeros((0, 0)))      # zs slot 0: families without internal state
         for (e, parts), (keep, mp) in zip(system._evals, system._maps):
             kind = KINDS.get(type(e))
             if kind is None:
@@ -126,14 +139,18 @@ class CompiledSystem:
             z0 = e.init_internal()
             if z0 is not None:                     # kept (n, n_z) here, the element's own shape in a State
                 zi = len(zs)
-                zs.append(np.ascontiguousarray(np.reshape(z0, (e.n, -1)), dtype=float))
+                _push(zs, np.ascontiguousarray(np.reshape(z0, (e.n, -1)), dtype=float))
                 self.state_names.append(parts[0][0])
                 self.state_shapes.append(np.shape(z0))
             n, k = e.dofs.shape
             fams.append((kind.id, np.ascontiguousarray(e.dofs, dtype=np.int64), P, G, zi,
                          keep.astype(np.int64), np.asarray(mp, np.int64), np.zeros((n, k)), np.zeros((n, k)),
                          np.zeros((n, k)), np.zeros((n, k, k)), np.zeros((n, k, k))))
-        self.fams, self.zs = fams, zs
+        if not fams:      # numba cannot type an empty list of families: nothing to compile for
+            raise NotImplementedError("compiled path: the model has no element families")
+        self.fams, self.zs = _list_of(fams[0]), zs
+        for rec in fams[1:]:
+            _push(self.fams, rec)
         fixed = np.flatnonzero(m.fixed)
         frame_map = system._frame_map if system.rotating else np.zeros(0, np.int64)
         self.sysd = (m.free.astype(np.int64), (3 * fixed).astype(np.int64), np.ascontiguousarray(m.pose0[fixed], float),
