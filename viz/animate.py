@@ -138,12 +138,29 @@ class _Writer:
         if self._gif:
             if not (write and self._frames):
                 return
-            import imageio.v3 as iio
-            # duration in ms per frame; loop=0 repeats forever.
-            iio.imwrite(self.path, np.stack(self._frames), plugin="pillow",
-                        duration=1000.0 / self.fps, loop=0)
+            _write_gif(self.path, self._frames, self.fps)
         else:
             self._mp4.close()
+
+
+def _write_gif(path: Path, frames: list[np.ndarray], fps: float) -> None:
+    """A looping GIF of RGB ``frames``, written atomically. One 255-colour palette for every frame, taken
+    from eight frames spread over the film (these figures have few colours): mapping each frame to it is
+    ≈ 20× faster than Pillow's per-frame median-cut quantisation (1.5 s instead of 20 s for 150 frames of
+    1600×460) and keeps colours steady from frame to frame."""
+    from PIL import Image
+
+    pick = np.unique(np.linspace(0, len(frames) - 1, 8).astype(int))
+    palette = Image.fromarray(np.concatenate([frames[i] for i in pick], axis=0)).quantize(
+        colors=255, method=Image.Quantize.FASTOCTREE)
+    images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
+    tmp = path.with_name(f".{path.name}.tmp")
+    try:        # duration in ms per frame; loop=0 repeats forever
+        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], duration=1000.0 / fps, loop=0,
+                       optimize=True)
+        tmp.replace(path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def _lines_cells(segments: Sequence[Sequence[int]]) -> np.ndarray:
