@@ -247,7 +247,33 @@ class Recorder:
             self._sample(t, q, v, a, s0.z)
             self.next_index = k + 1
 
-    def _sample(self, t, q, v, a, z):
+    def record_block(self, block) -> None:
+        """Every sample time in a compiled block's span (its start state's t, its last step's end], as
+        :meth:`record` step by step; the element outputs of all its samples in one call
+        (:meth:`mbd.System.outputs_batch`)."""
+        t = np.concatenate([[block.start.t], block.log[:, 0]])
+        ks = self.sample_times(t[0], t[-1], include_start=False)
+        if ks.size == 0:
+            return
+        ts = self.t_start + ks * self.dt
+        tol = 1e-12 * np.maximum(1.0, np.abs(t))
+        j = np.clip(np.searchsorted(t + tol, ts, side="left"), 1, t.size - 1) - 1    # sample in step (t_j, t_j+1]
+        _, Q, V, A, Z = block.arrays()
+        h = (t[j + 1] - t[j])[:, None]
+        th = np.clip((ts[:, None] - t[j][:, None]) / h, 0.0, 1.0)
+        q, v, a = hermite_rows(Q[j], V[j], A[j], Q[j + 1], V[j + 1], A[j + 1], th, h)
+        z = {k: x[j] for k, x in Z.items()}                 # the step's start (as record: s0.z)
+        outs = self.system.outputs_batch(ts, q, v, z) if self._needs_outputs else None
+        for n, k in enumerate(ks):
+            one = None if outs is None else {f: {key: x[n] for key, x in o.items()} for f, o in outs.items()}
+            self._sample(ts[n], q[n], v[n], a[n], {key: x[n] for key, x in z.items()}, one)
+            self.next_index = k + 1
+
+    @property
+    def _needs_outputs(self) -> bool:
+        return any(kind != "body" for kind, _, _ in self._plan)
+
+    def _sample(self, t, q, v, a, z, outs=None):
         m = self.model
         qf, vf = m.full(t, q, v)
         af = np.zeros_like(qf)
@@ -255,7 +281,6 @@ class Recorder:
         fs = m.frame.at(t)
         if m.fixed.any() and not m.frame.is_inertial:
             _fixed_body_acceleration(m, fs, qf, vf, af)
-        outs = None
         for kind, p, sel in self._plan:
             if kind == "body":
                 Q, V, A = qf.reshape(-1, 3)[sel], vf.reshape(-1, 3)[sel], af.reshape(-1, 3)[sel]
@@ -380,16 +405,32 @@ def _fixed_body_acceleration(m, fs, qf, vf, af) -> None:
     af[3 * idx + 2] = -dW
 
 
+def hermite_rows(q0, v0, a0, q1, v1, a1, th, h):
+    """:func:`hermite` for many steps at once: rows of the step ends, ``th`` and ``h`` as (S, 1) columns."""
+    th2 = th * th           # products, not powers: a scalar and an array then round alike
+    th3 = th2 * th
+    h00 = 2 * th3 - 3 * th2 + 1
+    h10 = th3 - 2 * th2 + th
+    h01 = -2 * th3 + 3 * th2
+    h11 = th3 - th2
+    q = h00 * q0 + h10 * h * v0 + h01 * q1 + h11 * h * v1
+    v = h00 * v0 + h10 * h * a0 + h01 * v1 + h11 * h * a1
+    a = (1 - th) * a0 + th * a1
+    return q, v, a
+
+
 def hermite(s0, s1, th, h):
     """Cubic Hermite interpolation of (q, v) and linear of a at fraction th of the step."""
     if th <= 0.0:
         return s0.q, s0.v, s0.a
     if th >= 1.0:
         return s1.q, s1.v, s1.a
-    h00 = 2 * th**3 - 3 * th**2 + 1
-    h10 = th**3 - 2 * th**2 + th
-    h01 = -2 * th**3 + 3 * th**2
-    h11 = th**3 - th**2
+    th2 = th * th           # products, not powers: a scalar and an array then round alike
+    th3 = th2 * th
+    h00 = 2 * th3 - 3 * th2 + 1
+    h10 = th3 - 2 * th2 + th
+    h01 = -2 * th3 + 3 * th2
+    h11 = th3 - th2
     q = h00 * s0.q + h10 * h * s0.v + h01 * s1.q + h11 * h * s1.v
     v = h00 * s0.v + h10 * h * s0.a + h01 * s1.v + h11 * h * s1.a
     a = (1 - th) * s0.a + th * s1.a

@@ -269,25 +269,18 @@ class _Loop:
         return self._count(s1, error, h_try, h_next)
 
     def accepted_block(self, blk) -> bool:
-        """The same for a compiled block of steps: each observer takes the block in one call, the recorder
-        the steps a sample falls due in; a checkpoint can only fall on the block's last step (the runner ends
-        blocks there)."""
+        """The same for a compiled block of steps: the recorder and each observer take the block in one call;
+        a checkpoint can only fall on the block's last step (the runner ends blocks there)."""
+        if self.recorder is not None:
+            self.recorder.record_block(blk)
         for ob in self.observers:
             ob.on_block(blk)
         last = len(blk) - 1
-        s0 = blk.start
-        for i in range(last + 1):
+        for i in range(last):
             t1, h_try, err = (float(x) for x in blk.log[i, :3])
-            s1 = None
-            if self.recorder is not None and self.recorder.due(t1):
-                s1 = blk.state_at(i)
-                self.recorder.record(s0 if s0 is not None else blk.state_at(i - 1), s1)
-            if i == last:
-                return self._count(blk.state, err, h_try, blk.h)
             _add_step(self.stats, err, h_try)
             self.bar.update(t1, self.counters)
-            s0 = s1
-        return False
+        return self._count(blk.state, float(blk.log[last, 2]), float(blk.log[last, 1]), blk.h)
 
     def _count(self, s1: State, error: float, h_try: float, h_next: float) -> bool:
         _add_step(self.stats, error, h_try)
