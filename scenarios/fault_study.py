@@ -68,7 +68,7 @@ FAULTS = {
 }
 COLUMNS = ["fault", "direction", "bearing", "load_sharing_factor", "bearing_load_mean_N", "bearing_load_max_N",
            "roller_max_N", "life_iso281_h", "life_iso16281_h", "life_relative", "cage_slip_pct",
-           "pocket_impacts_per_rev", "cage_acc_rel_rms",
+           "pocket_impacts_per_rev", "cage_acc_rel_rms_m_s2",
            "sensor_f_m", "sensor_f_m-1f_c", "sensor_f_m+1f_c", "sensor_f_m-3f_c", "sensor_f_m+3f_c",
            "sensor_own", "own_frequency", "notes"]
 
@@ -200,7 +200,7 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
                    "life_iso281_h": d["life_iso281_h"], "life_iso16281_h": d["life_iso16281_h"],
                    "life_relative": life, "cage_slip_pct": d.get("cage_slip_pct"),
                    "pocket_impacts_per_rev": d.get("pocket_impacts_per_rev"),
-                   "cage_acc_rel_rms": d.get("cage_acc_rel_magnitude_rms"),
+                   "cage_acc_rel_rms_m_s2": d.get("cage_acc_rel_magnitude_rms_m_s2"),
                    **{k: v for k, v in sensor.items() if k.startswith("sensor")},
                    "sensor_own": min(sensor["own-"], sensor["own+"]) if own is not None and not coarse else None,
                    "own_frequency": own,
