@@ -527,7 +527,7 @@ class GearSetParams(Params):
     """Sun, inner planets, outer planets, ring and carrier of the double planetary set.
 
     ``handedness`` h: the outer planet stands at ψ_b = ψ_a + h·Δψ (+1: it leads its inner planet in the
-    positive angular direction). ``planet_angle`` ψ_0: angle of pair 0's inner planet at t = 0.
+    positive angular direction). ``planet_angle`` ψ_0: angle of pair 1's inner planet (a1) at t = 0.
     """
 
     _prefix: ClassVar[str] = "gears"

@@ -69,7 +69,7 @@ def reference_gears() -> GearSetParams:
         planets=paper(3, "default planet count of the study"),
         handedness=assumed(-1, "outer planet trails its inner planet by delta_psi in the forward "
                                "(counter-clockwise) carrier direction"),
-        planet_angle=assumed("0 deg", "pair 0 on the +x axis at t = 0"),
+        planet_angle=assumed("0 deg", "pair 1 (planet a1) on the +x axis at t = 0"),
     )
 
 

@@ -1,6 +1,8 @@
 """summary.json's names (issue 24 §4): every numeric key with a unit ends in its unit's suffix, every other numeric
 key is on the explicit list of dimensionless ones, and every key is documented — in
-components.outputs.SUMMARY_WORDS or in the README's summary.json section — checked on a real run's file."""
+components.outputs.SUMMARY_WORDS or in the README's summary.json section — checked on a real run's file.
+And one indexing convention: planets and pairs counted from 1 as they are named (a1/b1 = pair 1) in messages,
+plots and options; rollers and teeth by their index from 0 as the parameters give them."""
 from __future__ import annotations
 
 import itertools
@@ -135,3 +137,45 @@ def test_integration_record_names_its_units():
     assert r["h_s"] == mbd.PRODUCTION.h and r["atol_pos_m"] == mbd.PRODUCTION.atol_pos
     assert r["atol_rot_rad"] == mbd.PRODUCTION.atol_rot and "h" not in r
 
+
+# ------------------------------------------------------------------------------------------------------------
+# one indexing convention
+# ------------------------------------------------------------------------------------------------------------
+def test_design_messages_name_planets_and_pairs_from_1():
+    from components.geometry import design_findings
+
+    found = {f.parameter: f.message for f in design_findings(reference_dpgt(3, "forward"))}
+    assert "the sun and outer planet b1 (not in mesh)" in found["gears.sun"]          # was "outer planet 0"
+    four = [f.message for f in design_findings(with_overrides(reference_dpgt(3, "forward"), {"gears.planets": 4}))]
+    assert any("pairs 2..4 are off the ring's teeth by -0.25, -0.5, +0.25 pitch" in m for m in four), four
+    # inner planet a1 against outer planet b2: the planets as the parameters name them (a1..aN, b1..bN)
+    assert any("inner planet a1 and outer planet b2" in m for m in four), four
+    assert not any(re.search(r"planet \d", m) for m in four)
+
+
+def test_animate_pair_option_counts_from_1(run_dir, monkeypatch, capsys):
+    """dpgt animate --pair n shows pair n (planets an, bn): --pair 0 and a pair the run lacks are usage errors."""
+    from viz import cli, render_check
+    import viz.animate as animate
+    import viz.results as results
+
+    nc = str(run_dir / "results.nc")
+    assert cli.main([nc, "--out", "x.gif", "--pair", "0"]) == 2
+    assert "--pair" in capsys.readouterr().err
+    assert cli.main([nc, "--out", "x.gif", "--pair", "4"]) == 2
+    assert "pairs 1..3" in capsys.readouterr().err
+    seen = {}
+    real = results.cage_panels
+    def panels(runs, pair, rollers):
+        seen["pair"] = pair
+        return real(runs, pair=pair, rollers=rollers)
+
+    monkeypatch.setattr(cli, "cage_panels", panels)
+    monkeypatch.setattr(render_check, "check_offscreen", lambda: (True, ""))
+    monkeypatch.setattr(animate, "cage_orbit_animation",
+                        lambda out, *a, title, **k: seen.setdefault("title", title) and Path(out))
+    cli.main([nc, "--out", str(run_dir / "x.gif"), "--pair", "2", "--max-frames", "2"])
+    assert seen["pair"] == 1                          # pair 2 is index 1: planets a2 and b2
+    assert "planet pair 2" in seen["title"]
+    run = results.load_run(nc)
+    assert run.bearing("inner", 1)["planet"] == "a2"

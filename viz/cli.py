@@ -68,8 +68,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="at most this many frames, spread evenly over the run (default: every sample)")
     p.add_argument("--compare", default=None, metavar="OTHER_RESULTS",
                    help="cage: a second run (e.g. the reverse one) shown side by side")
-    p.add_argument("--pair", type=int, default=0,
-                   help="planet pair of the cage orbits, 0-based (default 0: the reference pair)")
+    p.add_argument("--pair", type=_positive(int), default=1,
+                   help="planet pair of the cage orbits, counted from 1 as the planets are named (pair n holds "
+                        "a<n> and b<n>; default 1: the reference pair)")
     p.add_argument("--no-rollers", action="store_true", help="cage: leave out the roller offsets")
     return p
 
@@ -99,7 +100,10 @@ def main(argv=None) -> int:
         run = load_run(args.results)
         other = load_run(args.compare) if args.compare else None
         if args.kind == "cage":
-            panels = cage_panels([run] + ([other] if other else []), pair=args.pair,
+            if args.pair > len(run.pairs):
+                return _fail(f"argument --pair: {args.pair} is not a planet pair of {args.results} "
+                             f"(pairs 1..{len(run.pairs)})", 2)
+            panels = cage_panels([run] + ([other] if other else []), pair=args.pair - 1,
                                  rollers=not args.no_rollers)
         else:
             bodies = train_bodies(run, frame=args.frame,
@@ -115,7 +119,7 @@ def main(argv=None) -> int:
         if args.kind == "cage":
             size = args.size or _DEFAULT_SIZE["cage-compare" if other else "cage"]
             title = "Cage orbits in the guide clearance" + (
-                f", planet pair {args.pair + 1}" if args.pair else "")
+                f", planet pair {args.pair}" if args.pair != 1 else "")
             if other is None:
                 title += f" ({run.direction})"
             path = animate.cage_orbit_animation(out, panels["t"], panels["orbits"], panels["clearance_m"],

@@ -128,7 +128,7 @@ class Run:
         for b in self.bearings:
             if b["name"] == which or (b["kind"] == which and b["pair"] == pair):
                 return b
-        raise ResultsError(f"{self.path}: no bearing {which!r}" + (f" in pair {pair}" if which in
+        raise ResultsError(f"{self.path}: no bearing {which!r}" + (f" in pair {pair + 1} (index {pair})" if which in
                            ("inner", "outer") else "") + "; bearings: "
                            + ", ".join(b["name"] for b in self.bearings))
 
@@ -307,7 +307,7 @@ def _require_cage(run: Run, b: Mapping) -> str:
 def cage_orbits(run: Run, pair: int | None = 0, frame: str = "carrier") -> dict[str, np.ndarray]:
     """Cage-centre offset e = c_cage − c_bore (the bore centre is the planet centre) [m].
 
-    pair=n → {"inner": (n_t, 2), "outer": (n_t, 2)} for the bearings of planet pair n (pair 0 is the
+    pair=n → {"inner": (n_t, 2), "outer": (n_t, 2)} for the bearings of planet pair n (index 0, pair 1, is the
     reference pair of the study); pair=None → {bearing name: (n_t, 2)} for every bearing.
     frame: axes of the offset, see :func:`view_angle`; "carrier" (default) is the frame R itself for a
     run in the rotating frame and makes runs in either frame comparable.  |e| is the guide contact's
