@@ -82,6 +82,8 @@ BAD_ARGUMENTS = [
     ("spectrum", ["--carrier-rpm", "-5"], "--carrier-rpm: must be > 0 r/min"),
     ("bearing_rig", ["--radial-load", "0 N"], "--radial-load: must be > 0"),
     ("bearing_rig", ["--rollers", "2"], "--rollers: must be a whole number in [3"),
+    ("bearing_rig", ["--speed", "70 Hz"], "--speed: expected an angular velocity (e.g. '4200 rpm'), got '70 Hz': "
+                                          "needs an angle unit"),
     ("modal", ["--condition", "5"], "--condition: must be a whole number in [1, 4]"),
     ("stability", ["--scipy", "Radau:x"], "--scipy: expects METHOD:RTOL"),
     ("stability", ["--cases", "nonsense"], "--cases: takes cases"),
