@@ -20,6 +20,7 @@ from .params import (BearingParams, BearingRigParams, CageParams, CarrierRippleP
                      overrides_from_toml, paper, with_overrides)
 from .tolerances import radial_runout
 from .units import Q_, ParameterError
+from .names import did_you_mean
 
 __all__ = ["CONDITIONS", "DIRECTIONS", "OIL_GRADES", "oil_grade", "operating_point", "reference_gears", "reference_bearing",
            "reference_dpgt", "reference_bearing_rig", "rig_accelerometer", "rig_housing", "ideal_carrier_drive", "load_toml",
@@ -95,7 +96,8 @@ OIL_GRADES = dict(sorted(OIL_GRADES.items(), key=lambda kv: int(kv[0][2:])))
 def oil_grade(name: str) -> dict:
     """Overrides {"lubricant.viscosity_40": ..., "lubricant.viscosity_100": ...} of an ISO VG grade."""
     if name not in OIL_GRADES:
-        raise ParameterError.at("lubricant grade", f"expected one of {sorted(OIL_GRADES)}, got {name!r}")
+        raise ParameterError.at("lubricant grade", f"expected one of {sorted(OIL_GRADES)}, got {name!r}"
+                                                   f"{did_you_mean(name, OIL_GRADES)}")
     return {f"lubricant.{k}": v for k, v in OIL_GRADES[name].items()}
 
 

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.names import did_you_mean
 from components.units import ParameterError
 from mbd.recorder import atomic_write_text
 
@@ -96,7 +97,8 @@ def _fault_list(text: str) -> list[str]:
     names = [f.strip() for f in text.split(",") if f.strip()]
     unknown = [f for f in names if f not in FAULTS]
     if unknown:
-        raise argparse.ArgumentTypeError(f"unknown fault(s) {unknown}; the catalogue has {', '.join(FAULTS)}")
+        raise argparse.ArgumentTypeError(f"unknown fault(s) {unknown}{did_you_mean(unknown[0], FAULTS)}; the catalogue "
+                                         f"has {', '.join(FAULTS)}")
     return names
 
 

@@ -250,7 +250,7 @@ def test_unknown_override_keys_list_valid_keys():
     with pytest.raises(ParameterError) as exc:
         with_overrides(reference_dpgt(), {"bearing.clearence": "30 um"})
     msg = str(exc.value)
-    assert msg.startswith("bearing.clearence: unknown parameter (did you mean bearing.clearance")
+    assert msg.startswith("bearing.clearence: unknown parameter (did you mean 'bearing.clearance'?)")
     assert "bearing.roller_diameter" in msg and "gears.planets" not in msg  # keys of the section at fault
     with pytest.raises(ParameterError, match=r"^bearings\.clearance: unknown parameter.*valid keys: .*gears\.planets"):
         with_overrides(reference_dpgt(), {"bearings.clearance": "30 um"})

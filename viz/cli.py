@@ -19,6 +19,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from components.names import argparse_hint
+
 from . import render_check
 from .results import ResultsError, cage_panels, load_run, train_bodies
 
@@ -50,8 +52,15 @@ def _positive(kind):
     return conv
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse whose unknown options and invalid choices name the closest valid ones."""
+
+    def error(self, message):
+        super().error(argparse_hint(self, message))
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog=PROG, description="Animate saved DPGT results (offscreen).",
+    p = _Parser(prog=PROG, description="Animate saved DPGT results (offscreen).",
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog=__doc__.split("\n\n", 2)[2] if __doc__ else None)
     p.add_argument("results", help="results.nc of a DPGT run, or its run directory")
