@@ -2,7 +2,8 @@
 key is on the explicit list of dimensionless ones, and every key is documented — in
 components.outputs.SUMMARY_WORDS or in the README's summary.json section — checked on a real run's file.
 And one indexing convention: planets and pairs counted from 1 as they are named (a1/b1 = pair 1) in messages,
-plots and options; rollers and teeth by their index from 0 as the parameters give them."""
+plots and options; rollers and teeth by their index from 0 as the parameters give them. And results.nc through
+viz.results.attribute_names: every variable, coordinate and dimension reachable by xarray's attribute access."""
 from __future__ import annotations
 
 import itertools
@@ -179,3 +180,51 @@ def test_animate_pair_option_counts_from_1(run_dir, monkeypatch, capsys):
     assert "planet pair 2" in seen["title"]
     run = results.load_run(nc)
     assert run.bearing("inner", 1)["planet"] == "a2"
+
+
+# ------------------------------------------------------------------------------------------------------------
+# results.nc: names attribute access can use
+# ------------------------------------------------------------------------------------------------------------
+def test_results_reachable_by_attribute_access_and_the_readers_unchanged(run_dir):
+    xr = pytest.importorskip("xarray")
+    import numpy as np
+    from viz.results import attribute_name, attribute_names, load_run, open_results
+
+    raw = xr.open_dataset(run_dir / "results.nc", engine="h5netcdf")
+    ds = open_results(run_dir)
+    assert "race_inner.load" in raw.variables and not hasattr(raw, "race_inner")      # the trap
+    for name in [*raw.variables, *raw.dims]:
+        new = attribute_name(name)
+        assert new.isidentifier() and "." not in new, name
+        if name in raw.variables:
+            got = getattr(ds, new)                                  # attribute access reaches it
+            assert isinstance(got, xr.DataArray) and got.name == new
+            np.testing.assert_array_equal(got.values, raw[name].values)
+            assert got.attrs.get("units") == raw[name].attrs.get("units"), name
+            if new != name:
+                assert got.attrs["results_name"] == name
+        else:
+            assert new in ds.dims
+    load = ds.race_inner_load.sel(race_inner_instance="a1.pb.roller0")
+    np.testing.assert_array_equal(load.values, raw["race_inner.load"].sel({"race_inner.instance": "a1.pb.roller0"}).values)
+    assert ds.race_inner_load.attrs["units"] == "N" and ds.bearing_load_radial.dims == ("time", "bearing_load_radial_instance")
+    assert json.loads(ds.attrs["results_names"])["motion_position"] == "motion.position"
+    assert ds.attrs["Conventions"] == raw.attrs["Conventions"]
+    assert open_results(run_dir, attribute_access=False).identical(raw)
+    # the file keeps its names: the one reader loads it as before
+    run = load_run(run_dir)
+    assert run.output("race_inner.load").shape == raw["race_inner.load"].shape
+
+
+def test_attribute_names_refuses_names_that_would_meet_or_hide():
+    xr = pytest.importorskip("xarray")
+    import numpy as np
+    from viz.results import ResultsError, attribute_names
+
+    a = np.zeros(2)
+    with pytest.raises(ResultsError, match="would meet: \\['a_b'\\]"):
+        attribute_names(xr.Dataset({"a.b": ("t", a), "a_b": ("t", a)}))
+    with pytest.raises(ResultsError, match="hide behind Dataset attributes: \\['mean'\\]"):
+        attribute_names(xr.Dataset({"mean": ("t", a)}))
+    ok = attribute_names(xr.Dataset({"x.y": ("t.n", a)}))
+    assert ok.x_y.dims == ("t_n",) and ok.x_y.attrs["results_name"] == "x.y"
