@@ -5,7 +5,8 @@
                  [--no-rollers]
 
 RESULTS is a results.nc or the run directory holding it; FILE ends in .gif or .mp4.
-  --kind cage   cage-centre orbits of planet pair --pair (inner and outer PB) in the guide clearance;
+  --kind cage   cage-centre orbits of planet pair --pair (1..N, default 1: planets a1, b1; inner and outer PB)
+                in the guide clearance;
                 with --compare, the two runs side by side (forward and reverse);
                 --magnify scales the schematic roller pocket offsets (default: automatic).
   --kind train  the whole train, rollers coloured by their inner-race load, seen from the carrier
