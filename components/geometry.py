@@ -28,7 +28,7 @@ p ≡ 0 exactly when a tooth of gear 1 has its centre line on the line of centre
 symmetrically). The planet's position enters through φ_e, evaluated from the states: at assembly
 (θ = 0, φ_e = nominal) the mesh position is ``p_assembly = frac(z_1·(γ_1 − φ_e)/2π)``. For the
 sun–inner meshes p0 = 0 (γ_sun = 0) and p_assembly = frac(−z_s·ψ_an/2π), the familiar sequential
-phasing; with ψ_0 = 0, pair 0 starts with the sun's tooth 0 on its pitch point (p = 0).
+phasing; with ψ_0 = 0, pair 1 (a1) starts with the sun's tooth 0 on its pitch point (p = 0).
 
 Flank f (MODEL.md §3.2) of a standard tooth (thickness half the circular pitch, no backlash) has its
 contact on the pitch point when ``p ≡ −σf/4`` (σ = +1 external, −1 internal). Measured along that
@@ -535,8 +535,12 @@ class Finding:
         return f"{self.parameter}: {self.message}"
 
 
-def _overlap_findings(out, name_i, name_j, ci, cj, ri, rj, parameter, same=False, pitch=None):
-    """Warn about the worst tip-circle overlap between two families of gear centres (non-meshing)."""
+_TAG = {"inner_planet": "a", "outer_planet": "b"}     # planets are named a1..aN, b1..bN (components.dpgt)
+
+
+def _overlap_findings(out, name_i, name_j, ci, cj, ri, rj, parameter, same=False, pitch=None, tags=("", "")):
+    """Warn about the worst tip-circle overlap between two families of gear centres (non-meshing). ``tags``: the
+    planets' name letters ("a" inner, "b" outer): a planet is named as everywhere else, a1..aN (pair n from 1)."""
     ci, cj = np.atleast_2d(ci), np.atleast_2d(cj)
     d = np.linalg.norm(ci[:, None, :] - cj[None, :, :], axis=-1)
     if same:
@@ -545,8 +549,8 @@ def _overlap_findings(out, name_i, name_j, ci, cj, ri, rj, parameter, same=False
     k = np.unravel_index(np.argmax(ov), ov.shape)
     if ov[k] > 1e-12:
         i, j = (int(k[0]), int(k[1]))
-        who_i = f"{name_i} {i}" if len(ci) > 1 else name_i
-        who_j = f"{name_j} {j}" if len(cj) > 1 else name_j
+        who_i = f"{name_i} {tags[0]}{i + 1}" if tags[0] else name_i
+        who_j = f"{name_j} {tags[1]}{j + 1}" if tags[1] else name_j
         what = f"tip circles of {who_i} and {who_j} (not in mesh) overlap by {ov[k] * 1e3:.2f} mm " \
                f"(centre distance {d[k] * 1e3:.2f} mm < {(ri + rj) * 1e3:.2f} mm)"
         collides = bool(pitch is not None and d[k] < sum(pitch))
@@ -627,7 +631,7 @@ def _mesh_findings(lay, out) -> None:
         mis = ", ".join(f"{x:+.3g}" for x in lay.phasing.ring_mismatch[1:])
         out.append(Finding("warning", "gears.planets",
                            f"(z_r - z_s)/N = {lay.assembly_number:.4g} is not an integer: equally spaced pairs do "
-                           f"not assemble (pairs 1.. are off the ring's teeth by {mis} pitch); each pair's meshes "
+                           f"not assemble (pairs 2..{lay.planets} are off the ring's teeth by {mis} pitch); each pair's meshes "
                            f"are phased from its real position"))
 
 
@@ -636,7 +640,7 @@ def _interference_findings(lay, G, out) -> None:
     ra = {n: G[n].tip_radius for n in _GEARS}
     zero = np.zeros((1, 2))
     _overlap_findings(out, "the sun", "outer planet", zero, lay.centres_b, ra["sun"], ra["outer_planet"], "gears.sun",
-                      pitch=(G["sun"].pitch_radius, G["outer_planet"].pitch_radius))
+                      pitch=(G["sun"].pitch_radius, G["outer_planet"].pitch_radius), tags=("", "b"))
     # inner planet inside the ring: its outermost point must stay inside the ring's tip (inner) circle
     reach = lay.r_ca + ra["inner_planet"]
     if reach > ra["ring"] + 1e-12:
@@ -656,7 +660,7 @@ def _interference_findings(lay, G, out) -> None:
                                    (("outer_planet", cb), ("outer_planet", cb)),
                                    (("inner_planet", ca), ("outer_planet", cb))):  # a_n vs b_m, n != m
             _overlap_findings(out, ni.replace("_", " "), nj.replace("_", " "), ci, cj, ra[ni], ra[nj],
-                              "gears.planets", same=True, pitch=(rp[ni], rp[nj]))
+                              "gears.planets", same=True, pitch=(rp[ni], rp[nj]), tags=(_TAG[ni], _TAG[nj]))
 
 
 def _bearing_findings(bs, G, out) -> None:

@@ -42,7 +42,7 @@ from .lubrication import bearing_film
 
 __all__ = ["FAMILY", "MESH_FAMILY", "BearingSeries", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
            "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life",
-           "contact_film", "SUMMARY_WORDS"]
+           "contact_film", "SUMMARY_WORDS", "UNIT_SUFFIXES", "DIMENSIONLESS_KEYS", "unit_of_key"]
 
 
 
@@ -140,30 +140,104 @@ def contact_film(race: dict, bearing, lubricant, inner: bool) -> dict[str, np.nd
     return {**film, "film_lambda": film["film_min"] / lubricant.roughness}
 
 
-# what each summary key means, in words and units (for tables and plot axes)
+# what each summary key means, in words and units (for tables and plot axes; README: What summary.json holds).
+# Every key of :meth:`WindowStatistics.summary` is here. A key with a unit ends in its suffix (UNIT_SUFFIXES);
+# a key without one is dimensionless ("1": a count, a ratio, a factor) and is listed in DIMENSIONLESS_KEYS.
+UNIT_SUFFIXES = {"_N": "N", "_m": "m", "_m_s": "m/s", "_m_s2": "m/s^2", "_s": "s", "_h": "h", "_W": "W", "_pct": "%",
+                 "_Mrev": "10^6 rev", "_hz": "Hz", "_rpm": "r/min", "_rad": "rad"}
+
+
+def _cage_acc_words() -> dict:
+    views = {"": "cage acc.", "rel_": "cage acc. rel. planet"}
+    stats = {"rms": "RMS", "max": "max"}
+    out = {f"cage_acc_{v}{c}_{s}_m_s2": (f"{w} {stats[s]}, {c}", "m/s^2")
+           for v, w in views.items() for c in ("radial", "tangential", "magnitude") for s in stats}
+    out.update({f"cage_acc_{c}_rms_m_s2": (f"cage acc. rel. planet RMS, {c} (model axes)", "m/s^2") for c in ("x", "y")})
+    return out
+
+
 SUMMARY_WORDS = {
+    "window_s": ("statistics window, start and end", "s"),
+    "window_duration_s": ("length of the mesh statistics window", "s"),
+    "carrier_speed_error_mean_pct": ("carrier speed against its drive's reference, time mean", "%"),
+    "whole_revolutions": ("bearing windows end after whole cage revolutions", "1"),
     "bearing_load_mean_N": ("planet bearing load, mean", "N"),
+    "bearing_load_mean_all_N": ("planet bearing load, mean of the bearings of the type", "N"),
+    "bearing_load_mean_per_planet_N": ("planet bearing load, mean, per planet", "N"),
+    "bearing_load_radial_mean_N": ("planet bearing load, mean, radial", "N"),
+    "bearing_load_tangential_mean_N": ("planet bearing load, mean, tangential", "N"),
+    "bearing_load_max_N": ("planet bearing load, max", "N"),
+    "load_sharing_factor": ("load sharing K_γ: most loaded planet over the mean", "1"),
     "equivalent_load_N": ("planet bearing equivalent load (ISO 281)", "N"),
+    "dynamic_load_rating_N": ("basic dynamic load rating C_r (ISO 281)", "N"),
     "life_L10_relative": ("L10 life relative to forward", "1"),
+    "life_iso281_Mrev": ("L10 life, ISO 281 from the bearing load", "10^6 rev"),
     "life_iso281_h": ("L10 life, ISO 281 from the bearing load", "h"),
+    "life_iso16281_Mrev": ("L10 life, ISO/TS 16281-style from the roller loads", "10^6 rev"),
     "life_iso16281_h": ("L10 life, ISO/TS 16281-style from the roller loads", "h"),
+    "roller_equivalent_load_pin_N": ("equivalent roller load on the pin (ISO/TS 16281)", "N"),
+    "roller_equivalent_load_bore_N": ("equivalent roller load on the bore (ISO/TS 16281)", "N"),
     "roller_inner_race_rms_N": ("roller–inner race load RMS", "N"),
     "roller_inner_race_max_N": ("roller–inner race load max", "N"),
+    "roller_inner_race_mean_N": ("roller–inner race load mean", "N"),
+    "roller_inner_race_mean_spread": ("spread of the rollers' mean inner-race loads, (max − min)/mean", "1"),
     "roller_outer_race_rms_N": ("roller–outer race load RMS", "N"),
     "roller_outer_race_max_N": ("roller–outer race load max", "N"),
+    "roller_outer_race_mean_N": ("roller–outer race load mean", "N"),
     "roller_cage_rms_N": ("roller–cage force RMS", "N"),
     "roller_cage_max_N": ("roller–cage force max", "N"),
     "cage_guide_rms_N": ("cage–guide force RMS", "N"),
     "cage_guide_max_N": ("cage–guide force max", "N"),
-    "cage_acc_radial_rms": ("cage acc. RMS, radial", "m/s^2"),
-    "cage_acc_tangential_rms": ("cage acc. RMS, tangential", "m/s^2"),
-    "cage_acc_rel_radial_rms": ("cage acc. rel. planet RMS, radial", "m/s^2"),
-    "cage_acc_rel_tangential_rms": ("cage acc. rel. planet RMS, tangential", "m/s^2"),
+    "cage_guide_mean_N": ("cage–guide force mean", "N"),
+    **_cage_acc_words(),
     "cage_slip_pct": ("cage slip", "%"),
+    "cage_slip_all_pct": ("cage slip, mean of the bearings of the type", "%"),
+    "cage_revolutions": ("cage revolutions relative to the carrier in the window", "1"),
+    "pocket_impacts": ("pocket impacts in the window", "1"),
     "pocket_impacts_per_rev": ("pocket impacts per cage revolution", "1"),
-    "pocket_impact_speed_max": ("pocket impact speed max", "m/s"),
+    "pocket_touches_per_rev": ("gentle pocket contacts (below the impact speed floor) per cage revolution", "1"),
+    "pocket_impact_speed_max_m_s": ("pocket impact speed max", "m/s"),
+    "pocket_impact_speed_mean_m_s": ("pocket impact speed mean", "m/s"),
     "pocket_impact_peak_max_N": ("pocket impact peak force max", "N"),
+    "pocket_impact_peak_mean_N": ("pocket impact peak force mean", "N"),
+    "heat_traction_W": ("heat from roller–raceway traction, mean", "W"),
+    "heat_traction_all_W": ("heat from roller–raceway traction, mean of the bearings of the type", "W"),
+    "heat_land_W": ("heat from the cage land's friction, mean", "W"),
+    "heat_land_all_W": ("heat from the cage land's friction, mean of the bearings of the type", "W"),
+    "traction_coefficient_max": ("largest traction coefficient of a loaded contact", "1"),
+    "film_min_m": ("thinnest EHL film h_min", "m"),
+    "film_mean_m": ("thinnest EHL film, time mean", "m"),
+    "film_min_isothermal_m": ("thinnest EHL film without the thermal reduction", "m"),
+    "lambda_min": ("film parameter Λ = h_min/σ, smallest", "1"),
+    "lambda_mean": ("film parameter Λ = h_min/σ, time mean", "1"),
+    "film_min_thermal_loading": ("thermal loading L at the thinnest film", "1"),
+    "film_thermal_loading_max": ("thermal loading L, largest", "1"),
+    "film_thermal_factor_min": ("thermal reduction φ_T, smallest", "1"),
+    "film_load_parameter_max": ("load parameter W′ = w′/(E′R), largest", "1"),
+    "film_central_ratio_min": ("h_c/h_min, smallest", "1"),
+    "drive_flank": ("the flank the torque path loads (+1/−1)", "1"),
+    **{f"{f}_force_{s}_N": (f"{f} flank force {s}", "N") for f in ("drive", "coast") for s in ("mean", "max")},
+    **{f"{f}_deflection_{s}_m": (f"{f} flank deflection {s}", "m") for f in ("drive", "coast") for s in ("mean", "max")},
+    **{f"{f}_force_mean_per_pair_N": (f"{f} flank force mean, per pair", "N") for f in ("drive", "coast")},
+    "te_peak_to_peak_m": ("loaded transmission error peak-to-peak, largest pair", "m"),
+    "te_peak_to_peak_per_pair_m": ("loaded transmission error peak-to-peak, per pair", "m"),
+    "dynamic_factor": ("dynamic factor K_v, largest pair", "1"),
+    "dynamic_factor_per_pair": ("dynamic factor K_v, per pair", "1"),
 }
+
+# numeric summary keys without a unit (counts, ratios, factors, signs): the only ones without a UNIT_SUFFIXES suffix
+DIMENSIONLESS_KEYS = frozenset(k for k, (_, unit) in SUMMARY_WORDS.items() if unit == "1") | {
+    # what the runner adds (scenarios.runner): counts and the error estimate in units of the tolerance
+    "condition", "planets", "rollers", "rows", "samples", "steps", "rejected_steps", "newton_per_step",
+    "error_estimate.rms", "error_estimate.max", "integration.alpha"}
+
+
+def unit_of_key(key: str) -> str | None:
+    """The unit a summary key's suffix names (None: no unit suffix)."""
+    for suffix in sorted(UNIT_SUFFIXES, key=len, reverse=True):
+        if key.endswith(suffix):
+            return UNIT_SUFFIXES[suffix]
+    return None
 
 
 def radial_tangential(vec, planet_xy, carrier_xy):
@@ -530,7 +604,7 @@ class WindowStatistics(mbd.Observer):
         self._pocket_cols = (col["pocket_force"] + np.arange(npk)).astype(np.int64) if npk else np.zeros(0, np.int64)
 
     def _choose_reference(self, x0, x1, w):
-        """Reference roller of each bearing kind: the roller of pair 0's bearing nearest its load-zone
+        """Reference roller of each bearing kind: the roller of pair 1's bearing (index 0) nearest its load-zone
         centre (opposite the pin force: the loaded rollers press the pin away from them) at the window
         start."""
         p = self.plan
@@ -671,8 +745,8 @@ class WindowStatistics(mbd.Observer):
                 d["pocket_impacts"] = int(count)
                 d["pocket_impacts_per_rev"] = float(count / revs) if revs > 0 else None
                 d["pocket_touches_per_rev"] = float(im["touches"][pk].sum() / revs) if revs > 0 else None
-                d["pocket_impact_speed_max"] = float(im["speed_max"][pk].max())
-                d["pocket_impact_speed_mean"] = float(im["speed_sum"][pk].sum() / count) if count else 0.0
+                d["pocket_impact_speed_max_m_s"] = float(im["speed_max"][pk].max())
+                d["pocket_impact_speed_mean_m_s"] = float(im["speed_sum"][pk].sum() / count) if count else 0.0
                 d["pocket_impact_peak_max_N"] = float(im["peak_max"][pk].max())
                 d["pocket_impact_peak_mean_N"] = float(im["peak_sum"][pk].sum() / count) if count else 0.0
         d["all_rollers"] = al
@@ -708,7 +782,7 @@ class WindowStatistics(mbd.Observer):
             if key in (self._keys or ()):
                 m = self.stats(key)["mean"]
                 d[f"heat_{name}_W"] = float(m[ref])
-                d[f"heat_{name}_W_all"] = float(m[sel].mean())
+                d[f"heat_{name}_all_W"] = float(m[sel].mean())
         d["traction_coefficient_max"] = float(self.stats("traction_coefficient")["max"][sel].max())
 
     def _film_summary(self, d, sel):
@@ -739,18 +813,18 @@ class WindowStatistics(mbd.Observer):
         for view in ("", "rel_"):
             for comp in ("radial", "tangential", "magnitude"):
                 st = self.stats(f"cage_acc_{view}{comp}")
-                d[f"cage_acc_{view}{comp}_rms"] = float(st["rms"][ref])
-                d[f"cage_acc_{view}{comp}_max"] = float(max(st["max"][ref], -st["min"][ref]))
+                d[f"cage_acc_{view}{comp}_rms_m_s2"] = float(st["rms"][ref])
+                d[f"cage_acc_{view}{comp}_max_m_s2"] = float(max(st["max"][ref], -st["min"][ref]))
         for comp in ("x", "y"):
-            d[f"cage_acc_{comp}_rms"] = float(self.stats(f"cage_acc_{comp}")["rms"][ref])
+            d[f"cage_acc_{comp}_rms_m_s2"] = float(self.stats(f"cage_acc_{comp}")["rms"][ref])
         # every cage of this bearing type: RMS over all their windows (steadier than one cage's)
-        d["all_cages"] = {f"cage_acc_{view}{comp}_rms": self.aggregate_rms(f"cage_acc_{view}{comp}", sel)
+        d["all_cages"] = {f"cage_acc_{view}{comp}_rms_m_s2": self.aggregate_rms(f"cage_acc_{view}{comp}", sel)
                           for view in ("", "rel_") for comp in ("radial", "tangential", "magnitude")}
         w_cage = self.stats("cage_speed_rel")["mean"]
         w_epi = p.pitch_ratio * self.stats("planet_speed_rel")["mean"]
         slip = 100.0 * (1.0 - w_cage / w_epi)
         d["cage_slip_pct"] = float(slip[ref])
-        d["cage_slip_pct_all"] = float(slip[sel].mean())
+        d["cage_slip_all_pct"] = float(slip[sel].mean())
         d["cage_revolutions"] = float(abs(self._angle[ref]) / (2 * math.pi))
         if p.guide is not None:
             st = self.stats("guide_force")

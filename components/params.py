@@ -34,7 +34,6 @@ values fit together (rollers fit, gears assemble, tip circles clear) is checked 
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import json
 import math
 import numbers
@@ -48,6 +47,7 @@ import numpy as np
 
 from . import geometry as geo
 from .units import ParameterError, Quantity, format_quantity, quantity, to_si
+from .names import did_you_mean
 
 __all__ = [
     "Source", "Sourced", "paper", "derived", "assumed", "SI", "Derived", "Params",
@@ -207,8 +207,9 @@ def _convert(spec: _Spec, name: str, value):
                 unknown = sorted(set(value) - {f.name for f in fs})
                 missing = [f.name for f in fs if f.name not in value
                            and f.default is MISSING and f.default_factory is MISSING]
+                hint = did_you_mean(unknown[0], [f.name for f in fs]) if unknown else ""
                 raise ParameterError.at(name, f"a {spec.cls.__name__} table needs all of {missing} "
-                                              f"(unknown: {unknown}); to change single values use dotted "
+                                              f"(unknown: {unknown}{hint}); to change single values use dotted "
                                               f"overrides such as '{name}.{fs[0].name}'") from None
         raise ParameterError.at(name, f"expected {spec.cls.__name__} or a table, got {type(value).__name__}")
     if k == "count":
@@ -226,7 +227,9 @@ def _convert(spec: _Spec, name: str, value):
         return bool(value)
     if k == "name":
         if not (isinstance(value, str) and re.fullmatch(spec.pattern, value)):
-            raise ParameterError.at(name, f"expected {spec.bound_text}, got {value!r}")
+            near = [n for n in ("sun", "ring") if re.fullmatch(spec.pattern, n)]     # the gears' fixed names
+            hint = did_you_mean(value, near) if isinstance(value, str) and near else ""
+            raise ParameterError.at(name, f"expected {spec.bound_text}, got {value!r}{hint}")
         return value
     if k == "entries":
         return _convert_entries(spec, name, value)
@@ -239,7 +242,8 @@ def _convert(spec: _Spec, name: str, value):
         return v
     if k == "choice":
         if value not in spec.choices:
-            raise ParameterError.at(name, f"expected one of {list(spec.choices)}, got {value!r}")
+            raise ParameterError.at(name, f"expected one of {list(spec.choices)}, got {value!r}"
+                                          f"{did_you_mean(value, spec.choices) if isinstance(value, str) else ''}")
         return value
     q = quantity(name, value, k)
     _check_bounds(spec, name, to_si(q), value if isinstance(value, (str, numbers.Real)) else str(q))
@@ -269,7 +273,8 @@ def _convert_entries(spec: _Spec, name: str, value) -> tuple:
             fs = _param_fields(spec.cls)
             unknown = sorted(set(item) - {f.name for f in fs})
             missing = [f.name for f in fs if f.name not in item and f.default is MISSING]
-            raise ParameterError.at(path, f"needs {missing} (unknown keys: {unknown})") from None
+            hint = did_you_mean(unknown[0], [f.name for f in fs]) if unknown else ""
+            raise ParameterError.at(path, f"needs {missing} (unknown keys: {unknown}{hint})") from None
     return tuple(out)
 
 
@@ -400,7 +405,8 @@ class Params:
         tags: dict[str, Source] = {}
         for key, src in dict(self.sources).items():
             if key not in names:
-                raise ParameterError.at(self._path(key), f"source given for an unknown parameter; valid: {sorted(names)}")
+                raise ParameterError.at(self._path(key), f"source given for an unknown parameter"
+                                                         f"{did_you_mean(key, names)}; valid: {sorted(names)}")
             tags[key] = src if isinstance(src, Source) else Source(str(src))
         for f in _param_fields(type(self)):
             value = getattr(self, f.name)
@@ -437,14 +443,15 @@ class Params:
         for f in _param_fields(cls):
             if f.name == name:
                 return f.metadata["spec"]
-        raise ParameterError.at(cls._path(name), f"unknown parameter; valid: {[f.name for f in _param_fields(cls)]}")
+        valid = [f.name for f in _param_fields(cls)]
+        raise ParameterError.at(cls._path(name), f"unknown parameter{did_you_mean(name, valid)}; valid: {valid}")
 
     def replace(self, **changes) -> "Params":
         """A copy with some fields changed (values converted and checked like at construction)."""
         valid = [f.name for f in _param_fields(type(self))]
         for key in changes:
             if key not in valid:
-                raise ParameterError.at(self._path(key), f"unknown parameter; valid: {valid}")
+                raise ParameterError.at(self._path(key), f"unknown parameter{did_you_mean(key, valid)}; valid: {valid}")
         return dataclasses.replace(self, **changes)
 
     def si(self) -> SI:
@@ -527,7 +534,7 @@ class GearSetParams(Params):
     """Sun, inner planets, outer planets, ring and carrier of the double planetary set.
 
     ``handedness`` h: the outer planet stands at ψ_b = ψ_a + h·Δψ (+1: it leads its inner planet in the
-    positive angular direction). ``planet_angle`` ψ_0: angle of pair 0's inner planet at t = 0.
+    positive angular direction). ``planet_angle`` ψ_0: angle of pair 1's inner planet (a1) at t = 0.
     """
 
     _prefix: ClassVar[str] = "gears"
@@ -1181,8 +1188,7 @@ def parameter_names(params: Params) -> list[str]:
 
 def _unknown(params: Params, key: str, path: str) -> ParameterError:
     names = [f"{path}{n}" for n in parameter_names(params)]
-    close = difflib.get_close_matches(f"{path}{key}", names, n=3)
-    hint = f" (did you mean {', '.join(close)}?)" if close else ""
+    hint = did_you_mean(f"{path}{key}", names)
     return ParameterError.at(f"{path}{key}", f"unknown parameter{hint}; valid keys: {', '.join(names)}")
 
 

@@ -57,6 +57,7 @@ from mbd.elements.gear_mesh import mesh_u0
 from .geometry import DesignWarning, mesh_damping
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError, quantity, to_si
+from .names import did_you_mean
 
 __all__ = ["EXAMPLE_PLANETARY", "MemberSpec", "PlanetarySpec", "planetary_spec", "load_planetary_toml",
            "build_single_planetary", "modal_state", "planetary_modes", "classify_modes", "PlanetaryModes",
@@ -143,7 +144,8 @@ def _table(d: Mapping, name: str, keys) -> Mapping:
     unknown = sorted(set(t) - set(keys))
     missing = sorted(set(keys) - set(t))
     if unknown:
-        raise ParameterError.at(f"{name}.{unknown[0]}", f"unknown key; valid keys of [{name}]: {sorted(keys)}")
+        raise ParameterError.at(f"{name}.{unknown[0]}", f"unknown key{did_you_mean(unknown[0], keys)}; valid keys of "
+                                                        f"[{name}]: {sorted(keys)}")
     if missing:
         raise ParameterError.at(f"{name}.{missing[0]}", f"missing; [{name}] needs {sorted(keys)}")
     return t
@@ -179,7 +181,8 @@ def planetary_spec(spec: Mapping | PlanetarySpec, overrides: Mapping | None = No
     d = _merge(spec, overrides)
     unknown = sorted(set(d) - _TOP_KEYS)
     if unknown:
-        raise ParameterError.at(unknown[0], f"unknown key; valid keys: {sorted(_TOP_KEYS)}")
+        raise ParameterError.at(unknown[0], f"unknown key{did_you_mean(unknown[0], _TOP_KEYS)}; valid keys: "
+                                            f"{sorted(_TOP_KEYS)}")
     if d.get("kind", "single_planetary") != "single_planetary":
         raise ParameterError.at("kind", f"expected 'single_planetary', got {d.get('kind')!r}")
     for key in ("planets", "module", "pressure_angle"):

@@ -20,6 +20,7 @@ from .params import (BearingParams, BearingRigParams, CageParams, CarrierRippleP
                      overrides_from_toml, paper, with_overrides)
 from .tolerances import radial_runout
 from .units import Q_, ParameterError
+from .names import did_you_mean
 
 __all__ = ["CONDITIONS", "DIRECTIONS", "OIL_GRADES", "oil_grade", "operating_point", "reference_gears", "reference_bearing",
            "reference_dpgt", "reference_bearing_rig", "rig_accelerometer", "rig_housing", "ideal_carrier_drive", "load_toml",
@@ -69,7 +70,7 @@ def reference_gears() -> GearSetParams:
         planets=paper(3, "default planet count of the study"),
         handedness=assumed(-1, "outer planet trails its inner planet by delta_psi in the forward "
                                "(counter-clockwise) carrier direction"),
-        planet_angle=assumed("0 deg", "pair 0 on the +x axis at t = 0"),
+        planet_angle=assumed("0 deg", "pair 1 (planet a1) on the +x axis at t = 0"),
     )
 
 
@@ -95,7 +96,8 @@ OIL_GRADES = dict(sorted(OIL_GRADES.items(), key=lambda kv: int(kv[0][2:])))
 def oil_grade(name: str) -> dict:
     """Overrides {"lubricant.viscosity_40": ..., "lubricant.viscosity_100": ...} of an ISO VG grade."""
     if name not in OIL_GRADES:
-        raise ParameterError.at("lubricant grade", f"expected one of {sorted(OIL_GRADES)}, got {name!r}")
+        raise ParameterError.at("lubricant grade", f"expected one of {sorted(OIL_GRADES)}, got {name!r}"
+                                                   f"{did_you_mean(name, OIL_GRADES)}")
     return {f"lubricant.{k}": v for k, v in OIL_GRADES[name].items()}
 
 

@@ -89,7 +89,7 @@ FILM_OUTPUTS = {FAMILY["race_inner"]: (True, _film("inner")), FAMILY["race_outer
 _BEARING_COORDS = {  # coordinate -> (long_name, field of the bearing_map record)
     "bearing": ("planet bearing name", "name"),
     "planet": ("planet the bearing carries", "planet"),
-    "pair": ("planet pair index (0-based: pair n holds planets a{n+1}, b{n+1})", "pair"),
+    "pair": ("planet pair index from 0 (index n is pair n+1, planets a{n+1} and b{n+1})", "pair"),
     "bearing_kind": ("bearing of the inner (a) or outer (b) planet of the pair", "kind"),
 }
 

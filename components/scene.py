@@ -16,6 +16,8 @@ import numpy as np
 import mbd
 from mbd.model import to_reference
 
+from .names import did_you_mean
+
 __all__ = ["Scene", "BuiltScene", "FamilyCollector", "SceneOptions"]
 
 
@@ -45,7 +47,8 @@ class SceneOptions:
             object.__setattr__(self, "cage", "free" if self.cage else "none")
         for key, allowed in self._CHOICES.items():
             if getattr(self, key) not in (None, *allowed):
-                raise mbd.ModelError(f"scene option {key!r} must be one of {allowed}, got {getattr(self, key)!r}")
+                raise mbd.ModelError(f"scene option {key!r} must be one of {allowed}, got {getattr(self, key)!r}"
+                                     f"{did_you_mean(getattr(self, key), allowed)}")
         for key in ("drag", "gravity"):
             if getattr(self, key) is not None and not isinstance(getattr(self, key), bool):
                 raise mbd.ModelError(f"scene option {key!r} must be true or false, got {getattr(self, key)!r}")
@@ -64,7 +67,9 @@ class SceneOptions:
         valid = [f.name for f in fields(cls)]
         unknown = set(d) - set(valid)
         if unknown:
-            raise mbd.ModelError(f"unknown scene option(s) {sorted(unknown)}; valid options: {valid}")
+            first = sorted(unknown)[0]
+            raise mbd.ModelError(f"unknown scene option(s) {sorted(unknown)}{did_you_mean(first, valid)}; "
+                                 f"valid options: {valid}")
         return cls(**d)
 
 

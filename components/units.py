@@ -11,9 +11,11 @@ engine is plain SI floats. This module is the only bridge:
 * :func:`to_si` — a quantity as a float in SI base units (radians for angles, rad/s for speeds).
 
 Angles: pint treats the radian as dimensionless, so "1 Hz" converts to "1 rad/s" without complaint
-(a factor 2π error for a speed meant as revolutions per second). Angular velocities must therefore
-carry an angle unit (rad/s, rpm, rev/s, deg/s); ``Hz`` and ``1/s`` are refused as ambiguous. Angles
-likewise need an angle unit (``"20 deg"``, ``"0.35 rad"``): a bare number could be either.
+(a factor 2π error for a speed meant as revolutions per second), and "600 rpm" to "62.8 Hz" (not 10).
+Angular velocities must therefore carry an angle unit (rad/s, rpm, rev/s, deg/s); ``Hz`` and ``1/s`` are
+refused as ambiguous. A frequency (cycles per second) given as a rotation speed is converted with one cycle =
+one revolution = 2π rad ("600 rpm" → 10 Hz, "62.83 rad/s" → 10 Hz, "360 deg/s" → 1 Hz), never with pint's
+radian = 1. Angles likewise need an angle unit (``"20 deg"``, ``"0.35 rad"``): a bare number could be either.
 """
 from __future__ import annotations
 
@@ -161,8 +163,14 @@ def quantity(name: str, value, dimension: str) -> Quantity:
     want = ureg.parse_units(kind.si_unit).dimensionality if dimension != "dimensionless" else {}
     if not _same_dimensionality(q.dimensionality, want):
         raise ParameterError.at(name, f"{expect}, got {_shown(value)!r}")
+    power = dict(q.to_base_units().unit_items()).get("radian", 0)
+    if dimension == "frequency" and abs(power) > _TOL:
+        # a rotation speed where cycles per second are meant: one revolution is one cycle (2π rad), not pint's 1 rad
+        if abs(power - 1) > _TOL:
+            raise ParameterError.at(name, f"{expect}, got {_shown(value)!r}: give Hz (cycles per second) or a "
+                                          f"rotation speed (rpm, rev/s, rad/s)")
+        q = Q_(float(q.to_base_units().magnitude) / (2.0 * math.pi), "Hz")
     if kind.angle_power:
-        power = dict(q.to_base_units().unit_items()).get("radian", 0)
         if abs(power - kind.angle_power) > _TOL:
             hint = " ('Hz' and '1/s' are ambiguous for a rotation speed: use rpm, rad/s or rev/s)" \
                 if dimension == "angular_velocity" else " (a bare number could be radians or degrees)"

@@ -12,6 +12,8 @@ import os
 import re
 from pathlib import Path
 
+from components.names import argparse_hint, did_you_mean
+
 __all__ = ["Parser", "positive", "nonnegative", "count", "alpha", "conditions", "directions", "existing_file",
            "quantity_of", "key_value", "scheduler", "out_folder", "choice_list", "float_list"]
 
@@ -20,10 +22,11 @@ DIRECTIONS = ("forward", "reverse")
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse whose usage errors are one line ``error: ...`` (raised as SystemExit for the command wrapper)."""
+    """argparse whose usage errors are one line ``error: ...`` (raised as SystemExit for the command wrapper); an
+    unknown option or an invalid choice names the closest valid ones (:func:`components.names.argparse_hint`)."""
 
     def error(self, message):
-        raise SystemExit(f"error: {message}")
+        raise SystemExit(f"error: {argparse_hint(self, message)}")
 
 
 def _named(fn, name):
@@ -96,7 +99,8 @@ def choice_list(allowed, what: str):
         items = _items(text, what)
         bad = [x for x in items if x not in allowed]
         if bad:
-            raise argparse.ArgumentTypeError(f"takes {what} from {', '.join(map(str, allowed))}; got {bad[0]!r}")
+            raise argparse.ArgumentTypeError(f"takes {what} from {', '.join(map(str, allowed))}; got {bad[0]!r}"
+                                             f"{did_you_mean(bad[0], allowed)}")
         return ",".join(dict.fromkeys(items))
     return _named(conv, what)
 

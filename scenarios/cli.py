@@ -9,6 +9,8 @@ from __future__ import annotations
 import importlib
 import sys
 
+from components.names import did_you_mean
+
 from .command import command
 
 SCENARIOS = {
@@ -47,7 +49,7 @@ def main(argv=None) -> int:
         return 0
     name, rest = argv[0], argv[1:]
     if name not in have:
-        print(f"dpgt: unknown scenario {name!r}; available: {', '.join(have)}", file=sys.stderr)
+        print(f"dpgt: unknown scenario {name!r}{did_you_mean(name, have)}; available: {', '.join(have)}", file=sys.stderr)
         return 2
     mod = importlib.import_module("viz.cli" if name == "animate" else f"scenarios.{name}")
     main = mod.main if hasattr(mod.main, "__wrapped__") else command(mod.main)   # viz's too: one-line errors

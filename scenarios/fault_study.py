@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.names import did_you_mean
 from components.units import ParameterError
 from mbd.recorder import atomic_write_text
 
@@ -68,7 +69,7 @@ FAULTS = {
 }
 COLUMNS = ["fault", "direction", "bearing", "load_sharing_factor", "bearing_load_mean_N", "bearing_load_max_N",
            "roller_max_N", "life_iso281_h", "life_iso16281_h", "life_relative", "cage_slip_pct",
-           "pocket_impacts_per_rev", "cage_acc_rel_rms",
+           "pocket_impacts_per_rev", "cage_acc_rel_rms_m_s2",
            "sensor_f_m", "sensor_f_m-1f_c", "sensor_f_m+1f_c", "sensor_f_m-3f_c", "sensor_f_m+3f_c",
            "sensor_own", "own_frequency", "notes"]
 
@@ -96,7 +97,8 @@ def _fault_list(text: str) -> list[str]:
     names = [f.strip() for f in text.split(",") if f.strip()]
     unknown = [f for f in names if f not in FAULTS]
     if unknown:
-        raise argparse.ArgumentTypeError(f"unknown fault(s) {unknown}; the catalogue has {', '.join(FAULTS)}")
+        raise argparse.ArgumentTypeError(f"unknown fault(s) {unknown}{did_you_mean(unknown[0], FAULTS)}; the catalogue "
+                                         f"has {', '.join(FAULTS)}")
     return names
 
 
@@ -200,7 +202,7 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
                    "life_iso281_h": d["life_iso281_h"], "life_iso16281_h": d["life_iso16281_h"],
                    "life_relative": life, "cage_slip_pct": d.get("cage_slip_pct"),
                    "pocket_impacts_per_rev": d.get("pocket_impacts_per_rev"),
-                   "cage_acc_rel_rms": d.get("cage_acc_rel_magnitude_rms"),
+                   "cage_acc_rel_rms_m_s2": d.get("cage_acc_rel_magnitude_rms_m_s2"),
                    **{k: v for k, v in sensor.items() if k.startswith("sensor")},
                    "sensor_own": min(sensor["own-"], sensor["own+"]) if own is not None and not coarse else None,
                    "own_frequency": own,

@@ -49,7 +49,7 @@ QUANTITIES = {
     "roller_max_N": (None, "largest roller load", "N"),
     "cage_guide_max_N": ("cage_guide_max_N", "largest cage-guide force", "N"),
     "pocket_impact_peak_max_N": ("pocket_impact_peak_max_N", "largest pocket impact", "N"),
-    "pocket_impact_speed_max": ("pocket_impact_speed_max", "fastest pocket impact", "m/s"),
+    "pocket_impact_speed_max_m_s": ("pocket_impact_speed_max_m_s", "fastest pocket impact", "m/s"),
     "load_sharing_factor": ("load_sharing_factor", "load sharing K_γ", None),
     "life_iso281_h": ("life_iso281_h", "ISO 281 life (pair 1)", "h"),
     "life_iso16281_h": ("life_iso16281_h", "roller-load life (pair 1)", "h"),

@@ -37,14 +37,14 @@ from .lock import holds_out_folder
 # the summary keys the comparison shows, with their units (words: components.outputs.SUMMARY_WORDS)
 QUANTITIES = [(k, SUMMARY_WORDS[k][1]) for k in (
     "roller_cage_rms_N", "roller_cage_max_N", "cage_guide_rms_N", "cage_guide_max_N", "roller_inner_race_rms_N",
-    "roller_inner_race_max_N", "roller_outer_race_rms_N", "roller_outer_race_max_N", "cage_acc_radial_rms",
-    "cage_acc_tangential_rms", "cage_acc_rel_radial_rms", "cage_acc_rel_tangential_rms", "cage_slip_pct",
-    "pocket_impacts_per_rev", "pocket_impact_speed_max", "pocket_impact_peak_max_N", "bearing_load_mean_N",
+    "roller_inner_race_max_N", "roller_outer_race_rms_N", "roller_outer_race_max_N", "cage_acc_radial_rms_m_s2",
+    "cage_acc_tangential_rms_m_s2", "cage_acc_rel_radial_rms_m_s2", "cage_acc_rel_tangential_rms_m_s2", "cage_slip_pct",
+    "pocket_impacts_per_rev", "pocket_impact_speed_max_m_s", "pocket_impact_peak_max_N", "bearing_load_mean_N",
     "life_L10_relative", "life_iso281_h", "life_iso16281_h")]
 # bar chart: RMS values, cage accelerations relative to the planet, radial/tangential (comparable between
 # inner and outer planets, unlike x/y)
 BAR_QUANTITIES = ["roller_cage_rms_N", "cage_guide_rms_N", "roller_inner_race_rms_N", "roller_outer_race_rms_N",
-                  "cage_acc_rel_radial_rms", "cage_acc_rel_tangential_rms"]
+                  "cage_acc_rel_radial_rms_m_s2", "cage_acc_rel_tangential_rms_m_s2"]
 
 
 def parse_args(argv):

@@ -215,12 +215,22 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
             "rms": res.error_rms, "max": res.error_max, "atol_m": integ.atol_pos,
             "max_local_displacement_error_m": res.error_max * integ.atol_pos,
         },
-        "integration": asdict(integ),
+        "integration": integration_record(integ),
         "fingerprint": fp, "parameters_fingerprint": parameters_fingerprint(params, cfg),
         "run_description": run_description(params, cfg),
     })
     atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2, default=_json_default))
     return summary
+
+
+# the unit of each IntegratorSettings field, as summary.json's key suffix (README: What summary.json holds)
+INTEGRATION_UNITS = {"h": "s", "h_max": "s", "h_min": "s", "atol_pos": "m", "atol_rot": "rad"}
+
+
+def integration_record(integ: mbd.IntegratorSettings) -> dict:
+    """The integrator settings as summary.json keeps them: every field with a unit carries it as a suffix
+    (``h_s``, ``atol_pos_m``, ``atol_rot_rad``)."""
+    return {(f"{k}_{INTEGRATION_UNITS[k]}" if k in INTEGRATION_UNITS else k): v for k, v in asdict(integ).items()}
 
 
 def accuracy_warnings(integ: mbd.IntegratorSettings, error_rms: float) -> list[str]:

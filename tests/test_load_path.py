@@ -232,6 +232,6 @@ def test_no_load_forward_and_reverse_of_one_machine(runs):
             assert r[kind][k] == pytest.approx(f[kind][k], rel=0.02), (kind, k)
         for k in ("roller_inner_race_rms_N", "roller_outer_race_rms_N", "roller_cage_rms_N"):
             assert r[kind]["all_rollers"][k] == pytest.approx(f[kind]["all_rollers"][k], rel=0.02), (kind, k)
-        a, b = f[kind]["cage_acc_magnitude_rms"], r[kind]["cage_acc_magnitude_rms"]
+        a, b = f[kind]["cage_acc_magnitude_rms_m_s2"], r[kind]["cage_acc_magnitude_rms_m_s2"]
         print(f"no load, {kind} cage acceleration RMS: forward {a:.0f}, reverse {b:.0f} m/s^2 ({(b / a - 1) * 100:+.1f} %)")
     assert runs[4, "forward"][1].stats("outer_ring_coast_force")["mean"].min() > 10.0   # the loss torque path

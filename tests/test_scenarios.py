@@ -13,14 +13,14 @@ SUMMARY_KEYS = {"condition", "direction", "carrier_rpm", "sun_rpm", "power_W", "
                 "wall_s", "steps", "error_estimate", "inner", "outer"}
 BEARING_KEYS = {"roller_cage_rms_N", "roller_cage_max_N", "cage_guide_rms_N", "cage_guide_max_N",
                 "roller_inner_race_rms_N", "roller_inner_race_max_N", "roller_outer_race_rms_N",
-                "roller_outer_race_max_N", "cage_acc_x_rms", "cage_acc_y_rms", "bearing_load_mean_N",
-                "life_L10_relative", "all_rollers", "cage_acc_radial_rms", "cage_acc_tangential_rms",
-                "cage_acc_magnitude_rms", "cage_acc_rel_radial_rms", "cage_acc_rel_tangential_rms",
-                "cage_acc_rel_magnitude_rms", "pocket_impacts_per_rev", "pocket_impact_speed_max",
+                "roller_outer_race_max_N", "cage_acc_x_rms_m_s2", "cage_acc_y_rms_m_s2", "bearing_load_mean_N",
+                "life_L10_relative", "all_rollers", "cage_acc_radial_rms_m_s2", "cage_acc_tangential_rms_m_s2",
+                "cage_acc_magnitude_rms_m_s2", "cage_acc_rel_radial_rms_m_s2", "cage_acc_rel_tangential_rms_m_s2",
+                "cage_acc_rel_magnitude_rms_m_s2", "pocket_impacts_per_rev", "pocket_impact_speed_max_m_s",
                 "pocket_impact_peak_max_N", "cage_slip_pct", "life_iso281_h", "life_iso16281_h",
                 "roller_equivalent_load_pin_N", "roller_equivalent_load_bore_N", "dynamic_load_rating_N"}
 
-SIGNED = {"bearing_load_radial_mean_N", "bearing_load_tangential_mean_N", "cage_slip_pct", "cage_slip_pct_all"}
+SIGNED = {"bearing_load_radial_mean_N", "bearing_load_tangential_mean_N", "cage_slip_pct", "cage_slip_all_pct"}
 
 REDUCED = ["--settle", "0.002", "--window", "0.001", "--set", "bearing.rollers=8", "--no-progress",
            "--workers", "1"]

@@ -164,7 +164,7 @@ def test_accumulators_reproduce_ramps_on_uneven_steps_and_whole_cage_revolutions
         assert d["window_s"] == pytest.approx([t0, t_close[ref]], rel=1e-12)
         assert d["whole_revolutions"] == (kind == "outer")
         assert d["cage_slip_pct"] == pytest.approx(100 * slip[ref], rel=1e-9)
-        assert d["cage_slip_pct_all"] == pytest.approx(100 * slip[sel].mean(), rel=1e-9)
+        assert d["cage_slip_all_pct"] == pytest.approx(100 * slip[sel].mean(), rel=1e-9)
         assert d["cage_revolutions"] == pytest.approx(n_turns[kind], rel=1e-12)
         for field_, key, i in (("roller_inner_race", "roller_inner_load", r), ("roller_outer_race", "roller_outer_load", r),
                                ("roller_cage", "pocket_force", r), ("cage_guide", "guide_force", ref)):
@@ -185,10 +185,10 @@ def test_accumulators_reproduce_ramps_on_uneven_steps_and_whole_cage_revolutions
         for view in ("", "rel_"):
             for comp in ("radial", "tangential", "magnitude"):
                 a, c = coef[f"cage_acc_{view}{comp}"]
-                assert d[f"cage_acc_{view}{comp}_rms"] == pytest.approx(
+                assert d[f"cage_acc_{view}{comp}_rms_m_s2"] == pytest.approx(
                     ramp_truth(a[ref], c[ref], 0.0, u_end[ref])[1], rel=1e-6)
                 _, _, _, _, sq = ramp_truth(a[sel], c[sel], 0.0, u_end[sel])
-                assert d["all_cages"][f"cage_acc_{view}{comp}_rms"] == pytest.approx(
+                assert d["all_cages"][f"cage_acc_{view}{comp}_rms_m_s2"] == pytest.approx(
                     math.sqrt(sq.sum() / u_end[sel].sum()), rel=1e-6)
         radial, tangential = (ramp_truth(*coef[k], 0.0, u_end)[0] for k in ("load_radial", "load_tangential"))
         assert d["bearing_load_radial_mean_N"] == pytest.approx(radial[ref], rel=1e-11)
@@ -292,7 +292,7 @@ def test_pocket_impacts_count_onsets_in_each_bearings_window(scene):
     assert d["pocket_impacts"] == 2
     assert d["pocket_impacts_per_rev"] == pytest.approx(2 / (3 * 2.0), rel=1e-12)
     assert d["pocket_touches_per_rev"] == pytest.approx(1 / (3 * 2.0), rel=1e-12)
-    assert d["pocket_impact_speed_max"] == 0.8 and d["pocket_impact_speed_mean"] == pytest.approx(0.65)
+    assert d["pocket_impact_speed_max_m_s"] == 0.8 and d["pocket_impact_speed_mean_m_s"] == pytest.approx(0.65)
     # the second impact's force rises from 500 to 900 N in the step where its window closes: the peak reached
     # within the window is the force there (linear in the step, as every window end is taken)
     k = k_close2 - 1
@@ -301,4 +301,4 @@ def test_pocket_impacts_count_onsets_in_each_bearings_window(scene):
     assert d["pocket_impact_peak_mean_N"] == pytest.approx(0.5 * (300.0 + peak), rel=1e-12)
     o = s["outer"]
     assert o["pocket_impacts"] == 1 and o["pocket_impacts_per_rev"] == pytest.approx(1 / (3 * stats.target[1]))
-    assert o["pocket_impact_speed_max"] == 0.3 and o["pocket_impact_peak_max_N"] == 60.0
+    assert o["pocket_impact_speed_max_m_s"] == 0.3 and o["pocket_impact_peak_max_N"] == 60.0

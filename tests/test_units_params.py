@@ -26,6 +26,43 @@ def test_rpm_converts_to_rad_per_s():
     assert to_si(quantity("n", "10 deg/s", "angular_velocity")) == pytest.approx(math.radians(10))
 
 
+def test_a_frequency_given_as_a_rotation_speed_counts_revolutions_as_cycles():
+    """The pint trap (issue 24 §4): the radian is dimensionless in pint, so pint alone reads "600 rpm" as
+    600·2π/60 = 62.83 Hz. One revolution is one cycle: 600 rpm = 600/60 = 10 Hz; 2π·10 rad/s = 10 Hz."""
+    f = lambda v: to_si(quantity("rig.carrier_drive_bandwidth", v, "frequency"))
+    assert f("600 rpm") == pytest.approx(10.0, rel=1e-14)                   # 600 rev / 60 s
+    assert f("4800 rpm") == pytest.approx(80.0, rel=1e-14)
+    assert f("62.83185307179586 rad/s") == pytest.approx(10.0, rel=1e-14)   # 2π·10 rad/s
+    assert f("360 deg/s") == pytest.approx(1.0, rel=1e-14) and f("3 rev/s") == pytest.approx(3.0, rel=1e-14)
+    assert f("80 Hz") == 80.0 and f("1.2 kHz") == pytest.approx(1200.0) and f("80 1/s") == 80.0
+    assert f("600 rpm") != pytest.approx(600 * RPM)                        # not pint's 62.83
+    with pytest.raises(ParameterError, match=r"^rig\.carrier_drive_bandwidth: .*give Hz \(cycles per second\)"):
+        f("1 rad**2/s")
+    # and through the parameters, as --set gives it: the drive bandwidth the model uses, in Hz
+    p = with_overrides(reference_dpgt(), {"rig.carrier_drive_bandwidth": "4800 rpm"})
+    assert p.si().rig.carrier_drive_bandwidth == pytest.approx(80.0, rel=1e-14)
+    assert p.si().rig.carrier_drive_bandwidth == reference_dpgt().si().rig.carrier_drive_bandwidth
+    sensor = with_overrides(reference_dpgt(), {"rig.sensor.housing.rocking_frequency": "37800 rpm"})
+    assert sensor.si().rig.sensor.housing.rocking_frequency == pytest.approx(630.0, rel=1e-14)   # 37800/60
+
+
+def test_a_rotation_speed_in_rpm_and_rev_per_s_by_hand():
+    """rpm → rad/s by 2π/60, rev/s by 2π (numbers by hand); Hz and 1/s for a speed are refused in one line naming
+    the parameter and the units to use."""
+    w = lambda v: to_si(quantity("operating.carrier_speed", v, "angular_velocity"))
+    assert w("600 rpm") == pytest.approx(20 * math.pi, rel=1e-14)          # 600·2π/60
+    assert w("10 rev/s") == pytest.approx(20 * math.pi, rel=1e-14)
+    assert w("20 rad/s") == 20.0
+    for bad in ("10 Hz", "10 1/s", "10 kHz"):
+        with pytest.raises(ParameterError) as exc:
+            w(bad)
+        msg = str(exc.value)
+        assert msg.startswith("operating.carrier_speed: expected an angular velocity") and "\n" not in msg
+        assert "use rpm, rad/s or rev/s" in msg
+    p = with_overrides(reference_dpgt(), {"operating.carrier_speed": "600 rpm"})
+    assert p.si().operating.carrier_speed == pytest.approx(20 * math.pi, rel=1e-14)
+
+
 def test_hz_and_bare_numbers_are_refused_where_ambiguous():
     with pytest.raises(ParameterError, match=r"^operating\.carrier_speed: .*Hz"):
         quantity("operating.carrier_speed", "70 Hz", "angular_velocity")
@@ -213,7 +250,7 @@ def test_unknown_override_keys_list_valid_keys():
     with pytest.raises(ParameterError) as exc:
         with_overrides(reference_dpgt(), {"bearing.clearence": "30 um"})
     msg = str(exc.value)
-    assert msg.startswith("bearing.clearence: unknown parameter (did you mean bearing.clearance")
+    assert msg.startswith("bearing.clearence: unknown parameter (did you mean 'bearing.clearance'?)")
     assert "bearing.roller_diameter" in msg and "gears.planets" not in msg  # keys of the section at fault
     with pytest.raises(ParameterError, match=r"^bearings\.clearance: unknown parameter.*valid keys: .*gears\.planets"):
         with_overrides(reference_dpgt(), {"bearings.clearance": "30 um"})

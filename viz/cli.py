@@ -5,7 +5,8 @@
                  [--no-rollers]
 
 RESULTS is a results.nc or the run directory holding it; FILE ends in .gif or .mp4.
-  --kind cage   cage-centre orbits of planet pair --pair (inner and outer PB) in the guide clearance;
+  --kind cage   cage-centre orbits of planet pair --pair (1..N, default 1: planets a1, b1; inner and outer PB)
+                in the guide clearance;
                 with --compare, the two runs side by side (forward and reverse);
                 --magnify scales the schematic roller pocket offsets (default: automatic).
   --kind train  the whole train, rollers coloured by their inner-race load, seen from the carrier
@@ -18,6 +19,8 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+
+from components.names import argparse_hint
 
 from . import render_check
 from .results import ResultsError, cage_panels, load_run, train_bodies
@@ -50,8 +53,15 @@ def _positive(kind):
     return conv
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse whose unknown options and invalid choices name the closest valid ones."""
+
+    def error(self, message):
+        super().error(argparse_hint(self, message))
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog=PROG, description="Animate saved DPGT results (offscreen).",
+    p = _Parser(prog=PROG, description="Animate saved DPGT results (offscreen).",
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog=__doc__.split("\n\n", 2)[2] if __doc__ else None)
     p.add_argument("results", help="results.nc of a DPGT run, or its run directory")
@@ -68,8 +78,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="at most this many frames, spread evenly over the run (default: every sample)")
     p.add_argument("--compare", default=None, metavar="OTHER_RESULTS",
                    help="cage: a second run (e.g. the reverse one) shown side by side")
-    p.add_argument("--pair", type=int, default=0,
-                   help="planet pair of the cage orbits, 0-based (default 0: the reference pair)")
+    p.add_argument("--pair", type=_positive(int), default=1,
+                   help="planet pair of the cage orbits, counted from 1 as the planets are named (pair n holds "
+                        "a<n> and b<n>; default 1: the reference pair)")
     p.add_argument("--no-rollers", action="store_true", help="cage: leave out the roller offsets")
     return p
 
@@ -99,7 +110,10 @@ def main(argv=None) -> int:
         run = load_run(args.results)
         other = load_run(args.compare) if args.compare else None
         if args.kind == "cage":
-            panels = cage_panels([run] + ([other] if other else []), pair=args.pair,
+            if args.pair > len(run.pairs):
+                return _fail(f"argument --pair: {args.pair} is not a planet pair of {args.results} "
+                             f"(pairs 1..{len(run.pairs)})", 2)
+            panels = cage_panels([run] + ([other] if other else []), pair=args.pair - 1,
                                  rollers=not args.no_rollers)
         else:
             bodies = train_bodies(run, frame=args.frame,
@@ -115,7 +129,7 @@ def main(argv=None) -> int:
         if args.kind == "cage":
             size = args.size or _DEFAULT_SIZE["cage-compare" if other else "cage"]
             title = "Cage orbits in the guide clearance" + (
-                f", planet pair {args.pair + 1}" if args.pair else "")
+                f", planet pair {args.pair}" if args.pair != 1 else "")
             if other is None:
                 title += f" ({run.direction})"
             path = animate.cage_orbit_animation(out, panels["t"], panels["orbits"], panels["clearance_m"],

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["ResultsError", "GeometryWarning", "Run", "load_run", "cage_orbits", "roller_offsets", "train_bodies", "study_cage_animation",
+__all__ = ["ResultsError", "GeometryWarning", "Run", "load_run", "attribute_name", "attribute_names", "open_results", "cage_orbits", "roller_offsets", "train_bodies", "study_cage_animation",
            "study_cage_pictures",
            "cage_panels", "view_angle"]
 
@@ -128,7 +128,7 @@ class Run:
         for b in self.bearings:
             if b["name"] == which or (b["kind"] == which and b["pair"] == pair):
                 return b
-        raise ResultsError(f"{self.path}: no bearing {which!r}" + (f" in pair {pair}" if which in
+        raise ResultsError(f"{self.path}: no bearing {which!r}" + (f" in pair {pair + 1} (index {pair})" if which in
                            ("inner", "outer") else "") + "; bearings: "
                            + ", ".join(b["name"] for b in self.bearings))
 
@@ -241,6 +241,62 @@ def load_run(path, fallback_geometry: Mapping | None = None) -> Run:
     return run
 
 
+# ----------------------------------------------------------------------------------------------
+# names xarray's attribute access can use
+
+def attribute_name(name: str) -> str:
+    """The name :func:`attribute_names` gives a results.nc variable, coordinate or dimension: every character that
+    cannot stand in a Python identifier becomes "_" ("race_inner.load" → "race_inner_load", "motion.body" →
+    "motion_body", "bearing.load_radial.instance" → "bearing_load_radial_instance")."""
+    import keyword
+    import re
+
+    out = re.sub(r"\W", "_", str(name))
+    if not out or out[0].isdigit():
+        out = "v_" + out
+    return out + "_" if keyword.iskeyword(out) else out
+
+
+def attribute_names(ds):
+    """An xarray Dataset of results.nc (``xarray.open_dataset``) renamed so that attribute access reaches every
+    variable, coordinate and dimension: ``ds.race_inner_load`` for ``ds["race_inner.load"]``,
+    ``ds.race_inner_load.sel(race_inner_instance=...)``. The file keeps its dotted names (every reader uses them);
+    each renamed variable keeps its name in the file as ``attrs["results_name"]``, and the dataset the whole
+    mapping as ``attrs["results_names"]`` (JSON, new → file name). Raises :class:`ResultsError` if two names would
+    meet or a name would hide behind a Dataset attribute (``ds.mean``)."""
+    import xarray as xr
+
+    names = list(dict.fromkeys([*ds.variables, *ds.dims]))
+    mapping = {n: attribute_name(n) for n in names if attribute_name(n) != n}
+    new_names = [mapping.get(n, n) for n in names]
+    clash = sorted({x for x in new_names if new_names.count(x) > 1})
+    if clash:
+        raise ResultsError(f"attribute names would meet: {clash}")
+    hidden = sorted(x for x in set(new_names) if hasattr(xr.Dataset, x))
+    if hidden:
+        raise ResultsError(f"attribute names would hide behind Dataset attributes: {hidden}")
+    out = ds.rename(mapping)
+    for old, new in mapping.items():
+        if new in out.variables:
+            out[new].attrs["results_name"] = old
+    out.attrs["results_names"] = json.dumps({new: old for old, new in mapping.items()})
+    return out
+
+
+def open_results(path, attribute_access: bool = True):
+    """``xarray.open_dataset`` of a results.nc (or a run directory holding one), with :func:`attribute_names`
+    applied unless ``attribute_access`` is false."""
+    import xarray as xr
+
+    path = Path(path)
+    if path.is_dir():
+        path = path / "results.nc"
+    if not path.is_file():
+        raise ResultsError(f"no such results file: {path}")
+    ds = xr.open_dataset(path, engine="h5netcdf")
+    return attribute_names(ds) if attribute_access else ds
+
+
 def _resolve_geometry(path: Path, attrs: Mapping, meta: Mapping, given: Mapping | None) -> dict:
     """The file's drawing geometry, completed from ``given``; ``source`` says which was used."""
     g_file = None
@@ -307,7 +363,7 @@ def _require_cage(run: Run, b: Mapping) -> str:
 def cage_orbits(run: Run, pair: int | None = 0, frame: str = "carrier") -> dict[str, np.ndarray]:
     """Cage-centre offset e = c_cage − c_bore (the bore centre is the planet centre) [m].
 
-    pair=n → {"inner": (n_t, 2), "outer": (n_t, 2)} for the bearings of planet pair n (pair 0 is the
+    pair=n → {"inner": (n_t, 2), "outer": (n_t, 2)} for the bearings of planet pair n (index 0, pair 1, is the
     reference pair of the study); pair=None → {bearing name: (n_t, 2)} for every bearing.
     frame: axes of the offset, see :func:`view_angle`; "carrier" (default) is the frame R itself for a
     run in the rotating frame and makes runs in either frame comparable.  |e| is the guide contact's
