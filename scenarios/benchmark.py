@@ -265,7 +265,8 @@ def _factors(text: str) -> list[float]:
 
 @command
 def main(argv=None) -> int:
-    ap = args.Parser(prog="python -m scenarios.benchmark", description=__doc__.splitlines()[0])
+    ap = args.parser("benchmark", __doc__, examples=["{prog} --out results/numerics", "{prog} --window 0.02 --scipy-methods Radau --json"],
+                      writes="benchmark.json (and the settled state dpgt_settled.npz, shared with work_precision); --json prints it as the last line", out="results/numerics")
     ap.add_argument("--json", action="store_true", help="print one JSON object on the last line")
     ap.add_argument("--window", type=args.positive("s"), default=0.1, help="simulated window after settling [s]")
     ap.add_argument("--ref-window", type=args.positive("s"), default=0.01, help="sub-window for the error and scipy [s]")
@@ -284,7 +285,7 @@ def main(argv=None) -> int:
     ap.add_argument("--profile", action="store_true", help="print the cProfile top entries (2 ms of the window)")
     ap.add_argument("--scaling", action="store_true", help="cost per step against N·Z")
     ap.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="settling time before the window [s]")
-    ap.add_argument("--out", default="results/numerics", type=args.out_folder)
+    args.add_shared(ap, "out", out="results/numerics")
     a = ap.parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -37,7 +37,6 @@ from mbd.recorder import atomic_write_text
 from . import args
 from .command import command
 from .lock import holds_out_folder
-from .paper_study import parse_sets
 from .plausibility import check_runs
 from .runner import RunConfig
 from .analysis import line_table
@@ -73,10 +72,17 @@ COLUMNS = ["fault", "direction", "bearing", "load_sharing_factor", "bearing_load
            "sensor_own", "own_frequency", "notes"]
 
 
+EXAMPLES = ["{prog} --faults cracked_tooth,spall_pin --directions forward --out results/faults",
+            "{prog} --conditions 2 --machine bent=bent_carrier.toml --faults ''",
+            '{prog} --set bearing.clearance="30 um" --workers 2']
+WRITES = ("{fault}_{direction}/{results.nc, summary.json} per run (perfect_{direction} the perfect machine); "
+          "summary.csv and summary.md (per run and bearing type: load sharing, bearing and roller loads, lives, cage "
+          "slip, pocket impacts, the housing sensor's lines over the floor); findings.md (the table in words); "
+          "loads.png, spectra.png, study.json")
+
+
 def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.fault_study", description=__doc__.split("\n\n")[0])
-    p.add_argument("--condition", type=args.count(1, 4), default=2,
-                   help="operating condition 1-4 (default 2: carrier 2000 r/min, the source's rig speed)")
+    p = args.parser("fault_study", __doc__, examples=EXAMPLES, writes=WRITES, out="results/faults")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     p.add_argument("--faults", default=",".join(FAULTS), type=_fault_list,
                    help=f"comma list from {', '.join(FAULTS)} ('' for none: only --machine)")
@@ -86,9 +92,8 @@ def parse_args(argv):
     p.add_argument("--window", type=args.positive("s"), default=0.1,
                    help="seconds analysed (default 0.1: 10 Hz resolution, the f_c sidebands at 2000 r/min)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz] (> 2 f_m)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
-                   help="override a parameter (repeatable)")
-    args.add_sweep_options(p, "results/faults")
+    # one condition per study: its folders are named by machine and direction
+    args.add_shared(p, out="results/faults", conditions="2", one_condition_only=True)
     return p.parse_args(argv)
 
 
@@ -111,7 +116,7 @@ def make_cases(a, out: Path) -> list[Case]:
     """The perfect machine, each catalogue fault and each ``--machine`` in every direction. The sweep owns the
     operating point and the errors: ``--set`` may not touch either, a machine's file not the operating point,
     and a machine may not take the name of the perfect machine or of a catalogue fault."""
-    operating = {"operating.carrier_speed": "--condition", "operating.output_power": "--condition",
+    operating = {"operating.carrier_speed": "--conditions", "operating.output_power": "--conditions",
                  "operating.direction": "--directions"}
     machines: dict[str, tuple[dict, str | None]] = {"perfect": ({}, None)}
     machines.update({f: (FAULTS[f][0], None) for f in a.faults})
@@ -121,8 +126,11 @@ def make_cases(a, out: Path) -> list[Case]:
             raise SystemExit(f"error: --machine {name}={path}: the name {name!r} is {what}'s; choose another")
         user_overrides({}, str(path), operating)
         machines[name] = ({}, str(path))
-    user = user_overrides(parse_sets(a.set), None, {**operating, "errors": "--faults or --machine NAME=FILE.toml"})
-    return [Case(a.condition, d, str(out / f"{name}_{d}"), {**user, **ov}, path, tag=name)
+    # --params holds what every machine shares (not its errors): read into the overrides, so that a machine's own
+    # file can sit beside it
+    user = user_overrides(args.parse_sets(a.set), a.params, {**operating, "errors": "--faults or --machine NAME=FILE.toml"},
+                          merge_file=True)
+    return [Case(int(a.conditions), d, str(out / f"{name}_{d}"), {**user, **ov}, path, tag=name)
             for name, (ov, path) in machines.items() for d in a.directions.split(",")]
 
 

@@ -34,7 +34,6 @@ from mbd.recorder import atomic_write_text
 from . import args
 from .command import command
 from .lock import holds_out_folder
-from .paper_study import parse_sets
 from .plausibility import check_runs
 from .runner import RunConfig
 from .sweep import OPERATING_AXES, Case, build_params, check_folders, run_sweep, study_epilogue, user_overrides, validate_cases
@@ -58,9 +57,16 @@ COLUMNS = (["condition", "direction", "grade", "seed", "bearing", *QUANTITIES]
            + [f"{k}_{m}" for m in MESHES for k in ("dynamic_factor", "te_p2p_um")])
 
 
+EXAMPLES = ["{prog} --conditions 3 --grades 6 --seeds 1 --out results/gear_quality",
+            "{prog} --conditions 1,2,3,4 --grades 5,6,8 --seeds 1,2,3 --workers 2",
+            "{prog} --params my_machine.toml --grades 8 --systematic-share 0.2"]
+WRITES = ("c{condition}_{direction}_{perfect|class{G}_seed{S}}/{results.nc, summary.json} per run; runs.csv (a "
+          "row per run and bearing type), by_grade.csv (per class the mean over the seeds and their range, the "
+          "forward/reverse change), findings.md (the answer in words, also printed), quality.png, study.json")
+
+
 def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.gear_quality", description=__doc__.split("\n\n")[0])
-    p.add_argument("--conditions", default="1,2,3,4", type=args.conditions, help="comma list of conditions 1-4")
+    p = args.parser("gear_quality", __doc__, examples=EXAMPLES, writes=WRITES, out="results/gear_quality")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     p.add_argument("--grades", default="5,6,8", type=_int_list(1, 11, "flank tolerance classes"),
                    help="ISO 1328-1:2013 flank tolerance classes 1..11 (default 5,6,8)")
@@ -70,9 +76,7 @@ def parse_args(argv):
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded (default 0.03)")
     p.add_argument("--window", type=args.positive("s"), default=None,
                    help="seconds analysed (default: the paper study's, whole cage revolutions)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
-                   help="override a parameter (repeatable)")
-    args.add_sweep_options(p, "results/gear_quality")
+    args.add_shared(p, out="results/gear_quality", conditions="1,2,3,4")
     return p.parse_args(argv)
 
 
@@ -104,7 +108,7 @@ def _tag(grade, seed) -> str:
 
 def make_cases(a, out: Path) -> list[Case]:
     """Perfect teeth, and every class × seed, at every condition and direction."""
-    user = user_overrides(parse_sets(a.set), None, {**OPERATING_AXES, "errors.flank_class": "--grades and --seeds"})
+    user = user_overrides(args.parse_sets(a.set), a.params, {**OPERATING_AXES, "errors.flank_class": "--grades and --seeds"})
     machines = [(None, None)] + [(g, s) for g in a.grades for s in a.seeds]
     cases = []
     for c in (int(x) for x in a.conditions.split(",")):
@@ -114,7 +118,7 @@ def make_cases(a, out: Path) -> list[Case]:
                 if g is not None:
                     ov["errors.flank_class"] = [{"gear": "all", "grade": g, "seed": s,
                                                  "systematic_share": a.systematic_share}]
-                cases.append(Case(c, d, str(out / f"c{c}_{d}_{_tag(g, s)}"), ov, tag=_tag(g, s)))
+                cases.append(Case(c, d, str(out / f"c{c}_{d}_{_tag(g, s)}"), ov, a.params, tag=_tag(g, s)))
     return cases
 
 

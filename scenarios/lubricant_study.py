@@ -41,7 +41,6 @@ from components.units import ParameterError, quantity, to_si
 from mbd.elements.ehl import FILM_MIN_U_EXPONENT, thermal_factor
 from mbd.recorder import atomic_write_text
 
-from .paper_study import parse_sets
 from .runner import RunConfig
 from .plausibility import check_runs
 from .sweep import OPERATING_AXES, Case, _case_cfg, build_params, check_folders, run_sweep, study_epilogue, user_overrides, validate_cases
@@ -62,9 +61,17 @@ _FROM_SUMMARY = {"h_min_m": "film_min_m", "h_mean_m": "film_mean_m", "h_min_isot
                  "thermal_factor_min": "film_thermal_factor_min", "thermal_loading_max": "film_thermal_loading_max"}
 
 
+EXAMPLES = ["{prog} --conditions 3 --out results/lubricant",
+            "{prog} --conditions 1,2,3,4 --grades VG32,VG68,VG150,VG220 --workers 2",
+            '{prog} --viscosities "10,30,100 mPa*s" --directions reverse']
+WRITES = ("c{condition}_{direction}_{oil}/{results.nc, summary.json} per run; summary.csv and summary.md (a row "
+          "per run and bearing type: film with and without its thermal reduction, Λ and its regime, traction, "
+          "loads, cage guide, cage slip, pocket impacts, heat); answer.md (the answer in words, also printed); "
+          "film_and_slip.png; study.json")
+
+
 def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.lubricant_study", description=__doc__.split("\n\n")[0])
-    p.add_argument("--conditions", default="3", type=args.conditions, help="comma list of operating conditions 1-4 (default 3)")
+    p = args.parser("lubricant_study", __doc__, examples=EXAMPLES, writes=WRITES, out="results/lubricant")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--grades", default=None, type=args.choice_list(tuple(OIL_GRADES), "ISO VG grades"),
@@ -74,9 +81,7 @@ def parse_args(argv):
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded after the start (default 0.03)")
     p.add_argument("--window", type=args.positive("s"), default=None, help="statistics window [s] (default: the study's rule)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=2000.0, help="recording rate [Hz] (statistics use every step)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="override a parameter (repeatable)")
-    p.add_argument("--params", default=None, type=args.existing_file, help="TOML file of parameter overrides")
-    args.add_sweep_options(p, "results/lubricant")
+    args.add_shared(p, out="results/lubricant", conditions="3")
     return p.parse_args(argv)
 
 
@@ -109,7 +114,7 @@ def make_cases(a, out: Path) -> list[Case]:
     oils = "--grades or --viscosities"
     owned = {**OPERATING_AXES, "lubricant.viscosity_40": oils, "lubricant.viscosity_100": oils,
              "lubricant.oil_viscosity": oils}
-    user = {"bearing.traction_law": "ehl", **user_overrides(parse_sets(a.set), a.params, owned)}
+    user = {"bearing.traction_law": "ehl", **user_overrides(args.parse_sets(a.set), a.params, owned)}
     return [Case(c, d, str(out / f"c{c}_{d}_{lab}"), {**user, **ov}, a.params, tag=lab)
             for lab, ov in lubricants(a).items() for c in conds for d in dirs]
 

@@ -11,7 +11,6 @@ and the cage orbits DIR/c{condition}_cage_orbit_{inner,outer}.png, and (with --a
 """
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import csv
 import io
@@ -47,11 +46,19 @@ BAR_QUANTITIES = ["roller_cage_rms_N", "cage_guide_rms_N", "roller_inner_race_rm
                   "cage_acc_rel_radial_rms", "cage_acc_rel_tangential_rms"]
 
 
-def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.paper_study", description=__doc__.split("\n\n")[0],
-                    formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--conditions", default="3", type=args.conditions,
-                   help="comma list of operating conditions 1-4 (default 3)")
+EXAMPLES = ["{prog} --conditions 3 --out results/study",
+            '{prog} --conditions 1,2,3,4 --directions forward,reverse --workers 2 --set bearing.clearance="30 um"',
+            "{prog} --params my_machine.toml --animate --out results/mine"]
+WRITES = ("c{condition}_{direction}/{results.nc, summary.json} per run; comparison.csv and comparison.md (every "
+          "quantity forward vs reverse, the change in %); bearing_load_life.png (the headline: mean load and L10 "
+          "life per bearing type), bars.png, per condition the time histories c{condition}_{bearing_loads, "
+          "roller_contacts, cage, mesh}.png and the cage orbits c{condition}_cage_orbit_{inner,outer}.png; with "
+          "--animate c{condition}_cage_orbits.gif")
+
+
+def build_parser(name: str = "paper_study", out: str = "results/study", doc: str = __doc__,
+                 examples: list[str] = EXAMPLES):
+    p = args.parser(name, doc, examples=examples, writes=WRITES, out=out)
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     p.add_argument("--planets", type=args.count(1), default=None, help="planet pairs N (default 3, the reference machine)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03,
@@ -60,46 +67,24 @@ def parse_args(argv):
                    help="seconds recorded and analysed (default: max(0.02 s, one carrier revolution), rounded up "
                         "to whole revolutions of the slowest cage relative to the carrier)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=25000.0, help="recording rate [Hz]")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
-                   help='override a parameter, e.g. --set bearing.clearance="30 um" (repeatable)')
-    p.add_argument("--params", default=None, type=args.existing_file, help="TOML file of parameter overrides")
     p.add_argument("--method", default="hht-adaptive", choices=["hht-adaptive", "hht-fixed"])
     p.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="fixed step / initial step [s]")
     p.add_argument("--alpha", type=args.alpha, default=-0.3, help="HHT alpha in [-1/3, 0]")
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
                    help="scene switch, e.g. --option drag=false --option bearings=linear")
     p.add_argument("--animate", action="store_true", help="write a cage-orbit animation per condition")
-    args.add_sweep_options(p, "results/study")
-    return p.parse_args(argv)
+    args.add_shared(p, out=out, conditions="3")
+    return p
 
 
-def _bool(v: str):
-    lv = v.strip().lower()
-    if lv in ("true", "yes", "on", "1"):
-        return True
-    if lv in ("false", "no", "off", "0"):
-        return False
-    return v
-
-
-def parse_sets(items: list[str]) -> dict:
-    out = {}
-    for it in items:
-        if "=" not in it:
-            raise SystemExit(f"error: --set expects KEY=VALUE (e.g. bearing.clearance=\"30 um\"), got {it!r}")
-        k, v = it.split("=", 1)
-        v = v.strip().strip('"').strip("'")
-        out[k.strip()] = int(v) if v.lstrip("+-").isdigit() else v   # counts (planets, rollers) are integers
-    return out
+def parse_args(argv):
+    return build_parser().parse_args(argv)
 
 
 def build_config(a) -> RunConfig:
-    from components.scene import SceneOptions
-
-    opts = {k: _bool(v) for k, v in parse_sets(a.option).items()}
     return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate,
                      integration=dataclasses.replace(mbd.PRODUCTION, method=a.method, h=a.h, alpha=a.alpha),
-                     options=SceneOptions.from_dict(opts), progress=not a.no_progress)
+                     options=args.scene_options(a.option), progress=not a.no_progress)
 
 
 def make_cases(a, out: Path) -> list[Case]:
@@ -108,7 +93,7 @@ def make_cases(a, out: Path) -> list[Case]:
     for d in dirs:
         if d not in ("forward", "reverse"):
             raise SystemExit(f"error: --directions takes forward and/or reverse, got {d!r}")
-    overrides = user_overrides(parse_sets(a.set), a.params, OPERATING_AXES)
+    overrides = user_overrides(args.parse_sets(a.set), a.params, OPERATING_AXES)
     if a.planets is not None:
         overrides["gears.planets"] = a.planets
     for c in conds:
@@ -371,11 +356,14 @@ def run(a) -> dict:
     return {"results": results, "rows": rows, "failed": failed, "figures": figs, "animations": anims}
 
 
+def finish(r: dict) -> int:
+    """The exit code of a finished study: 1 if a run failed."""
+    return 1 if r["failed"] else 0
+
+
 @command
 def main(argv=None) -> int:
-    a = parse_args(sys.argv[1:] if argv is None else argv)
-    r = run(a)
-    return 1 if r["failed"] else 0
+    return finish(run(parse_args(sys.argv[1:] if argv is None else argv)))
 
 
 if __name__ == "__main__":

@@ -65,8 +65,15 @@ SEEN = {"housing": ("phasing", "transfer path"), "mesh": ("phasing", "transfer p
 SIDEBANDS = 6         # the line table covers f_m + k f_c, |k| <= SIDEBANDS
 
 
+EXAMPLES = ["{prog} --out results/spectrum", "{prog} --sensor mesh --carrier-rpm 1500 --perfect",
+            "{prog} --params my_rig_machine.toml --set rig.sensor.direction=tangential"]
+WRITES = ("run/{results.nc, summary.json} (the run); spectrum.csv (the chosen sensor's amplitude, every path, their "
+          "sum, the axis sensor), lines.csv (f_m + k f_c, |k| <= 6: amplitude, over the floor, origin, the path "
+          "carrying it), peaks.csv, summary.json, spectrum.png")
+
+
 def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.spectrum", description=__doc__.split("\n\n")[0])
+    p = args.parser("spectrum", __doc__, examples=EXAMPLES, writes=WRITES, out="results/spectrum")
     p.add_argument("--carrier-rpm", type=args.positive("r/min"), default=2000.0, help="carrier speed [r/min] (default 2000)")
     p.add_argument("--sun-rpm", type=args.positive("r/min"), default=None,
                    help="sun speed [r/min] magnitude; must match the ring-fixed ratio (3290 at 2000)")
@@ -80,23 +87,15 @@ def parse_args(argv):
     p.add_argument("--gear-grade", type=args.count(1, 11), default=None,
                    help="ISO 1328-1 flank tolerance class of the gears behind the default manufacturing errors "
                         "(default 6: every gear's teeth drawn for that class, runouts F_r/2 of that grade, all "
-                        "carrier pinholes within ±10 µm; components.presets.typical_errors)")
+                        "carrier pinholes within ±10 µm; components.presets.typical_errors); errors given by --params "
+                        "or --set errors.* replace them; the operating point is this command's options")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.06,
                    help="seconds discarded (default 0.06: a lightly damped ~2.6 kHz mode rings for ~50 ms after the start)")
     p.add_argument("--window", type=args.positive("s"), default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz]")
-    p.add_argument("--params", default=None, type=args.existing_file,
-                   help="TOML file of parameter overrides: a user's machine on the rig (its errors replace the "
-                        "--gear-grade ones; the operating point is this command's options)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="parameter override")
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="scene switch")
     p.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="initial step [s]")
-    p.add_argument("--force", action="store_true",
-                   help="run although the gears collide or the recording is too large for the limit or the disk")
-    p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace a finished run of other parameters or settings in --out (else refused)")
-    p.add_argument("--out", default="results/spectrum", type=args.out_folder)
+    args.add_shared(p, "params", "set", "out", "overwrite", "force", "no-progress", out="results/spectrum")
     return p.parse_args(argv)
 
 
@@ -110,13 +109,11 @@ def machine(a):
     from components.presets import reference_dpgt, typical_errors
     from components.units import ParameterError
 
-    from .paper_study import parse_sets
-
     try:
         from_file = overrides_from_toml(Path(a.params).read_text(encoding="utf-8")) if a.params else {}
     except (ParameterError, ValueError) as exc:          # not TOML, not UTF-8, or a bad value
         raise SystemExit(f"error: --params {a.params}: {exc}".splitlines()[0]) from None
-    given = {**from_file, **parse_sets(a.set)}
+    given = {**from_file, **args.parse_sets(a.set)}
     options = {"operating.carrier_speed": "--carrier-rpm", "operating.output_power": "--power",
                "operating.direction": "--direction"}
     for key in given:
@@ -146,12 +143,7 @@ def machine(a):
 
 def run_config(a) -> RunConfig:
     """The run settings from the command line (window, recording, integration, scene switches)."""
-    from components.scene import SceneOptions
-
-    from .paper_study import _bool, parse_sets
-
-    opts = SceneOptions.from_dict({k: _bool(v) for k, v in parse_sets(a.option).items()})
-    return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, options=opts,
+    return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, options=args.scene_options(a.option),
                      integration=dataclasses.replace(mbd.PRODUCTION, h=a.h), progress=not a.no_progress)
 
 

@@ -44,12 +44,13 @@ OPERATING_AXES = {"operating.carrier_speed": "--conditions", "operating.output_p
                   "operating.direction": "--directions"}
 
 
-def user_overrides(sets: dict, params_file: str | None, owned: dict[str, str]) -> dict:
+def user_overrides(sets: dict, params_file: str | None, owned: dict[str, str], merge_file: bool = False) -> dict:
     """The ``--set`` overrides of a study, after checking that neither they nor the ``--params`` file touch a
     parameter the study's sweep owns (``owned``: dotted key or prefix → the option that sets it). Such an override
     would silently relabel runs — a folder ``c3_forward`` holding a reverse run — so it is refused in one line
     naming the key, where it came from and the option to use. A file that is not UTF-8 TOML is a usage error
-    naming the file."""
+    naming the file. ``merge_file``: the file's overrides are returned too (under the ``--set`` ones), for a study
+    whose cases carry their own files."""
     from components.params import overrides_from_toml
     from components.units import ParameterError
 
@@ -64,7 +65,7 @@ def user_overrides(sets: dict, params_file: str | None, owned: dict[str, str]) -
             for axis, option in owned.items():
                 if key == axis or key.startswith(axis + ".") or axis.startswith(key + "."):
                     raise SystemExit(f"error: {key} is set by this study's {option}, not by {where}")
-    return dict(sets)
+    return {**from_file, **sets} if merge_file else dict(sets)
 
 
 def validate_cases(cases: list[Case], check=None) -> None:

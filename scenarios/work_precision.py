@@ -290,10 +290,11 @@ def markdown(res: dict) -> str:
 
 @command
 def main(argv=None) -> int:
-    ap = args.Parser(prog="python -m scenarios.work_precision", description=__doc__.splitlines()[0])
+    ap = args.parser("work_precision", __doc__, examples=["{prog} --quick --out results/numerics", "{prog} --problems rig --repeats 3 --figures docs/numerics"],
+                      writes="work_precision_<problem>.csv, work_precision_<problem>.png (error against wall time), work_precision_<problem>_rms.png, work_precision.json, work_precision.md and the settled states <problem>_settled.npz", out="results/numerics")
     ap.add_argument("--problems", default="rig,dpgt", type=args.choice_list(("rig", "dpgt"), "problems"), help="comma-separated: rig, dpgt")
     ap.add_argument("--quick", action="store_true", help="short window, fewer settings (minutes, not tens of minutes)")
-    ap.add_argument("--out", default="results/numerics", type=args.out_folder, help="output directory")
+    args.add_shared(ap, "out", out="results/numerics")
     ap.add_argument("--repeats", type=args.count(1), default=1, help="timing repeats per contender (median reported)")
     ap.add_argument("--cap", type=args.positive("s"), default=None, help="wall-time cap per scipy run [s]")
     ap.add_argument("--window", type=args.positive("s"), default=None, help="integration window after settling [s]")

@@ -88,6 +88,14 @@ BAD_ARGUMENTS = [
     ("work_precision", ["--problems", "ring"], "--problems: takes problems"),
     ("benchmark", ["--scipy-methods", "Euler"], "--scipy-methods: takes scipy methods"),
     ("bench_engine", ["--steps", "-1"], "--steps: must be a whole number"),
+    # the shared grammar: --conditions everywhere (one condition where a command runs one), --params, --set
+    ("fault_study", ["--conditions", "2,3"], "--conditions/--condition: this command runs one condition at a time"),
+    ("fault_study", ["--condition", "7"], "--conditions/--condition: must be a whole number in [1, 4]"),
+    ("modal", ["--conditions", "3,4"], "this command runs one condition at a time, got '3,4'"),
+    ("gear_quality", ["--params", "/no/such.toml"], "--params: no such file"),
+    ("fault_study", ["--params", "/no/such.toml"], "--params: no such file"),
+    ("bearing_rig", ["--set", "clearance"], "--set: expects KEY=VALUE"),
+    ("spectrum", ["--workers", "2"], "unrecognized arguments: --workers"),       # one run: no sweep options
 ]
 
 
@@ -103,3 +111,58 @@ def test_an_output_folder_that_cannot_exist_is_a_usage_error(tmp_path, capsys):
     (tmp_path / "a_file").write_text("")
     assert cli.main(["paper_study", "--out", str(tmp_path / "a_file" / "out")]) == USAGE
     assert "argument --out: cannot make the folder" in capsys.readouterr().err
+
+
+# the shared command grammar (issue 24 §3): one definition of every shared option, the same in every command
+STUDIES = {"paper_study": "results/study", "demo": "results/demo", "lubricant_study": "results/lubricant",
+           "fault_study": "results/faults", "gear_quality": "results/gear_quality"}
+OTHERS = {"spectrum": "results/spectrum", "bearing_rig": "results/bearing_rig", "modal": "results/modal",
+          "work_precision": "results/numerics", "stability": "results/numerics", "benchmark": "results/numerics",
+          "bench_engine": None}
+SHARED_OPTIONS = ("--params", "--set", "--out", "--overwrite", "--force", "--no-progress", "--workers",
+                  "--scheduler", "--conditions")
+
+
+def _help(name, capsys):
+    assert cli.main([name, "--help"]) == 0
+    return capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name", STUDIES)
+def test_every_study_takes_the_shared_options_with_one_help_text(name, capsys):
+    from scenarios.args import SHARED
+
+    text = _help(name, capsys)
+    assert text.startswith(f"usage: dpgt {name} ")             # under the console command it names itself so
+    for option in SHARED_OPTIONS:
+        assert option in text, option
+    flat = " ".join(text.split())
+    for key in ("params", "overwrite", "force", "no-progress", "scheduler"):     # the one definition's words
+        assert " ".join(SHARED[key][1]["help"].split()) in flat, key
+    assert f"output folder (default {STUDIES[name]})" in flat
+    assert "examples:" in text and f"dpgt {name} --" in text.split("examples:")[1]
+    assert f"writes (into --out, default {STUDIES[name]}):" in text and f"default --out: {STUDIES[name]}" in text
+
+
+@pytest.mark.parametrize("name", OTHERS)
+def test_every_other_command_lists_examples_what_it_writes_and_its_default_out(name, capsys):
+    text = _help(name, capsys)
+    assert text.startswith(f"usage: dpgt {name} ") and "examples:" in text and "writes" in text
+    if OTHERS[name]:
+        assert f"default --out: {OTHERS[name]}" in text and "--out DIR" in text
+
+
+def test_outside_the_console_command_the_usage_names_the_module(capsys):
+    from scenarios import lubricant_study
+
+    assert lubricant_study.main(["--help"]) == 0
+    assert capsys.readouterr().out.startswith("usage: python -m scenarios.lubricant_study ")
+
+
+def test_one_condition_commands_take_conditions_and_the_former_spelling():
+    from scenarios import fault_study
+
+    assert fault_study.parse_args(["--conditions", "3"]).conditions == 3
+    assert fault_study.parse_args(["--condition", "1"]).conditions == 1        # the former spelling still works
+    assert fault_study.parse_args([]).conditions == 2                           # the source's rig speed
+
