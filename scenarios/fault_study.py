@@ -171,8 +171,7 @@ def _own_frequency(case: Case, si, fr: dict) -> float | None:
 def sensor_spectrum(run_dir: Path, f_c: float):
     """(f, amplitude, why) of the recorded housing sensor of a run (scenarios.spectrum's definition); ``why`` says
     why its lines mean nothing (too few carrier revolutions), None when they do."""
-    from .spectrum import sensor_signal
-    from .analysis import amplitude_spectrum, sideband_resolution
+    from .analysis import amplitude_spectrum, sensor_signal, sideband_resolution
 
     t, x = sensor_signal(run_dir / "results.nc", f_c)
     f, amp, _ = amplitude_spectrum(t, x)

@@ -41,7 +41,8 @@ import mbd
 from components.sensor import PATHS as SENSOR_PATHS
 from mbd.recorder import atomic_write_text
 
-from .analysis import amplitude_spectrum, line_table, peak_table, sideband_resolution
+from .analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution
+from .analysis import whole_revolutions as _whole_revolutions
 from .plausibility import check_runs
 from .runner import RunConfig, run_case, run_report
 from . import args
@@ -197,36 +198,6 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     return summary
 
 
-def sensor_paths(path: Path, sensor=None) -> tuple[np.ndarray, dict]:
-    """(t, {"mesh", "torque", "bearing", "housing"}): the housing accelerometer's paths and their sum [m/s^2] at
-    every sample of a run's ``results.nc`` (recorded with ``RunConfig(sensor=True)``), by
-    :func:`components.sensor.paths` from the recorded outer planets' angles and ring-mesh forces and the loads on
-    the housing. ``sensor`` (:class:`components.params.SensorSI`): the run's own (stored with it) unless given.
-    The one place a run's file becomes the sensor's signals: the spectrum and the fault study read through it."""
-    import xarray as xr
-
-    from components.families import MESH_FAMILY
-    from components.sensor import paths, sensor_from_dict
-
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
-        if "housing.force_x" not in ds:
-            raise ValueError(f"{path}: the run recorded no loads on the housing (run it with RunConfig(sensor=True))")
-        sensor = sensor if sensor is not None else sensor_from_dict(json.loads(ds.attrs["sensor"]))
-        t = ds["time"].values
-        bodies = list(ds["motion.body"].values)
-        phi = (ds["fixed.angle"].values[:, list(ds["fixed.body"].values).index("carrier")]
-               - ds["motion.angle"].values[:, bodies.index("carrier")])           # the frame's angle
-        fam = MESH_FAMILY["outer_ring"]
-        P = ds["motion.position"].values[:, [bodies.index(g) for g in ds[f"{fam}.gear1"].values]]
-        psi = np.arctan2(P[..., 1], P[..., 0]) + phi[:, None]
-        c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
-        fx, fy = ds[f"{fam}.fx"].values, ds[f"{fam}.fy"].values                 # on the ring, in R
-        ring = np.stack([c * fx - s * fy, s * fx + c * fy], axis=-1)
-        force = np.column_stack([ds["housing.force_x"].values.sum(axis=1), ds["housing.force_y"].values.sum(axis=1)])
-        torque = ds["housing.torque"].values.sum(axis=1)
-        return t, paths(t, psi, ring, force, torque, sensor)
-
-
 def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
     """Sample times and the signals of a run: "amplitude" (the sensor read), every path of the housing sensor
     and their sum, and the axis sensor's x and y."""
@@ -237,22 +208,6 @@ def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
         acc = ds["fixed.acceleration"].values[:, list(ds["fixed.body"].values).index("carrier")]
     signals.update({"axis_x": acc[:, 0], "axis_y": acc[:, 1]})
     return t, {"amplitude": signals["axis_x" if sensor == "axis" else sensor], **signals}
-
-
-def sensor_signal(path: Path, f_c: float, sensor: str = "housing") -> tuple[np.ndarray, np.ndarray]:
-    """(t, a) of a run's housing sensor (or one of its paths, :func:`sensor_paths`) over the first whole number
-    of carrier revolutions: what every spectrum of the sensor is taken of."""
-    t, signals = _whole_revolutions(*sensor_paths(Path(path)), f_c)
-    return t, signals[sensor]
-
-
-def _whole_revolutions(t, signals: dict, f_c: float):
-    """The first whole number of carrier revolutions of the samples (all of them if less than one): the
-    lines f_m + k f_c then fall on frequency bins, and the Hann window's leakage stays within ±1 bin."""
-    dt, fc = float(np.median(np.diff(t))), abs(f_c)
-    revs = np.floor(len(t) * dt * fc + 1e-9) if fc > 0 else 0.0
-    n = min(int(round(revs / (fc * dt))), len(t)) if revs >= 1 else len(t)
-    return t[:n], {k: x[:n] for k, x in signals.items()}
 
 
 def _lines(f, spectra, f_m, f_c, z_r: int, planets: int, sensor: str) -> list[dict]:
