@@ -118,7 +118,7 @@ STUDIES = {"paper_study": "results/study", "demo": "results/demo", "lubricant_st
            "fault_study": "results/faults", "gear_quality": "results/gear_quality"}
 OTHERS = {"spectrum": "results/spectrum", "bearing_rig": "results/bearing_rig", "modal": "results/modal",
           "work_precision": "results/numerics", "stability": "results/numerics", "benchmark": "results/numerics",
-          "bench_engine": None}
+          "bench_engine": None, "params": None}
 SHARED_OPTIONS = ("--params", "--set", "--out", "--overwrite", "--force", "--no-progress", "--workers",
                   "--scheduler", "--conditions")
 
@@ -166,3 +166,21 @@ def test_one_condition_commands_take_conditions_and_the_former_spelling():
     assert fault_study.parse_args(["--condition", "1"]).conditions == 1        # the former spelling still works
     assert fault_study.parse_args([]).conditions == 2                           # the source's rig speed
 
+
+
+def test_dpgt_params_lists_every_key_with_value_unit_source_and_meaning(capsys):
+    from components.params import parameter_names
+    from components.presets import reference_dpgt
+
+    assert cli.main(["params", "--grep", "clearance"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    row = next(line for line in lines if line.startswith("bearing.clearance "))
+    assert row.split()[1:4] == ["20", "µm", "[assumed]"] and "diametral clearance" in row
+    assert all("clearance" in line.lower() for line in lines[1:])                   # only what --grep asks for
+    assert cli.main(["params"]) == 0
+    keys = [line.split()[0] for line in capsys.readouterr().out.splitlines()[1:]]
+    assert keys == parameter_names(reference_dpgt())                                # every key, none twice
+    assert cli.main(["params", "--grep", "bearing.clearance", "--set", "bearing.clearance=30 um"]) == 0
+    assert capsys.readouterr().out.splitlines()[1].split()[1:4] == ["30", "µm", "[user]"]
+    assert cli.main(["params", "--set", "bearing.clearence=30 um"]) == 2           # a near miss: did you mean
+    assert "did you mean bearing.clearance" in capsys.readouterr().err
