@@ -1,9 +1,9 @@
 """What errors and faults do to the planet bearings and to the rig's sensor (MODEL.md §3.9–3.10).
 
-    python -m scenarios.fault_study [--condition 2] [--directions forward,reverse]
+    python -m scenarios.fault_study [--conditions 2] [--directions forward,reverse]
         [--faults pinhole,runout,roller,spall_pin,spall_bore,cracked_tooth,missing_tooth]
         [--machine NAME=FILE.toml ...] [--settle S] [--window S] [--sample-rate HZ]
-        [--set KEY=VALUE ...] [--workers N | --scheduler ADDR] [--force] [--overwrite] [--out DIR]
+        [--params FILE.toml] [--set KEY=VALUE ...] [--workers N | --scheduler ADDR] [--force] [--overwrite] [--out DIR]
 
 Every fault (the catalogue :data:`FAULTS`, each a stated size with its basis; or a damaged machine described
 in a TOML file, README "A damaged machine") runs beside the perfect machine in every direction, through the
@@ -22,9 +22,7 @@ from __future__ import annotations
 
 import argparse
 import csv
-import dataclasses
 import io
-import json
 import sys
 from pathlib import Path
 
@@ -37,10 +35,10 @@ from mbd.recorder import atomic_write_text
 from . import args
 from .command import command
 from .lock import holds_out_folder
-from .plausibility import check_runs
 from .runner import RunConfig
 from .analysis import line_table
-from .sweep import Case, build_params, check_folders, run_sweep, study_epilogue, user_overrides, validate_cases
+from .study import Study, StudyRun
+from .sweep import Case, build_params, user_overrides
 
 __all__ = ["FAULTS", "main", "run", "characteristic_frequencies", "COLUMNS"]
 
@@ -217,7 +215,8 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
     return rows, spectra
 
 
-def write_outputs(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
+def write_tables(rows: list[dict], out: Path) -> list[Path]:
+    """summary.csv, summary.md and findings.md."""
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=COLUMNS)
     w.writeheader()
@@ -228,15 +227,24 @@ def write_outputs(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
     md += ["| " + " | ".join(fmt(r[c]) for c in COLUMNS) + " |" for r in rows]
     atomic_write_text(out / "summary.md", "\n".join(md) + "\n")
     atomic_write_text(out / "findings.md", findings(rows) + "\n")
+    return [out / "summary.csv", out / "summary.md", out / "findings.md"]
+
+
+def plots(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
+    """loads.png and (with a perfect machine to compare against) spectra.png."""
     from viz.plots import fault_loads, fault_spectra
 
-    files = [out / "summary.csv", out / "summary.md", out / "findings.md",
-             fault_loads(rows, out / "loads.png", title="What each fault does to the planet bearings (pair 1)")]
+    files = [fault_loads(rows, out / "loads.png", title="What each fault does to the planet bearings (pair 1)")]
     panels = _spectrum_panels(spectra)
     if panels:
         files.append(fault_spectra(panels, out / "spectra.png",
                                    title="The housing sensor around the mesh frequency: each fault against the perfect machine"))
     return files
+
+
+def write_outputs(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
+    """The tables and the figures (module docstring)."""
+    return write_tables(rows, out) + plots(rows, spectra, out)
 
 
 SENSOR_LINES = ("sensor_f_m", "sensor_f_m-1f_c", "sensor_f_m+1f_c", "sensor_f_m-3f_c", "sensor_f_m+3f_c", "sensor_own")
@@ -294,26 +302,41 @@ def _spectrum_panels(spectra: dict) -> list[tuple]:
     return panels
 
 
+class FaultStudy(Study):
+    """The perfect machine, each fault and each damaged machine in every direction
+    (:class:`scenarios.study.Study`): per damaged machine a line first, then the tables and the figures."""
+
+    def config(self) -> RunConfig:
+        a = self.a
+        return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
+                         progress=not a.no_progress, sensor=True)
+
+    def cases(self) -> list[Case]:
+        return make_cases(self.a, self.out)
+
+    def check(self, case: Case, cfg: RunConfig) -> None:
+        _check_case(case, cfg)
+
+    def study_record(self) -> dict:
+        return {"faults": {k: v[1] for k, v in FAULTS.items()}}
+
+    def report(self, run: StudyRun) -> dict:
+        rows, spectra = rows_of(run.cases, run.results)
+        for row in rows:                     # the headline first
+            if row["bearing"] == "outer":
+                print(f"{row['fault']:>14} {row['direction']:>8}: K_γ {row['load_sharing_factor']:.3f}, "
+                      f"max bearing load {row['bearing_load_max_N']:.0f} N, life {row['life_relative'] or float('nan'):.2f}, "
+                      + (f"sensor f_m / floor {row['sensor_f_m']:.3g}" if row["sensor_f_m"] is not None
+                         else "sensor lines not meaningful (too short a window)"))
+        if rows:
+            run.step("tables", write_tables, rows, self.out)
+            run.step("figures", plots, rows, spectra, self.out)
+        return {"rows": rows}
+
+
 @holds_out_folder
 def run(a) -> dict:
-    out = Path(a.out)
-    cases = make_cases(a, out)
-    cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
-                    progress=not a.no_progress, sensor=True)
-    validate_cases(cases, lambda c: _check_case(c, cfg))     # every parameter checked before any run starts
-    out.mkdir(parents=True, exist_ok=True)
-    for w in check_runs([(c.label, build_params(c), cfg) for c in cases], out, a.force):
-        print(f"warning (--force): {w}")
-    check_folders(cases, cfg, a.overwrite)   # never replace results of other parameters silently
-    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
-                        overwrite=a.overwrite)
-    rows, spectra = rows_of(cases, results)
-    files = write_outputs(rows, spectra, out) if rows else []
-    failed = {k: v["error"] for k, v in results.items() if "error" in v}
-    atomic_write_text(out / "study.json", json.dumps({"cases": [dataclasses.asdict(c) for c in cases],
-                                                      "faults": {k: v[1] for k, v in FAULTS.items()},
-                                                      "failed": failed}, indent=2, default=str))
-    return {"rows": rows, "failed": failed, "files": files, "results": results}
+    return FaultStudy(a).run()
 
 
 def _check_case(case: Case, cfg: RunConfig) -> None:
@@ -327,14 +350,7 @@ def _check_case(case: Case, cfg: RunConfig) -> None:
 
 @command
 def main(argv=None) -> int:
-    r = run(parse_args(sys.argv[1:] if argv is None else argv))
-    for row in r["rows"]:
-        if row["bearing"] == "outer":
-            print(f"{row['fault']:>14} {row['direction']:>8}: K_γ {row['load_sharing_factor']:.3f}, "
-                  f"max bearing load {row['bearing_load_max_N']:.0f} N, life {row['life_relative'] or float('nan'):.2f}, "
-                  + (f"sensor f_m / floor {row['sensor_f_m']:.3g}" if row["sensor_f_m"] is not None
-                     else "sensor lines not meaningful (too short a window)"))
-    return study_epilogue(r)
+    return Study.exit_code(run(parse_args(sys.argv[1:] if argv is None else argv)))
 
 
 if __name__ == "__main__":

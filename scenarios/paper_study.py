@@ -25,10 +25,9 @@ from components.outputs import SUMMARY_WORDS
 from components.outputs import relative_life as iso_relative_life
 from mbd.recorder import atomic_write_text
 
-from .runner import RunConfig, sweep_report
-from .integrity import read_summary
-from .plausibility import check_runs
-from .sweep import OPERATING_AXES, Case, _case_cfg, build_params, check_folders, run_sweep, user_overrides, validate_cases
+from .runner import RunConfig
+from .study import Study, StudyRun
+from .sweep import OPERATING_AXES, Case, user_overrides
 from . import args
 from .command import command
 from .lock import holds_out_folder
@@ -312,53 +311,44 @@ def animate(results: dict, out: Path) -> list[Path]:
     return paths
 
 
-def _keep_finished_on_disk(results: dict, out: Path) -> None:
-    """A run that failed this time but finished before keeps its summary in the tables: a re-run in which
-    nothing succeeds never replaces good tables with empty ones (its failure is still reported)."""
-    for label, s in list(results.items()):
-        if "error" in s:
-            old = read_summary(out / label / "summary.json")      # a damaged one is moved aside, not used
-            if old is not None and "error" not in old and "inner" in old:
-                results[label] = {**old, "stale_after_failure": s["error"]}
+class PaperStudy(Study):
+    """Forward vs reverse per condition (:class:`scenarios.study.Study`): the comparison table first, then its
+    files, the figures and (``--animate``) the cage-orbit animations. A run that fails now but finished before
+    keeps its summary in the tables."""
+
+    keep_earlier = True
+    record = False
+
+    def config(self) -> RunConfig:
+        return build_config(self.a)
+
+    def cases(self) -> list[Case]:
+        return make_cases(self.a, self.out)
+
+    def report(self, run: StudyRun) -> dict:
+        results = run.results
+        relative_life(results)
+        for label, s in results.items():   # store the relative life in each run's summary (atomic rewrite)
+            if "stale_after_failure" not in s:
+                atomic_write_text(Path(run.outcomes[label].case.out_dir) / "summary.json",
+                                  json.dumps(s, indent=2, default=str))
+        rows = comparison_rows(results)
+        csv_p, md_p, text = write_tables(rows, self.out)
+        print("\n" + text)                  # the headline table first
+        run.step("tables", lambda: [csv_p, md_p])
+        figs = run.step("figures", plots, results, self.out)
+        anims = run.step("animation", animate, results, self.out) if self.a.animate else []
+        return {"rows": rows, "figures": figs, "animations": anims}
 
 
 @holds_out_folder
 def run(a) -> dict:
-    out = Path(a.out)
-    out.mkdir(parents=True, exist_ok=True)
-    cfg = build_config(a)
-    cases = make_cases(a, out)
-    validate_cases(cases)         # before any run starts: clear errors, design warnings once
-    for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], out, a.force):
-        print(f"warning (--force): {w}")
-    check_folders(cases, cfg, a.overwrite)      # never replace results of other parameters silently
-    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
-                        overwrite=a.overwrite)
-    _keep_finished_on_disk(results, out)
-    relative_life(results)
-    for label, s in results.items():   # store the relative life in each run's summary (atomic rewrite)
-        if "error" not in s and "stale_after_failure" not in s:
-            s.pop("skipped", None)
-            atomic_write_text(out / label / "summary.json", json.dumps(s, indent=2, default=str))
-    rows = comparison_rows(results)
-    csv_p, md_p, text = write_tables(rows, out)
-    figs = plots(results, out)
-    anims = animate(results, out) if a.animate else []
-    print("\n" + text)
-    failed = {k: v.get("error", v.get("stale_after_failure")) for k, v in results.items()
-              if "error" in v or "stale_after_failure" in v}
-    for k, v in failed.items():
-        print(f"FAILED {k}: {v}  (details in {out / k / 'error.json'})")
-    print("run time and accuracy per run:", *sweep_report(results), sep="\n")
-    print("\nwritten:")
-    for p in [csv_p, md_p, *figs, *anims]:
-        print(f"  {p}")
-    return {"results": results, "rows": rows, "failed": failed, "figures": figs, "animations": anims}
+    return PaperStudy(a).run()
 
 
 def finish(r: dict) -> int:
     """The exit code of a finished study: 1 if a run failed."""
-    return 1 if r["failed"] else 0
+    return Study.exit_code(r)
 
 
 @command

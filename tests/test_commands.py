@@ -45,16 +45,22 @@ def test_a_bad_condition_through_the_dpgt_command(tmp_path, capsys):
 
 def test_a_failed_rerun_keeps_the_finished_summaries_in_the_tables(tmp_path):
     import json
+
+    from scenarios.study import Study, StudyRun
+    from scenarios.sweep import Case, Outcome, Status
     good, damaged = tmp_path / "c4_forward", tmp_path / "c4_reverse"
     good.mkdir()
     damaged.mkdir()
     (good / "summary.json").write_text(json.dumps({"inner": {"bearing_load_mean_N": 1.0}, "outer": {}}))
     (damaged / "summary.json").write_text("{not json")
-    results = {"c4_forward": {"error": "boom"}, "c4_reverse": {"error": "bang"}}
-    paper_study._keep_finished_on_disk(results, tmp_path)
+    run = StudyRun(tmp_path, [], {"c4_forward": Outcome(Case(4, "forward", str(good)), Status.FAILED, error="boom"),
+                                  "c4_reverse": Outcome(Case(4, "reverse", str(damaged)), Status.FAILED, error="bang")})
+    run.kept = Study._earlier(run)                                      # what the paper study does (keep_earlier)
+    results = run.results
     assert results["c4_forward"]["inner"] == {"bearing_load_mean_N": 1.0}
     assert results["c4_forward"]["stale_after_failure"] == "boom"      # still reported as failed
-    assert results["c4_reverse"] == {"error": "bang"}                 # a damaged summary is not used
+    assert run.failed == {"c4_forward": "boom", "c4_reverse": "bang"}
+    assert "c4_reverse" not in results                                # a damaged summary is not used
 
 
 # every command checks all its arguments before anything runs: one line naming the argument, exit 2
@@ -184,3 +190,45 @@ def test_dpgt_params_lists_every_key_with_value_unit_source_and_meaning(capsys):
     assert capsys.readouterr().out.splitlines()[1].split()[1:4] == ["30", "µm", "[user]"]
     assert cli.main(["params", "--set", "bearing.clearence=30 um"]) == 2           # a near miss: did you mean
     assert "did you mean bearing.clearance" in capsys.readouterr().err
+
+
+TINY_STUDY = ["--conditions", "4", "--directions", "forward", "--settle", "0.0005", "--window", "0.0005",
+              "--set", "bearing.rollers=8", "--no-progress", "--workers", "1"]
+
+
+def test_a_study_says_what_happens_and_marks_reused_runs(tmp_path, capsys):
+    """Typed outcomes (finished, reused, failed); the headline table first, one line per post-processing step; a
+    run taken from an earlier one is reported as reused, with the wall time of the run that made it."""
+    import json
+
+    from scenarios.sweep import Status
+
+    r = paper_study.run(paper_study.parse_args([*TINY_STUDY, "--out", str(tmp_path)]))
+    assert r["outcomes"]["c4_forward"].status is Status.FINISHED and not r["failed"]
+    first = capsys.readouterr().out
+    assert "runs: 1 finished now, 0 reused" in first and ": reused (" not in first
+    wall = json.loads((tmp_path / "c4_forward" / "summary.json").read_text())["wall_s"]
+    r = paper_study.run(paper_study.parse_args([*TINY_STUDY, "--out", str(tmp_path)]))
+    o = r["outcomes"]["c4_forward"]
+    assert o.status is Status.REUSED and o.wall_s == pytest.approx(wall)
+    text = capsys.readouterr().out
+    assert "runs: 0 finished now, 1 reused" in text
+    line = next(x for x in text.splitlines() if x.startswith("  c4_forward: reused ("))
+    assert f"{wall:.1f} s wall" in line                          # the original run's wall time
+    lines = text.splitlines()
+    head, tables, figures = (next(i for i, x in enumerate(lines) if x.startswith(w))
+                             for w in ("### Condition 4", "tables: ", "figures: "))
+    assert head < tables < figures                                 # the headline table first
+    assert lines[tables] == "tables: comparison.csv, comparison.md" and "bearing_load_life.png" in lines[figures]
+    assert sum(x.startswith(("tables: ", "figures: ", "animation: ")) for x in lines) == 2   # one line per step
+
+
+def test_a_failed_run_is_an_outcome_not_a_dict(tmp_path):
+    from scenarios.runner import RunConfig
+    from scenarios.sweep import Case, Status, sweep
+
+    bad = Case(4, "reverse", str(tmp_path / "bad"), {"bearing.rollers": 8, "gears.planets": 0})
+    o = sweep([bad], RunConfig(settle=0.0005, window=0.0005, progress=False), workers=1, progress=False)["c4_reverse"]
+    assert o.status is Status.FAILED and not o.ok and o.summary is None and "gears.planets" in o.error
+    assert o.as_dict()["error"] == o.error                         # run_sweep's plain form, for old callers
+
