@@ -279,11 +279,6 @@ def add_shared(p, *names: str, out: str | None = None, conditions: str | None = 
         g.add_argument(*flags, **kw)
 
 
-def add_sweep_options(p, out_default: str) -> None:
-    """The options every study shares besides --conditions, --params and --set (:data:`SHARED`)."""
-    add_shared(p, "workers", "scheduler", "force", "overwrite", "no-progress", "out", out=out_default)
-
-
 def parser(name: str, doc: str, *, examples: list[str], writes: str, out: str | None) -> Parser:
     """The parser of the scenario ``name``: its description (the first paragraph of ``doc``), and after the
     options its examples (``{prog}`` stands for the command), what it writes and its default output folder."""

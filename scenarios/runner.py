@@ -9,7 +9,7 @@ Results layout of a run directory:
                    with its bearing, planet, pair, bearing_kind, roller (components.results_schema);
                    with RunConfig.sensor what the supports put on the housing ("housing.force_x/force_y/torque",
                    fixed frame) and the sensor's parameters (attrs "sensor"), from which the housing
-                   accelerometer's paths are computed (MODEL.md §3.10, scenarios.analysis.sensor_paths);
+                   accelerometer's paths are computed (MODEL.md §3.10, scenarios.spectrum.sensor_paths);
                    attrs hold the run summary and, as JSON, the bearing map, meta, label and geometry
     summary.json   the statistics users read, taken on every accepted step over the window
                    (:class:`components.outputs.WindowStatistics`; the recording is for plots only)
