@@ -124,7 +124,7 @@ STUDIES = {"paper_study": "results/study", "demo": "results/demo", "lubricant_st
            "fault_study": "results/faults", "gear_quality": "results/gear_quality"}
 OTHERS = {"spectrum": "results/spectrum", "bearing_rig": "results/bearing_rig", "modal": "results/modal",
           "work_precision": "results/numerics", "stability": "results/numerics", "benchmark": "results/numerics",
-          "bench_engine": None, "params": None}
+          "bench_engine": None, "params": None, "animate": None}
 SHARED_OPTIONS = ("--params", "--set", "--out", "--overwrite", "--force", "--no-progress", "--workers",
                   "--scheduler", "--conditions")
 
