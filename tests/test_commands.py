@@ -245,3 +245,23 @@ def test_the_python_entry_point_runs_reuses_and_opens_a_run(tmp_path):
     assert again.status == "reused" and again.wall_s == first.wall_s
     with again.dataset() as ds:
         assert ds["race_inner.load"].attrs["units"] == "N" and ds.sizes["time"] == first.summary["samples"]
+
+
+def test_params_files_reach_every_case_of_the_studies_that_gained_them(tmp_path):
+    """--params in the fault study (beside each machine's own file) and in the gear-quality study."""
+    from scenarios import fault_study, gear_quality
+    from scenarios.sweep import build_params
+
+    common, dent = tmp_path / "common.toml", tmp_path / "dent.toml"
+    common.write_text('[bearing]\nclearance = "30 um"\n')
+    dent.write_text('[[errors.pinhole]]\nplanet = "b1"\nradial = "0 um"\ntangential = "30 um"\n')
+    a = fault_study.parse_args(["--params", str(common), "--machine", f"bent={dent}", "--faults", "runout",
+                                "--directions", "forward", "--out", str(tmp_path / "f")])
+    by = {c.tag: build_params(c).si() for c in fault_study.make_cases(a, tmp_path / "f")}
+    assert set(by) == {"perfect", "runout", "bent"}
+    assert all(si.bearing.clearance == pytest.approx(30e-6) for si in by.values())
+    assert by["bent"].errors.pinhole and by["runout"].errors.runout and not by["perfect"].errors.pinhole
+    a = gear_quality.parse_args(["--params", str(common), "--conditions", "3", "--grades", "6", "--seeds", "1",
+                                 "--out", str(tmp_path / "g")])
+    assert all(build_params(c).si().bearing.clearance == pytest.approx(30e-6)
+               for c in gear_quality.make_cases(a, tmp_path / "g"))
