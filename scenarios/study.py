@@ -132,7 +132,7 @@ class Study:
             print(f"warning (--force): {w}")
         check_folders(cases, cfg, a.overwrite)                  # never replace results of other parameters silently
         outcomes = sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
-                         overwrite=a.overwrite)
+                         overwrite=a.overwrite, announce=True)
         run = StudyRun(self.out, cases, outcomes)
         print(runs_line(outcomes), flush=True)
         if self.keep_earlier:

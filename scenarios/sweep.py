@@ -260,12 +260,16 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
 
 
 def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | None = None,
-          progress: bool = True, overwrite: bool = False) -> dict[str, Outcome]:
+          progress: bool = True, overwrite: bool = False, announce: bool = False) -> dict[str, Outcome]:
     """Run every case; returns {label: :class:`Outcome`}. One case runs in-process (no cluster).
-    ``overwrite``: replace finished results of other parameters (else :func:`check_folders` refuses)."""
+    ``overwrite``: replace finished results of other parameters (else :func:`check_folders` refuses);
+    ``announce``: say first how many runs will run and how many are reused."""
     from tqdm.auto import tqdm
 
     todo = [c for c in cases if not _is_finished(c, cfg)]
+    if announce:
+        print(f"runs: {len(todo)} to run, {len(cases) - len(todo)} reused (finished earlier with the same parameters, "
+              f"settings and code)", flush=True)
     results = {c.label: execute_case(c, cfg) for c in cases if c not in todo}   # finished: just load
     if not todo:
         return results

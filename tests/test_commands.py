@@ -212,7 +212,7 @@ def test_a_study_says_what_happens_and_marks_reused_runs(tmp_path, capsys):
     o = r["outcomes"]["c4_forward"]
     assert o.status is Status.REUSED and o.wall_s == pytest.approx(wall)
     text = capsys.readouterr().out
-    assert "runs: 0 finished now, 1 reused" in text
+    assert "runs: 0 to run, 1 reused" in text and "runs: 0 finished now, 1 reused" in text
     line = next(x for x in text.splitlines() if x.startswith("  c4_forward: reused ("))
     assert f"{wall:.1f} s wall" in line                          # the original run's wall time
     lines = text.splitlines()
