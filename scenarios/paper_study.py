@@ -152,6 +152,31 @@ def write_tables(rows: list[dict], out: Path) -> tuple[Path, Path, str]:
     return out / "comparison.csv", out / "comparison.md", text
 
 
+HEADLINE = (("bearing_load_mean_N", "mean load", 1e-3, "kN"), ("life_iso281_h", "L10 ISO 281", 1.0, "h"),
+            ("life_iso16281_h", "L10 roller loads", 1.0, "h"))
+
+
+def headline_table(rows: list[dict]) -> str:
+    """The study's answer in a few lines (what the headline figure shows): per condition and bearing type the mean
+    bearing load and both L10 lives, forward / reverse and the change, from the comparison's rows."""
+    at = {(r["condition"], r["bearing"], r["quantity"]): r for r in rows}
+    num = lambda x, k: "–" if x is None else f"{x * k:.3g}"
+    head = "".join(f" | {w} fwd / rev [{u}] (change)" for _, w, _, u in HEADLINE)
+    lines = [f"headline (pair 1's planet bearings, forward vs reverse):\n| condition | bearing{head} |",
+             "|---|---" + "|---" * len(HEADLINE) + "|"]
+    for c, b in sorted({(r["condition"], r["bearing"]) for r in rows}):
+        cells = []
+        for q, _, k, _ in HEADLINE:
+            r = at.get((c, b, q))
+            if r is None:
+                cells.append("–")
+                continue
+            d = r["difference_pct"]
+            cells.append(f"{num(r['forward'], k)} / {num(r['reverse'], k)}" + ("" if d is None else f" ({d:+.1f} %)"))
+        lines.append(f"| {c} | {b} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def _runs_of(results: dict, out: Path, c: int) -> dict[str, Path]:
     """direction -> results.nc of condition ``c``'s runs that finished (a missing run is left out, not faked)."""
     runs = {}
@@ -334,7 +359,8 @@ class PaperStudy(Study):
                                   json.dumps(s, indent=2, default=str))
         rows = comparison_rows(results)
         csv_p, md_p, text = write_tables(rows, self.out)
-        print("\n" + text)                  # the headline table first
+        print("\n" + headline_table(rows))   # the headline first, then the whole comparison
+        print("\n" + text)
         run.step("tables", lambda: [csv_p, md_p])
         figs = run.step("figures", plots, results, self.out)
         anims = run.step("animation", animate, results, self.out) if self.a.animate else []

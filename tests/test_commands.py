@@ -216,9 +216,10 @@ def test_a_study_says_what_happens_and_marks_reused_runs(tmp_path, capsys):
     line = next(x for x in text.splitlines() if x.startswith("  c4_forward: reused ("))
     assert f"{wall:.1f} s wall" in line                          # the original run's wall time
     lines = text.splitlines()
-    head, tables, figures = (next(i for i, x in enumerate(lines) if x.startswith(w))
-                             for w in ("### Condition 4", "tables: ", "figures: "))
-    assert head < tables < figures                                 # the headline table first
+    head, table, tables, figures = (next(i for i, x in enumerate(lines) if x.startswith(w))
+                                    for w in ("headline (", "### Condition 4", "tables: ", "figures: "))
+    assert head < table < tables < figures                         # the headline table first
+    assert lines[head + 3].startswith("| 4 | inner | ") and " / – " in lines[head + 3]   # no reverse run: no change
     assert lines[tables] == "tables: comparison.csv, comparison.md" and "bearing_load_life.png" in lines[figures]
     assert sum(x.startswith(("tables: ", "figures: ", "animation: ")) for x in lines) == 2   # one line per step
 
