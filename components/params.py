@@ -46,8 +46,8 @@ from typing import Any, ClassVar, Mapping
 import numpy as np
 
 from . import geometry as geo
-from .units import ParameterError, Quantity, format_quantity, quantity, to_si
 from .names import did_you_mean
+from .units import KINDS, ParameterError, Quantity, format_quantity, quantity, to_si
 
 __all__ = [
     "Source", "Sourced", "paper", "derived", "assumed", "SI", "Derived", "Params",
@@ -58,7 +58,7 @@ __all__ = [
     "GearSI", "GearSetSI", "CageSI", "SlideRollTractionSI", "LifeSI", "BearingSI", "LubricantSI", "SupportSI", "MeshSI",
     "OperatingSI", "HousingSI", "SensorSI", "CarrierRippleSI", "RigSI", "DPGTSI", "DPGTOperatingSI", "DPGTSupportSI",
     "BearingRigSI",
-    "with_overrides", "parameter_names", "flatten", "describe", "to_toml", "overrides_from_toml",
+    "with_overrides", "parameter_names", "flatten", "describe", "parameter_rows", "to_toml", "overrides_from_toml",
 ]
 
 
@@ -1240,8 +1240,15 @@ def _si_at(view, path: str):
     return view
 
 
-def describe(params: Params) -> str:
-    """A table: dotted path, value (rule-based values resolved, in SI), source tag and note."""
+def _unit_text(u) -> str:
+    text = f"{u:~P}"
+    return text or "1"
+
+
+def parameter_rows(params: Params) -> list[dict[str, str]]:
+    """Every leaf parameter as text: ``key`` (dotted), ``value`` and ``unit`` (a value left to its rule resolved, in
+    SI), ``source`` (its tag, ``[paper]`` ...), ``note`` (the source's note) and ``meaning`` (the field's one-line
+    description). What :func:`describe` and ``dpgt params`` show."""
     try:
         si = params.si()
     except ParameterError:
@@ -1252,12 +1259,27 @@ def describe(params: Params) -> str:
         owner = params
         for p in owner_path:
             owner = getattr(owner, p)
+        spec = type(owner)._spec(name)
         if v is None:
             resolved = _si_at(si, path) if si is not None else None
-            shown = f"{resolved:.6g} (SI)" if resolved is not None else "(rule)"
+            kind = KINDS.get(spec.kind)
+            value = f"{resolved:.6g}" if isinstance(resolved, (int, float)) else "(rule)"
+            unit = _unit_text(Quantity(1.0, kind.si_unit).units) if kind is not None and resolved is not None else ""
+        elif isinstance(v, Quantity):
+            value, unit = f"{v.magnitude:g}", _unit_text(v.units)
         else:
-            shown = _describe_value(v)
-        rows.append((path, shown, str(owner.source(name))))
+            value, unit = _describe_value(v), ""
+        src = owner.source(name)
+        rows.append({"key": path, "value": value, "unit": unit, "source": f"[{src.tag}]", "note": src.note,
+                     "meaning": " ".join(spec.doc.split()), "shown": (
+                         f"{_si_at(si, path):.6g} (SI)" if v is None and si is not None and _si_at(si, path) is not None
+                         else "(rule)" if v is None else _describe_value(v))})
+    return rows
+
+
+def describe(params: Params) -> str:
+    """A table: dotted path, value (rule-based values resolved, in SI), source tag and note."""
+    rows = [(r["key"], r["shown"], f"{r['source']}" + (f" {r['note']}" if r["note"] else "")) for r in parameter_rows(params)]
     w0 = max(len(r[0]) for r in rows)
     w1 = max(len(r[1]) for r in rows)
     return "\n".join(f"{a:<{w0}}  {b:<{w1}}  {c}" for a, b, c in rows)

@@ -1,9 +1,14 @@
-"""Spectra for the scenarios (the statistics of a run live in components.outputs)."""
+"""Spectra for the scenarios, and the housing sensor's signals of a recorded run (the statistics of a run live in
+components.outputs)."""
 from __future__ import annotations
+
+import json
+from pathlib import Path
 
 import numpy as np
 
-__all__ = ["amplitude_spectrum", "peak_table", "line_table", "sideband_resolution", "MIN_REVOLUTIONS"]
+__all__ = ["amplitude_spectrum", "peak_table", "line_table", "sideband_resolution", "MIN_REVOLUTIONS",
+           "sensor_paths", "sensor_signal", "whole_revolutions"]
 
 MIN_REVOLUTIONS = 3     # carrier revolutions a spectrum needs to tell the f_c sidebands from the band's floor
 
@@ -82,3 +87,52 @@ def sideband_resolution(t: np.ndarray, f_c: float) -> str | None:
     return (f"the spectrum covers {revs:.2g} carrier revolutions (< {MIN_REVOLUTIONS}): its resolution "
             f"{1.0 / span if span > 0 else float('inf'):.3g} Hz cannot tell the f_c = {abs(f_c):.3g} Hz sidebands from "
             f"the floor; its lines mean nothing (a window of at least {MIN_REVOLUTIONS / abs(f_c):.3g} s)")
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# the housing accelerometer of a recorded run (MODEL.md §3.10): what the spectrum and the fault study read
+# ---------------------------------------------------------------------------------------------------------------
+def sensor_paths(path: Path, sensor=None) -> tuple[np.ndarray, dict]:
+    """(t, {"mesh", "torque", "bearing", "housing"}): the housing accelerometer's paths and their sum [m/s^2] at
+    every sample of a run's ``results.nc`` (recorded with ``RunConfig(sensor=True)``), by
+    :func:`components.sensor.paths` from the recorded outer planets' angles and ring-mesh forces and the loads on
+    the housing. ``sensor`` (:class:`components.params.SensorSI`): the run's own (stored with it) unless given.
+    The one place a run's file becomes the sensor's signals: the spectrum and the fault study read through it."""
+    import xarray as xr
+
+    from components.families import MESH_FAMILY
+    from components.sensor import paths, sensor_from_dict
+
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
+        if "housing.force_x" not in ds:
+            raise ValueError(f"{path}: the run recorded no loads on the housing (run it with RunConfig(sensor=True))")
+        sensor = sensor if sensor is not None else sensor_from_dict(json.loads(ds.attrs["sensor"]))
+        t = ds["time"].values
+        bodies = list(ds["motion.body"].values)
+        phi = (ds["fixed.angle"].values[:, list(ds["fixed.body"].values).index("carrier")]
+               - ds["motion.angle"].values[:, bodies.index("carrier")])           # the frame's angle
+        fam = MESH_FAMILY["outer_ring"]
+        P = ds["motion.position"].values[:, [bodies.index(g) for g in ds[f"{fam}.gear1"].values]]
+        psi = np.arctan2(P[..., 1], P[..., 0]) + phi[:, None]
+        c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
+        fx, fy = ds[f"{fam}.fx"].values, ds[f"{fam}.fy"].values                 # on the ring, in R
+        ring = np.stack([c * fx - s * fy, s * fx + c * fy], axis=-1)
+        force = np.column_stack([ds["housing.force_x"].values.sum(axis=1), ds["housing.force_y"].values.sum(axis=1)])
+        torque = ds["housing.torque"].values.sum(axis=1)
+        return t, paths(t, psi, ring, force, torque, sensor)
+
+
+def sensor_signal(path: Path, f_c: float, sensor: str = "housing") -> tuple[np.ndarray, np.ndarray]:
+    """(t, a) of a run's housing sensor (or one of its paths, :func:`sensor_paths`) over the first whole number
+    of carrier revolutions: what every spectrum of the sensor is taken of."""
+    t, signals = whole_revolutions(*sensor_paths(Path(path)), f_c)
+    return t, signals[sensor]
+
+
+def whole_revolutions(t, signals: dict, f_c: float):
+    """The first whole number of carrier revolutions of the samples (all of them if less than one): the
+    lines f_m + k f_c then fall on frequency bins, and the Hann window's leakage stays within ±1 bin."""
+    dt, fc = float(np.median(np.diff(t))), abs(f_c)
+    revs = np.floor(len(t) * dt * fc + 1e-9) if fc > 0 else 0.0
+    n = min(int(round(revs / (fc * dt))), len(t)) if revs >= 1 else len(t)
+    return t[:n], {k: x[:n] for k, x in signals.items()}

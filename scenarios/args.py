@@ -14,16 +14,46 @@ from pathlib import Path
 
 from components.names import argparse_hint, did_you_mean
 
-__all__ = ["Parser", "positive", "nonnegative", "count", "alpha", "conditions", "directions", "existing_file",
-           "quantity_of", "key_value", "scheduler", "out_folder", "choice_list", "float_list"]
+__all__ = ["Parser", "parser", "add_shared", "SHARED", "positive", "nonnegative", "count", "alpha", "conditions",
+           "one_condition", "directions", "existing_file", "quantity_of", "key_value", "scheduler", "out_folder",
+           "choice_list", "float_list", "parse_sets", "switch_value", "scene_options", "invoked_as"]
 
 CONDITIONS = (1, 2, 3, 4)
 DIRECTIONS = ("forward", "reverse")
 
 
+_INVOKED_AS: list[str] = []       # "dpgt" while scenarios.cli runs a command (its usage line then says dpgt NAME)
+
+
+class invoked_as:
+    """Context in which commands name themselves ``PREFIX NAME`` in their usage and examples (``dpgt``)."""
+
+    def __init__(self, prefix: str):
+        self.prefix = prefix
+
+    def __enter__(self):
+        _INVOKED_AS.append(self.prefix)
+
+    def __exit__(self, *exc):
+        _INVOKED_AS.pop()
+
+
+def command_name(name: str) -> str:
+    """How a user calls the scenario ``name`` now: ``dpgt NAME`` under the console command, else
+    ``python -m scenarios.NAME``."""
+    return f"{_INVOKED_AS[-1]} {name}" if _INVOKED_AS else f"python -m scenarios.{name}"
+
+
 class Parser(argparse.ArgumentParser):
     """argparse whose usage errors are one line ``error: ...`` (raised as SystemExit for the command wrapper); an
-    unknown option or an invalid choice names the closest valid ones (:func:`components.names.argparse_hint`)."""
+    unknown option or an invalid choice names the closest valid ones (:func:`components.names.argparse_hint`).
+    A ``prog`` of ``python -m scenarios.NAME`` reads ``dpgt NAME`` when the console command runs it."""
+
+    def __init__(self, *a, **kw):
+        prog = kw.get("prog")
+        if prog and prog.startswith("python -m scenarios."):
+            kw["prog"] = command_name(prog[len("python -m scenarios."):])
+        super().__init__(*a, **kw)
 
     def error(self, message):
         raise SystemExit(f"error: {argparse_hint(self, message)}")
@@ -114,6 +144,18 @@ def conditions(text):
     return ",".join(dict.fromkeys(items))
 
 
+def one_condition(text):
+    """One operating condition 1-4 (a command that runs one at a time): a comma list of more is refused in one
+    line saying so."""
+    items = _items(text, "operating conditions 1-4")
+    if len(items) > 1:
+        raise argparse.ArgumentTypeError(f"this command runs one condition at a time, got {text!r}; run it once "
+                                         f"per condition (each with its own --out)")
+    return count(1, 4)(items[0])
+
+
+one_condition.__name__ = "operating condition"
+
 directions = choice_list(DIRECTIONS, "directions")
 
 
@@ -185,14 +227,108 @@ def out_folder(text):
     return str(p)
 
 
-def add_sweep_options(p, out_default: str) -> None:
-    """The options every study shares: where its runs go (Dask local workers or a scheduler), what may be
-    replaced or forced, progress bars, and its output folder."""
-    p.add_argument("--workers", type=count(1), default=None, help="Dask local workers (default: one per core)")
-    p.add_argument("--scheduler", default=None, type=scheduler, help="address of an existing Dask scheduler")
-    p.add_argument("--force", action="store_true",
-                   help="run although the gears collide or the recording is too large for the limit or the disk")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace finished results of other parameters or settings in --out (else refused)")
-    p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--out", default=out_default, type=out_folder, help="output directory")
+# ---------------------------------------------------------------------------------------------------------------
+# the shared command grammar: one definition of every option the commands share (issue 24 §3)
+# ---------------------------------------------------------------------------------------------------------------
+SHARED = {
+    "conditions": (("--conditions",), dict(type=conditions, metavar="C[,C...]",
+                                            help="comma list of operating conditions 1-4 (PARAMETERS.md; default "
+                                                 "{conditions})")),
+    "params": (("--params",), dict(default=None, type=existing_file, metavar="FILE.toml",
+                                   help="TOML file of parameter overrides, dotted keys as `dpgt params` lists them")),
+    "set": (("--set",), dict(action="append", default=[], metavar="KEY=VALUE", type=key_value,
+                             help='override a parameter, e.g. --set bearing.clearance="30 um" (repeatable; keys, '
+                                  'values, units and sources: `dpgt params`)')),
+    "out": (("--out",), dict(type=out_folder, metavar="DIR", help="output folder (default {out})")),
+    "overwrite": (("--overwrite",), dict(action="store_true",
+                                         help="replace finished results of other parameters or settings in --out "
+                                              "(else refused)")),
+    "force": (("--force",), dict(action="store_true",
+                                 help="run although the gears collide or the recording is too large for the limit "
+                                      "or the disk")),
+    "no-progress": (("--no-progress",), dict(action="store_true",
+                                             help="no progress bars (a log file or a pipe gets plain lines anyway)")),
+    "workers": (("--workers",), dict(type=count(1), default=None, metavar="N",
+                                     help="runs at a time on a local Dask cluster (default: one per core, at most "
+                                          "one per run)")),
+    "scheduler": (("--scheduler",), dict(default=None, type=scheduler, metavar="ADDR",
+                                         help="address of an existing Dask scheduler, e.g. tcp://host:8786 "
+                                              "(default: a local cluster)")),
+}
+SHARED_TITLE = "shared options (the same name, default and meaning in every dpgt command)"
+SWEEP = ("conditions", "params", "set", "out", "overwrite", "force", "no-progress", "workers", "scheduler")
+
+
+def add_shared(p, *names: str, out: str | None = None, conditions: str | None = None,
+               one_condition_only: bool = False) -> None:
+    """Add the shared options ``names`` (keys of :data:`SHARED`; default: all of them) to the parser ``p``, with
+    one help text each. ``out``: the command's default output folder; ``conditions``: its default conditions;
+    ``one_condition_only``: the command runs one condition (``--condition`` then stays as the former spelling)."""
+    g = p.add_argument_group(SHARED_TITLE)
+    for name in names or SWEEP:
+        flags, kw = SHARED[name]
+        kw = dict(kw)
+        if name == "out":
+            kw["default"] = out
+            kw["help"] = kw["help"].format(out=out)
+        elif name == "conditions":
+            kw["default"] = conditions
+            if one_condition_only:
+                flags = (*flags, "--condition")
+                kw.update(type=one_condition, metavar="C",
+                          help=f"operating condition 1-4, one (PARAMETERS.md; default {conditions}; --condition: "
+                               f"the former spelling, still accepted)")
+            else:
+                kw["help"] = kw["help"].format(conditions=conditions)
+        g.add_argument(*flags, **kw)
+
+
+def parser(name: str, doc: str, *, examples: list[str], writes: str, out: str | None) -> Parser:
+    """The parser of the scenario ``name``: its description (the first paragraph of ``doc``), and after the
+    options its examples (``{prog}`` stands for the command), what it writes and its default output folder."""
+    prog = command_name(name)
+    ex = "\n".join(f"  {e.format(prog=prog)}" for e in examples)
+    wrapped = "\n".join("  " + line for line in _wrap(writes))
+    where = f"writes (into --out, default {out}):" if out else "writes:"
+    return Parser(prog=f"python -m scenarios.{name}", description=" ".join(doc.strip().split("\n\n")[0].split()),
+                  epilog=f"examples:\n{ex}\n\n{where}\n{wrapped}" + (f"\n\ndefault --out: {out}" if out else ""),
+                  formatter_class=argparse.RawDescriptionHelpFormatter)
+
+
+def _wrap(text: str, width: int = 100) -> list[str]:
+    import textwrap
+
+    return textwrap.wrap(" ".join(text.split()), width - 2)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# values of repeated KEY=VALUE options
+# ---------------------------------------------------------------------------------------------------------------
+def parse_sets(items: list[str]) -> dict:
+    """``--set``/``--option`` items KEY=VALUE -> {key: value}; quotes around a value dropped, whole numbers as int
+    (counts: planets, rollers)."""
+    out = {}
+    for it in items:
+        if "=" not in it:
+            raise SystemExit(f"error: --set expects KEY=VALUE (e.g. bearing.clearance=\"30 um\"), got {it!r}")
+        k, v = it.split("=", 1)
+        v = v.strip().strip('"').strip("'")
+        out[k.strip()] = int(v) if v.lstrip("+-").isdigit() else v   # counts (planets, rollers) are integers
+    return out
+
+
+def switch_value(v: str):
+    """A scene switch's value: true/yes/on/1 and false/no/off/0 as booleans, anything else as given."""
+    lv = v.strip().lower()
+    if lv in ("true", "yes", "on", "1"):
+        return True
+    if lv in ("false", "no", "off", "0"):
+        return False
+    return v
+
+
+def scene_options(items: list[str]):
+    """``--option KEY=VALUE`` items -> :class:`components.scene.SceneOptions`."""
+    from components.scene import SceneOptions
+
+    return SceneOptions.from_dict({k: switch_value(str(v)) for k, v in parse_sets(items).items()})

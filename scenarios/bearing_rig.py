@@ -27,8 +27,14 @@ from .runner import accuracy_line
 ATOL = mbd.PRODUCTION.atol_pos     # the rig runs the production stepper (components.rig.rig_static_solution)
 
 
+EXAMPLES = ['{prog} --radial-load "10 kN" --clearance "20 um" --out results/rig', "{prog} --cage free --speed \"3000 rpm\"",
+            '{prog} --params my_bearing.toml --set bearing.contact_damping_ratio=0.05']
+WRITES = ("summary.json (roller loads against their angle from the load-zone centre, Q_max, Q_max·Z/F_r, load zone, "
+          "ring deflection, the classical discrete-roller solution) and load_distribution.png")
+
+
 def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.bearing_rig", description=__doc__.split("\n\n")[0])
+    p = args.parser("bearing_rig", __doc__, examples=EXAMPLES, writes=WRITES, out="results/bearing_rig")
     p.add_argument("--radial-load", default="10 kN", type=args.quantity_of("force", positive_only=True), help='radial load on the outer ring (default "10 kN")')
     p.add_argument("--clearance", default=None, type=args.quantity_of("length"), help='diametral clearance P_d (default: preset, "20 um")')
     p.add_argument("--rollers", type=args.count(3), default=None, help="number of rollers Z (default 12)")
@@ -38,8 +44,19 @@ def parse_args(argv):
     p.add_argument("--speed", default="0 rpm", type=args.quantity_of("angular_velocity"), help='outer ring speed (default "0 rpm": static)')
     p.add_argument("--cage", default="held", choices=["held", "free", "none"], help="cage held (default), free or absent")
     p.add_argument("--no-drag", action="store_true", help="switch lubricant drag off")
-    p.add_argument("--out", default="results/bearing_rig", type=args.out_folder)
+    # the bearing's parameters (bearing.*) from a file or --set; the options above win over them
+    args.add_shared(p, "params", "set", "out", out="results/bearing_rig")
     return p.parse_args(argv)
+
+
+def _file_overrides(path) -> dict:
+    from components.params import overrides_from_toml
+    from components.units import ParameterError
+
+    try:
+        return overrides_from_toml(Path(path).read_text(encoding="utf-8")) if path else {}
+    except (ParameterError, ValueError) as exc:          # not TOML, not UTF-8
+        raise SystemExit(f"error: --params {path}: {exc}".splitlines()[0]) from None
 
 
 def run(a) -> dict:
@@ -55,7 +72,7 @@ def run(a) -> dict:
                             "bearing.roller_diameter": a.roller_diameter, "bearing.roller_length": a.roller_length,
                             "bearing.pitch_diameter": a.pitch_diameter}.items() if v is not None}
     try:
-        params = with_overrides(reference_dpgt(), ov)
+        params = with_overrides(reference_dpgt(), {**_file_overrides(a.params), **args.parse_sets(a.set), **ov})
         F = to_si(quantity("radial_load", a.radial_load, "force"))
         w = to_si(quantity("speed", a.speed, "angular_velocity"))
         if F <= 0:

@@ -172,7 +172,8 @@ def agreement(hht: dict, radau: dict, model: mbd.Model) -> float:
 
 @command
 def main(argv=None) -> int:
-    p = args.Parser(prog="python -m scenarios.bench_engine", description=__doc__.splitlines()[0])
+    p = args.parser("bench_engine", __doc__, examples=["{prog}", "{prog} --chain --sizes 10 50 --repeats 3", "{prog} --json bench.json"],
+                     writes="a table on the screen; with --json the results to that JSON file", out=None)
     p.add_argument("--sizes", type=args.count(1), nargs="+", default=[10, 50, 100, 250], help="numbers of bodies M")
     p.add_argument("--steps", type=args.count(1), default=2000, help="HHT steps of h = 5 µs")
     p.add_argument("--repeats", type=args.count(1), default=3, help="HHT repeats (the median is reported)")

@@ -47,7 +47,7 @@ from components.outputs import FAMILY
 from components.presets import reference_dpgt
 
 from .numerics_common import (design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note,
-                              observables, peak_rss_mb, run_hht, run_scipy, settled_state, warm_up)
+                              observables, peak_rss_mb, run_hht, run_scipy, settled_state, warm_up, hht_reference)
 from . import args
 from .command import command
 
@@ -91,8 +91,7 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
         f"{c['newton'] / run.steps:.2f} Newton/step, {c['factor']} LU, {c['jacobian']} Jacobians, {c['rejected']} rejected")
     obs = observables(prob, sub, run.q, run.v, run.z)
     # the reference gets the 100x tighter Newton tolerance of the work-precision reference
-    from .work_precision import _hht_tight
-    ref = _hht_tight(prob, s0, t0 + ref_window, sub, h / 8)
+    ref = hht_reference(prob, s0, t0 + ref_window, sub, h / 8)
     ref_obs = observables(prob, sub, ref.q, ref.v, ref.z)
     err = error_metrics(obs, ref_obs)
     log(f"error vs reference (h/8) over {ref_window:g} s: RMS inner-race load {err['err_rms_inner']:.2e}, "
@@ -149,7 +148,6 @@ def stiff_comparison(factors, settle: float, window: float, scipy_methods, scipy
     residual, with every bearing contact stiffness (roller–raceway, pocket, guide land) × ``factor``: each
     settles for ``settle`` s, then both integrate ``window`` s; errors of the RMS roller–inner-race load
     against a tight HHT reference (α = −0.1, h = 0.5 µs / √factor)."""
-    from .work_precision import _hht_tight
     base = reference_dpgt(3, "forward").si().bearing
     rows = []
     for f in factors:
@@ -161,7 +159,7 @@ def stiff_comparison(factors, settle: float, window: float, scipy_methods, scipy
         grid = _grid(s0.t, s0.t + window)
         P = mbd.PRODUCTION
         hht = run_hht(prob, s0, grid[-1], grid, alpha=P.alpha, atol_pos=P.atol_pos, h_max=P.h_max / np.sqrt(f))
-        ref = _hht_tight(prob, s0, grid[-1], grid, 5e-7 / np.sqrt(f))
+        ref = hht_reference(prob, s0, grid[-1], grid, 5e-7 / np.sqrt(f))
         ref_obs = observables(prob, grid, ref.q, ref.v, ref.z)
         err = lambda r: error_metrics(observables(prob, grid, r.q, r.v, r.z), ref_obs)["err_rms_inner"]  # noqa: E731
         row = {"factor": f, "hht_wall_s": hht.wall_s, "hht_steps": hht.steps, "hht_completed": hht.completed,
@@ -265,7 +263,8 @@ def _factors(text: str) -> list[float]:
 
 @command
 def main(argv=None) -> int:
-    ap = args.Parser(prog="python -m scenarios.benchmark", description=__doc__.splitlines()[0])
+    ap = args.parser("benchmark", __doc__, examples=["{prog} --out results/numerics", "{prog} --window 0.02 --scipy-methods Radau --json"],
+                      writes="benchmark.json (and the settled state dpgt_settled.npz, shared with work_precision); --json prints it as the last line", out="results/numerics")
     ap.add_argument("--json", action="store_true", help="print one JSON object on the last line")
     ap.add_argument("--window", type=args.positive("s"), default=0.1, help="simulated window after settling [s]")
     ap.add_argument("--ref-window", type=args.positive("s"), default=0.01, help="sub-window for the error and scipy [s]")
@@ -284,7 +283,7 @@ def main(argv=None) -> int:
     ap.add_argument("--profile", action="store_true", help="print the cProfile top entries (2 ms of the window)")
     ap.add_argument("--scaling", action="store_true", help="cost per step against N·Z")
     ap.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="settling time before the window [s]")
-    ap.add_argument("--out", default="results/numerics", type=args.out_folder)
+    args.add_shared(ap, "out", out="results/numerics")
     a = ap.parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -11,9 +11,11 @@ import sys
 
 from components.names import did_you_mean
 
+from . import args
 from .command import command
 
 SCENARIOS = {
+    "params": "every parameter key with its value, unit, source tag and meaning (--grep WORD)",
     "demo": "the default job: forward vs reverse study at condition 3 (what `make demo` runs)",
     "paper_study": "forward/reverse study over operating conditions, comparison tables and plots",
     "lubricant_study": "which oil for which direction: film, traction, cage slip and heat against viscosity",
@@ -53,7 +55,8 @@ def main(argv=None) -> int:
         return 2
     mod = importlib.import_module("viz.cli" if name == "animate" else f"scenarios.{name}")
     main = mod.main if hasattr(mod.main, "__wrapped__") else command(mod.main)   # viz's too: one-line errors
-    return main(rest)
+    with args.invoked_as("dpgt"):        # usage lines and examples say `dpgt NAME`
+        return main(rest)
 
 
 if __name__ == "__main__":

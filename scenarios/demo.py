@@ -11,15 +11,20 @@ import sys
 from . import paper_study
 from .command import command
 
+EXAMPLES = ["{prog}", "{prog} --out results/demo --workers 2", '{prog} --set bearing.clearance="30 um" --out results/demo_30um']
+
+
+def build_parser():
+    """The paper study's options, with the demo's defaults: condition 3, both directions, the animation."""
+    p = paper_study.build_parser("demo", out="results/demo", doc=__doc__, examples=EXAMPLES)
+    p.set_defaults(animate=True)
+    return p
+
 
 @command
 def main(argv=None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
-    if any(a in ("-h", "--help") for a in argv):
-        print(__doc__)
-        return paper_study.main(["--help"])
-    defaults = ["--conditions", "3", "--directions", "forward,reverse", "--animate"]
-    return paper_study.main(defaults + argv)
+    a = build_parser().parse_args(list(sys.argv[1:] if argv is None else argv))
+    return paper_study.finish(paper_study.run(a))
 
 
 if __name__ == "__main__":

@@ -1,9 +1,9 @@
 """What errors and faults do to the planet bearings and to the rig's sensor (MODEL.md §3.9–3.10).
 
-    python -m scenarios.fault_study [--condition 2] [--directions forward,reverse]
+    python -m scenarios.fault_study [--conditions 2] [--directions forward,reverse]
         [--faults pinhole,runout,roller,spall_pin,spall_bore,cracked_tooth,missing_tooth]
         [--machine NAME=FILE.toml ...] [--settle S] [--window S] [--sample-rate HZ]
-        [--set KEY=VALUE ...] [--workers N | --scheduler ADDR] [--force] [--overwrite] [--out DIR]
+        [--params FILE.toml] [--set KEY=VALUE ...] [--workers N | --scheduler ADDR] [--force] [--overwrite] [--out DIR]
 
 Every fault (the catalogue :data:`FAULTS`, each a stated size with its basis; or a damaged machine described
 in a TOML file, README "A damaged machine") runs beside the perfect machine in every direction, through the
@@ -22,9 +22,7 @@ from __future__ import annotations
 
 import argparse
 import csv
-import dataclasses
 import io
-import json
 import sys
 from pathlib import Path
 
@@ -38,11 +36,10 @@ from mbd.recorder import atomic_write_text
 from . import args
 from .command import command
 from .lock import holds_out_folder
-from .paper_study import parse_sets
-from .plausibility import check_runs
 from .runner import RunConfig
 from .analysis import line_table
-from .sweep import Case, build_params, check_folders, run_sweep, study_epilogue, user_overrides, validate_cases
+from .study import Study, StudyRun
+from .sweep import Case, build_params, user_overrides
 
 __all__ = ["FAULTS", "main", "run", "characteristic_frequencies", "COLUMNS"]
 
@@ -74,10 +71,17 @@ COLUMNS = ["fault", "direction", "bearing", "load_sharing_factor", "bearing_load
            "sensor_own", "own_frequency", "notes"]
 
 
+EXAMPLES = ["{prog} --faults cracked_tooth,spall_pin --directions forward --out results/faults",
+            "{prog} --conditions 2 --machine bent=bent_carrier.toml --faults ''",
+            '{prog} --set bearing.clearance="30 um" --workers 2']
+WRITES = ("{fault}_{direction}/{results.nc, summary.json} per run (perfect_{direction} the perfect machine); "
+          "summary.csv and summary.md (per run and bearing type: load sharing, bearing and roller loads, lives, cage "
+          "slip, pocket impacts, the housing sensor's lines over the floor); findings.md (the table in words); "
+          "loads.png, spectra.png, study.json")
+
+
 def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.fault_study", description=__doc__.split("\n\n")[0])
-    p.add_argument("--condition", type=args.count(1, 4), default=2,
-                   help="operating condition 1-4 (default 2: carrier 2000 r/min, the source's rig speed)")
+    p = args.parser("fault_study", __doc__, examples=EXAMPLES, writes=WRITES, out="results/faults")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     p.add_argument("--faults", default=",".join(FAULTS), type=_fault_list,
                    help=f"comma list from {', '.join(FAULTS)} ('' for none: only --machine)")
@@ -87,9 +91,8 @@ def parse_args(argv):
     p.add_argument("--window", type=args.positive("s"), default=0.1,
                    help="seconds analysed (default 0.1: 10 Hz resolution, the f_c sidebands at 2000 r/min)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz] (> 2 f_m)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
-                   help="override a parameter (repeatable)")
-    args.add_sweep_options(p, "results/faults")
+    # one condition per study: its folders are named by machine and direction
+    args.add_shared(p, out="results/faults", conditions="2", one_condition_only=True)
     return p.parse_args(argv)
 
 
@@ -113,7 +116,7 @@ def make_cases(a, out: Path) -> list[Case]:
     """The perfect machine, each catalogue fault and each ``--machine`` in every direction. The sweep owns the
     operating point and the errors: ``--set`` may not touch either, a machine's file not the operating point,
     and a machine may not take the name of the perfect machine or of a catalogue fault."""
-    operating = {"operating.carrier_speed": "--condition", "operating.output_power": "--condition",
+    operating = {"operating.carrier_speed": "--conditions", "operating.output_power": "--conditions",
                  "operating.direction": "--directions"}
     machines: dict[str, tuple[dict, str | None]] = {"perfect": ({}, None)}
     machines.update({f: (FAULTS[f][0], None) for f in a.faults})
@@ -123,8 +126,11 @@ def make_cases(a, out: Path) -> list[Case]:
             raise SystemExit(f"error: --machine {name}={path}: the name {name!r} is {what}'s; choose another")
         user_overrides({}, str(path), operating)
         machines[name] = ({}, str(path))
-    user = user_overrides(parse_sets(a.set), None, {**operating, "errors": "--faults or --machine NAME=FILE.toml"})
-    return [Case(a.condition, d, str(out / f"{name}_{d}"), {**user, **ov}, path, tag=name)
+    # --params holds what every machine shares (not its errors): read into the overrides, so that a machine's own
+    # file can sit beside it
+    user = user_overrides(args.parse_sets(a.set), a.params, {**operating, "errors": "--faults or --machine NAME=FILE.toml"},
+                          merge_file=True)
+    return [Case(int(a.conditions), d, str(out / f"{name}_{d}"), {**user, **ov}, path, tag=name)
             for name, (ov, path) in machines.items() for d in a.directions.split(",")]
 
 
@@ -165,8 +171,7 @@ def _own_frequency(case: Case, si, fr: dict) -> float | None:
 def sensor_spectrum(run_dir: Path, f_c: float):
     """(f, amplitude, why) of the recorded housing sensor of a run (scenarios.spectrum's definition); ``why`` says
     why its lines mean nothing (too few carrier revolutions), None when they do."""
-    from .spectrum import sensor_signal
-    from .analysis import amplitude_spectrum, sideband_resolution
+    from .analysis import amplitude_spectrum, sensor_signal, sideband_resolution
 
     t, x = sensor_signal(run_dir / "results.nc", f_c)
     f, amp, _ = amplitude_spectrum(t, x)
@@ -212,7 +217,8 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
     return rows, spectra
 
 
-def write_outputs(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
+def write_tables(rows: list[dict], out: Path) -> list[Path]:
+    """summary.csv, summary.md and findings.md."""
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=COLUMNS)
     w.writeheader()
@@ -223,15 +229,24 @@ def write_outputs(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
     md += ["| " + " | ".join(fmt(r[c]) for c in COLUMNS) + " |" for r in rows]
     atomic_write_text(out / "summary.md", "\n".join(md) + "\n")
     atomic_write_text(out / "findings.md", findings(rows) + "\n")
+    return [out / "summary.csv", out / "summary.md", out / "findings.md"]
+
+
+def plots(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
+    """loads.png and (with a perfect machine to compare against) spectra.png."""
     from viz.plots import fault_loads, fault_spectra
 
-    files = [out / "summary.csv", out / "summary.md", out / "findings.md",
-             fault_loads(rows, out / "loads.png", title="What each fault does to the planet bearings (pair 1)")]
+    files = [fault_loads(rows, out / "loads.png", title="What each fault does to the planet bearings (pair 1)")]
     panels = _spectrum_panels(spectra)
     if panels:
         files.append(fault_spectra(panels, out / "spectra.png",
                                    title="The housing sensor around the mesh frequency: each fault against the perfect machine"))
     return files
+
+
+def write_outputs(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
+    """The tables and the figures (module docstring)."""
+    return write_tables(rows, out) + plots(rows, spectra, out)
 
 
 SENSOR_LINES = ("sensor_f_m", "sensor_f_m-1f_c", "sensor_f_m+1f_c", "sensor_f_m-3f_c", "sensor_f_m+3f_c", "sensor_own")
@@ -289,26 +304,41 @@ def _spectrum_panels(spectra: dict) -> list[tuple]:
     return panels
 
 
+class FaultStudy(Study):
+    """The perfect machine, each fault and each damaged machine in every direction
+    (:class:`scenarios.study.Study`): per damaged machine a line first, then the tables and the figures."""
+
+    def config(self) -> RunConfig:
+        a = self.a
+        return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
+                         progress=not a.no_progress, sensor=True)
+
+    def cases(self) -> list[Case]:
+        return make_cases(self.a, self.out)
+
+    def check(self, case: Case, cfg: RunConfig) -> None:
+        _check_case(case, cfg)
+
+    def study_record(self) -> dict:
+        return {"faults": {k: v[1] for k, v in FAULTS.items()}}
+
+    def report(self, run: StudyRun) -> dict:
+        rows, spectra = rows_of(run.cases, run.results)
+        for row in rows:                     # the headline first
+            if row["bearing"] == "outer":
+                print(f"{row['fault']:>14} {row['direction']:>8}: K_γ {row['load_sharing_factor']:.3f}, "
+                      f"max bearing load {row['bearing_load_max_N']:.0f} N, life {row['life_relative'] or float('nan'):.2f}, "
+                      + (f"sensor f_m / floor {row['sensor_f_m']:.3g}" if row["sensor_f_m"] is not None
+                         else "sensor lines not meaningful (too short a window)"))
+        if rows:
+            run.step("tables", write_tables, rows, self.out)
+            run.step("figures", plots, rows, spectra, self.out)
+        return {"rows": rows}
+
+
 @holds_out_folder
 def run(a) -> dict:
-    out = Path(a.out)
-    cases = make_cases(a, out)
-    cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
-                    progress=not a.no_progress, sensor=True)
-    validate_cases(cases, lambda c: _check_case(c, cfg))     # every parameter checked before any run starts
-    out.mkdir(parents=True, exist_ok=True)
-    for w in check_runs([(c.label, build_params(c), cfg) for c in cases], out, a.force):
-        print(f"warning (--force): {w}")
-    check_folders(cases, cfg, a.overwrite)   # never replace results of other parameters silently
-    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
-                        overwrite=a.overwrite)
-    rows, spectra = rows_of(cases, results)
-    files = write_outputs(rows, spectra, out) if rows else []
-    failed = {k: v["error"] for k, v in results.items() if "error" in v}
-    atomic_write_text(out / "study.json", json.dumps({"cases": [dataclasses.asdict(c) for c in cases],
-                                                      "faults": {k: v[1] for k, v in FAULTS.items()},
-                                                      "failed": failed}, indent=2, default=str))
-    return {"rows": rows, "failed": failed, "files": files, "results": results}
+    return FaultStudy(a).run()
 
 
 def _check_case(case: Case, cfg: RunConfig) -> None:
@@ -322,14 +352,7 @@ def _check_case(case: Case, cfg: RunConfig) -> None:
 
 @command
 def main(argv=None) -> int:
-    r = run(parse_args(sys.argv[1:] if argv is None else argv))
-    for row in r["rows"]:
-        if row["bearing"] == "outer":
-            print(f"{row['fault']:>14} {row['direction']:>8}: K_γ {row['load_sharing_factor']:.3f}, "
-                  f"max bearing load {row['bearing_load_max_N']:.0f} N, life {row['life_relative'] or float('nan'):.2f}, "
-                  + (f"sensor f_m / floor {row['sensor_f_m']:.3g}" if row["sensor_f_m"] is not None
-                     else "sensor lines not meaningful (too short a window)"))
-    return study_epilogue(r)
+    return Study.exit_code(run(parse_args(sys.argv[1:] if argv is None else argv)))
 
 
 if __name__ == "__main__":

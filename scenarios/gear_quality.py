@@ -20,9 +20,7 @@ from __future__ import annotations
 
 import argparse
 import csv
-import dataclasses
 import io
-import json
 import sys
 from pathlib import Path
 
@@ -34,10 +32,9 @@ from mbd.recorder import atomic_write_text
 from . import args
 from .command import command
 from .lock import holds_out_folder
-from .paper_study import parse_sets
-from .plausibility import check_runs
 from .runner import RunConfig
-from .sweep import OPERATING_AXES, Case, build_params, check_folders, run_sweep, study_epilogue, user_overrides, validate_cases
+from .study import Study, StudyRun
+from .sweep import OPERATING_AXES, Case, user_overrides
 
 __all__ = ["main", "run", "make_cases", "rows_of", "by_grade", "findings", "QUANTITIES", "MESHES"]
 
@@ -58,9 +55,16 @@ COLUMNS = (["condition", "direction", "grade", "seed", "bearing", *QUANTITIES]
            + [f"{k}_{m}" for m in MESHES for k in ("dynamic_factor", "te_p2p_um")])
 
 
+EXAMPLES = ["{prog} --conditions 3 --grades 6 --seeds 1 --out results/gear_quality",
+            "{prog} --conditions 1,2,3,4 --grades 5,6,8 --seeds 1,2,3 --workers 2",
+            "{prog} --params my_machine.toml --grades 8 --systematic-share 0.2"]
+WRITES = ("c{condition}_{direction}_{perfect|class{G}_seed{S}}/{results.nc, summary.json} per run; runs.csv (a "
+          "row per run and bearing type), by_grade.csv (per class the mean over the seeds and their range, the "
+          "forward/reverse change), findings.md (the answer in words, also printed), quality.png, study.json")
+
+
 def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.gear_quality", description=__doc__.split("\n\n")[0])
-    p.add_argument("--conditions", default="1,2,3,4", type=args.conditions, help="comma list of conditions 1-4")
+    p = args.parser("gear_quality", __doc__, examples=EXAMPLES, writes=WRITES, out="results/gear_quality")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     p.add_argument("--grades", default="5,6,8", type=_int_list(1, 11, "flank tolerance classes"),
                    help="ISO 1328-1:2013 flank tolerance classes 1..11 (default 5,6,8)")
@@ -70,9 +74,7 @@ def parse_args(argv):
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded (default 0.03)")
     p.add_argument("--window", type=args.positive("s"), default=None,
                    help="seconds analysed (default: the paper study's, whole cage revolutions)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
-                   help="override a parameter (repeatable)")
-    args.add_sweep_options(p, "results/gear_quality")
+    args.add_shared(p, out="results/gear_quality", conditions="1,2,3,4")
     return p.parse_args(argv)
 
 
@@ -104,7 +106,7 @@ def _tag(grade, seed) -> str:
 
 def make_cases(a, out: Path) -> list[Case]:
     """Perfect teeth, and every class × seed, at every condition and direction."""
-    user = user_overrides(parse_sets(a.set), None, {**OPERATING_AXES, "errors.flank_class": "--grades and --seeds"})
+    user = user_overrides(args.parse_sets(a.set), a.params, {**OPERATING_AXES, "errors.flank_class": "--grades and --seeds"})
     machines = [(None, None)] + [(g, s) for g in a.grades for s in a.seeds]
     cases = []
     for c in (int(x) for x in a.conditions.split(",")):
@@ -114,7 +116,7 @@ def make_cases(a, out: Path) -> list[Case]:
                 if g is not None:
                     ov["errors.flank_class"] = [{"gear": "all", "grade": g, "seed": s,
                                                  "systematic_share": a.systematic_share}]
-                cases.append(Case(c, d, str(out / f"c{c}_{d}_{_tag(g, s)}"), ov, tag=_tag(g, s)))
+                cases.append(Case(c, d, str(out / f"c{c}_{d}_{_tag(g, s)}"), ov, a.params, tag=_tag(g, s)))
     return cases
 
 
@@ -222,42 +224,55 @@ def _write_csv(path: Path, rows: list[dict], columns=None) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-def write_outputs(rows: list[dict], out: Path) -> list[Path]:
-    from viz.plots import gear_quality
-
+def write_tables(rows: list[dict], out: Path) -> list[Path]:
+    """runs.csv, by_grade.csv and findings.md."""
     groups = by_grade(rows)
     _write_csv(out / "runs.csv", rows, COLUMNS)
     _write_csv(out / "by_grade.csv", groups)
     atomic_write_text(out / "findings.md", findings(groups) + "\n")
-    return [out / "runs.csv", out / "by_grade.csv", out / "findings.md", gear_quality(groups, out / "quality.png")]
+    return [out / "runs.csv", out / "by_grade.csv", out / "findings.md"]
+
+
+def plot(rows: list[dict], out: Path) -> list[Path]:
+    """quality.png."""
+    from viz.plots import gear_quality
+
+    return [gear_quality(by_grade(rows), out / "quality.png")]
+
+
+def write_outputs(rows: list[dict], out: Path) -> list[Path]:
+    """The tables and the figure (module docstring)."""
+    return write_tables(rows, out) + plot(rows, out)
+
+
+class GearQualityStudy(Study):
+    """Perfect teeth and every class × seed at every condition and direction (:class:`scenarios.study.Study`):
+    the findings first, then the tables and the figure."""
+
+    def config(self) -> RunConfig:
+        a = self.a
+        return RunConfig(settle=a.settle, window=a.window, integration=mbd.PRODUCTION, progress=not a.no_progress)
+
+    def cases(self) -> list[Case]:
+        return make_cases(self.a, self.out)
+
+    def report(self, run: StudyRun) -> dict:
+        rows = rows_of(run.cases, run.results)
+        if rows:
+            print(findings(by_grade(rows)))      # the headline first
+            run.step("tables", write_tables, rows, self.out)
+            run.step("figures", plot, rows, self.out)
+        return {"rows": rows}
 
 
 @holds_out_folder
 def run(a) -> dict:
-    out = Path(a.out)
-    cases = make_cases(a, out)
-    cfg = RunConfig(settle=a.settle, window=a.window, integration=mbd.PRODUCTION, progress=not a.no_progress)
-    validate_cases(cases)                    # every parameter checked before any run starts
-    out.mkdir(parents=True, exist_ok=True)
-    for w in check_runs([(c.label, build_params(c), cfg) for c in cases], out, a.force):
-        print(f"warning (--force): {w}")
-    check_folders(cases, cfg, a.overwrite)
-    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
-                        overwrite=a.overwrite)
-    rows = rows_of(cases, results)
-    files = write_outputs(rows, out) if rows else []
-    failed = {k: v["error"] for k, v in results.items() if "error" in v}
-    atomic_write_text(out / "study.json", json.dumps({"cases": [dataclasses.asdict(c) for c in cases],
-                                                      "failed": failed}, indent=2, default=str))
-    return {"rows": rows, "failed": failed, "files": files, "results": results}
+    return GearQualityStudy(a).run()
 
 
 @command
 def main(argv=None) -> int:
-    r = run(parse_args(sys.argv[1:] if argv is None else argv))
-    if r["files"]:
-        print((Path(r["files"][2])).read_text())
-    return study_epilogue(r)
+    return Study.exit_code(run(parse_args(sys.argv[1:] if argv is None else argv)))
 
 
 if __name__ == "__main__":

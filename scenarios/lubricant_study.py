@@ -23,9 +23,7 @@ so whether reverse wants a stronger oil, and by how much.
 from __future__ import annotations
 
 import csv
-import dataclasses
 import io
-import json
 import math
 import sys
 from pathlib import Path
@@ -41,10 +39,9 @@ from components.units import ParameterError, quantity, to_si
 from mbd.elements.ehl import FILM_MIN_U_EXPONENT, thermal_factor
 from mbd.recorder import atomic_write_text
 
-from .paper_study import parse_sets
 from .runner import RunConfig
-from .plausibility import check_runs
-from .sweep import OPERATING_AXES, Case, _case_cfg, build_params, check_folders, run_sweep, study_epilogue, user_overrides, validate_cases
+from .study import Study, StudyRun
+from .sweep import OPERATING_AXES, Case, build_params, user_overrides
 from . import args
 from .command import command
 from .lock import holds_out_folder
@@ -62,9 +59,17 @@ _FROM_SUMMARY = {"h_min_m": "film_min_m", "h_mean_m": "film_mean_m", "h_min_isot
                  "thermal_factor_min": "film_thermal_factor_min", "thermal_loading_max": "film_thermal_loading_max"}
 
 
+EXAMPLES = ["{prog} --conditions 3 --out results/lubricant",
+            "{prog} --conditions 1,2,3,4 --grades VG32,VG68,VG150,VG220 --workers 2",
+            '{prog} --viscosities "10,30,100 mPa*s" --directions reverse']
+WRITES = ("c{condition}_{direction}_{oil}/{results.nc, summary.json} per run; summary.csv and summary.md (a row "
+          "per run and bearing type: film with and without its thermal reduction, Λ and its regime, traction, "
+          "loads, cage guide, cage slip, pocket impacts, heat); answer.md (the answer in words, also printed); "
+          "film_and_slip.png; study.json")
+
+
 def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.lubricant_study", description=__doc__.split("\n\n")[0])
-    p.add_argument("--conditions", default="3", type=args.conditions, help="comma list of operating conditions 1-4 (default 3)")
+    p = args.parser("lubricant_study", __doc__, examples=EXAMPLES, writes=WRITES, out="results/lubricant")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--grades", default=None, type=args.choice_list(tuple(OIL_GRADES), "ISO VG grades"),
@@ -74,9 +79,7 @@ def parse_args(argv):
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded after the start (default 0.03)")
     p.add_argument("--window", type=args.positive("s"), default=None, help="statistics window [s] (default: the study's rule)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=2000.0, help="recording rate [Hz] (statistics use every step)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="override a parameter (repeatable)")
-    p.add_argument("--params", default=None, type=args.existing_file, help="TOML file of parameter overrides")
-    args.add_sweep_options(p, "results/lubricant")
+    args.add_shared(p, out="results/lubricant", conditions="3")
     return p.parse_args(argv)
 
 
@@ -109,7 +112,7 @@ def make_cases(a, out: Path) -> list[Case]:
     oils = "--grades or --viscosities"
     owned = {**OPERATING_AXES, "lubricant.viscosity_40": oils, "lubricant.viscosity_100": oils,
              "lubricant.oil_viscosity": oils}
-    user = {"bearing.traction_law": "ehl", **user_overrides(parse_sets(a.set), a.params, owned)}
+    user = {"bearing.traction_law": "ehl", **user_overrides(args.parse_sets(a.set), a.params, owned)}
     return [Case(c, d, str(out / f"c{c}_{d}_{lab}"), {**user, **ov}, a.params, tag=lab)
             for lab, ov in lubricants(a).items() for c in conds for d in dirs]
 
@@ -189,7 +192,8 @@ def _eta(rows, lab) -> float:
     return next(r["viscosity_Pa_s"] for r in rows if r["lubricant"] == lab)
 
 
-def write_outputs(rows: list[dict], out: Path) -> list[Path]:
+def write_tables(rows: list[dict], out: Path) -> list[Path]:
+    """summary.csv, summary.md and answer.md."""
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=COLUMNS)
     w.writeheader()
@@ -199,8 +203,12 @@ def write_outputs(rows: list[dict], out: Path) -> list[Path]:
     md += ["| " + " | ".join(f"{r[c]:.4g}" if isinstance(r[c], float) else str(r[c]) for c in COLUMNS) + " |"
            for r in rows]
     atomic_write_text(out / "summary.md", "\n".join(md) + "\n")
-    text = answer(rows)
-    atomic_write_text(out / "answer.md", text + "\n")
+    atomic_write_text(out / "answer.md", answer(rows) + "\n")
+    return [out / "summary.csv", out / "summary.md", out / "answer.md"]
+
+
+def plot(rows: list[dict], out: Path) -> list[Path]:
+    """film_and_slip.png: Λ, film, cage slip and traction heat against the viscosity."""
     from viz.plots import against_viscosity
 
     series = {}
@@ -209,44 +217,52 @@ def write_outputs(rows: list[dict], out: Path) -> list[Path]:
             x, y = series.setdefault((key, r["bearing"], r["direction"]), ([], []))
             x.append(r["viscosity_Pa_s"])
             y.append(r[key])
-    fig = against_viscosity(series, [("lambda_min", "film parameter Λ_min = h_min/σ", "1", True),
-                                     ("h_min_m", "thinnest film h_min", "m", True),
-                                     ("cage_slip_pct", "cage slip", "%", False),
-                                     ("heat_traction_W", "traction heat", "W", False)],
-                            out / "film_and_slip.png",
-                            title="Film and cage against the oil's viscosity (at the operating temperature)",
-                            names={r["lubricant"]: r["viscosity_Pa_s"] for r in rows},
-                            levels={"lambda_min": {1.0: "Λ = 1: below, boundary-dominated",
-                                                   FULL_FILM_LAMBDA: f"Λ = {FULL_FILM_LAMBDA:g}: full film above"}})
-    return [out / "summary.csv", out / "summary.md", out / "answer.md", fig]
+    return [against_viscosity(series, [("lambda_min", "film parameter Λ_min = h_min/σ", "1", True),
+                                       ("h_min_m", "thinnest film h_min", "m", True),
+                                       ("cage_slip_pct", "cage slip", "%", False),
+                                       ("heat_traction_W", "traction heat", "W", False)],
+                              out / "film_and_slip.png",
+                              title="Film and cage against the oil's viscosity (at the operating temperature)",
+                              names={r["lubricant"]: r["viscosity_Pa_s"] for r in rows},
+                              levels={"lambda_min": {1.0: "Λ = 1: below, boundary-dominated",
+                                                     FULL_FILM_LAMBDA: f"Λ = {FULL_FILM_LAMBDA:g}: full film above"}})]
+
+
+def write_outputs(rows: list[dict], out: Path) -> list[Path]:
+    """The tables and the figure (module docstring)."""
+    return write_tables(rows, out) + plot(rows, out)
+
+
+class LubricantStudy(Study):
+    """Every condition × direction × oil (:class:`scenarios.study.Study`): the answer first, then the tables and
+    the figure."""
+
+    def config(self) -> RunConfig:
+        a = self.a
+        return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
+                         progress=not a.no_progress)
+
+    def cases(self) -> list[Case]:
+        return make_cases(self.a, self.out)
+
+    def report(self, run: StudyRun) -> dict:
+        rows = rows_of(run.cases, run.results)
+        text = answer(rows) if rows else ""
+        print(text)                          # the headline first
+        if rows:
+            run.step("tables", write_tables, rows, self.out)
+            run.step("figures", plot, rows, self.out)
+        return {"rows": rows, "answer": text}
 
 
 @holds_out_folder
 def run(a) -> dict:
-    out = Path(a.out)
-    out.mkdir(parents=True, exist_ok=True)
-    cases = make_cases(a, out)
-    validate_cases(cases)                    # every parameter checked before any run starts
-    cfg = RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, integration=mbd.PRODUCTION,
-                    progress=not a.no_progress)
-    for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], out, a.force):
-        print(f"warning (--force): {w}")
-    check_folders(cases, cfg, a.overwrite)      # never replace results of other parameters silently
-    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
-                        overwrite=a.overwrite)
-    rows = rows_of(cases, results)
-    files = write_outputs(rows, out) if rows else []
-    failed = {k: v["error"] for k, v in results.items() if "error" in v}
-    atomic_write_text(out / "study.json", json.dumps({"cases": [dataclasses.asdict(c) for c in cases],
-                                                      "failed": failed}, indent=2, default=str))
-    return {"rows": rows, "failed": failed, "files": files, "answer": answer(rows) if rows else "", "results": results}
+    return LubricantStudy(a).run()
 
 
 @command
 def main(argv=None) -> int:
-    r = run(parse_args(sys.argv[1:] if argv is None else argv))
-    print(r["answer"])
-    return study_epilogue(r)
+    return Study.exit_code(run(parse_args(sys.argv[1:] if argv is None else argv)))
 
 
 if __name__ == "__main__":

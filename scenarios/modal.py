@@ -28,14 +28,21 @@ from . import args
 from .command import command
 
 
+EXAMPLES = ["{prog} --params my_planetary.toml --out results/modal", "{prog} --set planets=4",
+            "{prog} --dpgt --conditions 3 --set bearing.linear_stiffness=\"5e8 N/m\" --out results/modal_dpgt"]
+WRITES = ("summary.json (frequencies_hz ascending, rigid-body modes as 0, mode_class, multiplicity), modes.csv, "
+          "mode_shapes.png")
+
+
 def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.modal", description=__doc__.split("\n\n")[0])
+    p = args.parser("modal", __doc__, examples=EXAMPLES, writes=WRITES, out="results/modal")
     p.add_argument("--params", default=None, type=args.existing_file, help="TOML file of the single planetary set (default: built-in example)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="override, e.g. planets=4")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="override a key of the single planetary set, e.g. planets=4; with --dpgt a DPGT parameter "
+                        "(keys: `dpgt params`) (repeatable)")
     p.add_argument("--dpgt", action="store_true", help="analyse the DPGT with linear bearings instead")
-    p.add_argument("--condition", type=args.count(1, 4), default=3, help="DPGT operating condition (default 3)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="DPGT: seconds to reach the loaded steady state")
-    p.add_argument("--out", default="results/modal", type=args.out_folder)
+    # --params and --set describe a single planetary set here (or, with --dpgt, --set the DPGT's keys)
+    args.add_shared(p, "conditions", "out", out="results/modal", conditions="3", one_condition_only=True)
     return p.parse_args(argv)
 
 
@@ -51,12 +58,10 @@ def planetary(a):
     from components.planetary import EXAMPLE_PLANETARY, build_single_planetary, load_planetary_toml, planetary_modes
     from components.units import ParameterError
 
-    from .paper_study import parse_sets
-
     try:
-        spec = load_planetary_toml(a.params, parse_sets(a.set)) if a.params else None
+        spec = load_planetary_toml(a.params, args.parse_sets(a.set)) if a.params else None
         built = build_single_planetary(spec if spec is not None else EXAMPLE_PLANETARY,
-                                       overrides=None if a.params else parse_sets(a.set))
+                                       overrides=None if a.params else args.parse_sets(a.set))
     except (ParameterError, OSError) as exc:
         raise SystemExit(f"error: {exc}") from None
     modes = planetary_modes(built)
@@ -73,13 +78,11 @@ def dpgt(a):
     from components.params import with_overrides
     from components.units import ParameterError
 
-    from .paper_study import parse_sets
-
     if a.params:      # the file is a single planetary set's; the DPGT takes its own parameters through --set
         raise SystemExit(f"error: --params {a.params} describes a single planetary set; with --dpgt give DPGT "
                          "parameters with --set KEY=VALUE")
     try:
-        params = with_overrides(reference_dpgt(a.condition, "forward"), parse_sets(a.set))
+        params = with_overrides(reference_dpgt(int(a.conditions), "forward"), args.parse_sets(a.set))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             built = build_dpgt(params, SceneOptions(bearings="linear", mesh_stiffness="constant", gravity=False))

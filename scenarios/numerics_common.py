@@ -236,6 +236,15 @@ def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float
                      q=np.array(sampler.q), v=np.array(sampler.v), z=sampler.z, engine=res.engine)
 
 
+def hht_reference(prob, s0, t1, grid, h, frozen_z=False):
+    """Reference-quality HHT run (the reference of work_precision and benchmark): α = −0.1, fixed h, Newton tolerance scaled by atol 0.1 nm / 10 nrad.
+    ``frozen_z``: hold element internal states at their initial value (what the scipy adapter does)."""
+    r = run_hht(prob, s0, t1, grid, alpha=-0.1, h=h, tol=mbd.Tolerance(atol_pos=1e-10, atol_rot=1e-8),
+                freeze_internal=frozen_z, label=f"fixed h={h:.2e}")
+    r.method = "HHT-ref"
+    return r
+
+
 def scipy_atol(model: mbd.Model, tol: float) -> np.ndarray:
     """Absolute tolerances for y = (q, v) at a scipy setting ``tol`` (= rtol): positions 1e-2·tol m
     (tol = 1e-6 → 10 nm, HHT's default length scale), angles tol rad, velocities 1e3× those per s."""

@@ -11,7 +11,6 @@ and the cage orbits DIR/c{condition}_cage_orbit_{inner,outer}.png, and (with --a
 """
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import csv
 import io
@@ -26,10 +25,9 @@ from components.outputs import SUMMARY_WORDS
 from components.outputs import relative_life as iso_relative_life
 from mbd.recorder import atomic_write_text
 
-from .runner import RunConfig, sweep_report
-from .integrity import read_summary
-from .plausibility import check_runs
-from .sweep import OPERATING_AXES, Case, _case_cfg, build_params, check_folders, run_sweep, user_overrides, validate_cases
+from .runner import RunConfig
+from .study import Study, StudyRun
+from .sweep import OPERATING_AXES, Case, user_overrides
 from . import args
 from .command import command
 from .lock import holds_out_folder
@@ -47,11 +45,19 @@ BAR_QUANTITIES = ["roller_cage_rms_N", "cage_guide_rms_N", "roller_inner_race_rm
                   "cage_acc_rel_radial_rms_m_s2", "cage_acc_rel_tangential_rms_m_s2"]
 
 
-def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.paper_study", description=__doc__.split("\n\n")[0],
-                    formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--conditions", default="3", type=args.conditions,
-                   help="comma list of operating conditions 1-4 (default 3)")
+EXAMPLES = ["{prog} --conditions 3 --out results/study",
+            '{prog} --conditions 1,2,3,4 --directions forward,reverse --workers 2 --set bearing.clearance="30 um"',
+            "{prog} --params my_machine.toml --animate --out results/mine"]
+WRITES = ("c{condition}_{direction}/{results.nc, summary.json} per run; comparison.csv and comparison.md (every "
+          "quantity forward vs reverse, the change in %); bearing_load_life.png (the headline: mean load and L10 "
+          "life per bearing type), bars.png, per condition the time histories c{condition}_{bearing_loads, "
+          "roller_contacts, cage, mesh}.png and the cage orbits c{condition}_cage_orbit_{inner,outer}.png; with "
+          "--animate c{condition}_cage_orbits.gif")
+
+
+def build_parser(name: str = "paper_study", out: str = "results/study", doc: str = __doc__,
+                 examples: list[str] = EXAMPLES):
+    p = args.parser(name, doc, examples=examples, writes=WRITES, out=out)
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     p.add_argument("--planets", type=args.count(1), default=None, help="planet pairs N (default 3, the reference machine)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03,
@@ -60,46 +66,24 @@ def parse_args(argv):
                    help="seconds recorded and analysed (default: max(0.02 s, one carrier revolution), rounded up "
                         "to whole revolutions of the slowest cage relative to the carrier)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=25000.0, help="recording rate [Hz]")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
-                   help='override a parameter, e.g. --set bearing.clearance="30 um" (repeatable)')
-    p.add_argument("--params", default=None, type=args.existing_file, help="TOML file of parameter overrides")
     p.add_argument("--method", default="hht-adaptive", choices=["hht-adaptive", "hht-fixed"])
     p.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="fixed step / initial step [s]")
     p.add_argument("--alpha", type=args.alpha, default=-0.3, help="HHT alpha in [-1/3, 0]")
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
                    help="scene switch, e.g. --option drag=false --option bearings=linear")
     p.add_argument("--animate", action="store_true", help="write a cage-orbit animation per condition")
-    args.add_sweep_options(p, "results/study")
-    return p.parse_args(argv)
+    args.add_shared(p, out=out, conditions="3")
+    return p
 
 
-def _bool(v: str):
-    lv = v.strip().lower()
-    if lv in ("true", "yes", "on", "1"):
-        return True
-    if lv in ("false", "no", "off", "0"):
-        return False
-    return v
-
-
-def parse_sets(items: list[str]) -> dict:
-    out = {}
-    for it in items:
-        if "=" not in it:
-            raise SystemExit(f"error: --set expects KEY=VALUE (e.g. bearing.clearance=\"30 um\"), got {it!r}")
-        k, v = it.split("=", 1)
-        v = v.strip().strip('"').strip("'")
-        out[k.strip()] = int(v) if v.lstrip("+-").isdigit() else v   # counts (planets, rollers) are integers
-    return out
+def parse_args(argv):
+    return build_parser().parse_args(argv)
 
 
 def build_config(a) -> RunConfig:
-    from components.scene import SceneOptions
-
-    opts = {k: _bool(v) for k, v in parse_sets(a.option).items()}
     return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate,
                      integration=dataclasses.replace(mbd.PRODUCTION, method=a.method, h=a.h, alpha=a.alpha),
-                     options=SceneOptions.from_dict(opts), progress=not a.no_progress)
+                     options=args.scene_options(a.option), progress=not a.no_progress)
 
 
 def make_cases(a, out: Path) -> list[Case]:
@@ -108,7 +92,7 @@ def make_cases(a, out: Path) -> list[Case]:
     for d in dirs:
         if d not in ("forward", "reverse"):
             raise SystemExit(f"error: --directions takes forward and/or reverse, got {d!r}")
-    overrides = user_overrides(parse_sets(a.set), a.params, OPERATING_AXES)
+    overrides = user_overrides(args.parse_sets(a.set), a.params, OPERATING_AXES)
     if a.planets is not None:
         overrides["gears.planets"] = a.planets
     for c in conds:
@@ -166,6 +150,31 @@ def write_tables(rows: list[dict], out: Path) -> tuple[Path, Path, str]:
     text = "\n".join(md).strip() + "\n"
     atomic_write_text(out / "comparison.md", text)
     return out / "comparison.csv", out / "comparison.md", text
+
+
+HEADLINE = (("bearing_load_mean_N", "mean load", 1e-3, "kN"), ("life_iso281_h", "L10 ISO 281", 1.0, "h"),
+            ("life_iso16281_h", "L10 roller loads", 1.0, "h"))
+
+
+def headline_table(rows: list[dict]) -> str:
+    """The study's answer in a few lines (what the headline figure shows): per condition and bearing type the mean
+    bearing load and both L10 lives, forward / reverse and the change, from the comparison's rows."""
+    at = {(r["condition"], r["bearing"], r["quantity"]): r for r in rows}
+    num = lambda x, k: "–" if x is None else f"{x * k:.3g}"
+    head = "".join(f" | {w} fwd / rev [{u}] (change)" for _, w, _, u in HEADLINE)
+    lines = [f"headline (pair 1's planet bearings, forward vs reverse):\n| condition | bearing{head} |",
+             "|---|---" + "|---" * len(HEADLINE) + "|"]
+    for c, b in sorted({(r["condition"], r["bearing"]) for r in rows}):
+        cells = []
+        for q, _, k, _ in HEADLINE:
+            r = at.get((c, b, q))
+            if r is None:
+                cells.append("–")
+                continue
+            d = r["difference_pct"]
+            cells.append(f"{num(r['forward'], k)} / {num(r['reverse'], k)}" + ("" if d is None else f" ({d:+.1f} %)"))
+        lines.append(f"| {c} | {b} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
 def _runs_of(results: dict, out: Path, c: int) -> dict[str, Path]:
@@ -327,55 +336,50 @@ def animate(results: dict, out: Path) -> list[Path]:
     return paths
 
 
-def _keep_finished_on_disk(results: dict, out: Path) -> None:
-    """A run that failed this time but finished before keeps its summary in the tables: a re-run in which
-    nothing succeeds never replaces good tables with empty ones (its failure is still reported)."""
-    for label, s in list(results.items()):
-        if "error" in s:
-            old = read_summary(out / label / "summary.json")      # a damaged one is moved aside, not used
-            if old is not None and "error" not in old and "inner" in old:
-                results[label] = {**old, "stale_after_failure": s["error"]}
+class PaperStudy(Study):
+    """Forward vs reverse per condition (:class:`scenarios.study.Study`): the comparison table first, then its
+    files, the figures and (``--animate``) the cage-orbit animations. A run that fails now but finished before
+    keeps its summary in the tables."""
+
+    keep_earlier = True
+    record = False
+
+    def config(self) -> RunConfig:
+        return build_config(self.a)
+
+    def cases(self) -> list[Case]:
+        return make_cases(self.a, self.out)
+
+    def report(self, run: StudyRun) -> dict:
+        results = run.results
+        relative_life(results)
+        for label, s in results.items():   # store the relative life in each run's summary (atomic rewrite)
+            if "stale_after_failure" not in s:
+                atomic_write_text(Path(run.outcomes[label].case.out_dir) / "summary.json",
+                                  json.dumps(s, indent=2, default=str))
+        rows = comparison_rows(results)
+        csv_p, md_p, text = write_tables(rows, self.out)
+        print("\n" + headline_table(rows))   # the headline first, then the whole comparison
+        print("\n" + text)
+        run.step("tables", lambda: [csv_p, md_p])
+        figs = run.step("figures", plots, results, self.out)
+        anims = run.step("animation", animate, results, self.out) if self.a.animate else []
+        return {"rows": rows, "figures": figs, "animations": anims}
 
 
 @holds_out_folder
 def run(a) -> dict:
-    out = Path(a.out)
-    out.mkdir(parents=True, exist_ok=True)
-    cfg = build_config(a)
-    cases = make_cases(a, out)
-    validate_cases(cases)         # before any run starts: clear errors, design warnings once
-    for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], out, a.force):
-        print(f"warning (--force): {w}")
-    check_folders(cases, cfg, a.overwrite)      # never replace results of other parameters silently
-    results = run_sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
-                        overwrite=a.overwrite)
-    _keep_finished_on_disk(results, out)
-    relative_life(results)
-    for label, s in results.items():   # store the relative life in each run's summary (atomic rewrite)
-        if "error" not in s and "stale_after_failure" not in s:
-            s.pop("skipped", None)
-            atomic_write_text(out / label / "summary.json", json.dumps(s, indent=2, default=str))
-    rows = comparison_rows(results)
-    csv_p, md_p, text = write_tables(rows, out)
-    figs = plots(results, out)
-    anims = animate(results, out) if a.animate else []
-    print("\n" + text)
-    failed = {k: v.get("error", v.get("stale_after_failure")) for k, v in results.items()
-              if "error" in v or "stale_after_failure" in v}
-    for k, v in failed.items():
-        print(f"FAILED {k}: {v}  (details in {out / k / 'error.json'})")
-    print("run time and accuracy per run:", *sweep_report(results), sep="\n")
-    print("\nwritten:")
-    for p in [csv_p, md_p, *figs, *anims]:
-        print(f"  {p}")
-    return {"results": results, "rows": rows, "failed": failed, "figures": figs, "animations": anims}
+    return PaperStudy(a).run()
+
+
+def finish(r: dict) -> int:
+    """The exit code of a finished study: 1 if a run failed."""
+    return Study.exit_code(r)
 
 
 @command
 def main(argv=None) -> int:
-    a = parse_args(sys.argv[1:] if argv is None else argv)
-    r = run(a)
-    return 1 if r["failed"] else 0
+    return finish(run(parse_args(sys.argv[1:] if argv is None else argv)))
 
 
 if __name__ == "__main__":

@@ -41,7 +41,8 @@ import mbd
 from components.sensor import PATHS as SENSOR_PATHS
 from mbd.recorder import atomic_write_text
 
-from .analysis import amplitude_spectrum, line_table, peak_table, sideband_resolution
+from .analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution
+from .analysis import whole_revolutions as _whole_revolutions
 from .plausibility import check_runs
 from .runner import RunConfig, run_case, run_report
 from . import args
@@ -65,8 +66,15 @@ SEEN = {"housing": ("phasing", "transfer path"), "mesh": ("phasing", "transfer p
 SIDEBANDS = 6         # the line table covers f_m + k f_c, |k| <= SIDEBANDS
 
 
+EXAMPLES = ["{prog} --out results/spectrum", "{prog} --sensor mesh --carrier-rpm 1500 --perfect",
+            "{prog} --params my_rig_machine.toml --set rig.sensor.direction=tangential"]
+WRITES = ("run/{results.nc, summary.json} (the run); spectrum.csv (the chosen sensor's amplitude, every path, their "
+          "sum, the axis sensor), lines.csv (f_m + k f_c, |k| <= 6: amplitude, over the floor, origin, the path "
+          "carrying it), peaks.csv, summary.json, spectrum.png")
+
+
 def parse_args(argv):
-    p = args.Parser(prog="python -m scenarios.spectrum", description=__doc__.split("\n\n")[0])
+    p = args.parser("spectrum", __doc__, examples=EXAMPLES, writes=WRITES, out="results/spectrum")
     p.add_argument("--carrier-rpm", type=args.positive("r/min"), default=2000.0, help="carrier speed [r/min] (default 2000)")
     p.add_argument("--sun-rpm", type=args.positive("r/min"), default=None,
                    help="sun speed [r/min] magnitude; must match the ring-fixed ratio (3290 at 2000)")
@@ -80,23 +88,15 @@ def parse_args(argv):
     p.add_argument("--gear-grade", type=args.count(1, 11), default=None,
                    help="ISO 1328-1 flank tolerance class of the gears behind the default manufacturing errors "
                         "(default 6: every gear's teeth drawn for that class, runouts F_r/2 of that grade, all "
-                        "carrier pinholes within ±10 µm; components.presets.typical_errors)")
+                        "carrier pinholes within ±10 µm; components.presets.typical_errors); errors given by --params "
+                        "or --set errors.* replace them; the operating point is this command's options")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.06,
                    help="seconds discarded (default 0.06: a lightly damped ~2.6 kHz mode rings for ~50 ms after the start)")
     p.add_argument("--window", type=args.positive("s"), default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz]")
-    p.add_argument("--params", default=None, type=args.existing_file,
-                   help="TOML file of parameter overrides: a user's machine on the rig (its errors replace the "
-                        "--gear-grade ones; the operating point is this command's options)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="parameter override")
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="scene switch")
     p.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="initial step [s]")
-    p.add_argument("--force", action="store_true",
-                   help="run although the gears collide or the recording is too large for the limit or the disk")
-    p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace a finished run of other parameters or settings in --out (else refused)")
-    p.add_argument("--out", default="results/spectrum", type=args.out_folder)
+    args.add_shared(p, "params", "set", "out", "overwrite", "force", "no-progress", out="results/spectrum")
     return p.parse_args(argv)
 
 
@@ -110,13 +110,11 @@ def machine(a):
     from components.presets import reference_dpgt, typical_errors
     from components.units import ParameterError
 
-    from .paper_study import parse_sets
-
     try:
         from_file = overrides_from_toml(Path(a.params).read_text(encoding="utf-8")) if a.params else {}
     except (ParameterError, ValueError) as exc:          # not TOML, not UTF-8, or a bad value
         raise SystemExit(f"error: --params {a.params}: {exc}".splitlines()[0]) from None
-    given = {**from_file, **parse_sets(a.set)}
+    given = {**from_file, **args.parse_sets(a.set)}
     options = {"operating.carrier_speed": "--carrier-rpm", "operating.output_power": "--power",
                "operating.direction": "--direction"}
     for key in given:
@@ -146,12 +144,7 @@ def machine(a):
 
 def run_config(a) -> RunConfig:
     """The run settings from the command line (window, recording, integration, scene switches)."""
-    from components.scene import SceneOptions
-
-    from .paper_study import _bool, parse_sets
-
-    opts = SceneOptions.from_dict({k: _bool(v) for k, v in parse_sets(a.option).items()})
-    return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, options=opts,
+    return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, options=args.scene_options(a.option),
                      integration=dataclasses.replace(mbd.PRODUCTION, h=a.h), progress=not a.no_progress)
 
 
@@ -205,36 +198,6 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     return summary
 
 
-def sensor_paths(path: Path, sensor=None) -> tuple[np.ndarray, dict]:
-    """(t, {"mesh", "torque", "bearing", "housing"}): the housing accelerometer's paths and their sum [m/s^2] at
-    every sample of a run's ``results.nc`` (recorded with ``RunConfig(sensor=True)``), by
-    :func:`components.sensor.paths` from the recorded outer planets' angles and ring-mesh forces and the loads on
-    the housing. ``sensor`` (:class:`components.params.SensorSI`): the run's own (stored with it) unless given.
-    The one place a run's file becomes the sensor's signals: the spectrum and the fault study read through it."""
-    import xarray as xr
-
-    from components.families import MESH_FAMILY
-    from components.sensor import paths, sensor_from_dict
-
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
-        if "housing.force_x" not in ds:
-            raise ValueError(f"{path}: the run recorded no loads on the housing (run it with RunConfig(sensor=True))")
-        sensor = sensor if sensor is not None else sensor_from_dict(json.loads(ds.attrs["sensor"]))
-        t = ds["time"].values
-        bodies = list(ds["motion.body"].values)
-        phi = (ds["fixed.angle"].values[:, list(ds["fixed.body"].values).index("carrier")]
-               - ds["motion.angle"].values[:, bodies.index("carrier")])           # the frame's angle
-        fam = MESH_FAMILY["outer_ring"]
-        P = ds["motion.position"].values[:, [bodies.index(g) for g in ds[f"{fam}.gear1"].values]]
-        psi = np.arctan2(P[..., 1], P[..., 0]) + phi[:, None]
-        c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
-        fx, fy = ds[f"{fam}.fx"].values, ds[f"{fam}.fy"].values                 # on the ring, in R
-        ring = np.stack([c * fx - s * fy, s * fx + c * fy], axis=-1)
-        force = np.column_stack([ds["housing.force_x"].values.sum(axis=1), ds["housing.force_y"].values.sum(axis=1)])
-        torque = ds["housing.torque"].values.sum(axis=1)
-        return t, paths(t, psi, ring, force, torque, sensor)
-
-
 def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
     """Sample times and the signals of a run: "amplitude" (the sensor read), every path of the housing sensor
     and their sum, and the axis sensor's x and y."""
@@ -245,22 +208,6 @@ def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
         acc = ds["fixed.acceleration"].values[:, list(ds["fixed.body"].values).index("carrier")]
     signals.update({"axis_x": acc[:, 0], "axis_y": acc[:, 1]})
     return t, {"amplitude": signals["axis_x" if sensor == "axis" else sensor], **signals}
-
-
-def sensor_signal(path: Path, f_c: float, sensor: str = "housing") -> tuple[np.ndarray, np.ndarray]:
-    """(t, a) of a run's housing sensor (or one of its paths, :func:`sensor_paths`) over the first whole number
-    of carrier revolutions: what every spectrum of the sensor is taken of."""
-    t, signals = _whole_revolutions(*sensor_paths(Path(path)), f_c)
-    return t, signals[sensor]
-
-
-def _whole_revolutions(t, signals: dict, f_c: float):
-    """The first whole number of carrier revolutions of the samples (all of them if less than one): the
-    lines f_m + k f_c then fall on frequency bins, and the Hann window's leakage stays within ±1 bin."""
-    dt, fc = float(np.median(np.diff(t))), abs(f_c)
-    revs = np.floor(len(t) * dt * fc + 1e-9) if fc > 0 else 0.0
-    n = min(int(round(revs / (fc * dt))), len(t)) if revs >= 1 else len(t)
-    return t[:n], {k: x[:n] for k, x in signals.items()}
 
 
 def _lines(f, spectra, f_m, f_c, z_r: int, planets: int, sensor: str) -> list[dict]:

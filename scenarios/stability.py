@@ -224,9 +224,10 @@ def _scipy_runs(text: str) -> list[tuple[str, float]]:
 
 @command
 def main(argv=None) -> int:
-    ap = args.Parser(prog="python -m scenarios.stability", description=__doc__.splitlines()[0])
+    ap = args.parser("stability", __doc__, examples=["{prog} --quick --out results/numerics", "{prog} --cases nominal,contact_x10,N4 --no-radau"],
+                      writes="stability.csv, stability.json, stability.md (the table for docs/numerics.md)", out="results/numerics")
     ap.add_argument("--quick", action="store_true", help="fewer cases, 1.5 ms window")
-    ap.add_argument("--out", default="results/numerics", type=args.out_folder, help="output directory")
+    args.add_shared(ap, "out", out="results/numerics")
     ap.add_argument("--window", type=args.positive("s"), default=None, help="simulated time per case [s]")
     ap.add_argument("--cap", type=args.positive("s"), default=None, help="wall-time cap of each Radau run [s]")
     ap.add_argument("--cases", default=None, type=args.choice_list(tuple(CASES), "cases"), help=f"comma-separated subset of: {', '.join(CASES)}")

@@ -1,10 +1,11 @@
 """Sweeps of many runs on Dask: a local cluster by default, or an existing one (``scheduler``).
 
 Each case is plain data (condition, direction, parameter overrides as strings, run config), so it
-travels to any worker; the worker rebuilds the pint parameters itself. A case whose summary.json
-was made from the same parameters, settings and code (its fingerprint, :func:`runner.run_fingerprint`)
-is skipped, so a restarted sweep resumes; a stale one is recomputed. A failing case writes error.json
-with its traceback and does not stop the others; every file is written atomically. An interrupted client
+travels to any worker; the worker rebuilds the pint parameters itself. What becomes of a case is an
+:class:`Outcome`: ``finished`` (run now), ``reused`` (its summary.json was made from the same parameters,
+settings and code — its fingerprint, :func:`runner.run_fingerprint` — so a restarted sweep resumes; a stale
+one is recomputed) or ``failed`` (it wrote error.json with its traceback and did not stop the others); every
+file is written atomically. An interrupted client
 (Ctrl-C) cancels its runs on the scheduler, and a local cluster's workers stop with it.
 """
 from __future__ import annotations
@@ -15,13 +16,15 @@ import sys
 import time
 import traceback
 from dataclasses import dataclass, field
+from enum import Enum
 from pathlib import Path
 
 from mbd.recorder import atomic_write_text
 
 from .integrity import OtherResults, claim_folder, differences, read_summary, results_intact
 
-__all__ = ["Case", "run_sweep", "execute_case", "check_folders", "user_overrides", "validate_cases", "OPERATING_AXES"]
+__all__ = ["Case", "Status", "Outcome", "sweep", "run_sweep", "execute_case", "check_folders", "user_overrides",
+           "validate_cases", "OPERATING_AXES"]
 
 
 @dataclass(frozen=True)
@@ -39,17 +42,57 @@ class Case:
         return f"c{self.condition}_{self.direction}" + (f"_{self.tag}" if self.tag else "")
 
 
+class Status(str, Enum):
+    """What became of a case: run now, taken from an earlier run of the same parameters, settings and code, or
+    failed (error.json in its folder says why)."""
+    FINISHED = "finished"
+    REUSED = "reused"
+    FAILED = "failed"
+
+
+@dataclass
+class Outcome:
+    """One case of a sweep after it: its :class:`Status`, its summary (finished or reused; a reused summary keeps
+    the wall time of the run that made it) or what went wrong (failed)."""
+    case: Case
+    status: Status
+    summary: dict | None = None
+    error: str | None = None
+    traceback: str = ""
+
+    @property
+    def label(self) -> str:
+        return self.case.label
+
+    @property
+    def ok(self) -> bool:
+        return self.status is not Status.FAILED
+
+    @property
+    def wall_s(self) -> float | None:
+        """Wall time of the run that made the results (for a reused one: when it ran)."""
+        return None if self.summary is None else self.summary.get("wall_s")
+
+    def as_dict(self) -> dict:
+        """The summary (reused: with ``"skipped": True``), or ``{"case", "error", "traceback"}`` for a failed case:
+        :func:`run_sweep`'s plain-dict form."""
+        if self.status is Status.FAILED:
+            return {"case": self.label, "error": self.error, **({"traceback": self.traceback} if self.traceback else {})}
+        return {**self.summary, "skipped": True} if self.status is Status.REUSED else self.summary
+
+
 # the parameters every study's sweep sets itself (its axes), and the option that sets them
 OPERATING_AXES = {"operating.carrier_speed": "--conditions", "operating.output_power": "--conditions",
                   "operating.direction": "--directions"}
 
 
-def user_overrides(sets: dict, params_file: str | None, owned: dict[str, str]) -> dict:
+def user_overrides(sets: dict, params_file: str | None, owned: dict[str, str], merge_file: bool = False) -> dict:
     """The ``--set`` overrides of a study, after checking that neither they nor the ``--params`` file touch a
     parameter the study's sweep owns (``owned``: dotted key or prefix → the option that sets it). Such an override
     would silently relabel runs — a folder ``c3_forward`` holding a reverse run — so it is refused in one line
     naming the key, where it came from and the option to use. A file that is not UTF-8 TOML is a usage error
-    naming the file."""
+    naming the file. ``merge_file``: the file's overrides are returned too (under the ``--set`` ones), for a study
+    whose cases carry their own files."""
     from components.params import overrides_from_toml
     from components.units import ParameterError
 
@@ -64,7 +107,7 @@ def user_overrides(sets: dict, params_file: str | None, owned: dict[str, str]) -
             for axis, option in owned.items():
                 if key == axis or key.startswith(axis + ".") or axis.startswith(key + "."):
                     raise SystemExit(f"error: {key} is set by this study's {option}, not by {where}")
-    return dict(sets)
+    return {**from_file, **sets} if merge_file else dict(sets)
 
 
 def validate_cases(cases: list[Case], check=None) -> None:
@@ -146,8 +189,9 @@ def _is_finished(case: Case, cfg) -> bool:
         return False
 
 
-def execute_case(case: Case, cfg, overwrite: bool = False) -> dict:
-    """Run one case (on whichever process). Returns its summary, or {"error": ...}; never raises."""
+def execute_case(case: Case, cfg, overwrite: bool = False) -> Outcome:
+    """Run one case (on whichever process), or reuse its finished results. Never raises: a failure is an
+    :class:`Outcome` of status failed (and error.json in the case's folder)."""
     from .runner import run_case
 
     out = Path(case.out_dir)
@@ -156,13 +200,13 @@ def execute_case(case: Case, cfg, overwrite: bool = False) -> dict:
         cfg = _case_cfg(case, cfg)
         done = _finished(case, params, cfg)
         if done is not None:
-            return {**done, "skipped": True}
+            return Outcome(case, Status.REUSED, summary=done)
         s = run_case(params, cfg, out, label={"condition": case.condition, "direction": case.direction},
                      overwrite=overwrite)
         err = out / "error.json"
         if err.exists():
             err.unlink()
-        return s
+        return Outcome(case, Status.FINISHED, summary=s)
     except Exception as exc:  # reported, never hidden; the sweep goes on
         out.mkdir(parents=True, exist_ok=True)
         info = {"case": case.label, "error": f"{type(exc).__name__}: {exc}", "traceback": traceback.format_exc()}
@@ -170,7 +214,7 @@ def execute_case(case: Case, cfg, overwrite: bool = False) -> dict:
             atomic_write_text(out / "error.json", json.dumps(info, indent=2))
         except OSError:       # disk full or unwritable: the caller still gets the report
             pass
-        return info
+        return Outcome(case, Status.FAILED, error=info["error"], traceback=info["traceback"])
 
 
 class _RunBars:
@@ -211,11 +255,21 @@ class _RunBars:
 
 def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | None = None,
               progress: bool = True, overwrite: bool = False) -> dict[str, dict]:
-    """Run every case; returns {label: summary or error}. One case runs in-process (no cluster).
-    ``overwrite``: replace finished results of other parameters (else :func:`check_folders` refuses)."""
+    """:func:`sweep` with plain dicts: {label: summary (reused: ``"skipped": True``) or {"case", "error"}}."""
+    return {k: o.as_dict() for k, o in sweep(cases, cfg, workers, scheduler, progress, overwrite).items()}
+
+
+def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | None = None,
+          progress: bool = True, overwrite: bool = False, announce: bool = False) -> dict[str, Outcome]:
+    """Run every case; returns {label: :class:`Outcome`}. One case runs in-process (no cluster).
+    ``overwrite``: replace finished results of other parameters (else :func:`check_folders` refuses);
+    ``announce``: say first how many runs will run and how many are reused."""
     from tqdm.auto import tqdm
 
     todo = [c for c in cases if not _is_finished(c, cfg)]
+    if announce:
+        print(f"runs: {len(todo)} to run, {len(cases) - len(todo)} reused (finished earlier with the same parameters, "
+              f"settings and code)", flush=True)
     results = {c.label: execute_case(c, cfg) for c in cases if c not in todo}   # finished: just load
     if not todo:
         return results
@@ -259,14 +313,14 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
             try:
                 results[c.label] = fut.result()
             except Exception as exc:   # worker died: report, keep going
-                results[c.label] = {"case": c.label, "error": f"worker failure: {exc}"}
+                results[c.label] = Outcome(c, Status.FAILED, error=f"worker failure: {exc}")
             bar.update(1)
             runs.finish(c)
             if plain:
                 n_done = sum(futs[f].label in results for f in futs)
                 print(f"runs: {n_done}/{len(futs)} done ({c.label})", file=sys.stderr, flush=True)
-            if "error" in results[c.label]:
-                bar.write(f"run {c.label} failed: {results[c.label]['error']}")
+            if not results[c.label].ok:
+                bar.write(f"run {c.label} failed: {results[c.label].error}")
         runs.close()
         bar.close()
     except BaseException:       # Ctrl-C or a failure of the client: take its runs off the scheduler
@@ -277,15 +331,3 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
         if cluster is not None:
             cluster.close()     # a local cluster's workers stop with it
     return results
-
-
-def study_epilogue(r: dict) -> int:
-    """What a study prints after its tables: every run's time, error estimate and warnings, the failed runs,
-    the files written. Returns the exit code (1 if any run failed). ``r``: results, failed, files."""
-    from .runner import sweep_report
-
-    print("\nrun time and accuracy per run:", *sweep_report(r["results"]), sep="\n")
-    for k, v in r["failed"].items():
-        print(f"FAILED {k}: {v}")
-    print("\nwritten:\n" + "\n".join(f"  {p}" for p in r["files"]))
-    return 1 if r["failed"] else 0

@@ -44,7 +44,7 @@ import mbd
 from components.outputs import FAMILY
 
 from .numerics_common import (dpgt_problem, error_metrics, eval_costs, machine_note, observables, peak_rss_mb,
-                              rig_problem, run_hht, run_scipy, settled_state, warm_up)
+                              rig_problem, run_hht, run_scipy, settled_state, warm_up, hht_reference)
 from . import args
 from .command import command
 
@@ -106,7 +106,7 @@ def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None,
 
     # reference and its convergence check
     def ref_run(h):
-        return _hht_tight(prob, s0, t1, grid, h)
+        return hht_reference(prob, s0, t1, grid, h)
 
     ref = ref_run(P["h_ref"])
     chk = ref_run(2 * P["h_ref"])
@@ -116,7 +116,7 @@ def study(problem: str, out: Path, quick: bool, repeats: int, cap: float | None,
     # scipy's first-order form holds element internal states (the carrier drive's PI integral) at their
     # initial value; its errors are measured against a reference with the same frozen state, and the
     # difference of the two references (the model difference, not an integration error) is reported
-    frozen = obs_of(_hht_tight(prob, s0, t1, grid, P["h_ref"], frozen_z=True)) if s0.z else ref_obs
+    frozen = obs_of(hht_reference(prob, s0, t1, grid, P["h_ref"], frozen_z=True)) if s0.z else ref_obs
     frozen_diff = error_metrics(frozen, ref_obs)
     ref_check = error_metrics(chk_obs, ref_obs)
     _log(f"[{problem}] reference h={P['h_ref']:.2e} s ({ref.wall_s:.1f} s); check at 2h: pin max error "
@@ -197,15 +197,6 @@ def _floor_check(problem, prob, s0, t1, grid, steps, ref_obs, obs_of) -> list:
             _log(f"[{problem}] floor check newton_tol={nt:g} h={h:.0e}: "
                  + (f"pin {m['err_pin_rel']:.2e} ({m['err_pin_max_N']:.3f} N)" if m else r.message))
     return floor
-
-
-def _hht_tight(prob, s0, t1, grid, h, frozen_z=False):
-    """Reference-quality HHT run: α = −0.1, fixed h, Newton tolerance scaled by atol 0.1 nm / 10 nrad.
-    ``frozen_z``: hold element internal states at their initial value (what the scipy adapter does)."""
-    r = run_hht(prob, s0, t1, grid, alpha=-0.1, h=h, tol=mbd.Tolerance(atol_pos=1e-10, atol_rot=1e-8),
-                freeze_internal=frozen_z, label=f"fixed h={h:.2e}")
-    r.method = "HHT-ref"
-    return r
 
 
 def _write(out: Path, problem: str, rows: list) -> None:
@@ -290,10 +281,11 @@ def markdown(res: dict) -> str:
 
 @command
 def main(argv=None) -> int:
-    ap = args.Parser(prog="python -m scenarios.work_precision", description=__doc__.splitlines()[0])
+    ap = args.parser("work_precision", __doc__, examples=["{prog} --quick --out results/numerics", "{prog} --problems rig --repeats 3 --figures docs/numerics"],
+                      writes="work_precision_<problem>.csv, work_precision_<problem>.png (error against wall time), work_precision_<problem>_rms.png, work_precision.json, work_precision.md and the settled states <problem>_settled.npz", out="results/numerics")
     ap.add_argument("--problems", default="rig,dpgt", type=args.choice_list(("rig", "dpgt"), "problems"), help="comma-separated: rig, dpgt")
     ap.add_argument("--quick", action="store_true", help="short window, fewer settings (minutes, not tens of minutes)")
-    ap.add_argument("--out", default="results/numerics", type=args.out_folder, help="output directory")
+    args.add_shared(ap, "out", out="results/numerics")
     ap.add_argument("--repeats", type=args.count(1), default=1, help="timing repeats per contender (median reported)")
     ap.add_argument("--cap", type=args.positive("s"), default=None, help="wall-time cap per scipy run [s]")
     ap.add_argument("--window", type=args.positive("s"), default=None, help="integration window after settling [s]")

@@ -170,3 +170,20 @@ def test_scene_handles_are_typed():
         pair.inner = "x"
     b = pair.inner_bearing
     assert b.kind == "rollers" and len(b.rollers) == 12 and b.guide is not None and b.spring is None
+
+
+# the modules every scenario builds on; a scenario borrows nothing from another scenario (issue 24 §3)
+SCENARIO_INFRASTRUCTURE = {"scenarios", "scenarios.args", "scenarios.command", "scenarios.runner", "scenarios.sweep",
+                           "scenarios.study", "scenarios.integrity", "scenarios.lock", "scenarios.plausibility",
+                           "scenarios.analysis", "scenarios.numerics_common"}
+
+
+def test_no_scenario_borrows_from_another_scenario():
+    """Shared helpers (--set parsing, scene switches, the reference HHT run, the housing sensor's signals) live in
+    the infrastructure modules, not in the study that wrote them first; only the demo is another study (the paper
+    study with its own defaults)."""
+    graph = import_graph()
+    borrowed = {(mod, d) for mod, deps in graph.items() if mod.startswith("scenarios.")
+                and mod not in SCENARIO_INFRASTRUCTURE for d in deps
+                if d.startswith("scenarios.") and d not in SCENARIO_INFRASTRUCTURE}
+    assert borrowed <= {("scenarios.demo", "scenarios.paper_study")}, sorted(borrowed)

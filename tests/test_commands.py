@@ -45,16 +45,22 @@ def test_a_bad_condition_through_the_dpgt_command(tmp_path, capsys):
 
 def test_a_failed_rerun_keeps_the_finished_summaries_in_the_tables(tmp_path):
     import json
+
+    from scenarios.study import Study, StudyRun
+    from scenarios.sweep import Case, Outcome, Status
     good, damaged = tmp_path / "c4_forward", tmp_path / "c4_reverse"
     good.mkdir()
     damaged.mkdir()
     (good / "summary.json").write_text(json.dumps({"inner": {"bearing_load_mean_N": 1.0}, "outer": {}}))
     (damaged / "summary.json").write_text("{not json")
-    results = {"c4_forward": {"error": "boom"}, "c4_reverse": {"error": "bang"}}
-    paper_study._keep_finished_on_disk(results, tmp_path)
+    run = StudyRun(tmp_path, [], {"c4_forward": Outcome(Case(4, "forward", str(good)), Status.FAILED, error="boom"),
+                                  "c4_reverse": Outcome(Case(4, "reverse", str(damaged)), Status.FAILED, error="bang")})
+    run.kept = Study._earlier(run)                                      # what the paper study does (keep_earlier)
+    results = run.results
     assert results["c4_forward"]["inner"] == {"bearing_load_mean_N": 1.0}
     assert results["c4_forward"]["stale_after_failure"] == "boom"      # still reported as failed
-    assert results["c4_reverse"] == {"error": "bang"}                 # a damaged summary is not used
+    assert run.failed == {"c4_forward": "boom", "c4_reverse": "bang"}
+    assert "c4_reverse" not in results                                # a damaged summary is not used
 
 
 # every command checks all its arguments before anything runs: one line naming the argument, exit 2
@@ -115,6 +121,14 @@ BAD_ARGUMENTS = [
     ("stability", ["--cases", "torque_stepp"], "(did you mean 'torque_step'?)"),
     ("work_precision", ["--problems", "dpg"], "(did you mean 'dpgt'?)"),
     ("benchmark", ["--scipy-methods", "radau"], "(did you mean 'Radau'?)"),
+    # the shared grammar: --conditions everywhere (one condition where a command runs one), --params, --set
+    ("fault_study", ["--conditions", "2,3"], "--conditions/--condition: this command runs one condition at a time"),
+    ("fault_study", ["--condition", "7"], "--conditions/--condition: must be a whole number in [1, 4]"),
+    ("modal", ["--conditions", "3,4"], "this command runs one condition at a time, got '3,4'"),
+    ("gear_quality", ["--params", "/no/such.toml"], "--params: no such file"),
+    ("fault_study", ["--params", "/no/such.toml"], "--params: no such file"),
+    ("bearing_rig", ["--set", "clearance"], "--set: expects KEY=VALUE"),
+    ("spectrum", ["--workers", "2"], "unrecognized arguments: --workers"),       # one run: no sweep options
 ]
 
 
@@ -174,3 +188,152 @@ def test_did_you_mean_is_one_helper_with_sane_matches():
     assert argparse_hint(p, "unrecognized arguments: --condtions=3") == \
         "unrecognized arguments: --condtions=3 (did you mean '--conditions'?)"
     assert argparse_hint(p, "unrecognized arguments: --zzz") == "unrecognized arguments: --zzz"
+
+
+# the shared command grammar (issue 24 §3): one definition of every shared option, the same in every command
+STUDIES = {"paper_study": "results/study", "demo": "results/demo", "lubricant_study": "results/lubricant",
+           "fault_study": "results/faults", "gear_quality": "results/gear_quality"}
+OTHERS = {"spectrum": "results/spectrum", "bearing_rig": "results/bearing_rig", "modal": "results/modal",
+          "work_precision": "results/numerics", "stability": "results/numerics", "benchmark": "results/numerics",
+          "bench_engine": None, "params": None, "animate": None}
+SHARED_OPTIONS = ("--params", "--set", "--out", "--overwrite", "--force", "--no-progress", "--workers",
+                  "--scheduler", "--conditions")
+
+
+def _help(name, capsys):
+    assert cli.main([name, "--help"]) == 0
+    return capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name", STUDIES)
+def test_every_study_takes_the_shared_options_with_one_help_text(name, capsys):
+    from scenarios.args import SHARED
+
+    text = _help(name, capsys)
+    assert text.startswith(f"usage: dpgt {name} ")             # under the console command it names itself so
+    for option in SHARED_OPTIONS:
+        assert option in text, option
+    flat = " ".join(text.split())
+    for key in ("params", "overwrite", "force", "no-progress", "scheduler"):     # the one definition's words
+        assert " ".join(SHARED[key][1]["help"].split()) in flat, key
+    assert f"output folder (default {STUDIES[name]})" in flat
+    assert "examples:" in text and f"dpgt {name} --" in text.split("examples:")[1]
+    assert f"writes (into --out, default {STUDIES[name]}):" in text and f"default --out: {STUDIES[name]}" in text
+
+
+@pytest.mark.parametrize("name", OTHERS)
+def test_every_other_command_lists_examples_what_it_writes_and_its_default_out(name, capsys):
+    text = _help(name, capsys)
+    assert text.startswith(f"usage: dpgt {name} ") and "examples:" in text and "writes" in text
+    if OTHERS[name]:
+        assert f"default --out: {OTHERS[name]}" in text and "--out DIR" in text
+
+
+def test_outside_the_console_command_the_usage_names_the_module(capsys):
+    from scenarios import lubricant_study
+
+    assert lubricant_study.main(["--help"]) == 0
+    assert capsys.readouterr().out.startswith("usage: python -m scenarios.lubricant_study ")
+
+
+def test_one_condition_commands_take_conditions_and_the_former_spelling():
+    from scenarios import fault_study
+
+    assert fault_study.parse_args(["--conditions", "3"]).conditions == 3
+    assert fault_study.parse_args(["--condition", "1"]).conditions == 1        # the former spelling still works
+    assert fault_study.parse_args([]).conditions == 2                           # the source's rig speed
+
+
+
+def test_dpgt_params_lists_every_key_with_value_unit_source_and_meaning(capsys):
+    from components.params import parameter_names
+    from components.presets import reference_dpgt
+
+    assert cli.main(["params", "--grep", "clearance"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    row = next(line for line in lines if line.startswith("bearing.clearance "))
+    assert row.split()[1:4] == ["20", "µm", "[assumed]"] and "diametral clearance" in row
+    assert all("clearance" in line.lower() for line in lines[1:])                   # only what --grep asks for
+    assert cli.main(["params"]) == 0
+    keys = [line.split()[0] for line in capsys.readouterr().out.splitlines()[1:]]
+    assert keys == parameter_names(reference_dpgt())                                # every key, none twice
+    assert cli.main(["params", "--grep", "bearing.clearance", "--set", "bearing.clearance=30 um"]) == 0
+    assert capsys.readouterr().out.splitlines()[1].split()[1:4] == ["30", "µm", "[user]"]
+    assert cli.main(["params", "--set", "bearing.clearence=30 um"]) == 2           # a near miss: did you mean
+    assert "(did you mean 'bearing.clearance'?)" in capsys.readouterr().err
+
+
+TINY_STUDY = ["--conditions", "4", "--directions", "forward", "--settle", "0.0005", "--window", "0.0005",
+              "--set", "bearing.rollers=8", "--no-progress", "--workers", "1"]
+
+
+def test_a_study_says_what_happens_and_marks_reused_runs(tmp_path, capsys):
+    """Typed outcomes (finished, reused, failed); the headline table first, one line per post-processing step; a
+    run taken from an earlier one is reported as reused, with the wall time of the run that made it."""
+    import json
+
+    from scenarios.sweep import Status
+
+    r = paper_study.run(paper_study.parse_args([*TINY_STUDY, "--out", str(tmp_path)]))
+    assert r["outcomes"]["c4_forward"].status is Status.FINISHED and not r["failed"]
+    first = capsys.readouterr().out
+    assert "runs: 1 finished now, 0 reused" in first and ": reused (" not in first
+    wall = json.loads((tmp_path / "c4_forward" / "summary.json").read_text())["wall_s"]
+    r = paper_study.run(paper_study.parse_args([*TINY_STUDY, "--out", str(tmp_path)]))
+    o = r["outcomes"]["c4_forward"]
+    assert o.status is Status.REUSED and o.wall_s == pytest.approx(wall)
+    text = capsys.readouterr().out
+    assert "runs: 0 to run, 1 reused" in text and "runs: 0 finished now, 1 reused" in text
+    line = next(x for x in text.splitlines() if x.startswith("  c4_forward: reused ("))
+    assert f"{wall:.1f} s wall" in line                          # the original run's wall time
+    lines = text.splitlines()
+    head, table, tables, figures = (next(i for i, x in enumerate(lines) if x.startswith(w))
+                                    for w in ("headline (", "### Condition 4", "tables: ", "figures: "))
+    assert head < table < tables < figures                         # the headline table first
+    assert lines[head + 3].startswith("| 4 | inner | ") and " / – " in lines[head + 3]   # no reverse run: no change
+    assert lines[tables] == "tables: comparison.csv, comparison.md" and "bearing_load_life.png" in lines[figures]
+    assert sum(x.startswith(("tables: ", "figures: ", "animation: ")) for x in lines) == 2   # one line per step
+
+
+def test_a_failed_run_is_an_outcome_not_a_dict(tmp_path):
+    from scenarios.runner import RunConfig
+    from scenarios.sweep import Case, Status, sweep
+
+    bad = Case(4, "reverse", str(tmp_path / "bad"), {"bearing.rollers": 8, "gears.planets": 0})
+    o = sweep([bad], RunConfig(settle=0.0005, window=0.0005, progress=False), workers=1, progress=False)["c4_reverse"]
+    assert o.status is Status.FAILED and not o.ok and o.summary is None and "gears.planets" in o.error
+    assert o.as_dict()["error"] == o.error                         # run_sweep's plain form, for old callers
+
+
+def test_the_python_entry_point_runs_reuses_and_opens_a_run(tmp_path):
+    """scenarios.run: the run every study makes, from a script or a notebook; the same run again is reused."""
+    import scenarios
+
+    kw = dict(condition=4, set={"bearing.rollers": 8}, settle=0.0005, window=0.0005, progress=False)
+    first = scenarios.run(out=tmp_path / "run", **kw)
+    assert first.status == "finished" and first.summary["rollers"] == 8 and first.summary["condition"] == 4
+    again = scenarios.run(scenarios.parameters(4, set={"bearing.rollers": 8}), tmp_path / "run",
+                          **{k: v for k, v in kw.items() if k not in ("condition", "set")})
+    assert again.status == "reused" and again.wall_s == first.wall_s
+    with again.dataset() as ds:
+        assert ds["race_inner.load"].attrs["units"] == "N" and ds.sizes["time"] == first.summary["samples"]
+
+
+def test_params_files_reach_every_case_of_the_studies_that_gained_them(tmp_path):
+    """--params in the fault study (beside each machine's own file) and in the gear-quality study."""
+    from scenarios import fault_study, gear_quality
+    from scenarios.sweep import build_params
+
+    common, dent = tmp_path / "common.toml", tmp_path / "dent.toml"
+    common.write_text('[bearing]\nclearance = "30 um"\n')
+    dent.write_text('[[errors.pinhole]]\nplanet = "b1"\nradial = "0 um"\ntangential = "30 um"\n')
+    a = fault_study.parse_args(["--params", str(common), "--machine", f"bent={dent}", "--faults", "runout",
+                                "--directions", "forward", "--out", str(tmp_path / "f")])
+    by = {c.tag: build_params(c).si() for c in fault_study.make_cases(a, tmp_path / "f")}
+    assert set(by) == {"perfect", "runout", "bent"}
+    assert all(si.bearing.clearance == pytest.approx(30e-6) for si in by.values())
+    assert by["bent"].errors.pinhole and by["runout"].errors.runout and not by["perfect"].errors.pinhole
+    a = gear_quality.parse_args(["--params", str(common), "--conditions", "3", "--grades", "6", "--seeds", "1",
+                                 "--out", str(tmp_path / "g")])
+    assert all(build_params(c).si().bearing.clearance == pytest.approx(30e-6)
+               for c in gear_quality.make_cases(a, tmp_path / "g"))

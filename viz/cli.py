@@ -13,6 +13,12 @@ RESULTS is a results.nc or the run directory holding it; FILE ends in .gif or .m
                 (--frame carrier) or from the housing (--frame fixed); --magnify scales displacements
                 from the nominal positions (default 1: true scale).
 Exit status: 0 written, 1 bad input file or no offscreen rendering, 2 bad arguments.
+
+examples:
+  dpgt animate results/demo/c3_forward --compare results/demo/c3_reverse --out cage_orbits.gif
+  dpgt animate results/demo/c3_reverse/results.nc --kind train --frame fixed --max-frames 200 --out train.mp4
+
+writes: the animation FILE given by --out (required: no default)
 """
 from __future__ import annotations
 

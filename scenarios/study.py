@@ -1,0 +1,173 @@
+"""One skeleton for every sweep study (issue 24 §3): cases → validate → check runs and folders → sweep → rows →
+write → epilogue.
+
+A study is a subclass of :class:`Study` that says what is particular to it — its run settings (:meth:`config`),
+its cases (:meth:`cases`), its own check of a case (:meth:`check`) and what it makes of the runs
+(:meth:`report`: rows, the headline table, files) — and inherits the rest, in the same order and with the same
+words in every study:
+
+1. every case's parameters converted and its design checked before anything runs (design warnings once);
+2. the recordings checked against the limit and the disk (``--force``), the folders against results of other
+   parameters (``--overwrite``);
+3. the sweep (:func:`scenarios.sweep.sweep`): each case an :class:`~scenarios.sweep.Outcome`, finished, reused
+   or failed;
+4. the study's report: its headline table first, then one line per post-processing step (:meth:`StudyRun.step`:
+   tables, figures, animation);
+5. the epilogue: each run's wall time and error estimate (a reused run marked "reused", with the wall time of
+   the run that made it), its warnings, the failed runs, the files written.
+
+A new study writes those four methods and a parser (:func:`scenarios.args.parser` and
+:func:`scenarios.args.add_shared` for the shared options).
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, ClassVar
+
+from mbd.recorder import atomic_write_text
+
+from .integrity import read_summary
+from .plausibility import check_runs
+from .runner import RunConfig, run_report
+from .sweep import Case, Outcome, Status, _case_cfg, build_params, check_folders, sweep, validate_cases
+
+__all__ = ["Study", "StudyRun", "run_lines", "runs_line"]
+
+
+@dataclass
+class StudyRun:
+    """A study after its sweep: its cases, their outcomes, and the files its report writes."""
+    out: Path
+    cases: list[Case]
+    outcomes: dict[str, Outcome]
+    files: list[Path] = field(default_factory=list)
+    kept: dict[str, dict] = field(default_factory=dict)    # failed now, but finished before: the earlier summary
+
+    @property
+    def results(self) -> dict[str, dict]:
+        """{label: summary} of every run the tables can use: finished and reused ones, and a failed one's earlier
+        summary (marked ``stale_after_failure`` with the error) when the study keeps those."""
+        out = {k: o.summary for k, o in self.outcomes.items() if o.ok}
+        out.update({k: {**s, "stale_after_failure": self.outcomes[k].error} for k, s in self.kept.items()})
+        return out
+
+    @property
+    def failed(self) -> dict[str, str]:
+        """{label: what went wrong} of every failed run."""
+        return {k: o.error for k, o in self.outcomes.items() if not o.ok}
+
+    def step(self, what: str, make: Callable[..., list], *a, **kw) -> list[Path]:
+        """One post-processing step (tables, figures, animation): make its files and say so in one line."""
+        paths = [Path(p) for p in (make(*a, **kw) or [])]
+        self.files += paths
+        names = ", ".join(p.name for p in paths)
+        print(f"{what}: {names if paths else 'nothing to write'}", flush=True)
+        return paths
+
+
+def runs_line(outcomes: dict[str, Outcome]) -> str:
+    """How many runs finished now, were reused from earlier runs and failed, in one line."""
+    n = {st: sum(o.status is st for o in outcomes.values()) for st in Status}
+    return (f"runs: {n[Status.FINISHED]} finished now, {n[Status.REUSED]} reused (finished earlier with the same "
+            f"parameters, settings and code), {n[Status.FAILED]} failed")
+
+
+def run_lines(outcomes: dict[str, Outcome]) -> list[str]:
+    """Each run's wall time, steps and error estimate, then its warnings, a line each; a reused run is marked so,
+    with the wall time of the run that made its results."""
+    lines = []
+    for k, o in sorted(outcomes.items()):
+        if not o.ok or "error_estimate" not in (o.summary or {}):
+            continue
+        first, *warns = run_report(o.summary)
+        if o.status is Status.REUSED:
+            first = f"reused (its results are from an earlier run of the same parameters and code: {first})"
+        lines += [f"  {k}: {first}", *(f"  {k}: {w}" for w in warns)]
+    return lines
+
+
+class Study:
+    """The skeleton of a sweep study (module docstring). ``a``: the parsed command line, with at least the shared
+    options ``--out``, ``--force``, ``--overwrite``, ``--workers``, ``--scheduler`` and ``--no-progress``."""
+
+    keep_earlier: ClassVar[bool] = False   # a run that fails now but finished before keeps its summary in the tables
+    record: ClassVar[bool] = True          # write study.json: the cases and the failed runs
+
+    def __init__(self, a):
+        self.a = a
+        self.out = Path(a.out)
+
+    # -- what a study says ------------------------------------------------------------------------------------
+    def config(self) -> RunConfig:
+        raise NotImplementedError
+
+    def cases(self) -> list[Case]:
+        raise NotImplementedError
+
+    def check(self, case: Case, cfg: RunConfig) -> None:
+        """A study's own check of a case before anything runs (raise ParameterError to refuse it)."""
+
+    def report(self, run: StudyRun) -> dict:
+        """Rows, the headline table (printed first) and the files (:meth:`StudyRun.step`); returns what the
+        study's result holds besides results, outcomes, failed and files."""
+        raise NotImplementedError
+
+    def study_record(self) -> dict:
+        """What study.json holds besides the cases and the failed runs."""
+        return {}
+
+    # -- the skeleton -----------------------------------------------------------------------------------------
+    def run(self) -> dict:
+        """Cases → validate → check runs and folders → sweep → report → epilogue; returns {"results",
+        "outcomes", "failed", "files", ...the report's}."""
+        a = self.a
+        cfg = self.config()
+        cases = self.cases()
+        validate_cases(cases, lambda c: self.check(c, cfg))      # every parameter checked before any run starts
+        self.out.mkdir(parents=True, exist_ok=True)
+        for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], self.out, a.force):
+            print(f"warning (--force): {w}")
+        check_folders(cases, cfg, a.overwrite)                  # never replace results of other parameters silently
+        outcomes = sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
+                         overwrite=a.overwrite, announce=True)
+        run = StudyRun(self.out, cases, outcomes)
+        print(runs_line(outcomes), flush=True)
+        if self.keep_earlier:
+            run.kept = self._earlier(run)
+        extra = self.report(run)
+        if self.record:
+            atomic_write_text(self.out / "study.json", json.dumps(
+                {"cases": [dataclasses.asdict(c) for c in cases], **self.study_record(), "failed": run.failed},
+                indent=2, default=str))
+        r = {"results": run.results, "outcomes": outcomes, "failed": run.failed, "files": run.files, **extra}
+        self.epilogue(run)
+        return r
+
+    @staticmethod
+    def _earlier(run: StudyRun) -> dict[str, dict]:
+        """A run that failed this time but finished before keeps its summary in the tables: a re-run in which
+        nothing succeeds never replaces good tables with empty ones (its failure is still reported). A damaged
+        summary is moved aside, not used."""
+        kept = {}
+        for k, o in run.outcomes.items():
+            if not o.ok:
+                old = read_summary(Path(o.case.out_dir) / "summary.json")
+                if old is not None and "error" not in old and "inner" in old:
+                    kept[k] = old
+        return kept
+
+    def epilogue(self, run: StudyRun) -> None:
+        """Every run's time, error estimate and warnings (reused ones marked), the failed runs, the files."""
+        print("\nrun time and accuracy per run:", *run_lines(run.outcomes), sep="\n")
+        for k, o in run.outcomes.items():
+            if not o.ok:
+                kept = "; its earlier results stay in the tables" if k in run.kept else ""
+                print(f"FAILED {k}: {o.error}  (details in {Path(o.case.out_dir) / 'error.json'}{kept})")
+        print("\nwritten:\n" + "\n".join(f"  {p}" for p in run.files))
+
+    @staticmethod
+    def exit_code(r: dict) -> int:
+        return 1 if r["failed"] else 0
