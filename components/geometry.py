@@ -740,7 +740,8 @@ def check_design(params, strict: bool = True) -> list[Finding]:
     errors = [f for f in found if f.severity == "error"]
     for f in found:
         if f.severity == "warning" or not strict:
-            warnings.warn(f"{f.severity}: {f}", DesignWarning, stacklevel=2)
+            # a DesignWarning says it is a warning; an error let through (strict=False) says it is one
+            warnings.warn(str(f) if f.severity == "warning" else f"{f.severity}: {f}", DesignWarning, stacklevel=2)
     if strict and errors:
         lines = "\n".join(f"  {f}" for f in errors)
         first = errors[0]
