@@ -14,6 +14,7 @@ results of other parameters is refused unless ``overwrite=True``.
 """
 from __future__ import annotations
 
+import sys
 import tempfile
 import warnings
 from dataclasses import dataclass
@@ -79,8 +80,7 @@ def run(params=None, out=None, *, condition: int = 3, direction: str = "forward"
     from components.params import with_overrides
     from components.scene import SceneOptions
 
-    from .integrity import read_summary, results_intact
-    from .runner import RunConfig, run_case, run_fingerprint
+    from .runner import RunConfig, finished_run, run_case
 
     label = {}
     if params is None:
@@ -93,11 +93,18 @@ def run(params=None, out=None, *, condition: int = 3, direction: str = "forward"
     cfg = RunConfig(settle=settle, window=window, sample_rate=sample_rate, integration=integration or mbd.PRODUCTION,
                     options=SceneOptions.from_dict(options), progress=progress, sensor=sensor)
     out = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="dpgt-run-"))
-    s = read_summary(out / "summary.json")
-    if s is not None and s.get("fingerprint") == run_fingerprint(params, cfg) \
-            and results_intact(out / "results.nc", s.get("samples")):
-        return Run(out, s, "reused")
+    s = finished_run(out, params, cfg)
+    if s is not None:
+        return _said(Run(out, s, "reused"))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # the design's warnings were given above
         s = run_case(params, cfg, out, label=label, overwrite=overwrite)
-    return Run(out, s, "finished")
+    return _said(Run(out, s, "finished"))
+
+
+def _said(run: "Run") -> "Run":
+    """The run's statistics warnings (summary.json ``warnings``: a window too short to mean anything, an unsettled
+    drive), one line each on stderr, as the commands print them."""
+    for w in run.summary.get("warnings", []):
+        print(f"warning: {w}", file=sys.stderr, flush=True)
+    return run

@@ -16,9 +16,7 @@ EXAMPLES = ["{prog}", "{prog} --out results/demo --workers 2", '{prog} --set bea
 
 def build_parser():
     """The paper study's options, with the demo's defaults: condition 3, both directions, the animation."""
-    p = paper_study.build_parser("demo", out="results/demo", doc=__doc__, examples=EXAMPLES)
-    p.set_defaults(animate=True)
-    return p
+    return paper_study.build_parser("demo", out="results/demo", doc=__doc__, examples=EXAMPLES, animate=True)
 
 
 @command

@@ -326,7 +326,7 @@ class FaultStudy(Study):
         rows, spectra = rows_of(run.cases, run.results)
         for row in rows:                     # the headline first
             if row["bearing"] == "outer":
-                print(f"{row['fault']:>14} {row['direction']:>8}: K_γ {row['load_sharing_factor']:.3f}, "
+                print(f"{row['fault']:>14} {row['direction']:>8}, outer planet bearings: K_γ {row['load_sharing_factor']:.3f}, "
                       f"max bearing load {row['bearing_load_max_N']:.0f} N, life {row['life_relative'] or float('nan'):.2f}, "
                       + (f"sensor f_m / floor {row['sensor_f_m']:.3g}" if row["sensor_f_m"] is not None
                          else "sensor lines not meaningful (too short a window)"))

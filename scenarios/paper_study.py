@@ -11,6 +11,8 @@ and the cage orbits DIR/c{condition}_cage_orbit_{inner,outer}.png, and (with --a
 """
 from __future__ import annotations
 
+import argparse
+
 import dataclasses
 import csv
 import io
@@ -56,8 +58,10 @@ WRITES = ("c{condition}_{direction}/{results.nc, summary.json} per run; comparis
 
 
 def build_parser(name: str = "paper_study", out: str = "results/study", doc: str = __doc__,
-                 examples: list[str] = EXAMPLES):
-    p = args.parser(name, doc, examples=examples, writes=WRITES, out=out)
+                 examples: list[str] = EXAMPLES, animate: bool = False):
+    """The study's options; ``animate``: the animation is on by default (the demo), and the help says so."""
+    writes = WRITES.replace("with --animate", "and (unless --no-animate)") if animate else WRITES
+    p = args.parser(name, doc, examples=examples, writes=writes, out=out)
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     p.add_argument("--planets", type=args.count(1), default=None, help="planet pairs N (default 3, the reference machine)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03,
@@ -71,7 +75,9 @@ def build_parser(name: str = "paper_study", out: str = "results/study", doc: str
     p.add_argument("--alpha", type=args.alpha, default=-0.3, help="HHT alpha in [-1/3, 0]")
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
                    help="scene switch, e.g. --option drag=false --option bearings=linear")
-    p.add_argument("--animate", action="store_true", help="write a cage-orbit animation per condition")
+    p.add_argument("--animate", action=argparse.BooleanOptionalAction, default=animate,
+                   help="write a cage-orbit animation per condition (forward beside reverse)"
+                        + (" (default: on)" if animate else ""))
     args.add_shared(p, out=out, conditions="3")
     return p
 
@@ -333,6 +339,9 @@ def animate(results: dict, out: Path) -> list[Path]:
         f, r = out / f"c{c}_forward" / "results.nc", out / f"c{c}_reverse" / "results.nc"
         if f.exists() and r.exists():
             paths.append(Path(study_cage_animation(f, r, out / f"c{c}_cage_orbits.gif", max_frames=150)))
+        else:      # the animation sets forward beside reverse
+            print(f"animation of condition {c} skipped: it shows forward beside reverse, and "
+                  f"{'c%d_reverse' % c if f.exists() else 'c%d_forward' % c} was not run (--directions forward,reverse)")
     return paths
 
 

@@ -39,10 +39,10 @@ from components.outputs import BearingSeries, WindowStatistics, bearing_map, cag
 from components.sensor import HousingLoads
 from components.results_schema import drawing_geometry, element_probes
 
-from .integrity import checkpoint_usable, claim_folder
+from .integrity import checkpoint_usable, claim_folder, read_summary, results_intact
 from .lock import folder_lock
 
-__all__ = ["RunConfig", "run_case", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
+__all__ = ["RunConfig", "run_case", "finished_run", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
            "accuracy_line", "FIXED_STEP_ERROR_FACTOR"]
 
 # A fixed-step run whose RMS local error estimate exceeds its tolerance (atol) by more than this factor ends
@@ -136,6 +136,16 @@ def _probes(scene, sensor: bool = False) -> list:
             BodyMotion("fixed", bodies=["sun", "carrier", "ring"], frame="fixed"),
             *element_probes(scene), *BearingSeries(scene).probes(),
             *(HousingLoads(scene).probes() if sensor else [])]
+
+
+def finished_run(out_dir, params: DPGTParams, cfg: RunConfig) -> dict | None:
+    """The summary of ``out_dir`` if a run of these parameters, settings and code finished there and its results.nc
+    is intact (it is then reused, not recomputed), else None."""
+    out = Path(out_dir)
+    s = read_summary(out / "summary.json")
+    if s is None or s.get("fingerprint") != run_fingerprint(params, cfg):
+        return None
+    return s if results_intact(out / "results.nc", s.get("samples")) else None
 
 
 def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None, overwrite: bool = False) -> dict:

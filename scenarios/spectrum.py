@@ -44,7 +44,7 @@ from mbd.recorder import atomic_write_text
 from .analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution
 from .analysis import whole_revolutions as _whole_revolutions
 from .plausibility import check_runs
-from .runner import RunConfig, run_case, run_report
+from .runner import RunConfig, finished_run, run_case, run_report
 from . import args
 from .command import command
 
@@ -162,9 +162,14 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     cfg = dataclasses.replace(cfg, sensor=True)          # every path is written, whichever sensor is read
     for w in check_runs([("spectrum", params, cfg)], out, force):
         print(f"warning (--force): {w}")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        s = run_case(params, cfg, out / "run", label={"scenario": "spectrum", "sensor": sensor}, overwrite=overwrite)
+    s = finished_run(out / "run", params, cfg)       # the same machine, settings and code: read, not re-run
+    if s is not None:
+        print(f"{out / 'run'}: reused (same parameters, settings and code; {s.get('wall_s', 0.0):.1f} s wall when made)")
+    else:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            s = run_case(params, cfg, out / "run", label={"scenario": "spectrum", "sensor": sensor},
+                         overwrite=overwrite)
     t, signals = _whole_revolutions(*_signals(out / "run" / "results.nc", sensor), s["f_c_hz"])
     spectra = {k: amplitude_spectrum(t, x) for k, x in signals.items()}
     f, amp, df = spectra["amplitude"]
@@ -251,7 +256,7 @@ def _plot(f, spectra, f_m, f_c, s, sensor, out):
     marks = {"f_m": f_m, **{f"f_m{'+' if k > 0 else '−'}{abs(k)}f_c": f_m + k * f_c for k in (-3, -1, 1, 3)}}
     where = "carrier acceleration (fixed frame)" if sensor == "axis" else "housing accelerometer"
     return vp.spectrum(f, {names[k]: spectra[k][1] for k in shown}, marks, out / "spectrum.png",
-                       fmax=min(f[-1], 2.5 * f_m), quantity=where, unit="m/s^2", logy=True,
+                       fmax=min(f[-1], 2.5 * f_m), quantity=where, unit="m/s²", logy=True,
                        title=f"{where.capitalize()}, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min")
 
 

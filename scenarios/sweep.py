@@ -21,7 +21,7 @@ from pathlib import Path
 
 from mbd.recorder import atomic_write_text
 
-from .integrity import OtherResults, claim_folder, differences, read_summary, results_intact
+from .integrity import OtherResults, claim_folder, differences, read_summary
 
 __all__ = ["Case", "Status", "Outcome", "sweep", "run_sweep", "execute_case", "check_folders", "user_overrides",
            "validate_cases", "OPERATING_AXES"]
@@ -155,13 +155,9 @@ def _case_cfg(case: Case, cfg):
 def _finished(case: Case, params, cfg) -> dict | None:
     """The case's summary if it was finished from the same parameters, settings and code and its results.nc
     is intact, else None (then recomputed, not reused; damaged files are moved aside, scenarios.integrity)."""
-    from .runner import run_fingerprint
+    from .runner import finished_run
 
-    out = Path(case.out_dir)
-    s = read_summary(out / "summary.json")
-    if s is None or s.get("fingerprint") != run_fingerprint(params, cfg):
-        return None
-    return s if results_intact(out / "results.nc", s.get("samples")) else None
+    return finished_run(case.out_dir, params, cfg)
 
 
 def check_folders(cases: list[Case], cfg, overwrite: bool = False) -> None:

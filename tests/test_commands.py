@@ -305,13 +305,16 @@ def test_a_failed_run_is_an_outcome_not_a_dict(tmp_path):
     assert o.as_dict()["error"] == o.error                         # run_sweep's plain form, for old callers
 
 
-def test_the_python_entry_point_runs_reuses_and_opens_a_run(tmp_path):
-    """scenarios.run: the run every study makes, from a script or a notebook; the same run again is reused."""
+def test_the_python_entry_point_runs_reuses_and_opens_a_run(tmp_path, capsys):
+    """scenarios.run: the run every study makes, from a script or a notebook; the same run again is reused. Its
+    statistics warnings (here: a 0.5 ms window, a fraction of a cage revolution) are printed, as the commands do."""
     import scenarios
 
     kw = dict(condition=4, set={"bearing.rollers": 8}, settle=0.0005, window=0.0005, progress=False)
     first = scenarios.run(out=tmp_path / "run", **kw)
     assert first.status == "finished" and first.summary["rollers"] == 8 and first.summary["condition"] == 4
+    said = [x for x in capsys.readouterr().err.splitlines() if x.startswith("warning: ")]
+    assert said and len(said) == len(first.summary["warnings"]) and any("cage revolution" in x for x in said)
     again = scenarios.run(scenarios.parameters(4, set={"bearing.rollers": 8}), tmp_path / "run",
                           **{k: v for k, v in kw.items() if k not in ("condition", "set")})
     assert again.status == "reused" and again.wall_s == first.wall_s

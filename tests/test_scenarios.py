@@ -195,16 +195,23 @@ def test_spectrum_peaks_sit_on_mesh_sidebands(tmp_path):
 
 
 @pytest.mark.slow
-def test_spectrum_housing_sensor_on_a_perfect_machine(tmp_path):
+def test_spectrum_housing_sensor_on_a_perfect_machine(tmp_path, capsys):
     """The windowed housing sensor (MODEL.md §3.10) on a perfect machine: a passing-planet window carries every
     carrier order, so besides f_m − f_c the other lines planet phasing allows for z_r = 82, N = 3 appear —
     f_m + 2f_c, f_m − 4f_c, f_m + 5f_c stand out of the band's median by ≥ 5× (seen: 8e4–2e5×) — while
     the lines phasing cancels, f_m, f_m + f_c and f_m ± 3f_c among them, stay below 1 % of the strongest
     (seen: ≤ 5e-4 %): the window alone does not bring f_m or f_m + f_c (McFadden & Smith 1985: "complete
     suppression of the component at the tooth meshing frequency"); errors (MODEL.md §3.9) must."""
-    s = spectrum.run(spectrum.parse_args(["--out", str(tmp_path), "--settle", "0.06", "--window", "0.09",
-                                          "--option", "bearings=linear", "--no-progress", "--perfect"]))
+    argv = ["--out", str(tmp_path), "--settle", "0.06", "--window", "0.09", "--option", "bearings=linear",
+            "--no-progress", "--perfect"]
+    s = spectrum.run(spectrum.parse_args(argv))
     assert s["sensor"] == "housing" and s["resolution_hz"] == pytest.approx(s["f_c_hz"] / 3, rel=1e-3)
+    # another sensor of the same machine reads the same run: reused, said so, not simulated again
+    nc = tmp_path / "run" / "results.nc"
+    made, capsys_before = nc.stat().st_mtime_ns, capsys.readouterr()
+    assert spectrum.run(spectrum.parse_args([*argv, "--sensor", "axis"]))["sensor"] == "axis"
+    assert nc.stat().st_mtime_ns == made and "run: reused (same parameters, settings and code" in capsys.readouterr().out
+    s = spectrum.run(spectrum.parse_args(argv))
     lines = {r["k"]: r for r in s["lines"]}
     strongest = max(r["amplitude"] for r in s["lines"])
     assert [k for k, r in lines.items() if r["perfect_machine_shows"] and abs(k) <= 5] == [-4, -1, 2, 5]

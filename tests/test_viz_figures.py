@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 
+import matplotlib.colors
 import matplotlib.image as mpimg
 import numpy as np
 import pytest
@@ -286,3 +287,21 @@ def test_display_unit(unit, values, factor, shown):
                                      (159.4, "+159 %")])
 def test_format_pct(p, text):
     assert plots.format_pct(p) == text
+
+
+def test_a_spectrum_of_several_paths_gives_each_its_own_colour(captured, tmp_path):
+    """The housing sensor and its three paths (four curves): four colours, one legend entry each, and the
+    marks and the unit on the axes."""
+    f = np.linspace(0.0, 2000.0, 401)
+    curves = {name: (k + 1.0) * (1.0 + np.abs(np.sin(f / (50.0 + k)))) for k, name in
+              enumerate(("housing sensor", "mesh path", "torque path", "bearing path"))}
+    plots.spectrum(f, curves, {"f_m": 900.0}, tmp_path / "s.png", quantity="housing accelerometer", unit="m/s²",
+                   logy=True)
+    fig = captured[-1]
+    ax = _visible_axes(fig)[0]
+    colours = [tuple(matplotlib.colors.to_rgba(line.get_color())) for line in ax.get_lines() if line.get_label() in curves]
+    assert len(colours) == 4
+    rgb = np.array(colours)[:, :3]
+    apart = min(np.linalg.norm(rgb[i] - rgb[j]) for i in range(4) for j in range(i))
+    assert apart > 0.25, apart          # told apart by eye, not only by value (two blues were 0.1 apart)
+    assert _legend_labels(fig) == list(curves) and "[m/s²]" in ax.get_ylabel()

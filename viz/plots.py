@@ -147,6 +147,9 @@ def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]
         return _save(fig, path)
 
 
+_MORE_COLORS = ("tab:green", "tab:purple", "tab:brown", "tab:gray", "tab:olive")
+
+
 def spectrum(freq_hz, amplitude, marks: Mapping[str, float], path, fmax: float | None = None, *,
              quantity: str = "amplitude", unit: str = "a.u.", logy: bool = False,
              title: str | None = None) -> Path:
@@ -167,8 +170,8 @@ def spectrum(freq_hz, amplitude, marks: Mapping[str, float], path, fmax: float |
             st = dict(styles[i % 2]) if label is not None else dict(FWD)
             st["linestyle"] = "-"
             st["label"] = label
-            if i >= 2:
-                st.pop("color")
+            if i >= 2:           # beyond forward/reverse: colours of their own (the cycle would repeat theirs)
+                st["color"] = _MORE_COLORS[(i - 2) % len(_MORE_COLORS)]
             ax.plot(f[keep], np.asarray(a, float)[keep], **st)
         if logy:
             ax.set_yscale("log")
@@ -176,7 +179,7 @@ def spectrum(freq_hz, amplitude, marks: Mapping[str, float], path, fmax: float |
         ax.set_xlabel(_axis_label("frequency", "Hz"))
         ax.set_ylabel(_axis_label(quantity, unit))
         if any(k is not None for k in curves):
-            ax.legend(loc="center right")
+            ax.legend(loc="best", fontsize=8, framealpha=0.9)
         if title:
             ax.set_title(title)
         _mark_frequencies(fig, ax, marks, fmax)
