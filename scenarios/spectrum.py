@@ -266,12 +266,15 @@ def _report(lines, peaks, f_m, f_c, df, t, sensor) -> None:
     print("lines f_m + k f_c (origin: phasing = a perfect machine shows it at the axis; transfer path = "
           "phasing allows it through a position-dependent path; errors = cancelled in a perfect machine); "
           "each path's amplitude over its own band median, and the path that carries the line:")
-    print(f"  {'line':>9} {'freq':>9}    {'amp':>9}  {'x median':>8}   {'origin':<13} {'':8} "
+    print("  (amp in m/s²; 'x median' and the path columns: amplitude over that signal's own band median; "
+          "'perfect': a perfect machine shows the line; –: the path is zero for this sensor)")
+    print(f"  {'line':>9} {'freq':>9}    {'amp':>9}  {'x median':>8}   {'origin':<13} {'perfect':8} "
           + " ".join(f"{p:>8}" for p in PATHS) + "  carried by")
+    ratio = lambda x: f"{x:8.2f}" if np.isfinite(x) else f"{'–':>8}"
     for r in lines:
         print(f"  {r['line']:>9} {r['frequency_hz']:6.1f} Hz  {r['amplitude']:9.3g}  {r['over_median']:8.1f}   "
-              f"{r['origin']:<13} {'expected' if r['perfect_machine_shows'] else '-':8} "
-              + " ".join(f"{r[f'{p}_over_floor']:8.2f}" for p in PATHS) + f"  {r['carried_by']}")
+              f"{r['origin']:<13} {'yes' if r['perfect_machine_shows'] else 'no':8} "
+              + " ".join(ratio(r[f'{p}_over_floor']) for p in PATHS) + f"  {r['carried_by']}")
     print("strongest peaks near f_m:")
     for r in peaks:
         print(f"  {r['frequency_hz']:9.1f} Hz  amp {r['amplitude']:.3g} m/s^2   nearest {r['nearest']:>8} "

@@ -166,7 +166,9 @@ class Study:
             if not o.ok:
                 kept = "; its earlier results stay in the tables" if k in run.kept else ""
                 print(f"FAILED {k}: {o.error}  (details in {Path(o.case.out_dir) / 'error.json'}{kept})")
-        print("\nwritten:\n" + "\n".join(f"  {p}" for p in run.files))
+        runs = [Path(o.case.out_dir) / name for o in run.outcomes.values() if o.ok
+                for name in ("summary.json", "results.nc") if (Path(o.case.out_dir) / name).exists()]
+        print("\nwritten:\n" + "\n".join(f"  {p}" for p in [*run.files, *runs]))
 
     @staticmethod
     def exit_code(r: dict) -> int:
