@@ -116,11 +116,11 @@ def run(a) -> dict:
     # shapes: scale rotations by a representative radius so x, y and θ bars compare (metres of arc)
     radius = 0.05
     scale = np.where(m.free % 3 == 2, radius, 1.0)[:, None]
-    nz = np.flatnonzero(f > 0)[:12]
+    nz = np.flatnonzero(f > 0)
     from viz import plots as vp
 
-    fig = vp.mode_shapes(f[nz], (X[:, nz] * scale).T, labels, out / "mode_shapes.png",
-                         title="Mode shapes (θ scaled by 50 mm)")
+    fig = vp.mode_shapes(f[nz], (X[:, nz] * scale).T, labels, out / "mode_shapes.png", numbers=nz + 1,
+                         title="Mode shapes (θ scaled by 50 mm; the rigid-body modes at 0 Hz left out)")
     print(f"{summary['model']}: {m.ndof} DOF")
     for i, (fi, k, mu) in enumerate(zip(f, kind, mult)):
         print(f"  mode {i + 1:3d}: {fi:12.2f} Hz  {k:<13} ×{mu}")

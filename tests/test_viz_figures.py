@@ -305,3 +305,14 @@ def test_a_spectrum_of_several_paths_gives_each_its_own_colour(captured, tmp_pat
     apart = min(np.linalg.norm(rgb[i] - rgb[j]) for i in range(4) for j in range(i))
     assert apart > 0.25, apart          # told apart by eye, not only by value (two blues were 0.1 apart)
     assert _legend_labels(fig) == list(curves) and "[m/s²]" in ax.get_ylabel()
+
+
+def test_mode_shapes_are_numbered_as_the_table_and_say_what_is_left_out(captured, tmp_path):
+    """The modal table counts the rigid-body mode at 0 Hz as mode 1; the figure leaves it out but keeps its numbers,
+    and says how many modes it does not show."""
+    f = np.array([10.0, 20.0, 30.0, 40.0])
+    plots.mode_shapes(f, np.eye(4), ["a", "b", "c", "d"], tmp_path / "m.png", max_modes=3, numbers=[2, 3, 4, 5])
+    fig = captured[-1]
+    titles = [ax.get_title() for ax in _visible_axes(fig)]
+    assert titles == ["mode 2: f = 10 Hz", "mode 3: f = 20 Hz", "mode 4: f = 30 Hz"]
+    assert any(t.get_text() == "the first 3 of 4 modes shown" for t in fig.texts)

@@ -141,6 +141,8 @@ def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]
             ax.grid(axis="x", visible=False)
         for ax in axes[n:]:
             ax.set_visible(False)
+        if freqs.size > n:       # say what is left out
+            fig.text(0.5, 0.0, f"the first {n} of {freqs.size} modes shown", ha="center", va="bottom", fontsize=8)
         _direction_legend(fig, [d for d in ("forward", "reverse") if d in present], hatch=True)
         if title:
             fig.suptitle(title)
@@ -275,8 +277,9 @@ def load_distribution(angles_rad, loads_N, path, *, title: str | None = None) ->
 
 
 def mode_shapes(freqs_hz, shapes, labels: Sequence[str], path, *, max_modes: int = 12,
-                title: str | None = None) -> Path:
-    """Bar chart of each mode shape (rows of `shapes`, one entry per coordinate in `labels`).
+                title: str | None = None, numbers: Sequence[int] | None = None) -> Path:
+    """Bar chart of each mode shape (rows of `shapes`, one entry per coordinate in `labels`); ``numbers``: each
+    mode's number as the caller's table counts it (default 1, 2, ...).
 
     Each shape is scaled to unit maximum magnitude, so the bars read as relative participation;
     pass comparable coordinates (e.g. rotations times a base radius) for that to be meaningful.
@@ -301,13 +304,15 @@ def mode_shapes(freqs_hz, shapes, labels: Sequence[str], path, *, max_modes: int
             ax.bar(x, s, color=FWD["color"])
             ax.axhline(0.0, color="k", lw=0.6)
             ax.set_ylim(-1.1, 1.1)
-            ax.set_title(f"mode {i + 1}: f = {freqs[i]:.4g} Hz")
+            ax.set_title(f"mode {numbers[i] if numbers is not None else i + 1}: f = {freqs[i]:.4g} Hz")
             ax.set_xticks(x, labels, rotation=90, fontsize=7)
             ax.set_ylabel(_axis_label("amplitude", "–"))
             ax.set_xlabel(_axis_label("coordinate", "–"))
             ax.grid(axis="x", visible=False)
         for ax in axes[n:]:
             ax.set_visible(False)
+        if freqs.size > n:       # say what is left out
+            fig.text(0.5, 0.0, f"the first {n} of {freqs.size} modes shown", ha="center", va="bottom", fontsize=8)
         if title:
             fig.suptitle(title)
         return _save(fig, path)
