@@ -141,8 +141,6 @@ def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]
             ax.grid(axis="x", visible=False)
         for ax in axes[n:]:
             ax.set_visible(False)
-        if freqs.size > n:       # say what is left out
-            fig.text(0.5, 0.0, f"the first {n} of {freqs.size} modes shown", ha="center", va="bottom", fontsize=8)
         _direction_legend(fig, [d for d in ("forward", "reverse") if d in present], hatch=True)
         if title:
             fig.suptitle(title)
