@@ -237,7 +237,8 @@ def plot(rows: list[dict], out: Path) -> list[Path]:
     """quality.png."""
     from viz.plots import gear_quality
 
-    return [gear_quality(by_grade(rows), out / "quality.png")]
+    return [gear_quality(by_grade(rows), out / "quality.png",
+                         title="Gear tooth quality (ISO 1328 flank class) against perfect teeth: planet bearings and the ring mesh")]
 
 
 def write_outputs(rows: list[dict], out: Path) -> list[Path]:

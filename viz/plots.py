@@ -316,10 +316,13 @@ def mode_shapes(freqs_hz, shapes, labels: Sequence[str], path, *, max_modes: int
         return _save(fig, path)
 
 
-def _plain_log(axis) -> None:
-    """Tick labels of a log axis as plain numbers (0.3, 2, 40), not powers of ten: these axes span a decade or two."""
+def _plain_log(axis, decades: float = 2.0) -> None:
+    """Tick labels of a log axis as plain numbers (0.3, 2, 40), not powers of ten; 1-2-3-5 ticks over a
+    span of up to ``decades`` decades, one per decade beyond (they would crowd)."""
     from matplotlib.ticker import LogLocator
-    axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 3.0, 5.0)))
+    lo, hi = axis.get_view_interval()
+    wide = lo > 0 and hi / lo > 10.0 ** decades
+    axis.set_major_locator(LogLocator(subs=(1.0,) if wide else (1.0, 2.0, 3.0, 5.0)))
     axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     axis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
 
@@ -459,11 +462,11 @@ def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = 
 def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple] = (
         ("bearing_load_mean_N", "mean bearing load", "kN", 1e-3), ("bearing_load_max_N", "largest bearing load", "kN", 1e-3),
         ("roller_max_N", "largest roller load", "kN", 1e-3), ("life_iso16281_h", "roller-load life, pair 1", "h", 1.0)),
-        meshes: Sequence[str] = ("sun_inner", "inner_outer", "outer_ring")) -> Path:
+        meshes: Sequence[str] = ("sun_inner", "inner_outer", "outer_ring"), title: str | None = None) -> Path:
     """Per condition, perfect teeth against each tooth class (markers: the seeds' mean, bars: their range),
     forward filled and reverse open; one row per quantity and a column per bearing type, and a last row with
-    the largest dynamic factor K_v and loaded transmission error p2p of the meshes. ``groups``: rows of
-    :func:`scenarios.gear_quality.by_grade`."""
+    the ring mesh's dynamic factor K_v and loaded transmission error p2p (the mesh the rig's sensor hears; the
+    printed findings name the largest K_v of any mesh). ``groups``: rows of :func:`scenarios.gear_quality.by_grade`."""
     grades = [None] + sorted({g["grade"] for g in groups if g["grade"] is not None})
     conds = sorted({g["condition"] for g in groups})
     at = {(g["condition"], g["direction"], g["grade"], g["bearing"]): g for g in groups}
@@ -499,6 +502,7 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
                 ax.set_ylabel(_axis_label(words, unit))
                 if key.startswith("life"):            # lives span decades between conditions
                     ax.set_yscale("log")
+                    _plain_log(ax.yaxis, decades=1.5)
                 if r == 0:
                     ax.set_title(f"{b} planet bearings")
         for col, (prefix, words, unit, scale) in enumerate((("dynamic_factor", "K_v", None, 1.0),
@@ -509,13 +513,17 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
                     for key in meshes[-1:]:           # the ring mesh: the one the rig's sensor hears
                         series(ax, f"{prefix}_{key}", "outer", scale, d, k, g)
             ax.set_ylabel(_axis_label(words + ", ring mesh", unit))
+            ax.set_title("ring mesh (outer planets–ring)")       # not a bearing column: say so
         for ax in axes[-1]:
             ax.set_xticks(range(len(conds)), [f"condition {c}" for c in conds])
             ax.set_xlim(-0.55, len(conds) - 0.45)
         axes[0, 0].legend(loc="best", title="filled: forward, open: reverse", title_fontsize=7)
         for ax in axes.ravel():
-            if ax.get_yscale() == "linear" and ax.get_ylim()[0] > 0:
-                ax.set_ylim(bottom=0)
+            if ax.get_yscale() == "linear":      # from zero, with room above the highest marker
+                lo, hi = ax.get_ylim()
+                ax.set_ylim(min(lo, 0.0), hi + 0.06 * (hi - min(lo, 0.0)))
+        if title:
+            fig.suptitle(title)
         return _save(fig, path)
 
 
