@@ -74,7 +74,7 @@ COLUMNS = ["fault", "direction", "bearing", "load_sharing_factor", "bearing_load
 EXAMPLES = ["{prog} --faults cracked_tooth,spall_pin --directions forward --out results/faults",
             "{prog} --conditions 2 --machine bent=bent_carrier.toml --faults ''",
             '{prog} --set bearing.clearance="30 um" --workers 2']
-WRITES = ("{fault}_{direction}/{results.nc, summary.json} per run (perfect_{direction} the perfect machine); "
+WRITES = ("c{condition}_{direction}_{fault}/{results.nc, summary.json} per run (…_perfect: the perfect machine); "
           "summary.csv and summary.md (per run and bearing type: load sharing, bearing and roller loads, lives, cage "
           "slip, pocket impacts, the housing sensor's lines over the floor); findings.md (the table in words); "
           "loads.png, spectra.png, study.json")
@@ -130,7 +130,8 @@ def make_cases(a, out: Path) -> list[Case]:
     # file can sit beside it
     user = user_overrides(args.parse_sets(a.set), a.params, {**operating, "errors": "--faults or --machine NAME=FILE.toml"},
                           merge_file=True)
-    return [Case(int(a.conditions), d, str(out / f"{name}_{d}"), {**user, **ov}, path, tag=name)
+    # a run's folder is named as its progress and time lines name it (Case.label: c{condition}_{direction}_{machine})
+    return [Case(int(a.conditions), d, str(out / f"c{int(a.conditions)}_{d}_{name}"), {**user, **ov}, path, tag=name)
             for name, (ov, path) in machines.items() for d in a.directions.split(",")]
 
 
