@@ -406,7 +406,8 @@ def _fixed_body_acceleration(m, fs, qf, vf, af) -> None:
 
 
 def hermite_rows(q0, v0, a0, q1, v1, a1, th, h):
-    """:func:`hermite` for many steps at once: rows of the step ends, ``th`` and ``h`` as (S, 1) columns."""
+    """The Hermite weights of :func:`hermite` applied to the step ends; for many steps at once pass rows of
+    the ends and ``th``, ``h`` as (S, 1) columns."""
     th2 = th * th           # products, not powers: a scalar and an array then round alike
     th3 = th2 * th
     h00 = 2 * th3 - 3 * th2 + 1
@@ -425,13 +426,4 @@ def hermite(s0, s1, th, h):
         return s0.q, s0.v, s0.a
     if th >= 1.0:
         return s1.q, s1.v, s1.a
-    th2 = th * th           # products, not powers: a scalar and an array then round alike
-    th3 = th2 * th
-    h00 = 2 * th3 - 3 * th2 + 1
-    h10 = th3 - 2 * th2 + th
-    h01 = -2 * th3 + 3 * th2
-    h11 = th3 - th2
-    q = h00 * s0.q + h10 * h * s0.v + h01 * s1.q + h11 * h * s1.v
-    v = h00 * s0.v + h10 * h * s0.a + h01 * s1.v + h11 * h * s1.a
-    a = (1 - th) * s0.a + th * s1.a
-    return q, v, a
+    return hermite_rows(s0.q, s0.v, s0.a, s1.q, s1.v, s1.a, th, h)

@@ -21,6 +21,7 @@ A new study writes those four methods and a parser (:func:`scenarios.args.parser
 """
 from __future__ import annotations
 
+import abc
 import dataclasses
 import json
 from dataclasses import dataclass, field
@@ -89,7 +90,7 @@ def run_lines(outcomes: dict[str, Outcome]) -> list[str]:
     return lines
 
 
-class Study:
+class Study(abc.ABC):
     """The skeleton of a sweep study (module docstring). ``a``: the parsed command line, with at least the shared
     options ``--out``, ``--force``, ``--overwrite``, ``--workers``, ``--scheduler`` and ``--no-progress``."""
 
@@ -101,19 +102,21 @@ class Study:
         self.out = Path(a.out)
 
     # -- what a study says ------------------------------------------------------------------------------------
+    @abc.abstractmethod
     def config(self) -> RunConfig:
-        raise NotImplementedError
+        """The runs' settings (step, window, recording)."""
 
+    @abc.abstractmethod
     def cases(self) -> list[Case]:
-        raise NotImplementedError
+        """Every run of the study."""
 
     def check(self, case: Case, cfg: RunConfig) -> None:
         """A study's own check of a case before anything runs (raise ParameterError to refuse it)."""
 
+    @abc.abstractmethod
     def report(self, run: StudyRun) -> dict:
         """Rows, the headline table (printed first) and the files (:meth:`StudyRun.step`); returns what the
         study's result holds besides results, outcomes, failed and files."""
-        raise NotImplementedError
 
     def study_record(self) -> dict:
         """What study.json holds besides the cases and the failed runs."""
