@@ -255,9 +255,11 @@ def _plot(f, spectra, f_m, f_c, s, sensor, out):
              "axis_x": "x", "axis_y": "y"}
     marks = {"f_m": f_m, **{f"f_m{'+' if k > 0 else '−'}{abs(k)}f_c": f_m + k * f_c for k in (-3, -1, 1, 3)}}
     where = "carrier acceleration (fixed frame)" if sensor == "axis" else "housing accelerometer"
-    return vp.spectrum(f, {names[k]: spectra[k][1] for k in shown}, marks, out / "spectrum.png",
-                       fmax=min(f[-1], 2.5 * f_m), quantity=where, unit="m/s²", logy=True,
-                       title=f"{where.capitalize()}, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min")
+    zero = [k for k in shown if not np.any(spectra[k][1])]      # a log axis cannot draw them: said in the title
+    title = f"{where.capitalize()}, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min" + (
+        f"\n({', '.join(names[k] for k in zero)} zero for this sensor, not drawn)" if zero else "")
+    return vp.spectrum(f, {names[k]: spectra[k][1] for k in shown if k not in zero}, marks, out / "spectrum.png",
+                       fmax=min(f[-1], 2.5 * f_m), quantity=where, unit="m/s²", logy=True, title=title)
 
 
 def _report(lines, peaks, f_m, f_c, df, t, sensor) -> None:
