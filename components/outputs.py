@@ -584,6 +584,23 @@ class WindowStatistics(mbd.Observer):
                          self._pocket_cols, self._pocket_owner, Zf, self._floor, self._imp)
         self._prev = {k: x[-1].copy() for k, x in rows.items()}
 
+    def add_samples(self, rows) -> None:
+        """Equally weighted states instead of integrator steps (a static solution's snapshots,
+        :mod:`components.static`): ``rows`` as :meth:`snapshots` returns them; each state counts one unit of
+        time in every window, so means are plain averages and max/min the extremes over the states."""
+        K = len(rows["load_x"])
+        if self.ref_roller is None and self.plan.rollers:
+            first = {k: rows[k][0] for k in ("_roller_angle", "load_x", "load_y")}
+            self._choose_reference(first, first, 0.0)
+        if self._flat is None:
+            self._layout({k: x[-1] for k, x in rows.items()})
+        V = np.concatenate([np.asarray(rows[k], float).reshape(K, -1) for k in self._keys], axis=1)
+        self._flat[0] += V.sum(axis=0)
+        self._flat[1] += (V * V).sum(axis=0)
+        np.maximum(self._flat[2], V.max(axis=0), out=self._flat[2])
+        np.minimum(self._flat[3], V.min(axis=0), out=self._flat[3])
+        self._Tw += K
+
     def _layout(self, x) -> None:
         """One flat accumulator (sum, sum of squares, max, min) for every quantity of a snapshot, each
         instance tagged with its bearing (or −1: the global window); ``_acc[key]`` are views into it."""

@@ -1,0 +1,159 @@
+"""The DPGT's quasi-static solution: the same model's steady state in the carrier frame (:mod:`mbd.static`),
+at a few instants spread over the mesh and roller positions, and the statistics users read from it.
+
+The steady motion is the scene's kinematic one: gears spin at their nominal speeds, planets rest on the
+carrier, every roller circles its pin at its cage's pure-rolling speed. Held at their kinematic values
+(their equations dropped, :func:`mbd.static.solve_static`): the carrier's angle (the speed drive supplies
+whatever torque the balance needs) and every roller's and cage's spin (nothing in a static balance fixes
+them). Everything else — every body's translation, the gears' and planets' twist — is solved. The sun
+torque is at its full value (after its ramp).
+
+Statistics (:meth:`components.outputs.WindowStatistics.add_samples`): each snapshot weighs the same, and the
+quantities are the ones a dynamic run averages (one definition). What only a dynamic run can give — cage
+slip and accelerations, pocket impacts, a mesh's dynamic factor and transmission-error range — is left out
+of the summary and named in ``omitted``.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+import mbd
+from mbd.static import SteadyMotion, solve_static
+
+from .outputs import WindowStatistics, cage_period
+
+__all__ = ["steady_motion", "held_dofs", "snapshot_times", "solve_snapshots", "static_summary", "DYNAMIC_ONLY"]
+
+# summary keys a static solution cannot give (they need the motion's transients)
+DYNAMIC_ONLY = ("cage_", "pocket_", "guide_", "heat_land", "whole_revolutions", "carrier_speed_error",
+                "te_peak_to_peak", "dynamic_factor", "roller_cage_")
+
+
+def _rollers(scene):
+    for pair in scene.handles["pairs"]:
+        for kind in ("inner", "outer"):
+            h = pair.bearing(kind)
+            if h.kind == "rollers":
+                yield h
+
+
+def steady_motion(scene) -> SteadyMotion:
+    """The scene's kinematic steady motion in its frame: rollers circle their pins at the cage's pure-rolling
+    speed, every other body's centre rests (the carrier frame; a fixed frame is refused with the body that moves)."""
+    m = scene.model
+    orbit = np.zeros(m.n_bodies)
+    for h in _rollers(scene):
+        for r in h.rollers:
+            orbit[m.body(r).index] = h.omega_cage - m.frame.omega
+    return SteadyMotion.from_state(m, scene.q0, scene.v0, orbit)
+
+
+def _angles(scene, bodies) -> np.ndarray:
+    m = scene.model
+    idx = m.full_to_free[[3 * m.body(b).index + 2 for b in bodies]]
+    return idx[idx >= 0]
+
+
+def held_dofs(scene) -> np.ndarray:
+    """Free-DOF indices held at their kinematic values: the carrier's angle (its drive supplies the torque) and
+    every cage's (its pockets are left open: the rollers keep their places on their orbits)."""
+    return _angles(scene, ["carrier"] + [h.cage for h in _rollers(scene) if h.cage is not None])
+
+
+def spin_dofs(scene) -> np.ndarray:
+    """The rollers' angles: held, their spin *rates* solved (a roller spins where its raceway tractions balance)."""
+    return _angles(scene, [r for h in _rollers(scene) for r in h.rollers])
+
+
+def snapshot_times(scene, n: int) -> np.ndarray:
+    """``n`` instants after the load ramp spread over the mesh and roller positions: one cage revolution
+    relative to the carrier (every roller passes every position), at an irrational fraction of a mesh period
+    apart (the golden ratio), so no mesh or roller phase repeats before the others are visited."""
+    if not (isinstance(n, (int, np.integer)) and n >= 1):
+        raise mbd.ModelError(f"snapshots must be an integer >= 1, got {n!r}")
+    meta = scene.meta
+    sp = meta["speeds_rad_s"]
+    b = meta["bearing"]
+    T = max((cage_period(b, sp["carrier"], sp[f"{k}_planet"]) for k in ("inner", "outer")), default=math.inf)
+    f_m = meta.get("f_m_hz", 0.0)
+    t0 = float(meta.get("ramp_s", 0.0))
+    if not np.isfinite(T):
+        T = 1.0 / f_m if f_m > 0 else 1.0
+    k = np.arange(n)
+    t = t0 + (k + 0.5) / n * T
+    if f_m > 0:    # shift each instant by a golden-ratio fraction of a mesh period: mesh phases spread too
+        t += ((k * 0.6180339887498949) % 1.0) / f_m
+    return t
+
+
+def solve_snapshots(scene, times, engine: str = "auto", system: mbd.System | None = None) -> list:
+    """Static solutions at ``times``; each starts from the previous one (the first from the kinematic pose
+    with the load brought in from zero)."""
+    m = scene.model
+    system = system if system is not None else mbd.System(m)
+    motion, hold, spin = steady_motion(scene), held_dofs(scene), spin_dofs(scene)
+    from mbd.static import _evaluator      # one evaluator (compiled when it can) for every instant
+    ev = _evaluator(system, engine)
+    # rollers have moved on along their orbits: only the other bodies' displacements carry over
+    f2f = m.full_to_free
+    orbiting = np.flatnonzero(motion.orbit != 0.0)
+    moved = np.concatenate([f2f[3 * orbiting], f2f[3 * orbiting + 1]])
+    out, q = [], None
+    for t in times:
+        if q is not None:   # carry the solved displacement to the next instant's kinematic pose
+            dq = q - motion.at(m, out[-1].t)[0]
+            dq[moved] = 0.0
+            q = motion.at(m, float(t))[0] + dq
+        try:
+            sol = solve_static(m, motion, float(t), hold=hold, spin=spin, q_start=q, system=system, evaluator=ev)
+        except mbd.ModelError:
+            if q is None:
+                raise
+            # the previous instant's contacts can be a worse start than none: from the kinematic pose
+            sol = solve_static(m, motion, float(t), hold=hold, spin=spin, system=system, evaluator=ev)
+        out.append(sol)
+        q = sol.q
+    return out
+
+
+def static_summary(scene, n_snapshots: int = 8, engine: str = "auto") -> dict:
+    """The statistics of ``n_snapshots`` static solutions, in summary.json's keys (dynamic-only ones left out
+    and listed in ``omitted``), with the solver's cost."""
+    t_wall = time.perf_counter()
+    m = scene.model
+    system = mbd.System(m)
+    times = snapshot_times(scene, n_snapshots)
+    sols = solve_snapshots(scene, times, engine=engine, system=system)
+    stats = WindowStatistics(scene, float(times[0]), float(times[-1]) + 1e-9, whole_revolutions=False)
+    stats.bind(m, system, None)
+    K = len(sols)
+    z = {k: np.stack([np.asarray(s.z[k]) for s in sols]) for k in sols[0].z}
+    rows = stats.snapshots(np.array([s.t for s in sols]), np.stack([s.q for s in sols]),
+                           np.stack([s.v for s in sols]), np.stack([s.a for s in sols]), z)
+    stats.add_samples(rows)
+    full = stats.summary()
+    omitted: set[str] = set()
+    summary = _drop(full, omitted)
+    summary["mode"] = "static"
+    summary["snapshots"] = K
+    summary["omitted"] = sorted(omitted)
+    summary["static_solver"] = {"newton_iterations": int(sum(s.iterations for s in sols)),
+                                "load_steps": int(sum(s.load_steps for s in sols)),
+                                "solve_s": float(sum(s.wall_s for s in sols)),
+                                "wall_s": time.perf_counter() - t_wall}
+    return summary
+
+
+def _drop(d, omitted: set, prefix: str = ""):
+    if not isinstance(d, dict):
+        return d
+    out = {}
+    for k, v in d.items():
+        if k.startswith(DYNAMIC_ONLY) or k in ("window_s", "window_duration_s"):
+            omitted.add(k)
+            continue
+        out[k] = _drop(v, omitted, prefix + k + ".")
+    return out
