@@ -45,10 +45,13 @@ def steady_motion(scene) -> SteadyMotion:
     speed, every other body's centre rests (the carrier frame; a fixed frame is refused with the body that moves)."""
     m = scene.model
     orbit = np.zeros(m.n_bodies)
+    host = np.full(m.n_bodies, -1)
     for h in _rollers(scene):
         for r in h.rollers:
             orbit[m.body(r).index] = h.omega_cage - m.frame.omega
-    return SteadyMotion.from_state(m, scene.q0, scene.v0, orbit)
+            if h.cage is not None:       # each roller keeps its pocket's centre, wherever the cage sits
+                host[m.body(r).index] = m.body(h.cage).index
+    return SteadyMotion.from_state(m, scene.q0, scene.v0, orbit, host=host)
 
 
 def _angles(scene, bodies) -> np.ndarray:
