@@ -21,11 +21,11 @@ import time
 import numpy as np
 
 import mbd
-from mbd.static import SteadyMotion, solve_static
+from mbd.static import SteadyMotion, _evaluator, solve_static
 
 from .outputs import WindowStatistics, cage_period
 
-__all__ = ["steady_motion", "held_dofs", "snapshot_times", "solve_snapshots", "static_summary", "DYNAMIC_ONLY"]
+__all__ = ["steady_motion", "held_dofs", "snapshot_times", "solve_snapshots", "static_summary", "rate_groups", "DYNAMIC_ONLY"]
 
 # summary keys a static solution cannot give (they need the motion's transients)
 DYNAMIC_ONLY = ("cage_", "pocket_", "guide_", "heat_land", "whole_revolutions", "carrier_speed_error",
@@ -51,24 +51,27 @@ def steady_motion(scene) -> SteadyMotion:
             orbit[m.body(r).index] = h.omega_cage - m.frame.omega
             if h.cage is not None:       # each roller keeps its pocket's centre, wherever the cage sits
                 host[m.body(r).index] = m.body(h.cage).index
-    return SteadyMotion.from_state(m, scene.q0, scene.v0, orbit, host=host)
-
-
-def _angles(scene, bodies) -> np.ndarray:
-    m = scene.model
-    idx = m.full_to_free[[3 * m.body(b).index + 2 for b in bodies]]
-    return idx[idx >= 0]
+    return SteadyMotion.from_state(m, scene.q0, scene.v0, orbit, host)
 
 
 def held_dofs(scene) -> np.ndarray:
-    """Free-DOF indices held at their kinematic values: the carrier's angle (its drive supplies the torque) and
-    every cage's (its pockets are left open: the rollers keep their places on their orbits)."""
-    return _angles(scene, ["carrier"] + [h.cage for h in _rollers(scene) if h.cage is not None])
+    """Free-DOF indices held at their steady values: the carrier's angle (its speed drive supplies the torque)."""
+    m = scene.model
+    idx = m.full_to_free[[3 * m.body("carrier").index + 2]]
+    return idx[idx >= 0]
 
 
-def spin_dofs(scene) -> np.ndarray:
-    """The rollers' angles: held, their spin *rates* solved (a roller spins where its raceway tractions balance)."""
-    return _angles(scene, [r for h in _rollers(scene) for r in h.rollers])
+def rate_groups(scene) -> list:
+    """The spin rates solved (:func:`mbd.static.solve_static`): each cage with its rollers' orbits (the cage
+    turns where the moments on it and its rollers balance: its slip) and each roller's own spin (where its
+    raceway tractions' moments balance). Rollers keep the centres of their pockets."""
+    m = scene.model
+    out = []
+    for h in _rollers(scene):
+        rollers = [m.body(r).index for r in h.rollers]
+        out.append((m.body(h.cage).index if h.cage else -1, rollers))
+        out += [(r, []) for r in rollers]
+    return out
 
 
 def snapshot_times(scene, n: int) -> np.ndarray:
@@ -97,8 +100,7 @@ def solve_snapshots(scene, times, engine: str = "auto", system: mbd.System | Non
     with the load brought in from zero)."""
     m = scene.model
     system = system if system is not None else mbd.System(m)
-    motion, hold, spin = steady_motion(scene), held_dofs(scene), spin_dofs(scene)
-    from mbd.static import _evaluator      # one evaluator (compiled when it can) for every instant
+    motion, hold, rates = steady_motion(scene), held_dofs(scene), rate_groups(scene)
     ev = _evaluator(system, engine)
     # rollers have moved on along their orbits: only the other bodies' displacements carry over
     f2f = m.full_to_free
@@ -111,12 +113,12 @@ def solve_snapshots(scene, times, engine: str = "auto", system: mbd.System | Non
             dq[moved] = 0.0
             q = motion.at(m, float(t))[0] + dq
         try:
-            sol = solve_static(m, motion, float(t), hold=hold, spin=spin, q_start=q, system=system, evaluator=ev)
+            sol = solve_static(m, motion, float(t), hold=hold, rates=rates, q_start=q, system=system, evaluator=ev)
         except mbd.ModelError:
             if q is None:
                 raise
             # the previous instant's contacts can be a worse start than none: from the kinematic pose
-            sol = solve_static(m, motion, float(t), hold=hold, spin=spin, system=system, evaluator=ev)
+            sol = solve_static(m, motion, float(t), hold=hold, rates=rates, system=system, evaluator=ev)
         out.append(sol)
         q = sol.q
     return out
@@ -143,8 +145,7 @@ def static_summary(scene, n_snapshots: int = 8, engine: str = "auto") -> dict:
     summary["mode"] = "static"
     summary["snapshots"] = K
     summary["omitted"] = sorted(omitted)
-    summary["static_solver"] = {"newton_iterations": int(sum(s.iterations for s in sols)),
-                                "load_steps": int(sum(s.load_steps for s in sols)),
+    summary["static_solver"] = {"steps": int(sum(s.steps for s in sols)),
                                 "solve_s": float(sum(s.wall_s for s in sols)),
                                 "wall_s": time.perf_counter() - t_wall}
     return summary
