@@ -45,6 +45,8 @@ from .model import Model
 __all__ = ["SteadyMotion", "StaticSolution", "solve_static"]
 
 _TRACE = bool(os.environ.get("MBD_STATIC_TRACE"))     # one line per continuation step on stdout
+_STUCK = None
+_WATCH = int(os.environ['MBD_WATCH']) if os.environ.get('MBD_WATCH') else None
 
 
 @dataclass(frozen=True)
@@ -379,23 +381,24 @@ def _bracketed(x, dx, g, lo, hi, cap):
 
 
 def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarray, max_iter: int = 100):
-    """Solve every local group (a row of ``local``: radius, tangential place and spin rate of one orbiting body,
-    −1 where absent) for fixed outer unknowns, all groups at once. No element joins two groups, so one
+    """Solve every local group (a row of ``local``: radius, place and own spin rate of one orbiting body, −1
+    where absent) for fixed outer unknowns, all groups at once. No element joins two groups, so one
     perturbation of every group's first unknown gives each group's first Jacobian column, and so on: a 3×3
-    Newton system per group. Each unknown stays inside the bracket its residual's sign keeps (each falls as its
-    unknown grows: the radial force as the outer contact closes, the tangential one as the pocket closes, the
-    traction moment as the spin rate grows); steps are clipped to their caps. Returns (x, g, converged)."""
+    Newton system per group (an unknown whose own stiffness is not positive steps by its cap along its
+    residual). Steps are clipped to their caps and damped per group: a group whose scaled residual grew has
+    its next step halved (a contact that opened or closed too far), one whose residual fell regains full steps.
+    Returns (x, g, converged)."""
     x = x.copy()
     L = local.shape[0]
     idx = np.where(local >= 0, local, 0)
     present = local >= 0
-    lo, hi = np.full((L, 3), -np.inf), np.full((L, 3), np.inf)
+    damp = np.ones(L)
+    size = np.full(L, np.inf)
+    reach = cap[idx].copy()                 # each unknown's own step bound: quartered when its residual flips sign
+    sign = np.zeros((L, 3))
     g = prob.residual(x)[0]
-    floor = None
     for _ in range(max_iter):
         gl = np.where(present, g[idx], 0.0)
-        if floor is not None and np.all(np.abs(gl) <= np.where(present, floor, np.inf)):
-            return x, g, True
         Kl = np.zeros((L, 3, 3))
         for j in range(3):
             if not present[:, j].any():
@@ -409,18 +412,29 @@ def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarr
             Kl[~present[:, j], j, j] = 1.0
         diag = np.diagonal(Kl, axis1=1, axis2=2)
         floor = (np.abs(diag) + prob.mu_min * prob.M[idx]) * prob.tol[idx]      # each unknown's own stiffness
-        if np.all(np.abs(gl) <= np.where(present, floor, np.inf)):
+        scaled = np.where(present, np.abs(gl) / floor, 0.0)
+        if np.all(scaled <= 1.0):
             return x, g, True
+        new_size = scaled.max(axis=1)
+        damp = np.where(new_size > size, 0.5 * damp, np.minimum(1.0, 2.0 * damp))
+        size = new_size
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             fin = np.all(np.isfinite(Kl), axis=(1, 2))
             det = np.where(fin, np.linalg.det(np.where(fin[:, None, None], Kl, np.eye(3))), 0.0)
             good = np.all(diag > 0, axis=1) & (det > 0)
             d = np.linalg.solve(np.where(good[:, None, None], Kl, np.eye(3)), gl[..., None])[..., 0]
             good &= np.all(np.isfinite(d), axis=1)
-            d = np.where(good[:, None], d, np.where(diag > 0, gl / diag, np.nan))
-        new, lo, hi = _bracketed(x[idx], d, gl, lo, hi, cap[idx])
-        x[local[present]] = new[present]
+            d = np.where(good[:, None], d, np.where(diag > 0, gl / diag, np.sign(gl) * cap[idx]))
+        flipped = sign * np.sign(gl) < 0
+        reach = np.where(flipped, 0.25 * reach, np.minimum(cap[idx], 1.5 * reach))
+        sign = np.sign(gl)
+        d = np.clip(d * damp[:, None], -reach, reach)
+        x[local[present]] += d[present]
         g = prob.residual(x)[0]
+    if _WATCH is not None:
+        bad = np.flatnonzero(np.any(scaled > 1.0, axis=1))
+        for j in bad[:3]:
+            print("  stuck", prob.label(int(local[j, 0])), x[idx[j]], gl[j], floor[j], np.diagonal(Kl[j]), good[j], damp[j])
     return x, g, False
 
 
