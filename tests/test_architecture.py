@@ -1,10 +1,12 @@
-"""Architecture rules that keep the code honest (ARCHITECTURE.md): no import cycles between modules,
+"""Architecture rules that keep the code honest: no import cycles between modules,
 the engine never imports the domain, and no physics value hides in an element constructor's default."""
 from __future__ import annotations
 
 import ast
 import dataclasses
 import inspect
+import re
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -187,3 +189,35 @@ def test_no_scenario_borrows_from_another_scenario():
                 and mod not in SCENARIO_INFRASTRUCTURE for d in deps
                 if d.startswith("scenarios.") and d not in SCENARIO_INFRASTRUCTURE}
     assert borrowed <= {("scenarios.demo", "scenarios.paper_study")}, sorted(borrowed)
+
+
+# what a clone does not have: the specification files the project was started from, which lived beside the
+# repository, and paths of the machine it was written on (patterns split so that this file does not match itself)
+OUTSIDE = re.compile("|".join([re.escape("shared" + "/spec"), re.escape("../" + "shared"), re.escape("/" + "work/"),
+                               r"\b(?:MODEL|PARAMETERS|ARCHITECTURE)" + r"\.md\b"]))
+
+
+def tracked_text_files() -> list[Path]:
+    """The repository's tracked files (git ls-files; the source packages, docs and tests when git is absent),
+    text only."""
+    try:
+        out = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, check=True).stdout
+        files = [ROOT / f for f in out.decode().split("\0") if f]
+    except (OSError, subprocess.CalledProcessError):
+        files = [p for d in (*PACKAGES, "tests", "docs") for p in (ROOT / d).rglob("*") if p.is_file()]
+        files += [ROOT / "README.md", ROOT / "Makefile", ROOT / "pyproject.toml"]
+    return [f for f in files if f.is_file() and b"\0" not in f.read_bytes()[:8192]]
+
+
+def test_no_tracked_file_cites_a_file_outside_the_repository():
+    """The model and the parameters are the project's own documents (docs/model.md §N, docs/parameters.md); a
+    citation of the specification files beside the repository, or of a path on one machine, points nowhere in a
+    clone."""
+    assert OUTSIDE.search("see " + "MODEL" + ".md §3.2") and OUTSIDE.search("../" + "shared" + "/spec/x")
+    assert not OUTSIDE.search("docs/model.md §6.2, docs/parameters.md")
+    files = tracked_text_files()
+    assert any(f.name == "model.md" for f in files) and any(f.suffix == ".py" for f in files)
+    bad = [f"{f.relative_to(ROOT)}:{n}: {line.strip()[:80]}" for f in files
+           for n, line in enumerate(f.read_text(encoding="utf-8", errors="replace").splitlines(), 1)
+           if OUTSIDE.search(line)]
+    assert not bad, "citations of files outside the repository:\n" + "\n".join(bad)

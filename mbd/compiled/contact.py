@@ -572,7 +572,7 @@ def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         fr = -mu * th * Fi
         wx, wy = vg0 - vo0, vg1 - vo1
         Fn_f, Ft_f, sh = 0.0, 0.0, 0.0
-        if hydro:      # the oil film carries the cage; its shear adds to the friction (MODEL.md §3.8)
+        if hydro:      # the oil film carries the cage; its shear adds to the friction (docs/model.md §9.4)
             film = _film(clr, G[1], G[2], G[3], rL, ex, ey, eps, wx, wy, vg2, vo2, v_t)
             Fn_f, Ft_f, sh = film[0], film[1], film[2]
         Fnt, Ftt = -Fi + Fn_f, fr + sh + Ft_f
