@@ -70,8 +70,8 @@ def drags(n, rng):
 
 
 def bench(label, elem, qf, vf, z, repeats):
-    kind = kind_of(type(elem))
-    pack, kernel = kind.pack, kind.evaluate
+    twin = kind_of(type(elem))
+    pack, kernel = twin.pack, twin.evaluate
     P, G = pack(elem)
     n, k = elem.dofs.shape
     F, Jq, Jv = np.empty((n, k)), np.empty((n, k, k)), np.empty((n, k, k))

@@ -43,8 +43,8 @@ MULTS = st.one_of(st.just(1), st.lists(st.integers(1, 3), min_size=N, max_size=N
 
 def compiled(elem, fs, qf, vf, z, jac, t=0.0):
     """(F, J_q, J_v) of the compiled kernel; outputs start as NaN so that every entry must be written."""
-    kind = kind_of(type(elem))
-    pack, kernel = kind.pack, kind.evaluate
+    twin = kind_of(type(elem))
+    pack, kernel = twin.pack, twin.evaluate
     P, G = pack(elem)
     ql, vl = np.ascontiguousarray(qf[elem.dofs]), np.ascontiguousarray(vf[elem.dofs])
     n, k = ql.shape
@@ -224,8 +224,8 @@ def test_update_matches_update_internal(kind, data, z):
         s0, s1 = data.draw(guide_states()), data.draw(guide_states())
         q0, v0, elem = guide_scene(*s0)
         q1, v1, _ = guide_scene(*s1)
-    kind = kind_of(type(elem))
-    pack, update = kind.pack, kind.update
+    twin = kind_of(type(elem))
+    pack, update = twin.pack, twin.update
     P, G = pack(elem)
     loc = lambda a: np.ascontiguousarray(a[elem.dofs])    # noqa: E731
     cols = lambda a: list(a[elem.dofs].T)                  # noqa: E731

@@ -64,8 +64,8 @@ def libm_arctan2():
 
 def compiled(elem, t, fs, q, v, z=None, jac=True):
     """F, J_q, J_v of a family from its compiled kernel (and a check that jac=False gives the same F)."""
-    kind = kind_of(type(elem))
-    pack, kern = kind.pack, kind.evaluate
+    twin = kind_of(type(elem))
+    pack, kern = twin.pack, twin.evaluate
     P, G = pack(elem)
     n, k = elem.dofs.shape
     ql, vl = np.ascontiguousarray(q[elem.dofs]), np.ascontiguousarray(v[elem.dofs])
@@ -329,6 +329,6 @@ def test_kernel_tables():
     assert set(tables[0]) == {GearMesh}
     assert set(tables[1]) == {GroundSupport, BodySpring, TorsionalSpring, TorqueSource, ForceSource, SpeedDrive}
     for table in tables:
-        for cls, kind in table.items():
-            assert callable(kind.pack) and callable(kind.evaluate)
-            assert (kind.update is not None) == (cls is SpeedDrive)
+        for cls, twin in table.items():
+            assert callable(twin.pack) and callable(twin.evaluate)
+            assert (twin.update is not None) == (cls is SpeedDrive)
