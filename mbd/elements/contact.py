@@ -370,6 +370,7 @@ class RaceContact(Element):
     """
     batched = True
     n_local = 6
+    compiled_twin = "contact.race"
 
     def __init__(self, name, roller, race_body, *, kind, race_marker, R_race, D, K, exponent, zeta, m_roller,
                  traction: Traction, multiplicity=1, spall_angle=None, spall_width=None, spall_depth=None,
@@ -521,6 +522,7 @@ class PocketContact(_Impact):
     """
     batched = True
     n_local = 6
+    compiled_twin = "contact.pocket"
 
     def __init__(self, name, roller, cage, *, pocket_angle, pitch_radius, clearance, K_p, restitution,
                  impact_law, v_min, mu, v_mu, D, multiplicity=1):
@@ -668,6 +670,7 @@ class GuideContact(_Impact):
     """
     batched = True
     n_local = 6
+    compiled_twin = "contact.guide"
 
     def __init__(self, name, cage, planet, *, clearance, K_g, restitution, impact_law, v_min, mu, v_mu,
                  land_radius, land: "LandLaw"):
@@ -741,6 +744,7 @@ class LubricantDrag(Element):
     """
     batched = True
     n_local = 6
+    compiled_twin = "contact.drag"
 
     def __init__(self, name, roller, race_body, *, race_marker, C_d, rho, D, l, d_m, multiplicity=1):
         self.name = name

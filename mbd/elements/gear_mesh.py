@@ -254,6 +254,7 @@ class GearMesh(Element):
     """
     batched = True
     n_local = 6
+    compiled_twin = "mesh.gear_mesh"
 
     def __init__(self, name, gear1, gear2, *, internal: bool, rb1, rb2, alpha, a0, teeth1, k_mean,
                  c_mesh=0.0, u0=0.0, p0=0.0, backlash=0.0, stiffness: StiffnessShape | None = None,
