@@ -412,7 +412,10 @@ def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarr
             Kl[~present[:, j], j, j] = 1.0
         diag = np.diagonal(Kl, axis1=1, axis2=2)
         floor = (np.abs(diag) + prob.mu_min * prob.M[idx]) * prob.tol[idx]      # each unknown's own stiffness
-        scaled = np.where(present, np.abs(gl) / floor, 0.0)
+        # settled: below its floor, or bracketed by sign changes within its tolerance (a force that jumps at a
+        # contact's onset — the compression-rate damping of a contact whose races are not concentric — has no
+        # exact root: the body rests at the jump)
+        scaled = np.where(present & (reach > prob.tol[idx]), np.abs(gl) / floor, 0.0)
         if np.all(scaled <= 1.0):
             return x, g, True
         new_size = scaled.max(axis=1)
@@ -471,8 +474,9 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
         Klo, Kll = K[loc][:, outer].toarray(), K[loc][:, loc].tocsc()
         try:
             lu = spla.splu(Kll + sp.diags(mu_min * M[loc]))
-            X, y = lu.solve(Klo), lu.solve(g[loc])
-            d = np.linalg.solve(Koo - Kol @ X + np.diag(mu * Mo), g[outer] - Kol @ y)
+            # the local residuals are settled (solved, or resting at a force's jump): the outer step does not chase them
+            X = lu.solve(Klo)
+            d = np.linalg.solve(Koo - Kol @ X + np.diag(mu * Mo), g[outer])
         except (RuntimeError, np.linalg.LinAlgError):
             return x, k, False
         if not np.all(np.isfinite(d)):
@@ -480,12 +484,14 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
         d = np.clip(d, -cap[outer], cap[outer])
         x_new = x.copy()
         x_new[outer] += d
-        x_new[loc] += np.clip(y - X @ d, -cap[loc], cap[loc])        # the locals' linear prediction
+        x_new[loc] += np.clip(-X @ d, -cap[loc], cap[loc])        # the locals' linear prediction
         x_new, g_new, ok_new = _local_solve(prob, x_new, local, cap)
         ratio = norm(g_new) / max(norm(g), 1e-300) if np.all(np.isfinite(g_new)) else np.inf
         if _TRACE:
             top = outer[np.argsort(-np.abs(g[outer]) / np.sqrt(Mo))[:3]]
-            print(f"{k} mu {mu:.2e} |g| {norm(g):.3e} -> {norm(g_new):.3e} largest: "
+            rate = outer >= prob.nB
+            print(f"{k} mu {mu:.2e} |g| {norm(g):.3e} -> {norm(g_new):.3e} rate step {np.abs(d[rate]).max() if rate.any() else 0:.2e} "
+                  f"Kc_rate {np.diag(Koo - Kol @ X)[rate].min() if rate.any() else 0:.2e} largest: "
                   + ", ".join(f"{prob.label(int(i))} {g[i]:.3g}" for i in top))
         if ratio > 2.0:
             mu = max(10.0 * mu, 10.0 * mu_min)
