@@ -25,7 +25,7 @@ from mbd.static import SteadyMotion, _evaluator, solve_static
 
 from .outputs import WindowStatistics, cage_period
 
-__all__ = ["steady_motion", "held_dofs", "snapshot_times", "solve_snapshots", "static_summary", "rate_groups", "DYNAMIC_ONLY"]
+__all__ = ["steady_motion", "held_dofs", "snapshot_times", "solve_snapshots", "static_statistics", "static_summary", "rate_groups", "DYNAMIC_ONLY"]
 
 # summary keys a static solution cannot give (they need the motion's transients)
 DYNAMIC_ONLY = ("cage_", "pocket_", "guide_", "heat_land", "whole_revolutions", "carrier_speed_error",
@@ -124,26 +124,31 @@ def solve_snapshots(scene, times, engine: str = "auto", system: mbd.System | Non
     return out
 
 
-def static_summary(scene, n_snapshots: int = 8, engine: str = "auto") -> dict:
-    """The statistics of ``n_snapshots`` static solutions, in summary.json's keys (dynamic-only ones left out
-    and listed in ``omitted``), with the solver's cost."""
-    t_wall = time.perf_counter()
+def static_statistics(scene, n_snapshots: int = 8, engine: str = "auto"):
+    """(statistics, solutions): the :class:`~components.outputs.WindowStatistics` of ``n_snapshots`` static
+    solutions (each an equally weighted sample) and the solutions themselves."""
     m = scene.model
     system = mbd.System(m)
     times = snapshot_times(scene, n_snapshots)
     sols = solve_snapshots(scene, times, engine=engine, system=system)
     stats = WindowStatistics(scene, float(times[0]), float(times[-1]) + 1e-9, whole_revolutions=False)
     stats.bind(m, system, None)
-    K = len(sols)
     z = {k: np.stack([np.asarray(s.z[k]) for s in sols]) for k in sols[0].z}
     rows = stats.snapshots(np.array([s.t for s in sols]), np.stack([s.q for s in sols]),
                            np.stack([s.v for s in sols]), np.stack([s.a for s in sols]), z)
     stats.add_samples(rows)
-    full = stats.summary()
+    return stats, sols
+
+
+def static_summary(scene, n_snapshots: int = 8, engine: str = "auto") -> dict:
+    """The statistics of ``n_snapshots`` static solutions in summary.json's keys (dynamic-only ones left out and
+    listed in ``omitted``), with the solver's cost."""
+    t_wall = time.perf_counter()
+    stats, sols = static_statistics(scene, n_snapshots, engine)
     omitted: set[str] = set()
-    summary = _drop(full, omitted)
+    summary = _drop(stats.summary(), omitted)
     summary["mode"] = "static"
-    summary["snapshots"] = K
+    summary["snapshots"] = len(sols)
     summary["omitted"] = sorted(omitted)
     summary["static_solver"] = {"steps": int(sum(s.steps for s in sols)),
                                 "solve_s": float(sum(s.wall_s for s in sols)),

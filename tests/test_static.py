@@ -1,0 +1,137 @@
+"""The quasi-static solution (mbd.static): closed forms on small scenes, its exact Jacobian, bad input.
+The DPGT's static solution against the dynamic runs' means is in tests/test_load_path.py (same runs)."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import mbd
+from mbd.elements import BodySpring, ForceSource, GroundSupport, TorqueSource
+from mbd.static import SteadyMotion, _directions, _evaluator, _Problem, solve_static
+
+M, K, F, W = 2.0, 4.0e6, 150.0, 900.0        # kg, N/m, N, rad/s (m W² = 1.62e6 N/m: the centrifugal term matters)
+
+
+def _state(mb, vel):
+    model = mb.build()
+    q0 = model.pose0.ravel()[model.free]
+    return model, q0, np.asarray(vel, float)[model.free]
+
+
+def test_a_spring_in_a_turning_frame_stretches_by_the_centrifugal_closed_form():
+    """A body at rest in a frame turning at W, on a ground spring K and damper c, pushed by F along x. At rest in R
+    it moves through the fixed frame at W k × r, so the damper pulls it back along the turn:
+    (K − M W²) x − c W y = F, (K − M W²) y + c W x = 0."""
+    mb = mbd.ModelBuilder(frame=mbd.Frame.rotating(W))
+    b = mb.add_body("b", M, 0.1)
+    mb.add(GroundSupport("s", [b.index], kx=K, cx=50.0, k_theta=1e4))
+    mb.add(ForceSource("f", [b.index], (F, 0.0)))
+    model, q0, v0 = _state(mb, np.zeros(3))
+    sol = solve_static(model, SteadyMotion.from_state(model, q0, v0, np.zeros(1)), 0.0)
+    a, b = K - M * W ** 2, 50.0 * W
+    np.testing.assert_allclose(sol.q[:2], [F * a / (a * a + b * b), -F * b / (a * a + b * b)], rtol=1e-9)
+
+
+def test_an_orbiting_body_moves_out_by_its_centripetal_closed_form():
+    """A body circling the origin at W in an inertial frame, on a zero-length ground spring K, pushed outwards by
+    F at the instant it crosses the x axis: K ρ − M W² ρ = F (its place on the circle held)."""
+    mb = mbd.ModelBuilder()
+    b = mb.add_body("b", M, 0.1, pose=(0.05, 0.0, 0.0))
+    mb.add(GroundSupport("s", [b.index], kx=K))
+    mb.add(ForceSource("f", [b.index], (F, 0.0)))
+    model, q0, v0 = _state(mb, [0.0, W * 0.05, 0.0])
+    motion = SteadyMotion.from_state(model, q0, v0, np.array([W]))
+    np.testing.assert_allclose(motion.centre[0], [0.0, 0.0], atol=1e-15)
+    sol = solve_static(model, motion, 0.0)
+    np.testing.assert_allclose(sol.q[0], F / (K - M * W ** 2), rtol=1e-9)
+    np.testing.assert_allclose(sol.v[1], W * sol.q[0], rtol=1e-12)          # the circle at the displaced radius
+    np.testing.assert_allclose(sol.a[0], -W ** 2 * sol.q[0], rtol=1e-12)
+
+
+def test_a_spin_rate_settles_where_torque_and_damping_balance():
+    """A body driven by a torque T against a torsional damper c: the solved spin rate is T/c, whatever it started at;
+    held instead, its equation's residual is the reaction T − c ω₀."""
+    T, c, w0 = 3.0, 0.02, 40.0
+    mb = mbd.ModelBuilder()
+    b = mb.add_body("b", M, 0.1)
+    mb.add(GroundSupport("s", [b.index], kx=K, c_theta=c))
+    mb.add(TorqueSource("t", [b.index], T))
+    model, q0, v0 = _state(mb, [0.0, 0.0, w0])
+    motion = SteadyMotion.from_state(model, q0, v0, np.zeros(1))
+    sol = solve_static(model, motion, 0.0, rates=[(0, [])])
+    np.testing.assert_allclose(sol.v[2], T / c, rtol=1e-9)
+    held = solve_static(model, motion, 0.0, hold=[2])
+    np.testing.assert_allclose(held.residual[2], T - c * w0, rtol=1e-12)
+
+
+def test_a_cage_and_its_roller_turn_where_the_torque_meets_the_drag():
+    """A 'cage' driven by a torque T carries a 'roller' on a spring k from a marker at radius ρ; a translational
+    damper c on the roller drags it. One rate W for both: T = c W r², r = ρ + d the roller's displaced radius,
+    k d = m W² r — whatever rate they started at."""
+    T, c, rho, w0, k, m, kc = 0.9, 30.0, 0.04, 100.0, 1e7, 0.02, 1e13
+    mb = mbd.ModelBuilder()
+    cage = mb.add_body("cage", 0.5, 1e-3)
+    roller = mb.add_body("roller", m, 1e-6, pose=(rho, 0.0, 0.0))
+    mb.add(GroundSupport("s", [cage.index, roller.index], kx=[kc, 0.0], cx=[0.0, c]))
+    mb.add(BodySpring("k", cage.index, roller.index, k, marker_a=(rho, 0.0)))
+    mb.add(TorqueSource("t", [cage.index], T))
+    model, q0, v0 = _state(mb, [0.0, 0.0, w0, 0.0, w0 * rho, 0.0])
+    motion = SteadyMotion.from_state(model, q0, v0, np.array([0.0, w0]), host=np.array([-1, 0]))
+    sol = solve_static(model, motion, 0.0, rates=[(0, [1])], hold=[5], length_tol=1e-15, rate_tol=1e-12)
+    w, r = T / (c * rho ** 2), rho
+    for _ in range(100):                     # the closed form's two equations, by fixed point
+        d = m * w * w * r / k
+        r = rho + d + k * d / kc
+        w = T / (c * r * r)
+    np.testing.assert_allclose(sol.v[2], w, rtol=1e-9)
+    np.testing.assert_allclose(sol.q[3], r, rtol=1e-9)
+    np.testing.assert_allclose(sol.v[4], w * sol.q[3], rtol=1e-12)
+
+
+def test_the_static_jacobian_is_the_derivative_of_the_residual():
+    """K = −∂g/∂x of the DPGT's static problem (displacements, the cages' rates carrying their rollers' orbits,
+    the rollers' spins) against central differences at a displaced state with changed rates."""
+    from components import static
+    from components.dpgt import build_dpgt
+    from components.presets import reference_dpgt
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sc = build_dpgt(reference_dpgt(3, "forward"))
+    m = sc.model
+    system = mbd.System(m)
+    motion = static.steady_motion(sc)
+    rates = static.rate_groups(sc)
+    held = np.zeros(m.ndof, bool)
+    held[static.held_dofs(sc)] = True
+    held[m.full_to_free[[3 * sb + 2 for sb, _ in rates]]] = True
+    B, _, _ = _directions(m, motion, 0.0045, held, False)
+    prob = _Problem(system, _evaluator(system, "numpy"), motion, 0.0045, B, rates, system.init_internal())
+    rng = np.random.default_rng(1)
+    x = np.concatenate([rng.normal(0.0, 3e-6, B.shape[1]), rng.normal(0.0, 2.0, len(rates))])
+    g, Kx = prob.residual(x, jac=True)
+    Kx = Kx.toarray()
+    for j in rng.choice(x.size, 40, replace=False):
+        h = 1e-11 if j < B.shape[1] else 1e-4        # a contact's curvature needs a short difference
+        e = np.zeros(x.size)
+        e[j] = h
+        fd = -(prob.residual(x + e)[0] - prob.residual(x - e)[0]) / (2 * h)
+        scale = max(np.abs(Kx[:, j]).max(), np.abs(fd).max())
+        roundoff = 10 * np.finfo(float).eps * np.abs(g).max() / h       # the difference of two residuals of size |g|
+        err = np.abs(fd - Kx[:, j]).max()
+        assert err <= 1e-5 * scale + roundoff, (prob.label(int(j)), err, scale, roundoff)
+
+
+def test_bad_input_is_refused_in_one_line():
+    mb = mbd.ModelBuilder()
+    b = mb.add_body("b", M, 0.1)
+    mb.add(ForceSource("f", [b.index], (F, 0.0)))
+    model, q0, _ = _state(mb, np.zeros(3))
+    with pytest.raises(mbd.ModelError, match="body 'b' moves in the reference frame .* no orbit rate"):
+        SteadyMotion.from_state(model, q0, np.array([1.0, 0.0, 0.0]), np.zeros(1))
+    with pytest.raises(mbd.ModelError, match="orbit: one finite rate"):
+        SteadyMotion.from_state(model, q0, np.zeros(3), np.zeros(2))
+    motion = SteadyMotion.from_state(model, q0, np.zeros(3), np.zeros(1))
+    with pytest.raises(mbd.ModelError, match=r"no static state .*\(worst unknown: b\.x\)"):
+        solve_static(model, motion, 0.0, max_steps=30)       # a force and nothing to hold the body
