@@ -78,6 +78,24 @@ def test_study_figures_show_the_runs_data(zero_power_study):
         t, y = by_col["outer"]["reverse"]
         np.testing.assert_array_equal(t, ds["time"].values)
         np.testing.assert_array_equal(y, ds["bearing.load_radial"].values[:, names.index("b1.pb")])
+    # the mesh row is the drive flank's force minus the coast flank's: results.nc holds flank +1's minus flank
+    # −1's, and the torque path loads flanks (−1, +1, +1) of (sun–inner, inner–outer, outer–ring) forward and the
+    # others in reverse (components.geometry.loaded_flanks; the sun's speed decides it at zero power)
+    mesh = {w: by for w, _, by in groups["mesh"][0]}
+    assert set(mesh) == {paper_study.MESH_FORCE_WORDS, "loaded transmission error"}
+    assert paper_study.MESH_FORCE_WORDS == "drive-flank force − coast-flank force"
+    loaded = {"forward": {"sun_inner": -1, "inner_outer": 1, "outer_ring": 1}}
+    loaded["reverse"] = {k: -f for k, f in loaded["forward"].items()}
+    from components.families import MESH_FAMILY
+    for d, path in runs.items():
+        with xr.open_dataset(path, engine="h5netcdf") as ds:
+            for key, sign in loaded[d].items():
+                t, y = mesh[paper_study.MESH_FORCE_WORDS][key][d]
+                np.testing.assert_array_equal(y, sign * ds[f"{MESH_FAMILY[key]}.force"].values[:, 0])
+                drive, coast = ("force_drive", "force_coast") if sign > 0 else ("force_coast", "force_drive")
+                fam = MESH_FAMILY[key]     # the element's own flank forces: drive − coast, sample by sample
+                np.testing.assert_allclose(y, ds[f"{fam}.{drive}"].values[:, 0] - ds[f"{fam}.{coast}"].values[:, 0],
+                                           rtol=0, atol=1e-9 * max(1.0, float(np.abs(y).max())))
     vals = paper_study.headline_values(r["results"])
     for d in ("forward", "reverse"):
         s = json.loads((out / f"c4_{d}" / "summary.json").read_text())
