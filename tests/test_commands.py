@@ -244,6 +244,27 @@ def test_one_condition_commands_take_conditions_and_the_former_spelling():
     assert fault_study.parse_args([]).conditions == 2                           # the source's rig speed
 
 
+def test_bench_statistics_takes_one_condition_through_the_shared_grammar(capsys):
+    """--conditions with one value (the studies' spelling), --condition still accepted; a list of two, a condition
+    out of range and a bad window are one-line usage errors before anything runs; no advice about an --out it
+    does not have."""
+    from scenarios import bench_statistics
+
+    assert bench_statistics.parse_args(["--conditions", "2"]).conditions == 2
+    assert bench_statistics.parse_args(["--condition", "1"]).conditions == 1
+    assert bench_statistics.parse_args([]).conditions == 3
+    for argv, words in ((["--conditions", "1,2"], "--conditions/--condition: this command runs one condition at a "
+                                                  "time, got '1,2'; run it once per condition"),
+                        (["--condition", "5"], "--conditions/--condition: must be a whole number in [1, 4]"),
+                        (["--window", "-1"], "--window: must be > 0 s")):
+        assert bench_statistics.main(argv) == USAGE
+        err = capsys.readouterr().err
+        assert err.startswith("error: ") and words in err and err.count("\n") == 1 and "--out" not in err, err
+    assert bench_statistics.main(["--help"]) == 0
+    text = capsys.readouterr().out
+    assert "--conditions C, --condition C" in text and "examples:" in text
+
+
 
 def test_dpgt_params_lists_every_key_with_value_unit_source_and_meaning(capsys):
     from components.params import parameter_names
