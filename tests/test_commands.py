@@ -244,6 +244,32 @@ def test_one_condition_commands_take_conditions_and_the_former_spelling():
     assert fault_study.parse_args([]).conditions == 2                           # the source's rig speed
 
 
+def test_bench_engine_says_once_in_one_line_what_falls_back_and_why(tmp_path, capsys):
+    """The ring's drive torque is a Python function of time, which the compiled engine cannot take: the ring's HHT
+    runs on the numpy path. bench_engine says so once, before the table, in one line naming the engine path and
+    the element (no memory address), instead of mbd's line on every run; the JSON records it."""
+    import json
+
+    import mbd
+    from scenarios import bench_engine
+
+    model, q0, v0 = bench_engine.ring_model(4)
+    with pytest.raises(mbd.ModelError, match="Python callable of time"):     # the truth: it cannot be compiled
+        mbd.simulate(model, q0, v0, 0.0, controller=mbd.FixedStep(bench_engine.H), progress=False, engine="compiled")
+    out = tmp_path / "b.json"
+    assert bench_engine.main(["--sizes", "4", "5", "--steps", "3", "--repeats", "2", "--no-radau",
+                              "--json", str(out)]) == 0
+    cap = capsys.readouterr()
+    said = [line for line in (cap.out + cap.err).splitlines() if "numpy engine path" in line]
+    assert len(said) == 1 and said[0] == cap.out.splitlines()[0], said
+    assert said[0].startswith("fallback: the ring's HHT runs on the numpy engine path")
+    assert "TorqueSource 'drive': torque given as a Python callable of time cannot be compiled" in said[0]
+    assert "0x" not in said[0] and "<function" not in said[0]
+    r = json.loads(out.read_text())
+    assert r["engine"] == "numpy" and "TorqueSource 'drive'" in r["engine_note"]
+    assert [row["engine"] for row in r["results"]] == ["numpy", "numpy"]
+
+
 def test_bench_statistics_takes_one_condition_through_the_shared_grammar(capsys):
     """--conditions with one value (the studies' spelling), --condition still accepted; a list of two, a condition
     out of range and a bad window are one-line usage errors before anything runs; no advice about an --out it
