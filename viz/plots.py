@@ -243,34 +243,57 @@ def work_precision(rows: Sequence[tuple], path, *, error_label: str = "error",
         return _save(fig, path)
 
 
-def load_distribution(angles_rad, loads_N, path, *, title: str | None = None) -> Path:
-    """Polar plot of roller loads at their angular positions.
+def load_distribution(angles_rad, loads_N, path, *, title: str | None = None, zero: str | None = None,
+                      theory: tuple | None = None) -> Path:
+    """Polar plot of roller loads at their angular positions: the angle in degrees (ticks every 30°), the load
+    radially in kN from 1 kN on (:func:`display_unit`), its unit on the radial axis.
 
-    loads_N: (Z,) array, or label -> (Z,) array (e.g. forward/reverse) sharing angles_rad.
-    Each roller is a stem from the centre plus a marker; the envelope is closed around the bearing.
-    """
+    loads_N: (Z,) array, or label -> (Z,) array (e.g. forward/reverse) sharing angles_rad. zero: what angle 0
+    is (e.g. "the load-zone centre"), said in the title. theory: optional (label, angles [rad], loads [N]) drawn
+    as open markers, e.g. the classical discrete-roller solution. Each roller is a stem from the centre plus a
+    marker; the envelope is closed around the bearing. The radial labels sit opposite the loaded rollers, where
+    they collide with nothing."""
+    from matplotlib.ticker import MaxNLocator
+
     ang = np.asarray(angles_rad, float)
     curves = dict(loads_N) if isinstance(loads_N, Mapping) else {None: loads_N}
+    every = [np.asarray(v, float) for v in curves.values()] + ([np.asarray(theory[2], float)] if theory else [])
+    scale, unit = display_unit("N", np.concatenate(every))
     order = np.argsort(np.mod(ang, 2 * np.pi))
     styles = [FWD, REV]
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(4.8, 4.8), layout="constrained")
+        fig = Figure(figsize=(5.2, 5.6), layout="constrained")
         ax = fig.add_subplot(projection="polar")
         for i, (label, load) in enumerate(curves.items()):
             st = styles[i % 2]
             a = np.mod(ang, 2 * np.pi)[order]
-            q = np.asarray(load, float)[order]
+            q = np.asarray(load, float)[order] * scale
             ax.vlines(a, 0.0, q, color=st["color"], lw=2.0, alpha=0.6)
             ax.plot(np.append(a, a[0]), np.append(q, q[0]), color=st["color"], ls=st["linestyle"],
                     marker="o", ms=3.5, label=label)
-        ax.set_rlabel_position(100)
-        # A polar axis has no radial axis label of its own: the unit goes on every radial tick.
-        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g} N"))
-        ax.set_xlabel(_axis_label("roller angle", "°") + "   radial: roller load [N]")
-        if any(k is not None for k in curves):
-            ax.legend(loc="lower right", bbox_to_anchor=(1.12, -0.08))
-        if title:
-            ax.set_title(title)
+        if theory:
+            ax.plot(np.mod(np.asarray(theory[1], float), 2 * np.pi), np.asarray(theory[2], float) * scale, ls="none",
+                    marker="o", ms=8, mfc="none", mec="k", mew=0.9, label=theory[0])
+        ax.set_thetagrids(np.arange(0, 360, 30), [f"{d}°" for d in range(0, 360, 30)])
+        # a few round radial ticks, the outer circle one of them
+        top = max(float(np.nanmax(np.concatenate(every))) * scale, 1e-12)
+        ticks = MaxNLocator(4, steps=[1, 2, 2.5, 5, 10]).tick_values(0.0, top)
+        ticks = ticks[: int(np.searchsorted(ticks, top - 1e-9 * top)) + 1]
+        ax.set_rlim(0.0, ticks[-1])
+        ax.set_rticks(ticks[1:])
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        # the radial labels opposite the loads' centre, between two angle grid lines, and the unit beyond them
+        q_all = np.concatenate([np.asarray(v, float) for v in curves.values()])
+        a_all = np.tile(ang, len(curves))
+        centre = np.degrees(np.angle(np.sum(np.nan_to_num(q_all) * np.exp(1j * a_all)))) if np.any(q_all) else 0.0
+        where = (round((centre + 180.0) / 30.0) * 30.0 + 15.0) % 360.0
+        ax.set_rlabel_position(where)
+        ax.text(np.radians(where), ticks[-1] * 1.25, f"roller load\n[{unit}]", ha="center", va="center",
+                fontsize=8, gid="radial_unit")
+        ax.set_xlabel(_axis_label("roller angle", "°"))
+        if any(k is not None for k in curves) or theory:
+            fig.legend(loc="outside lower center", ncols=2, frameon=False)
+        ax.set_title("\n".join(t for t in (title, f"(0° = {zero})" if zero else None) if t), pad=14)
         return _save(fig, path)
 
 
