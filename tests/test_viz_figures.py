@@ -373,3 +373,52 @@ def test_load_distribution_below_a_kilonewton_in_newtons(tmp_path, captured):
     ax = captured[-1].axes[0]
     assert "[N]" in next(t.get_text() for t in ax.texts if t.get_gid() == "radial_unit")
     assert 120.0 < (ax.get_rlabel_position() - 90.0) % 360.0 < 240.0       # opposite the loads, centred on 90°
+
+
+def _inside(fig, ax, texts):
+    """Every text's drawn box lies inside the axes' box (pixels)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    r = canvas.get_renderer()
+    box = ax.get_window_extent(r)
+    for t in texts:
+        e = t.get_window_extent(r)
+        assert box.x0 <= e.x0 and e.x1 <= box.x1 and box.y0 <= e.y0 and e.y1 <= box.y1, (t.get_text(), e, box)
+
+
+@pytest.mark.parametrize("top", [2.96, 3.0, 4.1, 1.4])
+def test_film_regime_labels_stay_inside_their_panels(tmp_path, captured, top):
+    """The regimes' bounds Λ = 1 and 3 are drawn in every Λ panel with their words inside it — also when the
+    thinnest film reaches just under, at or over a bound at the panel's top edge (the Λ = 3 label was clipped
+    there), or when no oil comes near it."""
+    eta = [0.0128, 0.0241]
+    series = {("lambda_min", b, "forward"): (eta, [0.7 * top, top]) for b in ("inner", "outer")}
+    plots.against_viscosity(series, [("lambda_min", "Λ_min", "1", True)], tmp_path / "v.png",
+                            levels={"lambda_min": {1.0: "Λ = 1: below, boundary-dominated", 3.0: "Λ = 3: full film above"}})
+    fig = captured[-1]
+    for ax in fig.axes:
+        lo, hi = ax.get_ylim()
+        assert lo < 1.0 and 3.0 < hi                       # both bounds in view
+        labels = [t for t in ax.texts if t.get_gid() == "level"]
+        assert sorted(t.get_text()[:5] for t in labels) == ["Λ = 1", "Λ = 3"]
+        _inside(fig, ax, labels)
+
+
+def test_against_viscosity_a_line_and_a_marker_per_condition(tmp_path, captured):
+    """Several conditions: each its own line (a study over conditions 1-4 drew one zig-zag line through all of
+    them) with its own marker, named once in the legend beside the directions."""
+    eta = [0.0128, 0.0241, 0.0476]
+    series = {("lambda_min", b, d, f"condition {c}"): (eta, [c * 0.5, c * 0.8, c * 1.2])
+              for b in ("inner", "outer") for d in ("forward", "reverse") for c in (1, 3)}
+    plots.against_viscosity(series, [("lambda_min", "Λ_min", "1", True)], tmp_path / "v.png",
+                            names={"VG32": 0.0128, "VG68": 0.0241, "VG150": 0.0476})
+    fig = captured[-1]
+    assert _legend_labels(fig) == ["forward", "reverse", "condition 1", "condition 3"]
+    for ax in fig.axes:
+        lines = [ln for ln in ax.get_lines() if ln.get_linestyle() != ":"]
+        assert len(lines) == 4                              # 2 conditions × 2 directions, 3 points each
+        assert all(len(ln.get_xdata()) == 3 for ln in lines)
+        assert {ln.get_marker() for ln in lines if ln.get_ydata()[0] == 0.5} != \
+            {ln.get_marker() for ln in lines if ln.get_ydata()[0] == 1.5}
+        assert [t.get_text() for t in ax.get_xticklabels()] == ["12.8\nVG32", "24.1\nVG68", "47.6\nVG150"]

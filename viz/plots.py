@@ -350,40 +350,49 @@ def _plain_log(axis, decades: float = 2.0) -> None:
     axis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
 
 
+_GROUP_MARKERS = "osD^vP"
+
+
 def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple], path, *,
                       title: str | None = None, levels: Mapping[str, Mapping[float, str]] | None = None,
                       names: Mapping[str, float] | None = None) -> Path:
     """Quantities against the oil's viscosity, forward vs reverse, one column per bearing type, one legend.
 
-    series: (quantity key, bearing, direction) -> (viscosities [Pa·s], values [SI]);  quantities: (key, words,
-    SI unit, log scale) — one row each, shown in a unit that suits the range (a film in µm); levels: quantity
-    key -> {value: words}, dotted horizontal lines (e.g. the film regimes' bounds of Λ); names: oil name ->
-    its viscosity [Pa·s], written under the bottom row's ticks at the oils. Bearings and directions are read from
-    the series' keys."""
-    bearings = sorted({b for _, b, _ in series})
-    present = sorted({d for _, _, d in series}, key=lambda d: {"forward": 0, "reverse": 1}.get(d, 2))
+    series: (quantity key, bearing, direction[, group]) -> (viscosities [Pa·s], values [SI]); a group (e.g.
+    "condition 3") is a line of its own with its own marker, named in the legend when there is more than one;
+    quantities: (key, words, SI unit, log scale) — one row each, shown in a unit that suits the range (a film in
+    µm); levels: quantity key -> {value: words}, dotted horizontal lines (e.g. the film regimes' bounds of Λ),
+    each inside its panel with its words (below the line where there is no room above it); names: oil name ->
+    its viscosity [Pa·s], written under the bottom row's ticks at the oils. Bearings, directions and groups are
+    read from the series' keys."""
+    from matplotlib.lines import Line2D
+
+    bearings = sorted({k[1] for k in series})
+    present = sorted({k[2] for k in series}, key=lambda d: {"forward": 0, "reverse": 1}.get(d, 2))
+    groups = list(dict.fromkeys(k[3] if len(k) > 3 else None for k in series))
+    marker = {g: _GROUP_MARKERS[i % len(_GROUP_MARKERS)] for i, g in enumerate(groups)}
     with mpl.rc_context(STYLE):
         fig = Figure(figsize=(3.4 * len(bearings) + 0.6, 2.5 * len(quantities) + 0.8), layout="constrained")
         axes = fig.subplots(len(quantities), len(bearings), squeeze=False, sharex=True)
         for r, (key, words, unit, log) in enumerate(quantities):
-            ys = [v for (k, _, _), (_, y) in series.items() if k == key for v in y if v is not None]
+            ys = [v for k, (_, y) in series.items() if k[0] == key for v in y if v is not None]
             scale, shown = display_unit(unit, ys)
             for c, b in enumerate(bearings):
                 ax = axes[r, c]
-                for d, style in (("forward", FWD), ("reverse", REV)):
-                    if (key, b, d) in series:
-                        x, y = series[(key, b, d)]
-                        y = np.array([np.nan if v is None else v for v in y], float)
-                        ax.plot(np.asarray(x) * 1e3, y * scale, marker="o", **style)
+                for g in groups:
+                    for d, style in (("forward", FWD), ("reverse", REV)):
+                        k = (key, b, d) if g is None else (key, b, d, g)
+                        if k in series:
+                            x, y = series[k]
+                            y = np.array([np.nan if v is None else v for v in y], float)
+                            ax.plot(np.asarray(x) * 1e3, y * scale, marker=marker[g], ms=4.5, **style)
                 ax.set_xscale("log")
                 _plain_log(ax.xaxis)
                 if log:
                     ax.set_yscale("log")
+                _levels(ax, {v * scale: words for v, words in (levels or {}).get(key, {}).items()})
+                if log:
                     _plain_log(ax.yaxis)
-                for value, label in (levels or {}).get(key, {}).items():
-                    ax.axhline(value * scale, color=_MARK_COLOR, lw=0.8, ls=":")
-                    ax.text(0.02, value * scale, label, transform=ax.get_yaxis_transform(), fontsize=7,
-                            color=_MARK_COLOR, va="bottom")
                 if r == 0:
                     ax.set_title(f"{b} planet bearings")
                 ax.set_ylabel(_axis_label(_wrap(words, 24), shown))
@@ -393,10 +402,40 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
                         ax.set_xticks([1e3 * v for v in names.values()],
                                       [f"{1e3 * v:.3g}\n{n}" for n, v in names.items()])
                         ax.xaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
-        _direction_legend(fig, present)
+        handles = [Line2D([], [], color=st["color"], ls=st["linestyle"], label=d)
+                   for d, st in (("forward", FWD), ("reverse", REV)) if d in present]
+        if len(groups) > 1:
+            handles += [Line2D([], [], color="0.3", ls="none", marker=marker[g], label=str(g)) for g in groups]
+        if handles:
+            fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 6), frameon=False)
         if title:
             fig.suptitle(title)
         return _save(fig, path)
+
+
+def _levels(ax, levels: Mapping[float, str]) -> None:
+    """Dotted horizontal lines at ``levels`` (value in the axis' unit -> words), each kept in view, its words
+    inside the panel: above the line, or below it where the line runs near the panel's top."""
+    if not levels:
+        return
+    lo, hi = ax.get_ylim()
+    want_lo, want_hi = min(lo, *levels), max(hi, *levels)
+    if ax.get_yscale() == "log":         # a margin of 4 % of the panel's height beyond a level at its edge
+        span = np.log10(want_hi / want_lo)
+        want_lo, want_hi = (want_lo / 10 ** (0.04 * span) if want_lo < lo else lo,
+                            want_hi * 10 ** (0.04 * span) if want_hi > hi else hi)
+    else:
+        span = want_hi - want_lo
+        want_lo, want_hi = (want_lo - 0.04 * span if want_lo < lo else lo, want_hi + 0.04 * span if want_hi > hi else hi)
+    ax.set_ylim(want_lo, want_hi)
+    to_axes = ax.transScale + ax.transLimits            # data -> axes fraction
+    for value, words in levels.items():
+        ax.axhline(value, color=_MARK_COLOR, lw=0.8, ls=":")
+        frac = float(to_axes.transform((1.0, value))[1])
+        top = frac > 0.85                                # no room above the line for its words
+        ax.annotate(words, (0.02, frac), xycoords="axes fraction", xytext=(0, -2 if top else 2),
+                    textcoords="offset points", fontsize=7, color=_MARK_COLOR, va="top" if top else "bottom",
+                    gid="level")
 
 
 def fault_spectra(panels: Sequence[tuple], path, *, quantity: str = "sensor acceleration",
