@@ -144,17 +144,19 @@ def conditions(text):
     return ",".join(dict.fromkeys(items))
 
 
-def one_condition(text):
+def _one_condition(then: str = ""):
     """One operating condition 1-4 (a command that runs one at a time): a comma list of more is refused in one
-    line saying so."""
-    items = _items(text, "operating conditions 1-4")
-    if len(items) > 1:
-        raise argparse.ArgumentTypeError(f"this command runs one condition at a time, got {text!r}; run it once "
-                                         f"per condition (each with its own --out)")
-    return count(1, 4)(items[0])
+    line saying so; ``then`` ends that line (what a user does besides running it once per condition)."""
+    def conv(text):
+        items = _items(text, "operating conditions 1-4")
+        if len(items) > 1:
+            raise argparse.ArgumentTypeError(f"this command runs one condition at a time, got {text!r}; run it "
+                                             f"once per condition{then}")
+        return count(1, 4)(items[0])
+    return _named(conv, "operating condition")
 
 
-one_condition.__name__ = "operating condition"
+one_condition = _one_condition(" (each with its own --out)")
 
 directions = choice_list(DIRECTIONS, "directions")
 
@@ -275,7 +277,8 @@ def add_shared(p, *names: str, out: str | None = None, conditions: str | None = 
             kw["default"] = conditions
             if one_condition_only:
                 flags = (*flags, "--condition")
-                kw.update(type=one_condition, metavar="C",
+                writes = "out" in (names or SWEEP)          # a command without --out: no advice about it
+                kw.update(type=one_condition if writes else _one_condition(), metavar="C",
                           help=f"operating condition 1-4, one (docs/parameters.md; default {conditions}; --condition: "
                                f"the former spelling, still accepted)")
             else:

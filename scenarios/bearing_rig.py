@@ -7,7 +7,8 @@ presses the rollers onto the pin (the ring is pulled along the load, so that cen
 pull, on the pin's far side).
 Writes DIR/summary.json (radial_load_N, clearance_m, roller_angle_deg from the load-zone centre,
 roller_load_N time-mean per roller, q_max_N, stribeck_ratio = Q_max·Z/F_r, load_zone_deg, ring_deflection_m,
-and the classical discrete-roller solution for comparison) and DIR/load_distribution.png.
+and the classical discrete-roller solution for comparison) and DIR/load_distribution.png (polar: the
+angle in degrees from the load-zone centre, the roller loads in kN, the discrete-roller solution beside them).
 """
 from __future__ import annotations
 
@@ -110,7 +111,8 @@ def run(a) -> dict:
     from viz import plots as vp
 
     fig = vp.load_distribution(sol.angles[order], {"simulated (time mean)": sol.loads[order]},
-                               out / "load_distribution.png",
+                               out / "load_distribution.png", zero="the load-zone centre",
+                               theory=("discrete-roller theory (rigid rings)", theory.angles, theory.loads),
                                title=f"Roller loads, F_r = {F / 1e3:.3g} kN, P_d = {b.clearance * 1e6:.0f} µm, Z = {b.rollers}")
     print(f"F_r = {F:.0f} N, P_d = {b.clearance * 1e6:.1f} um, Z = {b.rollers}: Q_max = {sol.q_max:.0f} N, "
           f"Q_max·Z/F_r = {sol.stribeck:.2f}, load zone {np.degrees(sol.zone_angle):.0f} deg, "

@@ -59,7 +59,7 @@ _FROM_SUMMARY = {"h_min_m": "film_min_m", "h_mean_m": "film_mean_m", "h_min_isot
                  "thermal_factor_min": "film_thermal_factor_min", "thermal_loading_max": "film_thermal_loading_max"}
 
 
-EXAMPLES = ["{prog} --conditions 3 --out results/lubricant",
+EXAMPLES = ["{prog} --conditions 3 --out results/lubricant", "{prog} --replot --out results/lubricant",
             "{prog} --conditions 1,2,3,4 --grades VG32,VG68,VG150,VG220 --workers 2",
             '{prog} --viscosities "10,30,100 mPa*s" --directions reverse']
 WRITES = ("c{condition}_{direction}_{oil}/{results.nc, summary.json} per run; summary.csv and summary.md (a row "
@@ -79,8 +79,17 @@ def parse_args(argv):
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded after the start (default 0.03)")
     p.add_argument("--window", type=args.positive("s"), default=None, help="statistics window [s] (default: the study's rule)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=2000.0, help="recording rate [Hz] (statistics use every step)")
+    p.add_argument("--replot", action="store_true",
+                   help="redraw film_and_slip.png from --out's summary.csv and stop (runs nothing)")
     args.add_shared(p, out="results/lubricant", conditions="3")
-    return p.parse_args(argv)
+    a = p.parse_args(argv)
+    if a.replot:        # it runs nothing: an option about runs would be ignored without a word
+        given = [act.option_strings[0] for act in p._actions if act.dest not in ("help", "replot", "out", "no_progress")
+                 and act.option_strings and getattr(a, act.dest) != act.default]
+        if given:
+            p.error(f"--replot redraws the figure from --out's summary.csv and runs nothing: {', '.join(given)} "
+                    f"would have no effect")
+    return a
 
 
 def lubricants(a) -> dict[str, dict]:
@@ -208,24 +217,55 @@ def write_tables(rows: list[dict], out: Path) -> list[Path]:
 
 
 def plot(rows: list[dict], out: Path) -> list[Path]:
-    """film_and_slip.png: Λ, film, cage slip and traction heat against the viscosity."""
+    """film_and_slip.png: Λ, film, cage slip and traction heat against the viscosity, a line per condition and
+    direction (the conditions' own markers when there are several)."""
     from viz.plots import against_viscosity
 
+    conds = sorted({r["condition"] for r in rows})
     series = {}
     for key in ("lambda_min", "h_min_m", "cage_slip_pct", "heat_traction_W"):
         for r in sorted(rows, key=lambda r: r["viscosity_Pa_s"]):
-            x, y = series.setdefault((key, r["bearing"], r["direction"]), ([], []))
+            k = (key, r["bearing"], r["direction"]) + ((f"condition {r['condition']}",) if len(conds) > 1 else ())
+            x, y = series.setdefault(k, ([], []))
             x.append(r["viscosity_Pa_s"])
             y.append(r[key])
+    at = f", condition {conds[0]}" if len(conds) == 1 else ""
     return [against_viscosity(series, [("lambda_min", "film parameter Λ_min = h_min/σ", "1", True),
                                        ("h_min_m", "thinnest film h_min", "m", True),
                                        ("cage_slip_pct", "cage slip", "%", False),
                                        ("heat_traction_W", "traction heat", "W", False)],
                               out / "film_and_slip.png",
-                              title="Film and cage against the oil's viscosity (at the operating temperature)",
-                              names={r["lubricant"]: r["viscosity_Pa_s"] for r in rows},
+                              title=f"Film and cage against the oil's viscosity (at the operating temperature){at}",
+                              # the grades by name; a viscosity given as such is its own tick label
+                              names={r["lubricant"]: r["viscosity_Pa_s"] for r in rows if r["lubricant"] in OIL_GRADES}
+                              or None,
                               levels={"lambda_min": {1.0: "Λ = 1: below, boundary-dominated",
                                                      FULL_FILM_LAMBDA: f"Λ = {FULL_FILM_LAMBDA:g}: full film above"}})]
+
+
+_TEXT_COLUMNS = ("direction", "lubricant", "bearing", "regime")
+
+
+def read_rows(path) -> list[dict]:
+    """The rows of a study's summary.csv (:data:`COLUMNS`) with their types: the condition a whole number, the
+    words as text, every other value a float (None where the study had none)."""
+    with open(path, newline="", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    if not rows or set(COLUMNS) - set(rows[0]):
+        raise ParameterError.at("--replot", f"{path} is not a lubricant study's summary.csv (columns "
+                                            f"{', '.join(sorted(set(COLUMNS) - set(rows[0] if rows else {})))} missing)")
+    return [{c: int(r[c]) if c == "condition" else r[c] if c in _TEXT_COLUMNS else
+             (float(r[c]) if r[c] != "" else None) for c in COLUMNS} for r in rows]
+
+
+def replot(out: Path) -> list[Path]:
+    """film_and_slip.png redrawn from ``out``/summary.csv, without running anything (``--replot``)."""
+    path = Path(out) / "summary.csv"
+    if not path.is_file():
+        raise ParameterError.at("--replot", f"no summary.csv in {out} (run the study there first)")
+    files = plot(read_rows(path), Path(out))
+    print("figures: " + ", ".join(str(f) for f in files))
+    return files
 
 
 def write_outputs(rows: list[dict], out: Path) -> list[Path]:
@@ -257,6 +297,8 @@ class LubricantStudy(Study):
 
 @holds_out_folder
 def run(a) -> dict:
+    if a.replot:
+        return {"failed": {}, "files": replot(Path(a.out))}
     return LubricantStudy(a).run()
 
 

@@ -27,6 +27,7 @@ from components.outputs import SUMMARY_WORDS
 from components.outputs import relative_life as iso_relative_life
 from mbd.recorder import atomic_write_text
 
+from .integrity import read_summary
 from .runner import RunConfig
 from .study import Study, StudyRun
 from .sweep import OPERATING_AXES, Case, user_overrides
@@ -200,6 +201,7 @@ HISTORY_GROUPS = {"bearing_loads": "planet bearing loads (pin reaction, pair 1)"
                   "mesh": "gear meshes (pair 1)"}
 MESH_COLUMNS = {"sun_inner": "sun – inner planet", "inner_outer": "inner – outer planet",
                 "outer_ring": "outer planet – ring"}
+MESH_FORCE_WORDS = "drive-flank force − coast-flank force"     # drive: the flank the torque path loads
 
 
 def history_groups(runs: dict[str, Path]) -> dict[str, tuple[list, list[str]]]:
@@ -217,6 +219,9 @@ def history_groups(runs: dict[str, Path]) -> dict[str, tuple[list, list[str]]]:
         rows[group].setdefault((words, unit), {}).setdefault(col, {})[run] = (t, np.asarray(y, float))
 
     for d, p in runs.items():
+        # the flank the torque path loads, per mesh, as the run recorded it (reverse loads the other flanks)
+        drive = {k: m.get("drive_flank") for k, m in ((read_summary(p.parent / "summary.json") or {}).get("meshes")
+                                                     or {}).items()}
         with xr.open_dataset(p, engine="h5netcdf") as ds:
             bmap = json.loads(ds.attrs["bearings"])
             t = np.asarray(ds["time"].values, float)
@@ -250,8 +255,10 @@ def history_groups(runs: dict[str, Path]) -> dict[str, tuple[list, list[str]]]:
                     put("cage", "cage slip", "%", col, d, t, ds["bearing.cage_slip"].values[:, i])
             for key in MESH_COLUMNS:
                 fam = MESH_FAMILY[key]
-                if f"{fam}.force" in ds:
-                    put("mesh", "mesh force, flank +1 − flank −1", "N", key, d, t, ds[f"{fam}.force"].values[:, 0])
+                if f"{fam}.force" in ds and drive.get(key) in (1, -1):
+                    # the file's force is flank +1's minus flank −1's: times the drive flank's sign it reads
+                    # drive − coast, > 0 while the loaded flank carries the load, in either direction
+                    put("mesh", MESH_FORCE_WORDS, "N", key, d, t, drive[key] * ds[f"{fam}.force"].values[:, 0])
                 if f"{fam}.transmission_error" in ds:
                     put("mesh", "loaded transmission error", "m", key, d, t,
                         ds[f"{fam}.transmission_error"].values[:, 0])

@@ -17,7 +17,8 @@ and f_m ± f_c, f_m ± 3 f_c marked, DIR/lines.csv (f_m + k f_c, |k| ≤ 6: the 
 band's median, what lets a sensor see the line — planet phasing, the transfer path, or errors,
 :func:`components.geometry.sideband_origin` — and every path's amplitude and amplitude over its own band
 median, with the path that carries the most of it), the strongest peaks near f_m in DIR/peaks.csv, and
-DIR/summary.json. The spectrum covers the first whole number
+DIR/summary.json (its keys with a unit end in it, as a run's summary: ``amplitude_m_s2``, ``f_m_hz``; the machine's
+errors and the rig's parameters as text with their units). The spectrum covers the first whole number
 of carrier revolutions of the window (the lines then fall on bins); its resolution is f_c/revolutions: resolve
 f_c sidebands with a window of several carrier periods (default 0.1 s: 3 revolutions at 2000 r/min, 11.1 Hz
 against f_c = 33.3 Hz).
@@ -180,7 +181,8 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     for r in lines:
         r["meaningful"] = coarse is None
     expected = {r["line"]: r["frequency_hz"] for r in lines}
-    peaks = peak_table(f, amp, f_m, (SIDEBANDS + 0.5) * f_c, expected, n=8) if amp.any() else []   # a path at 0
+    peaks = [_renamed(r, {"amplitude": "amplitude_m_s2"})                  # every sensor reads an acceleration
+             for r in (peak_table(f, amp, f_m, (SIDEBANDS + 0.5) * f_c, expected, n=8) if amp.any() else [])]
     _write_csv(out / "spectrum.csv", [{"frequency_hz": fi, **{k: a[1][i] for k, a in spectra.items()}}
                                       for i, fi in enumerate(f.tolist())])
     _write_csv(out / "lines.csv", lines)
@@ -188,9 +190,10 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     summary = {"f_m_hz": f_m, "f_c_hz": f_c, "resolution_hz": df, "window_s": s["window_s"],
                "carrier_rpm": s["carrier_rpm"], "sun_rpm": s["sun_rpm"], "power_W": s["power_W"],
                "sensor": sensor, "quantity": SENSORS[sensor],
-               "errors": {k: [e.to_dict() for e in v] for k, v in params.si().errors.to_dict().items()},
-               "sensor_parameters": params.si().rig.sensor.to_dict(),
-               "carrier_ripple": params.si().rig.carrier_ripple.to_dict(),
+               # the machine's errors and the rig as their parameters read, each value with its unit (as text)
+               "errors": {k: [_as_text(e) for e in getattr(params.errors, k)] for k in params.si().errors.to_dict()},
+               "sensor_parameters": _as_text(params.rig.sensor),
+               "carrier_ripple": _as_text(params.rig.carrier_ripple),
                "lines": lines, "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"],
                "error_estimate": s["error_estimate"], "warnings": s["warnings"] + ([coarse] if coarse else [])}
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
@@ -201,6 +204,28 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     print("run time and accuracy: " + "\n".join(run_report(s)))
     print(f"written: {out / 'spectrum.csv'}, {out / 'lines.csv'}, {out / 'peaks.csv'}, {out / 'summary.json'}, {fig}")
     return summary
+
+
+# summary.json's numeric keys without a unit suffix (components.outputs.UNIT_SUFFIXES): ratios and counts
+DIMENSIONLESS_KEYS = frozenset({"over_median", "k", "distance_bins", *(f"{p}_over_floor" for p in PATHS)})
+
+
+def _renamed(row: dict, names: dict) -> dict:
+    """``row`` with its keys renamed by ``names``, in its order (the CSV's columns)."""
+    return {names.get(k, k): v for k, v in row.items()}
+
+
+def _as_text(params) -> dict:
+    """{dotted key: value with its unit, as text} of a parameter group (a dimensionless one as its number's text):
+    what the parameters say, with units, in summary.json."""
+    from components.params import flatten
+
+    out = {}
+    for k, v in flatten(params).items():
+        if hasattr(v, "unitless"):               # a pint quantity (an angle keeps its degree)
+            v = f"{v.magnitude:g}" if v.unitless else f"{v:~P}"
+        out[k] = str(v)
+    return out
 
 
 def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
@@ -226,15 +251,15 @@ def _lines(f, spectra, f_m, f_c, z_r: int, planets: int, sensor: str) -> list[di
     marks = {f"f_m{k:+d}f_c" if k else "f_m": f_m + k * f_c for k in ks}
     band = (f_m - (SIDEBANDS + 0.5) * f_c, f_m + (SIDEBANDS + 0.5) * f_c)
     table = {name: line_table(f, spectra[name][1], marks, band) for name in ("amplitude", *PATHS)}
-    rows = table["amplitude"]
+    rows = [_renamed(r, {"amplitude": "amplitude_m_s2"}) for r in table["amplitude"]]   # accelerations, m/s²
     for i, (k, r) in enumerate(zip(ks, rows)):
         r["k"] = k
         r["origin"] = sideband_origin(k, z_r, planets)
         r["perfect_machine_shows"] = r["origin"] in SEEN[sensor]
         for name in PATHS:
-            r[f"{name}_amplitude"] = table[name][i]["amplitude"]
+            r[f"{name}_amplitude_m_s2"] = table[name][i]["amplitude"]
             r[f"{name}_over_floor"] = table[name][i]["over_median"]
-        r["carried_by"] = max(SENSOR_PATHS, key=lambda name: r[f"{name}_amplitude"])
+        r["carried_by"] = max(SENSOR_PATHS, key=lambda name: r[f"{name}_amplitude_m_s2"])
     return rows
 
 
@@ -274,12 +299,12 @@ def _report(lines, peaks, f_m, f_c, df, t, sensor) -> None:
           + " ".join(f"{p:>8}" for p in PATHS) + "  carried by")
     ratio = lambda x: f"{x:8.2f}" if np.isfinite(x) else f"{'–':>8}"
     for r in lines:
-        print(f"  {r['line']:>9} {r['frequency_hz']:6.1f} Hz  {r['amplitude']:9.3g}  {r['over_median']:8.1f}   "
+        print(f"  {r['line']:>9} {r['frequency_hz']:6.1f} Hz  {r['amplitude_m_s2']:9.3g}  {r['over_median']:8.1f}   "
               f"{r['origin']:<13} {'yes' if r['perfect_machine_shows'] else 'no':8} "
               + " ".join(ratio(r[f'{p}_over_floor']) for p in PATHS) + f"  {r['carried_by']}")
     print("strongest peaks near f_m:")
     for r in peaks:
-        print(f"  {r['frequency_hz']:9.1f} Hz  amp {r['amplitude']:.3g} m/s^2   nearest {r['nearest']:>8} "
+        print(f"  {r['frequency_hz']:9.1f} Hz  amp {r['amplitude_m_s2']:.3g} m/s^2   nearest {r['nearest']:>8} "
               f"({r['expected_hz']:.1f} Hz, {r['distance_bins']:+.2f} bins)")
 
 

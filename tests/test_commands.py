@@ -244,6 +244,53 @@ def test_one_condition_commands_take_conditions_and_the_former_spelling():
     assert fault_study.parse_args([]).conditions == 2                           # the source's rig speed
 
 
+def test_bench_engine_says_once_in_one_line_what_falls_back_and_why(tmp_path, capsys):
+    """The ring's drive torque is a Python function of time, which the compiled engine cannot take: the ring's HHT
+    runs on the numpy path. bench_engine says so once, before the table, in one line naming the engine path and
+    the element (no memory address), instead of mbd's line on every run; the JSON records it."""
+    import json
+
+    import mbd
+    from scenarios import bench_engine
+
+    model, q0, v0 = bench_engine.ring_model(4)
+    with pytest.raises(mbd.ModelError, match="Python callable of time"):     # the truth: it cannot be compiled
+        mbd.simulate(model, q0, v0, 0.0, controller=mbd.FixedStep(bench_engine.H), progress=False, engine="compiled")
+    out = tmp_path / "b.json"
+    assert bench_engine.main(["--sizes", "4", "5", "--steps", "3", "--repeats", "2", "--no-radau",
+                              "--json", str(out)]) == 0
+    cap = capsys.readouterr()
+    said = [line for line in (cap.out + cap.err).splitlines() if "numpy engine path" in line]
+    assert len(said) == 1 and said[0] == cap.out.splitlines()[0], said
+    assert said[0].startswith("fallback: the ring's HHT runs on the numpy engine path")
+    assert "TorqueSource 'drive': torque given as a Python callable of time cannot be compiled" in said[0]
+    assert "0x" not in said[0] and "<function" not in said[0]
+    r = json.loads(out.read_text())
+    assert r["engine"] == "numpy" and "TorqueSource 'drive'" in r["engine_note"]
+    assert [row["engine"] for row in r["results"]] == ["numpy", "numpy"]
+
+
+def test_bench_statistics_takes_one_condition_through_the_shared_grammar(capsys):
+    """--conditions with one value (the studies' spelling), --condition still accepted; a list of two, a condition
+    out of range and a bad window are one-line usage errors before anything runs; no advice about an --out it
+    does not have."""
+    from scenarios import bench_statistics
+
+    assert bench_statistics.parse_args(["--conditions", "2"]).conditions == 2
+    assert bench_statistics.parse_args(["--condition", "1"]).conditions == 1
+    assert bench_statistics.parse_args([]).conditions == 3
+    for argv, words in ((["--conditions", "1,2"], "--conditions/--condition: this command runs one condition at a "
+                                                  "time, got '1,2'; run it once per condition"),
+                        (["--condition", "5"], "--conditions/--condition: must be a whole number in [1, 4]"),
+                        (["--window", "-1"], "--window: must be > 0 s")):
+        assert bench_statistics.main(argv) == USAGE
+        err = capsys.readouterr().err
+        assert err.startswith("error: ") and words in err and err.count("\n") == 1 and "--out" not in err, err
+    assert bench_statistics.main(["--help"]) == 0
+    text = capsys.readouterr().out
+    assert "--conditions C, --condition C" in text and "examples:" in text
+
+
 
 def test_dpgt_params_lists_every_key_with_value_unit_source_and_meaning(capsys):
     from components.params import parameter_names

@@ -57,6 +57,30 @@ def test_a_rerun_resumes_and_bad_oils_are_refused(study, capsys):
     assert "error: argument --grades: takes ISO VG grades" in capsys.readouterr().err
 
 
+def test_replot_redraws_the_figure_from_summary_csv_alone(study, tmp_path, capsys, monkeypatch):
+    """--replot reads the study's summary.csv back (every value as the study wrote it, typed) and redraws
+    film_and_slip.png from it without running anything; an option about runs beside it is refused in one line."""
+    import shutil
+
+    rows = lubricant_study.read_rows(study / "summary.csv")
+    with open(study / "summary.csv") as fh:
+        raw = list(csv.DictReader(fh))
+    assert len(rows) == len(raw) == 8
+    for r, w in zip(rows, raw):
+        assert r["condition"] == int(w["condition"]) and r["bearing"] == w["bearing"] and r["regime"] == w["regime"]
+        assert r["lambda_min"] == float(w["lambda_min"]) and isinstance(r["h_min_m"], float)
+    shutil.copy(study / "summary.csv", tmp_path / "summary.csv")
+    drawn = []
+    monkeypatch.setattr(lubricant_study, "plot", lambda rr, out: drawn.append((rr, out)) or [out / "film_and_slip.png"])
+    monkeypatch.setattr(lubricant_study.LubricantStudy, "run", lambda self: pytest.fail("--replot ran the study"))
+    assert lubricant_study.main(["--replot", "--out", str(tmp_path)]) == 0
+    assert drawn == [(rows, tmp_path)] and sorted(p.name for p in tmp_path.iterdir()) == ["summary.csv"]
+    assert lubricant_study.main(["--replot", "--out", str(tmp_path), "--grades", "VG68"]) == 2
+    assert "--replot redraws the figure from --out's summary.csv and runs nothing: --grades" in capsys.readouterr().err
+    assert lubricant_study.main(["--replot", "--out", str(tmp_path / "empty")]) == 2
+    assert "no summary.csv in" in capsys.readouterr().err
+
+
 def test_a_thin_film_is_flagged_outside_the_ehl_laws_validity(study, capsys):
     """Λ_min < 1 with the EHL traction law: a warning names the bearing type and Λ; the dry laws, or a thicker
     film, give none. The study's own runs (condition 3, 10 and 100 mPa·s: Λ ≈ 1.5–4) carry no such warning."""

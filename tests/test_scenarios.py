@@ -78,6 +78,24 @@ def test_study_figures_show_the_runs_data(zero_power_study):
         t, y = by_col["outer"]["reverse"]
         np.testing.assert_array_equal(t, ds["time"].values)
         np.testing.assert_array_equal(y, ds["bearing.load_radial"].values[:, names.index("b1.pb")])
+    # the mesh row is the drive flank's force minus the coast flank's: results.nc holds flank +1's minus flank
+    # −1's, and the torque path loads flanks (−1, +1, +1) of (sun–inner, inner–outer, outer–ring) forward and the
+    # others in reverse (components.geometry.loaded_flanks; the sun's speed decides it at zero power)
+    mesh = {w: by for w, _, by in groups["mesh"][0]}
+    assert set(mesh) == {paper_study.MESH_FORCE_WORDS, "loaded transmission error"}
+    assert paper_study.MESH_FORCE_WORDS == "drive-flank force − coast-flank force"
+    loaded = {"forward": {"sun_inner": -1, "inner_outer": 1, "outer_ring": 1}}
+    loaded["reverse"] = {k: -f for k, f in loaded["forward"].items()}
+    from components.families import MESH_FAMILY
+    for d, path in runs.items():
+        with xr.open_dataset(path, engine="h5netcdf") as ds:
+            for key, sign in loaded[d].items():
+                t, y = mesh[paper_study.MESH_FORCE_WORDS][key][d]
+                np.testing.assert_array_equal(y, sign * ds[f"{MESH_FAMILY[key]}.force"].values[:, 0])
+                drive, coast = ("force_drive", "force_coast") if sign > 0 else ("force_coast", "force_drive")
+                fam = MESH_FAMILY[key]     # the element's own flank forces: drive − coast, sample by sample
+                np.testing.assert_allclose(y, ds[f"{fam}.{drive}"].values[:, 0] - ds[f"{fam}.{coast}"].values[:, 0],
+                                           rtol=0, atol=1e-9 * max(1.0, float(np.abs(y).max())))
     vals = paper_study.headline_values(r["results"])
     for d in ("forward", "reverse"):
         s = json.loads((out / f"c4_{d}" / "summary.json").read_text())
@@ -176,8 +194,8 @@ def test_spectrum_peaks_sit_on_mesh_sidebands(tmp_path):
                                           "--perfect"]))
     assert s["f_c_hz"] == pytest.approx(2000 / 60) and s["f_m_hz"] == pytest.approx(82 * 2000 / 60)
     assert s["resolution_hz"] == pytest.approx(1 / 0.09, rel=0.01)
-    big = s["peaks"][0]["amplitude"] if s["peaks"] else 0.0
-    top = [p for p in s["peaks"][:3] if p["amplitude"] >= big * 10 ** (-30 / 20)]
+    big = s["peaks"][0]["amplitude_m_s2"] if s["peaks"] else 0.0
+    top = [p for p in s["peaks"][:3] if p["amplitude_m_s2"] >= big * 10 ** (-30 / 20)]
     assert top, s["peaks"]
     k0 = round((top[0]["frequency_hz"] - s["f_m_hz"]) / s["f_c_hz"])
     assert (82 + k0) % 3 == 0, (k0, s["peaks"])
@@ -189,9 +207,9 @@ def test_spectrum_peaks_sit_on_mesh_sidebands(tmp_path):
     assert set(rows[0]) >= {"frequency_hz", "amplitude"}
     assert (tmp_path / "spectrum.png").exists()
     lines = {r["k"]: r for r in s["lines"]}
-    strongest = max(r["amplitude"] for r in s["lines"])
-    assert lines[-1]["origin"] == "phasing" and lines[-1]["amplitude"] == strongest
-    assert all(r["amplitude"] < 0.01 * strongest for r in s["lines"] if r["origin"] != "phasing"), s["lines"]
+    strongest = max(r["amplitude_m_s2"] for r in s["lines"])
+    assert lines[-1]["origin"] == "phasing" and lines[-1]["amplitude_m_s2"] == strongest
+    assert all(r["amplitude_m_s2"] < 0.01 * strongest for r in s["lines"] if r["origin"] != "phasing"), s["lines"]
 
 
 @pytest.mark.slow
@@ -213,22 +231,22 @@ def test_spectrum_housing_sensor_on_a_perfect_machine(tmp_path, capsys):
     assert nc.stat().st_mtime_ns == made and "run: reused (same parameters, settings and code" in capsys.readouterr().out
     s = spectrum.run(spectrum.parse_args(argv))
     lines = {r["k"]: r for r in s["lines"]}
-    strongest = max(r["amplitude"] for r in s["lines"])
+    strongest = max(r["amplitude_m_s2"] for r in s["lines"])
     assert [k for k, r in lines.items() if r["perfect_machine_shows"] and abs(k) <= 5] == [-4, -1, 2, 5]
     for k in (-4, -1, 2, 5):
         assert lines[k]["over_median"] >= 5.0, lines[k]
     for r in s["lines"]:
         if r["origin"] == "errors":
-            assert r["amplitude"] < 0.01 * strongest, r
+            assert r["amplitude_m_s2"] < 0.01 * strongest, r
     rows = list(csv.DictReader((tmp_path / "lines.csv").open()))
     assert {r["origin"] for r in rows} == {"phasing", "transfer path", "errors"}
     # every path's line, over its own floor, and the path that carries it (the sum is the mesh path here; the
     # rig's radial sensor at the top does not see the rocking: its torque path is 0)
     for r in s["lines"]:
-        assert r["housing_amplitude"] == pytest.approx(r["amplitude"], rel=1e-12)
-        assert r["torque_amplitude"] == 0.0 and r["carried_by"] == "mesh"
+        assert r["housing_amplitude_m_s2"] == pytest.approx(r["amplitude_m_s2"], rel=1e-12)
+        assert r["torque_amplitude_m_s2"] == 0.0 and r["carried_by"] == "mesh"
     assert lines[-1]["bearing_over_floor"] > 5.0 and lines[-1]["mesh_over_floor"] > 5.0
-    assert {f"{p}_{q}" for p in ("mesh", "torque", "bearing", "housing") for q in ("amplitude", "over_floor")} < set(rows[0])
+    assert {f"{p}_{q}" for p in ("mesh", "torque", "bearing", "housing") for q in ("amplitude_m_s2", "over_floor")} < set(rows[0])
     for sensor in ("mesh", "torque", "bearing", "axis"):
         _, signals = spectrum._signals(tmp_path / "run" / "results.nc", sensor)
         assert signals["amplitude"] is signals["axis_x" if sensor == "axis" else sensor]
@@ -330,8 +348,8 @@ def test_spectrum_rig_machine_errors_bring_the_cancelled_lines(tmp_path):
     p = {r["k"]: r for r in perfect["lines"]}
     r = {x["k"]: x for x in rig["lines"]}
     for k in (0, 1, -3, 3):
-        assert p[k]["origin"] == "errors" and r[k]["amplitude"] > 30 * p[k]["amplitude"], (k, p[k], r[k])
-    assert max(r.values(), key=lambda x: x["amplitude"])["k"] == -1
+        assert p[k]["origin"] == "errors" and r[k]["amplitude_m_s2"] > 30 * p[k]["amplitude_m_s2"], (k, p[k], r[k])
+    assert max(r.values(), key=lambda x: x["amplitude_m_s2"])["k"] == -1
     assert r[1]["bearing_over_floor"] > 3.0 and p[1]["bearing_over_floor"] < 2.0
     assert all(x["carried_by"] == "mesh" for x in r.values())
 

@@ -21,4 +21,4 @@ def test_a_perfect_machine_keeps_the_cancelled_lines_at_the_floor_with_the_full_
     assert lines[-1]["over_median"] > 30.0, lines[-1]
     for k in CANCELLED:
         assert lines[k]["over_median"] < 3.0, (k, lines[k])
-    assert max(lines[k]["amplitude"] for k in CANCELLED) < 0.05 * lines[-1]["amplitude"]
+    assert max(lines[k]["amplitude_m_s2"] for k in CANCELLED) < 0.05 * lines[-1]["amplitude_m_s2"]

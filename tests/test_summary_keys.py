@@ -41,12 +41,16 @@ def readme_summary_names() -> set[str]:
 
 
 def leaves(d: dict, path: str = ""):
-    """(dotted path, key, value, parent key) of every entry of a nested summary (lists kept whole)."""
+    """(dotted path, key, value, parent key) of every entry of a nested summary; a list of numbers kept whole, a
+    list of rows (dicts: the spectrum's lines and peaks) entered row by row as ``path[]``."""
     for k, v in d.items():
         p = f"{path}.{k}" if path else k
         yield p, k, v, path.rsplit(".", 1)[-1]
         if isinstance(v, dict) and k != "run_description":
             yield from leaves(v, p)
+        elif isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
+            for row in v:
+                yield from leaves(row, f"{p}[]")
 
 
 def _numeric(v) -> bool:
@@ -58,15 +62,16 @@ def _numeric(v) -> bool:
                                                    or x is None for x in v) and any(x is not None for x in v)
 
 
-def unit_problems(summary: dict) -> list[str]:
+def unit_problems(summary: dict, dimensionless=DIMENSIONLESS_KEYS) -> list[str]:
     """Numeric keys that neither carry a unit suffix (theirs or their mapping's) nor are declared dimensionless."""
     bad = []
     for path, key, value, parent in leaves(summary):
         if not _numeric(value) or path.startswith("run_description"):
             continue
-        if unit_of_key(key) or key in DIMENSIONLESS_KEYS or path in DIMENSIONLESS_KEYS or unit_of_key(parent):
+        if unit_of_key(key) or key in dimensionless or path in dimensionless or unit_of_key(parent):
             continue
-        bad.append(path)
+        if path not in bad:
+            bad.append(path)
     return bad
 
 
@@ -107,6 +112,45 @@ def test_the_check_catches_a_key_without_its_unit():
     assert unit_problems({"backlash_m": {"sun_inner": 1e-4}, "window_s": [0.0, 0.1], "rollers": 12}) == []
     assert unit_problems({"rms": 1.0}) == ["rms"]            # dimensionless only where it is declared so
     assert unit_problems({"error_estimate": {"rms": 1.0}}) == []
+
+
+@pytest.fixture(scope="module")
+def spectrum_summary(tmp_path_factory):
+    """A real (short) run of the rig's spectrum with the rig's machine (its errors), linear bearings."""
+    from scenarios import spectrum
+
+    out = tmp_path_factory.mktemp("spectrum")
+    spectrum.run(spectrum.parse_args(["--out", str(out), "--settle", "0.002", "--window", "0.012", "--option",
+                                      "bearings=linear", "--no-progress"]))
+    return json.loads((out / "summary.json").read_text()), out
+
+
+def test_the_spectrum_summary_follows_the_unit_suffix_rule(spectrum_summary):
+    """The spectrum's summary.json by the same rule, its rows (lines, peaks) entered: amplitudes in m/s² say so;
+    the over-the-floor ratios, k and the distance in bins are its declared dimensionless keys; the machine's errors
+    and the rig's parameters are text with their units, not bare SI numbers."""
+    import csv
+
+    from scenarios.spectrum import DIMENSIONLESS_KEYS as SPECTRUM_DIMENSIONLESS
+
+    s, out = spectrum_summary
+    assert unit_problems(s, DIMENSIONLESS_KEYS | SPECTRUM_DIMENSIONLESS) == []
+    assert s["lines"] and s["peaks"]                                   # the rows were checked, not skipped
+    line, peak = s["lines"][0], s["peaks"][0]
+    assert {"amplitude_m_s2", "housing_amplitude_m_s2", "mesh_amplitude_m_s2", "over_median"} <= set(line)
+    assert "amplitude" not in line and "amplitude" not in peak and "amplitude_m_s2" in peak
+    assert s["sensor_parameters"]["angle"] == "90 deg" and s["sensor_parameters"]["housing.mass"] == "50 kg"
+    assert s["errors"]["pinhole"] and all(v.endswith(" µm") for e in s["errors"]["pinhole"]
+                                           for k, v in e.items() if k != "planet")
+    # lines.csv and peaks.csv carry the same names
+    with open(out / "lines.csv") as fh:
+        assert list(csv.DictReader(fh).fieldnames) == list(line)
+    with open(out / "peaks.csv") as fh:
+        assert list(csv.DictReader(fh).fieldnames) == list(peak)
+    # before: bare amplitudes and SI numbers without units failed the rule
+    old = {"lines": [{"amplitude": 1.0, "over_median": 2.0}], "sensor_parameters": {"angle": 1.57}}
+    assert unit_problems(old, DIMENSIONLESS_KEYS | SPECTRUM_DIMENSIONLESS) == ["lines[].amplitude",
+                                                                                "sensor_parameters.angle"]
 
 
 def test_every_key_of_a_real_run_is_documented(summary):

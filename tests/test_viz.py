@@ -237,6 +237,51 @@ def test_train_animation(animate, tmp_path, ext):
     assert np.mean(chroma > 80) > 0.002
 
 
+@pytest.mark.parametrize("forces, factor, unit, top, step", [
+    ((0.0, 5150.0), 1e-3, "kN", 6.0, 2.0), ((0.0, 2600.0), 1e-3, "kN", 3.0, 1.0),
+    ((0.0, 12345.0), 1e-3, "kN", 12.5, 2.5), ((0.0, 900.0), 1.0, "N", 1000.0, 200.0),
+    ((0.0, 999.0), 1.0, "N", 1000.0, 200.0), ((0.0, 1000.0), 1e-3, "kN", 1.0, 0.2)])
+def test_force_colour_bar_in_N_or_kN_with_round_labels(forces, factor, unit, top, step):
+    """The train animation's colour bar: kN from 1 kN on (as the figures), its unit in the title, from 0 to a round
+    top at or above the largest force, a label on every round step (VTK spaces n labels evenly over the limits)."""
+    from viz.animate import force_colour_scale
+
+    f, title, (lo, hi), n = force_colour_scale(np.array(forces), "roller load")
+    assert (f, title) == (factor, f"roller load ({unit})")
+    assert lo == 0.0 and hi == pytest.approx(top) and hi >= max(forces) * factor
+    np.testing.assert_allclose(np.linspace(lo, hi, n), np.arange(n) * step, atol=1e-12)
+    assert n <= 6
+
+
+def test_train_animation_colours_rollers_in_the_bars_unit(animate, tmp_path, monkeypatch):
+    """The discs' scalars are the forces in the colour bar's unit, and the bar's title names it."""
+    import pyvista as pv
+
+    seen = {}
+    real_bar, real_mesh = pv.Plotter.add_scalar_bar, pv.Plotter.add_mesh
+
+    def bar(self, *a, **kw):
+        seen["bar"] = kw
+        return real_bar(self, *a, **kw)
+
+    def mesh(self, m, *a, **kw):
+        if kw.get("scalars") == "force":
+            seen["clim"], seen["first"] = kw["clim"], np.array(m.cell_data["force"])
+        return real_mesh(self, m, *a, **kw)
+
+    monkeypatch.setattr(pv.Plotter, "add_scalar_bar", bar)
+    monkeypatch.setattr(pv.Plotter, "add_mesh", mesh)
+    t, bodies = _train_bodies(N_FRAMES)
+    for b in bodies:
+        if b["kind"] == "roller":
+            b["force"] = 8.0 * b["force"]             # up to 4 kN
+    animate.train_animation(tmp_path / "t.gif", t, bodies, size=SIZE, force_label="roller load")
+    assert seen["bar"]["title"] == "roller load (kN)"
+    forces = np.array([b["force"][0] for b in bodies if b["kind"] == "roller"])
+    np.testing.assert_allclose(seen["first"], forces / 1e3)
+    assert seen["clim"][0] == 0.0 and seen["clim"][1] >= forces.max() / 1e3
+
+
 def test_animation_argument_errors(tmp_path):
     from viz import animate
     t, orbits, C, _ = _orbit_data(4)

@@ -316,3 +316,109 @@ def test_mode_shapes_are_numbered_as_the_table_and_say_what_is_left_out(captured
     titles = [ax.get_title() for ax in _visible_axes(fig)]
     assert titles == ["mode 2: f = 10 Hz", "mode 3: f = 20 Hz", "mode 4: f = 30 Hz"]
     assert any(t.get_text() == "the first 3 of 4 modes shown" for t in fig.texts)
+
+
+# ------------------------------------------------------------------------------ bearing rig: polar load distribution
+def _boxes_apart(fig, texts):
+    """No two of the drawn texts' boxes overlap (pixels, after drawing)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    r = canvas.get_renderer()
+    boxes = [(t.get_text(), t.get_window_extent(r)) for t in texts if t.get_visible() and t.get_text()]
+    for i, (a, ba) in enumerate(boxes):
+        for b, bb in boxes[:i]:
+            assert not ba.overlaps(bb), (a, b)
+
+
+def test_load_distribution_degrees_kN_and_labels_apart(tmp_path, captured):
+    """The bearing rig's polar plot: angle ticks in degrees every 30°, what 0° is in the title, the loads in kN on
+    the radial axis with the unit written there, the radial labels opposite the loaded rollers, and no label on
+    another (the angle and radial labels collided before)."""
+    Z = 12
+    ang = 2 * np.pi * np.arange(Z) / Z - np.pi             # -180° .. 150°, the load zone centred on 0°
+    load = 3844.8 * np.clip(np.cos(ang), 0.0, None) ** 1.5
+    theory = ("theory", 2 * np.pi * np.arange(Z) / Z, 3843.5 * np.clip(np.cos(2 * np.pi * np.arange(Z) / Z), 0, None) ** 1.5)
+    path = plots.load_distribution(ang, {"simulated": load}, tmp_path / "p.png", title="rig",
+                                   zero="the load-zone centre", theory=theory)
+    _not_blank(path)
+    fig = captured[-1]
+    ax = fig.axes[0]
+    assert "0° = the load-zone centre" in ax.get_title() and "rig" in ax.get_title()
+    assert [t.get_text() for t in ax.get_xticklabels()] == [f"{d}°" for d in range(0, 360, 30)]
+    np.testing.assert_allclose(np.degrees(ax.get_xticks()), np.arange(0, 360, 30))
+    # the data in kN: the envelope's radii are the loads / 1000, in angle order
+    order = np.argsort(np.mod(ang, 2 * np.pi))
+    env = next(ln for ln in ax.get_lines() if ln.get_label() == "simulated")
+    np.testing.assert_allclose(env.get_ydata()[:-1], load[order] / 1e3)
+    np.testing.assert_allclose(env.get_xdata()[:-1], np.mod(ang, 2 * np.pi)[order])
+    th = next(ln for ln in ax.get_lines() if ln.get_label() == "theory")
+    np.testing.assert_allclose(th.get_ydata(), theory[2] / 1e3)
+    unit = [t for t in ax.texts if t.get_gid() == "radial_unit"]
+    assert len(unit) == 1 and "[kN]" in unit[0].get_text()
+    # round radial ticks, the outer circle one of them, covering the largest load
+    ticks = ax.get_yticks()
+    assert ax.get_ylim()[0] == 0.0 and ax.get_ylim()[1] == ticks[-1] >= load.max() / 1e3
+    assert [t.get_text() for t in ax.get_yticklabels()] == [f"{v:g}" for v in ticks]
+    # the radial labels on the unloaded side (the loads sit around 0°)
+    where = ax.get_rlabel_position()
+    assert 120.0 < where % 360.0 < 240.0, where
+    _boxes_apart(fig, [*ax.get_xticklabels(), *ax.get_yticklabels(), *unit, ax.title])
+    assert sorted(_legend_labels(fig)) == ["simulated", "theory"]
+
+
+def test_load_distribution_below_a_kilonewton_in_newtons(tmp_path, captured):
+    ang = 2 * np.pi * np.arange(8) / 8
+    plots.load_distribution(ang, 600.0 * np.clip(np.cos(ang - np.pi / 2), 0, None), tmp_path / "p.png")
+    ax = captured[-1].axes[0]
+    assert "[N]" in next(t.get_text() for t in ax.texts if t.get_gid() == "radial_unit")
+    assert 120.0 < (ax.get_rlabel_position() - 90.0) % 360.0 < 240.0       # opposite the loads, centred on 90°
+
+
+def _inside(fig, ax, texts):
+    """Every text's drawn box lies inside the axes' box (pixels)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    r = canvas.get_renderer()
+    box = ax.get_window_extent(r)
+    for t in texts:
+        e = t.get_window_extent(r)
+        assert box.x0 <= e.x0 and e.x1 <= box.x1 and box.y0 <= e.y0 and e.y1 <= box.y1, (t.get_text(), e, box)
+
+
+@pytest.mark.parametrize("top", [2.96, 3.0, 4.1, 1.4])
+def test_film_regime_labels_stay_inside_their_panels(tmp_path, captured, top):
+    """The regimes' bounds Λ = 1 and 3 are drawn in every Λ panel with their words inside it — also when the
+    thinnest film reaches just under, at or over a bound at the panel's top edge (the Λ = 3 label was clipped
+    there), or when no oil comes near it."""
+    eta = [0.0128, 0.0241]
+    series = {("lambda_min", b, "forward"): (eta, [0.7 * top, top]) for b in ("inner", "outer")}
+    plots.against_viscosity(series, [("lambda_min", "Λ_min", "1", True)], tmp_path / "v.png",
+                            levels={"lambda_min": {1.0: "Λ = 1: below, boundary-dominated", 3.0: "Λ = 3: full film above"}})
+    fig = captured[-1]
+    for ax in fig.axes:
+        lo, hi = ax.get_ylim()
+        assert lo < 1.0 and 3.0 < hi                       # both bounds in view
+        labels = [t for t in ax.texts if t.get_gid() == "level"]
+        assert sorted(t.get_text()[:5] for t in labels) == ["Λ = 1", "Λ = 3"]
+        _inside(fig, ax, labels)
+
+
+def test_against_viscosity_a_line_and_a_marker_per_condition(tmp_path, captured):
+    """Several conditions: each its own line (a study over conditions 1-4 drew one zig-zag line through all of
+    them) with its own marker, named once in the legend beside the directions."""
+    eta = [0.0128, 0.0241, 0.0476]
+    series = {("lambda_min", b, d, f"condition {c}"): (eta, [c * 0.5, c * 0.8, c * 1.2])
+              for b in ("inner", "outer") for d in ("forward", "reverse") for c in (1, 3)}
+    plots.against_viscosity(series, [("lambda_min", "Λ_min", "1", True)], tmp_path / "v.png",
+                            names={"VG32": 0.0128, "VG68": 0.0241, "VG150": 0.0476})
+    fig = captured[-1]
+    assert _legend_labels(fig) == ["forward", "reverse", "condition 1", "condition 3"]
+    for ax in fig.axes:
+        lines = [ln for ln in ax.get_lines() if ln.get_linestyle() != ":"]
+        assert len(lines) == 4                              # 2 conditions × 2 directions, 3 points each
+        assert all(len(ln.get_xdata()) == 3 for ln in lines)
+        assert {ln.get_marker() for ln in lines if ln.get_ydata()[0] == 0.5} != \
+            {ln.get_marker() for ln in lines if ln.get_ydata()[0] == 1.5}
+        assert [t.get_text() for t in ax.get_xticklabels()] == ["12.8\nVG32", "24.1\nVG68", "47.6\nVG150"]

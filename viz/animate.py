@@ -20,7 +20,7 @@ from .render_check import require_offscreen
 
 pv.OFF_SCREEN = True  # before any plotter exists: never try to open a window
 
-__all__ = ["cage_orbit_animation", "train_animation", "frame_indices"]
+__all__ = ["cage_orbit_animation", "train_animation", "frame_indices", "force_colour_scale"]
 
 _BG = "white"
 _INK = "black"
@@ -667,9 +667,30 @@ def _place_outline(g, i, zz):
 _DISC_SIDES = 24
 
 
+def force_colour_scale(forces_N, words: str) -> tuple[float, str, list[float], int]:
+    """The colour bar of roller forces [N]: (factor to the unit shown — kN from 1 kN on, as the figures
+    (:func:`viz.plots.display_unit`) —, the bar's title ``words (unit)``, colour limits in that unit from 0 (or a
+    negative least force) to a round top, the number of labels that puts a label on every round step)."""
+    from .plots import display_unit
+
+    f = np.asarray(forces_N, float)
+    f = f[np.isfinite(f)]
+    lo, hi = (min(0.0, float(f.min())), float(f.max())) if f.size else (0.0, 0.0)
+    factor, unit = display_unit("N", [lo, hi])
+    lo, hi = lo * factor, hi * factor
+    span = hi - lo if hi > lo else 1.0
+    e = 10.0 ** math.floor(math.log10(span / 5.0))
+    step = next(m * e for m in (1.0, 2.0, 2.5, 5.0, 10.0) if span / (m * e) <= 5.0 + 1e-9)   # at most 5 steps
+    lo, top = math.floor(lo / step + 1e-9) * step, math.ceil(hi / step - 1e-9) * step
+    top = max(top, lo + step)
+    # VTK's font draws "[" and "]" as "(" and ")": the unit in parentheses
+    return factor, f"{words} ({unit})", [lo, top], int(round((top - lo) / step)) + 1
+
+
 def _roller_discs(p, rollers, idx, n_t, has_force, force_label, fs):
-    """Filled roller discs: one polygon per roller, coloured by its force (cell data) with a colour bar.
-    Returns (the disc mesh, the (n_r, n_t) forces or None)."""
+    """Filled roller discs: one polygon per roller, coloured by its force (cell data, in the unit of the colour
+    bar: :func:`force_colour_scale`) with a colour bar. Returns (the disc mesh, the (n_r, n_t) forces in that
+    unit or None)."""
     nd = _DISC_SIDES
     faces = np.hstack([np.r_[nd, np.arange(nd) + nd * k] for k in range(len(rollers))])
     disc = pv.PolyData(np.zeros((nd * len(rollers), 3)), faces=faces)
@@ -677,13 +698,13 @@ def _roller_discs(p, rollers, idx, n_t, has_force, force_label, fs):
         p.add_mesh(disc, color="#9ecae1", lighting=False)
         return disc, None
     fr = np.stack([b["force"] if b["force"] is not None else np.full(n_t, np.nan) for b in rollers])
-    fmin, fmax = float(np.nanmin(fr[:, idx])), float(np.nanmax(fr[:, idx]))
-    clim = [min(0.0, fmin), fmax if fmax > min(0.0, fmin) else min(0.0, fmin) + 1.0]
+    factor, title, clim, n_labels = force_colour_scale(fr[:, idx], force_label)
+    fr = fr * factor
     disc.cell_data["force"] = fr[:, idx[0]]
     p.add_mesh(disc, scalars="force", cmap="viridis", clim=clim, lighting=False, nan_color="#cccccc",
                show_scalar_bar=False)
-    p.add_scalar_bar(title=force_label, vertical=True, position_x=0.83, position_y=0.12, width=0.07, height=0.72,
-                     n_labels=4, title_font_size=fs, label_font_size=fs, color=_INK, fmt="%.3g",
+    p.add_scalar_bar(title=title, vertical=True, position_x=0.83, position_y=0.12, width=0.07, height=0.72,
+                     n_labels=n_labels, title_font_size=fs, label_font_size=fs, color=_INK, fmt="%.3g",
                      unconstrained_font_size=True)
     return disc, fr
 
@@ -704,14 +725,15 @@ def _train_extent(parsed, idx):
 
 def train_animation(path, t, bodies: Sequence[Mapping], magnify: float = 1.0, fps: float = 20,
                     size: Sequence[int] = (600, 600), title: str | None = None,
-                    max_frames: int | None = None, force_label: str = "roller force (N)") -> Path:
+                    max_frames: int | None = None, force_label: str = "roller force") -> Path:
     """Animate a gear train: outlines rotating with θ, rollers as discs coloured by contact force.
 
     bodies: dicts with
       kind: "gear" | "ring" | "carrier" | "roller" | "cage";  radius: m (pitch radius for toothed bodies)
       teeth: optional tooth count (ticks at the teeth);  xy: (n_t, 2) centre, m;  theta: (n_t,) rad
       force: optional (n_t,) N, colours a roller;  ref: optional (2,) or (n_t, 2) nominal centre.
-    force_label: colour-bar title (parentheses: VTK's default font draws "[" and "]" as "(" and ")").
+    force_label: words of the colour bar's title; its unit (N, or kN from 1 kN on) is added in parentheses
+    (:func:`force_colour_scale`).
     magnify: displacements xy − ref are drawn multiplied by this factor.  Without `ref` the time-mean
     position is the reference, which is right only for bodies whose nominal centre is fixed in the
     plotted frame; rollers travel round their bearing, so magnify != 1 requires `ref` for them.

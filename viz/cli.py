@@ -151,7 +151,7 @@ def main(argv=None) -> int:
                 title += f", displacements ×{args.magnify:g}"
             path = animate.train_animation(out, run.t, bodies, magnify=1.0, fps=args.fps, size=size,
                                            title=title, max_frames=args.max_frames,
-                                           force_label="inner-race load (N)")
+                                           force_label="roller load\non the pin")
             n_t = run.n_t
     except (ValueError, RuntimeError) as exc:  # argument checks of viz.animate, renderer failures
         return _fail(str(exc))

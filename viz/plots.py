@@ -243,34 +243,57 @@ def work_precision(rows: Sequence[tuple], path, *, error_label: str = "error",
         return _save(fig, path)
 
 
-def load_distribution(angles_rad, loads_N, path, *, title: str | None = None) -> Path:
-    """Polar plot of roller loads at their angular positions.
+def load_distribution(angles_rad, loads_N, path, *, title: str | None = None, zero: str | None = None,
+                      theory: tuple | None = None) -> Path:
+    """Polar plot of roller loads at their angular positions: the angle in degrees (ticks every 30°), the load
+    radially in kN from 1 kN on (:func:`display_unit`), its unit on the radial axis.
 
-    loads_N: (Z,) array, or label -> (Z,) array (e.g. forward/reverse) sharing angles_rad.
-    Each roller is a stem from the centre plus a marker; the envelope is closed around the bearing.
-    """
+    loads_N: (Z,) array, or label -> (Z,) array (e.g. forward/reverse) sharing angles_rad. zero: what angle 0
+    is (e.g. "the load-zone centre"), said in the title. theory: optional (label, angles [rad], loads [N]) drawn
+    as open markers, e.g. the classical discrete-roller solution. Each roller is a stem from the centre plus a
+    marker; the envelope is closed around the bearing. The radial labels sit opposite the loaded rollers, where
+    they collide with nothing."""
+    from matplotlib.ticker import MaxNLocator
+
     ang = np.asarray(angles_rad, float)
     curves = dict(loads_N) if isinstance(loads_N, Mapping) else {None: loads_N}
+    every = [np.asarray(v, float) for v in curves.values()] + ([np.asarray(theory[2], float)] if theory else [])
+    scale, unit = display_unit("N", np.concatenate(every))
     order = np.argsort(np.mod(ang, 2 * np.pi))
     styles = [FWD, REV]
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(4.8, 4.8), layout="constrained")
+        fig = Figure(figsize=(5.2, 5.6), layout="constrained")
         ax = fig.add_subplot(projection="polar")
         for i, (label, load) in enumerate(curves.items()):
             st = styles[i % 2]
             a = np.mod(ang, 2 * np.pi)[order]
-            q = np.asarray(load, float)[order]
+            q = np.asarray(load, float)[order] * scale
             ax.vlines(a, 0.0, q, color=st["color"], lw=2.0, alpha=0.6)
             ax.plot(np.append(a, a[0]), np.append(q, q[0]), color=st["color"], ls=st["linestyle"],
                     marker="o", ms=3.5, label=label)
-        ax.set_rlabel_position(100)
-        # A polar axis has no radial axis label of its own: the unit goes on every radial tick.
-        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g} N"))
-        ax.set_xlabel(_axis_label("roller angle", "°") + "   radial: roller load [N]")
-        if any(k is not None for k in curves):
-            ax.legend(loc="lower right", bbox_to_anchor=(1.12, -0.08))
-        if title:
-            ax.set_title(title)
+        if theory:
+            ax.plot(np.mod(np.asarray(theory[1], float), 2 * np.pi), np.asarray(theory[2], float) * scale, ls="none",
+                    marker="o", ms=8, mfc="none", mec="k", mew=0.9, label=theory[0])
+        ax.set_thetagrids(np.arange(0, 360, 30), [f"{d}°" for d in range(0, 360, 30)])
+        # a few round radial ticks, the outer circle one of them
+        top = max(float(np.nanmax(np.concatenate(every))) * scale, 1e-12)
+        ticks = MaxNLocator(4, steps=[1, 2, 2.5, 5, 10]).tick_values(0.0, top)
+        ticks = ticks[: int(np.searchsorted(ticks, top - 1e-9 * top)) + 1]
+        ax.set_rlim(0.0, ticks[-1])
+        ax.set_rticks(ticks[1:])
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        # the radial labels opposite the loads' centre, between two angle grid lines, and the unit beyond them
+        q_all = np.concatenate([np.asarray(v, float) for v in curves.values()])
+        a_all = np.tile(ang, len(curves))
+        centre = np.degrees(np.angle(np.sum(np.nan_to_num(q_all) * np.exp(1j * a_all)))) if np.any(q_all) else 0.0
+        where = (round((centre + 180.0) / 30.0) * 30.0 + 15.0) % 360.0
+        ax.set_rlabel_position(where)
+        ax.text(np.radians(where), ticks[-1] * 1.25, f"roller load\n[{unit}]", ha="center", va="center",
+                fontsize=8, gid="radial_unit")
+        ax.set_xlabel(_axis_label("roller angle", "°"))
+        if any(k is not None for k in curves) or theory:
+            fig.legend(loc="outside lower center", ncols=2, frameon=False)
+        ax.set_title("\n".join(t for t in (title, f"(0° = {zero})" if zero else None) if t), pad=14)
         return _save(fig, path)
 
 
@@ -327,40 +350,49 @@ def _plain_log(axis, decades: float = 2.0) -> None:
     axis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
 
 
+_GROUP_MARKERS = "osD^vP"
+
+
 def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple], path, *,
                       title: str | None = None, levels: Mapping[str, Mapping[float, str]] | None = None,
                       names: Mapping[str, float] | None = None) -> Path:
     """Quantities against the oil's viscosity, forward vs reverse, one column per bearing type, one legend.
 
-    series: (quantity key, bearing, direction) -> (viscosities [Pa·s], values [SI]);  quantities: (key, words,
-    SI unit, log scale) — one row each, shown in a unit that suits the range (a film in µm); levels: quantity
-    key -> {value: words}, dotted horizontal lines (e.g. the film regimes' bounds of Λ); names: oil name ->
-    its viscosity [Pa·s], written under the bottom row's ticks at the oils. Bearings and directions are read from
-    the series' keys."""
-    bearings = sorted({b for _, b, _ in series})
-    present = sorted({d for _, _, d in series}, key=lambda d: {"forward": 0, "reverse": 1}.get(d, 2))
+    series: (quantity key, bearing, direction[, group]) -> (viscosities [Pa·s], values [SI]); a group (e.g.
+    "condition 3") is a line of its own with its own marker, named in the legend when there is more than one;
+    quantities: (key, words, SI unit, log scale) — one row each, shown in a unit that suits the range (a film in
+    µm); levels: quantity key -> {value: words}, dotted horizontal lines (e.g. the film regimes' bounds of Λ),
+    each inside its panel with its words (below the line where there is no room above it); names: oil name ->
+    its viscosity [Pa·s], written under the bottom row's ticks at the oils. Bearings, directions and groups are
+    read from the series' keys."""
+    from matplotlib.lines import Line2D
+
+    bearings = sorted({k[1] for k in series})
+    present = sorted({k[2] for k in series}, key=lambda d: {"forward": 0, "reverse": 1}.get(d, 2))
+    groups = list(dict.fromkeys(k[3] if len(k) > 3 else None for k in series))
+    marker = {g: _GROUP_MARKERS[i % len(_GROUP_MARKERS)] for i, g in enumerate(groups)}
     with mpl.rc_context(STYLE):
         fig = Figure(figsize=(3.4 * len(bearings) + 0.6, 2.5 * len(quantities) + 0.8), layout="constrained")
         axes = fig.subplots(len(quantities), len(bearings), squeeze=False, sharex=True)
         for r, (key, words, unit, log) in enumerate(quantities):
-            ys = [v for (k, _, _), (_, y) in series.items() if k == key for v in y if v is not None]
+            ys = [v for k, (_, y) in series.items() if k[0] == key for v in y if v is not None]
             scale, shown = display_unit(unit, ys)
             for c, b in enumerate(bearings):
                 ax = axes[r, c]
-                for d, style in (("forward", FWD), ("reverse", REV)):
-                    if (key, b, d) in series:
-                        x, y = series[(key, b, d)]
-                        y = np.array([np.nan if v is None else v for v in y], float)
-                        ax.plot(np.asarray(x) * 1e3, y * scale, marker="o", **style)
+                for g in groups:
+                    for d, style in (("forward", FWD), ("reverse", REV)):
+                        k = (key, b, d) if g is None else (key, b, d, g)
+                        if k in series:
+                            x, y = series[k]
+                            y = np.array([np.nan if v is None else v for v in y], float)
+                            ax.plot(np.asarray(x) * 1e3, y * scale, marker=marker[g], ms=4.5, **style)
                 ax.set_xscale("log")
                 _plain_log(ax.xaxis)
                 if log:
                     ax.set_yscale("log")
+                _levels(ax, {v * scale: words for v, words in (levels or {}).get(key, {}).items()})
+                if log:
                     _plain_log(ax.yaxis)
-                for value, label in (levels or {}).get(key, {}).items():
-                    ax.axhline(value * scale, color=_MARK_COLOR, lw=0.8, ls=":")
-                    ax.text(0.02, value * scale, label, transform=ax.get_yaxis_transform(), fontsize=7,
-                            color=_MARK_COLOR, va="bottom")
                 if r == 0:
                     ax.set_title(f"{b} planet bearings")
                 ax.set_ylabel(_axis_label(_wrap(words, 24), shown))
@@ -370,10 +402,40 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
                         ax.set_xticks([1e3 * v for v in names.values()],
                                       [f"{1e3 * v:.3g}\n{n}" for n, v in names.items()])
                         ax.xaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
-        _direction_legend(fig, present)
+        handles = [Line2D([], [], color=st["color"], ls=st["linestyle"], label=d)
+                   for d, st in (("forward", FWD), ("reverse", REV)) if d in present]
+        if len(groups) > 1:
+            handles += [Line2D([], [], color="0.3", ls="none", marker=marker[g], label=str(g)) for g in groups]
+        if handles:
+            fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 6), frameon=False)
         if title:
             fig.suptitle(title)
         return _save(fig, path)
+
+
+def _levels(ax, levels: Mapping[float, str]) -> None:
+    """Dotted horizontal lines at ``levels`` (value in the axis' unit -> words), each kept in view, its words
+    inside the panel: above the line, or below it where the line runs near the panel's top."""
+    if not levels:
+        return
+    lo, hi = ax.get_ylim()
+    want_lo, want_hi = min(lo, *levels), max(hi, *levels)
+    if ax.get_yscale() == "log":         # a margin of 4 % of the panel's height beyond a level at its edge
+        span = np.log10(want_hi / want_lo)
+        want_lo, want_hi = (want_lo / 10 ** (0.04 * span) if want_lo < lo else lo,
+                            want_hi * 10 ** (0.04 * span) if want_hi > hi else hi)
+    else:
+        span = want_hi - want_lo
+        want_lo, want_hi = (want_lo - 0.04 * span if want_lo < lo else lo, want_hi + 0.04 * span if want_hi > hi else hi)
+    ax.set_ylim(want_lo, want_hi)
+    to_axes = ax.transScale + ax.transLimits            # data -> axes fraction
+    for value, words in levels.items():
+        ax.axhline(value, color=_MARK_COLOR, lw=0.8, ls=":")
+        frac = float(to_axes.transform((1.0, value))[1])
+        top = frac > 0.85                                # no room above the line for its words
+        ax.annotate(words, (0.02, frac), xycoords="axes fraction", xytext=(0, -2 if top else 2),
+                    textcoords="offset points", fontsize=7, color=_MARK_COLOR, va="top" if top else "bottom",
+                    gid="level")
 
 
 def fault_spectra(panels: Sequence[tuple], path, *, quantity: str = "sensor acceleration",
