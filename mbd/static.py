@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
+from threadpoolctl import threadpool_limits
 
 from .assembly import System
 from .errors import ModelError
@@ -162,6 +162,10 @@ class _Problem:
         f2f = m.full_to_free
         self.q_ref = motion.poses(t).ravel()[m.free]
         self.Bt = B.T.tocsr()
+        self.Bd = B.toarray()
+        sysm = system
+        self._rows = sysm._indices.astype(np.int64)
+        self._cols = np.repeat(np.arange(m.ndof), np.diff(sysm._indptr))
         self.nB, self.nu = B.shape[1], len(groups)
         self.orbiting = np.flatnonzero((motion.orbit != 0.0) & ~m.fixed)
         self.ix, self.iy = f2f[3 * self.orbiting], f2f[3 * self.orbiting + 1]
@@ -224,7 +228,7 @@ class _Problem:
         return self.evaluate(self.t, q, v, self.z, False).F - self.model.mdiag * a
 
     def residual(self, x: np.ndarray, jac: bool = False):
-        """g(x) and, with ``jac``, K = −∂g/∂x (CSC)."""
+        """g(x) and, with ``jac``, K = −∂g/∂x (dense: a few hundred unknowns)."""
         q, X, ds, do = self._parts(x)
         _, v, a = self.motion.at(self.model, self.t, q, ds, do)
         ev = self.evaluate(self.t, q, v, self.z, jac)
@@ -232,32 +236,40 @@ class _Problem:
         g = self._equations(r, X)
         if not jac:
             return g, None
-        m, mo, n = self.model, self.motion, self.model.ndof
-        Jq, Jv = self.system._csc(ev.Jq), self.system._csc(ev.Jv)
-        # the steady motion's dependence on the pose: v = w k × r, a = −w² r (r carried by the host)
+        m, mo = self.model, self.motion
+        Jq, Jv = self._dense(ev.Jq), self._dense(ev.Jv)
+        # the steady motion's dependence on the pose, v = w k × r, a = −w² r: column operations on J_v and M
         w = (mo.orbit + do)[self.orbiting]
         ix, iy = self.ix, self.iy
-        dv = sp.csc_matrix((np.concatenate([w, -w]), (np.concatenate([iy, ix]), np.concatenate([ix, iy]))), (n, n))
-        w2 = w * w
-        da = sp.csc_matrix((np.concatenate([-w2, -w2]), (np.concatenate([ix, iy]), np.concatenate([ix, iy]))), (n, n))
+        drq = Jq.copy()
+        drq[:, ix] += Jv[:, iy] * w
+        drq[:, iy] -= Jv[:, ix] * w
+        drq[ix, ix] += m.mdiag[ix] * w * w
+        drq[iy, iy] += m.mdiag[iy] * w * w
         # ... and on the rates: a spin rate moves its θ rate; an orbital rate v = k × r, a = −2 w r
         ro = X[self.orb_b, :2] - mo.centre[self.orb_b]
         wo = (mo.orbit + do)[self.orb_b]
-        nu, og = self.nu, self.orb_g
-        W = sp.csc_matrix((np.concatenate([np.ones(self.spin_b.size), -ro[:, 1], ro[:, 0]]),
-                           (np.concatenate([self.spin_dofs, self.ox, self.oy]), np.concatenate([self.spin_g, og, og]))), (n, nu))
-        dau = sp.csc_matrix((np.concatenate([-2 * wo * ro[:, 0], -2 * wo * ro[:, 1]]),
-                             (np.concatenate([self.ox, self.oy]), np.concatenate([og, og]))), (n, nu))
-        Md = sp.diags(m.mdiag)
-        drq = (Jq + Jv @ dv - Md @ da).tocsc()
-        dru = (Jv @ W - Md @ dau).tocsc()
+        W = np.zeros((m.ndof, self.nu))
+        W[self.spin_dofs, self.spin_g] = 1.0
+        W[self.ox, self.orb_g] = -ro[:, 1]
+        W[self.oy, self.orb_g] = ro[:, 0]
+        dru = Jv @ W
+        dru[self.ox, self.orb_g] += m.mdiag[self.ox] * 2 * wo * ro[:, 0]
+        dru[self.oy, self.orb_g] += m.mdiag[self.oy] * 2 * wo * ro[:, 1]
         # rows: Bᵀ, and the rates' W(q)ᵀ — whose own dependence on q adds r's moment arm terms
-        Wt = W.T.tocsr()
-        arm = sp.csr_matrix((np.concatenate([r[self.oy], -r[self.ox]]), (np.concatenate([og, og]),
-                                                                           np.concatenate([self.ox, self.oy]))), (nu, n))
-        top = sp.hstack([self.Bt @ drq @ self.B, self.Bt @ dru])
-        bottom = sp.hstack([(Wt @ drq + arm) @ self.B, Wt @ dru])
-        return g, (-sp.vstack([top, bottom])).tocsc()
+        Bd = self.Bd
+        rows = np.vstack([Bd.T, W.T])
+        dq = rows @ drq
+        dq[self.nB + self.orb_g, self.ox] += r[self.oy]
+        dq[self.nB + self.orb_g, self.oy] -= r[self.ox]
+        return g, -np.hstack([dq @ Bd, rows @ dru])
+
+    def _dense(self, data: np.ndarray) -> np.ndarray:
+        """A Jacobian's data on the system's CSC pattern as a dense (n, n) array."""
+        n = self.model.ndof
+        out = np.zeros((n, n))
+        out[self._rows, self._cols] = data
+        return out
 
 
 def _evaluator(system: System, engine: str):
@@ -356,7 +368,8 @@ def solve_static(model: Model, motion: SteadyMotion, t: float, *, hold=(), rates
     scale = np.asarray(abs(B).T @ gyr).ravel() / np.asarray(abs(B).sum(axis=0)).ravel()
     tol = np.concatenate([length_tol / scale, np.full(len(rates), rate_tol)])
     cap = np.concatenate([max_step / scale, np.full(len(rates), max_rate_step)])
-    x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization)
+    with threadpool_limits(limits=1, user_api="blas"):     # dense systems of a few hundred: threads only contend
+        x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization)
     if not ok:
         worst = int(np.argmax(np.abs(prob.residual(x)[0]) / np.maximum(prob.floor, 1e-300)))
         raise ModelError(f"solve_static: no static state at t = {t:.6g} s within {max_steps} steps (worst unknown: "
@@ -452,26 +465,25 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
     forces = outer[outer < prob.nB]        # the continuation follows the forces; rates settle with them
     norm = lambda y: float(np.sqrt(np.sum(y[forces] ** 2 / M[forces])))
     g, K = prob.residual(x, jac=True)
-    mu_min = regularization * float(np.max(np.abs(K.diagonal()) / M))
+    mu_min = regularization * float(np.max(np.abs(np.diagonal(K)) / M))
     prob.mu_min, prob.tol = mu_min, tol
-    prob.floor = (np.abs(K.diagonal()) + mu_min * M) * tol
+    prob.floor = (np.abs(np.diagonal(K)) + mu_min * M) * tol
     x, g, local_ok = _local_solve(prob, x, local, cap)
     g, K = prob.residual(x, jac=True)
     mu = max(float(np.max(np.abs(g[outer]) / (Mo * cap[outer]))), mu_min)
     for k in range(max_steps + 1):
-        prob.floor = (np.abs(K.diagonal()) + mu_min * M) * tol
+        prob.floor = (np.abs(np.diagonal(K)) + mu_min * M) * tol
         if np.all(np.abs(g[outer]) <= prob.floor[outer]) and local_ok:
             return x, k, True
         if k == max_steps:
             break
-        Koo, Kol = K[outer][:, outer].toarray(), K[outer][:, loc]
-        Klo, Kll = K[loc][:, outer].toarray(), K[loc][:, loc].tocsc()
+        Koo, Kol = K[np.ix_(outer, outer)], K[np.ix_(outer, loc)]
+        Klo, Kll = K[np.ix_(loc, outer)], K[np.ix_(loc, loc)]
         try:
-            lu = spla.splu(Kll + sp.diags(mu_min * M[loc]))
             # the local residuals are settled (solved, or resting at a force's jump): the outer step does not chase them
-            X = lu.solve(Klo)
+            X = np.linalg.solve(Kll + np.diag(mu_min * M[loc]), Klo)
             d = np.linalg.solve(Koo - Kol @ X + np.diag(mu * Mo), g[outer])
-        except (RuntimeError, np.linalg.LinAlgError):
+        except np.linalg.LinAlgError:
             return x, k, False
         if not np.all(np.isfinite(d)):
             return x, k, False
