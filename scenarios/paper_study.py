@@ -76,6 +76,12 @@ def build_parser(name: str = "paper_study", out: str = "results/study", doc: str
     p.add_argument("--alpha", type=args.alpha, default=-0.3, help="HHT alpha in [-1/3, 0]")
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value,
                    help="scene switch, e.g. --option drag=false --option bearings=linear")
+    p.add_argument("--mode", default="dynamic", choices=["dynamic", "static"],
+                   help="dynamic: time integration (default); static: the quasi-static solution of the same model "
+                        "(mean loads, load sharing, lives in seconds; quantities only a dynamic run gives — cage "
+                        "motion, impacts, RMS values, time histories — are left out and said so)")
+    p.add_argument("--snapshots", type=args.count(1), default=8,
+                   help="static mode: instants over the mesh and roller positions averaged (default 8)")
     p.add_argument("--animate", action=argparse.BooleanOptionalAction, default=animate,
                    help="write a cage-orbit animation per condition (forward beside reverse)"
                         + (" (default: on)" if animate else ""))
@@ -90,7 +96,8 @@ def parse_args(argv):
 def build_config(a) -> RunConfig:
     return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate,
                      integration=dataclasses.replace(mbd.PRODUCTION, method=a.method, h=a.h, alpha=a.alpha),
-                     options=args.scene_options(a.option), progress=not a.no_progress)
+                     options=args.scene_options(a.option), progress=not a.no_progress,
+                     mode=getattr(a, "mode", "dynamic"), snapshots=getattr(a, "snapshots", 8))
 
 
 def make_cases(a, out: Path) -> list[Case]:
@@ -329,6 +336,20 @@ def plots(results: dict, out: Path) -> list[Path]:
     return paths
 
 
+def static_plots(results: dict, out: Path) -> list[Path]:
+    """Static mode's figure: the headline (mean load and lives, forward vs reverse); the others need time series."""
+    from viz import plots as vp
+
+    vals = headline_values(results)
+    if not vals:
+        return []
+    conds = sorted({s["condition"] for s in results.values() if "error" not in s})
+    one = f", condition {conds[0]}" if len(conds) == 1 else ""
+    return [vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
+                                        title=f"Planet bearings (pair 1), quasi-static: mean load and L10 life, "
+                                              f"forward vs reverse{one}")]
+
+
 def animate(results: dict, out: Path) -> list[Path]:
     paths = []
     try:
@@ -373,13 +394,21 @@ class PaperStudy(Study):
             if "stale_after_failure" not in s:
                 atomic_write_text(Path(run.outcomes[label].case.out_dir) / "summary.json",
                                   json.dumps(s, indent=2, default=str))
+        static = getattr(self.a, "mode", "dynamic") == "static"
         rows = comparison_rows(results)
+        if static:         # a quantity only a dynamic run gives is not in the tables at all (not a row of dashes)
+            rows = [r for r in rows if r["forward"] is not None or r["reverse"] is not None]
         csv_p, md_p, text = write_tables(rows, self.out)
         print("\n" + headline_table(rows))   # the headline first, then the whole comparison
         print("\n" + text)
+        if static:
+            left = sorted({q for q, _ in QUANTITIES} - {r["quantity"] for r in rows})
+            print(f"static mode ({self.a.snapshots} snapshots): left out, as only a dynamic run gives them: "
+                  f"{', '.join(left)}; no time histories, cage orbits, bars of RMS values or animation")
         run.step("tables", lambda: [csv_p, md_p])
-        figs = run.step("figures", plots, results, self.out)
-        anims = run.step("animation", animate, results, self.out) if self.a.animate else []
+        figs = run.step("figures", plots, results, self.out) if not static else \
+            run.step("figures", static_plots, results, self.out)
+        anims = run.step("animation", animate, results, self.out) if self.a.animate and not static else []
         return {"rows": rows, "figures": figs, "animations": anims}
 
 

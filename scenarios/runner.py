@@ -68,8 +68,17 @@ def _code_digest() -> str:
     return _CODE_DIGEST
 
 
-def _digest(params: DPGTParams, cfg: "RunConfig", code: bool) -> str:
+def _settings(cfg: "RunConfig") -> dict:
+    """The run settings that identify a run (the progress display is not one; a dynamic run's static-mode
+    settings are not either, so the results of runs made before static mode existed stay theirs)."""
     settings = asdict(replace(cfg, progress=False))
+    if cfg.mode == "dynamic":
+        del settings["mode"], settings["snapshots"]
+    return settings
+
+
+def _digest(params: DPGTParams, cfg: "RunConfig", code: bool) -> str:
+    settings = _settings(cfg)
     what = {"params": repr(params), "cfg": settings, **({"code": _code_digest()} if code else {})}
     return hashlib.sha256(json.dumps(what, sort_keys=True, default=repr).encode()).hexdigest()[:16]
 
@@ -85,7 +94,7 @@ def run_description(params: DPGTParams, cfg: "RunConfig") -> dict[str, str]:
     from components.params import flatten
 
     out = {k: str(v) for k, v in flatten(params).items()}
-    out.update({f"settings.{k}": repr(v) for k, v in asdict(replace(cfg, progress=False)).items()})
+    out.update({f"settings.{k}": repr(v) for k, v in _settings(cfg).items()})
     return out
 
 
@@ -105,8 +114,14 @@ class RunConfig:
     progress: bool = True
     checkpoint_every: int = 2000
     sensor: bool = False          # record what the housing accelerometer needs (rig.sensor, docs/model.md §12)
+    mode: str = "dynamic"         # "static": the quasi-static solution of the same model (components.static)
+    snapshots: int = 8            # static mode: instants over the mesh and roller positions
 
     def __post_init__(self):
+        if self.mode not in ("dynamic", "static"):
+            raise mbd.ModelError(f"mode must be 'dynamic' or 'static', got {self.mode!r}")
+        if not (isinstance(self.snapshots, (int, np.integer)) and self.snapshots >= 1):
+            raise mbd.ModelError(f"snapshots must be an integer >= 1, got {self.snapshots!r}")
         for k in ("settle", "window"):
             if getattr(self, k) is not None and not (np.isfinite(getattr(self, k)) and getattr(self, k) >= 0):
                 raise mbd.ModelError(f"{k} must be >= 0 s, got {getattr(self, k)!r}")
@@ -145,6 +160,8 @@ def finished_run(out_dir, params: DPGTParams, cfg: RunConfig) -> dict | None:
     s = read_summary(out / "summary.json")
     if s is None or s.get("fingerprint") != run_fingerprint(params, cfg):
         return None
+    if s.get("mode") == "static":      # a static solution writes no results.nc
+        return s
     return s if results_intact(out / "results.nc", s.get("samples")) else None
 
 
@@ -158,7 +175,31 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
                            description=run_description(params, cfg))
         if how == "recompute":
             print(f"{out_dir}: recomputing, its results were made by other code")
+        if cfg.mode == "static":
+            return _run_static(params, cfg, Path(out_dir), label)
         return _run_case(params, cfg, Path(out_dir), label)
+
+
+def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> dict:
+    """The quasi-static solution (:mod:`components.static`) of one operating point: summary.json in the dynamic
+    run's keys, those only a dynamic run gives left out (listed in ``omitted``); no results.nc."""
+    from components.static import static_summary
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")   # design warnings were shown once by the caller
+        scene = build_dpgt(params, cfg.options)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    summary = _run_info(params, scene, None)
+    summary["statistics"] = (f"quasi-static: the mean of {cfg.snapshots} static solutions spread over the mesh and "
+                             "roller positions (components.static); max over them")
+    summary.update(static_summary(scene, cfg.snapshots))
+    summary.update(label or {})
+    summary.update({"warnings": validity_warnings(params.si(), summary), "wall_s": summary["static_solver"]["wall_s"],
+                    "fingerprint": run_fingerprint(params, cfg),
+                    "parameters_fingerprint": parameters_fingerprint(params, cfg),
+                    "run_description": run_description(params, cfg)})
+    atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2, default=_json_default))
+    return summary
 
 
 def _earlier_wall(out_dir: Path, resuming: bool) -> float:
@@ -312,17 +353,22 @@ def accuracy_line(wall_s: float, steps: int, error_rms: float, error_max: float,
 
 
 def run_report(s: dict) -> list[str]:
-    """Lines for a finished run's summary: run time and error estimate, then any warning."""
-    e = s["error_estimate"]
-    return [accuracy_line(s["wall_s"], s["steps"], e["rms"], e["max"], e["atol_m"]),
-            *(f"warning: {w}" for w in s.get("warnings", []))]
+    """Lines for a finished run's summary: run time and error estimate (a static solution: its snapshots and
+    continuation steps), then any warning."""
+    if s.get("mode") == "static":
+        head = (f"{s['wall_s']:.1f} s wall, quasi-static: {s['snapshots']} snapshots, "
+                f"{s['static_solver']['steps']} continuation steps")
+    else:
+        e = s["error_estimate"]
+        head = accuracy_line(s["wall_s"], s["steps"], e["rms"], e["max"], e["atol_m"])
+    return [head, *(f"warning: {w}" for w in s.get("warnings", []))]
 
 
 def sweep_report(results: dict) -> list[str]:
     """Run time, error estimate and warnings of every finished run of a sweep ({label: summary}), a line each."""
     lines = []
     for k, s in sorted(results.items()):
-        if "error" not in s and "error_estimate" in s:
+        if "error" not in s and ("error_estimate" in s or s.get("mode") == "static"):
             first, *warns = run_report(s)
             lines += [f"  {k}: {first}", *(f"  {k}: {w}" for w in warns)]
     return lines
