@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 import mbd
-from mbd.static import SteadyMotion, _evaluator, solve_static
+from mbd.static import SteadyMotion, _evaluator, carry, solve_static
 
 from .outputs import WindowStatistics, cage_period
 
@@ -96,31 +96,24 @@ def snapshot_times(scene, n: int) -> np.ndarray:
 
 
 def solve_snapshots(scene, times, engine: str = "auto", system: mbd.System | None = None) -> list:
-    """Static solutions at ``times``; each starts from the previous one (the first from the kinematic pose
-    with the load brought in from zero)."""
+    """Static solutions at ``times``; each starts from the previous one carried over (:func:`mbd.static.carry`: the
+    rollers' displacements and spin rates by their angle in the load zone), the first from the kinematic pose."""
     m = scene.model
     system = system if system is not None else mbd.System(m)
     motion, hold, rates = steady_motion(scene), held_dofs(scene), rate_groups(scene)
     ev = _evaluator(system, engine)
-    # rollers have moved on along their orbits: only the other bodies' displacements carry over
-    f2f = m.full_to_free
-    orbiting = np.flatnonzero(motion.orbit != 0.0)
-    moved = np.concatenate([f2f[3 * orbiting], f2f[3 * orbiting + 1]])
-    out, q = [], None
+    out = []
     for t in times:
-        if q is not None:   # carry the solved displacement to the next instant's kinematic pose
-            dq = q - motion.at(m, out[-1].t)[0]
-            dq[moved] = 0.0
-            q = motion.at(m, float(t))[0] + dq
+        start = carry(m, motion, out[-1], float(t), rates) if out else (None, None)
         try:
-            sol = solve_static(m, motion, float(t), hold=hold, rates=rates, q_start=q, system=system, evaluator=ev)
+            sol = solve_static(m, motion, float(t), hold=hold, rates=rates, q_start=start[0], rates_start=start[1],
+                               system=system, evaluator=ev)
         except mbd.ModelError:
-            if q is None:
+            if not out:
                 raise
             # the previous instant's contacts can be a worse start than none: from the kinematic pose
             sol = solve_static(m, motion, float(t), hold=hold, rates=rates, system=system, evaluator=ev)
         out.append(sol)
-        q = sol.q
     return out
 
 

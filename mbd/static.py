@@ -42,7 +42,7 @@ from .assembly import System
 from .errors import ModelError
 from .model import Model
 
-__all__ = ["SteadyMotion", "StaticSolution", "solve_static"]
+__all__ = ["SteadyMotion", "StaticSolution", "carry", "solve_static"]
 
 _TRACE = bool(os.environ.get("MBD_STATIC_TRACE"))     # MBD_STATIC_TRACE=1: a line per continuation step (stdout)
 
@@ -132,14 +132,15 @@ class SteadyMotion:
 @dataclass
 class StaticSolution:
     """One static state at time ``t``: ``q``, ``v``, ``a`` on the free DOFs (the steady motion at q with the solved
-    rates), ``z`` the element internal states used, ``residual`` r with the held DOFs' reactions in it, the
-    continuation's ``steps`` and ``wall_s``."""
+    rates), ``z`` the element internal states used, ``residual`` r with the held DOFs' reactions in it, ``rates``
+    the solved rate changes (one per rate group), the continuation's ``steps`` and ``wall_s``."""
     t: float
     q: np.ndarray
     v: np.ndarray
     a: np.ndarray
     z: dict
     residual: np.ndarray
+    rates: np.ndarray
     steps: int
     wall_s: float
 
@@ -325,8 +326,9 @@ def _directions(model: Model, motion: SteadyMotion, t: float, held: np.ndarray, 
 
 
 def solve_static(model: Model, motion: SteadyMotion, t: float, *, hold=(), rates=(), tangential: bool = False,
-                 q_start: np.ndarray | None = None, z: dict | None = None, system: System | None = None,
-                 engine: str = "auto", evaluator=None, length_tol: float = 1e-11, rate_tol: float = 1e-6,
+                 q_start: np.ndarray | None = None, rates_start=None, z: dict | None = None,
+                 system: System | None = None, engine: str = "auto", evaluator=None, length_tol: float = 1e-11,
+                 rate_tol: float = 1e-6,
                  max_steps: int = 200, max_step: float = 2e-5, max_rate_step: float = 1e3,
                  regularization: float = 1e-12) -> StaticSolution:
     """The static state at time ``t`` (module docstring).
@@ -336,11 +338,18 @@ def solve_static(model: Model, motion: SteadyMotion, t: float, *, hold=(), rates
     body's angle is held. A group of one spinning orbiting body and nothing else is *local* (a roller's spin),
     solved with that body's radius inside every step. ``tangential``: orbiting bodies move along their circle
     (else they keep their place on it, carried by their host; their tangential force is then a reaction).
-    ``q_start``: a pose to start from (default the steady pose; the previous instant's solution continues a
-    sequence). ``z``: element internal states (default their initial values). Converged when every unknown's
+    ``q_start``, ``rates_start``: a pose and rate changes to start from (default the steady pose and rates; a
+    sequence of instants starts each from the last, :func:`carry`). ``z``: element internal states (default their initial values). Converged when every unknown's
     residual would move it less than its tolerance under its own stiffness — ``length_tol`` [m] (angles at
     their body's radius of gyration), ``rate_tol`` [rad/s]; ``max_step`` [m] and ``max_rate_step`` [rad/s] bound
     one step. One-line ModelError, naming the worst unknown, when it fails."""
+    with threadpool_limits(limits=1, user_api="blas"):     # dense systems of a few hundred: threads only contend
+        return _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, system, engine, evaluator,
+                      length_tol, rate_tol, max_steps, max_step, max_rate_step, regularization)
+
+
+def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, system, engine, evaluator, length_tol,
+           rate_tol, max_steps, max_step, max_rate_step, regularization) -> StaticSolution:
     t_wall = time.perf_counter()
     system = system if system is not None else System(model)
     evaluate = evaluator if evaluator is not None else _evaluator(system, engine)
@@ -355,9 +364,10 @@ def solve_static(model: Model, motion: SteadyMotion, t: float, *, hold=(), rates
     prob = _Problem(system, evaluate, motion, t, B, rates, z)
     nB = B.shape[1]
     x = np.zeros(nB + len(rates))
-    if q_start is not None:     # the start's displacement along the non-local directions
-        x[:nB] = B.T @ (np.asarray(q_start, float) - prob.q_ref)
-        x[groups[groups >= 0]] = 0.0
+    if q_start is not None:     # the start's displacement along the solved directions (least squares: a host's
+        x[:nB] = np.linalg.lstsq(prob.Bd, np.asarray(q_start, float) - prob.q_ref, rcond=None)[0]   # columns carry guests)
+    if rates_start is not None:
+        x[nB:] = np.asarray(rates_start, float)
     own = -np.ones(model.n_bodies, np.int64)          # each orbiting body's own spin-rate group
     for j, (sb, ob) in enumerate(rates):
         if sb >= 0 and not ob and motion.orbit[sb] != 0.0:
@@ -368,14 +378,50 @@ def solve_static(model: Model, motion: SteadyMotion, t: float, *, hold=(), rates
     scale = np.asarray(abs(B).T @ gyr).ravel() / np.asarray(abs(B).sum(axis=0)).ravel()
     tol = np.concatenate([length_tol / scale, np.full(len(rates), rate_tol)])
     cap = np.concatenate([max_step / scale, np.full(len(rates), max_rate_step)])
-    with threadpool_limits(limits=1, user_api="blas"):     # dense systems of a few hundred: threads only contend
-        x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization)
+    x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization)
     if not ok:
         worst = int(np.argmax(np.abs(prob.residual(x)[0]) / np.maximum(prob.floor, 1e-300)))
         raise ModelError(f"solve_static: no static state at t = {t:.6g} s within {max_steps} steps (worst unknown: "
                          f"{prob.label(worst)}): a body without support, or a load no contact can carry?")
     q, v, a = prob.state(x)
-    return StaticSolution(float(t), q, v, a, z, prob.full_residual(x), steps, time.perf_counter() - t_wall)
+    return StaticSolution(float(t), q, v, a, z, prob.full_residual(x), x[nB:].copy(), steps, time.perf_counter() - t_wall)
+
+
+def carry(model: Model, motion: SteadyMotion, sol: StaticSolution, t: float, rates=()) -> tuple[np.ndarray, np.ndarray]:
+    """A start for time ``t`` from the solution ``sol`` of another instant: every displacement carried over, except
+    that orbiting bodies have moved along their circles — theirs (radial and tangential) are interpolated, as a
+    function of the angle on the circle, among the bodies sharing that circle's centre and rate (a bearing's
+    rollers: the load zone stays where it was); so are the rates of groups that spin one such body. Returns
+    (q_start, rates_start) for :func:`solve_static` with the same ``rates``."""
+    P0, P1 = motion.poses(sol.t), motion.poses(t)
+    X = np.zeros((model.n_bodies, 3))
+    X.ravel()[model.free] = sol.q
+    D = X - P0
+    D[model.fixed] = 0.0
+    orb = np.flatnonzero((motion.orbit != 0.0) & ~model.fixed)
+    rates = [(int(sb), list(ob)) for sb, ob in rates]
+    u = np.asarray(sol.rates, float).copy() if len(rates) else np.zeros(0)
+    own = {sb: j for j, (sb, ob) in enumerate(rates) if sb >= 0 and not ob}
+    key = np.round(np.column_stack([motion.centre[orb], motion.orbit[orb]]), 12)
+    for k in np.unique(key, axis=0):
+        grp = orb[np.all(key == k, axis=1)]
+        c = motion.centre[grp]
+        r0, r1 = P0[grp, :2] - c, P1[grp, :2] - c
+        a0, a1 = np.arctan2(r0[:, 1], r0[:, 0]), np.arctan2(r1[:, 1], r1[:, 0])
+        e0 = r0 / np.hypot(*r0.T)[:, None]
+        rad, tan = np.sum(D[grp, :2] * e0, axis=1), e0[:, 0] * D[grp, 1] - e0[:, 1] * D[grp, 0]
+        order = np.argsort(a0)
+        per = lambda v: np.interp(a1, a0[order], v[order], period=2 * np.pi)
+        e1 = r1 / np.hypot(*r1.T)[:, None]
+        rr, tt = per(rad), per(tan)
+        D[grp, 0], D[grp, 1] = rr * e1[:, 0] - tt * e1[:, 1], rr * e1[:, 1] + tt * e1[:, 0]
+        idx = [own.get(int(b), -1) for b in grp]
+        if all(i >= 0 for i in idx):
+            u[idx] = per(u[idx])
+    return (P1 + D).ravel()[model.free], u
+
+
+
 
 
 def _bracketed(x, dx, g, lo, hi, cap):
