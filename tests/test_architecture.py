@@ -155,6 +155,34 @@ def test_parameter_choices_name_the_registered_laws():
     assert choices(BearingParams, "traction_law") == set(TRACTION_LAWS)
 
 
+def test_the_parameter_package_is_entered_through_components_params():
+    """Parameters are used through ``components.params`` (its __init__ re-exports every public name); its modules,
+    the machinery above all, are the package's own business (issue 27 §4)."""
+    graph = import_graph()
+    assert {"components.params._machinery", "components.params.machine"} <= set(graph)
+    inner = {(mod, d) for mod, deps in graph.items() if not mod.startswith("components.params")
+             for d in deps if d.startswith("components.params.")}
+    assert not inner, sorted(inner)
+
+
+def test_every_si_class_is_written_out_next_to_its_parameter_class():
+    """No SI class is made at run time (a type checker would not see it): each is a class statement in its
+    parameter class's module, declaring every field (issue 27 §4; tests/test_params_typing.py runs mypy)."""
+    import components.params as P
+
+    def subclasses(cls):
+        for sub in cls.__subclasses__():
+            yield sub
+            yield from subclasses(sub)
+
+    for cls in [*subclasses(P.Params), P.DPGTOperatingSI, P.DPGTSupportSI]:
+        si = cls.SI if issubclass(cls, P.Params) else cls
+        src = inspect.getsource(si)
+        assert si.__module__ == cls.__module__ and src.lstrip("@").split("\n")[1].startswith(f"class {si.__name__}(")
+        own = si.__dict__["__annotations__"]
+        assert own and all(re.search(rf"^    {n}: ", src, re.M) for n in own), si.__name__
+
+
 def test_scene_handles_are_typed():
     """A DPGT's pairs and bearings are frozen dataclasses (attributes, not string keys)."""
     import dataclasses as dc
