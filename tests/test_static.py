@@ -135,3 +135,23 @@ def test_bad_input_is_refused_in_one_line():
     motion = SteadyMotion.from_state(model, q0, np.zeros(3), np.zeros(1))
     with pytest.raises(mbd.ModelError, match=r"no static state .*\(worst unknown: b\.x\)"):
         solve_static(model, motion, 0.0, max_steps=30)       # a force and nothing to hold the body
+
+
+def test_the_paper_study_in_static_mode(tmp_path):
+    """--mode static: each run's summary.json says so and lists what it leaves out, there is no results.nc, the
+    comparison has the static quantities only, and the reverse inner planet bearing carries more than forward
+    (the load path's sign, as the dynamic study finds it)."""
+    import csv
+    import json
+
+    from scenarios import paper_study
+    assert paper_study.main(["--mode", "static", "--snapshots", "4", "--conditions", "3", "--out", str(tmp_path),
+                             "--no-progress"]) == 0
+    s = json.loads((tmp_path / "c3_reverse" / "summary.json").read_text())
+    assert s["mode"] == "static" and s["snapshots"] == 4 and "cage_slip_pct" in s["omitted"]
+    assert not (tmp_path / "c3_reverse" / "results.nc").exists()
+    rows = list(csv.DictReader((tmp_path / "comparison.csv").open()))
+    quantities = {r["quantity"] for r in rows}
+    assert "bearing_load_mean_N" in quantities and "cage_slip_pct" not in quantities
+    inner = next(r for r in rows if r["bearing"] == "inner" and r["quantity"] == "bearing_load_mean_N")
+    assert float(inner["reverse"]) > 1.2 * float(inner["forward"])
