@@ -330,7 +330,7 @@ def solve_static(model: Model, motion: SteadyMotion, t: float, *, hold=(), rates
                  system: System | None = None, engine: str = "auto", evaluator=None, length_tol: float = 1e-11,
                  rate_tol: float = 1e-6,
                  max_steps: int = 200, max_step: float = 2e-5, max_rate_step: float = 1e3,
-                 regularization: float = 1e-12) -> StaticSolution:
+                 regularization: float = 1e-12, force_rtol: float = 1e-8) -> StaticSolution:
     """The static state at time ``t`` (module docstring).
 
     ``hold``: free-DOF indices kept at their steady values (equations dropped). ``rates``: rate groups, each
@@ -339,17 +339,19 @@ def solve_static(model: Model, motion: SteadyMotion, t: float, *, hold=(), rates
     solved with that body's radius inside every step. ``tangential``: orbiting bodies move along their circle
     (else they keep their place on it, carried by their host; their tangential force is then a reaction).
     ``q_start``, ``rates_start``: a pose and rate changes to start from (default the steady pose and rates; a
-    sequence of instants starts each from the last, :func:`carry`). ``z``: element internal states (default their initial values). Converged when every unknown's
-    residual would move it less than its tolerance under its own stiffness — ``length_tol`` [m] (angles at
-    their body's radius of gyration), ``rate_tol`` [rad/s]; ``max_step`` [m] and ``max_rate_step`` [rad/s] bound
+    sequence of instants starts each from the last, :func:`carry`). ``z``: element internal states (default
+    their initial values). Converged when every unknown's residual would move it less than its tolerance under
+    its own stiffness — ``length_tol`` [m] (angles at their body's radius of gyration), ``rate_tol`` [rad/s] — or
+    is below ``force_rtol`` of the largest force balanced at the start (at its length scale: a body floating in
+    a clearance keeps a round-off force and no stiffness); ``max_step`` [m] and ``max_rate_step`` [rad/s] bound
     one step. One-line ModelError, naming the worst unknown, when it fails."""
     with threadpool_limits(limits=1, user_api="blas"):     # dense systems of a few hundred: threads only contend
         return _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, system, engine, evaluator,
-                      length_tol, rate_tol, max_steps, max_step, max_rate_step, regularization)
+                      length_tol, rate_tol, max_steps, max_step, max_rate_step, regularization, force_rtol)
 
 
 def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, system, engine, evaluator, length_tol,
-           rate_tol, max_steps, max_step, max_rate_step, regularization) -> StaticSolution:
+           rate_tol, max_steps, max_step, max_rate_step, regularization, force_rtol) -> StaticSolution:
     t_wall = time.perf_counter()
     system = system if system is not None else System(model)
     evaluate = evaluator if evaluator is not None else _evaluator(system, engine)
@@ -378,6 +380,11 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
     scale = np.asarray(abs(B).T @ gyr).ravel() / np.asarray(abs(B).sum(axis=0)).ravel()
     tol = np.concatenate([length_tol / scale, np.full(len(rates), rate_tol)])
     cap = np.concatenate([max_step / scale, np.full(len(rates), max_rate_step)])
+    # a force no displacement resolves: a fraction force_rtol of the largest force being balanced at the start, at
+    # each unknown's length scale (a body floating in a clearance carries a round-off residual and no stiffness)
+    g0 = np.abs(prob.residual(x)[0][:nB])
+    prob.force_floor = np.concatenate([force_rtol * float(g0.max(initial=0.0)) * scale,
+                                       np.zeros(len(rates))])
     x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization)
     if not ok:
         worst = int(np.argmax(np.abs(prob.residual(x)[0]) / np.maximum(prob.floor, 1e-300)))
@@ -468,7 +475,8 @@ def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarr
             Kl[:, :, j] = np.where(present[:, j, None], -(gp - gl) / h[:, None], 0.0)
             Kl[~present[:, j], j, j] = 1.0
         diag = np.diagonal(Kl, axis1=1, axis2=2)
-        floor = (np.abs(diag) + prob.mu_min * prob.M[idx]) * prob.tol[idx]      # each unknown's own stiffness
+        # each unknown's own stiffness times its tolerance, or the force floor
+        floor = np.maximum((np.abs(diag) + prob.mu_min * prob.M[idx]) * prob.tol[idx], prob.force_floor[idx])
         # settled: below its floor, or bracketed by sign changes within its tolerance (a force that jumps at a
         # contact's onset — the compression-rate damping of a contact whose races are not concentric — has no
         # exact root: the body rests at the jump)
@@ -513,12 +521,12 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
     g, K = prob.residual(x, jac=True)
     mu_min = regularization * float(np.max(np.abs(np.diagonal(K)) / M))
     prob.mu_min, prob.tol = mu_min, tol
-    prob.floor = (np.abs(np.diagonal(K)) + mu_min * M) * tol
+    prob.floor = np.maximum((np.abs(np.diagonal(K)) + mu_min * M) * tol, prob.force_floor)
     x, g, local_ok = _local_solve(prob, x, local, cap)
     g, K = prob.residual(x, jac=True)
     mu = max(float(np.max(np.abs(g[outer]) / (Mo * cap[outer]))), mu_min)
     for k in range(max_steps + 1):
-        prob.floor = (np.abs(np.diagonal(K)) + mu_min * M) * tol
+        prob.floor = np.maximum((np.abs(np.diagonal(K)) + mu_min * M) * tol, prob.force_floor)
         if np.all(np.abs(g[outer]) <= prob.floor[outer]) and local_ok:
             return x, k, True
         if k == max_steps:
