@@ -96,15 +96,36 @@ class ModelBuilder:
             raise ModelError(f"body {name!r}: mass must be > 0 kg, got {mass!r}")
         if not (np.isfinite(inertia) and inertia > 0):
             raise ModelError(f"body {name!r}: polar inertia must be > 0 kg*m^2, got {inertia!r}")
-        pose = np.asarray(pose, dtype=float)
-        if pose.shape != (3,) or not np.all(np.isfinite(pose)):
-            raise ModelError(f"body {name!r}: pose must be finite (x [m], y [m], theta [rad]), got {pose!r}")
+        pose = _checked_pose(name, pose)
         self._names.append(name)
         self._mass.append(float(mass))
         self._inertia.append(float(inertia))
         self._fixed.append(bool(fixed))
         self._pose.append(pose)
         return BodyRef(len(self._names) - 1, name)
+
+    def set_pose(self, index: int, pose) -> None:
+        """Change body ``index``'s nominal pose (x, y, θ) in the fixed frame at t = 0 before :meth:`build`
+        (e.g. a ring turned to mate with its planets)."""
+        if not (isinstance(index, (int, np.integer)) and 0 <= index < len(self._names)):
+            raise ModelError(f"body index must be an integer in [0, {len(self._names)}), got {index!r}")
+        self._pose[index] = _checked_pose(self._names[index], pose).copy()
+
+    def pose(self, index: int) -> np.ndarray:
+        """Body ``index``'s nominal pose (x, y, θ) in the fixed frame at t = 0 (a copy)."""
+        return self._pose[index].copy()
+
+    def poses(self) -> np.ndarray:
+        """(nb, 3) nominal poses in the fixed frame at t = 0, in body order."""
+        return np.array(self._pose).reshape(-1, 3)
+
+    def masses(self) -> np.ndarray:
+        """(nb,) body masses [kg], in body order."""
+        return np.array(self._mass)
+
+    def inertias(self) -> np.ndarray:
+        """(nb,) polar moments of inertia [kg·m²], in body order."""
+        return np.array(self._inertia)
 
     def add(self, element):
         if any(e.name == element.name for e in self._elements):
@@ -235,6 +256,13 @@ class Model:
 
     def poses(self, q_full: np.ndarray) -> np.ndarray:
         return q_full.reshape(-1, 3)
+
+
+def _checked_pose(name: str, pose) -> np.ndarray:
+    pose = np.asarray(pose, dtype=float)
+    if pose.shape != (3,) or not np.all(np.isfinite(pose)):
+        raise ModelError(f"body {name!r}: pose must be finite (x [m], y [m], theta [rad]), got {pose!r}")
+    return pose
 
 
 def to_reference(pose_I: np.ndarray, vel_I: np.ndarray, fs: FrameState):
