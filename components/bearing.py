@@ -159,17 +159,16 @@ def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel,
     scene.body(cage, c.mass, c.inertia, pose=(*pin_xy, 0.0), vel=(*pin_vel, wm), fixed=held)
     law = IMPACT_LAWS[c.impact_law]()
     pocket = scene.family(FAMILY["pocket"], PocketContact, ("roller", "cage"), impact_law=law)
-    handles = {}
-    handles["pocket"] = pocket.add(Z, roller=names, cage=[cage] * Z, pocket_angle=psi, pitch_radius=0.5 * b.pitch_diameter,
-                             clearance=c.pocket_clearance, K_p=c.pocket_stiffness, restitution=c.restitution,
-                             v_min=c.impact_speed_floor, mu=c.pocket_friction, v_mu=c.friction_speed, D=D,
-                             multiplicity=b.rows)
+    pockets = pocket.add(Z, roller=names, cage=[cage] * Z, pocket_angle=psi, pitch_radius=0.5 * b.pitch_diameter,
+                         clearance=c.pocket_clearance, K_p=c.pocket_stiffness, restitution=c.restitution,
+                         v_min=c.impact_speed_floor, mu=c.pocket_friction, v_mu=c.friction_speed, D=D,
+                         multiplicity=b.rows)
+    guides = None                 # a held cage has no guide land
     if not held:
         guide = scene.family(FAMILY["guide"], GuideContact, ("cage", "planet"), impact_law=law,
                              land=_land(c, lubricant))
-        handles["guide"] = guide.add(1, cage=[cage], planet=[outer_body], clearance=c.guide_clearance,
-                               K_g=c.guide_stiffness, restitution=c.restitution, v_min=c.impact_speed_floor,
-                               mu=c.guide_friction, v_mu=c.friction_speed,
-                               land_radius=0.5 * (b.pitch_diameter + D))
-    handles["cage"] = cage
-    return handles
+        guides = guide.add(1, cage=[cage], planet=[outer_body], clearance=c.guide_clearance,
+                           K_g=c.guide_stiffness, restitution=c.restitution, v_min=c.impact_speed_floor,
+                           mu=c.guide_friction, v_mu=c.friction_speed,
+                           land_radius=0.5 * (b.pitch_diameter + D))
+    return {"pocket": pockets, "guide": guides, "cage": cage}

@@ -19,17 +19,17 @@ from .bearing import BearingHandles, add_planet_bearing
 from .gears import add_mesh_family
 from .geometry import check_design, loaded_flanks
 from .families import FAMILY, MESH_FAMILY
-from .params import CarrierRippleParams, DPGTParams
+from .params import BearingSI, CarrierRippleParams, DPGTParams, LubricantSI
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError
 
-__all__ = ["build_dpgt", "PairHandles", "carrier_ripple"]
+__all__ = ["build_dpgt", "DPGTScene", "PlanetBearingScene", "Speeds", "PairHandles", "carrier_ripple"]
 
 
 @dataclass(frozen=True)
 class PairHandles:
     """One planet pair of the DPGT: the planets' body names, their angles ψ on the carrier [rad] and
-    what their bearings added (``scene.handles["pairs"]`` holds one per pair)."""
+    what their bearings added (:attr:`PlanetBearingScene.pairs` holds one per pair)."""
     inner: str
     outer: str
     psi_a: float
@@ -43,6 +43,64 @@ class PairHandles:
 
     def bearing(self, kind: str) -> BearingHandles:
         return self.inner_bearing if kind == "inner" else self.outer_bearing
+
+
+@dataclass(frozen=True)
+class Speeds:
+    """The kinematic steady state's absolute spin speeds [rad/s] (fixed frame; reverse rotation: all negative)."""
+    sun: float
+    inner_planet: float
+    outer_planet: float
+    carrier: float
+
+    def planet(self, kind: str) -> float:
+        """The inner or outer planet's speed."""
+        if kind not in ("inner", "outer"):
+            raise ValueError(f"planet kind must be 'inner' or 'outer', got {kind!r}")
+        return self.inner_planet if kind == "inner" else self.outer_planet
+
+    def to_dict(self) -> dict[str, float]:
+        return {"sun": self.sun, "inner_planet": self.inner_planet, "outer_planet": self.outer_planet,
+                "carrier": self.carrier}
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class PlanetBearingScene(BuiltScene):
+    """Planet bearings on a carrier, what the statistics and results read (:mod:`components.outputs`,
+    :mod:`components.results_schema`, :mod:`components.static`): the DPGT, or a rig of planet bearings."""
+    pairs: tuple[PairHandles, ...]
+    speeds: Speeds
+    bearing: BearingSI
+    lubricant: LubricantSI | None         # None: no film statistics or outputs
+    flanks: dict[str, int]                # loaded flank (+1/−1) per mesh type (:data:`MESH_FAMILY` keys); {} without meshes
+    sun_torque: float                     # [N·m]; 0: the train transmits no torque (no nominal mesh load)
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class DPGTScene(PlanetBearingScene):
+    """The built DPGT (:func:`build_dpgt`) with what its runner, statistics and studies read."""
+    options: SceneOptions                 # the resolved switches the scene was built with
+    direction: str                        # "forward" | "reverse"
+    f_m: float                            # mesh frequency [Hz]
+    f_c: float                            # carrier rotation frequency |f_c| [Hz]
+    carrier_torque: float                 # [N·m]
+    ramp: float                           # duration of the sun torque's ramp [s]
+    ring_mismatch: tuple[float, ...]      # planets' ring-mesh phase mismatch [teeth]
+
+    @property
+    def planets(self) -> int:
+        return len(self.pairs)
+
+    @property
+    def rollers(self) -> int:
+        return int(self.bearing.rollers)
+
+    def run_metadata(self) -> dict:
+        """What results.nc keeps as its ``meta`` attribute (JSON; read back by :mod:`viz.results`)."""
+        return {"speeds_rad_s": self.speeds.to_dict(), "f_c_hz": self.f_c, "f_m_hz": self.f_m,
+                "sun_torque_Nm": self.sun_torque, "carrier_torque_Nm": self.carrier_torque, "ramp_s": self.ramp,
+                "ring_mismatch_teeth": list(self.ring_mismatch), "planets": self.planets, "rollers": self.rollers,
+                "direction": self.direction, "frame": self.options.frame, "bearings": self.options.bearings}
 
 
 def _bearing_damage(si, planet: str, psi: float) -> dict:
@@ -63,7 +121,7 @@ def carrier_ripple(ripple, wc: float) -> list[tuple[float, float, float]] | None
     return [(k * wc, getattr(ripple, f"amplitude_{k}"), getattr(ripple, f"phase_{k}")) for k in orders] or None
 
 
-def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: bool = True) -> BuiltScene:
+def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: bool = True) -> DPGTScene:
     """Build the DPGT scene. Design errors raise ParameterError; design warnings are issued."""
     opt = (options or SceneOptions()).resolved()
     if opt.cage == "held":   # a cage fixed to the carrier would need a joint the engine does not have
@@ -138,12 +196,7 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     scene.add_element(SpeedDrive("carrier_drive", scene.index["carrier"], wc, k=J_eff * wd**2,
                                  c=2 * rig.carrier_drive_damping_ratio * J_eff * wd, k_i=J_eff * wd**3 / 5,
                                  ripple=carrier_ripple(rig.carrier_ripple, wc)))
-    scene.handles.update({"pairs": tuple(pairs), "flanks": flanks})
-    scene.meta.update({
-        "speeds_rad_s": {"sun": speed["sun"], "inner_planet": speed["a"], "outer_planet": speed["b"], "carrier": wc},
-        "f_c_hz": abs(op.carrier_frequency), "f_m_hz": f_m, "sun_torque_Nm": T_s, "carrier_torque_Nm": op.carrier_torque,
-        "ramp_s": ramp_t, "ring_mismatch_teeth": [float(x) for x in ph.ring_mismatch], "planets": N,
-        "rollers": b.rollers, "direction": op.direction, "frame": opt.frame, "bearings": opt.bearings, "bearing": b,
-        "lubricant": si.lubricant,
-    })
-    return scene.build()
+    return scene.build(DPGTScene, pairs=tuple(pairs), flanks=flanks, lubricant=si.lubricant, bearing=b, options=opt,
+                       speeds=Speeds(sun=speed["sun"], inner_planet=speed["a"], outer_planet=speed["b"], carrier=wc),
+                       f_c=abs(op.carrier_frequency), f_m=f_m, sun_torque=T_s, carrier_torque=op.carrier_torque,
+                       ramp=ramp_t, ring_mismatch=tuple(float(x) for x in ph.ring_mismatch), direction=op.direction)

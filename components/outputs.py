@@ -53,7 +53,7 @@ def bearing_map(scene) -> list[dict]:
     """Per bearing: name, kind (inner/outer), pair index, planet, cage, and the instance ranges of the
     roller families (all rollers of all bearings share one family each, in bearing order)."""
     out = []
-    for n, pair in enumerate(scene.handles["pairs"]):
+    for n, pair in enumerate(scene.pairs):
         for kind in ("inner", "outer"):
             h, planet = pair.bearing(kind), pair.planet(kind)
             rec = {"name": f"{planet}.pb", "kind": kind, "pair": n, "planet": planet, "type": h.kind}
@@ -262,7 +262,7 @@ class BearingSeries:
         idx = lambda name: model.body(name).index
         self.planet = np.array([idx(b["planet"]) for b in self.bmap])
         self.carrier = idx("carrier")
-        self.rows = int(getattr(scene.meta["bearing"], "rows", 1))
+        self.rows = int(scene.bearing.rows)
         self.rollers = self.bmap[0]["type"] == "rollers"
         if self.rollers:
             self.roller_bearing = np.concatenate([np.full(b["race_inner"][1] - b["race_inner"][0], i)
@@ -270,7 +270,7 @@ class BearingSeries:
         else:
             self.spring = np.array([b["spring"] for b in self.bmap])
         self.cage = np.array([idx(b["cage"]) for b in self.bmap]) if self.rollers and "cage" in self.bmap[0] else None
-        bs = scene.meta["bearing"]
+        bs = scene.bearing
         Ri, Ro = 0.5 * (bs.pitch_diameter - bs.roller_diameter), 0.5 * (bs.pitch_diameter + bs.roller_diameter)
         self.pitch_ratio = Ro / (Ri + Ro)
         self.names = tuple(b["name"] for b in self.bmap)
@@ -333,9 +333,8 @@ class WindowStatistics(mbd.Observer):
     point of the load zone. Run the simulation to :attr:`t_end` (t1 plus a margin for the slip); a cage
     that slips more than the margin ends at the run's end and is reported with whole_revolutions false.
 
-    ``scene``: a built scene with handles["pairs"] (see :func:`bearing_map`), meta["speeds_rad_s"]
-    ["carrier"] (the carrier frame's speed), meta["bearing"] (:class:`~components.params.BearingSI`) and handles["flanks"]
-    (the loaded flank of each mesh type). After the run, :meth:`summary` gives the numbers.
+    ``scene``: a :class:`~components.dpgt.PlanetBearingScene` (its pairs, see :func:`bearing_map`; speeds; bearing;
+    lubricant; the loaded flank of each mesh type; the sun torque). After the run, :meth:`summary` gives the numbers.
     """
 
     MARGIN = 0.05      # extra run time for slipping cages, as a fraction of the window
@@ -346,22 +345,22 @@ class WindowStatistics(mbd.Observer):
         self.t0, self.t1 = float(t0), float(t1)
         self.scene = scene
         self.bmap = bearing_map(scene)
-        sp = scene.meta["speeds_rad_s"]
-        self.omega_c = float(sp["carrier"])
-        self.flanks = dict(scene.handles.get("flanks", {}))
+        sp = scene.speeds
+        self.omega_c = float(sp.carrier)
+        self.flanks = dict(scene.flanks)
         rollers = self.bmap[0]["type"] == "rollers" and "cage" in self.bmap[0]
         self.target = None
         if whole_revolutions and rollers:
-            b = scene.meta["bearing"]
-            T = {k: cage_period(b, self.omega_c, sp[f"{k}_planet"]) for k in ("inner", "outer")}
+            b = scene.bearing
+            T = {k: cage_period(b, self.omega_c, sp.planet(k)) for k in ("inner", "outer")}
             revs = np.array([(self.t1 - self.t0) / T[x["kind"]] for x in self.bmap])
             if np.all(np.isfinite(revs)) and np.all(revs >= 0.5):
                 self.target = np.maximum(np.round(revs), 1.0)
         self.t_end = self.t1 + (self.MARGIN * (self.t1 - self.t0) if self.target is not None else 0.0)
-        self._lubricant = scene.meta.get("lubricant")       # None: no film statistics (e.g. the bearing rig)
-        self._qc = raceway_ratings(scene.meta["bearing"])    # (pin, bore) roller contact ratings [N]
+        self._lubricant = scene.lubricant       # None: no film statistics (e.g. the bearing rig)
+        self._qc = raceway_ratings(scene.bearing)    # (pin, bore) roller contact ratings [N]
         # the planet's speed relative to its pin, per bearing kind: the revolutions a life counts
-        self._w_rel = {k: float(sp[f"{k}_planet"]) - self.omega_c for k in ("inner", "outer")}
+        self._w_rel = {k: float(sp.planet(k)) - self.omega_c for k in ("inner", "outer")}
 
     # setup -------------------------------------------------------------------------------------
     def bind(self, model, system, state) -> None:
@@ -370,7 +369,7 @@ class WindowStatistics(mbd.Observer):
         bm = self.bmap
         idx = lambda name: model.body(name).index
         rollers = bm[0]["type"] == "rollers"
-        b = self.scene.meta["bearing"]
+        b = self.scene.bearing
         Ri, Ro = 0.5 * (b.pitch_diameter - b.roller_diameter), 0.5 * (b.pitch_diameter + b.roller_diameter)
         cage = np.array([idx(x["cage"]) for x in bm]) if rollers and "cage" in bm[0] else None
         rb = np.concatenate([np.full(x["race_inner"][1] - x["race_inner"][0], i) for i, x in enumerate(bm)]) \
@@ -508,7 +507,7 @@ class WindowStatistics(mbd.Observer):
         and without the thermal reduction, the thermal loading L of the contact with the thinnest film, the
         largest L and load parameter W' of any, and the smallest h_c/h_min (< 1: Pan & Hamrock's fit beyond
         its range); NaN where no roller is loaded."""
-        b, lub = self.scene.meta["bearing"], self._lubricant
+        b, lub = self.scene.bearing, self._lubricant
         films = [contact_film(race, b, lub, inner) for race, inner in ((race_inner, True), (race_outer, False))]
         f = {k: np.concatenate([x[k] for x in films], axis=-1) for k in films[0]}
         loaded = ~np.isnan(f["film_min"])
@@ -772,7 +771,7 @@ class WindowStatistics(mbd.Observer):
         """ISO 281 L10 from the bearing load and the ISO/TS 16281-style L10 from the roller loads
         (:mod:`components.life`), in 10^6 revolutions of the planet relative to its pin and in hours at the
         nominal relative speed: pair 1's bearing, and in ``all_rollers`` every bearing of this kind pooled."""
-        p, b, w = self.plan, self.scene.meta["bearing"], self._w_rel[kind]
+        p, b, w = self.plan, self.scene.bearing, self._w_rel[kind]
         d["dynamic_load_rating_N"] = iso281_rating(b)
         cases = [(d, np.array([ref]))]
         if p.rollers:
@@ -869,7 +868,7 @@ class WindowStatistics(mbd.Observer):
             f, x = self.stats(f"{key}_drive_force"), self.stats(f"{key}_drive_deflection")
             te = x["max"] - x["min"]
             # K_v has no meaning where the train transmits no torque (condition 4): no nominal load to scale
-            loaded = self.scene.meta.get("sun_torque_Nm", 1.0) != 0.0
+            loaded = self.scene.sun_torque != 0.0
             kv = f["max"] / np.where(loaded & (f["mean"] > 0), f["mean"], np.nan)
             d["te_peak_to_peak_m"] = float(te.max())
             d["te_peak_to_peak_per_pair_m"] = [float(y) for y in te]

@@ -60,7 +60,7 @@ from .units import ParameterError, quantity, to_si
 from .names import did_you_mean
 
 __all__ = ["EXAMPLE_PLANETARY", "MemberSpec", "PlanetarySpec", "planetary_spec", "load_planetary_toml",
-           "build_single_planetary", "modal_state", "planetary_modes", "classify_modes", "PlanetaryModes",
+           "build_single_planetary", "PlanetaryScene", "modal_state", "planetary_modes", "classify_modes", "PlanetaryModes",
            "CENTRAL"]
 
 CENTRAL = ("sun", "ring", "carrier")
@@ -225,15 +225,27 @@ def load_planetary_toml(path, overrides: Mapping | None = None) -> PlanetarySpec
     return planetary_spec(data, overrides)
 
 
+@dataclass(frozen=True, eq=False, kw_only=True)
+class PlanetaryScene(BuiltScene):
+    """The built single planetary set (:func:`build_single_planetary`)."""
+    spec: PlanetarySpec
+    planets: tuple[str, ...]              # planet body names
+    psi: np.ndarray                       # (N,) planet angles on the carrier [rad]
+    torque_sign: int                      # sign of the sun torque: the loaded flank (+1/−1) of both mesh types
+    base_radius_sun: float                # [m]
+    base_radius_planet: float             # [m]
+    base_radius_ring: float               # [m]
+
+
 def build_single_planetary(spec: Mapping | PlanetarySpec = EXAMPLE_PLANETARY, *, overrides: Mapping | None = None,
-                           torque_sign: int = 1) -> BuiltScene:
+                           torque_sign: int = 1) -> PlanetaryScene:
     """Build the set at rest (inertial frame, no gravity, no drives). ``spec``: the TOML-format mapping
     (or a PlanetarySpec); ``overrides``: dotted keys, e.g. {"planets": 5, "ring.torsional_stiffness":
-    "0 N*m/rad"}; ``torque_sign``: sign of the sun torque that decides the loaded flanks (meta["flanks"]).
+    "0 N*m/rad"}; ``torque_sign``: sign of the sun torque that decides the loaded flanks.
 
     Warns (DesignWarning) when (z_sun + z_ring)/N is not an integer (equally spaced planets would not
     assemble; with constant mesh stiffness the model is unaffected) or adjacent planets' tip circles
-    overlap. handles: "planets" (names), "psi" (planet angles)."""
+    overlap. Returns a :class:`PlanetaryScene`."""
     s = planetary_spec(spec, overrides)
     if torque_sign not in (1, -1):
         raise ParameterError.at("torque_sign", f"expected +1 or -1, got {torque_sign!r}")
@@ -276,22 +288,20 @@ def build_single_planetary(spec: Mapping | PlanetarySpec = EXAMPLE_PLANETARY, *,
     rp.add(N, gear1=names, gear2=["ring"] * N, rb1=rbp, rb2=rbr, alpha=s.pressure_angle, a0=r["ring"] - r["planet"],
            teeth1=s.z_planet, k_mean=s.k_ring_planet, c_mesh=c_rp, u0=mesh_u0(True, rbp, rbr, planet_poses, zero),
            backlash=0.0, phi_ref=psi)
-    scene.handles.update({"planets": names, "psi": psi})
-    scene.meta.update({"spec": s, "flanks": {"sun_planet": torque_sign, "ring_planet": torque_sign},
-                       "base_radii": {"sun": rbs, "planet": rbp, "ring": rbr}})
-    return scene.build()
+    return scene.build(PlanetaryScene, spec=s, planets=tuple(names), psi=psi, torque_sign=torque_sign,
+                       base_radius_sun=rbs, base_radius_planet=rbp, base_radius_ring=rbr)
 
 
-def modal_state(built: BuiltScene, preload: float = 1e-9) -> tuple[np.ndarray, np.ndarray]:
+def modal_state(built: PlanetaryScene, preload: float = 1e-9) -> tuple[np.ndarray, np.ndarray]:
     """(q, v) at which every mesh is compressed by ``preload`` [m] on its loaded flank (module docstring):
     the nominal state with the sun turned by f_sp·ε/r_b,sun and the ring by f_rp·ε/r_b,ring."""
     if not (np.isfinite(preload) and preload > 0):
         raise ParameterError.at("preload", f"must be > 0 m, got {preload!r}")
     m = built.model
-    f, rb = built.meta["flanks"], built.meta["base_radii"]
+    f = built.torque_sign
     qf, _ = m.full(0.0, built.q0, built.v0)
-    qf[3 * m.body("sun").index + 2] += f["sun_planet"] * preload / rb["sun"]
-    qf[3 * m.body("ring").index + 2] += f["ring_planet"] * preload / rb["ring"]
+    qf[3 * m.body("sun").index + 2] += f * preload / built.base_radius_sun
+    qf[3 * m.body("ring").index + 2] += f * preload / built.base_radius_ring
     return qf[m.free].copy(), np.zeros(m.ndof)
 
 
@@ -357,7 +367,7 @@ def classify_modes(model: mbd.Model, frequencies_hz, shapes, tol: float = 1e-6, 
     return PlanetaryModes(f, X, tuple(kind), tuple(groups), trans, rot)
 
 
-def planetary_modes(built: BuiltScene, preload: float = 1e-9, **classify_kw) -> PlanetaryModes:
+def planetary_modes(built: PlanetaryScene, preload: float = 1e-9, **classify_kw) -> PlanetaryModes:
     """Undamped modes about :func:`modal_state`, classified (:func:`classify_modes`)."""
     q, v = modal_state(built, preload)
     res = mbd.modal_analysis(built.model, 0.0, q, v)

@@ -6,7 +6,7 @@
 * :data:`FILM_OUTPUTS` — the EHL film of every roller–raceway contact, recorded along the raceway
   families when the scene has a lubricant (computed by :func:`components.outputs.contact_film`).
 * :func:`instance_coords` — per family, which bearing / roller / planet / mesh each instance is
-  (from ``scene.handles["pairs"]`` and :func:`components.outputs.bearing_map`).
+  (from ``scene.pairs`` and :func:`components.outputs.bearing_map`).
 * :func:`element_probes` — the :class:`mbd.ElementOutput` probes carrying both.
 * :func:`drawing_geometry` — the gears' and bearings' drawing geometry, stored as the file's ``geometry``.
 
@@ -114,7 +114,7 @@ def instance_coords(scene) -> dict[str, dict[str, tuple[str, list]]]:
                 put(FAMILY["guide"], b["guide"], instance=f"{b['name']}.cage", **base)
         else:
             put(FAMILY["linear"], b["spring"], instance=b["name"], **base)
-    for n, pair in enumerate(scene.handles["pairs"]):
+    for n, pair in enumerate(scene.pairs):
         gears = {"sun_inner": ("sun", pair.inner), "inner_outer": (pair.inner, pair.outer),
                  "outer_ring": (pair.outer, "ring")}
         for key, (g1, g2) in gears.items():
@@ -148,13 +148,13 @@ def loaded_transmission_error(outputs, flank: int) -> dict:
 
 def element_probes(scene) -> list[ElementOutput]:
     """The element outputs the runner records: every family of :data:`OUTPUTS` the scene has, with
-    units, long names and instance coordinates; with a lubricant (``scene.meta["lubricant"]``), the
+    units, long names and instance coordinates; with a lubricant (``scene.lubricant``), the
     raceway families' film (:data:`FILM_OUTPUTS`) as well; for every mesh its loaded transmission error
-    (:func:`loaded_transmission_error`, from the flank ``scene.handles["flanks"]`` says the torque loads)."""
+    (:func:`loaded_transmission_error`, from the flank ``scene.flanks`` says the torque loads)."""
     fams = {e.name for e in scene.model.elements}
     coords = instance_coords(scene)
-    lub = scene.meta.get("lubricant")
-    flanks = {MESH_FAMILY[k]: f for k, f in scene.handles.get("flanks", {}).items()}
+    lub = scene.lubricant
+    flanks = {MESH_FAMILY[k]: f for k, f in scene.flanks.items()}
     probes = []
     for f, meta in OUTPUTS.items():
         if f not in fams:
@@ -163,7 +163,7 @@ def element_probes(scene) -> list[ElementOutput]:
         if lub is not None and f in FILM_OUTPUTS:
             inner, film = FILM_OUTPUTS[f]
             meta = {**meta, **film}
-            derived = partial(contact_film, bearing=scene.meta["bearing"], lubricant=lub, inner=inner)
+            derived = partial(contact_film, bearing=scene.bearing, lubricant=lub, inner=inner)
         if f in flanks:
             meta = {**meta, "transmission_error": (
                 "m", f"{MESH_WORDS[f]} loaded transmission error: compression of the drive flank (flank "

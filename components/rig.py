@@ -26,14 +26,14 @@ import mbd
 from mbd.ad import wrap_angle
 from mbd.elements import ForceSource, GroundSupport, Ramp, SpeedDrive
 
-from .bearing import add_planet_bearing
+from .bearing import BearingHandles, add_planet_bearing
 from .families import FAMILY
 from .outputs import pin_reactions
 from .params import BearingParams, BearingRigParams, BearingRigSI, BearingSI, LubricantParams, LubricantSI
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError
 
-__all__ = ["build_bearing_rig", "rig_options", "run_sampled", "rig_loads", "RigSolution",
+__all__ = ["build_bearing_rig", "BearingRigScene", "rig_options", "run_sampled", "rig_loads", "RigSolution",
            "rig_static_solution", "discrete_load_distribution", "DiscreteDistribution"]
 
 
@@ -116,9 +116,28 @@ def discrete_load_distribution(b: BearingSI, radial_load: float, angles=None) ->
 # ----------------------------------------------------------------------------------------------
 # the scene
 # ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False, kw_only=True)
+class BearingRigScene(BuiltScene):
+    """The built bearing rig (:func:`build_bearing_rig`)."""
+    bearing_handles: BearingHandles       # what :func:`~components.bearing.add_planet_bearing` added
+    ring: str                             # the outer ring's body name
+    pin: str                              # the fixed pin's body name
+    bearing: BearingSI
+    options: SceneOptions                 # the resolved switches the rig was built with
+    radial_load: float                    # F_r [N]
+    load_angle: float                     # direction of the load on the ring [rad, fixed frame]
+    zone_angle: float                     # direction of the load-zone centre [rad]
+    outer_speed: float                    # the ring's spin [rad/s]
+    ramp: float                           # duration of the load ramp [s]
+    period: float                         # period of the ring's radial mode on the loaded bearing [s]
+    t_settle: float                       # a suggested start of the averaging window [s]
+    radial_stiffness: float               # dF/dδ_r of the classical solution [N/m] (0 unloaded)
+    reference: DiscreteDistribution | None    # the classical load distribution (None unloaded)
+
+
 def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 * np.pi, outer_speed: float = 0.0,
                       options: SceneOptions | None = None, lubricant=None,
-                      rig: BearingRigParams | None = None) -> BuiltScene:
+                      rig: BearingRigParams | None = None) -> BearingRigScene:
     """A bearing between a fixed pin and a loaded outer ring (SI arguments).
 
     ``bearing``: :class:`~components.params.BearingParams` or its SI object (``.si()``); ``lubricant`` a
@@ -135,9 +154,7 @@ def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 *
     from the ring to ground with ``rig.settle_damping_ratio`` of that mode's critical damping lets it
     settle (the Hertz contacts alone damp the ring very little).
 
-    meta: radial_load, load_angle, zone_angle (direction of the load-zone centre), ramp_s, t_settle_s
-    (a suggested start of the averaging window), period_s (the ring mode), cage, bearing (BearingSI).
-    handles: "bearing" (from add_planet_bearing), "ring", "pin".
+    Returns a :class:`BearingRigScene`.
     """
     b, lub, rs = _rig_inputs(bearing, lubricant, rig)
     _check_bearing(b)
@@ -167,11 +184,9 @@ def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 *
     c_settle = 2.0 * rs.settle_damping_ratio * np.sqrt(k_r * rs.ring_mass)
     if c_settle > 0:
         scene.add_element(GroundSupport("ring_damper", [scene.index["ring"]], kx=0.0, cx=c_settle))
-    scene.handles.update({"bearing": h, "ring": "ring", "pin": "pin"})
-    scene.meta.update({"radial_load": F, "load_angle": a, "zone_angle": a + np.pi, "outer_speed": w,
-                       "ramp_s": ramp, "period_s": period, "t_settle_s": ramp + 10.0 * period,
-                       "radial_stiffness": k_r, "cage": opt.cage, "bearing": b, "reference": ref})
-    return scene.build()
+    return scene.build(BearingRigScene, bearing_handles=h, ring="ring", pin="pin", bearing=b, options=opt,
+                       radial_load=F, load_angle=a, zone_angle=a + np.pi, outer_speed=w, ramp=ramp, period=period,
+                       t_settle=ramp + 10.0 * period, radial_stiffness=k_r, reference=ref)
 
 
 def rig_options(options: SceneOptions | None, has_lubricant: bool) -> SceneOptions:
@@ -277,7 +292,7 @@ def run_sampled(model: mbd.Model, q0, v0, times, *, controller, stepper: mbd.HHT
     return out
 
 
-def rig_loads(built: BuiltScene, system: mbd.System, s: mbd.State) -> dict:
+def rig_loads(built: BearingRigScene, system: mbd.System, s: mbd.State) -> dict:
     """Instantaneous roller loads of the rig at state ``s``: inner- and outer-raceway loads (Z,) [N],
     roller angles from the load-zone centre (Z,) [rad], the ring centre (2,) [m], and the vector sums
     (2,) [N, fixed frame] of the inner normal loads pressing the pin, Σ Q_j·(−e_j), and of the whole
@@ -285,17 +300,17 @@ def rig_loads(built: BuiltScene, system: mbd.System, s: mbd.State) -> dict:
     roller; the sums count every row."""
     m = built.model
     out = system.outputs(s.t, s.q, s.v, s.z)
-    h = built.handles["bearing"]
+    h = built.bearing_handles
     si, so = h.race_inner, h.race_outer
     inner, outer = out[FAMILY["race_inner"]], out[FAMILY["race_outer"]]
     ang = inner["angle"][si]                            # about the pin (fixed, θ = 0): fixed-frame angle
     e = np.column_stack([np.cos(ang), np.sin(ang)])
     qf, _ = m.full(s.t, s.q, s.v)
-    ring = qf[3 * m.body("ring").index: 3 * m.body("ring").index + 2]
+    ring = qf[3 * m.body(built.ring).index: 3 * m.body(built.ring).index + 2]
     Qi, Qo = inner["load"][si], outer["load"][so]
-    rows = built.meta["bearing"].rows
+    rows = built.bearing.rows
     return {
-        "t": s.t, "angle": wrap_angle(ang - built.meta["zone_angle"]), "load_inner": Qi, "load_outer": Qo,
+        "t": s.t, "angle": wrap_angle(ang - built.zone_angle), "load_inner": Qi, "load_outer": Qo,
         "ring": ring.copy(),
         "load_sum": -rows * (Qi[:, None] * e).sum(axis=0),
         "pin_force": pin_reactions(inner, si, np.zeros(si.stop - si.start, int), 1, rows)[0],
@@ -347,20 +362,19 @@ class RigSolution:
                 "deflection_um": self.deflection * 1e6, "load_sum_N": self.load_sum.tolist(), "wall_s": self.wall_s}
 
 
-def rig_static_solution(built: BuiltScene, *, t_settle: float | None = None, window: float | None = None,
+def rig_static_solution(built: BearingRigScene, *, t_settle: float | None = None, window: float | None = None,
                         samples: int = 40, controller=None, stepper: mbd.HHT | None = None,
                         zone_tol: float = 1e-3) -> RigSolution:
     """Run the rig built by :func:`build_bearing_rig` past the load ramp and average over a window.
 
-    Defaults: t_settle = meta["t_settle_s"], window = 10 periods of the ring's radial mode, ``samples``
+    Defaults: t_settle = ``built.t_settle``, window = 10 periods of the ring's radial mode, ``samples``
     equally spaced samples in it; ``controller`` Adaptive (h0 = 1 µs, h_max = period/20)."""
     import time
-    meta = built.meta
-    F, a, Z = meta["radial_load"], meta["load_angle"], meta["bearing"].rollers
-    t_settle = meta["t_settle_s"] if t_settle is None else float(t_settle)
-    window = 10.0 * meta["period_s"] if window is None else float(window)
+    F, a, Z = built.radial_load, built.load_angle, built.bearing.rollers
+    t_settle = built.t_settle if t_settle is None else float(t_settle)
+    window = 10.0 * built.period if window is None else float(window)
     if controller is None:
-        controller = mbd.Adaptive(h0=1e-6, h_max=meta["period_s"] / 20.0)
+        controller = mbd.Adaptive(h0=1e-6, h_max=built.period / 20.0)
     times = t_settle + window * np.arange(samples) / max(samples - 1, 1)
     system = mbd.System(built.model)
     w0 = time.perf_counter()
@@ -396,8 +410,8 @@ def rig_static_solution(built: BuiltScene, *, t_settle: float | None = None, win
     mean = lambda key: np.array([r[key] for r in recs]).mean(axis=0)
     return RigSolution(t0=float(times[0]), t1=float(times[-1]), samples=n, angles=angles, loads=loads,
                        loads_outer=loads_o, q_max=q_max,
-                       stribeck=q_max * Z * meta["bearing"].rows / F if F > 0 else float("nan"),
-                       zone_angle=zone, zone_angle_continuous=_zone_angle(defl, meta["bearing"].clearance),
+                       stribeck=q_max * Z * built.bearing.rows / F if F > 0 else float("nan"),
+                       zone_angle=zone, zone_angle_continuous=_zone_angle(defl, built.bearing.clearance),
                        deflection=defl, sideways=side, load_sum=mean("load_sum"), pin_force=mean("pin_force"),
                        ring_force=mean("ring_force"), radial_load=F, load_vector=F * u, wall_s=wall,
                        zone_tol=zone_tol, steps=steps, error_rms=err_rms,

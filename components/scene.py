@@ -8,8 +8,8 @@ A scene contains only what its components added: nothing unused is built or eval
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
-from typing import Any, ClassVar
+from dataclasses import dataclass, fields
+from typing import ClassVar, TypeVar
 
 import numpy as np
 
@@ -108,18 +108,20 @@ class FamilyCollector:
         return self.cls(self.name, **{b: cat.pop(b) for b in self.body_args}, **cat, **self.common)
 
 
-@dataclass
+@dataclass(frozen=True, eq=False, kw_only=True)
 class BuiltScene:
-    """A built model with its initial state (free DOFs, in R) and handles for outputs."""
+    """A built model with its initial state (free DOFs, in R). A scene builder returns a subclass whose
+    typed fields carry what its outputs need (:class:`components.dpgt.DPGTScene`,
+    :class:`components.rig.BearingRigScene`, :class:`components.planetary.PlanetaryScene`)."""
     model: mbd.Model
     q0: np.ndarray
     v0: np.ndarray
-    handles: dict = field(default_factory=dict)
-    meta: dict = field(default_factory=dict)
-    probes: list = field(default_factory=list)
 
     def body_index(self, name: str) -> int:
         return self.model.body(name).index
+
+
+S = TypeVar("S", bound=BuiltScene)
 
 
 class Scene:
@@ -128,38 +130,31 @@ class Scene:
         frame = mbd.Frame.rotating(frame_omega) if frame_omega != 0.0 else mbd.Frame.inertial()
         self.mb = mbd.ModelBuilder(frame=frame, gravity=(0.0, -gravity))
         self.frame_omega = frame_omega
-        self._pose: list[np.ndarray] = []
-        self._vel: list[np.ndarray] = []
+        self._vel: list[np.ndarray] = []           # initial velocities in I (the builder keeps the poses)
         self.index: dict[str, int] = {}
         self.families: dict[str, FamilyCollector] = {}
-        self.handles: dict[str, Any] = {}
-        self.meta: dict[str, Any] = {}
-        self.probes: list = []
         self._direct: list = []
 
     def body(self, name, mass, inertia, pose=(0.0, 0.0, 0.0), vel=(0.0, 0.0, 0.0), fixed=False) -> int:
         """Add a body with its initial pose and velocity in the fixed frame; returns its index."""
         ref = self.mb.add_body(name, mass, inertia, pose=pose, fixed=fixed)
         self.index[name] = ref.index
-        self._pose.append(np.asarray(pose, float))
         self._vel.append(np.zeros(3) if fixed else np.asarray(vel, float))
         return ref.index
 
     def pose(self, name: str) -> np.ndarray:
-        return self._pose[self.index[name]].copy()
+        return self.mb.pose(self.index[name])
 
     def set_pose(self, name: str, pose) -> None:
         """Change a body's initial pose in the fixed frame before the scene is built (e.g. a ring
         turned to mate with its planets). Its nominal pose in the model follows."""
-        i = self.index[name]
-        self._pose[i] = np.asarray(pose, float)
-        self.mb._pose[i] = self._pose[i].copy()
+        self.mb.set_pose(self.index[name], pose)
 
     def kinematic_inertia(self, speed: float) -> float:
         """2T/speed² [kg·m²] for initial velocities that all scale with ``speed`` (e.g. the carrier's in
         a ring-fixed train): the inertia a drive of that member sees. Velocities are divided by the speed
         before squaring, so tiny speeds do not underflow."""
-        m, J = np.array(self.mb._mass), np.array(self.mb._inertia)
+        m, J = self.mb.masses(), self.mb.inertias()
         u = np.array(self._vel) / speed
         return float(np.sum(m * (u[:, 0] ** 2 + u[:, 1] ** 2) + J * u[:, 2] ** 2))
 
@@ -173,7 +168,9 @@ class Scene:
         """A ready-made element family (e.g. one drive)."""
         self._direct.append(element)
 
-    def build(self) -> BuiltScene:
+    def build(self, kind: type[S] = BuiltScene, **fields) -> S:
+        """Freeze the model; returns ``kind`` (a :class:`BuiltScene` type) with the initial state and
+        ``fields``, the scene type's own (what its outputs read)."""
         for fam in self.families.values():
             if fam.n:
                 self.mb.add(fam.make(self.index))
@@ -181,7 +178,6 @@ class Scene:
             self.mb.add(e)
         model = self.mb.build()
         fs = model.frame.at(0.0)
-        q, v = to_reference(np.array(self._pose), np.array(self._vel), fs)
+        q, v = to_reference(self.mb.poses(), np.array(self._vel), fs)
         qf, vf = q.ravel(), v.ravel()
-        return BuiltScene(model, qf[model.free].copy(), vf[model.free].copy(), dict(self.handles),
-                          dict(self.meta), list(self.probes))
+        return kind(model=model, q0=qf[model.free].copy(), v0=vf[model.free].copy(), **fields)

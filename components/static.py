@@ -33,7 +33,7 @@ DYNAMIC_ONLY = ("cage_", "pocket_", "guide_", "heat_land", "whole_revolutions", 
 
 
 def _rollers(scene):
-    for pair in scene.handles["pairs"]:
+    for pair in scene.pairs:
         for kind in ("inner", "outer"):
             h = pair.bearing(kind)
             if h.kind == "rollers":
@@ -80,12 +80,10 @@ def snapshot_times(scene, n: int) -> np.ndarray:
     apart (the golden ratio), so no mesh or roller phase repeats before the others are visited."""
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise mbd.ModelError(f"snapshots must be an integer >= 1, got {n!r}")
-    meta = scene.meta
-    sp = meta["speeds_rad_s"]
-    b = meta["bearing"]
-    T = max((cage_period(b, sp["carrier"], sp[f"{k}_planet"]) for k in ("inner", "outer")), default=math.inf)
-    f_m = meta.get("f_m_hz", 0.0)
-    t0 = float(meta.get("ramp_s", 0.0))
+    sp, b = scene.speeds, scene.bearing
+    T = max((cage_period(b, sp.carrier, sp.planet(k)) for k in ("inner", "outer")), default=math.inf)
+    f_m = scene.f_m
+    t0 = float(scene.ramp)
     if not np.isfinite(T):
         T = 1.0 / f_m if f_m > 0 else 1.0
     k = np.arange(n)

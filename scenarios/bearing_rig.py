@@ -85,7 +85,7 @@ def run(a) -> dict:
         built = build_bearing_rig(params.bearing, lubricant=None if a.no_drag else params.lubricant, radial_load=F,
                                   outer_speed=w, options=SceneOptions(cage=a.cage, drag=not a.no_drag, gravity=False))
     sol = rig_static_solution(built)
-    b = built.meta["bearing"]
+    b = built.bearing
     theory = discrete_load_distribution(b, F)
     order = np.argsort(sol.angles)
     summary = {

@@ -43,7 +43,7 @@ __all__ = ["Problem", "dpgt_problem", "rig_problem", "settled_state", "StateSamp
 @dataclass
 class Problem:
     name: str
-    built: object                 # components.scene.BuiltScene
+    built: object                 # components.dpgt.DPGTScene or components.rig.BearingRigScene
     race_inner: slice             # instances of the reference bearing in the race_inner family
     roller: int                   # reference roller (race_inner instance index)
     guide: int | None             # guide-family instance of the reference cage
@@ -68,11 +68,11 @@ def dpgt_problem(condition: int = 3, direction: str = "forward", overrides: dict
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # design warnings (tip overlap, N not assemblable) are known
         sc = build_dpgt(params, options, strict=strict)
-    h = sc.handles["pairs"][0].inner_bearing
+    h = sc.pairs[0].inner_bearing
     if h.kind != "rollers":
         raise mbd.ModelError("the numerics scenarios need the roller bearing model")
     return Problem("dpgt", sc, h.race_inner, h.race_inner.start, h.guide.start if h.guide is not None else None,
-                   h.cage, sc.handles["pairs"][0].inner, settle, {"params": params})
+                   h.cage, sc.pairs[0].inner, settle, {"params": params})
 
 
 def rig_problem(radial_load: float = 5000.0, overrides: dict | None = None, outer_speed: float | None = None) -> Problem:
@@ -86,9 +86,9 @@ def rig_problem(radial_load: float = 5000.0, overrides: dict | None = None, oute
         outer_speed = op.inner_planet_speed - op.carrier_speed
     sc = build_bearing_rig(params.bearing, radial_load=radial_load, outer_speed=outer_speed,
                            lubricant=params.lubricant)
-    h = sc.handles["bearing"]
-    return Problem("rig", sc, h.race_inner, h.race_inner.start, h.guide.start, h.cage, "ring",
-                   float(sc.meta["t_settle_s"]), {"params": params, "outer_speed": outer_speed})
+    h = sc.bearing_handles
+    return Problem("rig", sc, h.race_inner, h.race_inner.start, h.guide.start, h.cage, sc.ring,
+                   float(sc.t_settle), {"params": params, "outer_speed": outer_speed})
 
 
 # ----------------------------------------------------------------------------------------------
@@ -321,7 +321,7 @@ def observables(prob: Problem, grid, q, v, z) -> dict[str, np.ndarray]:
     ic = m.body(prob.cage).index if prob.cage else None
     ip = m.body(prob.planet).index
     sl = prob.race_inner
-    rows = prob.built.meta["bearing"].rows
+    rows = prob.built.bearing.rows
     out = {k: [] for k in ("pin_load", "inner_load", "guide_force", "cage_acc_x", "cage_acc_y")}
     for t, qi, vi, zi in zip(grid, q, v, z):
         o = system.outputs(t, qi, vi, zi)

@@ -134,13 +134,13 @@ class RunConfig:
 def statistics_window(scene, base: float = 0.02) -> float:
     """Default window [s]: at least ``base`` and one carrier revolution, rounded up to whole revolutions
     of the slowest cage relative to the carrier (docs/model.md §13.3)."""
-    sp, b = scene.meta["speeds_rad_s"], scene.meta["bearing"]
-    wc = sp["carrier"]
+    sp, b = scene.speeds, scene.bearing
+    wc = sp.carrier
     if wc != 0.0:
         base = max(base, 2 * np.pi / abs(wc))
-    if scene.meta.get("bearings", "rollers") != "rollers":
+    if scene.options.bearings != "rollers":
         return base
-    return default_window(base, [cage_period(b, wc, sp[k]) for k in ("inner_planet", "outer_planet")])
+    return default_window(base, [cage_period(b, wc, sp.planet(k)) for k in ("inner", "outer")])
 
 
 def _probes(scene, sensor: bool = False) -> list:
@@ -215,7 +215,6 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
         scene = build_dpgt(params, cfg.options)
     bmap = bearing_map(scene)
-    meta = {k: v for k, v in scene.meta.items() if k not in ("bearing", "lubricant")}   # SI objects, not JSON
     window = cfg.window if cfg.window is not None else statistics_window(scene)
     stats = WindowStatistics(scene, cfg.settle, cfg.settle + window)
     sensor = {"sensor": params.si().rig.sensor.to_dict()} if cfg.sensor else {}
@@ -223,7 +222,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
                    attrs={"Conventions": "CF-1.10",
                           "title": f"DPGT run: carrier {params.si().operating.carrier_speed * 30 / np.pi:.0f} r/min, "
                                    f"{params.si().operating.output_power / 1e3:.0f} kW, {params.si().operating.direction}",
-                          "bearings": bmap, "meta": meta, "label": label or {},
+                          "bearings": bmap, "meta": scene.run_metadata(), "label": label or {},
                           "geometry": drawing_geometry(params), **sensor})
     integ = cfg.integration
     t_end = stats.t_end          # the window plus a margin for slipping cages (WindowStatistics)
@@ -254,7 +253,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     summary["samples"] = int(rec.next_index)      # recorded (for plots); the statistics use every step
     summary.update(label or {})
     summary.update({
-        "warnings": (accuracy_warnings(integ, res.error_rms) + statistics_warnings(summary, scene.meta, cfg.settle)
+        "warnings": (accuracy_warnings(integ, res.error_rms) + statistics_warnings(summary, scene.ramp, cfg.settle)
                      + validity_warnings(params.si(), summary)),
         "wall_s": wall, "steps": res.steps, "rejected_steps": res.counters["rejected"],
         "newton_per_step": res.counters["newton"] / max(res.steps, 1),
@@ -295,12 +294,13 @@ def accuracy_warnings(integ: mbd.IntegratorSettings, error_rms: float) -> list[s
 SETTLED_SPEED_ERROR_PCT = 0.1     # the carrier drive counts as settled within 0.1 % of its speed (README: --settle)
 
 
-def statistics_warnings(summary: dict, meta: dict, settle: float) -> list[str]:
+def statistics_warnings(summary: dict, ramp: float, settle: float) -> list[str]:
     """Statistics that cannot mean anything, said instead of reported silently: a bearing whose cage turned less
     than once relative to the carrier in the window (its rollers have not all passed the load zone: per-revolution
     counts, roller and cage statistics depend on where the window started), a carrier drive not settled in the
     window (its speed off by more than 0.1 % on average: the 80 runs of the gear-quality study, real teeth shaking
-    it by up to 1.3 %, averaged ≤ 0.06 % after the default 30 ms), a load ramp that ends inside the window."""
+    it by up to 1.3 %, averaged ≤ 0.06 % after the default 30 ms), a load ramp (``ramp`` [s]) that ends inside
+    the window."""
     out = []
     for kind in ("inner", "outer"):
         d = summary.get(kind, {})
@@ -314,7 +314,6 @@ def statistics_warnings(summary: dict, meta: dict, settle: float) -> list[str]:
     if err is not None and abs(err) > SETTLED_SPEED_ERROR_PCT:
         out.append(f"the carrier drive had not settled: its speed is off by {err:+.2g} % on average over the window "
                    f"(more than {SETTLED_SPEED_ERROR_PCT:g} %); a longer --settle than {settle:g} s discards the transient")
-    ramp = meta.get("ramp_s", 0.0)
     if ramp > settle:
         out.append(f"the sun-torque ramp ({ramp:.3g} s) ends inside the window (settle {settle:g} s): the statistics "
                    "include the load rising")
@@ -391,7 +390,7 @@ def _run_info(params: DPGTParams, scene, stats: WindowStatistics) -> dict:
         "sun_rpm": op.sun_speed * 30 / np.pi, "power_W": float(op.output_power),
         "planets": int(si.gears.planets), "rollers": int(si.bearing.rollers), "rows": int(si.bearing.rows),
         "backlash_m": {k: m.backlash for k, m in si.layout.meshes.items()},
-        "f_m_hz": scene.meta["f_m_hz"], "f_c_hz": scene.meta["f_c_hz"],
+        "f_m_hz": scene.f_m, "f_c_hz": scene.f_c,
         "statistics": "time-weighted over every accepted step in the window (trapezoid); max over the steps; "
                       "radial/tangential in the carrier frame (radial: carrier axis -> planet centre)",
     }

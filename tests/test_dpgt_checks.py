@@ -105,17 +105,17 @@ def rigid_state(bs, tau):
     """The kinematic steady state rigidly advanced by time tau, as free (q, v) in R: every gear turns
     at its nominal speed, the planets orbit with the carrier, the ring stands still."""
     m = bs.model
-    sp = bs.meta["speeds_rad_s"]
-    w = {"sun": sp["sun"], "carrier": sp["carrier"], "ring": 0.0}
+    sp = bs.speeds
+    w = {"sun": sp.sun, "carrier": sp.carrier, "ring": 0.0}
     P = m.pose0.copy()
     V = np.zeros_like(P)
-    wc = sp["carrier"]
+    wc = sp.carrier
     c, s = math.cos(wc * tau), math.sin(wc * tau)
     for i, name in enumerate(m.body_names):
         if name in w:
             spin = w[name]
         else:   # a planet a_n / b_n (linear bearings: no roller bodies)
-            spin = sp["inner_planet"] if name.startswith("a") else sp["outer_planet"]
+            spin = sp.inner_planet if name.startswith("a") else sp.outer_planet
             x, y = P[i, 0], P[i, 1]
             P[i, :2] = (c * x - s * y, s * x + c * y)
             V[i, :2] = (-wc * P[i, 1], wc * P[i, 0])
@@ -130,7 +130,7 @@ def rigid_state(bs, tau):
 def test_rigid_epicyclic_rolling_has_zero_mesh_deflection_and_rate(frame, speed, direction):
     bs = build(params(3, direction, {"operating.carrier_speed": speed}), bearings="linear", frame=frame)
     sysm = mbd.System(bs.model)
-    pitch_speed = abs(bs.meta["speeds_rad_s"]["sun"]) * 0.0465
+    pitch_speed = abs(bs.speeds.sun) * 0.0465
     for tau in (0.0, 3.7e-4, 1.33e-2):      # 13.3 ms: the planets have orbited past φ_e = ±π in I
         q, v = rigid_state(bs, tau)
         if tau == 0.0:
@@ -160,7 +160,7 @@ def test_scene_meshes_balance_and_jacobian_matches_finite_differences():
     q, v = rigid_state(bs, t)
     # twist the gear train so that every mesh is compressed on its loaded flank (sun by 3 µm and ring by
     # 3 µm of base-circle arc, inner planets by 1 µm), then add small random motions of every DOF
-    f = bs.handles["flanks"]
+    f = bs.flanks
     lay = params(3).si().layout
     twist = {"sun": f["sun_inner"] * 3e-6 / lay.meshes["sun_inner"].base_radius1,
              "ring": f["outer_ring"] * 3e-6 / lay.meshes["outer_ring"].base_radius2,
@@ -206,7 +206,7 @@ def polygon_terms(bs):
     W = m.frame.omega
     drag = m.element("drag")
     rows = []
-    for n, pair in enumerate(bs.handles["pairs"]):
+    for n, pair in enumerate(bs.pairs):
         for key in ("inner", "outer"):
             h = pair.bearing(key)
             bodies = np.array([m.body(x).index for x in (pair.planet(key), *h.rollers, h.cage)])
@@ -279,7 +279,7 @@ def test_quasi_static_force_polygon(polygons, direction):
     and the momentum stays bounded: P ≈ mesh + m r Ω² (§6.3; measured ≤ 1.8e-3 of P over this 3 ms window,
     where the mesh is 11–43 % of P; tolerance 3e-3). The carrier runs 3.4e-4 below its reference speed."""
     bs, rows, mean, dmom, w_c = polygons[direction]
-    b = bs.meta["bearing"]
+    b = bs.bearing
     W = bs.model.frame.omega
     assert w_c == pytest.approx(W, rel=1e-3)                  # the carrier runs at the reference speed
     m_s = bs.model.mass[bs.model.body("a1").index] + b.rollers * b.roller_mass + b.cage.mass
@@ -287,7 +287,7 @@ def test_quasi_static_force_polygon(polygons, direction):
     for k, (n, key, h, bodies, on) in enumerate(rows):
         pin, mesh, drag, frame = mean[k, 0:2], mean[k, 2:4], mean[k, 4:6], mean[k, 6:8]
         assert m_s == pytest.approx(bs.model.mass[bodies].sum(), rel=1e-12)
-        pair = bs.handles["pairs"][n]
+        pair = bs.pairs[n]
         psi = pair.psi_a if key == "inner" else pair.psi_b
         centrifugal = m_s * radius[key] * W * W * np.array([math.cos(psi), math.sin(psi)])
         P = np.linalg.norm(pin)
@@ -402,7 +402,7 @@ def _frame_differences(res):
         b_, s_, _ = res[frame]
         out = mbd.System(b_.model).outputs(s_.t, s_.q, s_.v, s_.z)["race_inner"]
         per = []
-        for pair in b_.handles["pairs"]:
+        for pair in b_.pairs:
             for key in ("inner", "outer"):
                 h = pair.bearing(key)
                 per.append(np.hypot(out["fx"][h.race_inner].sum(), out["fy"][h.race_inner].sum()))
@@ -455,8 +455,8 @@ def test_mirror_symmetry(bearings, t_end):
     zero = ZERO_BACKLASH if bearings == "rollers" else {}
     A = build(params(3, "forward", zero), bearings=bearings, gravity=False)
     B = build(params(3, "reverse", {"gears.handedness": 1, **zero}), bearings=bearings, gravity=False)
-    N, Z = A.meta["planets"], A.meta["rollers"]
-    assert A.handles["flanks"] == {k: -v for k, v in B.handles["flanks"].items()}
+    N, Z = A.planets, A.rollers
+    assert A.flanks == {k: -v for k, v in B.flanks.items()}
     ma, mb = A.model, B.model
     perm = np.array([mb.body(mirror_partner(n, N, Z)).index for n in ma.body_names])
     teeth = {"sun": 31, "ring": 82, "a": 24, "b": 24}
@@ -494,10 +494,10 @@ def test_mirror_symmetry(bearings, t_end):
         np.testing.assert_allclose(oa[fam]["fy"], -ob[fam]["fy"][pairs], atol=rel * scale)
         np.testing.assert_allclose(oa[fam]["stiffness"], ob[fam]["stiffness"][pairs], rtol=1e-7)
     if bearings == "rollers":   # bearing loads mirrored across the x axis
-        for n, pair in enumerate(A.handles["pairs"]):
+        for n, pair in enumerate(A.pairs):
             for key in ("inner", "outer"):
                 ha = pair.bearing(key).race_inner
-                hb = B.handles["pairs"][pairs[n]].bearing(key).race_inner
+                hb = B.pairs[pairs[n]].bearing(key).race_inner
                 fa = np.array([oa["race_inner"]["fx"][ha].sum(), oa["race_inner"]["fy"][ha].sum()])
                 fb = np.array([ob["race_inner"]["fx"][hb].sum(), -ob["race_inner"]["fy"][hb].sum()])
                 np.testing.assert_allclose(fa, fb, atol=rel * np.linalg.norm(fa) + 1e-6)

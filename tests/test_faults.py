@@ -246,7 +246,7 @@ def test_tooth_fault_weakens_its_mesh_once_per_revolution_of_its_gear(gear, toot
     smooth = p.si().mesh.smoothing_width
     assert abs(np.ptp(rel[low]) - mg.contact_ratio) < smooth + 0.02
     if gear == "b1":     # gear 1: the stretch is where geometry puts that tooth's pair, [−h, ε − h]
-        h = mg.entry_shift(dpgt_runs.build(p).handles["flanks"]["outer_ring"])
+        h = mg.entry_shift(dpgt_runs.build(p).flanks["outer_ring"])
         assert rel[low].min() > -h - smooth and rel[low].max() < mg.contact_ratio - h + smooth
 
 
@@ -258,7 +258,7 @@ def _bearing_history(overrides, window=0.01):
     rec = []
 
     def extra(bs, t0, t1):
-        pairs = bs.handles["pairs"]
+        pairs = bs.pairs
         b1, a1 = pairs[0].outer_bearing.race_inner, pairs[0].inner_bearing.race_inner
         fam = FAMILY["race_inner"]
 

@@ -52,14 +52,14 @@ def force_polygon(bs, stats, si):
     flank forces on its planet, each along its nominal line of action (drive and coast flank: the coast flanks
     carry the loss torque at no load), plus m r Ω² of planet, rollers and cage — the mesh part alone, and the
     radial unit vector."""
-    lay, m, b = si.layout, bs.model, bs.meta["bearing"]
+    lay, m, b = si.layout, bs.model, bs.bearing
     W = si.operating.carrier_speed
-    drive = bs.handles["flanks"]
+    drive = bs.flanks
     lr, lt = stats.stats("load_radial")["mean"], stats.stats("load_tangential")["mean"]
     carried = b.rollers * b.rows * b.roller_mass + b.cage.mass
     M = lay.meshes
     out = []
-    for n, pair in enumerate(bs.handles["pairs"]):
+    for n, pair in enumerate(bs.pairs):
         ca, cb = lay.centres_a[n], lay.centres_b[n]
         e = {"sun_inner": ca / np.linalg.norm(ca), "inner_outer": (cb - ca) / np.linalg.norm(cb - ca),
              "outer_ring": cb / np.linalg.norm(cb)}
@@ -154,7 +154,7 @@ def test_cage_slip_is_the_lag_behind_the_epicyclic_speed(full_load_reverse):
     6e-6 points at slips of 0.71 and 0.57 %; tolerance 1e-4). Inverted it would read ≈ −0.7 %."""
     bs, stats, (angles,), _ = full_load_reverse
     s = stats.summary()
-    b = bs.meta["bearing"]
+    b = bs.bearing
     t = np.array(angles.t)
     for kind, i in (("inner", 0), ("outer", 1)):
         d = s[kind]

@@ -1,6 +1,8 @@
 """The lubricant film of the roller contacts (components.lubrication, docs/model.md §9)."""
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
@@ -77,7 +79,7 @@ def loaded_state():
 
 
 def _snapshot(scene, state, lubricant):
-    scene.meta["lubricant"] = lubricant
+    scene = dataclasses.replace(scene, lubricant=lubricant)
     stats = WindowStatistics(scene, 0.001, 0.002, whole_revolutions=False)
     stats.bind(scene.model, mbd.System(scene.model), state)
     return stats.snapshot(state)
@@ -98,7 +100,7 @@ def test_the_thinnest_film_of_each_bearing_scales_with_the_oil(loaded_state):
     np.testing.assert_allclose(a["film_lambda"], a["film_thinnest"] / thin.roughness, rtol=1e-15)
     # the film of one contact by hand: the most loaded roller of bearing 0 on its pin
     out = mbd.System(sc.model).outputs(s.t, s.q, s.v, s.z)["race_inner"]
-    b0 = sc.meta["bearing"]
+    b0 = sc.bearing
     Z = b0.rollers
     j = int(np.argmax(out["load"][:Z]))
     R = roller_contact_radius(b0.roller_diameter, b0.inner_raceway_radius, True)
@@ -138,7 +140,7 @@ def test_heat_and_traction_coefficient_of_each_bearing(loaded_state):
     sc, s = loaded_state
     snap = _snapshot(sc, s, reference_dpgt(3, "forward").si().lubricant)
     out = mbd.System(sc.model).outputs(s.t, s.q, s.v, s.z)
-    Z = sc.meta["bearing"].rollers
+    Z = sc.bearing.rollers
     for k in range(len(snap["heat_traction"])):
         sl = slice(k * Z, (k + 1) * Z)
         by_hand = sum(np.sum(np.abs(out[f]["traction"][sl] * out[f]["slip_velocity"][sl]))
@@ -185,7 +187,7 @@ def test_the_film_of_every_contact_agrees_with_the_bearing_statistics(loaded_sta
     lub = reference_dpgt(3, "forward").si().lubricant
     snap = _snapshot(sc, s, lub)
     film = _race_film(sc, s)
-    b0 = sc.meta["bearing"]
+    b0 = sc.bearing
     nb, Z = len(snap["film_thinnest"]), b0.rollers
     for fam, o in film.items():
         assert o["film_min"].shape == o["film_central"].shape == o["film_lambda"].shape == (nb * Z,)
@@ -212,12 +214,7 @@ def test_the_film_of_every_contact_agrees_with_the_bearing_statistics(loaded_sta
 def test_no_film_is_recorded_without_a_lubricant(loaded_state):
     from components.results_schema import element_probes
     sc, _ = loaded_state
-    lub = sc.meta["lubricant"]
-    try:
-        sc.meta["lubricant"] = None
-        keys = {k for p in element_probes(sc) for k in p.keys}
-    finally:
-        sc.meta["lubricant"] = lub
+    keys = {k for p in element_probes(dataclasses.replace(sc, lubricant=None)) for k in p.keys}
     assert "load" in keys and not {k for k in keys if k.startswith("film_")}
 
 

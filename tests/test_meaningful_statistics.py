@@ -21,13 +21,13 @@ def _summary(revs=3.0, err=0.0, span=0.021):
 
 def test_statistics_warnings_at_their_thresholds():
     """One cage revolution, 0.1 % of mean speed error and a ramp ending at the settle are the limits."""
-    assert statistics_warnings(_summary(), {"ramp_s": 0.01}, 0.03) == []
-    assert statistics_warnings(_summary(revs=1.0, err=SETTLED_SPEED_ERROR_PCT), {"ramp_s": 0.03}, 0.03) == []
-    w = statistics_warnings(_summary(revs=0.25, span=0.005), {}, 0.03)
+    assert statistics_warnings(_summary(), 0.01, 0.03) == []
+    assert statistics_warnings(_summary(revs=1.0, err=SETTLED_SPEED_ERROR_PCT), 0.03, 0.03) == []
+    w = statistics_warnings(_summary(revs=0.25, span=0.005), 0.0, 0.03)
     assert len(w) == 2 and all("0.25 cage revolutions" in x and "0.02 s covers one" in x for x in w)
-    w = statistics_warnings(_summary(err=-0.15), {}, 0.002)
+    w = statistics_warnings(_summary(err=-0.15), 0.0, 0.002)
     assert w == [w[0]] and "-0.15 %" in w[0] and "--settle than 0.002 s" in w[0]
-    w = statistics_warnings(_summary(), {"ramp_s": 0.004}, 0.002)
+    w = statistics_warnings(_summary(), 0.004, 0.002)
     assert w == [w[0]] and "ramp (0.004 s) ends inside the window" in w[0]
 
 

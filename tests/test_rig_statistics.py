@@ -21,7 +21,7 @@ from scipy.integrate import quad
 import mbd
 from mbd.elements import ForceSource, GroundSupport, Ramp, SpeedDrive
 from components.bearing import add_planet_bearing, bearing_kinematics
-from components.dpgt import PairHandles
+from components.dpgt import PairHandles, PlanetBearingScene, Speeds
 from components.life import iso281_rating, raceway_ratings
 from components.outputs import WindowStatistics, cage_period
 from components.presets import reference_bearing, reference_bearing_rig
@@ -39,8 +39,9 @@ def bearing():
 
 
 def twin_rig(b, cage_speed=None):
-    """The two-ring rig (module docstring); ``cage_speed``: per ring a factor on the epicyclic cage speed at
-    which a speed drive (2000 Hz, integral term) holds that ring's cage, or None for free cages."""
+    """The two-ring rig (module docstring) and the time its rings have settled [s]; ``cage_speed``: per ring a
+    factor on the epicyclic cage speed at which a speed drive (2000 Hz, integral term) holds that ring's cage,
+    or None for free cages."""
     rs = reference_bearing_rig().si()
     scene = Scene(options=rig_options(SceneOptions(cage="free", drag=False), has_lubricant=False))
     scene.body("carrier", 1.0, 1.0, fixed=True)
@@ -54,29 +55,29 @@ def twin_rig(b, cage_speed=None):
         forces.append(F * np.array([math.cos(psi + beta), math.sin(psi + beta)]))
         # the single rig's mode, ramp and settling time for this load
         one = build_bearing_rig(b, radial_load=F, load_angle=psi + beta, outer_speed=w,
-                                options=SceneOptions(cage="free", drag=False)).meta
-        settle, ramp = max(settle, one["t_settle_s"]), max(ramp, one["ramp_s"])
+                                options=SceneOptions(cage="free", drag=False))
+        settle, ramp = max(settle, one.t_settle), max(ramp, one.ramp)
         wd = 2 * np.pi * 1000.0
         J = rs.ring_inertia
         scene.add_element(SpeedDrive(f"{name}_drive", rings[-1], w, k=J * wd**2, c=2 * 0.7 * J * wd, k_i=J * wd**3 / 5))
         scene.add_element(GroundSupport(f"{name}_settle", [rings[-1]], kx=0.0,
-                                        cx=2.0 * rs.settle_damping_ratio * math.sqrt(one["radial_stiffness"] * rs.ring_mass)))
+                                        cx=2.0 * rs.settle_damping_ratio * math.sqrt(one.radial_stiffness * rs.ring_mass)))
         if cage_speed is not None:
             wd, J = 2 * np.pi * 2000.0, b.cage.inertia
             wc = cage_speed[j] * bearing_kinematics(b, 0.0, w)[0]
             scene.add_element(SpeedDrive(f"{name}_cage_drive", scene.index[h.cage], wc, k=J * wd**2, c=2 * 0.7 * J * wd,
                                          k_i=J * wd**3 / 5))
     scene.add_element(ForceSource("load", rings, np.array(forces), ramp=Ramp(0.0, ramp)))
-    scene.handles["pairs"] = (PairHandles(RINGS[0][0], RINGS[1][0], RINGS[0][1], RINGS[1][1], *handles),)
-    scene.meta.update({"speeds_rad_s": {"carrier": 0.0, "inner_planet": RINGS[0][4], "outer_planet": RINGS[1][4]},
-                       "bearing": b, "t_settle_s": settle})
-    return scene.build()
+    pair = PairHandles(RINGS[0][0], RINGS[1][0], RINGS[0][1], RINGS[1][1], *handles)
+    # no sun, no meshes: its speed and torque are 0 (nothing reads them without meshes)
+    built = scene.build(PlanetBearingScene, pairs=(pair,), bearing=b, lubricant=None, flanks={}, sun_torque=0.0,
+                        speeds=Speeds(sun=0.0, inner_planet=RINGS[0][4], outer_planet=RINGS[1][4], carrier=0.0))
+    return built, settle
 
 
 def run(cage_speed=None):
     b = bearing()
-    bs = twin_rig(b, cage_speed)
-    t0 = bs.meta["t_settle_s"]
+    bs, t0 = twin_rig(b, cage_speed)
     stats = WindowStatistics(bs, t0, t0 + cage_period(b, 0.0, W))
     p = mbd.PRODUCTION
     mbd.simulate(bs.model, bs.q0, bs.v0, stats.t_end, stepper=p.stepper(), controller=p.controller(), progress=False,
@@ -120,7 +121,7 @@ def test_run_level_life_is_the_closed_form_roller_orbit_life(free, kind):
     instead of 4.5 moves the pin's load by 3.5 % and the life by ≈ 10 %. ISO 281's: the bearing load's
     equivalent is F_r (a constant load; measured 5e-8) and its life (C_r/F_r)^(10/3) (2e-7)."""
     bs, stats, s = free
-    b = bs.meta["bearing"]
+    b = bs.bearing
     d = s[kind]
     _, _, F, _, w = RINGS[0 if kind == "inner" else 1]
     q_pin, q_bore, life = closed_form(b, F, w)
@@ -143,7 +144,7 @@ def test_roller_load_rms_and_max_over_one_orbit(free, kind):
     its maximum Q_max (+ F_c) of the continuous zone (Z = 12 discrete rollers: measured −2.7e-4; tolerance
     1e-3) and its mean Q_max mean cos₊^n ψ (5.2e-4; tolerance 1e-3)."""
     bs, stats, s = free
-    b = bs.meta["bearing"]
+    b = bs.bearing
     d = s[kind]
     _, _, F, _, w = RINGS[0 if kind == "inner" else 1]
     n = b.contact_exponent
@@ -184,7 +185,7 @@ def test_free_cage_turns_at_the_epicyclic_speed(free):
     closes its revolution after 2π/ω_m, ω_m = bearing_kinematics(pin 0, ring ±300 rad/s) (measured 2e-15;
     tolerance 1e-6), and the slip is nil (measured < 1e-5 %; tolerance 1e-4 %)."""
     bs, stats, s = free
-    b = bs.meta["bearing"]
+    b = bs.bearing
     for kind, (_, _, _, _, w) in zip(("inner", "outer"), RINGS):
         d = s[kind]
         w_m = bearing_kinematics(b, 0.0, w)[0]

@@ -60,9 +60,9 @@ def held_rig_solutions():
 @pytest.mark.parametrize("clearance", ["0 um", "20 um", "40 um"])
 def test_rig_matches_the_classical_load_distribution(held_rig_solutions, clearance):
     rig, sol = held_rig_solutions[clearance]
-    ref = rig.meta["reference"]
+    ref = rig.reference
     # the load zone is opposite to the load on the ring (the pin is pressed along the load)
-    assert rig.meta["zone_angle"] == pytest.approx(np.pi / 2)
+    assert rig.zone_angle == pytest.approx(np.pi / 2)
     np.testing.assert_allclose(sol.load_sum, sol.load_vector, atol=1e-3 * F_R)
     # the pin reaction the statistics read (components.outputs.pin_reactions: normal + traction) is the load
     # (measured ≤ 1.9e-5 F_r, the 40 samples' mean of the settling ring)
@@ -91,7 +91,7 @@ def test_rig_oblique_load_on_an_unsymmetric_roller_set():
     a = np.radians(100.0)
     rig = build_bearing_rig(bearing("10 um"), radial_load=F_R, load_angle=a, options=SceneOptions(cage="held"))
     sol = rig_static_solution(rig)
-    ref = rig.meta["reference"]
+    ref = rig.reference
     np.testing.assert_allclose(sol.load_sum, F_R * np.array([np.cos(a), np.sin(a)]), atol=2e-3 * F_R)
     order = np.argsort(ref.angles)
     np.testing.assert_allclose(sol.loads, ref.loads[order], atol=3e-3 * ref.q_max)
@@ -121,7 +121,7 @@ def test_rig_turning_ring_with_free_cage():
     st = run_sampled(m, rig.q0, rig.v0, [sol.t0, sol.t1], controller=mbd.Adaptive(h0=1e-6, h_max=1e-5), system=sysm)
     ic = 3 * m.body("pb.cage").index + 2
     w_cage = (m.full(st[1].t, st[1].q, st[1].v)[0][ic] - m.full(st[0].t, st[0].q, st[0].v)[0][ic]) / (sol.t1 - sol.t0)
-    wm, _ = bearing_kinematics(rig.meta["bearing"], 0.0, w)
+    wm, _ = bearing_kinematics(rig.bearing, 0.0, w)
     assert w_cage == pytest.approx(wm, rel=0.03)
     assert w_cage < wm                                # drag and traction losses: the cage slips back
 
@@ -132,15 +132,15 @@ def test_rig_held_cage_with_turning_ring_starts_consistently():
     rig = build_bearing_rig(bearing(), radial_load=F_R, outer_speed=300.0, options=SceneOptions(cage="held"))
     m = rig.model
     qf, vf = m.full(0.0, rig.q0, rig.v0)
-    rollers = [m.body(n).index for n in rig.handles["bearing"].rollers]
+    rollers = [m.body(n).index for n in rig.bearing_handles.rollers]
     np.testing.assert_allclose(vf[3 * np.array(rollers)], 0.0, atol=1e-12)
     np.testing.assert_allclose(vf[3 * np.array(rollers) + 1], 0.0, atol=1e-12)
     sysm = mbd.System(m)
     assert np.all(sysm.outputs(0.0, rig.q0, rig.v0, {})["pocket"]["force"] == 0.0)
     sol = rig_static_solution(rig, window=1e-3, samples=21)
     np.testing.assert_allclose(sol.ring_force, sol.load_vector, atol=2e-3 * F_R)
-    b = rig.meta["bearing"]
-    start = wrap_angle(2 * np.pi * np.arange(b.rollers) / b.rollers - rig.meta["zone_angle"])    # the rig's wrap, (−π, π]
+    b = rig.bearing
+    start = wrap_angle(2 * np.pi * np.arange(b.rollers) / b.rollers - rig.zone_angle)    # the rig's wrap, (−π, π]
     # the two tractions push each loaded roller forwards (ω > 0) against its pocket wall: it sits within
     # the pocket clearance plus the wall's deflection under the traction force 2 μ Q
     offset = (sol.angles - np.sort(start)) * 0.5 * b.pitch_diameter      # sol.angles are sorted
@@ -155,7 +155,7 @@ def test_rig_handles_meta_and_instantaneous_loads():
     assert m.body("pin").index == 0 and bool(m.fixed[0])
     assert "pocket" not in [e.name for e in m.elements] and "drag" not in [e.name for e in m.elements]
     assert np.allclose(m.gravity, (0.0, -9.81))
-    assert rig.meta["ramp_s"] == pytest.approx(20 * rig.meta["period_s"])
+    assert rig.ramp == pytest.approx(20 * rig.period)
     r = rig_loads(rig, mbd.System(m), mbd.PRODUCTION.stepper().initial_state(mbd.System(m), 0.0, rig.q0, rig.v0))
     assert r["load_inner"].shape == (12,) and np.all(r["load_inner"] == 0.0)   # centred rollers, no load at t = 0
 
@@ -191,8 +191,8 @@ def test_scene_option_cage_vocabulary():
         SceneOptions(cage="loose")
     # the rig takes its own values only where the user gave none, and keeps the user's
     rig = build_bearing_rig(bearing(), radial_load=F_R, options=SceneOptions(cage="none"))
-    assert rig.meta["cage"] == "none" and np.allclose(rig.model.gravity, 0.0)
-    assert build_bearing_rig(bearing(), radial_load=F_R).meta["cage"] == "free"
+    assert rig.options.cage == "none" and np.allclose(rig.model.gravity, 0.0)
+    assert build_bearing_rig(bearing(), radial_load=F_R).options.cage == "free"
     from components.dpgt import build_dpgt
     with pytest.raises(ParameterError, match=r"^options\.cage: 'held' is a bearing-rig option"):
         build_dpgt(reference_dpgt(3), SceneOptions(cage="held"))
@@ -237,7 +237,7 @@ def _planet_local_motion(built, shape):
     full = np.zeros(3 * m.n_bodies)
     full[m.free] = shape
     out = []
-    for name, psi in zip(built.handles["planets"], built.handles["psi"]):
+    for name, psi in zip(built.planets, built.psi):
         i = 3 * m.body(name).index
         c, s = np.cos(psi), np.sin(psi)
         x, y = full[i], full[i + 1]

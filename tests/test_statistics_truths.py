@@ -66,8 +66,8 @@ def owners(bs):
     roller = np.empty(sum(x["race_inner"][1] - x["race_inner"][0] for x in bm), int)
     for i, x in enumerate(bm):
         roller[x["race_inner"][0]:x["race_inner"][1]] = i
-    sp, b = bs.meta["speeds_rad_s"], bs.meta["bearing"]
-    planet = np.array([sp[f"{x['kind']}_planet"] - sp["carrier"] for x in bm])
+    sp, b = bs.speeds, bs.bearing
+    planet = np.array([sp.planet(x["kind"]) - sp.carrier for x in bm])
     epi = np.array([bearing_kinematics(b, 0.0, w)[0] for w in planet])      # pin at rest: relative speeds
     return bm, roller, planet, epi
 
@@ -100,11 +100,11 @@ def test_accumulators_reproduce_ramps_on_uneven_steps_and_whole_cage_revolutions
     mean and maximum fields, cage slip, revolutions and windows are the same truths."""
     bs, system, template = scene
     bm, roller_of, planet, epi = owners(bs)
-    nb, Z = len(bm), bs.meta["bearing"].rollers
-    b = bs.meta["bearing"]
-    sp = bs.meta["speeds_rad_s"]
-    T_in = cage_period(b, sp["carrier"], sp["inner_planet"])
-    T_out = cage_period(b, sp["carrier"], sp["outer_planet"])
+    nb, Z = len(bm), bs.bearing.rollers
+    b = bs.bearing
+    sp = bs.speeds
+    T_in = cage_period(b, sp.carrier, sp.inner_planet)
+    T_out = cage_period(b, sp.carrier, sp.outer_planet)
     t0 = 0.0123
     W = 2.0 * T_in                                  # two inner-cage revolutions
     t1 = t0 + W
@@ -257,8 +257,8 @@ def test_pocket_impacts_count_onsets_in_each_bearings_window(scene):
     bs, system, template = scene
     bm, roller_of, planet, epi = owners(bs)
     nb = len(bm)
-    b, sp = bs.meta["bearing"], bs.meta["speeds_rad_s"]
-    T_in = cage_period(b, sp["carrier"], sp["inner_planet"])
+    b, sp = bs.bearing, bs.speeds
+    T_in = cage_period(b, sp.carrier, sp.inner_planet)
     t0 = 0.005
     stats = synthetic(scene, t0, t0 + 2 * T_in)
     w_cage = epi.copy()                             # pure rolling: every cage closes at t0 + n·T
