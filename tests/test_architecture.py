@@ -194,12 +194,78 @@ def test_scene_handles_are_typed():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         sc = build_dpgt(reference_dpgt(3, "forward"))
-    pair = sc.handles["pairs"][0]
+    pair = sc.pairs[0]
     assert isinstance(pair, PairHandles) and isinstance(pair.bearing("outer"), BearingHandles)
     with pytest.raises(dc.FrozenInstanceError):
         pair.inner = "x"
     b = pair.inner_bearing
     assert b.kind == "rollers" and len(b.rollers) == 12 and b.guide is not None and b.spring is None
+
+
+def test_each_scene_builder_returns_a_frozen_typed_scene():
+    """The DPGT, the bearing rig and the single planetary return frozen dataclasses derived from BuiltScene whose
+    fields are declared (no ``meta``/``handles`` dict); the DPGT's run metadata is plain JSON and holds what
+    viz.results reads back from results.nc (the carrier speed, direction, frame)."""
+    import dataclasses as dc
+    import json
+    import warnings
+
+    from components.dpgt import DPGTScene, build_dpgt
+    from components.planetary import PlanetaryScene, build_single_planetary
+    from components.presets import reference_dpgt
+    from components.rig import BearingRigScene, build_bearing_rig
+    from components.scene import BuiltScene
+
+    p = reference_dpgt(3, "reverse")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        built = {DPGTScene: build_dpgt(p), BearingRigScene: build_bearing_rig(p.bearing, radial_load=5e3),
+                 PlanetaryScene: build_single_planetary()}
+    for cls, sc in built.items():
+        assert type(sc) is cls and issubclass(cls, BuiltScene) and dc.is_dataclass(cls)
+        names = {f.name for f in dc.fields(cls)}
+        assert not names & {"meta", "handles"} and not hasattr(sc, "meta") and not hasattr(sc, "handles"), cls
+        with pytest.raises(dc.FrozenInstanceError):
+            sc.model = None
+    run_meta = json.loads(json.dumps(built[DPGTScene].run_metadata()))       # no default=: plain JSON types only
+    op = p.si().operating
+    assert run_meta["speeds_rad_s"] == {"sun": op.sun_speed, "inner_planet": op.inner_planet_speed,
+                                    "outer_planet": op.outer_planet_speed, "carrier": op.carrier_speed}
+    assert tuple(run_meta[k] for k in ("direction", "frame", "planets", "rollers")) == ("reverse", "rotating", 3, 12)
+
+
+# a string-keyed read or write of a scene's metadata or handles dict: by a literal key ([], get, setdefault, pop), update
+_STRING_KEYED = re.compile(r"""\b(meta|handles)\s*(\[\s*["']|\.(get|setdefault|pop)\(\s*["']|\.update\()""")
+# files that read results.nc's own "meta" attribute (a file format: JSON written from DPGTScene.run_metadata)
+_RESULTS_FILE_META = {"viz/results.py", "tests/test_viz_results.py"}
+
+
+def test_no_string_keyed_scene_metadata_or_handles():
+    """Scenes carry typed fields: no code reads ``meta[...]``/``handles[...]`` (or ``.get``/``.update`` them) by
+    string, except where results.nc's own JSON ``meta`` attribute is read back."""
+    hits = []
+    for path in sorted([*(p for pkg in PACKAGES for p in (ROOT / pkg).rglob("*.py")), *(ROOT / "tests").rglob("*.py")]):
+        rel = path.relative_to(ROOT).as_posix()
+        if rel in _RESULTS_FILE_META:
+            continue
+        for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            if _STRING_KEYED.search(line) and "_STRING_KEYED" not in line:
+                hits.append(f"{rel}:{n}: {line.strip()}")
+    assert not hits, "string-keyed scene metadata or handles:\n" + "\n".join(hits)
+    assert _STRING_KEYED.search('x = scene.meta["bearing"]') and _STRING_KEYED.search("h.handles.get('pairs', ())")
+
+
+def test_scene_touches_no_private_attribute_of_the_model_builder():
+    """components.scene works through ModelBuilder's public methods: no ``x._name`` on anything but its own self."""
+    import mbd
+
+    tree = ast.parse((ROOT / "components" / "scene.py").read_text(encoding="utf-8"))
+    private = [f"line {node.lineno}: {ast.unparse(node)}" for node in ast.walk(tree)
+               if isinstance(node, ast.Attribute) and node.attr.startswith("_") and not node.attr.startswith("__")
+               and not (isinstance(node.value, ast.Name) and node.value.id == "self")]
+    assert not private, f"components/scene.py reaches into another object's private attributes: {private}"
+    builder = set(vars(mbd.ModelBuilder(gravity=(0.0, 0.0))))
+    assert {"_pose", "_mass", "_inertia"} <= builder        # what Scene used to write and read
 
 
 # the modules every scenario builds on; a scenario borrows nothing from another scenario (issue 24 §3)
