@@ -168,7 +168,7 @@ class Scene:
         """A ready-made element family (e.g. one drive)."""
         self._direct.append(element)
 
-    def build(self, kind: type[S] = BuiltScene, **fields) -> S:
+    def build(self, kind: type[S], **fields) -> S:
         """Freeze the model; returns ``kind`` (a :class:`BuiltScene` type) with the initial state and
         ``fields``, the scene type's own (what its outputs read)."""
         for fam in self.families.values():
