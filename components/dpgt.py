@@ -2,9 +2,9 @@
 
 Bodies: sun, ring, carrier, N inner planets a_n, N outer planets b_n, and per planet a bearing (Z
 rollers + cage, or a linear spring). Meshes: sun–a_n, a_n–b_n (external), b_n–ring (internal).
-Rig (MODEL.md §3.7): sun driven by the torque P/|ω_s| along ω_s, carrier held at the reference speed
+Rig (docs/model.md §10.3): sun driven by the torque P/|ω_s| along ω_s, carrier held at the reference speed
 by a speed drive, ring fixed through stiff supports. Reverse rotation flips every speed.
-The initial state is the kinematic steady state (MODEL.md §4); the sun torque is ramped in.
+The initial state is the kinematic steady state (docs/model.md §10.4); the sun torque is ramped in.
 """
 from __future__ import annotations
 

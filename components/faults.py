@@ -1,4 +1,4 @@
-"""Manufacturing errors and faults of the DPGT (MODEL.md §3.9) as element parameters.
+"""Manufacturing errors and faults of the DPGT (docs/model.md §11) as element parameters.
 
 ``params.errors`` (:class:`components.params.ErrorsParams`) names planets ("a1".."aN" inner, "b1".."bN"
 outer) and gears ("sun", "ring" or a planet). :func:`check_errors` checks those names and sizes against

@@ -1,4 +1,4 @@
-"""Involute spur geometry, planet layout, kinematics, mesh phasing and design checks (MODEL.md §1).
+"""Involute spur geometry, planet layout, kinematics, mesh phasing and design checks (docs/model.md §1).
 
 Everything here works on SI floats (metres, radians, rad/s). Two entry points take a whole
 :class:`components.params.DPGTParams`: :func:`layout` (the nominal machine: centre distances, planet
@@ -14,14 +14,14 @@ Conventions
 * Meshes, gear 1 → gear 2: ``sun_inner`` sun → a_n (external), ``inner_outer`` a_n → b_n
   (external), ``outer_ring`` b_n → ring (internal, gear 1 is the planet). Line of centres φ_e: angle of
   the unit vector e from centre 1 to centre 2 (external) or from the ring centre to the planet centre
-  (internal) — as in MODEL.md §3.2. In both cases the pitch point lies at angle φ_e seen from gear 1.
+  (internal) — as in docs/model.md §6.1. In both cases the pitch point lies at angle φ_e seen from gear 1.
 * Gear angles θ are 0 at assembly. Tooth k of gear g then has its centre line at angle
   θ_g + γ_g + 2πk/z_g; γ_sun = 0 (sun tooth 0 on the +x axis); the others follow from meshing
   (:func:`mesh_phases`).
 
 Mesh position and phase
 -----------------------
-The mesh position of a mesh is ``p = z_1·(θ_1 − φ_e)/2π + p0 (mod 1)`` (MODEL.md §3.2): gear 1's
+The mesh position of a mesh is ``p = z_1·(θ_1 − φ_e)/2π + p0 (mod 1)`` (docs/model.md §1.4): gear 1's
 rotation relative to the line of centres counted in tooth pitches. With ``p0 = frac(z_1·γ_1/2π)``,
 p ≡ 0 exactly when a tooth of gear 1 has its centre line on the line of centres, at the pitch point
 (the mating gear then has a tooth space centred there: a tooth pair straddles the pitch point
@@ -30,13 +30,13 @@ symmetrically). The planet's position enters through φ_e, evaluated from the st
 sun–inner meshes p0 = 0 (γ_sun = 0) and p_assembly = frac(−z_s·ψ_an/2π), the familiar sequential
 phasing; with ψ_0 = 0, pair 1 (a1) starts with the sun's tooth 0 on its pitch point (p = 0).
 
-Flank f (MODEL.md §3.2) of a standard tooth (thickness half the circular pitch, no backlash) has its
+Flank f (docs/model.md §6.1) of a standard tooth (thickness half the circular pitch, no backlash) has its
 contact on the pitch point when ``p ≡ −σf/4`` (σ = +1 external, −1 internal). Measured along that
 flank's line of action from the pitch point, positive towards the end where gear 1's tip circle cuts
 it, the contact points of the tooth pairs sit at ``s = (σ·f·p + 1/4 + k)·p_b`` for integers k, and a
 pair carries load while ``−g_2 ≤ s ≤ g_1`` (``g_1``, ``g_2``: the parts of the path of contact in gear
 1's and gear 2's addendum). :meth:`MeshGeometry.pairs_in_contact` evaluates this; its mean over p is
-the contact ratio ε_α. The rectangular stiffness wave of MODEL.md §3.2 is this count, smoothed; its
+the contact ratio ε_α. The rectangular stiffness wave of docs/model.md §6.3 is this count, smoothed; its
 phase depends on the loaded flank: :meth:`MeshGeometry.wave_p0` gives the phase for a wave whose
 double contact starts at p' = 0, :func:`loaded_flanks` which flank the torque path loads.
 """
@@ -145,7 +145,7 @@ def mesh_equivalent_mass(J1, J2, rb1, rb2):
 
 
 def mesh_damping(zeta, k_mean, J1, J2, rb1, rb2):
-    """Mesh damping c_m = 2 ζ sqrt(k_mean m_eq) [N·s/m] (MODEL.md §3.2), m_eq from :func:`mesh_equivalent_mass`."""
+    """Mesh damping c_m = 2 ζ sqrt(k_mean m_eq) [N·s/m] (docs/model.md §1.5), m_eq from :func:`mesh_equivalent_mass`."""
     zeta, k_mean, J1, J2, rb1, rb2 = (np.asarray(x, float) for x in (zeta, k_mean, J1, J2, rb1, rb2))
     for name, x in (("zeta", zeta), ("k_mean", k_mean), ("J1", J1), ("J2", J2), ("rb1", rb1), ("rb2", rb2)):
         if not np.all(np.isfinite(x)) or np.any(x < 0 if name == "zeta" else x <= 0):
@@ -155,7 +155,7 @@ def mesh_damping(zeta, k_mean, J1, J2, rb1, rb2):
 
 def iso_minimum_backlash(centre_distance: float, module: float) -> float:
     """Minimum normal backlash of ISO/TR 10064-2 for steel gears in a steel housing [m]:
-    j_bn,min = (2/3)(0.06 + 0.0005 a + 0.03 m_n) mm with a and m_n in mm (PARAMETERS.md)."""
+    j_bn,min = (2/3)(0.06 + 0.0005 a + 0.03 m_n) mm with a and m_n in mm (docs/model.md §1.5)."""
     a_mm, m_mm = 1e3 * centre_distance, 1e3 * module
     return (2.0 / 3.0) * (0.06 + 0.0005 * a_mm + 0.03 * m_mm) * 1e-3
 
@@ -234,7 +234,7 @@ def sideband_origin(k: int, z_r: int, n_planets: int, harmonic: int = 1) -> str:
     * ``"transfer path"``: N | (l z_r + k), |k| ≠ 1 — allowed, but only a path whose weight depends on the
       planet's angle (a passing-planet window) carries carrier order k (82, 3: f_m + 2f_c, f_m − 4f_c, ...);
     * ``"errors"``: N ∤ (l z_r + k) — cancelled in a perfect machine; something that differs between
-      planets (MODEL.md §3.9 errors, bearing states that differ) brings it (82, 3: f_m, f_m ± 3f_c, f_m + f_c).
+      planets (docs/model.md §11 errors, bearing states that differ) brings it (82, 3: f_m, f_m ± 3f_c, f_m + f_c).
 
     Gravity (fixed in I) turns in the carrier frame and adds orders ±1 to each planet's force, so a sensor at
     the axis may also carry a weak k = 0, ±2 where N | (l z_r + k) (82, 3: f_m + 2f_c). The rule needs the

@@ -1,4 +1,4 @@
-"""Fatigue life of a planet bearing (MODEL.md §5): the laws, defined once. The statistics that feed them
+"""Fatigue life of a planet bearing (docs/model.md §14): the laws, defined once. The statistics that feed them
 (the bearing load and every roller's raceway loads on every accepted step) are taken by
 :class:`components.outputs.WindowStatistics`.
 

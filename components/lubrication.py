@@ -1,4 +1,4 @@
-"""Lubricant film of the roller–raceway contacts (MODEL.md §3.8): the one owner of these laws.
+"""Lubricant film of the roller–raceway contacts (docs/model.md §9): the one owner of these laws.
 
 * :func:`walther_viscosity` — kinematic viscosity at a temperature from its values at 40 °C and 100 °C
   (Walther's equation, ASTM D341: log₁₀ log₁₀(ν + 0.7) = A − B log₁₀ T, ν in mm²/s, T in K), and

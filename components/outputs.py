@@ -1,4 +1,4 @@
-"""What the model outputs (MODEL.md §5), defined once.
+"""What the model outputs (docs/model.md §13), defined once.
 
 Every derived quantity a user reads — a planet bearing's load (pin reaction), roller and cage forces,
 each mesh flank's force and deflection, cage accelerations in the carrier frame (own, relative to the
@@ -14,7 +14,7 @@ taken here, by :class:`WindowStatistics`, an observer of the one simulation loop
   carrier); *radial* is from the carrier axis through the planet's centre, *tangential* 90° ahead.
   Both are independent of where the planet sits and of the frame the model is integrated in.
 
-The rig's accelerometer on the housing (MODEL.md §3.10) and its transfer paths are in :mod:`components.sensor`.
+The rig's accelerometer on the housing (docs/model.md §12) and its transfer paths are in :mod:`components.sensor`.
 
 Bearing lives (:mod:`components.life` owns the laws): ISO 281's from the bearing load's equivalent
 (mean P^(10/3)), and the ISO/TS 16281-style one from every roller's raceway loads, accumulated here as

@@ -1,7 +1,7 @@
 """Parameter objects of the DPGT: frozen dataclasses of pint quantities, each value with its source.
 
-Design (ARCHITECTURE.md idea 6)
--------------------------------
+Design
+------
 * Every parameter class is a frozen, keyword-only dataclass. Its fields hold pint quantities (or ints,
   bools, strings for counts, flags, choices; or nested parameter objects). At construction every value
   may be given as a pint quantity, a string (``"3 mm"``, ``"4200 rpm"``) or, for dimensionless values,
@@ -696,7 +696,7 @@ BearingSI = BearingParams.SI
 @_with_si("LubricantSI")
 @dataclass(frozen=True, kw_only=True)
 class LubricantParams(Params):
-    """The oil and the oil–air mixture around the rollers (MODEL.md §3.6, §3.8).
+    """The oil and the oil–air mixture around the rollers (docs/model.md §8.7, §9).
 
     Drag: F = C_d ρ D l (d_m Ω_m)^2 / 8 with the mixture density. Film: the oil's kinematic viscosity at
     40 °C and 100 °C (an ISO VG grade's data sheet) gives its viscosity at the operating temperature by
@@ -833,7 +833,7 @@ OperatingSI = OperatingPoint.SI
 @_with_si("HousingSI")
 @dataclass(frozen=True, kw_only=True)
 class HousingParams(Params):
-    """The housing the rig's accelerometer sits on, as two rigid-body modes on its mounting (MODEL.md §3.10),
+    """The housing the rig's accelerometer sits on, as two rigid-body modes on its mounting (docs/model.md §12),
     each a linear mass–spring–damper driven one way by what the train puts on the housing
     (:mod:`components.sensor`): a translation (modal mass m_h, the same in x and y) and a rocking about the
     mounting's elastic centre O, ``rocking_centre_depth`` below the gear axis (a gearbox on feet rocks about
@@ -855,7 +855,7 @@ HousingSI = HousingParams.SI
 @_with_si("SensorSI")
 @dataclass(frozen=True, kw_only=True)
 class SensorParams(Params):
-    """The rig's accelerometer on the housing (MODEL.md §3.10) at angle ``angle`` ψ_s of the fixed frame and
+    """The rig's accelerometer on the housing (docs/model.md §12) at angle ``angle`` ψ_s of the fixed frame and
     distance ``radius`` from the gear axis, along its axis e (radial at ψ_s, or tangential 90° ahead). It reads
     the sum of three paths (:mod:`components.sensor`):
 
@@ -888,7 +888,7 @@ def _ripple_amplitude(order: int):
 @_with_si("CarrierRippleSI")
 @dataclass(frozen=True, kw_only=True)
 class CarrierRippleParams(Params):
-    """Carrier-synchronous speed ripple of the rig's carrier speed drive (MODEL.md §3.10: the loading motor and
+    """Carrier-synchronous speed ripple of the rig's carrier speed drive (docs/model.md §10.3: the loading motor and
     its coupling). The drive's speed reference becomes ω_c + Σ_k A_k cos(k ω_c t + φ_k) over the orders
     k = 1, 2, 4 of the carrier frequency, its angle reference the exact integral
     (:class:`mbd.elements.SpeedDrive` ``ripple``). Every amplitude 0: an ideal drive."""
@@ -907,7 +907,7 @@ CarrierRippleSI = CarrierRippleParams.SI
 @_with_si("RigSI")
 @dataclass(frozen=True, kw_only=True)
 class RigParams(Params):
-    """The source's test rig around the train (MODEL.md §3.7): the loading motor holds the carrier at its
+    """The source's test rig around the train (docs/model.md §10.3): the loading motor holds the carrier at its
     speed through a PI speed drive (stiffness, damping and integral gain from the bandwidth and damping
     ratio on the train's kinetic inertia), with its carrier-synchronous speed ripple, and the driving
     motor's sun torque is ramped in."""
@@ -938,7 +938,7 @@ DPGTSupportSI = _extend_si(
 
 
 # ---------------------------------------------------------------------------------------------
-# manufacturing errors and faults (MODEL.md §3.9): lists of entries, none by default (a perfect machine)
+# manufacturing errors and faults (docs/model.md §11): lists of entries, none by default (a perfect machine)
 # ---------------------------------------------------------------------------------------------
 _PLANET = r"[ab][1-9][0-9]*"
 _PLANET_TEXT = "a planet name 'a1'..'aN' (inner) or 'b1'..'bN' (outer)"
@@ -1064,7 +1064,7 @@ FlankClassSI = FlankClassParams.SI
 @_with_si("ErrorsSI")
 @dataclass(frozen=True, kw_only=True)
 class ErrorsParams(Params):
-    """Manufacturing errors and faults of the machine (MODEL.md §3.9); every list empty: the perfect
+    """Manufacturing errors and faults of the machine (docs/model.md §11); every list empty: the perfect
     machine. In TOML each entry is a table, e.g. ``[[errors.pinhole]]`` with ``planet``, ``radial``,
     ``tangential`` (README, "A damaged machine")."""
     _prefix: ClassVar[str] = "errors"
@@ -1140,7 +1140,7 @@ def _planets_with_bore(gears: GearSetParams, g: "GearSetSI", bore: float) -> "Ge
 @_with_si("BearingRigSI")
 @dataclass(frozen=True, kw_only=True)
 class BearingRigParams(Params):
-    """The single-bearing test rig (:func:`components.rig.build_bearing_rig`, MODEL.md §6 check 4): a
+    """The single-bearing test rig (:func:`components.rig.build_bearing_rig`, docs/model.md §10.5): a
     planet-like outer ring on the bearing, its spin held by a speed drive, the radial load ramped in and
     a settling dashpot from the ring to ground. The ramp and the dashpot do not change the static solution."""
 

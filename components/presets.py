@@ -1,4 +1,4 @@
-"""The reference machine of the source study (PARAMETERS.md), with the source of every value.
+"""The reference machine of the source study, with the source of every value.
 
 ``reference_dpgt(condition=3, direction="forward")`` → :class:`DPGTParams`; change anything with
 :func:`components.params.with_overrides`. Values from the study's tables are tagged [paper], values
@@ -119,7 +119,7 @@ def reference_bearing() -> BearingParams:
         land_width=assumed("4 mm", "two side rails of about 2 mm"),
         land_min_film=assumed("1 um", "a few composite roughnesses"),
         impact_law=derived("exact", "lambda(e) from ln((1+lambda)/(1-lambda e)) = lambda (1+e): the set e holds "
-                                    "at any approach speed (MODEL.md 3.4)"),
+                                    "at any approach speed (docs/model.md §8.4)"),
     )
     return BearingParams(
         pitch_diameter=paper("39 mm"),
@@ -129,9 +129,9 @@ def reference_bearing() -> BearingParams:
         rows=paper(1, "one row in the source's table"),
         clearance=assumed("20 um", "diametral"),
         roller_density=assumed("7850 kg/m^3", "bearing steel"),
-        contact_exponent=derived(10.0 / 9.0, "Palmgren line contact Q = K delta^(10/9) (MODEL.md 3.3)"),
+        contact_exponent=derived(10.0 / 9.0, "Palmgren line contact Q = K delta^(10/9) (docs/model.md §8.1)"),
         contact_damping_ratio=assumed(0.05, "of critical, gated to compression"),
-        traction_law=assumed("tanh", "PARAMETERS.md; slide_roll: an EHL-type curve of the slide-to-roll ratio"),
+        traction_law=assumed("tanh", "a smooth, bounded Coulomb-like law (docs/model.md §8.2); slide_roll: an EHL-type curve of the slide-to-roll ratio"),
         traction_mu_max=assumed(0.08, "mu = 0.08 tanh(v_s / 0.3 m/s)"),
         traction_v0=assumed("0.3 m/s"),
         slide_roll_traction=SlideRollTractionParams(
@@ -152,7 +152,7 @@ def reference_bearing() -> BearingParams:
 
 
 def perfect_machine() -> ErrorsParams:
-    """No manufacturing errors or faults: the machine the source models (MODEL.md §3.9)."""
+    """No manufacturing errors or faults: the machine the source models (docs/model.md §11)."""
     return ErrorsParams(**{f: paper((), "the source models a perfect machine")
                            for f in ("pinhole", "runout", "roller_diameter", "spall", "tooth_fault", "tooth",
                                      "flank_class")})
@@ -165,7 +165,7 @@ def typical_errors(params: DPGTParams, grade: int) -> ErrorsParams:
     half its grade's runout tolerance (:func:`components.tolerances.radial_runout`) at an arbitrary but fixed
     phase, and all 2N carrier pinholes off by up to 10 µm (a precision carrier's position tolerance, of the
     order Bodas & Kahraman (2004) study; drawn uniformly, seed 2). What the spectrum scenario puts on the rig
-    by default (MODEL.md §3.10)."""
+    by default (docs/model.md §11.8)."""
     si = params.si()
     G, N = si.gears, si.layout.planets
     note = f"ISO 1328 grade {grade}: eccentricity = F_r/2 (ISO 1328-2 Annex B); phase arbitrary"
@@ -194,7 +194,7 @@ def typical_errors(params: DPGTParams, grade: int) -> ErrorsParams:
 
 
 def rig_housing() -> HousingParams:
-    """The housing under the accelerometer (MODEL.md §3.10), as two rigid-body modes on its feet. The source
+    """The housing under the accelerometer (docs/model.md §12), as two rigid-body modes on its feet. The source
     describes neither housing nor mounting: a cast-iron housing around the 246 mm ring, bolted by four feet
     to a stiff bed, sized here from the gears."""
     feet = "four bolted feet of ~5e8 N/m each on a stiff bed"
@@ -215,7 +215,7 @@ def rig_housing() -> HousingParams:
 
 
 def rig_accelerometer() -> SensorParams:
-    """The housing accelerometer of MODEL.md §3.10. The source gives only "on the carrier bearing housing near
+    """The housing accelerometer of docs/model.md §12. The source gives only "on the carrier bearing housing near
     the carrier axis"; where on the housing, how wide a planet is heard and through what mass, and the
     housing's modes (:func:`rig_housing`) are assumed."""
     return SensorParams(
@@ -233,15 +233,15 @@ def rig_accelerometer() -> SensorParams:
 
 
 def ideal_carrier_drive() -> CarrierRippleParams:
-    """No speed ripple: the reference machine's carrier drive (MODEL.md §3.10: 0 for the reference machine)."""
-    ideal = "an ideal drive (MODEL.md 3.10: no ripple on the reference machine)"
+    """No speed ripple: the reference machine's carrier drive (docs/model.md §10.3: 0 for the reference machine)."""
+    ideal = "an ideal drive (docs/model.md §10.3: no ripple on the reference machine)"
     return CarrierRippleParams(**{f"amplitude_{k}": assumed("0 rad/s", ideal) for k in CarrierRippleParams.ORDERS},
                                **{f"phase_{k}": assumed("0 deg", "immaterial without ripple")
                                   for k in CarrierRippleParams.ORDERS})
 
 
 def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams:
-    """The reference DPGT exactly per PARAMETERS.md, at operating ``condition`` (1..4) and ``direction``."""
+    """The reference DPGT (every value in docs/parameters.md, generated from here), at operating ``condition`` (1..4) and ``direction``."""
     return DPGTParams(
         gears=reference_gears(),
         bearing=reference_bearing(),
@@ -278,7 +278,7 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
         mesh=MeshParams(
             c_gamma_alpha=assumed("20 N/(mm*um)", "ISO 6336 typical c_gamma_alpha"),
             stiffness_ratio=assumed(1.5, "k_double / k_single"),
-            smoothing_width=assumed(0.05, "not in PARAMETERS.md: 5 % of a mesh cycle per step, "
+            smoothing_width=assumed(0.05, "the source gives none: 5 % of a mesh cycle per step, "
                                           "smooth enough for Newton, sharp enough to keep the wave"),
             damping_ratio=assumed(0.07),
         ),
@@ -288,7 +288,7 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
                                                      "it still swung 8 rad/s), far below the mesh frequency"),
             carrier_drive_damping_ratio=assumed(0.7),
             carrier_ripple=ideal_carrier_drive(),
-            load_ramp_mesh_periods=assumed(20.0, "no impulse at the start (MODEL.md 4)"),
+            load_ramp_mesh_periods=assumed(20.0, "no impulse at the start (docs/model.md §10.4)"),
             load_ramp_max=assumed("0.05 s", "near-zero speeds have no mesh period"),
             sensor=rig_accelerometer()),
         gravity=assumed("9.81 m/s^2", "standard gravity along -Y of the fixed frame"),
@@ -297,7 +297,7 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
 
 
 def reference_bearing_rig() -> BearingRigParams:
-    """The single-bearing rig (MODEL.md §6 check 4): a planet-like outer ring, its speed drive and the
+    """The single-bearing rig (docs/model.md §10.5): a planet-like outer ring, its speed drive and the
     aids that let the loaded ring settle (they do not change the static solution)."""
     return BearingRigParams(
         ring_mass=assumed("0.557 kg", "a planet-like outer ring: the reference planet's mass"),

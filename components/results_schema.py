@@ -188,7 +188,7 @@ def drawing_geometry(params) -> dict:
         "pitch_radius": {k: float(g.pitch_radius) for k, g in parts.items()},
         "r_ca": float(lay.r_ca),
         "r_cb": float(lay.r_cb),
-        # the carrier plate as in the inertia rule of PARAMETERS.md (disc of radius 1.2 r_cb)
+        # the carrier plate as in the inertia rule of gears.carrier_inertia (disc of radius 1.2 r_cb)
         "carrier_radius": 1.2 * float(lay.r_cb),
         # pin (bearing) centres in carrier axes, per planet pair: exact positions for the drawing
         "pins": {"inner": np.asarray(lay.centres_a, float).tolist(),

@@ -1,4 +1,4 @@
-"""A planet bearing alone on a test rig (MODEL.md §6 check 4), and its quasi-static post-processing.
+"""A planet bearing alone on a test rig (docs/model.md §10.5, check §15.4), and its quasi-static post-processing.
 
 Scene: a pin fixed to ground (the inner raceway), an outer ring (the "planet": the outer raceway),
 Z rollers and a cage between them (:func:`components.bearing.add_planet_bearing`). A radial load F_r,

@@ -1,4 +1,4 @@
-"""The rig's accelerometer on the housing as transfer paths (MODEL.md §3.10).
+"""The rig's accelerometer on the housing as transfer paths (docs/model.md §12).
 
 The sensor sits on the housing at angle ψ_s of the fixed frame, at distance r_s from the gear axis, and
 reads along its axis e (radial at ψ_s, or tangential 90° ahead). What it reads is the sum of three paths,

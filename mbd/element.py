@@ -53,6 +53,15 @@ class Element:
     # the kernel is elementwise over its instances: (K, n) columns evaluate K states at once
     # (System.outputs_batch); False for kernels that call arbitrary functions of t
     batched: bool = False
+    # the family's compiled twin: "module.name" of its kernels in mbd.compiled (pack_name, evaluate_name and,
+    # with internal state, update_name), dispatched by mbd.compiled.registry; None: the numpy path only.
+    # Not inherited (see __init_subclass__): a subclass may change the law its parent's kernel computes.
+    compiled_twin: str | None = None
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "compiled_twin" not in vars(cls):
+            cls.compiled_twin = None
 
     @property
     def n(self) -> int:

@@ -395,7 +395,7 @@ class Recorder:
 
 
 def _fixed_body_acceleration(m, fs, qf, vf, af) -> None:
-    """Acceleration in R of the bodies at rest in I (the frame terms with F = 0, MODEL.md §2):
+    """Acceleration in R of the bodies at rest in I (the frame terms with F = 0, docs/model.md §2.3):
     a fixed body seen from a rotating R accelerates, and to_fixed must map it back to zero."""
     idx = np.flatnonzero(m.fixed)
     x, y, vx, vy = qf[3 * idx], qf[3 * idx + 1], vf[3 * idx], vf[3 * idx + 1]

@@ -23,9 +23,10 @@ from .assembly import System
 from .errors import IntegrationError, ModelError
 from .hht import HHT, NewtonCache, StepInfo
 from .model import Model, State
-from .recorder import Recorder, atomic_write_bytes
+from .protocols import Controller, Observer, Recorder, require
+from .recorder import atomic_write_bytes
 
-__all__ = ["simulate", "SimResult", "Checkpoint", "Counters", "Observer", "TimeMean", "save_state", "load_state"]
+__all__ = ["simulate", "SimResult", "Checkpoint", "Counters", "TimeMean", "save_state", "load_state"]
 
 
 @dataclass
@@ -102,34 +103,6 @@ def load_state(path, with_arrays: bool = False):
     return (s, extra, arrays) if with_arrays else (s, extra)
 
 
-class Observer:
-    """Something the loop calls on every accepted step (statistics, averages, monitors).
-
-    ``bind`` is called once before the first step (also on resume, before ``load_state_dict``),
-    ``step(s0, s1)`` after every accepted step from s0 to s1, ``state_dict``/``load_state_dict`` carry
-    its running state through checkpoints (a dict of numpy arrays), so a resumed run ends identical.
-    """
-
-    def bind(self, model: Model, system: System, state: State) -> None:
-        pass
-
-    def step(self, s0: State, s1: State) -> None:
-        raise TypeError(f"{type(self).__name__} must define step(s0, s1)")
-
-    def on_block(self, block) -> None:
-        """Every accepted step of a compiled block (:class:`mbd.compiled.runner.Block`) in one call; by default
-        :meth:`step` on each. An observer that overrides it reads the block's stacked states
-        (``block.arrays()``) and skips building a State per step."""
-        for s0, s1, _, _ in block.steps:
-            self.step(s0, s1)
-
-    def state_dict(self) -> dict:
-        return {}
-
-    def load_state_dict(self, d: dict) -> None:
-        pass
-
-
 class TimeMean(Observer):
     """Time mean of ``fn(system, state)`` (an array) over [t0, t1], by the trapezoidal rule on the
     accepted steps that end inside it (every contact event the integrator resolves is in the mean; a mean
@@ -168,7 +141,7 @@ class TimeMean(Observer):
 
 
 def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 0.0,
-             stepper: HHT | None = None, controller=None, recorder: Recorder | None = None,
+             stepper: HHT | None = None, controller: Controller | None = None, recorder: Recorder | None = None,
              checkpoint: Checkpoint | None = None, resume: bool = False, progress: bool | None = None,
              failed_state_path=None, state: State | None = None, system: System | None = None,
              on_progress=None, observers=(), engine: str = "auto") -> SimResult:
@@ -180,10 +153,13 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
     be built, else numpy; ``SimResult.engine`` says which ran). Progress bar: on for runs of more than ~2 s
     wall unless ``progress=False`` or the environment sets DPGT_PROGRESS=0. ``on_progress(t, t_end,
     counters)`` is called at most twice a second (e.g. to report progress from a worker process).
-    ``observers`` (:class:`Observer`) see every accepted step, whatever the recorder's sample rate.
+    ``observers`` (:class:`~mbd.protocols.Observer`) see every accepted step, whatever the recorder's sample rate.
+    The controller, the recorder and each observer are checked against their protocols (:mod:`mbd.protocols`)
+    before anything is built: a missing method fails here, naming the argument.
     """
     if controller is None:
         raise ModelError("simulate: pass controller=FixedStep(h) or Adaptive(h0=..., ...)")
+    observers = _check_arguments(controller, recorder, observers)
     if stepper is None:
         from .settings import PRODUCTION
         stepper = PRODUCTION.stepper()
@@ -197,7 +173,11 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
         counters.residual += 1       # initial_state evaluates the forces once
     if not (np.isfinite(t_end) and t_end >= state.t):
         raise ModelError(f"simulate: t_end must be >= the start time {state.t} s, got {t_end!r}")
-    observers = list(observers)
+    if runner is None:       # the numpy path hands over single steps: an on_block-only observer cannot take them
+        for i, ob in enumerate(observers):
+            if type(ob).step is Observer.step:
+                raise ModelError(f"simulate: observers[{i}] ({type(ob).__name__}) does not define step(s0, s1), "
+                                 "which the numpy engine path calls")
     h, stats, counters, state, resumed_from = _begin(model, system, state, controller, counters, recorder,
                                                      observers, checkpoint, resume)
     show = progress if progress is not None else os.environ.get("DPGT_PROGRESS", "1") != "0"
@@ -224,6 +204,20 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
     if checkpoint is not None and Path(checkpoint.path).exists():
         Path(checkpoint.path).unlink()
     return res
+
+
+def _check_arguments(controller, recorder, observers) -> list:
+    """The observers as a list, after checking every argument against its protocol."""
+    require(Controller, controller, "controller")
+    if recorder is not None:
+        require(Recorder, recorder, "recorder")
+    try:
+        observers = list(observers)
+    except TypeError:
+        raise ModelError(f"simulate: observers must be a list of observers, got {type(observers).__name__}") from None
+    for i, ob in enumerate(observers):
+        require(Observer, ob, f"observers[{i}]")
+    return observers
 
 
 ENGINES = ("auto", "compiled", "numpy")

@@ -90,7 +90,7 @@ def sideband_resolution(t: np.ndarray, f_c: float) -> str | None:
 
 
 # ---------------------------------------------------------------------------------------------------------------
-# the housing accelerometer of a recorded run (MODEL.md §3.10): what the spectrum and the fault study read
+# the housing accelerometer of a recorded run (docs/model.md §12): what the spectrum and the fault study read
 # ---------------------------------------------------------------------------------------------------------------
 def sensor_paths(path: Path, sensor=None) -> tuple[np.ndarray, dict]:
     """(t, {"mesh", "torque", "bearing", "housing"}): the housing accelerometer's paths and their sum [m/s^2] at

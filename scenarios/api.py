@@ -52,7 +52,7 @@ class Run:
 
 
 def parameters(condition: int = 3, direction: str = "forward", set: dict | None = None, params_file=None):
-    """The reference machine at an operating condition (PARAMETERS.md) and direction, with a TOML file's and then
+    """The reference machine at an operating condition (docs/parameters.md) and direction, with a TOML file's and then
     ``set``'s dotted overrides (the keys `dpgt params` lists): a :class:`components.params.DPGTParams`."""
     from components.params import with_overrides
     from components.presets import load_toml, reference_dpgt

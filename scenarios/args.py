@@ -136,11 +136,11 @@ def choice_list(allowed, what: str):
 
 
 def conditions(text):
-    """Operating conditions (PARAMETERS.md): a non-empty comma list of 1, 2, 3, 4 -> comma string."""
+    """Operating conditions (docs/parameters.md): a non-empty comma list of 1, 2, 3, 4 -> comma string."""
     items = _items(text, "operating conditions 1-4")
     bad = [x for x in items if x not in {str(c) for c in CONDITIONS}]
     if bad:
-        raise argparse.ArgumentTypeError(f"takes 1, 2, 3 and/or 4 (PARAMETERS.md), got {bad[0]!r}")
+        raise argparse.ArgumentTypeError(f"takes 1, 2, 3 and/or 4 (docs/parameters.md), got {bad[0]!r}")
     return ",".join(dict.fromkeys(items))
 
 
@@ -232,7 +232,7 @@ def out_folder(text):
 # ---------------------------------------------------------------------------------------------------------------
 SHARED = {
     "conditions": (("--conditions",), dict(type=conditions, metavar="C[,C...]",
-                                            help="comma list of operating conditions 1-4 (PARAMETERS.md; default "
+                                            help="comma list of operating conditions 1-4 (docs/parameters.md; default "
                                                  "{conditions})")),
     "params": (("--params",), dict(default=None, type=existing_file, metavar="FILE.toml",
                                    help="TOML file of parameter overrides, dotted keys as `dpgt params` lists them")),
@@ -276,7 +276,7 @@ def add_shared(p, *names: str, out: str | None = None, conditions: str | None = 
             if one_condition_only:
                 flags = (*flags, "--condition")
                 kw.update(type=one_condition, metavar="C",
-                          help=f"operating condition 1-4, one (PARAMETERS.md; default {conditions}; --condition: "
+                          help=f"operating condition 1-4, one (docs/parameters.md; default {conditions}; --condition: "
                                f"the former spelling, still accepted)")
             else:
                 kw["help"] = kw["help"].format(conditions=conditions)

@@ -1,4 +1,4 @@
-"""What errors and faults do to the planet bearings and to the rig's sensor (MODEL.md §3.9–3.10).
+"""What errors and faults do to the planet bearings and to the rig's sensor (docs/model.md §11–12).
 
     python -m scenarios.fault_study [--conditions 2] [--directions forward,reverse]
         [--faults pinhole,runout,roller,spall_pin,spall_bore,cracked_tooth,missing_tooth]

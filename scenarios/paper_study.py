@@ -103,7 +103,7 @@ def make_cases(a, out: Path) -> list[Case]:
         overrides["gears.planets"] = a.planets
     for c in conds:
         if c not in (1, 2, 3, 4):
-            raise SystemExit(f"error: --conditions takes 1, 2, 3 and/or 4 (PARAMETERS.md), got {c}")
+            raise SystemExit(f"error: --conditions takes 1, 2, 3 and/or 4 (docs/parameters.md), got {c}")
     return [Case(c, d, str(out / f"c{c}_{d}"), overrides, a.params) for c in conds for d in dirs]
 
 

@@ -2,33 +2,46 @@
 
     python -m scenarios.params [--grep WORD] [--conditions C] [--direction forward|reverse] [--params FILE.toml]
                                [--set KEY=VALUE ...]
+    python -m scenarios.params --reference [FILE]
 
-The keys are the ones ``--set KEY=VALUE`` and a ``--params`` TOML file take in every command (PARAMETERS.md's
-dotted names); the source tag says where the value comes from ([paper] the source study, [derived] computed
+The keys are the ones ``--set KEY=VALUE`` and a ``--params`` TOML file take in every command (the names of
+docs/parameters.md); the source tag says where the value comes from ([paper] the source study, [derived] computed
 from paper values, [assumed] an engineering estimate — its basis follows — [user] given by you). A value left
 to its rule (e.g. the Palmgren contact stiffness) is shown resolved, in SI. With --params and --set the table is
-that machine's, so it checks a file before a study runs.
+that machine's, so it checks a file before a study runs. ``--reference`` writes the reference machine's parameter
+reference, docs/parameters.md (Markdown, :mod:`components.parameter_reference`), instead of the table.
 """
 from __future__ import annotations
 
 import sys
 import warnings
+from pathlib import Path
 
 from . import args
 from .command import command
 
 EXAMPLES = ["{prog}", "{prog} --grep clearance", "{prog} --grep bearing.cage --set bearing.cage.mass=\"0.05 kg\"",
-            "{prog} --params my_machine.toml --grep user"]
+            "{prog} --params my_machine.toml --grep user", "{prog} --reference"]
+REFERENCE = Path(__file__).resolve().parent.parent / "docs" / "parameters.md"     # the repository's reference
 
 
 def parse_args(argv):
-    p = args.parser("params", __doc__, examples=EXAMPLES, writes="nothing: the table goes to the screen", out=None)
+    p = args.parser("params", __doc__, examples=EXAMPLES, out=None,
+                    writes="nothing: the table goes to the screen; with --reference the Markdown reference FILE")
     p.add_argument("--grep", default=None, metavar="WORD",
                    help="only the parameters whose key, unit, source or meaning contains WORD (any case)")
     p.add_argument("--direction", default="forward", choices=["forward", "reverse"],
                    help="the carrier's direction (default forward)")
+    p.add_argument("--reference", nargs="?", const=str(REFERENCE), default=None, metavar="FILE",
+                   help="write the reference machine's parameter reference (Markdown) to FILE instead of the table "
+                        f"(default {REFERENCE.relative_to(REFERENCE.parent.parent)})")
     args.add_shared(p, "conditions", "params", "set", conditions="3", one_condition_only=True)
-    return p.parse_args(argv)
+    a = p.parse_args(argv)
+    given = [o for o, v in (("--grep", a.grep), ("--params", a.params), ("--set", a.set)) if v] + \
+            (["--conditions"] if a.conditions != 3 else []) + (["--direction"] if a.direction != "forward" else [])
+    if a.reference is not None and given:
+        p.error(f"--reference documents the reference machine at its defaults; it takes no {', '.join(given)}")
+    return a
 
 
 def rows(a) -> list[dict[str, str]]:
@@ -37,7 +50,6 @@ def rows(a) -> list[dict[str, str]]:
     from components.params import overrides_from_toml, parameter_rows, with_overrides
     from components.presets import reference_dpgt
     from components.units import ParameterError
-    from pathlib import Path
 
     try:
         from_file = overrides_from_toml(Path(a.params).read_text(encoding="utf-8")) if a.params else {}
@@ -69,6 +81,13 @@ def table(rs: list[dict[str, str]]) -> str:
 @command
 def main(argv=None) -> int:
     a = parse_args(sys.argv[1:] if argv is None else argv)
+    if a.reference is not None:
+        from components.parameter_reference import reference_markdown
+        from mbd.recorder import atomic_write_text
+
+        atomic_write_text(Path(a.reference), reference_markdown())
+        print(f"written: {a.reference}")
+        return 0
     rs = rows(a)
     if not rs:
         print(f"no parameter matches {a.grep!r}")

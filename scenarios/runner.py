@@ -9,7 +9,7 @@ Results layout of a run directory:
                    with its bearing, planet, pair, bearing_kind, roller (components.results_schema);
                    with RunConfig.sensor what the supports put on the housing ("housing.force_x/force_y/torque",
                    fixed frame) and the sensor's parameters (attrs "sensor"), from which the housing
-                   accelerometer's paths are computed (MODEL.md §3.10, scenarios.spectrum.sensor_paths);
+                   accelerometer's paths are computed (docs/model.md §12, scenarios.spectrum.sensor_paths);
                    attrs hold the run summary and, as JSON, the bearing map, meta, label and geometry
     summary.json   the statistics users read, taken on every accepted step over the window
                    (:class:`components.outputs.WindowStatistics`; the recording is for plots only)
@@ -104,7 +104,7 @@ class RunConfig:
     options: SceneOptions = field(default_factory=SceneOptions)
     progress: bool = True
     checkpoint_every: int = 2000
-    sensor: bool = False          # record what the housing accelerometer needs (rig.sensor, MODEL.md §3.10)
+    sensor: bool = False          # record what the housing accelerometer needs (rig.sensor, docs/model.md §12)
 
     def __post_init__(self):
         for k in ("settle", "window"):
@@ -118,7 +118,7 @@ class RunConfig:
 
 def statistics_window(scene, base: float = 0.02) -> float:
     """Default window [s]: at least ``base`` and one carrier revolution, rounded up to whole revolutions
-    of the slowest cage relative to the carrier (MODEL.md §5)."""
+    of the slowest cage relative to the carrier (docs/model.md §13.3)."""
     sp, b = scene.meta["speeds_rad_s"], scene.meta["bearing"]
     wc = sp["carrier"]
     if wc != 0.0:

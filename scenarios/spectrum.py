@@ -3,7 +3,7 @@
     python -m scenarios.spectrum --out results/spectrum [--sensor housing|mesh|torque|bearing|axis]
                                  [--carrier-rpm 2000] [--power "200 kW"]
 
-``--sensor housing`` (default): the rig's accelerometer on the housing at ψ_s (MODEL.md §3.10,
+``--sensor housing`` (default): the rig's accelerometer on the housing at ψ_s (docs/model.md §12,
 ``rig.sensor.*``, :mod:`components.sensor`), the sum of its three paths along the sensor's axis: ``mesh``
 (each outer planet's ring-mesh force weighted by a Hann window of its angular distance from the sensor, over
 m_eq), ``torque`` (the housing's rocking under the ring's support torque) and ``bearing`` (the housing's
@@ -49,7 +49,7 @@ from . import args
 from .command import command
 
 SENSORS = {
-    "housing": "housing accelerometer (MODEL.md 3.10): the sum of its mesh, torque and bearing paths, along the "
+    "housing": "housing accelerometer (docs/model.md §12): the sum of its mesh, torque and bearing paths, along the "
                "sensor's axis [m/s^2]",
     "mesh": "the housing accelerometer's local ring-mesh path: Hann-windowed ring-mesh forces / m_eq [m/s^2]",
     "torque": "the housing accelerometer's torque path: the housing's rocking under the ring's support torque [m/s^2]",

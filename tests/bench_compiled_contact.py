@@ -19,7 +19,7 @@ import numpy as np
 _HERE = Path(__file__).resolve().parent
 sys.path[:0] = [str(_HERE.parent), str(_HERE)]   # this checkout's packages first, then the test scenes
 
-from mbd.compiled.contact import KERNELS  # noqa: E402
+from mbd.compiled.registry import kind_of  # noqa: E402
 from mbd.element import evaluate  # noqa: E402
 from mbd.elements.contact import RaceContact  # noqa: E402
 from mbd.model import FrameState  # noqa: E402
@@ -70,7 +70,8 @@ def drags(n, rng):
 
 
 def bench(label, elem, qf, vf, z, repeats):
-    pack, kernel, _ = KERNELS[type(elem)]
+    twin = kind_of(type(elem))
+    pack, kernel = twin.pack, twin.evaluate
     P, G = pack(elem)
     n, k = elem.dofs.shape
     F, Jq, Jv = np.empty((n, k)), np.empty((n, k, k)), np.empty((n, k, k))

@@ -51,7 +51,7 @@ def run(condition, direction, overrides=None, *, window=None, settle=SETTLE, ext
 
 
 def line_of_action(e, flank, alpha, internal):
-    """Unit direction of a flank's force on gear 2 (external) or on the planet (internal), MODEL.md §3.2."""
+    """Unit direction of a flank's force on gear 2 (external) or on the planet (internal), docs/model.md §6.2."""
     t = np.array([-e[1], e[0]])
     s = -1.0 if internal else 1.0
     return s * math.sin(alpha) * e + flank * math.cos(alpha) * t

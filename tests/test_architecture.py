@@ -1,10 +1,12 @@
-"""Architecture rules that keep the code honest (ARCHITECTURE.md): no import cycles between modules,
+"""Architecture rules that keep the code honest: no import cycles between modules,
 the engine never imports the domain, and no physics value hides in an element constructor's default."""
 from __future__ import annotations
 
 import ast
 import dataclasses
 import inspect
+import re
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -187,3 +189,182 @@ def test_no_scenario_borrows_from_another_scenario():
                 and mod not in SCENARIO_INFRASTRUCTURE for d in deps
                 if d.startswith("scenarios.") and d not in SCENARIO_INFRASTRUCTURE}
     assert borrowed <= {("scenarios.demo", "scenarios.paper_study")}, sorted(borrowed)
+
+
+# what a clone does not have: the specification files the project was started from, which lived beside the
+# repository, and paths of the machine it was written on (patterns split so that this file does not match itself)
+OUTSIDE = re.compile("|".join([re.escape("shared" + "/spec"), re.escape("../" + "shared"), re.escape("/" + "work/"),
+                               r"\b(?:MODEL|PARAMETERS|ARCHITECTURE)" + r"\.md\b"]))
+
+
+def tracked_text_files() -> list[Path]:
+    """The repository's tracked files (git ls-files; the source packages, docs and tests when git is absent),
+    text only."""
+    try:
+        out = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, check=True).stdout
+        files = [ROOT / f for f in out.decode().split("\0") if f]
+    except (OSError, subprocess.CalledProcessError):
+        files = [p for d in (*PACKAGES, "tests", "docs") for p in (ROOT / d).rglob("*") if p.is_file()]
+        files += [ROOT / "README.md", ROOT / "Makefile", ROOT / "pyproject.toml"]
+    return [f for f in files if f.is_file() and b"\0" not in f.read_bytes()[:8192]]
+
+
+def test_no_tracked_file_cites_a_file_outside_the_repository():
+    """The model and the parameters are the project's own documents (docs/model.md §N, docs/parameters.md); a
+    citation of the specification files beside the repository, or of a path on one machine, points nowhere in a
+    clone."""
+    assert OUTSIDE.search("see " + "MODEL" + ".md §3.2") and OUTSIDE.search("../" + "shared" + "/spec/x")
+    assert not OUTSIDE.search("docs/model.md §6.2, docs/parameters.md")
+    files = tracked_text_files()
+    assert any(f.name == "model.md" for f in files) and any(f.suffix == ".py" for f in files)
+    bad = [f"{f.relative_to(ROOT)}:{n}: {line.strip()[:80]}" for f in files
+           for n, line in enumerate(f.read_text(encoding="utf-8", errors="replace").splitlines(), 1)
+           if OUTSIDE.search(line)]
+    assert not bad, "citations of files outside the repository:\n" + "\n".join(bad)
+
+
+# ------------------------------------------------------------------------------------------ compiled twins
+def _dispatch_branches(function: str) -> dict[str, str]:
+    """kind constant -> the kernel its branch of mbd.compiled.registry.<function> calls ("module.function"),
+    read from the if-chain's source (numba compiles that chain; nothing else dispatches)."""
+    tree = ast.parse((ROOT / "mbd" / "compiled" / "registry.py").read_text(encoding="utf-8"))
+    fn = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == function)
+    out = {}
+    for node in ast.walk(fn):
+        if isinstance(node, ast.If) and isinstance(node.test, ast.Compare) and isinstance(node.test.ops[0], ast.Eq):
+            const = node.test.comparators[0].id
+            call = node.body[0].value
+            assert isinstance(call, ast.Call) and isinstance(call.func, ast.Attribute), (function, const)
+            assert const not in out, f"{function}: two branches for {const}"
+            out[const] = f"{call.func.value.id}.{call.func.attr}"
+    return out
+
+
+def _families() -> list[type]:
+    """Every element family class of mbd.elements, the private bases included."""
+    seen, todo = [], [Element]
+    while todo:
+        for sub in todo.pop().__subclasses__():
+            if sub.__module__.startswith("mbd.elements") and sub not in seen:
+                seen.append(sub)
+                todo.append(sub)
+    return seen
+
+
+def test_every_declared_compiled_twin_has_its_kernels_and_dispatch_branches():
+    """Each family declares its compiled twin ("module.name") where it is defined; the registry gives each twin
+    an id whose branch of evaluate_kind calls module.evaluate_name, and of update_kind module.update_name
+    exactly when the family has internal state; pack_name exists. No kernel is left without a family."""
+    from mbd.compiled import registry
+    evaluate, update = _dispatch_branches("evaluate_kind"), _dispatch_branches("update_kind")
+    ids = {getattr(registry, c): c for c in evaluate}
+    assert len(ids) == len(evaluate) == len(registry.KIND_IDS) == len(set(registry.KIND_IDS.values()))
+    declared = {}
+    for cls in _families():
+        twin = cls.compiled_twin
+        if twin is None:
+            continue
+        assert twin in registry.KIND_IDS, f"{cls.__name__}.compiled_twin = {twin!r} is not in registry.KIND_IDS"
+        assert twin not in declared, f"{twin!r} declared by {declared[twin].__name__} and {cls.__name__}"
+        declared[twin] = cls
+        module, name = twin.split(".")
+        const = ids[registry.KIND_IDS[twin]]
+        assert evaluate[const] == f"{module}.evaluate_{name}", (twin, const, evaluate[const])
+        kind = registry.kind_of(cls)
+        assert callable(kind.pack) and kind.pack.__name__ == f"pack_{name}", twin
+        stateful = cls.update_internal is not Element.update_internal
+        assert (kind.update is not None) == stateful == (const in update), twin
+        if stateful:
+            assert update[const] == f"{module}.update_{name}", (twin, update[const])
+    assert set(declared) == set(registry.KIND_IDS), f"kernels without a family: {set(registry.KIND_IDS) - set(declared)}"
+
+
+def test_a_twin_is_declared_by_each_family_and_a_typo_fails_loudly():
+    """A subclass does not inherit its parent's twin (its law may differ); an unknown twin is a LookupError
+    naming the family, not a silent fall back to the numpy path."""
+    from mbd.compiled.registry import kind_of
+    from mbd.elements import RaceContact
+
+    class Sub(RaceContact):
+        pass
+
+    class Typo(RaceContact):
+        compiled_twin = "contact.raec"
+
+    assert RaceContact.compiled_twin == "contact.race" and Sub.compiled_twin is None and kind_of(Sub) is None
+    with pytest.raises(LookupError, match=r"Typo.compiled_twin = 'contact.raec'"):
+        kind_of(Typo)
+
+
+def _shipped_scenes():
+    """(label, builder) of every scene the studies and scenarios build: the DPGT at each condition and
+    direction, with every combination of the scene switches (--option), every fault of the fault study,
+    the gear-quality study's flank classes, every selectable contact law, the stability study's cases; the
+    bearing rig with each cage, with and without drag, at rest and turning; the single planetary (modal)."""
+    import itertools
+    import warnings
+
+    from components.dpgt import build_dpgt
+    from components.params import BearingParams, CageParams, with_overrides
+    from components.planetary import build_single_planetary
+    from components.presets import CONDITIONS, DIRECTIONS, reference_dpgt
+    from components.rig import build_bearing_rig
+    from components.scene import SceneOptions
+    from scenarios.fault_study import FAULTS
+    from scenarios.stability import CASES, case_overrides
+
+    def dpgt(overrides=None, options=None, condition=3, direction="forward", strict=True):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")           # design warnings of the stability study's variants
+            return build_dpgt(with_overrides(reference_dpgt(condition, direction), overrides or {}), options, strict)
+
+    for c, d in itertools.product(CONDITIONS, DIRECTIONS):
+        yield f"DPGT condition {c} {d}", lambda c=c, d=d: dpgt(condition=c, direction=d)
+    ch = SceneOptions._CHOICES
+    for b, cage, drag, mesh, frame in itertools.product(ch["bearings"], ("free", "none"), (True, False),
+                                                        ch["mesh_stiffness"], ch["frame"]):
+        o = SceneOptions(bearings=b, cage=cage, drag=drag, mesh_stiffness=mesh, frame=frame)
+        yield f"DPGT {o.given()}", lambda o=o: dpgt(options=o)
+    for name, (ov, _) in FAULTS.items():
+        yield f"fault study: {name}", lambda ov=ov: dpgt(ov)
+    for grade in (5, 6, 8):
+        ov = {"errors.flank_class": [{"gear": "all", "grade": grade, "seed": 1, "systematic_share": 0.5}]}
+        yield f"gear quality: grade {grade}", lambda ov=ov: dpgt(ov)
+    for key, cls, field in (("bearing.traction_law", BearingParams, "traction_law"),
+                            ("bearing.cage.impact_law", CageParams, "impact_law"),
+                            ("bearing.cage.land_law", CageParams, "land_law")):
+        for law in cls._spec(field).choices:
+            yield f"{key} = {law}", lambda ov={key: law}: dpgt(ov)
+    for name in CASES:
+        yield f"stability: {name}", lambda name=name: dpgt(case_overrides(name)[0], strict=False)
+    p = reference_dpgt()
+    for cage, drag, speed in itertools.product(("held", "free", "none"), (True, False), (0.0, 300.0)):
+        yield (f"bearing rig: cage {cage}, drag {drag}, {speed} rad/s",
+               lambda cage=cage, drag=drag, speed=speed: build_bearing_rig(
+                   p.bearing, radial_load=5e3, outer_speed=speed, lubricant=p.lubricant if drag else None,
+                   options=SceneOptions(cage=cage, drag=drag, gravity=False)))
+    yield "single planetary", build_single_planetary
+
+
+def test_every_family_of_the_shipped_scenes_has_a_compiled_twin():
+    """A family without a compiled twin sends a whole run to the ≈ 13× slower numpy path: every family of every
+    shipped scene declares one, and the compiled system of each scene builds (its law variants pack)."""
+    import mbd
+    from mbd.compiled.registry import kind_of
+    from mbd.compiled.system import CompiledSystem
+
+    missing, refused, n = {}, [], 0          # family class -> the scenes it is in
+    for label, build in _shipped_scenes():
+        model = build().model
+        n += 1
+        for e in model.elements:
+            if kind_of(type(e)) is None:
+                missing.setdefault(type(e).__name__, []).append(label)
+        try:
+            CompiledSystem(mbd.System(model))
+        except NotImplementedError as exc:
+            refused.append(f"{label}: {exc}")
+    assert n > 80
+    assert not missing, "families without a compiled twin: " + "; ".join(
+        f"{cls} (in {len(s)} scenes, e.g. {s[0]})" for cls, s in missing.items())
+    assert not refused, f"{len(refused)} scenes the compiled path cannot build, e.g. {refused[:3]}"

@@ -38,7 +38,7 @@ def test_debug_shows_the_traceback():
 
 def test_a_bad_condition_through_the_dpgt_command(tmp_path, capsys):
     assert cli.main(["paper_study", "--conditions", "7", "--out", str(tmp_path)]) == USAGE
-    assert capsys.readouterr().err.strip() == "error: argument --conditions: takes 1, 2, 3 and/or 4 (PARAMETERS.md), got '7'"
+    assert capsys.readouterr().err.strip() == "error: argument --conditions: takes 1, 2, 3 and/or 4 (docs/parameters.md), got '7'"
     assert paper_study.main(["--set", 'bearing.clearance=-1 um', "--out", str(tmp_path)]) == USAGE
     assert "bearing.clearance" in capsys.readouterr().err
 

@@ -30,7 +30,9 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from mbd.compiled.contact import KERNELS, TRACTION_IDS, pack_race
+import mbd.elements
+from mbd.compiled.contact import TRACTION_IDS, pack_race
+from mbd.compiled.registry import kind_of
 from mbd.element import evaluate
 from mbd.model import FrameState
 from mbd.elements.contact import (IMPACT_LAWS, EHLTraction, GuideContact, HydrodynamicLand, LubricantDrag,
@@ -52,7 +54,8 @@ MULTS = st.one_of(st.just(1), st.lists(st.integers(1, 3), min_size=N, max_size=N
 
 def compiled(elem, fs, qf, vf, z, jac, t=0.0):
     """(F, J_q, J_v) of the compiled kernel; outputs start as NaN so that every entry must be written."""
-    pack, kernel, _ = KERNELS[type(elem)]
+    twin = kind_of(type(elem))
+    pack, kernel = twin.pack, twin.evaluate
     P, G = pack(elem)
     ql, vl = np.ascontiguousarray(qf[elem.dofs]), np.ascontiguousarray(vf[elem.dofs])
     n, k = ql.shape
@@ -236,7 +239,8 @@ def test_update_matches_update_internal(kind, data, z):
         s0, s1 = data.draw(guide_states()), data.draw(guide_states())
         q0, v0, elem = guide_scene(*s0)
         q1, v1, _ = guide_scene(*s1)
-    pack, _, update = KERNELS[type(elem)]
+    twin = kind_of(type(elem))
+    pack, update = twin.pack, twin.update
     P, G = pack(elem)
     loc = lambda a: np.ascontiguousarray(a[elem.dofs])    # noqa: E731
     cols = lambda a: list(a[elem.dofs].T)                  # noqa: E731
@@ -282,6 +286,8 @@ def test_drag_zero_relative_orbit_has_zero_jacobian():
 
 
 def test_every_family_has_kernels():
-    assert set(KERNELS) == {RaceContact, PocketContact, GuideContact, LubricantDrag}
-    assert KERNELS[RaceContact][2] is None and KERNELS[LubricantDrag][2] is None
-    assert KERNELS[PocketContact][2] is not None and KERNELS[GuideContact][2] is not None
+    kinds = {c: kind_of(c) for c in vars(mbd.elements).values()
+             if isinstance(c, type) and str(getattr(c, "compiled_twin", None)).startswith("contact.")}
+    assert set(kinds) == {RaceContact, PocketContact, GuideContact, LubricantDrag}
+    assert kinds[RaceContact].update is None and kinds[LubricantDrag].update is None
+    assert kinds[PocketContact].update is not None and kinds[GuideContact].update is not None

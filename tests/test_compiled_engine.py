@@ -118,6 +118,26 @@ def test_what_cannot_be_compiled_falls_back_or_says_why(capsys):
         mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="fast", **kw)
 
 
+def test_a_family_without_a_compiled_twin_falls_back_and_says_so(capsys):
+    """A family that declares no compiled twin (here a subclass: it does not inherit its parent's, since its law
+    may differ) runs on the numpy path under "auto", announced in one line naming the family; "compiled" refuses."""
+    class HandTorque(mbd.elements.TorqueSource):
+        pass
+
+    mb = mbd.ModelBuilder()
+    mb.add_body("wheel", 1.0, 0.01)
+    mb.add(HandTorque("hand", [0], torque=1.0))
+    model = mb.build()
+    kw = dict(stepper=mbd.PRODUCTION.stepper(), controller=mbd.FixedStep(1e-3), progress=False)
+    res = mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="auto", **kw)
+    assert res.engine == "numpy" and "'hand' (HandTorque declares no compiled_twin)" in res.engine_note
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("mbd: running the numpy engine path") and "HandTorque" in err[0]
+    assert res.state.v[2] == pytest.approx(1.0 * 0.01 / 0.01)       # ω = τ·t/J: the numpy path ran the inherited law
+    with pytest.raises(mbd.ModelError, match="compiled engine cannot run.*HandTorque declares no compiled_twin"):
+        mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="compiled", **kw)
+
+
 def test_the_kernel_cache_is_dropped_when_any_compiled_source_changes(tmp_path, monkeypatch):
     """numba caches a function against its own file only: the compiled package keeps a hash of all its
     sources beside the cache and drops every cached kernel when it changes (a stale dispatch once kept

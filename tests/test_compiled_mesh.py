@@ -21,7 +21,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mbd import ad
+import mbd.elements
 from mbd.compiled import generic, mesh
+from mbd.compiled.registry import kind_of
 from mbd.element import evaluate
 from mbd.elements import (BodySpring, ForceSource, GearMesh, GroundSupport, Ramp, SpeedDrive, StiffnessShape,
                           TorqueSource, TorsionalSpring)
@@ -62,7 +64,8 @@ def libm_arctan2():
 
 def compiled(elem, t, fs, q, v, z=None, jac=True):
     """F, J_q, J_v of a family from its compiled kernel (and a check that jac=False gives the same F)."""
-    pack, kern, _ = {**mesh.KERNELS, **generic.KERNELS}[type(elem)]
+    twin = kind_of(type(elem))
+    pack, kern = twin.pack, twin.evaluate
     P, G = pack(elem)
     n, k = elem.dofs.shape
     ql, vl = np.ascontiguousarray(q[elem.dofs]), np.ascontiguousarray(v[elem.dofs])
@@ -314,15 +317,18 @@ def test_speed_drive_update_matches_update_internal(drive, fs0, fs1, s0, s1, t0,
 ])
 def test_callables_of_time_are_not_implemented(make, family):
     e = make()
-    pack = generic.KERNELS[type(e)][0]
+    pack = kind_of(type(e)).pack
     with pytest.raises(NotImplementedError, match=f"{family}.*callable"):
         pack(e)
 
 
 def test_kernel_tables():
-    assert set(mesh.KERNELS) == {GearMesh}
-    assert set(generic.KERNELS) == {GroundSupport, BodySpring, TorsionalSpring, TorqueSource, ForceSource, SpeedDrive}
-    for table in (mesh.KERNELS, generic.KERNELS):
-        for cls, (pack, kern, upd) in table.items():
-            assert callable(pack) and callable(kern)
-            assert (upd is not None) == (cls is SpeedDrive)
+    families = lambda module: {c: kind_of(c) for c in vars(mbd.elements).values()      # noqa: E731
+                               if isinstance(c, type) and str(getattr(c, "compiled_twin", None)).startswith(module)}
+    tables = families("mesh."), families("generic.")
+    assert set(tables[0]) == {GearMesh}
+    assert set(tables[1]) == {GroundSupport, BodySpring, TorsionalSpring, TorqueSource, ForceSource, SpeedDrive}
+    for table in tables:
+        for cls, twin in table.items():
+            assert callable(twin.pack) and callable(twin.evaluate)
+            assert (twin.update is not None) == (cls is SpeedDrive)

@@ -1,9 +1,9 @@
-"""Planet-bearing contact families (MODEL.md §3.3–3.6): exact Jacobians, Newton's third law, Palmgren's
+"""Planet-bearing contact families (docs/model.md §8): exact Jacobians, Newton's third law, Palmgren's
 law, no adhesion, traction/friction directions, pocket and guide geometry, lubricant drag; Hunt–Crossley
 impact damping with the approach speed as internal state (the restitution holds at any impact speed, checked
 with the engine); multiplicity (identical parallel contacts).
 
-Geometry from PARAMETERS.md: d_m = 39 mm, D = 7.5 mm, l = 9 mm, K = 1.22e9 N/m^(10/9), P_d = 20 µm.
+Geometry of the reference bearing (docs/parameters.md): d_m = 39 mm, D = 7.5 mm, l = 9 mm, K = 1.22e9 N/m^(10/9), P_d = 20 µm.
 """
 from __future__ import annotations
 
@@ -187,7 +187,7 @@ def race_scene(kind, pose, vel, psi, angles, deltas, v_normal, v_orbit, slips):
     return qf, vf, mk, R
 
 
-# the test laws (the preset's values, PARAMETERS.md): elements have no defaults for them
+# the test laws (the preset's values, docs/parameters.md): elements have no defaults for them
 TANH = TanhTraction(mu_max=0.08, v0=0.3)
 EHL = SlideRollTraction(A=-0.04, B=5.0, C=40.0, D=0.04, u_reg=0.1, s_eps=1e-4)
 FILM = EHLTraction(eta0=0.025, alpha_p=2.2e-8, E_red=2.31e11, length=LR, tau_L0=2e6, gamma_L=0.07, G_e=1e9,
@@ -274,7 +274,7 @@ def test_objectivity(elem_kind, data, alpha, w, u):
 
 # ---------------------------------------------------------------------------------------------
 def test_palmgren_constant_for_the_bearing():
-    """K = 8.06e4·l^(8/9) N/mm^(10/9) with l = 9 mm is 1.22e9 N/m^(10/9) (PARAMETERS.md), and it is the
+    """K = 8.06e4·l^(8/9) N/mm^(10/9) with l = 9 mm is 1.22e9 N/m^(10/9) (docs/parameters.md), and it is the
     inverse of Palmgren's δ[mm] = 3.84e-5 Q^0.9 / l^0.8."""
     l_mm = LR * 1e3
     K_mm = 8.06e4 * l_mm ** (8 / 9)                 # Q[N] = K_mm · δ[mm]^(10/9)
@@ -398,7 +398,7 @@ def _film_mu(law, v_s, u=5.0, Q=2000.0, R=3e-3):
 
 def test_ehl_traction_is_the_tanh_law_without_pressure_effects():
     """γ_L = 0, a rigid film (G_e → ∞) and α_p·p ≪ 1 (viscosity and limiting shear uniform over the strip):
-    the tanh law with μ_max = τ_L0/p̄ and v0 = h_c τ_L0/η₀ (MODEL.md §3.8's limit), to α_p·p_max."""
+    the tanh law with μ_max = τ_L0/p̄ and v0 = h_c τ_L0/η₀ (docs/model.md §9.3's limit), to α_p·p_max."""
     from mbd.elements import ehl
     law = EHLTraction(eta0=0.025, alpha_p=1e-13, E_red=2.31e11, length=LR, tau_L0=2e6, gamma_L=0.0, G_e=1e300,
                       u_reg=0.1, beta=0.0, k_oil=0.13)
@@ -885,7 +885,7 @@ def test_parameter_errors_name_the_parameter():
 
 
 # ---------------------------------------------------------------------------------------------
-# Hunt–Crossley damping with the real approach speed (MODEL.md §3.4)
+# Hunt–Crossley damping with the real approach speed (docs/model.md §8.4)
 @pytest.mark.parametrize("e", [0.999999, 0.99, 0.95, 0.9, 0.8, 0.5, 0.2, 0.05])
 def test_restitution_lambda_exact_relation(e):
     """ln((1 + λ)/(1 − λe)) = λ(1 + e): the residual vanishes, λ > 0, λ < 1/e."""
@@ -981,7 +981,7 @@ def _impact_run(kind, v_imp, e, gap_time=5e-6, periods=3.5, law=ExactRestitution
 @pytest.mark.parametrize("e", [0.8, 0.5])
 @pytest.mark.parametrize("v_imp", [0.1, 1.0, 3.0])
 def test_impact_restitution_holds_at_any_speed(kind, e, v_imp):
-    """MODEL.md §3.4 check: driven into the wall at 0.1, 1 and 3 m/s, the body leaves with e within 5 %."""
+    """docs/model.md §8.4 check: driven into the wall at 0.1, 1 and 3 m/s, the body leaves with e within 5 %."""
     rate0, out, z = _impact_run(kind, v_imp, e)
     assert rate0 == pytest.approx(v_imp, rel=1e-3)
     # separated: no penetration, approach speed and stored state back to 0, moving away

@@ -1,9 +1,9 @@
-"""MODEL.md §6: the physics checks of the DPGT on the reference machine (PARAMETERS.md).
+"""docs/model.md §15.1–15.7: the physics checks of the DPGT on the reference machine (docs/parameters.md).
 
 Each check builds only what it needs (SceneOptions), runs the engine and asserts a physical law:
 1 kinematics, 2 mesh invariants at the scene level, 3 the quasi-static force polygon of every planet
 bearing, 4 the bearing alone on its rig, 5 frame invariance, 6 mirror symmetry, 7 properties over
-random valid designs, 8 clear errors for bad input. (§6 check 7, conservation, is the engine's:
+random valid designs, 8 clear errors for bad input. (check §15.7, conservation, is the engine's:
 tests/test_engine_conservation.py.)
 """
 from __future__ import annotations
@@ -37,7 +37,7 @@ def params(condition=3, direction="forward", overrides=None):
 
 
 def build(p, **options):
-    """build_dpgt without the reference design's two known tip-overlap warnings (PARAMETERS.md)."""
+    """build_dpgt without the reference design's two known tip-overlap warnings (docs/model.md §1.6)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DesignWarning)
         return build_dpgt(p, SceneOptions(**options))
@@ -350,7 +350,7 @@ def test_bearing_alone_load_sum_and_load_zone(rig_runs):
 
 
 def test_a_double_row_bearing_under_twice_the_load_carries_per_roller_what_one_row_carries():
-    """bearing.rows = 2 (PARAMETERS.md): two identical rows move as one; under 2 F_r every physical roller
+    """bearing.rows = 2 (docs/model.md §10.2): two identical rows move as one; under 2 F_r every physical roller
     carries what a roller of the single-row bearing carries under F_r, and the rows together balance 2 F_r."""
     ref = params(3)
     sol = {}

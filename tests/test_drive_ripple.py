@@ -1,4 +1,4 @@
-"""The rig's carrier drive with carrier-synchronous speed ripple (MODEL.md §3.10, ``rig.carrier_ripple``):
+"""The rig's carrier drive with carrier-synchronous speed ripple (docs/model.md §10.3, ``rig.carrier_ripple``):
 the reference machine's zero ripple keeps the drive as it was, bad input is named, and a stiff drive makes
 the carrier follow its rippled reference."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Conservation (MODEL.md §6.7): no supports → linear and angular momentum conserved in I; no damping
+"""Conservation (docs/model.md §15.7): no supports → linear and angular momentum conserved in I; no damping
 and α = 0 on a linear system → energy conserved to round-off; Jacobi integral in a rotating frame."""
 from __future__ import annotations
 

@@ -303,7 +303,7 @@ def test_system_forces_include_frame_terms_exactly():
     v = np.array([0.3, 0.4, -1.0])
     F = s.forces(t, q, v, {})
     phi, W = W0 * t + 0.5 * dW * t * t, W0 + dW * t
-    gR = -9.81 * np.array([np.sin(phi), np.cos(phi)])   # g_R = −g (sin φ, cos φ), MODEL.md §2
+    gR = -9.81 * np.array([np.sin(phi), np.cos(phi)])   # g_R = −g (sin φ, cos φ), docs/model.md §2.3
     expect = np.array([2.0 * (W * W * 0.1 + 2 * W * 0.4 + dW * -0.2) + 2.0 * gR[0],
                        2.0 * (W * W * -0.2 - 2 * W * 0.3 - dW * 0.1) + 2.0 * gR[1],
                        -0.3 * dW])

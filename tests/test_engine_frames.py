@@ -1,4 +1,4 @@
-"""Frame invariance (MODEL.md §6.5): the same scene integrated in I and in a rotating R gives the same
+"""Frame invariance (docs/model.md §15.5): the same scene integrated in I and in a rotating R gives the same
 physical motion; frame conversions are consistent."""
 from __future__ import annotations
 

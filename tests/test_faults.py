@@ -1,4 +1,4 @@
-"""Manufacturing errors and faults (MODEL.md §3.9): the parameters, the perfect machine, and each
+"""Manufacturing errors and faults (docs/model.md §11): the parameters, the perfect machine, and each
 error's signature."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Spur gear mesh element (MODEL.md §3.2, checks §6.2)."""
+"""Spur gear mesh element (docs/model.md §6, checks §15.2)."""
 from __future__ import annotations
 
 import numpy as np

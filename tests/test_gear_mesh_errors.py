@@ -1,4 +1,4 @@
-"""Gear-mesh eccentricity (MODEL.md §3.9): the law on the geometric centres, in the numpy reference and
+"""Gear-mesh eccentricity (docs/model.md §6.4, §11.2): the law on the geometric centres, in the numpy reference and
 the compiled kernel. (Tooth faults and deviations: the tooth-pair law, tests/test_tooth_pairs.py.)
 
 (a) reference vs compiled forces and Jacobians, and Jacobians vs finite differences, with offsets, also

@@ -1,4 +1,4 @@
-"""Involute geometry, layout, kinematics, mesh phasing and design checks (MODEL.md §1, PARAMETERS.md)."""
+"""Involute geometry, layout, kinematics, mesh phasing and design checks (docs/model.md §1, docs/parameters.md)."""
 import math
 import warnings
 
@@ -32,7 +32,7 @@ def near_int(x, tol=1e-9):
     return np.abs(x - np.round(x)) < tol
 
 
-# ------------------------------------------------------------------ PARAMETERS.md derived numbers
+# ------------------------------------------------------------------ derived numbers (docs/parameters.md)
 def test_derived_numbers(lay):
     assert lay.r_ca == pytest.approx(82.5e-3, rel=1e-12)
     assert lay.r_cb == pytest.approx(87.0e-3, rel=1e-12)
@@ -203,7 +203,7 @@ def test_pairs_in_contact_and_flank_convention(lay):
 def test_flank_contact_position_matches_involute_teeth(lay):
     """Independent check of the flank convention with real involute teeth: gear 1 at the origin, line of
     centres along +x, tooth centre line at angle c (so p = z_1·c/2π). The face loaded on flank f is the
-    one whose outward normal is minus the force on gear 1 (MODEL.md §3.2: −n_f external, n_f internal);
+    one whose outward normal is minus the force on gear 1 (docs/model.md §6.2: −n_f external, n_f internal);
     its intersection with flank f's line of action must sit where contact_position says (mod p_b)."""
     from scipy.optimize import brentq
 
@@ -254,7 +254,7 @@ def test_wave_phase_reproduces_tooth_pair_count(lay):
 
 @pytest.mark.parametrize("sun_torque_sign", [1, -1])
 def test_loaded_flanks_follow_the_torque_path(sun_torque_sign):
-    """MODEL.md §3.2 compressions for a driven chain: the sun turns by s·ε with its planet held, then each
+    """docs/model.md §6.1 compressions for a driven chain: the sun turns by s·ε with its planet held, then each
     planet turns as it is driven with the next gear held; the compressed flank is the loaded one."""
     rb = {"s": 0.0437, "a": 0.0338, "b": 0.0338, "r": 0.1156}
     zs, za, zb = 31, 24, 24

@@ -1,4 +1,4 @@
-"""The load path through real gears (MODEL.md §3.2, §6.3): with the ISO/TR 10064-2 backlash the coast
+"""The load path through real gears (docs/model.md §6, §15.3): with the ISO/TR 10064-2 backlash the coast
 flanks stay open, the torque path loads the drive flanks, and the planet bearings — not the ring teeth —
 hold the planets' centrifugal load. Statistics come from components.outputs.WindowStatistics (every
 accepted step, a window of one whole cage revolution relative to the carrier)."""
@@ -173,7 +173,7 @@ def test_cage_slip_is_the_lag_behind_the_epicyclic_speed(full_load_reverse):
 def test_zero_backlash_hands_centrifugal_load_to_the_ring_teeth():
     """Zero backlash (not a real gear): the outer planets' centrifugal load closes both flanks of the ring
     mesh, so its coast flank carries a large mean force and the outer bearings less load than with backlash
-    (measured ≈ 5 kN on the coast flank; PARAMETERS.md). This is what the old default hid."""
+    (measured ≈ 5 kN on the coast flank; the backlash row of docs/parameters.md). This is what the old default hid."""
     zero = {f"mesh.backlash_{k}": "0 um" for k in MESH_FAMILY}
     bs, stats, _, _ = run(3, "forward", zero, window=2e-3)
     coast = stats.stats("outer_ring_coast_force")["mean"]

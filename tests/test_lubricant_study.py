@@ -1,4 +1,4 @@
-"""scenarios.lubricant_study end to end on a tiny window (MODEL.md §3.8, the source's open question)."""
+"""scenarios.lubricant_study end to end on a tiny window (docs/model.md §9, the source's open question)."""
 from __future__ import annotations
 
 import csv

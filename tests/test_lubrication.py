@@ -1,4 +1,4 @@
-"""The lubricant film of the roller contacts (components.lubrication, MODEL.md §3.8)."""
+"""The lubricant film of the roller contacts (components.lubrication, docs/model.md §9)."""
 from __future__ import annotations
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""A local raceway defect (spall) and per-roller diameters in the roller–raceway contact (MODEL.md §3.3, §3.9),
+"""A local raceway defect (spall) and per-roller diameters in the roller–raceway contact (docs/model.md §8.3, §11.3–11.4),
 in both engine paths: the law d(s) = h·B(s) against an independent smoothstep and a time difference of the
 deflection (the rate term), exact Jacobians (finite differences; compiled = reference on random states, on the
 edges of the defect, with the roller spinning), a family without a spall unchanged bit for bit, fusion, the

@@ -110,7 +110,7 @@ def _check_lives(d):
 
 def test_zero_power_forward_and_reverse_agree(zero_power_study):
     """With no transmitted power the bearing load is centrifugal (+ gravity): the direction of rotation
-    must not change the mean bearing load by more than 2 % (MODEL.md §6.6 in spirit). The relative life the
+    must not change the mean bearing load by more than 2 % (docs/model.md §15.6 in spirit). The relative life the
     study writes into each summary is ISO 281's (P_forward/P)^(10/3) of the two runs' equivalent loads (the
     forward run's is 1 by definition; the reverse's is what carries information)."""
     out, _ = zero_power_study
@@ -196,12 +196,12 @@ def test_spectrum_peaks_sit_on_mesh_sidebands(tmp_path):
 
 @pytest.mark.slow
 def test_spectrum_housing_sensor_on_a_perfect_machine(tmp_path, capsys):
-    """The windowed housing sensor (MODEL.md §3.10) on a perfect machine: a passing-planet window carries every
+    """The windowed housing sensor (docs/model.md §12) on a perfect machine: a passing-planet window carries every
     carrier order, so besides f_m − f_c the other lines planet phasing allows for z_r = 82, N = 3 appear —
     f_m + 2f_c, f_m − 4f_c, f_m + 5f_c stand out of the band's median by ≥ 5× (seen: 8e4–2e5×) — while
     the lines phasing cancels, f_m, f_m + f_c and f_m ± 3f_c among them, stay below 1 % of the strongest
     (seen: ≤ 5e-4 %): the window alone does not bring f_m or f_m + f_c (McFadden & Smith 1985: "complete
-    suppression of the component at the tooth meshing frequency"); errors (MODEL.md §3.9) must."""
+    suppression of the component at the tooth meshing frequency"); errors (docs/model.md §11) must."""
     argv = ["--out", str(tmp_path), "--settle", "0.06", "--window", "0.09", "--option", "bearings=linear",
             "--no-progress", "--perfect"]
     s = spectrum.run(spectrum.parse_args(argv))
@@ -318,7 +318,7 @@ def test_spectrum_rig_machine_errors_bring_the_cancelled_lines(tmp_path):
     planets' symmetry, so every line planet phasing cancels for a perfect machine rises far above its perfect
     level on the housing sensor (seen with linear bearings: f_m 9e-5 → 1.5, f_m + f_c 1e-4 → 2.1, f_m ± 3f_c 1e-4
     → 1.7–2.0 m/s²), the largest line in f_m ± 6 f_c stays f_m − f_c (one of the source's measured lines), and
-    the net force of the unequal load sharing puts f_m + f_c on the bearing path (11× its floor; MODEL.md §3.10:
+    the net force of the unequal load sharing puts f_m + f_c on the bearing path (11× its floor; docs/model.md §12.3:
     static planet-to-planet errors add just f_m + f_c to the net carrier force). What the source measured —
     f_m, f_m ± f_c, f_m ± 3f_c all standing out — is not reproduced: the teeth raise the band's floor with the
     lines, and on the sum (carried by the mesh path) f_m, f_m + f_c and f_m ± 3f_c stay at the floor

@@ -1,4 +1,4 @@
-"""The rig's housing accelerometer as transfer paths (MODEL.md §3.10, components.sensor): the passing-planet
+"""The rig's housing accelerometer as transfer paths (docs/model.md §12, components.sensor): the passing-planet
 window, each path against a closed form, the loads recorded on the housing, and the planet-phasing rule that
 says which sidebands a sensor can see (components.geometry.sideband_origin) — on every path of a simulated
 perfect machine."""

@@ -1,5 +1,5 @@
 """The rig's spectrum of a perfect machine with the full model (gravity, roller bearings with cages): the lines
-planet phasing cancels stay at the band's broadband floor on the housing sensor (MODEL.md §3.10). Its own file,
+planet phasing cancels stay at the band's broadband floor on the housing sensor (docs/model.md §12.3). Its own file,
 so that the ≈ 60 s run goes to a test worker of its own."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The tooth-pair mesh law (MODEL.md §3.2, mbd.elements.tooth_pairs): transmission error tooth by tooth.
+"""The tooth-pair mesh law (docs/model.md §7, mbd.elements.tooth_pairs): transmission error tooth by tooth.
 
 (a) numpy reference = compiled kernel (forces, Jacobians), Jacobians = finite differences, with deviations,
     relief, faults and eccentricity, also across the line of centres' branch cut and in a fused family;

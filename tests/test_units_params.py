@@ -117,7 +117,7 @@ def test_units_round_trip_mm_in_m_inside():
     assert s.clearance == pytest.approx(20e-6, rel=1e-12)
     assert s.inner_raceway_radius == pytest.approx(31.5e-3 / 2)
     assert s.outer_raceway_radius == pytest.approx((46.5e-3 + 20e-6) / 2)
-    # MODEL.md §3.3: P_d = 2R_o − 2R_i − 2D
+    # docs/model.md §8: P_d = 2R_o − 2R_i − 2D
     assert 2 * s.outer_raceway_radius - 2 * s.inner_raceway_radius - 2 * s.roller_diameter == pytest.approx(s.clearance)
 
 
@@ -419,7 +419,7 @@ def test_random_bearings_checks_never_crash_and_si_is_consistent(values):
 
 
 def test_backlash_defaults_to_the_iso_minimum_per_mesh_and_zero_is_allowed():
-    """PARAMETERS.md: j_bn,min = (2/3)(0.06 + 0.0005 a + 0.03 m_n) mm, a per mesh type, tagged [derived]."""
+    """docs/model.md §1.5: j_bn,min = (2/3)(0.06 + 0.0005 a + 0.03 m_n) mm, a per mesh type, tagged [derived]."""
     p = reference_dpgt()
     si = p.si()
     for key, a_mm, b_mm in (("sun_inner", 82.5, 0.1275), ("inner_outer", 72.0, 0.124), ("outer_ring", 87.0, 0.129)):

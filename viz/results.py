@@ -367,7 +367,7 @@ def cage_orbits(run: Run, pair: int | None = 0, frame: str = "carrier") -> dict[
     reference pair of the study); pair=None → {bearing name: (n_t, 2)} for every bearing.
     frame: axes of the offset, see :func:`view_angle`; "carrier" (default) is the frame R itself for a
     run in the rotating frame and makes runs in either frame comparable.  |e| is the guide contact's
-    eccentricity ε (MODEL.md §3.5)."""
+    eccentricity ε (docs/model.md §8.6)."""
     if pair is None:
         chosen = {b["name"]: b for b in run.bearings}
     else:
@@ -380,7 +380,7 @@ def cage_orbits(run: Run, pair: int | None = 0, frame: str = "carrier") -> dict[
 def roller_offsets(run: Run, bearing: str | Mapping = "inner", pair: int = 0) -> np.ndarray:
     """(n_t, Z, 2) offsets of the rollers from their ideal positions, in the axes of pocket j [m].
 
-    Ideal position of roller j: centred in pocket j (angle θ_g + 2πj/Z, MODEL.md §3.4) on the circle
+    Ideal position of roller j: centred in pocket j (angle θ_g + 2πj/Z, docs/model.md §8.5) on the circle
     d_m/2 about the pin.  The offset is expressed in cage axes, where pocket j lies at the fixed angle
     ψ_j = 2πj/Z, as radial·(cos ψ_j, sin ψ_j) + tangential·(−sin ψ_j, cos ψ_j) with
       tangential = s_j = (d_m/2)·wrap(β_j − θ_g − ψ_j), β_j the angle of the roller about the cage

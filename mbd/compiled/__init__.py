@@ -1,7 +1,9 @@
 """Compiled (numba) engine path. The plain numpy path (:mod:`mbd.element`, :mod:`mbd.assembly`,
 :mod:`mbd.hht`) stays the reference: tests hold the two together to round-off.
 
-Kernel convention (one module per group of element families; every function ``@njit(cache=True)``):
+Kernel convention (one module per group of element families; every function ``@njit(cache=True)``; a family
+declaring ``compiled_twin = "module.name"`` has ``pack_name``, ``evaluate_name`` and ``update_name`` there,
+see :mod:`.registry`):
 
 ``pack(elem) -> (P, G)``
     Python side, once at assembly: the family's per-instance parameters as one C-contiguous float64

@@ -43,7 +43,7 @@ from ..elements.contact import (DryLand, EHLTraction, GuideContact, Hydrodynamic
                                 RaceContact, SlideRollTraction, TanhTraction)
 
 __all__ = ["pack_race", "evaluate_race", "pack_pocket", "evaluate_pocket", "update_pocket", "pack_guide",
-           "evaluate_guide", "update_guide", "pack_drag", "evaluate_drag", "KERNELS", "TRACTION_IDS"]
+           "evaluate_guide", "update_guide", "pack_drag", "evaluate_drag", "TRACTION_IDS"]
 
 _ETA2 = 1e-24          # the reference's η² (mbd.elements.contact._ETA2)
 _TWO_PI = 2.0 * np.pi
@@ -572,7 +572,7 @@ def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         fr = -mu * th * Fi
         wx, wy = vg0 - vo0, vg1 - vo1
         Fn_f, Ft_f, sh = 0.0, 0.0, 0.0
-        if hydro:      # the oil film carries the cage; its shear adds to the friction (MODEL.md §3.8)
+        if hydro:      # the oil film carries the cage; its shear adds to the friction (docs/model.md §9.4)
             film = _film(clr, G[1], G[2], G[3], rL, ex, ey, eps, wx, wy, vg2, vo2, v_t)
             Fn_f, Ft_f, sh = film[0], film[1], film[2]
         Fnt, Ftt = -Fi + Fn_f, fr + sh + Ft_f
@@ -666,11 +666,3 @@ def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
             _write(F, Jq, Jv, i, j, mult, dFx, dFy, 0.0, -dFx, -dFy,
                    -_d_cross(px, py, drcx + ddx, drcy + ddy, Fx, Fy, dFx, dFy))
 
-
-# families -> (pack, evaluate, update or None), for the assembler
-KERNELS = {
-    RaceContact: (pack_race, evaluate_race, None),
-    PocketContact: (pack_pocket, evaluate_pocket, update_pocket),
-    GuideContact: (pack_guide, evaluate_guide, update_guide),
-    LubricantDrag: (pack_drag, evaluate_drag, None),
-}

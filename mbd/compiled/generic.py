@@ -31,7 +31,7 @@ from ..elements.springs import BodySpring, GroundSupport, TorsionalSpring
 __all__ = ["pack_ground_support", "evaluate_ground_support", "pack_body_spring", "evaluate_body_spring",
            "pack_torsional_spring", "evaluate_torsional_spring", "pack_torque_source", "evaluate_torque_source",
            "pack_force_source", "evaluate_force_source", "pack_speed_drive", "evaluate_speed_drive",
-           "update_speed_drive", "KERNELS"]
+           "update_speed_drive"]
 
 _NO_G = np.zeros(0)
 
@@ -305,12 +305,3 @@ def update_speed_drive(z, t0, t1, ql0, vl0, ql1, vl1, P, G, phi0, phi1):
         z1[i, 0] = z[i, 0] + 0.5 * (t1 - t0) * (e0 + e1)
     return z1
 
-
-KERNELS = {
-    GroundSupport: (pack_ground_support, evaluate_ground_support, None),
-    BodySpring: (pack_body_spring, evaluate_body_spring, None),
-    TorsionalSpring: (pack_torsional_spring, evaluate_torsional_spring, None),
-    TorqueSource: (pack_torque_source, evaluate_torque_source, None),
-    ForceSource: (pack_force_source, evaluate_force_source, None),
-    SpeedDrive: (pack_speed_drive, evaluate_speed_drive, update_speed_drive),
-}

@@ -43,7 +43,7 @@ from numba import njit
 from ..elements.gear_mesh import ConstantStiffness, FourierStiffness, GearMesh, RectangularStiffness
 from . import tooth_pairs
 
-__all__ = ["pack_gear_mesh", "evaluate_gear_mesh", "KERNELS"]
+__all__ = ["pack_gear_mesh", "evaluate_gear_mesh"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -339,5 +339,3 @@ def _meshes(ql, vl, P, G, F, Jq, Jv, jac):
         _put_row(Jq, Jv, i, 4, sig, hy, sig)
         _put_row(Jq, Jv, i, 5, -1.0 * rb2, hnet, sig)
 
-
-KERNELS = {GearMesh: (pack_gear_mesh, evaluate_gear_mesh, None)}

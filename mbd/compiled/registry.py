@@ -1,43 +1,57 @@
-"""Which compiled kernel evaluates which element family: a kind id per family class, and the compiled
-dispatch on it (a static if-chain: numba can cache it, no first-class functions needed).
+"""Which compiled kernel evaluates which element family, and the compiled dispatch on it (a static if-chain:
+numba can cache it, no first-class functions needed).
 
-Adding a compiled family: its pack/evaluate(/update) in a kernel module, an id below, one branch in
-:func:`evaluate_kind` (and :func:`update_kind` when it has internal state)."""
+Each family declares its twin where it is defined (``Element.compiled_twin = "module.name"``: the kernels
+``pack_name``, ``evaluate_name`` and, with internal state, ``update_name`` of ``mbd.compiled.module``); here
+each twin has a kind id and a branch of :func:`evaluate_kind` (and of :func:`update_kind`). Adding a compiled
+family: its kernels in a kernel module, the declaration on the family, an id in :data:`KIND_IDS` and the
+branches (tests/test_architecture.py checks that they agree)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 from numba import njit
 
-from ..elements import (BodySpring, ForceSource, GearMesh, GroundSupport, GuideContact, LubricantDrag,
-                        PocketContact, RaceContact, SpeedDrive, TorqueSource, TorsionalSpring)
 from . import contact, generic, mesh
 
-__all__ = ["Kind", "KINDS", "evaluate_kind", "update_kind"]
+__all__ = ["Kind", "KIND_IDS", "kind_of", "evaluate_kind", "update_kind"]
 
 
 @dataclass(frozen=True)
 class Kind:
     id: int
-    pack: object          # element -> (P, G)
+    pack: Callable            # element -> (P, G)
+    evaluate: Callable
+    update: Callable | None   # None: the family has no internal state
 
 
 _RACE, _POCKET, _GUIDE, _DRAG, _MESH, _SUPPORT, _BODY_SPRING, _TORSION, _TORQUE, _FORCE, _SPEED = range(11)
 
-KINDS = {
-    RaceContact: Kind(_RACE, contact.pack_race),
-    PocketContact: Kind(_POCKET, contact.pack_pocket),
-    GuideContact: Kind(_GUIDE, contact.pack_guide),
-    LubricantDrag: Kind(_DRAG, contact.pack_drag),
-    GearMesh: Kind(_MESH, mesh.pack_gear_mesh),
-    GroundSupport: Kind(_SUPPORT, generic.pack_ground_support),
-    BodySpring: Kind(_BODY_SPRING, generic.pack_body_spring),
-    TorsionalSpring: Kind(_TORSION, generic.pack_torsional_spring),
-    TorqueSource: Kind(_TORQUE, generic.pack_torque_source),
-    ForceSource: Kind(_FORCE, generic.pack_force_source),
-    SpeedDrive: Kind(_SPEED, generic.pack_speed_drive),
+# compiled twin (as the families declare it) -> its id in the dispatch below
+KIND_IDS = {
+    "contact.race": _RACE, "contact.pocket": _POCKET, "contact.guide": _GUIDE, "contact.drag": _DRAG,
+    "mesh.gear_mesh": _MESH,
+    "generic.ground_support": _SUPPORT, "generic.body_spring": _BODY_SPRING, "generic.torsional_spring": _TORSION,
+    "generic.torque_source": _TORQUE, "generic.force_source": _FORCE, "generic.speed_drive": _SPEED,
 }
+_MODULES = {"contact": contact, "generic": generic, "mesh": mesh}
+
+
+def kind_of(cls) -> Kind | None:
+    """The compiled twin a family class declares (``cls.compiled_twin``), or None when it declares none. A
+    declared twin the registry does not know raises LookupError: a typo must not send runs to the numpy path."""
+    twin = cls.compiled_twin
+    if twin is None:
+        return None
+    module, _, name = twin.partition(".")
+    if twin not in KIND_IDS or module not in _MODULES:
+        raise LookupError(f"{cls.__name__}.compiled_twin = {twin!r}: no such compiled kernel "
+                          f"(mbd.compiled.registry.KIND_IDS has {sorted(KIND_IDS)})")
+    mod = _MODULES[module]
+    return Kind(KIND_IDS[twin], getattr(mod, f"pack_{name}"), getattr(mod, f"evaluate_{name}"),
+                getattr(mod, f"update_{name}", None))
 
 
 @njit(cache=True)

@@ -12,7 +12,7 @@ from numba import njit
 from numba.typed import List
 
 from ..assembly import Evaluation, System
-from .registry import KINDS, evaluate_kind, update_kind
+from .registry import evaluate_kind, kind_of, update_kind
 
 __all__ = ["CompiledSystem", "assemble"]
 
@@ -119,7 +119,7 @@ class CompiledSystem:
     """The compiled twin of a :class:`mbd.System` (same fused families, pattern and maps).
 
     Raises NotImplementedError (naming the family or the frame) for what the compiled path cannot do:
-    a frame with a Python speed profile, or a family without a compiled kernel (see :mod:`.registry`)."""
+    a frame with a Python speed profile, or a family without a compiled twin (see :mod:`.registry`)."""
 
     def __init__(self, system: System):
         m = system.model
@@ -130,10 +130,10 @@ class CompiledSystem:
         self.state_shapes: list[tuple] = []
         fams, zs = [], _list_of(np.zeros((0, 0)))      # zs slot 0: families without internal state
         for (e, parts), (keep, mp) in zip(system._evals, system._maps):
-            kind = KINDS.get(type(e))
+            kind = kind_of(type(e))
             if kind is None:
                 raise NotImplementedError(f"compiled path: no compiled kernel for family {e.name!r} "
-                                          f"({type(e).__name__})")
+                                          f"({type(e).__name__} declares no compiled_twin)")
             P, G = kind.pack(e)
             zi = 0
             z0 = e.init_internal()

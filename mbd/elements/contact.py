@@ -1,4 +1,4 @@
-"""Planet-bearing contacts (MODEL.md §3.3–3.6): roller–raceway Hertz line contact with traction,
+"""Planet-bearing contacts (docs/model.md §8): roller–raceway Hertz line contact with traction,
 roller–cage pocket impact, cage–guide-land impact and lubricant drag on the rollers.
 
 Every family covers all rollers (or cages) of all bearings at once; each instance couples two bodies
@@ -90,7 +90,7 @@ def restitution_lambda(e) -> np.ndarray:
 
 
 class ImpactLaw:
-    """Base of the impact damping laws F = K x (1 + λ ẋ/v₀) (MODEL.md §3.4): a law is the dimensionless
+    """Base of the impact damping laws F = K x (1 + λ ẋ/v₀) (docs/model.md §8.4): a law is the dimensionless
     damping λ(e) = c·v₀ for a coefficient of restitution e, a small frozen dataclass registered in
     :data:`IMPACT_LAWS` by name (a parameter chooses one)."""
 
@@ -142,7 +142,7 @@ IMPACT_LAWS = MappingProxyType({"exact": ExactRestitution, "hunt_crossley": Hunt
 
 
 class _Impact(Element):
-    """Hunt–Crossley impact with the real approach speed (MODEL.md §3.4), shared by the pocket and
+    """Hunt–Crossley impact with the real approach speed (docs/model.md §8.4), shared by the pocket and
     guide-land contacts. Subclasses define ``_gap(q, v) -> (x, ẋ)`` (penetration and its rate).
 
     F = K x (1 + c ẋ) for x > 0, clipped at ≥ 0 (never pulling), else 0;  c = λ(e)/v₀ with λ(e) from
@@ -200,7 +200,7 @@ class _Impact(Element):
 
 # --------------------------------------------------------------------------------------------
 class Traction:
-    """Base of the roller–raceway traction laws μ: smooth, odd and bounded (MODEL.md §3.3). A law is a
+    """Base of the roller–raceway traction laws μ: smooth, odd and bounded (docs/model.md §8.2). A law is a
     small frozen dataclass registered in :data:`TRACTION_LAWS` by name; its fields have no defaults
     (every value comes from the parameters)."""
     needs_rolling_speed = False
@@ -263,7 +263,7 @@ class SlideRollTraction(Traction):
 
 @dataclass(frozen=True)
 class EHLTraction(Traction):
-    """EHL traction of a lubricated line contact (MODEL.md §3.8). Over the Hertz strip (8 Gauss points),
+    """EHL traction of a lubricated line contact (docs/model.md §9.3). Over the Hertz strip (8 Gauss points),
     the oil film shears with the effective viscosity of a Maxwell fluid crossing the contact,
     1/η_eff = 1/η(p) + u/(G_e b) (Barus η = eta0·e^(alpha_p·p); G_e the film's elastic shear modulus,
     b the Hertz half-width, u the entraining speed: a film element is sheared only for the transit time
@@ -347,7 +347,7 @@ class RaceContact(Element):
     contacts (a double-row bearing modelled as one row): the law above is one physical contact's (K, and
     m_roller the mass of one physical roller), and the generalized forces are multiplied by it.
 
-    Local raceway defect (spall, MODEL.md §3.9; all four per instance, or all None = no spall, the default):
+    Local raceway defect (spall, docs/model.md §8.3; all four per instance, or all None = no spall, the default):
     ``spall_angle`` [rad] the defect's centre, an angle about the raceway centre in the race body's axes (as
     the output "angle": the defect is fixed on the race body); ``spall_width`` w > 0 [m] its arc length along
     the raceway; ``spall_depth`` h ≥ 0 [m]; ``spall_edge`` e in (0, w] [m] the length over which the depth
@@ -370,6 +370,7 @@ class RaceContact(Element):
     """
     batched = True
     n_local = 6
+    compiled_twin = "contact.race"
 
     def __init__(self, name, roller, race_body, *, kind, race_marker, R_race, D, K, exponent, zeta, m_roller,
                  traction: Traction, multiplicity=1, spall_angle=None, spall_width=None, spall_depth=None,
@@ -496,7 +497,7 @@ class RaceContact(Element):
 
 # --------------------------------------------------------------------------------------------
 class PocketContact(_Impact):
-    """Roller–cage pocket impact with wall friction (MODEL.md §3.4).
+    """Roller–cage pocket impact with wall friction (docs/model.md §8.5).
 
     Instances couple a roller (first 3 coordinates) with its cage (last 3). Circumferential offset of
     the roller in pocket j: s = (d_m/2)·wrap(β − θ_g − ψ_j), β the angle of (p − c_g) in R. Penetration
@@ -521,6 +522,7 @@ class PocketContact(_Impact):
     """
     batched = True
     n_local = 6
+    compiled_twin = "contact.pocket"
 
     def __init__(self, name, roller, cage, *, pocket_angle, pitch_radius, clearance, K_p, restitution,
                  impact_law, v_min, mu, v_mu, D, multiplicity=1):
@@ -582,7 +584,7 @@ class PocketContact(_Impact):
 
 # --------------------------------------------------------------------------------------------
 class LandLaw:
-    """Base of the cage guide-land laws (MODEL.md §3.5, §3.8), registered in :data:`LAND_LAWS` by name."""
+    """Base of the cage guide-land laws (docs/model.md §8.6, §9.4), registered in :data:`LAND_LAWS` by name."""
 
 
 @dataclass(frozen=True)
@@ -647,7 +649,7 @@ LAND_LAWS = MappingProxyType({"dry": DryLand, "hydrodynamic": HydrodynamicLand})
 
 
 class GuideContact(_Impact):
-    """Cage–guide-land impact for an outer-raceway-guided cage (MODEL.md §3.5).
+    """Cage–guide-land impact for an outer-raceway-guided cage (docs/model.md §8.6).
 
     Instances couple a cage (first 3 coordinates) with its planet (last 3; the planet's centre is the
     bore centre). e = c_g − c_o, ε = |e|, n = e/ε, penetration x = ε − C_g, rate ẋ = ε̇. For x > 0 the
@@ -668,6 +670,7 @@ class GuideContact(_Impact):
     """
     batched = True
     n_local = 6
+    compiled_twin = "contact.guide"
 
     def __init__(self, name, cage, planet, *, clearance, K_g, restitution, impact_law, v_min, mu, v_mu,
                  land_radius, land: "LandLaw"):
@@ -725,7 +728,7 @@ class GuideContact(_Impact):
 
 # --------------------------------------------------------------------------------------------
 class LubricantDrag(Element):
-    """Lubricant (oil–air mixture) drag on the rollers' orbital motion (MODEL.md §3.6).
+    """Lubricant (oil–air mixture) drag on the rollers' orbital motion (docs/model.md §8.7).
 
     Instances couple a roller (first 3 coordinates) with the body carrying the inner raceway (last 3:
     the carrier, ``race_marker`` = pin centre in its axes). Ω_m = orbital angular speed of the roller
@@ -741,6 +744,7 @@ class LubricantDrag(Element):
     """
     batched = True
     n_local = 6
+    compiled_twin = "contact.drag"
 
     def __init__(self, name, roller, race_body, *, race_marker, C_d, rho, D, l, d_m, multiplicity=1):
         self.name = name

@@ -33,6 +33,7 @@ class TorqueSource(Element):
     """Torque on bodies: ``torque`` [N·m] scalar/(n,) constant, scaled by ``ramp`` (a callable of t),
     or ``torque`` a callable t -> (n,) torques."""
     n_local = 3
+    compiled_twin = "generic.torque_source"
 
     def __init__(self, name, bodies, torque, ramp: Callable[[float], float] | None = None):
         self.name = name
@@ -66,6 +67,7 @@ class SpeedDrive(Element):
     sin(Ω_j t + φ_j), its exact integral. Without ripple the reference is evaluated as without the term.
     """
     n_local = 3
+    compiled_twin = "generic.speed_drive"
 
     def __init__(self, name, body, omega_ref, k, c=0.0, k_i=0.0, theta0=0.0, ripple=None):
         self.name = name

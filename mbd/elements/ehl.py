@@ -1,4 +1,4 @@
-"""Elastohydrodynamic line contact (MODEL.md §3.8): the one owner of the film-thickness and Hertz-strip
+"""Elastohydrodynamic line contact (docs/model.md §9.2): the one owner of the film-thickness and Hertz-strip
 laws, written with :mod:`mbd.ad` so that the EHL traction law of the roller contacts differentiates
 exactly; :mod:`components.lubrication` uses the same functions for the film outputs.
 

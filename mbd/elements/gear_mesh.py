@@ -1,4 +1,4 @@
-"""Spur gear mesh: two flanks, optional backlash, time-varying stiffness (MODEL.md §3.2).
+"""Spur gear mesh: two flanks, optional backlash, time-varying stiffness (docs/model.md §6).
 
 One :class:`GearMesh` family holds n meshes of one kind (all external or all internal). Local
 coordinates are (x1, y1, θ1, x2, y2, θ2): gear 1 then gear 2. For the internal mesh gear 1 is the
@@ -34,7 +34,7 @@ Mesh-cycle convention of :class:`RectangularStiffness`: double-tooth contact is 
 on p = (ε_α − 1)/2, i.e. it spans p ∈ [0, ε_α − 1) (a new tooth pair enters at p = 0) and single
 contact spans [ε_α − 1, 1). Components choose p0 from the real tooth positions accordingly.
 
-Manufacturing errors (MODEL.md §3.9; default none, and then the evaluation is exactly the error-free
+Manufacturing errors (docs/model.md §11; default none, and then the evaluation is exactly the error-free
 one — the family skips them):
 
 - Eccentricity / runout: gear b's geometric (tooth) centre sits at c_geo = c + R(θ_b)·o_b, o_b
@@ -254,6 +254,7 @@ class GearMesh(Element):
     """
     batched = True
     n_local = 6
+    compiled_twin = "mesh.gear_mesh"
 
     def __init__(self, name, gear1, gear2, *, internal: bool, rb1, rb2, alpha, a0, teeth1, k_mean,
                  c_mesh=0.0, u0=0.0, p0=0.0, backlash=0.0, stiffness: StiffnessShape | None = None,

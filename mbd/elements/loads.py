@@ -12,6 +12,7 @@ class ForceSource(Element):
     """Force (Fx, Fy) in the *fixed* frame on each body's centre, scaled by ``ramp(t)``.
     ``force`` is an (n, 2) / (2,) constant [N] or a callable t -> (n, 2)."""
     n_local = 3
+    compiled_twin = "generic.force_source"
 
     def __init__(self, name, bodies, force, ramp: Callable[[float], float] | None = None):
         self.name = name

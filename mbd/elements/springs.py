@@ -17,6 +17,7 @@ class GroundSupport(Element):
     """
     batched = True
     n_local = 3
+    compiled_twin = "generic.ground_support"
 
     def __init__(self, name, bodies, kx, cx=0.0, ky=None, cy=None, anchor=(0.0, 0.0),
                  k_theta=0.0, c_theta=0.0, theta0=0.0):
@@ -66,6 +67,7 @@ class BodySpring(Element):
     """
     batched = True
     n_local = 6
+    compiled_twin = "generic.body_spring"
 
     def __init__(self, name, body_a, body_b, k, c=0.0, marker_a=(0.0, 0.0), marker_b=(0.0, 0.0)):
         self.name = name
@@ -95,6 +97,7 @@ class TorsionalSpring(Element):
     """Torsional spring-damper on the relative angle θ_B − θ_A − θ0 of two bodies."""
     batched = True
     n_local = 6
+    compiled_twin = "generic.torsional_spring"
 
     def __init__(self, name, body_a, body_b, k, c=0.0, theta0=0.0):
         self.name = name

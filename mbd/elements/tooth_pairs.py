@@ -1,4 +1,4 @@
-"""The tooth-pair mesh law: transmission error tooth by tooth (MODEL.md §3.2).
+"""The tooth-pair mesh law: transmission error tooth by tooth (docs/model.md §7).
 
 A flank f = ±1 of a spur mesh is the sum of the tooth pairs that can touch on it. With ε the contact
 ratio (1 < ε < 2) at most two pairs are engaged: the newest, which entered on flank f at its roll
