@@ -20,8 +20,6 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-from components.results import Summary
-
 __all__ = ["Run", "run", "parameters"]
 
 
@@ -30,7 +28,7 @@ class Run:
     """A finished run: its folder, its summary (summary.json) and whether it ran now (``"finished"``) or was
     taken from an earlier run of the same parameters, settings and code (``"reused"``)."""
     out: Path
-    summary: Summary
+    summary: dict
     status: str
 
     @property
@@ -45,9 +43,9 @@ class Run:
 
     def dataset(self):
         """results.nc as an :class:`xarray.Dataset` (close it when done, or use it in a ``with``)."""
-        from components.results import open_dataset
+        import xarray as xr
 
-        return open_dataset(self.results)
+        return xr.open_dataset(self.results, engine="h5netcdf")
 
     def __repr__(self) -> str:
         return f"Run({str(self.out)!r}, {self.status}, {self.summary.get('wall_s', float('nan')):.1f} s wall)"
