@@ -91,15 +91,18 @@ class NewtonPolicy:
     """The modified-Newton rules of one HHT step, as pure functions of plain numbers.
 
     Convergence (Hairer): η‖Δ‖ ≤ newton_tol with η = θ/(1−θ) from the rate θ observed on one matrix; the
-    first iteration on a matrix has no rate (η = ∞) and must be below 1e-2·newton_tol. A rate above
-    ``rate_refresh`` refreshes the Jacobian, at most ``max_refresh`` times per step; a rate ≥ 1 after that
-    is divergence."""
+    first iteration on a matrix has no rate (η = ∞) and must be below 1e-2·newton_tol. With
+    ``per_component`` (the default) the test holds for every DOF with its own rate
+    (:func:`mbd.rules.newton_converged_each`): the rate of the max norm is not the rate of the DOF that is
+    slowest to converge. A rate above ``rate_refresh`` (of the max norm) refreshes the Jacobian, at most
+    ``max_refresh`` times per step; a rate ≥ 1 after that is divergence."""
     newton_tol: float = 1e-3     # bound on η‖Δq‖ (scaled by the Tolerance); 0.03 left ~k·3e-10 m of force
                                  # error in stiff elements (a 2e-4 bias seen in a mesh test)
     max_iter: int = 10
     rate_refresh: float = 0.3    # contraction rate above which the Jacobian is refreshed
     max_refresh: int = 2         # Jacobian refreshes per step before a rate >= 1 counts as divergence
     reuse: bool = True           # False: fresh Jacobian + LU at the start of every step
+    per_component: bool = True   # False: the test on the max norm alone (the engine before issue 23)
 
     def __post_init__(self):
         if self.max_iter < 1 or not (0 < self.newton_tol < 1):
@@ -121,6 +124,10 @@ class NewtonPolicy:
 
     def converged(self, eta: float, nrm: float) -> bool:
         return bool(rules.newton_converged(eta, nrm, self.newton_tol))
+
+    def converged_each(self, x: np.ndarray, prev: np.ndarray | None) -> bool:
+        """The per-component test on the scaled corrections ``x`` and ``prev`` (None: first on a matrix)."""
+        return bool(rules.newton_converged_each(x, x if prev is None else prev, prev is not None, self.newton_tol))
 
     def after_iteration(self, it: int, rate: float | None, refreshes: int) -> NewtonAction:
         """Next move after unconverged iteration ``it`` (1-based) with contraction ``rate`` (None on the
@@ -145,6 +152,7 @@ class HHT:
     rate_refresh: float = NewtonPolicy.rate_refresh
     max_refresh: int = NewtonPolicy.max_refresh
     reuse: bool = NewtonPolicy.reuse
+    per_component: bool = NewtonPolicy.per_component
     tol: Tolerance = Tolerance()
 
     def __post_init__(self):
@@ -155,7 +163,7 @@ class HHT:
     def policy(self) -> NewtonPolicy:
         """The Newton reuse/refresh rules from this stepper's settings."""
         return NewtonPolicy(newton_tol=self.newton_tol, max_iter=self.max_iter, rate_refresh=self.rate_refresh,
-                            max_refresh=self.max_refresh, reuse=self.reuse)
+                            max_refresh=self.max_refresh, reuse=self.reuse, per_component=self.per_component)
 
     @property
     def beta_gamma(self):
@@ -251,7 +259,7 @@ class HHT:
             n_jac, fresh = n_jac + 1, True
             if F_here is None:
                 return a1, info(False, 0, np.inf, "singular Newton matrix")
-        prev = None                           # correction of the previous iteration with the same matrix
+        prev = x_prev = None                  # correction of the previous iteration with the same matrix
         for it in range(1, pol.max_iter + 1):
             q1 = qp + bh2 * a1
             v1 = vp + gh * a1
@@ -265,12 +273,13 @@ class HHT:
             r = M * a1 - (1.0 + a_) * F1 + a_ * s.f
             da = cache.lu.solve(r)
             a1 = a1 - da
-            nrm = float(np.max(np.abs(bh2 * da) / self.tol.scale(system.model, s.q, q1)))
+            x = np.abs(bh2 * da) / self.tol.scale(system.model, s.q, q1)     # scaled corrections
+            nrm = float(np.max(x)) if x.size else 0.0
             if not np.isfinite(nrm):
                 return a1, info(False, it, np.inf, "non-finite Newton correction")
             rate_now = None if prev is None else pol.rate(nrm, prev)
             rate = rate if rate_now is None else rate_now
-            if pol.converged(pol.eta(rate_now), nrm):
+            if pol.converged_each(x, x_prev) if pol.per_component else pol.converged(pol.eta(rate_now), nrm):
                 return a1, info(True, it, rate)
             action = pol.after_iteration(it, rate_now, refreshes)
             if action is NewtonAction.DIVERGED:
@@ -285,9 +294,9 @@ class HHT:
                 if F_here is None:
                     return a1, info(False, it, rate, "singular Newton matrix")
                 refreshes += 1
-                prev = None
+                prev = x_prev = None
                 continue
-            prev = nrm
+            prev, x_prev = nrm, x
         return a1, info(False, pol.max_iter, rate, "Newton did not converge in max_iter")
 
     def _update_internal(self, system, s, t1, q1, v1):

@@ -2,7 +2,7 @@
 
     python -m scenarios.benchmark [--json] [--window S] [--ref-window S] [--h S] [--alpha A] [--newton-tol T]
                                   [--scipy-cap S] [--scipy-tols T1,T2] [--scipy-methods M,...]
-                                  [--repeats K] [--profile] [--scaling] [--out DIR]
+                                  [--repeats K] [--compare-newton-tests] [--profile] [--scaling] [--out DIR]
 
 Settles once (HHT α = −0.3 adaptive, cached in OUT/dpgt_settled.npz, shared with work_precision), then
 times the window with the chosen setting — HHT α = −0.3, fixed h (default 5 µs: the cheapest fixed step
@@ -23,6 +23,10 @@ sub-window, each capped at --scipy-cap seconds, each with a tolerance ladder (lo
 1e-3 then 1e-4; the next is tried only while the error is above 1 %); the best is the fastest with
 error ≤ 1 % (else the one that got furthest). Its wall time is scaled to the full window (wall per
 simulated second) for the speed ratio; both the measured and scaled numbers are recorded.
+
+--compare-newton-tests: the whole window again with each of Newton's two convergence tests — per component
+(the engine's, issue 23) and the max norm's rate (the engine before) — interleaved ``--repeats`` times
+(medians), each with its counters and its error against the same reference (``newton_tests`` in the JSON).
 
 per_step_over_eval = (wall / steps) / (one compiled residual + Jacobian evaluation, measured in this run).
 Peak RSS is recorded after the timed HHT run (peak_rss_after_hht_mb) and at the end (scipy's LSODA
@@ -63,7 +67,7 @@ def _grid(t0, t1, dt=5e-6):
 def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: float, scipy_cap: float,
               scipy_tols=(1e-3, 1e-4), log=print, settle: float = 0.03,
               scipy_methods=("Radau", "BDF", "LSODA", "RK45"), repeats: int = 3,
-              newton_tol: float | None = None) -> dict:
+              newton_tol: float | None = None, compare_newton_tests: bool = False) -> dict:
     prob = dpgt_problem(settle=settle)
     s0, extra = settled_state(prob, out / "dpgt_settled.npz")
     ri = mbd.System(prob.model).outputs(s0.t, s0.q, s0.v, s0.z)[FAMILY["race_inner"]]["load"][prob.race_inner]
@@ -78,6 +82,7 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
         f"{costs['jacobian_s'] * 1e6:.0f} µs (residual alone {costs['compiled_residual_s'] * 1e6:.0f} / "
         f"{costs['residual_s'] * 1e6:.0f} µs)")
     engines = _engine_ratio(prob, s0, sub, alpha, h, newton_tol, repeats, log)
+    tests = _newton_tests(prob, s0, t1, sub, alpha, h, newton_tol, repeats, log) if compare_newton_tests else None
     # the timed run (sampling only q, v on the sub-window grid: no element evaluation in the loop)
     run = run_hht(prob, s0, t1, sub, alpha=alpha, h=h, newton_tol=newton_tol, label=f"fixed h={h:.1e}")
     if not run.completed:
@@ -96,6 +101,10 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
     err = error_metrics(obs, ref_obs)
     log(f"error vs reference (h/8) over {ref_window:g} s: RMS inner-race load {err['err_rms_inner']:.2e}, "
         f"pin-load history {err['err_pin_rel']:.2e} (rel. max-norm)")
+    for name, row in ((k, (tests or {})[k]) for k in ("per_component", "max_norm") if tests):
+        e = error_metrics(observables(prob, sub, row.pop("q"), row.pop("v"), row.pop("z")), ref_obs)
+        row["rel_error_rms_inner_race"], row["rel_error_pin_history"] = e["err_rms_inner"], e["err_pin_rel"]
+        log(f"Newton test {name}: error RMS inner-race load {e['err_rms_inner']:.2e}, pin history {e['err_pin_rel']:.2e}")
     sc = []
     for method in scipy_methods:
         # loosest tolerance first; tighten only while the error is above 1 % (a capped run stops the ladder)
@@ -140,6 +149,7 @@ def benchmark(out: Path, window: float, ref_window: float, h: float, alpha: floa
         "per_step_over_eval": (wall / run.steps) / costs["compiled_jacobian_s"],
         "engine": run.engine, "reference_wall_s": engines["numpy_s"] * window / ref_window,
         "speedup_vs_reference": engines["numpy_s"] / engines["compiled_s"], "engine_ratio": engines,
+        "newton_tests": tests,
         "peak_rss_after_hht_mb": rss_hht, "peak_rss_mb": peak_rss_mb(), "machine": machine_note(), "settle": extra,
         "load": {"before": load_before, "after_timed_run": load_after, "after_scipy": load1()},
     }
@@ -202,6 +212,32 @@ def _engine_ratio(prob, s0, grid, alpha, h, newton_tol, repeats, log) -> dict:
         f"numpy {med['numpy']:.2f} s (medians) -> {med['numpy'] / med['compiled']:.1f}x")
     return {"compiled_s": med["compiled"], "numpy_s": med["numpy"], "walls": walls,
             "span_s": float(grid[-1] - grid[0]), "repeats": repeats}
+
+
+def _newton_tests(prob, s0, t1, grid, alpha, h, newton_tol, repeats, log) -> dict:
+    """The window [s0.t, t1] with each of Newton's convergence tests (per component: the engine's; the max
+    norm's rate: the engine before issue 23), interleaved ``repeats`` times: median walls, the counters, and
+    the states on ``grid`` (for the error, filled in by the caller)."""
+    tests = {"per_component": True, "max_norm": False}
+    walls, rows = {k: [] for k in tests}, {}
+    for _ in range(max(1, repeats)):
+        for name, pc in tests.items():
+            r = run_hht(prob, s0, t1, grid, alpha=alpha, h=h, newton_tol=newton_tol, per_component=pc)
+            if not r.completed:
+                raise mbd.IntegrationError(f"benchmark (Newton test {name}) failed: {r.message}")
+            walls[name].append(r.wall_s)
+            rows.setdefault(name, {"steps": r.steps, "newton_per_step": r.newton / r.steps,
+                                   "jacobians_per_step": r.jacobian / r.steps, "rejected": r.rejected,
+                                   "q": r.q, "v": r.v, "z": r.z})
+    for name in tests:
+        rows[name]["wall_s"] = statistics.median(walls[name])
+        rows[name]["walls"] = walls[name]
+        row = rows[name]
+        log(f"Newton test {name}: {row['wall_s']:.2f} s (median of {len(walls[name])}, interleaved), "
+            f"{row['newton_per_step']:.3f} Newton/step, {row['jacobians_per_step']:.3f} Jacobians/step, "
+            f"{row['rejected']} rejected")
+    rows["wall_ratio_per_component_over_max_norm"] = rows["per_component"]["wall_s"] / rows["max_norm"]["wall_s"]
+    return rows
 
 
 def profile_window(out: Path, h: float, alpha: float, span: float = 2e-3, top: int = 18, settle: float = 0.03) -> str:
@@ -280,6 +316,8 @@ def main(argv=None) -> int:
     ap.add_argument("--scipy-methods", default="Radau,BDF,LSODA,RK45",
                     type=args.choice_list(("Radau", "BDF", "LSODA", "RK45", "RK23", "DOP853"), "scipy methods"))
     ap.add_argument("--repeats", type=args.count(1), default=3, help="interleaved repeats of each engine on the sub-window")
+    ap.add_argument("--compare-newton-tests", action="store_true",
+                    help="also time the window with each of Newton's convergence tests, interleaved (before/after issue 23)")
     ap.add_argument("--stiff", default="10,100", type=_factors, help="contact-stiffness factors for the stiff comparison ('' skips)")
     ap.add_argument("--stiff-window", type=args.positive("s"), default=2e-3, help="window of the stiff comparison [s]")
     ap.add_argument("--stiff-settle", type=args.nonnegative("s"), default=0.01, help="settling time of the stiff cases [s]")
@@ -294,7 +332,8 @@ def main(argv=None) -> int:
     log(machine_note())
     res = benchmark(out, a.window, a.ref_window, a.h, a.alpha, a.scipy_cap,
                     a.scipy_tols, log, a.settle,
-                    [m.strip() for m in a.scipy_methods.split(",") if m.strip()], a.repeats, a.newton_tol)
+                    [m.strip() for m in a.scipy_methods.split(",") if m.strip()], a.repeats, a.newton_tol,
+                    a.compare_newton_tests)
     res["stiff"] = stiff_comparison(a.stiff, a.stiff_settle, a.stiff_window,
                                     [m.strip() for m in a.scipy_methods.split(",") if m.strip()],
                                     a.scipy_tols, a.scipy_cap, log)

@@ -202,16 +202,19 @@ def warm_up(prob: Problem, state: mbd.State) -> None:
 def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float, h: float | None = None,
             atol_pos: float | None = None, repeats: int = 1, h_max: float = 2e-5, label: str = "",
             newton_tol: float | None = None, tol: mbd.Tolerance | None = None,
-            freeze_internal: bool = False, engine: str = "auto") -> RunResult:
+            freeze_internal: bool = False, engine: str = "auto", per_component: bool = True) -> RunResult:
     """The one way the numerics scripts run HHT from a state and sample it on ``grid``: fixed step
     (``h``) or adaptive (``atol_pos``; atol_rot = 100·atol_pos) from ``state``; ``newton_tol`` and ``tol``
     override the HHT defaults (error-floor study, references); ``freeze_internal`` holds element internal
-    states (the equations the scipy adapter integrates); ``engine`` as in :func:`mbd.simulate`."""
+    states (the equations the scipy adapter integrates); ``engine`` as in :func:`mbd.simulate`;
+    ``per_component=False`` runs Newton's convergence test of the engine before issue 23 (the max norm's
+    rate, :class:`mbd.hht.NewtonPolicy`) for before/after comparisons."""
     if (h is None) == (atol_pos is None):
         raise ValueError("give exactly one of h (fixed step) or atol_pos (adaptive)")
     if tol is None:
         tol = mbd.Tolerance() if atol_pos is None else mbd.Tolerance(atol_pos=atol_pos, atol_rot=100 * atol_pos)
-    stepper = mbd.HHT(alpha=alpha, tol=tol) if newton_tol is None else mbd.HHT(alpha=alpha, tol=tol, newton_tol=newton_tol)
+    extra = {} if newton_tol is None else {"newton_tol": newton_tol}
+    stepper = mbd.HHT(alpha=alpha, tol=tol, per_component=per_component, **extra)
     walls, res, sampler = [], None, None
     for r in range(max(1, repeats)):
         ctrl = mbd.FixedStep(h) if h is not None else mbd.Adaptive(h0=min(5e-6, h_max), h_max=h_max, h_min=1e-10)

@@ -9,6 +9,8 @@ spin after 300 steps. So the engines are held together over 150 steps exactly (c
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -27,8 +29,8 @@ def dpgt_state():
     return sc.model, s
 
 
-def _run(model, state, n, engine, observers=()):
-    return mbd.simulate(model, t_end=state.t + n * H, state=state.copy(), stepper=mbd.PRODUCTION.stepper(),
+def _run(model, state, n, engine, observers=(), stepper=None):
+    return mbd.simulate(model, t_end=state.t + n * H, state=state.copy(), stepper=stepper or mbd.PRODUCTION.stepper(),
                         controller=mbd.FixedStep(H), progress=False, engine=engine, observers=list(observers))
 
 
@@ -43,9 +45,12 @@ def test_compiled_assembly_equals_the_reference(dpgt_state):
     assert np.count_nonzero(ref.Jq) > 1000               # contacts, meshes and pockets are in the picture
 
 
-def test_the_engines_take_the_same_steps_to_the_same_states(dpgt_state):
+@pytest.mark.parametrize("per_component", [True, False], ids=["per-component test", "max-norm test"])
+def test_the_engines_take_the_same_steps_to_the_same_states(dpgt_state, per_component):
+    """Both Newton convergence tests (the production one and the one before issue 23) are compiled."""
     model, s = dpgt_state
-    c, r = _run(model, s, 150, "compiled"), _run(model, s, 150, "numpy")
+    st = dataclasses.replace(mbd.PRODUCTION.stepper(), per_component=per_component)
+    c, r = _run(model, s, 150, "compiled", stepper=st), _run(model, s, 150, "numpy", stepper=st)
     assert (c.engine, r.engine) == ("compiled", "numpy")
     assert c.counters == r.counters and c.counters["rejected"] + c.counters["accepted"] >= 150
     np.testing.assert_allclose(c.state.q, r.state.q, rtol=0, atol=1e-8)

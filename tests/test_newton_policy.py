@@ -1,7 +1,10 @@
 """NewtonPolicy: HHT's Jacobian/LU reuse and refresh rules on plain numbers (no model)."""
 import math
 
+import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 import mbd
 from mbd.hht import NewtonAction as A, NewtonPolicy
@@ -77,3 +80,44 @@ def test_after_iteration_out_of_iterations():
     assert POL.after_iteration(10, 1.5, 1) is A.OUT_OF_ITERATIONS
     one = NewtonPolicy(max_iter=1)
     assert one.after_iteration(1, None, 0) is A.OUT_OF_ITERATIONS
+
+
+# --- the per-component test (issue 23) ---------------------------------------------------------------
+
+def test_converged_each_takes_every_component_at_its_own_rate():
+    """Measured on the DPGT: after a refresh the largest correction moved from one DOF (6.1) to another
+    (0.067, 0.096 the iteration before). The max norm's rate 0.011 accepted that step; the DOF itself
+    contracts at 0.7, and the remaining correction measured from outside was 0.067 (67× the tolerance)."""
+    prev, x = np.array([6.1, 0.096]), np.array([1e-3, 0.067])
+    assert POL.converged(POL.eta(POL.rate(x.max(), prev.max())), x.max())
+    assert not POL.converged_each(x, prev)
+    # each component contracting fast enough: θ = 0.01 and 0.05, η_j x_j = 1e-6 and 2.6e-5
+    assert POL.converged_each(np.array([1e-4, 5e-4]), np.array([1e-2, 1e-2]))
+    # one component just too slow: θ = 0.5, η x = 1.1e-3 > 1e-3
+    assert not POL.converged_each(np.array([1e-4, 1.1e-3]), np.array([1e-2, 2.2e-3]))
+
+
+def test_converged_each_without_a_rate_or_with_a_growing_component():
+    assert POL.converged_each(np.array([1e-5, 0.0]), None)              # all below 1e-2·tol: no rate needed
+    assert not POL.converged_each(np.array([1e-5, 2e-5]), None)
+    # a component that does not contract (θ ≥ 1) above 1e-2·tol: nothing bounds what is left of it
+    assert not POL.converged_each(np.array([1e-9, 1e-4]), np.array([1.0, 1e-4]))
+    # below 1e-2·tol it does not count, whatever its rate
+    assert POL.converged_each(np.array([1e-9, 1e-5]), np.array([1.0, 1e-6]))
+    assert POL.converged_each(np.zeros(0), None)
+
+
+@given(st.lists(st.tuples(st.floats(0, 1e2), st.floats(1e-12, 1e2)), min_size=1, max_size=8),
+       st.floats(1e-6, 0.5))
+def test_converged_each_is_never_looser_than_the_max_norm_test(pairs, tol):
+    x, prev = (np.array(c) for c in zip(*pairs))
+    pol = NewtonPolicy(newton_tol=tol)
+    if pol.converged_each(x, prev):
+        assert pol.converged(pol.eta(pol.rate(x.max(), prev.max())), x.max())
+    if pol.converged_each(x, None):
+        assert pol.converged(math.inf, x.max())
+
+
+def test_hht_passes_the_test_choice_to_its_policy():
+    assert mbd.HHT(alpha=-0.3).policy.per_component
+    assert not mbd.HHT(alpha=-0.3, per_component=False).policy.per_component

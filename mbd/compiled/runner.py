@@ -97,7 +97,8 @@ class CompiledRunner:
         self.n = n
         beta, gamma = stepper.beta_gamma
         self.prm = np.array([stepper.alpha, beta, gamma, stepper.error_constant(), stepper.newton_tol,
-                             stepper.max_iter, stepper.rate_refresh, stepper.max_refresh, float(stepper.reuse)])
+                             stepper.max_iter, stepper.rate_refresh, stepper.max_refresh, float(stepper.reuse),
+                             float(stepper.per_component)])
         self.atol = np.where(m.angle_dofs, stepper.tol.atol_rot, stepper.tol.atol_pos).astype(float)
         self.rtol = float(stepper.tol.rtol)
         self.freeze = bool(system.freeze_internal)
@@ -109,7 +110,7 @@ class CompiledRunner:
                    np.zeros(n, np.int64))
         self.pat = (lu.indptr, lu.indices, np.ascontiguousarray(system._M, float), np.asarray(m.mdiag, float))
         self.cache = np.array([0.0, np.nan, 0.0])        # LU valid, its h, sparse (0) or dense (1)
-        self.work = tuple(np.zeros(n) for _ in range(8)) + (np.zeros(nnz), np.zeros(nnz), np.zeros(nnz))
+        self.work = tuple(np.zeros(n) for _ in range(10)) + (np.zeros(nnz), np.zeros(nnz), np.zeros(nnz))
         self.out = tuple(np.zeros(n) for _ in range(4))
         self.z_shapes = list(zip(self.cs.state_names, self.cs.state_shapes))
         self.n_z = sum(int(np.prod(s)) for _, s in self.z_shapes)

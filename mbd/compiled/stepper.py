@@ -92,7 +92,7 @@ def _refresh(t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F, Jq, Jv, A):
 @njit(cache=True)
 def _refresh_at(t1, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
     """Jacobian + LU at the current iterate a₁ (its forces left in work's F1); False when unusable."""
-    qp, vp, a1, q1, v1, F1, r, sc, Jq, Jv, A = work
+    qp, vp, a1, q1, v1, F1, r, sc, x, xp, Jq, Jv, A = work
     for i in range(a1.size):
         q1[i] = qp[i] + bh2 * a1[i]
         v1[i] = vp[i] + gh * a1[i]
@@ -126,7 +126,8 @@ def _newton(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, w
     [LU valid (1/0), h of the LU, LU kind (0 sparse, 1 dense)]; ``cnt``: this step's residuals, Jacobians."""
     alpha, beta, gamma = prm[0], prm[1], prm[2]
     newton_tol, max_iter, rate_refresh, max_refresh, reuse = prm[4], int(prm[5]), prm[6], int(prm[7]), prm[8] > 0
-    qp, vp, a1, q1, v1, F1, r, sc, Jq, Jv, A = work
+    per_component = prm[9] > 0
+    qp, vp, a1, q1, v1, F1, r, sc, x, xp, Jq, Jv, A = work
     n = q.size
     mdiag = pat[3]
     bh2, gh = beta * h * h, gamma * h
@@ -157,13 +158,18 @@ def _newton(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, w
         nrm = 0.0
         for i in range(n):
             a1[i] -= da[i]
-            nrm = max(nrm, abs(bh2 * da[i]) / sc[i])
+            x[i] = abs(bh2 * da[i]) / sc[i]                # scaled corrections
+            nrm = max(nrm, x[i])
         if not np.isfinite(nrm):
             return False, it, np.inf, _NONFINITE_DA
         rate_now = rules.newton_rate(nrm, prev) if has_prev else 0.0
         if has_prev:
             rate = rate_now
-        if rules.newton_converged(rules.newton_eta(rate_now, has_prev), nrm, newton_tol):
+        if per_component:
+            conv = rules.newton_converged_each(x, xp, has_prev, newton_tol)
+        else:
+            conv = rules.newton_converged(rules.newton_eta(rate_now, has_prev), nrm, newton_tol)
+        if conv:
             return True, it, rate, 0
         action = rules.newton_action(it, rate_now, has_prev, refreshes, rate_refresh, max_refresh, max_iter)
         if action == rules.DIVERGED:
@@ -181,6 +187,8 @@ def _newton(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, w
             has_prev = False
             continue
         prev = nrm
+        for i in range(n):
+            xp[i] = x[i]
         has_prev = True
     return False, max_iter, rate, _MAX_ITER
 
@@ -190,7 +198,7 @@ def _step(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, wor
     """One HHT step of size h from (t, q, v, a, f) into ``out`` = (q1, v1, a1, f1) without touching the
     start; (converged, iterations, rate, reason, error)."""
     alpha, beta, gamma, errc = prm[0], prm[1], prm[2], prm[3]
-    qp, vp, a1, q1, v1, F1, r, sc, Jq, Jv, A = work
+    qp, vp, a1, q1, v1, F1, r, sc, x, xp, Jq, Jv, A = work
     n = q.size
     for i in range(n):                        # predictor parts that do not depend on a₁
         qp[i] = q[i] + h * v[i] + h * h * (0.5 - beta) * a[i]
