@@ -25,6 +25,7 @@ interval; the P90 of K_γ against the number of samples), ``agreement.csv`` (sta
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import hashlib
 import io
@@ -253,26 +254,27 @@ def quantities_of(s: dict) -> dict:
 
 
 def solve_static_task(task: StaticTask) -> dict:
-    """Solve one machine (on whichever process) and write its result file atomically; a failure is returned, not
-    written (a re-run tries it again)."""
+    """Solve one machine (on whichever process) and write its result file atomically. A failure is written too
+    (with its error): the solution is deterministic, so the same parameters and code fail again — a re-run does
+    not try it again unless the code changed."""
     from components.dpgt import build_dpgt
     from components.static import static_summary
 
     asked, full = task.fingerprints()
     head = {"class": task.flank_class, "condition": task.case.condition, "direction": task.case.direction,
-            "torque_fraction": task.torque, "sample": task.sample, "drawn": task.drawn}
+            "torque_fraction": task.torque, "sample": task.sample, "drawn": task.drawn,
+            "parameters_fingerprint": asked, "fingerprint": full}
     try:
         params = build_params(task.case)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")      # design warnings were said once by the study
             scene = build_dpgt(params)
         s = static_summary(scene, task.snapshots)
+        op = params.si().operating
+        rec = {**head, "summary": _kept(s), "output_torque_N_m": op.output_power / abs(op.carrier_speed),
+               "static_solver": s["static_solver"], "snapshots": s["snapshots"]}
     except Exception as exc:      # reported in the tables, never hidden; the others go on
-        return {**head, "error": f"{type(exc).__name__}: {' '.join(str(exc).split())}"}
-    op = params.si().operating
-    rec = {**head, "summary": _kept(s), "output_torque_N_m": op.output_power / abs(op.carrier_speed),
-           "static_solver": s["static_solver"], "snapshots": s["snapshots"],
-           "parameters_fingerprint": asked, "fingerprint": full}
+        rec = {**head, "error": f"{type(exc).__name__}: {' '.join(str(exc).split())}"}
     Path(task.path).parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(Path(task.path), json.dumps(rec, indent=1, default=float))
     return rec
@@ -426,10 +428,11 @@ def convergence(x, seed: int) -> dict:
     return {"p90": steps, "settled_at_samples": settled}
 
 
-def statistics(records: dict, seed: int) -> list[dict]:
+def statistics(records: dict, seed: int, dynamic: dict | None = None) -> list[dict]:
     """Per class, condition, direction and torque: the perfect machine's quantities, the samples' mean, P50, P90 and
     P99 of every K_γ and load and the P10 of every life, each with its bootstrap 95 % interval, and the P90 of the
-    mesh K_γ against the number of samples."""
+    mesh K_γ against the number of samples; where machines ran dynamically too (``dynamic``: {task key: summary}),
+    the mean and P90 of K_γ over those machines, static and dynamic side by side."""
     out = []
     for (c, cond, d, f), e in _groups(records).items():
         ok = [r for r in e["samples"] if "quantities" in r]
@@ -446,6 +449,15 @@ def statistics(records: dict, seed: int) -> list[dict]:
                 g["quantities"][key] = {"mean": percentile_ci(x, None, seed),
                                         **{k: percentile_ci(x, q, seed) for k, q in PERCENTILES.items()}}
         g["convergence"] = {HEADLINE: convergence(_column(ok, HEADLINE), seed)} if ok else {}
+        both = [(r, dynamic[(c, cond, d, f, r["sample"])]) for r in ok if (c, cond, d, f, r["sample"]) in (dynamic or {})]
+        if both:
+            g["dynamic_subset"] = {"samples": len(both)}
+            for key in ("k_gamma_mesh", "k_gamma_inner", "k_gamma_outer"):
+                st = np.array([r["quantities"][key] for r, _ in both])
+                dy = np.array([quantities_of(sm)[key] for _, sm in both])
+                g["dynamic_subset"][key] = {
+                    way: {"mean": percentile_ci(x, None, seed), "p90": percentile_ci(x, 90.0, seed)}
+                    for way, x in (("static", st), ("dynamic", dy))}
         out.append(g)
     return out
 
@@ -542,9 +554,19 @@ def answer(stats: list[dict], agree: list[dict], a_record: dict) -> str:
                          f"{'unconservative' if (k['p90']['value'] or 0) > TABLE_K_GAMMA else 'conservative'} for "
                          f"9 in 10 machines by {100 * ((k['p90']['value'] or 1) - TABLE_K_GAMMA):.1f} % of the mean "
                          f"mesh load. {g['samples']} samples"
-                         + (f" ({len(g['failed'])} failed, left out)" if g["failed"] else "")
-                         + (f"; the P90 settled (every later estimate inside the final interval) at "
-                            f"{conv['settled_at_samples']} samples." if conv.get("settled_at_samples") else "."))
+                         + (f" ({len(g['failed'])} more failed: the static solver found no state; left out, listed in "
+                            f"statistics.json — if failures favour large errors, the upper percentiles are low)"
+                            if g["failed"] else "")
+                         + ("; the P90 against the number of samples: " + ", ".join(
+                             f"{x['samples']}: {x['value']:.4f}" for x in conv.get("p90", []))
+                            + (f" (inside the final interval from {conv['settled_at_samples']} samples on)"
+                               if conv.get("settled_at_samples") else "") + "." if conv.get("p90") else "."))
+                sub = g.get("dynamic_subset")
+                if sub:
+                    st, dy = sub[HEADLINE]["static"], sub[HEADLINE]["dynamic"]
+                    L.append(f"  - the {sub['samples']} machines also run dynamically: mesh K_γ mean {_ci(dy['mean'])}, "
+                             f"P90 {_ci(dy['p90'])} dynamic against mean {_ci(st['mean'])}, P90 {_ci(st['p90'])} "
+                             f"static (the same machines)")
                 for kind in KINDS:
                     kb = g["quantities"][f"k_gamma_{kind}"]
                     parts = []
@@ -584,15 +606,22 @@ def answer(stats: list[dict], agree: list[dict], a_record: dict) -> str:
                     continue
                 inc = np.array([r[f"{HEADLINE}_increment"] for r in rs])
                 loads = np.array([r[f"bearing_load_mean_{k}_N_increment_pct"] for r in rs for k in KINDS])
-                words = (f"- condition {cond}, {d}: over {len(rs)} machines the dynamic run adds "
-                         f"{inc.mean():+.4f} to the static mesh K_γ on average (from {inc.min():+.4f} to "
-                         f"{inc.max():+.4f}); the most loaded bearings' mean loads differ by {np.abs(loads).max():.2f} % "
-                         f"at most" if rs else f"- condition {cond}, {d}:")
+                words = (f"- condition {cond}, {d}: over {len(rs)} machine{'s' if len(rs) > 1 else ''} the dynamic mesh "
+                         f"K_γ minus the static one is {inc.mean():+.4f} on average (from {inc.min():+.4f} to "
+                         f"{inc.max():+.4f}, RMS {np.sqrt(np.mean(inc ** 2)):.4f}) — the dynamic increment and the static "
+                         f"estimate's error together: its snapshots see the teeth and runouts at a few instants only; "
+                         f"the most loaded bearings' mean loads differ by {np.abs(loads).max():.2f} % at most"
+                         if rs else f"- condition {cond}, {d}:")
                 if p:
                     words += (f"; the perfect machine: static {p[0][f'{HEADLINE}_static']:.4f}, dynamic "
                               f"{p[0][f'{HEADLINE}_dynamic']:.4f}")
                 L.append(words + ".")
         L.append("")
+    cost = a_record.get("static_cost") or {}
+    if cost.get("per_machine_s_median"):
+        L += ["## Cost", "", f"Static solutions: {cost['solved_now']} solved now in {cost['wall_s']:.0f} s wall, "
+              f"{cost['per_machine_s_median']:.2f} s per machine ({cost['per_snapshot_s_median'] * 1e3:.0f} ms per "
+              f"snapshot; medians of the solver's own time), {cost['reused']} reused, {cost['failed']} failed.", ""]
     L += ["The rating tables: up to three planets K_γ = 1.0 (ABS, as the FVA Workbench documents it: 4 planets 1.2, "
           "5: 1.3, 6 and more: 1.4); AGMA 6123-B06 gives a table of K_γ by the number of planets that published work "
           "calls vague as to tolerance and load (docs/tolerances.md cites both). A floating or semi-floating sun is "
@@ -690,16 +719,21 @@ class ToleranceStudy(Study):
         firsts = {}
         for t in self.tasks:
             firsts.setdefault((t.key()[:4], t.sample is None), t.case)
-        validate_cases(list(firsts.values()))
+        # the design warnings were said once already if the sweep has cases (the same machine)
+        with contextlib.redirect_stdout(io.StringIO()) if cases else contextlib.nullcontext():
+            validate_cases(list(firsts.values()))
         done, todo = _earlier(self.tasks, self.a.overwrite)
-        print(f"static: {len(todo)} solutions to solve, {len(done)} reused (same parameters and code); "
+        failed = sum("error" in r for r in done.values())
+        print(f"static: {len(todo)} solutions to solve, {len(done)} reused (same parameters and code"
+              + (f"; {failed} of them failed, and fail again with them" if failed else "") + f"); "
               f"{len(self.tasks)} machines × operating points", flush=True)
         t0 = time.perf_counter()
         new = solve_all(todo, self.a.workers, self.a.scheduler, not self.a.no_progress)
         wall = time.perf_counter() - t0
         self.records = {k: _with_quantities(r) for k, r in {**done, **new}.items()}
         solved = [r["static_solver"]["wall_s"] for r in new.values() if "static_solver" in r]
-        self.cost = {"solved_now": len(solved), "reused": len(done), "failed": sum("error" in r for r in new.values()),
+        self.cost = {"solved_now": len(solved), "reused": len(done),
+                     "failed": sum("error" in r for r in self.records.values()),
                      "wall_s": wall, "per_machine_s_median": float(np.median(solved)) if solved else None,
                      "per_snapshot_s_median": float(np.median(solved)) / self.a.snapshots if solved else None}
         if solved:
@@ -709,11 +743,11 @@ class ToleranceStudy(Study):
 
     def report(self, run: StudyRun) -> dict:
         a = self.a
-        stats = statistics(self.records, a.seed)
         by_label = {c.label: t.key() for c, t in zip(run.cases, self._dynamic_tasks())}
         dynamic = {by_label[k]: s for k, s in run.results.items() if k in by_label}
+        stats = statistics(self.records, a.seed, dynamic)
         agree = agreement_rows(self.records, dynamic)
-        record = {"samples": a.samples, "tolerances": self._tolerance_words()}
+        record = {"samples": a.samples, "tolerances": self._tolerance_words(), "static_cost": self.cost}
         text = answer(stats, agree, record)
         print(text)                               # the headline first
         rows = sample_rows(self.records)
