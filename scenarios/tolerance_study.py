@@ -315,9 +315,8 @@ def _earlier(tasks: list[StaticTask], overwrite: bool) -> tuple[dict, list[Stati
         stale += rec.get("parameters_fingerprint") == asked
         todo.append(t)
     if others:
-        raise OtherResults(f"{len(others)} static solutions in {Path(others[0]).parent.parent.parent} (e.g. "
-                           f"{others[0]}) were made from other parameters, tolerances or seed; pass --overwrite to "
-                           f"replace them, or choose another --out")
+        raise OtherResults(f"{len(others)} static solutions (e.g. {others[0]}) were made from other parameters, "
+                           f"tolerances or seed; pass --overwrite to replace them, or choose another --out")
     if stale:
         print(f"static: {stale} solutions were made by other code; recomputing them", flush=True)
     return done, todo
