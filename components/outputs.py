@@ -167,6 +167,7 @@ SUMMARY_WORDS = {
     "bearing_load_radial_mean_N": ("planet bearing load, mean, radial", "N"),
     "bearing_load_tangential_mean_N": ("planet bearing load, mean, tangential", "N"),
     "bearing_load_max_N": ("planet bearing load, max", "N"),
+    "bearing_load_max_per_planet_N": ("planet bearing load, max, per planet", "N"),
     "load_sharing_factor": ("load sharing K_γ: most loaded planet over the mean", "1"),
     "equivalent_load_N": ("planet bearing equivalent load (ISO 281)", "N"),
     "dynamic_load_rating_N": ("basic dynamic load rating C_r (ISO 281)", "N"),
@@ -175,6 +176,8 @@ SUMMARY_WORDS = {
     "life_iso281_h": ("L10 life, ISO 281 from the bearing load", "h"),
     "life_iso16281_Mrev": ("L10 life, ISO/TS 16281-style from the roller loads", "10^6 rev"),
     "life_iso16281_h": ("L10 life, ISO/TS 16281-style from the roller loads", "h"),
+    "life_iso281_per_planet_h": ("L10 life, ISO 281 from the bearing load, per planet", "h"),
+    "life_iso16281_per_planet_h": ("L10 life, ISO/TS 16281-style from the roller loads, per planet", "h"),
     "roller_equivalent_load_pin_N": ("equivalent roller load on the pin (ISO/TS 16281)", "N"),
     "roller_equivalent_load_bore_N": ("equivalent roller load on the bore (ISO/TS 16281)", "N"),
     "roller_inner_race_rms_N": ("roller–inner race load RMS", "N"),
@@ -718,6 +721,7 @@ class WindowStatistics(mbd.Observer):
             d["bearing_load_radial_mean_N"] = float(lr["mean"][ref])
             d["bearing_load_tangential_mean_N"] = float(lt["mean"][ref])
             d["bearing_load_max_N"] = float(lm["max"][ref])
+            d["bearing_load_max_per_planet_N"] = [float(x) for x in lm["max"][sel]]
             d["equivalent_load_N"] = float(self.stats("load_life")["mean"][ref] ** (1.0 / LIFE_EXPONENT))
             if p.rollers:
                 self._roller_summary(d, kind, sel)
@@ -776,7 +780,9 @@ class WindowStatistics(mbd.Observer):
         cases = [(d, np.array([ref]))]
         if p.rollers:
             cases.append((d["all_rollers"], sel))
-        for out, bearings in cases:
+        # each planet's own bearing: the most loaded one's life is what unequal load sharing costs
+        each = [({}, np.array([i])) for i in sel]
+        for out, bearings in cases + each:
             P = float(np.mean(self.stats("load_life")["mean"][bearings]) ** (1.0 / LIFE_EXPONENT))
             out["life_iso281_Mrev"] = iso281_life(P, b)
             out["life_iso281_h"] = hours(out["life_iso281_Mrev"], w)
@@ -790,6 +796,9 @@ class WindowStatistics(mbd.Observer):
             out["roller_equivalent_load_pin_N"], out["roller_equivalent_load_bore_N"] = q_pin, q_bore
             out["life_iso16281_Mrev"] = lundberg_palmgren_life(q_pin, q_bore, b)
             out["life_iso16281_h"] = hours(out["life_iso16281_Mrev"], w)
+        d["life_iso281_per_planet_h"] = [e["life_iso281_h"] for e, _ in each]
+        if p.rollers:
+            d["life_iso16281_per_planet_h"] = [e["life_iso16281_h"] for e, _ in each]
 
     def _heat_summary(self, d, ref, sel):
         """Heat from traction and land friction (time means, W): the reference bearing's and the mean of its

@@ -16,7 +16,7 @@ from components.names import argparse_hint, did_you_mean
 
 __all__ = ["Parser", "parser", "add_shared", "SHARED", "positive", "nonnegative", "count", "alpha", "conditions",
            "one_condition", "directions", "existing_file", "quantity_of", "key_value", "scheduler", "out_folder",
-           "choice_list", "float_list", "parse_sets", "switch_value", "scene_options", "invoked_as"]
+           "choice_list", "int_list", "float_list", "parse_sets", "switch_value", "scene_options", "invoked_as"]
 
 CONDITIONS = (1, 2, 3, 4)
 DIRECTIONS = ("forward", "reverse")
@@ -159,6 +159,21 @@ def _one_condition(then: str = ""):
 one_condition = _one_condition(" (each with its own --out)")
 
 directions = choice_list(DIRECTIONS, "directions")
+
+
+def int_list(lo: int, hi: int | None, what: str):
+    """A non-empty comma list of distinct whole numbers in [lo, hi] -> list of int."""
+    conv = count(lo, hi)
+
+    def parse(text: str) -> list[int]:
+        items = [x.strip() for x in text.split(",") if x.strip()]
+        if not items:
+            raise argparse.ArgumentTypeError(f"expected a comma list of {what}, got {text!r}")
+        out = [conv(x) for x in items]
+        if len(set(out)) < len(out):
+            raise argparse.ArgumentTypeError(f"{what} repeat in {text!r}")
+        return out
+    return _named(parse, f"comma list of {what}")
 
 
 def float_list(unit: str):

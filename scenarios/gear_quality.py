@@ -66,9 +66,9 @@ WRITES = ("c{condition}_{direction}_{perfect|class{G}_seed{S}}/{results.nc, summ
 def parse_args(argv):
     p = args.parser("gear_quality", __doc__, examples=EXAMPLES, writes=WRITES, out="results/gear_quality")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
-    p.add_argument("--grades", default="5,6,8", type=_int_list(1, 11, "flank tolerance classes"),
+    p.add_argument("--grades", default="5,6,8", type=args.int_list(1, 11, "flank tolerance classes"),
                    help="ISO 1328-1:2013 flank tolerance classes 1..11 (default 5,6,8)")
-    p.add_argument("--seeds", default="1,2,3", type=_int_list(0, None, "seeds"), help="seeds of the draws (default 1,2,3)")
+    p.add_argument("--seeds", default="1,2,3", type=args.int_list(0, None, "seeds"), help="seeds of the draws (default 1,2,3)")
     p.add_argument("--systematic-share", type=_share, default=0.5,
                    help="share of the profile deviations' variance common to a gear flank's teeth (default 0.5)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded (default 0.03)")
@@ -76,21 +76,6 @@ def parse_args(argv):
                    help="seconds analysed (default: the paper study's, whole cage revolutions)")
     args.add_shared(p, out="results/gear_quality", conditions="1,2,3,4")
     return p.parse_args(argv)
-
-
-def _int_list(lo: int, hi: int | None, what: str):
-    conv = args.count(lo, hi)
-
-    def parse(text: str) -> list[int]:
-        items = [x.strip() for x in text.split(",") if x.strip()]
-        if not items:
-            raise argparse.ArgumentTypeError(f"expected a comma list of {what}, got {text!r}")
-        out = [conv(x) for x in items]
-        if len(set(out)) < len(out):
-            raise argparse.ArgumentTypeError(f"{what} repeat in {text!r}")
-        return out
-    parse.__name__ = f"comma list of {what}"
-    return parse
 
 
 def _share(text: str) -> float:

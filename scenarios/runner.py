@@ -43,7 +43,7 @@ from .integrity import checkpoint_usable, claim_folder, read_summary, results_in
 from .lock import folder_lock
 
 __all__ = ["RunConfig", "run_case", "finished_run", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
-           "accuracy_line", "FIXED_STEP_ERROR_FACTOR"]
+           "accuracy_line", "code_digest", "FIXED_STEP_ERROR_FACTOR"]
 
 # A fixed-step run whose RMS local error estimate exceeds its tolerance (atol) by more than this factor ends
 # with a warning. Measured at condition 3 from the kinematic start: h = 5 us (the cheapest setting,
@@ -54,7 +54,7 @@ _ROOT = Path(__file__).resolve().parent.parent
 _CODE_DIGEST = None
 
 
-def _code_digest() -> str:
+def code_digest() -> str:
     """Digest of the code that makes a run's numbers (engine, components, this runner and its analysis)."""
     global _CODE_DIGEST
     if _CODE_DIGEST is None:
@@ -79,7 +79,7 @@ def _settings(cfg: "RunConfig") -> dict:
 
 def _digest(params: DPGTParams, cfg: "RunConfig", code: bool) -> str:
     settings = _settings(cfg)
-    what = {"params": repr(params), "cfg": settings, **({"code": _code_digest()} if code else {})}
+    what = {"params": repr(params), "cfg": settings, **({"code": code_digest()} if code else {})}
     return hashlib.sha256(json.dumps(what, sort_keys=True, default=repr).encode()).hexdigest()[:16]
 
 

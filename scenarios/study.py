@@ -8,7 +8,7 @@ words in every study:
 
 1. every case's parameters converted and its design checked before anything runs (design warnings once);
 2. the recordings checked against the limit and the disk (``--force``), the folders against results of other
-   parameters (``--overwrite``);
+   parameters (``--overwrite``); then the study's own work before its sweep, if any (:meth:`Study.prepare`);
 3. the sweep (:func:`scenarios.sweep.sweep`): each case an :class:`~scenarios.sweep.Outcome`, finished, reused
    or failed;
 4. the study's report: its headline table first, then one line per post-processing step (:meth:`StudyRun.step`:
@@ -122,6 +122,9 @@ class Study(abc.ABC):
         """What study.json holds besides the cases and the failed runs."""
         return {}
 
+    def prepare(self, cfg: RunConfig, cases: list[Case]) -> None:
+        """A study's own work after every check and before its sweep (the tolerance study's static solutions)."""
+
     # -- the skeleton -----------------------------------------------------------------------------------------
     def run(self) -> dict:
         """Cases → validate → check runs and folders → sweep → report → epilogue; returns {"results",
@@ -134,6 +137,7 @@ class Study(abc.ABC):
         for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], self.out, a.force):
             print(f"warning (--force): {w}")
         check_folders(cases, cfg, a.overwrite)                  # never replace results of other parameters silently
+        self.prepare(cfg, cases)
         outcomes = sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
                          overwrite=a.overwrite, announce=True)
         run = StudyRun(self.out, cases, outcomes)

@@ -10,6 +10,7 @@ file is written atomically. An interrupted client
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
@@ -24,7 +25,7 @@ from mbd.recorder import atomic_write_text
 from .integrity import OtherResults, claim_folder, differences, read_summary
 
 __all__ = ["Case", "Status", "Outcome", "sweep", "run_sweep", "execute_case", "check_folders", "user_overrides",
-           "validate_cases", "OPERATING_AXES"]
+           "validate_cases", "dask_client", "OPERATING_AXES"]
 
 
 @dataclass(frozen=True)
@@ -281,9 +282,48 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
         return results
     from dataclasses import replace
 
+    wcfg = replace(cfg, progress=False)   # per-run bars would interleave; the sweep bar shows progress
+    futs = {}
+    with dask_client(n_workers, scheduler) as client:
+        try:
+            futs = {client.submit(execute_case, c, wcfg, overwrite, pure=False, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
+            bar = tqdm(total=len(futs), desc="runs", disable=not bars, position=0)
+            runs = _RunBars(todo, bars)
+            while True:
+                done = [f for f in futs if f.done() and futs[f].label not in results]
+                if not done:
+                    if all(futs[f].label in results for f in futs):
+                        break
+                    runs.poll()
+                    time.sleep(0.5)
+                    continue
+                fut = done[0]
+                c = futs[fut]
+                try:
+                    results[c.label] = fut.result()
+                except Exception as exc:   # worker died: report, keep going
+                    results[c.label] = Outcome(c, Status.FAILED, error=f"worker failure: {exc}")
+                bar.update(1)
+                runs.finish(c)
+                if plain:
+                    n_done = sum(futs[f].label in results for f in futs)
+                    print(f"runs: {n_done}/{len(futs)} done ({c.label})", file=sys.stderr, flush=True)
+                if not results[c.label].ok:
+                    bar.write(f"run {c.label} failed: {results[c.label].error}")
+            runs.close()
+            bar.close()
+        except BaseException:       # Ctrl-C or a failure of the client: take its runs off the scheduler
+            client.cancel(list(futs), force=True)
+            raise
+    return results
+
+
+@contextlib.contextmanager
+def dask_client(n_workers: int, scheduler: str | None = None):
+    """A Dask client of the scheduler at ``scheduler``, or of a local cluster of ``n_workers`` single-threaded
+    processes that stops with it (its workers with it)."""
     from dask.distributed import Client, LocalCluster
 
-    wcfg = replace(cfg, progress=False)   # per-run bars would interleave; the sweep bar shows progress
     cluster = None
     if scheduler is None:
         cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
@@ -291,39 +331,9 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
         client = Client(cluster)
     else:
         client = Client(scheduler)
-    futs = {}
     try:
-        futs = {client.submit(execute_case, c, wcfg, overwrite, pure=False, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
-        bar = tqdm(total=len(futs), desc="runs", disable=not bars, position=0)
-        runs = _RunBars(todo, bars)
-        while True:
-            done = [f for f in futs if f.done() and futs[f].label not in results]
-            if not done:
-                if all(futs[f].label in results for f in futs):
-                    break
-                runs.poll()
-                time.sleep(0.5)
-                continue
-            fut = done[0]
-            c = futs[fut]
-            try:
-                results[c.label] = fut.result()
-            except Exception as exc:   # worker died: report, keep going
-                results[c.label] = Outcome(c, Status.FAILED, error=f"worker failure: {exc}")
-            bar.update(1)
-            runs.finish(c)
-            if plain:
-                n_done = sum(futs[f].label in results for f in futs)
-                print(f"runs: {n_done}/{len(futs)} done ({c.label})", file=sys.stderr, flush=True)
-            if not results[c.label].ok:
-                bar.write(f"run {c.label} failed: {results[c.label].error}")
-        runs.close()
-        bar.close()
-    except BaseException:       # Ctrl-C or a failure of the client: take its runs off the scheduler
-        client.cancel(list(futs), force=True)
-        raise
+        yield client
     finally:
         client.close()
         if cluster is not None:
-            cluster.close()     # a local cluster's workers stop with it
-    return results
+            cluster.close()

@@ -21,7 +21,7 @@ from matplotlib.ticker import FuncFormatter
 __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution", "against_viscosity",
            "mode_shapes", "fault_spectra", "fault_loads", "FAULT_QUANTITIES", "gear_quality", "forward_reverse_headline",
            "time_history_group", "cage_orbit_picture", "display_unit", "format_pct", "HEADLINE_QUANTITIES", "FWD", "REV",
-           "STYLE"]
+           "STYLE", "tolerance_distributions", "tolerance_against_torque", "tolerance_life_cdf"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
 STYLE = {
@@ -586,6 +586,153 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
                 ax.set_ylim(min(lo, 0.0), hi + 0.06 * (hi - min(lo, 0.0)))
         if title:
             fig.suptitle(title)
+        return _save(fig, path)
+
+
+# ----------------------------------------------------------------------------------------------
+# the tolerance study: distributions over machines drawn from their tolerances
+
+_CLASS_COLORS = ("#1f5fa8", "#c2255c", "#2b8a3e", "#e07b00", "#7a1f7a", "#222222")
+
+
+def _ecdf(x) -> tuple[np.ndarray, np.ndarray]:
+    """The empirical CDF as a post-step line: (values, share at or below), from 0 at the smallest value up a step
+    per machine (empty for no finite value)."""
+    x = np.sort(np.asarray([v for v in np.ravel(np.asarray(x, float)) if np.isfinite(v)]))
+    if not x.size:
+        return x, x
+    return np.r_[x[0], x], np.r_[0.0, np.arange(1, x.size + 1) / x.size]
+
+
+def _class_direction_legend(fig: Figure, classes: Sequence, directions: Sequence[str], extra=()) -> None:
+    from matplotlib.lines import Line2D
+    handles = [Line2D([], [], color=_CLASS_COLORS[i % len(_CLASS_COLORS)], lw=2, label=f"ISO 1328 class {c}")
+               for i, c in enumerate(classes)]
+    handles += [Line2D([], [], color="#444444", ls=(FWD if d == "forward" else REV)["linestyle"], label=d)
+                for d in directions]
+    # below the panels: above them it would collide with a suptitle
+    fig.legend(handles=[*handles, *extra], loc="outside lower center", frameon=False,
+               ncol=min(len(handles) + len(extra), max(2, int(fig.get_figwidth() / 2.4))))
+
+
+def tolerance_distributions(dist: Mapping[tuple, Mapping[tuple, Sequence[float]]], path, *, table: float = 1.0,
+                            title: str | None = None) -> Path:
+    """The distribution of the mesh K_γ over the machines (empirical CDF, a step per machine): a panel per
+    (condition, torque fraction), a colour per class, solid forward and dashed reverse; the rating tables' value
+    and the P90 level dotted. ``dist``: {(condition, torque fraction): {(class, direction): K_γ values}}."""
+    from matplotlib.lines import Line2D
+    conds = sorted({k[0] for k in dist})
+    torques = sorted({k[1] for k in dist})
+    classes = sorted({c for v in dist.values() for c, _ in v})
+    directions = [d for d in ("forward", "reverse") if any(dd == d for v in dist.values() for _, dd in v)]
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(max(6.5, 3.4 * len(torques) + 0.6), 2.8 * len(conds) + 1.2), layout="constrained")
+        axes = fig.subplots(len(conds), len(torques), squeeze=False, sharex=True, sharey=True)
+        for r, c in enumerate(conds):
+            for k, f in enumerate(torques):
+                ax = axes[r, k]
+                for (cl, d), x in sorted(dist.get((c, f), {}).items()):
+                    xs, ys = _ecdf(x)
+                    if xs.size:
+                        ax.step(xs, ys, where="post", color=_CLASS_COLORS[classes.index(cl) % len(_CLASS_COLORS)],
+                                ls=(FWD if d == "forward" else REV)["linestyle"], lw=1.3)
+                ax.axvline(table, color=_MARK_COLOR, ls=":", lw=0.9)
+                ax.axhline(0.9, color="#888888", ls=":", lw=0.8)
+                ax.set_ylim(0.0, 1.02)
+                ax.set_title(f"condition {c}, {f:g} × rated torque")
+                ax.set_xlabel(_axis_label("mesh load sharing K_γ", None))
+                if k == 0:
+                    ax.set_ylabel(_axis_label("share of machines at or below", None))
+        extra = [Line2D([], [], color=_MARK_COLOR, ls=":", label=f"rating tables, 3 planets ({table:g})"),
+                 Line2D([], [], color="#888888", ls=":", label="P90 level")]
+        _class_direction_legend(fig, classes, directions, extra)
+        if title:
+            fig.suptitle(_wrap(title, max(40, int(11 * fig.get_figwidth()))))
+        return _save(fig, path)
+
+
+def tolerance_against_torque(bands: Mapping[tuple, Mapping[int, Sequence[tuple]]], path, *, table: float = 1.0,
+                             title: str | None = None) -> Path:
+    """The mesh K_γ against the output torque: the machines' median (line and markers) and the band up to their
+    P90 (shaded, its edge thin), a panel per (condition, direction), a colour per class. ``bands``:
+    {(condition, direction): {class: [(output torque N·m, P50, P90), ...]}}."""
+    from matplotlib.lines import Line2D
+    conds = sorted({k[0] for k in bands})
+    directions = [d for d in ("forward", "reverse") if any(k[1] == d for k in bands)]
+    classes = sorted({c for v in bands.values() for c in v})
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(max(6.5, 4.2 * len(directions) + 0.6), 2.9 * len(conds) + 1.2), layout="constrained")
+        axes = fig.subplots(len(conds), len(directions), squeeze=False, sharey=True)
+        for r, c in enumerate(conds):
+            for k, d in enumerate(directions):
+                ax = axes[r, k]
+                for cl, pts in sorted(bands.get((c, d), {}).items()):
+                    pts = sorted((t, p50, p90) for t, p50, p90 in pts if p50 is not None and p90 is not None)
+                    if not pts:
+                        continue
+                    t, p50, p90 = (np.array(v, float) for v in zip(*pts))
+                    color = _CLASS_COLORS[classes.index(cl) % len(_CLASS_COLORS)]
+                    ax.fill_between(t, p50, p90, color=color, alpha=0.18, lw=0)
+                    ax.plot(t, p90, color=color, lw=0.8)
+                    ax.plot(t, p50, color=color, lw=1.4, marker="o", ms=4)
+                ax.axhline(table, color=_MARK_COLOR, ls=":", lw=0.9)
+                ax.set_xlim(0.0, 1.06 * ax.get_xlim()[1])        # from zero torque, the last marker inside
+                ax.set_title(f"condition {c}, {d}")
+                ax.set_xlabel(_axis_label("output torque", "N·m"))
+                if k == 0:
+                    ax.set_ylabel(_axis_label("mesh load sharing K_γ", None))
+        extra = [Line2D([], [], color="#444444", lw=1.4, marker="o", ms=4, label="median (P50)"),
+                 Line2D([], [], color="#444444", lw=0.8, label="P90 (band: P50–P90)"),
+                 Line2D([], [], color=_MARK_COLOR, ls=":", label=f"rating tables, 3 planets ({table:g})")]
+        handles = [Line2D([], [], color=_CLASS_COLORS[i % len(_CLASS_COLORS)], lw=2, label=f"ISO 1328 class {c}")
+                   for i, c in enumerate(classes)]
+        fig.legend(handles=[*handles, *extra], loc="outside lower center", frameon=False,
+                   ncol=min(len(handles) + 3, max(2, int(fig.get_figwidth() / 2.4))))
+        if title:
+            fig.suptitle(_wrap(title, max(40, int(11 * fig.get_figwidth()))))
+        return _save(fig, path)
+
+
+def tolerance_life_cdf(cdfs: Mapping[tuple, Mapping[tuple, tuple]], path, *, title: str | None = None) -> Path:
+    """The weakest planet bearing's L10 life over the machines (empirical CDF, log hours) against the perfect
+    machine's (a dotted vertical line per direction, black forward, grey reverse): a row per (condition, bearing
+    type), a column per life standard, a colour per class. ``cdfs``: {(condition, bearing type, standard):
+    {(class, direction): (lives in h, the perfect machine's life in h)}}."""
+    from matplotlib.lines import Line2D
+    rows = sorted({(k[0], k[1]) for k in cdfs})
+    stds = sorted({k[2] for k in cdfs}, key=lambda s: "16281" in s)
+    classes = sorted({c for v in cdfs.values() for c, _ in v})
+    directions = [d for d in ("forward", "reverse") if any(dd == d for v in cdfs.values() for _, dd in v)]
+    nominal_color = {"forward": "#000000", "reverse": "#888888"}
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(max(6.5, 4.2 * len(stds) + 0.6), 2.6 * len(rows) + 1.2), layout="constrained")
+        axes = fig.subplots(len(rows), len(stds), squeeze=False, sharey=True)
+        for r, (c, kind) in enumerate(rows):
+            for k, std in enumerate(stds):
+                ax = axes[r, k]
+                nominal = {}
+                for (cl, d), (x, nom) in sorted(cdfs.get((c, kind, std), {}).items()):
+                    xs, ys = _ecdf(x)
+                    if xs.size:
+                        ax.step(xs, ys, where="post", color=_CLASS_COLORS[classes.index(cl) % len(_CLASS_COLORS)],
+                                ls=(FWD if d == "forward" else REV)["linestyle"], lw=1.3)
+                    if nom:
+                        nominal[d] = nom
+                for d, nom in nominal.items():
+                    ax.axvline(nom, color=nominal_color[d], ls=":", lw=1.0)
+                ax.set_xscale("log")
+                _plain_log(ax.xaxis, decades=1.0)
+                ax.axhline(0.1, color="#888888", ls=":", lw=0.6)
+                ax.set_ylim(0.0, 1.02)
+                ax.set_title(f"condition {c}, {kind} planet bearings, {std}")
+                ax.set_xlabel(_axis_label("L10 life of the weakest bearing", "h"))
+                if k == 0:
+                    ax.set_ylabel(_axis_label("share of machines at or below", None))
+        extra = [Line2D([], [], color=nominal_color[d], ls=":", label=f"perfect machine, {d}") for d in directions]
+        extra.append(Line2D([], [], color="#888888", ls=":", lw=0.6, label="P10 level"))
+        _class_direction_legend(fig, classes, directions, extra)
+        if title:
+            fig.suptitle(_wrap(title, max(40, int(11 * fig.get_figwidth()))))
         return _save(fig, path)
 
 
