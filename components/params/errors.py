@@ -60,7 +60,7 @@ class RollerDiameterErrorParams(Params["RollerDiameterErrorSI"]):
     """One roller of a planet bearing larger (+) or smaller (−) than nominal (every row of that roller)."""
     _prefix: ClassVar[str] = "errors.roller_diameter"
     planet: str = named(_PLANET, _PLANET_TEXT, "the planet whose bearing has the roller")
-    roller: int = param("count", "roller index 0..Z-1 (roller 0 starts on the carrier's radial line)", lo=0.0,
+    roller: int = param("count", "roller index 0..Z-1 (roller 0 starts along the fixed frame's +x axis from its pin, the others counter-clockwise)", lo=0.0,
                         bound_text=">= 0")
     deviation: Quantity = param("length", "diameter deviation of the roller (+ larger)")
 
