@@ -2,11 +2,11 @@
 at a few instants spread over the mesh and roller positions, and the statistics users read from it.
 
 The steady motion is the scene's kinematic one: gears spin at their nominal speeds, planets rest on the
-carrier, every roller circles its pin at its cage's pure-rolling speed. Held at their kinematic values
-(their equations dropped, :func:`mbd.static.solve_static`): the carrier's angle (the speed drive supplies
-whatever torque the balance needs) and every roller's and cage's spin (nothing in a static balance fixes
-them). Everything else — every body's translation, the gears' and planets' twist — is solved. The sun
-torque is at its full value (after its ramp).
+carrier, every roller circles its pin at its cage's pure-rolling speed. Held (its equation dropped,
+:func:`mbd.static.solve_static`): the carrier's angle (the speed drive supplies whatever torque the balance
+needs). Solved: every body's translation (a roller's along its radius only: it keeps its pocket's centre), the
+gears' and planets' twist, each cage's rate with its rollers' orbits (its slip) and each roller's spin rate.
+The sun torque is at its full value (after its ramp).
 
 Statistics (:meth:`components.outputs.WindowStatistics.add_samples`): each snapshot weighs the same, and the
 quantities are the ones a dynamic run averages (one definition). What only a dynamic run can give — cage
@@ -147,7 +147,7 @@ def static_summary(scene, n_snapshots: int = 8, engine: str = "auto") -> dict:
     return summary
 
 
-def _drop(d, omitted: set, prefix: str = ""):
+def _drop(d, omitted: set):
     if not isinstance(d, dict):
         return d
     out = {}
@@ -155,5 +155,5 @@ def _drop(d, omitted: set, prefix: str = ""):
         if k.startswith(DYNAMIC_ONLY) or k in ("window_s", "window_duration_s"):
             omitted.add(k)
             continue
-        out[k] = _drop(v, omitted, prefix + k + ".")
+        out[k] = _drop(v, omitted)
     return out

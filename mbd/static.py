@@ -105,14 +105,6 @@ class SteadyMotion:
         P[:, 2] += self.spin * dt
         return P
 
-    def radius(self, X: np.ndarray) -> np.ndarray:
-        """x − c of every body at poses X (nb, 3), the centre carried by its host's displacement."""
-        r = X[:, :2] - self.centre
-        hosted = np.flatnonzero(self.host >= 0)
-        h = self.host[hosted]
-        r[hosted] -= X[h, :2] - self.q0[h, :2]
-        return r
-
     def at(self, model: Model, t: float, q_free: np.ndarray | None = None, d_spin: np.ndarray | None = None,
            d_orbit: np.ndarray | None = None):
         """(q, v, a) on the free DOFs at time t: the steady pose, or — given ``q_free`` — the steady velocity and
@@ -194,7 +186,7 @@ class _Problem:
         if rows.size == 2 and int(m.free[rows[0]]) // 3 == int(m.free[rows[1]]) // 3:
             vals = self.B[rows, i].toarray().ravel()
             body = int(m.free[rows[0]]) // 3
-            r = self.motion.radius(self.motion.poses(self.t))[body]
+            r = self.motion.poses(self.t)[body, :2] - self.motion.centre[body]
             return f"{m.body_names[body]}.{'radial' if abs(vals @ r) > 0.5 * np.hypot(*r) else 'tangential'}"
         dof = int(m.free[rows[0]])
         return f"{m.body_names[dof // 3]}.{'xyθ'[dof % 3]}"
@@ -310,7 +302,7 @@ def _directions(model: Model, motion: SteadyMotion, t: float, held: np.ndarray, 
         cols.append(hc[ok])
         vals.append(np.ones(int(ok.sum())))
     X = motion.poses(t)
-    e = motion.radius(X)[orbiting]
+    e = X[orbiting, :2] - motion.centre[orbiting]
     e /= np.hypot(e[:, 0], e[:, 1])[:, None]
     L = orbiting.size
     rad = solved.size + np.arange(L)
@@ -429,19 +421,6 @@ def carry(model: Model, motion: SteadyMotion, sol: StaticSolution, t: float, rat
 
 
 
-
-
-def _bracketed(x, dx, g, lo, hi, cap):
-    """One safeguarded step per unknown of a decreasing scalar function g: the Newton step ``dx`` clipped to
-    ``cap``, or — when it leaves the bracket (lo, hi) that g's sign keeps — the bracket's midpoint; without a
-    bracket on the side g points to, a full ``cap`` that way. Returns (x_new, lo, hi)."""
-    lo = np.where(g > 0, np.maximum(lo, x), lo)
-    hi = np.where(g < 0, np.minimum(hi, x), hi)
-    new = x + np.where(np.isfinite(dx), np.clip(dx, -cap, cap), np.sign(g) * cap)
-    bad = ~((new > lo) & (new < hi))
-    both = np.isfinite(lo) & np.isfinite(hi)
-    new = np.where(bad & both, 0.5 * (lo + hi), new)
-    return np.where(bad & ~both, x + np.sign(g) * cap, new), lo, hi
 
 
 def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarray, max_iter: int = 100):
