@@ -17,12 +17,12 @@ from .protocols import Controller, Observer
 from .recorder import BodyMotion, DerivedOutput, ElementOutput, Recorder
 from .scipy_adapter import FirstOrderSystem, solve_scipy
 from .settings import PRODUCTION, IntegratorSettings
-from .simulate import Checkpoint, Counters, SimResult, TimeMean, load_state, save_state, simulate
+from .simulate import Checkpoint, Counters, SimResult, TimeMean, load_state, output_evaluator, save_state, simulate
 
 __all__ = [
     "Adaptive", "BodyMotion", "BodyRef", "Checkpoint", "Controller", "Counters", "DerivedOutput", "Element", "ElementOutput", "Evaluation",
     "FirstOrderSystem", "FixedStep", "Frame", "FrameState", "HHT", "IntegratorSettings", "PRODUCTION", "IntegrationError", "Model",
     "ModelBuilder", "ModelError", "Observer", "Recorder", "SimResult", "State", "System", "TimeMean", "Tolerance",
     "body_dofs", "hht_coefficients", "protocols", "linearize", "load_state", "marker", "marker_velocity",
-    "modal_analysis", "point_force", "save_state", "simulate", "solve_scipy", "to_fixed", "to_reference",
+    "modal_analysis", "output_evaluator", "point_force", "save_state", "simulate", "solve_scipy", "to_fixed", "to_reference",
 ]

@@ -26,7 +26,8 @@ from .model import Model, State
 from .protocols import Controller, Observer, Recorder, require
 from .recorder import atomic_write_bytes
 
-__all__ = ["simulate", "SimResult", "Checkpoint", "Counters", "TimeMean", "save_state", "load_state"]
+__all__ = ["simulate", "SimResult", "Checkpoint", "Counters", "TimeMean", "save_state", "load_state",
+           "output_evaluator"]
 
 
 @dataclass
@@ -240,6 +241,24 @@ def _engine(engine: str, system: System, stepper, controller):
         print(f"mbd: running the numpy engine path (about 13x slower): the compiled one cannot run this model "
               f"({note})", file=sys.stderr, flush=True)
         return None, "numpy", note
+
+
+def output_evaluator(system: System, engine: str = "auto"):
+    """What evaluates the element outputs of K states at once (its ``outputs_batch(t, q, v, z, families)``, as
+    :meth:`System.outputs_batch`): "numpy" the System itself (the reference); "compiled" the compiled kernels
+    (:class:`mbd.compiled.outputs.CompiledOutputs`: the families whose twin gives outputs, the others through
+    numpy); "auto" the compiled ones when numba is there (else numpy: the engine falls back too, and says so)."""
+    if engine not in ENGINES:
+        raise ModelError(f"output_evaluator: engine must be one of {ENGINES}, got {engine!r}")
+    if engine == "numpy":
+        return system
+    try:
+        from .compiled.outputs import CompiledOutputs
+    except ImportError as exc:
+        if engine == "compiled":
+            raise ModelError(f"output_evaluator: the compiled outputs cannot run: {exc}") from None
+        return system
+    return CompiledOutputs(system)
 
 
 class _Loop:

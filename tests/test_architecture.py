@@ -373,6 +373,20 @@ def test_every_declared_compiled_twin_has_its_kernels_and_dispatch_branches():
     assert set(declared) == set(registry.KIND_IDS), f"kernels without a family: {set(registry.KIND_IDS) - set(declared)}"
 
 
+def test_each_compiled_output_kernel_is_dispatched():
+    """A twin that gives its family's outputs (registry.OUTPUT_NAMES, the names of the rows it writes) has
+    module.outputs_name, and the branch of outputs_kind for its id calls that; no branch without an entry."""
+    from mbd.compiled import registry
+    branches = _dispatch_branches("outputs_kind")
+    ids = {getattr(registry, c): c for c in branches}
+    assert len(ids) == len(branches) == len(registry.OUTPUT_NAMES)
+    for twin, names in registry.OUTPUT_NAMES.items():
+        module, name = twin.split(".")
+        const = ids[registry.KIND_IDS[twin]]
+        assert branches[const] == f"{module}.outputs_{name}", (twin, branches[const])
+        assert names and len(set(names)) == len(names), twin
+
+
 def test_a_twin_is_declared_by_each_family_and_a_typo_fails_loudly():
     """A subclass does not inherit its parent's twin (its law may differ); an unknown twin is a LookupError
     naming the family, not a silent fall back to the numpy path."""

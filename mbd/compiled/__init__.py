@@ -19,6 +19,11 @@ see :mod:`.registry`):
 
 ``update(z, t0, t1, ql0, vl0, ql1, vl1, P, G) -> z1`` (families with internal state only)
     the internal state after an accepted step, as ``Element.update_internal``.
+
+``outputs(t, phi, omega, domega, ql, vl, z, P, G, O)`` (families whose outputs the statistics read)
+    the family's outputs at one state into the rows of O (n_outputs, n), in the order its module's
+    ``NAME_OUTPUTS`` gives them (the reference's names): written by the same code that computes the forces,
+    where it computes each value (:mod:`.outputs` evaluates them for K states at once).
 """
 
 import hashlib as _hashlib
@@ -54,14 +59,14 @@ def _drop_stale_kernels() -> None:
 
 
 
-def kernels_cached() -> bool:
-    """Does numba's disk cache hold the compiled step loop of this code (so a run loads it in about a second
-    instead of compiling for about a minute)? Checked by its index file (:func:`_drop_stale_kernels` removes
-    stale ones)."""
+def kernels_cached(function: str = "stepper.advance") -> bool:
+    """Does numba's disk cache hold the compiled ``function`` ("module.name" in this package; by default the step
+    loop) of this code, so that a run loads it in about a second instead of compiling it? Checked by its index
+    file (:func:`_drop_stale_kernels` removes stale ones)."""
     from numba import config
     here = _Path(__file__).resolve().parent
     root = _Path(config.CACHE_DIR) if config.CACHE_DIR else here / "__pycache__"
-    return any(root.rglob("stepper.advance-*.nbi")) if root.is_dir() else False
+    return any(root.rglob(f"{function}-*.nbi")) if root.is_dir() else False
 
 
 _drop_stale_kernels()

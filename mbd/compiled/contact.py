@@ -1,5 +1,5 @@
 """Compiled kernels of the planet-bearing contact families (:mod:`mbd.elements.contact`), following the
-convention of :mod:`mbd.compiled` (pack / evaluate / update). The numpy kernels stay the reference.
+convention of :mod:`mbd.compiled` (pack / evaluate / update / outputs). The numpy kernels stay the reference.
 
 Layouts (P: one row per instance, columns in this order; G: family-wide values):
 
@@ -42,8 +42,9 @@ from ..elements import ehl
 from ..elements.contact import (DryLand, EHLTraction, GuideContact, HydrodynamicLand, LubricantDrag, PocketContact,
                                 RaceContact, SlideRollTraction, TanhTraction)
 
-__all__ = ["pack_race", "evaluate_race", "pack_pocket", "evaluate_pocket", "update_pocket", "pack_guide",
-           "evaluate_guide", "update_guide", "pack_drag", "evaluate_drag", "TRACTION_IDS"]
+__all__ = ["pack_race", "evaluate_race", "outputs_race", "pack_pocket", "evaluate_pocket", "outputs_pocket",
+           "update_pocket", "pack_guide", "evaluate_guide", "outputs_guide", "update_guide", "pack_drag",
+           "evaluate_drag", "TRACTION_IDS", "RACE_OUTPUTS", "POCKET_OUTPUTS", "GUIDE_OUTPUTS"]
 
 _ETA2 = 1e-24          # the reference's η² (mbd.elements.contact._ETA2)
 _TWO_PI = 2.0 * np.pi
@@ -240,17 +241,22 @@ def _ehl_traction(G, v_s, u, Q, Rr):
 
 
 @njit(cache=True)
+def _approach(v_min, xd, v_stored):
+    """(v₀, dv₀/dẋ): the stored approach speed if > 0, else max(ẋ, v_min) of the iterate."""
+    if v_stored > 0.0:
+        return v_stored, 0.0
+    if xd > v_min:
+        return xd, 1.0
+    return v_min, 0.0
+
+
+@njit(cache=True)
 def _impact(K, lam, v_min, x, xd, v_stored):
     """Impact force F = K x (1 + λ ẋ/v₀) ≥ 0 for x > 0 (else 0) and its partials ∂F/∂x, ∂F/∂ẋ (0 where
     F is clipped). v₀ = v_stored if > 0, else max(ẋ, v_min) of the iterate (then v₀ follows ẋ)."""
     if not x > 0.0:
         return 0.0, 0.0, 0.0
-    if v_stored > 0.0:
-        v_app, dv = v_stored, 0.0
-    elif xd > v_min:
-        v_app, dv = xd, 1.0
-    else:
-        v_app, dv = v_min, 0.0
+    v_app, dv = _approach(v_min, xd, v_stored)
     F = K * x * (1.0 + lam * xd / v_app)
     if not F > 0.0:
         return 0.0, 0.0, 0.0
@@ -272,6 +278,13 @@ def _impact_state(v0, x0, xd0, x1, xd1, v_min):
 
 
 # ----------------------------------------------------------------------------------- race contact
+@njit(cache=True)
+def _race_out(O, i, Q, delta, Ft, v_s, u, Fx, Fy):
+    """Row order of :data:`RACE_OUTPUTS`."""
+    O[0, i], O[1, i], O[2, i], O[3, i] = Q, delta, Ft, v_s
+    O[4, i], O[5, i], O[6, i] = u, Fx, Fy
+
+
 RACE_COLS = 8                                   # P columns of a race family without a spall
 
 
@@ -298,10 +311,47 @@ def _spall(P, i, R, dx, dy, wx, wy, thb, vb2):
 
 
 @njit(cache=True)
+def _race_surfaces(R, rho, ex, ey, tx, ty, rcx, rcy, vr0, vr1, vr2, vb0, vb1, vb2, Vcx, Vcy, wx, wy):
+    """Contact point P = c + R e seen from the roller centre (rr) and from the race body's centre (rb), the
+    surfaces' velocities there, their speeds along t, the slip v_s = u_r − u_b, (ṗ − ċ)·t and the rolling
+    speed u relative to the moving contact point (the traction laws and the outputs read them)."""
+    rl = R - rho
+    rrx, rry = rl * ex, rl * ey
+    rbx, rby = rcx + R * ex, rcy + R * ey
+    Vrx, Vry = vr0 - vr2 * rry, vr1 + vr2 * rrx
+    Vbx, Vby = vb0 - vb2 * rby, vb1 + vb2 * rbx
+    ur = Vrx * tx + Vry * ty
+    ub = Vbx * tx + Vby * ty
+    wt = wx * tx + wy * ty
+    u = 0.5 * (ur + ub) - (Vcx * tx + Vcy * ty + R * wt / rho)
+    return rl, rrx, rry, rbx, rby, Vrx, Vry, Vbx, Vby, ur, ub, ur - ub, wt, u
+
+
+# the outputs of RaceContact the compiled kernel gives (rows of O in outputs_race), as the reference names them;
+# not its "angle" (an arctan2 per contact, ≈ 4 µs a state for 144 contacts, that nothing reading these needs)
+RACE_OUTPUTS = ("load", "deflection", "traction", "slip_velocity", "rolling_speed", "fx", "fy")
+
+
+@njit(cache=True)
 def evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    _race(ql, vl, P, G, F, Jq, Jv, jac, np.empty((0, 0)))
+
+
+@njit(cache=True)
+def outputs_race(t, phi, omega, domega, ql, vl, z, P, G, O):
+    """The outputs :data:`RACE_OUTPUTS` of every instance into the rows of O (7, n): the force law of
+    :func:`evaluate_race`, evaluated once (the reference's outputs; per physical contact)."""
+    n = ql.shape[0]
+    _race(ql, vl, P, G, np.empty((n, 6)), np.empty((0, 6, 6)), np.empty((0, 6, 6)), False, O)
+
+
+@njit(cache=True)
+def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
+    """The race law: forces into F (and Jacobians); with O of 7 rows, the outputs too (else O is (0, 0))."""
     p, law = G[0], int(G[1])
     pe = 0.5 * (p - 1.0)                        # exponent of the damping's δ factor
     spall = P.shape[1] > RACE_COLS              # decided at pack time (see the module docstring)
+    out = O.shape[0] > 0
     for i in range(ql.shape[0]):
         kap, mx, my, R, D, K, c0, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6], P[i, 7]
         xr, yr = ql[i, 0], ql[i, 1]
@@ -324,27 +374,19 @@ def evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
             d_s, d_rate, hBs, hBss, s_dot = _spall(P, i, R, dx, dy, wx, wy, thb, vb2)
             delta, delta_dot = delta - d_s, delta_dot - d_rate
         # Hertz load with contact damping, clipped at >= 0 (ad.where: zero derivative when clipped)
-        if not delta > 0.0:
-            _zero(F, Jq, Jv, i, jac)
-            continue
-        dpe = delta ** pe
-        Q = K * delta ** p + c0 * dpe * delta_dot
+        Q, dpe = 0.0, 0.0
+        if delta > 0.0:
+            dpe = delta ** pe
+            Q = K * delta ** p + c0 * dpe * delta_dot
         if not Q > 0.0:
             _zero(F, Jq, Jv, i, jac)
+            if out:                              # no load, no traction; the kinematics as for a loaded one
+                k = _race_surfaces(R, rho, ex, ey, tx, ty, rcx, rcy, vr0, vr1, vr2, vb0, vb1, vb2, Vcx, Vcy, wx, wy)
+                _race_out(O, i, 0.0, delta, 0.0, k[11], k[13], 0.0, 0.0)
             continue
-        # contact point P = c + R e seen from the roller centre (rr) and from the race body's centre (rb)
-        rl = R - rho
-        rrx, rry = rl * ex, rl * ey
-        rbx, rby = rcx + R * ex, rcy + R * ey
-        Vrx, Vry = vr0 - vr2 * rry, vr1 + vr2 * rrx
-        Vbx, Vby = vb0 - vb2 * rby, vb1 + vb2 * rbx
-        ur = Vrx * tx + Vry * ty
-        ub = Vbx * tx + Vby * ty
-        v_s = ur - ub
-        wt = wx * tx + wy * ty
-        u = 0.0
-        if law != TANH:                          # rolling speed relative to the moving contact point
-            u = 0.5 * (ur + ub) - (Vcx * tx + Vcy * ty + R * wt / rho)
+        # contact point, surface speeds, slip and rolling speed (relative to the moving contact point)
+        rl, rrx, rry, rbx, rby, Vrx, Vry, Vbx, Vby, ur, ub, v_s, wt, u = _race_surfaces(
+            R, rho, ex, ey, tx, ty, rcx, rcy, vr0, vr1, vr2, vb0, vb1, vb2, Vcx, Vcy, wx, wy)
         mu_Q = 0.0
         if law == EHL:                           # the film's law needs the load and the reduced radius
             mu, mu_s, mu_u, mu_Q = _ehl_traction(G, v_s, u, Q, 1.0 / (2.0 / D + kap / R))
@@ -354,6 +396,8 @@ def evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         Fx = kap * Q * ex + Ft * tx
         Fy = kap * Q * ey + Ft * ty
         _write(F, Jq, Jv, i, -1, mult, Fx, Fy, rrx * Fy - rry * Fx, -Fx, -Fy, rbx * (-Fy) - rby * (-Fx))
+        if out:
+            _race_out(O, i, Q, delta, Ft, v_s, u, Fx, Fy)
         if not jac:
             continue
         Q_d = K * p * delta ** (p - 1.0) + c0 * pe * delta ** (pe - 1.0) * delta_dot   # ∂Q/∂δ
@@ -407,8 +451,26 @@ def _pocket_gap(xr, yr, xg, yg, thg, vr0, vr1, vg0, vg1, vg2, psi, rm, clearance
     return dx, dy, rho2, s, wx, wy, abs(s) - clearance, _sign(s) * s_dot
 
 
+# the outputs of PocketContact the compiled kernel gives (rows of O in outputs_pocket), as the reference names them
+POCKET_OUTPUTS = ("force", "offset", "penetration", "penetration_rate", "approach_speed")
+
+
 @njit(cache=True)
 def evaluate_pocket(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    _pocket(ql, vl, z, P, F, Jq, Jv, jac, np.empty((0, 0)))
+
+
+@njit(cache=True)
+def outputs_pocket(t, phi, omega, domega, ql, vl, z, P, G, O):
+    """The outputs :data:`POCKET_OUTPUTS` into the rows of O (5, n), by the law of :func:`evaluate_pocket`."""
+    n = ql.shape[0]
+    _pocket(ql, vl, z, P, np.empty((n, 6)), np.empty((0, 6, 6)), np.empty((0, 6, 6)), False, O)
+
+
+@njit(cache=True)
+def _pocket(ql, vl, z, P, F, Jq, Jv, jac, O):
+    """The pocket law: forces into F (and Jacobians); with O of 5 rows, the outputs too (else O is (0, 0))."""
+    out = O.shape[0] > 0
     for i in range(ql.shape[0]):
         psi, rm, clr, Kp, lam, v_min = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5]
         mu, v_mu, D, mult = P[i, 6], P[i, 7], P[i, 8], P[i, 9]
@@ -418,11 +480,15 @@ def evaluate_pocket(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         dx, dy, rho2, s, wx, wy, pen, pen_dot = _pocket_gap(xr, yr, xg, yg, thg, vr0, vr1, vg0, vg1, vg2, psi,
                                                             rm, clr)
         Fi, F_x, F_xd = _impact(Kp, lam, v_min, pen, pen_dot, z[i, 0])
+        sg = _sign(s)
+        Fs = Fi * sg
+        if out:            # (the reference's v₀ in use is 0 where the pocket is open)
+            touch = pen > 0.0
+            O[0, i], O[1, i], O[2, i], O[3, i] = Fs, s, pen if touch else 0.0, pen_dot
+            O[4, i] = _approach(v_min, pen_dot, z[i, 0])[0] if touch else 0.0
         if Fi == 0.0:
             _zero(F, Jq, Jv, i, jac)
             continue
-        sg = _sign(s)
-        Fs = Fi * sg
         # potential form −Fs ∂s/∂q: ∂s/∂p = rm (−dy, dx)/ρ² = (gx, gy)
         gx, gy = rm * (-dy) / rho2, rm * dx / rho2
         fnx, fny = -Fs * gx, -Fs * gy
@@ -548,9 +614,28 @@ def _dfilm(film, ex, ey, e_abs, wx, wy, dex, dey, de_abs, dwx, dwy, dw_g, dw_o, 
     return -1.0 * K0 * (dA + dB), sgn * K0 * (dCc + dDd), dsh
 
 
+# the outputs of GuideContact the compiled kernel gives (rows of O in outputs_guide), as the reference names them
+GUIDE_OUTPUTS = ("force", "eccentricity", "friction", "fx", "fy", "sliding_speed", "penetration_rate",
+                 "approach_speed")
+
+
 @njit(cache=True)
 def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    _guide(ql, vl, z, P, G, F, Jq, Jv, jac, np.empty((0, 0)))
+
+
+@njit(cache=True)
+def outputs_guide(t, phi, omega, domega, ql, vl, z, P, G, O):
+    """The outputs :data:`GUIDE_OUTPUTS` into the rows of O (8, n), by the law of :func:`evaluate_guide`."""
+    n = ql.shape[0]
+    _guide(ql, vl, z, P, G, np.empty((n, 6)), np.empty((0, 6, 6)), np.empty((0, 6, 6)), False, O)
+
+
+@njit(cache=True)
+def _guide(ql, vl, z, P, G, F, Jq, Jv, jac, O):
+    """The guide law: forces into F (and Jacobians); with O of 8 rows, the outputs too (else O is (0, 0))."""
     hydro = G.size > 0 and G[0] == 1.0
+    out = O.shape[0] > 0
     for i in range(ql.shape[0]):
         clr, Kg, lam, v_min, mu, v_mu, rL = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
         vg0, vg1, vg2 = vl[i, 0], vl[i, 1], vl[i, 2]
@@ -558,7 +643,7 @@ def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         ex, ey, eps, nx, ny, pen, eps_dot = _guide_gap(ql[i, 0], ql[i, 1], ql[i, 3], ql[i, 4], vg0, vg1, vo0,
                                                        vo1, clr)
         Fi, F_x, F_xd = _impact(Kg, lam, v_min, pen, eps_dot, z[i, 0])
-        if Fi == 0.0 and not hydro:
+        if Fi == 0.0 and not hydro and not out:     # (the outputs need the sliding speed all the same)
             _zero(F, Jq, Jv, i, jac)
             continue
         tx, ty = -ny, nx
@@ -579,6 +664,10 @@ def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         Fx = Fnt * nx + Ftt * tx
         Fy = Fnt * ny + Ftt * ty
         _write(F, Jq, Jv, i, -1, 1.0, Fx, Fy, rgx * Fy - rgy * Fx, -Fx, -Fy, rox * (-Fy) - roy * (-Fx))
+        if out:            # the impact force, the land's friction with the film's shear, the force on the cage
+            O[0, i], O[1, i], O[2, i], O[3, i], O[4, i] = Fi, np.hypot(ex, ey), fr + sh, Fx, Fy
+            O[5, i], O[6, i] = v_t, eps_dot
+            O[7, i] = _approach(v_min, eps_dot, z[i, 0])[0] if pen > 0.0 else 0.0
         if not jac:
             continue
         f_v = -mu * (1.0 - th * th) / v_mu * Fi  # ∂fr/∂v_t

@@ -5,7 +5,11 @@ Each family declares its twin where it is defined (``Element.compiled_twin = "mo
 ``pack_name``, ``evaluate_name`` and, with internal state, ``update_name`` of ``mbd.compiled.module``); here
 each twin has a kind id and a branch of :func:`evaluate_kind` (and of :func:`update_kind`). Adding a compiled
 family: its kernels in a kernel module, the declaration on the family, an id in :data:`KIND_IDS` and the
-branches (tests/test_architecture.py checks that they agree)."""
+branches (tests/test_architecture.py checks that they agree).
+
+A twin may also give its family's outputs (``outputs_name`` and the names of its rows, ``NAME_OUTPUTS``, in its
+module; a branch of :func:`outputs_kind`): :class:`mbd.compiled.outputs.CompiledOutputs` evaluates them for K
+states at once. The others' outputs come from the numpy kernels."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -16,7 +20,7 @@ from numba import njit
 
 from . import contact, generic, mesh
 
-__all__ = ["Kind", "KIND_IDS", "kind_of", "evaluate_kind", "update_kind"]
+__all__ = ["Kind", "KIND_IDS", "OUTPUT_NAMES", "kind_of", "evaluate_kind", "update_kind", "outputs_kind"]
 
 
 @dataclass(frozen=True)
@@ -37,6 +41,9 @@ KIND_IDS = {
     "generic.torque_source": _TORQUE, "generic.force_source": _FORCE, "generic.speed_drive": _SPEED,
 }
 _MODULES = {"contact": contact, "generic": generic, "mesh": mesh}
+# twins that give their outputs (outputs_kind) -> the reference's names of the rows they write
+OUTPUT_NAMES = {"contact.race": contact.RACE_OUTPUTS, "contact.pocket": contact.POCKET_OUTPUTS,
+                "contact.guide": contact.GUIDE_OUTPUTS, "mesh.gear_mesh": mesh.MESH_OUTPUTS}
 
 
 def kind_of(cls) -> Kind | None:
@@ -90,3 +97,16 @@ def update_kind(kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):
     if kind == _SPEED:
         return generic.update_speed_drive(z, t0, t1, ql0, vl0, ql1, vl1, P, G, phi0, phi1)
     return np.copy(z)
+
+
+@njit(cache=True)
+def outputs_kind(kind, t, phi, omega, domega, ql, vl, z, P, G, O):
+    """The outputs of a family whose twin gives them (:data:`OUTPUT_NAMES`) into the rows of O."""
+    if kind == _RACE:
+        contact.outputs_race(t, phi, omega, domega, ql, vl, z, P, G, O)
+    elif kind == _POCKET:
+        contact.outputs_pocket(t, phi, omega, domega, ql, vl, z, P, G, O)
+    elif kind == _GUIDE:
+        contact.outputs_guide(t, phi, omega, domega, ql, vl, z, P, G, O)
+    elif kind == _MESH:
+        mesh.outputs_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, O)
