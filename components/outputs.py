@@ -31,6 +31,7 @@ import numpy as np
 
 import mbd
 from mbd.ad import wrap_angle
+from mbd.simulate import ENGINES
 from mbd.elements.ehl import thermal_factor
 
 from .accumulate import IMPACT_ROWS, accumulate_steps
@@ -338,13 +339,18 @@ class WindowStatistics(mbd.Observer):
 
     ``scene``: a :class:`~components.dpgt.PlanetBearingScene` (its pairs, see :func:`bearing_map`; speeds; bearing;
     lubricant; the loaded flank of each mesh type; the sun torque). After the run, :meth:`summary` gives the numbers.
+    ``outputs``: what evaluates the element outputs (:func:`mbd.output_evaluator`): "auto" (the compiled kernels),
+    "compiled" or "numpy" (the reference kernels, as the tests use them to hold the compiled ones).
     """
 
     MARGIN = 0.05      # extra run time for slipping cages, as a fraction of the window
 
-    def __init__(self, scene, t0: float, t1: float, whole_revolutions: bool = True):
+    def __init__(self, scene, t0: float, t1: float, whole_revolutions: bool = True, outputs: str = "auto"):
         if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
             raise mbd.ModelError(f"statistics window must satisfy t1 > t0 [s], got [{t0!r}, {t1!r}]")
+        if outputs not in ENGINES:
+            raise mbd.ModelError(f"outputs must be one of {ENGINES}, got {outputs!r}")
+        self.outputs = outputs
         self.t0, self.t1 = float(t0), float(t1)
         self.scene = scene
         self.bmap = bearing_map(scene)
@@ -368,6 +374,7 @@ class WindowStatistics(mbd.Observer):
     # setup -------------------------------------------------------------------------------------
     def bind(self, model, system, state) -> None:
         self.model, self.system = model, system
+        self._outputs = mbd.output_evaluator(system, self.outputs)
         fams = {e.name for e in model.elements}
         bm = self.bmap
         idx = lambda name: model.body(name).index
@@ -432,9 +439,10 @@ class WindowStatistics(mbd.Observer):
 
     def snapshots(self, t, q, v, a, z) -> dict[str, np.ndarray]:
         """Every derived quantity at K states (``t`` (K,), ``q``, ``v``, ``a`` (K, n), ``z`` {family: (K, ...)}):
-        arrays (K, per bearing / roller / mesh), each from vectorised expressions over the K states."""
+        arrays (K, per bearing / roller / mesh), each from vectorised expressions over the K states; until the
+        reference rollers are chosen also the rollers' angles about their planets ("_roller_angle")."""
         p, m = self.plan, self.model
-        out = self.system.outputs_batch(t, q, v, z, families=self._families)
+        out = self._outputs.outputs_batch(t, q, v, z, families=self._families)
         X, V, A = carrier_frame_motion(m, t, q, v, a, self.omega_c)
         radial = lambda vec: radial_tangential(vec, X[:, p.planet, :2], X[:, p.carrier, :2][:, None, :])
         K, nb = t.size, p.planet.size
@@ -484,7 +492,7 @@ class WindowStatistics(mbd.Observer):
             snap[f"{key}_coast_force"] = np.asarray(o["force" + (coast or "_drive")], float)
             snap[f"{key}_drive_deflection"] = np.asarray(o["deflection" + drive], float)
             snap[f"{key}_coast_deflection"] = np.asarray(o["deflection" + coast], float)
-        if p.rollers:
+        if p.rollers and self.ref_roller is None:    # read only to choose the reference rollers (_accumulate)
             d = X[:, p.roller_body, :2] - X[:, p.planet[p.roller_bearing], :2]
             snap["_roller_angle"] = np.arctan2(d[..., 1], d[..., 0])
         return snap

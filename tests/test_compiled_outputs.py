@@ -13,15 +13,18 @@ of the block-vs-state outputs test (test_block_statistics.ROUND_OFF: 1e-12 of th
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 import mbd
+from components.outputs import WindowStatistics
 from components.params import with_overrides
 from components.presets import reference_dpgt
 from mbd.compiled.outputs import CompiledOutputs
 from mbd.compiled.registry import OUTPUT_NAMES
-from test_block_statistics import ROUND_OFF, build, faulty
+from test_block_statistics import ROUND_OFF, _numbers, build, faulty
 from test_compiled_mesh import libm_arctan2
 
 # what the compiled kernels leave out of the reference's outputs (not by-products of the force law)
@@ -101,12 +104,35 @@ def test_compiled_outputs_equal_the_reference_for_each_law_variant(overrides, op
         assert compiled == {"mesh_sa", "mesh_ab", "mesh_br"}
 
 
+def test_statistics_through_compiled_and_numpy_outputs_give_the_same_summary():
+    """The faulty machine in reverse (pocket impacts, film, a spall, a cracked tooth, class-6 teeth): the statistics
+    of one run taken through the compiled outputs and through the reference kernels (unchanged) give the same
+    summary, every number to 1e-9 and every count and flag exactly; the window starts and ends inside blocks."""
+    bs = build(faulty("reverse"))
+    t0, t1 = 4e-3, 6e-3
+    fast, ref = WindowStatistics(bs, t0, t1, outputs="compiled"), WindowStatistics(bs, t0, t1, outputs="numpy")
+    res = mbd.simulate(bs.model, bs.q0, bs.v0, fast.t_end + 3e-4, stepper=mbd.PRODUCTION.stepper(),
+                       controller=mbd.PRODUCTION.controller(), progress=False, observers=[fast, ref])
+    assert res.engine == "compiled"
+    assert isinstance(fast._outputs, CompiledOutputs) and isinstance(ref._outputs, mbd.System)
+    a, b = _numbers(fast.summary()), _numbers(ref.summary())
+    assert set(a) == set(b) and len(a) > 200
+    assert a["inner.pocket_impacts"] + a["outer.pocket_impacts"] > 0 and math.isfinite(a["inner.film_min_m"])
+    for k in a:
+        if isinstance(a[k], (bool, int)) or not isinstance(a[k], float):
+            assert a[k] == b[k], k
+        else:
+            assert a[k] == pytest.approx(b[k], rel=1e-9, abs=1e-300), k
+
+
 def test_the_outputs_engine_is_checked_and_a_compile_is_announced(capsys, monkeypatch):
     """An unknown engine is refused in one line naming the argument; building the compiled outputs when numba's
     cache does not hold them says so before it compiles, and gives the time (faked cold: the cache answers)."""
     import mbd.compiled as mc
 
     bs = build(reference_dpgt(3, "forward"))
+    with pytest.raises(mbd.ModelError, match=r"^outputs must be one of \('auto', 'compiled', 'numpy'\), got 'gpu'$"):
+        WindowStatistics(bs, 0.0, 1e-3, outputs="gpu")
     with pytest.raises(mbd.ModelError, match=r"^output_evaluator: engine must be one of"):
         mbd.output_evaluator(mbd.System(bs.model), "gpu")
     system = mbd.System(bs.model)
