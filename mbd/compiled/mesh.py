@@ -43,7 +43,7 @@ from numba import njit
 from ..elements.gear_mesh import ConstantStiffness, FourierStiffness, GearMesh, RectangularStiffness
 from . import tooth_pairs
 
-__all__ = ["pack_gear_mesh", "evaluate_gear_mesh", "outputs_gear_mesh", "MESH_OUTPUTS"]
+__all__ = ["pack_gear_mesh", "evaluate_gear_mesh"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -168,35 +168,14 @@ def evaluate_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     """Forces (and Jacobians) of n meshes; the mesh is frame-invariant, so phi/omega/domega are unused."""
     off = int(G[G_OFFSET])
     if off < 0:                      # no eccentricity: the law on the body centres, written in place
-        _meshes(ql, vl, P, G, F, Jq, Jv, jac, np.empty((0, 0)))
+        _meshes(ql, vl, P, G, F, Jq, Jv, jac)
         return
     n = ql.shape[0]
     qg, vg, r, Fg = np.empty((n, 6)), np.empty((n, 6)), np.empty((n, 4)), np.empty((n, 6))
     Jqg, Jvg = np.empty((n if jac else 0, 6, 6)), np.empty((n if jac else 0, 6, 6))
     _to_geometric(ql, vl, P, off, qg, vg, r)
-    _meshes(qg, vg, P, G, Fg, Jqg, Jvg, jac, np.empty((0, 0)))
+    _meshes(qg, vg, P, G, Fg, Jqg, Jvg, jac)
     _from_geometric(Fg, Jqg, Jvg, r, vl, F, Jq, Jv, jac)
-
-
-# the outputs of GearMesh the compiled kernel gives (rows of O in outputs_gear_mesh), as the reference names them;
-# not its "stiffness" (the tooth-pair law sums it only where a flank can touch)
-MESH_OUTPUTS = ("force", "force_drive", "force_coast", "deflection", "deflection_coast", "deflection_rate",
-                "deflection_rate_coast", "position", "fx", "fy")
-
-
-@njit(cache=True)
-def outputs_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, O):
-    """The outputs :data:`MESH_OUTPUTS` into the rows of O (10, n), by the law of :func:`evaluate_gear_mesh`
-    (with eccentricity on the geometric centres, where the reference's fx, fy act)."""
-    n = ql.shape[0]
-    off = int(G[G_OFFSET])
-    F, J = np.empty((n, 6)), np.empty((0, 6, 6))
-    if off < 0:
-        _meshes(ql, vl, P, G, F, J, J, False, O)
-        return
-    qg, vg, r = np.empty((n, 6)), np.empty((n, 6)), np.empty((n, 4))
-    _to_geometric(ql, vl, P, off, qg, vg, r)
-    _meshes(qg, vg, P, G, F, J, J, False, O)
 
 
 @njit(cache=True)
@@ -267,16 +246,13 @@ def _lumped_flanks(shape, P, i, G, p_geo, z1, k_mean, c, phx, phy, d_plus, d_min
 
 
 @njit(cache=True)
-def _meshes(ql, vl, P, G, F, Jq, Jv, jac, O):
-    """The mesh law at local coordinates ql, rates vl (the body centres, or the geometric centres); with O of
-    10 rows, the outputs :data:`MESH_OUTPUTS` too (else O is (0, 0))."""
+def _meshes(ql, vl, P, G, F, Jq, Jv, jac):
+    """The mesh law at local coordinates ql, rates vl (the body centres, or the geometric centres)."""
     shape, pcol, tstart = int(G[G_SHAPE]), int(G[G_PAIRS]), int(G[G_TABLE])
-    out = O.shape[0] > 0
     # gradients over (dx, dy, θ1, θ2, ḋx, ḋy, ω1, ω2), allocated once
-    S = np.zeros((14, 8))                       # one allocation (this runs for every state an output is read at)
-    ds, dsd, dr, drd, dkp = S[0], S[1], S[2], S[3], S[4]
-    gp, gm, hx, hy, hnet = S[5], S[6], S[7], S[8], S[9]
-    dd_p, dd_m, dv_p, dv_m = S[10], S[11], S[12], S[13]
+    ds, dsd, dr, drd, dkp = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
+    gp, gm, hx, hy, hnet = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
+    dd_p, dd_m, dv_p, dv_m = np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8)
     for i in range(ql.shape[0]):
         sig, rb1, rb2 = P[i, P_SIGMA], P[i, P_RB1], P[i, P_RB2]
         sa, kappa0, pb, z1 = P[i, P_SIN_ALPHA], P[i, P_KAPPA0], P[i, P_PITCH], P[i, P_TEETH1]
@@ -341,11 +317,6 @@ def _meshes(ql, vl, P, G, F, Jq, Jv, jac, O):
         F[i, 3] = sig * Fx_head
         F[i, 4] = sig * Fy_head
         F[i, 5] = -1.0 * rb2 * F_net
-        if out:
-            O[0, i], O[1, i], O[2, i], O[3, i], O[4, i] = F_net, F_plus, F_minus, d_plus, d_minus
-            O[5, i], O[6, i] = r_plus, r_minus
-            O[7, i] = np.mod(z1 * (th1 - phi_e) * (1.0 / _TWO_PI) + P[i, P_P0], 1.0)
-            O[8, i], O[9, i] = F[i, 3], F[i, 4]
         if not jac:
             continue
         # --- head force (F_net κ t + σ F_sum sin α e) and torques

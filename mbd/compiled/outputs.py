@@ -1,6 +1,6 @@
 """The element outputs of K states at once through the compiled kernels: the twin of
 :meth:`mbd.System.outputs_batch` for the families whose compiled twin gives its outputs
-(:data:`.registry.OUTPUT_NAMES`: roller–race, pocket, guide-land and gear-mesh contacts), the numpy kernels'
+(:data:`.registry.OUTPUT_NAMES`: the roller–race, pocket and guide-land contacts), the numpy kernels'
 (``System.outputs_batch``) for the others. An output is written by the compiled force law where it computes
 that value for the residual (one definition of each law); ``System.outputs_batch`` stays the reference the
 tests hold this to (tests/test_compiled_outputs.py)."""
@@ -35,9 +35,9 @@ def family_outputs(kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O):
 class CompiledOutputs:
     """``outputs_batch(t, q, v, z, families=None)`` as :meth:`mbd.System.outputs_batch` gives it (arrays (K, n)
     per family and output), the compiled families' outputs from their kernels: the names of
-    :data:`.registry.OUTPUT_NAMES`, the reference's but the race's "angle" and the mesh's "stiffness" (not
-    by-products of the force law: extra work that the statistics do not read; the recorder's probes take the
-    numpy kernels'). :attr:`engines` says which path evaluates each family ("compiled" / "numpy")."""
+    :data:`.registry.OUTPUT_NAMES`, the reference's but the race's "angle" (not a by-product of the force law:
+    an arctan2 per contact that the statistics do not read; the recorder's probes take the numpy kernels').
+    :attr:`engines` says which path evaluates each family ("compiled" / "numpy")."""
 
     def __init__(self, system: System):
         self.system, self.model = system, system.model
@@ -69,7 +69,7 @@ class CompiledOutputs:
         cold = not kernels_cached("outputs.family_outputs")
         if cold:
             print("mbd: compiling the element output kernels (the first run of this code on this machine; about "
-                  "20 s, then cached)", file=sys.stderr, flush=True)
+                  "10 s, then cached)", file=sys.stderr, flush=True)
         t0 = time.perf_counter()
         self.outputs_batch(np.zeros(0), np.zeros((0, self.model.ndof)), np.zeros((0, self.model.ndof)), {},
                            families={name for rec in self._compiled for name, _ in rec[0]})
