@@ -380,8 +380,9 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
     x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization)
     if not ok:
         worst = int(np.argmax(np.abs(prob.residual(x)[0]) / np.maximum(prob.floor, 1e-300)))
-        raise ModelError(f"solve_static: no static state at t = {t:.6g} s within {max_steps} steps (worst unknown: "
-                         f"{prob.label(worst)}): a body without support, or a load no contact can carry?")
+        raise ModelError(f"solve_static: no static state at t = {t:.6g} s after {steps} steps (worst unknown: "
+                         f"{prob.label(worst)}): a body without support, a load no contact can carry, or a state "
+                         f"resting on a force's jump (a contact's damping at its onset)?")
     q, v, a = prob.state(x)
     return StaticSolution(float(t), q, v, a, z, prob.full_residual(x), x[nB:].copy(), steps, time.perf_counter() - t_wall)
 
@@ -488,9 +489,10 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
     Schur complement of the local blocks and μ = 1/Δτ. μ starts where no unknown moves more than its ``cap``
     and follows the residual, μ ← μ·|g_new|/|g| (halved again while it falls; |g|² = Σ g²/M over the outer
     unknowns), down to ``regularization``·max K/M: the last steps are Newton's. A step that more than doubles
-    |g| is retried with a tenfold μ; steps are clipped to their caps. Converged when every unknown's residual
+    |g| is retried with a tenfold μ, and so is any growth once |g| is a hundredth of its start or μ at its floor
+    (Newton's steps can cycle across a kink of the forces); steps are clipped to their caps. Converged when every unknown's residual
     would move it less than its tolerance under its own stiffness, |g_i| ≤ (|K_ii| + μ_min M_i)·tol_i.
-    Returns (x, steps, converged)."""
+    Stops, unconverged, when μ has grown 10⁴-fold over its start (no step lowers |g|). Returns (x, steps, converged)."""
     M = prob.M
     loc = np.sort(local[local >= 0])
     outer = np.setdiff1d(np.arange(M.size), loc)
@@ -504,11 +506,12 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
     x, g, local_ok = _local_solve(prob, x, local, cap)
     g, K = prob.residual(x, jac=True)
     mu = max(float(np.max(np.abs(g[outer]) / (Mo * cap[outer]))), mu_min)
+    g_start, mu_start = norm(g), mu
     for k in range(max_steps + 1):
         prob.floor = np.maximum((np.abs(np.diagonal(K)) + mu_min * M) * tol, prob.force_floor)
         if np.all(np.abs(g[outer]) <= prob.floor[outer]) and local_ok:
             return x, k, True
-        if k == max_steps:
+        if k == max_steps or mu > 1e4 * mu_start:   # no step, however short, lowers |g|: resting on a force's jump
             break
         Koo, Kol = K[np.ix_(outer, outer)], K[np.ix_(outer, loc)]
         Klo, Kll = K[np.ix_(loc, outer)], K[np.ix_(loc, loc)]
@@ -528,9 +531,12 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
         ratio = norm(g_new) / max(norm(g), 1e-300) if np.all(np.isfinite(g_new)) else np.inf
         if _TRACE:
             top = outer[np.argsort(-np.abs(g[outer]) / np.sqrt(Mo))[:3]]
-            print(f"{k} mu {mu:.2e} |g| {norm(g):.3e} -> {norm(g_new):.3e} largest: "
+            print(f"{k} mu {mu:.2e} local {ok_new} |g| {norm(g):.3e} -> {norm(g_new):.3e} largest: "
                   + ", ".join(f"{prob.label(int(i))} {g[i]:.3g}" for i in top))
-        if ratio > 2.0:
+        # a step that doubles |g| is refused; so is any growth once |g| is a hundredth of its start (the contacts
+        # are in: what remains is Newton's end game) or μ at its floor — near a kink of the forces (a tooth pair's
+        # stiffness edge, a contact closing) Newton's steps can cycle between two states on either side of it
+        if ratio > 2.0 or (ratio > 1.0 and (mu <= mu_min or norm(g) < 1e-2 * g_start)):
             mu = max(10.0 * mu, 10.0 * mu_min)
             continue
         x, local_ok = x_new, ok_new
