@@ -43,7 +43,7 @@ import mbd
 from components.tolerance_sampling import (DISTRIBUTIONS, TOLERANCE_DEFAULTS, ToleranceSpec, coordinates, draw_errors,
                                            sobol_points, teeth_seed)
 from components.units import ParameterError
-from mbd.recorder import atomic_write_text
+from components.results.io import atomic_write_text
 
 from . import args
 from .command import command

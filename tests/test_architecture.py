@@ -80,16 +80,22 @@ def test_the_engine_knows_nothing_of_the_domain():
             assert not [d for d in deps if not d.startswith("mbd")], (mod, deps)
 
 
+# what viz reads results through (issue 27 §2): the results module's namespace, summary and reader
+RESULTS = "components.results"
+RESULTS_ENGINE_FREE = {RESULTS, f"{RESULTS}.summary", f"{RESULTS}.reader"}
+
+
 def test_viz_reads_results_only_and_scenarios_build_without_viz():
     """viz draws from files (no engine, no parameters); the simulation side builds without viz (the
-    scenarios that plot import it, the runner and the scene builders do not). The one exception: the
-    did-you-mean of every command (components.names), which imports nothing of the project."""
+    scenarios that plot import it, the runner and the scene builders do not). The exceptions: the
+    did-you-mean of every command (components.names), which imports nothing of the project, and the results
+    module's reader (RESULTS_ENGINE_FREE), which imports nothing beyond itself."""
     graph = import_graph()
     assert graph["components.names"] == set()
     for mod, deps in graph.items():
         if mod.startswith("viz"):
             assert not [d for d in deps if d.split(".")[0] in ("mbd", "components", "scenarios")
-                        and d != "components.names"], (mod, deps)
+                        and d not in {"components.names", *RESULTS_ENGINE_FREE}], (mod, deps)
         if mod.startswith(("components", "mbd")) or mod == "scenarios.runner":
             assert not [d for d in deps if d.startswith("viz")], (mod, deps)
 
@@ -462,3 +468,71 @@ def test_every_family_of_the_shipped_scenes_has_a_compiled_twin():
     assert not missing, "families without a compiled twin: " + "; ".join(
         f"{cls} (in {len(s)} scenes, e.g. {s[0]})" for cls, s in missing.items())
     assert not refused, f"{len(refused)} scenes the compiled path cannot build, e.g. {refused[:3]}"
+
+
+# ------------------------------------------------------------------------------------------ one results module
+
+
+def test_the_results_module_imports_no_engine_internals_and_viz_reads_through_it():
+    """components.results (issue 27 §2): its namespace, the summary and the reader import nothing of the project
+    (viz reads through them without the engine); its writer and schema take the engine only through ``mbd``'s
+    public API (never ``mbd.<module>``); viz enters the project through components.results alone (and the
+    did-you-mean, components.names)."""
+    graph = import_graph()
+    assert RESULTS_ENGINE_FREE | {f"{RESULTS}.io", f"{RESULTS}.schema"} <= set(graph)
+    for mod in RESULTS_ENGINE_FREE:
+        assert graph[mod] <= RESULTS_ENGINE_FREE, (mod, graph[mod])
+    for mod, deps in graph.items():
+        if mod.startswith(RESULTS):
+            assert not [d for d in deps if d.startswith("mbd.")], (mod, deps)
+        if mod.startswith("viz"):
+            assert {d for d in deps if d.split(".")[0] == "components"} <= {"components.names", *RESULTS_ENGINE_FREE}, \
+                (mod, deps)
+
+
+def _calls(tree) -> list[tuple[str, ast.Call]]:
+    """(dotted name of the callee, call) of every call in a module ("json.load", "xr.open_dataset", "File")."""
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call):
+            f, parts = node.func, []
+            while isinstance(f, ast.Attribute):
+                parts.append(f.attr)
+                f = f.value
+            if isinstance(f, ast.Name):
+                parts.append(f.id)
+            out.append((".".join(reversed(parts)), node))
+    return out
+
+
+# the engine writes results.nc (its Recorder: a generic file of probes), the results module reads it
+OPENS_RESULTS = {"mbd.recorder"}
+
+
+def test_results_files_are_opened_only_in_the_results_module():
+    """results.nc and summary.json are opened for reading only in components.results: no other module calls
+    xarray's open_dataset/load_dataset or h5py/h5netcdf's File, and no json.load(s) outside it reads a summary
+    (an argument that names one); the atomic writes come from components.results.io (mbd keeps its own)."""
+    opened, summaries, writes = [], [], []
+    for pkg in PACKAGES:
+        for path in (ROOT / pkg).rglob("*.py"):
+            mod = _module_name(path)
+            if mod.startswith(RESULTS):
+                continue
+            tree = ast.parse(path.read_text(encoding="utf-8"))
+            for name, call in _calls(tree):
+                last = name.rsplit(".", 1)[-1]
+                if last in ("open_dataset", "load_dataset", "open_mfdataset") and name != "open_dataset" \
+                        or name in ("h5py.File", "h5netcdf.File"):
+                    if mod not in OPENS_RESULTS:
+                        opened.append(f"{mod}: {name}")
+                if name in ("json.load", "json.loads") and "summary" in ast.unparse(call).lower():
+                    summaries.append(f"{mod}: {ast.unparse(call)}")
+            if not mod.startswith("mbd"):
+                for node in ast.walk(tree):
+                    if isinstance(node, ast.ImportFrom) and node.module == "mbd.recorder" \
+                            and any(a.name.startswith("atomic_write") for a in node.names):
+                        writes.append(mod)
+    assert not opened, f"results files opened outside components.results: {opened}"
+    assert not summaries, f"summaries read outside components.results: {summaries}"
+    assert not writes, f"atomic writes taken from mbd.recorder, not components.results.io: {writes}"
