@@ -39,7 +39,8 @@ from .families import FAMILY, MESH_FAMILY
 from .life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
                    iso281_rating, lundberg_palmgren_life, raceway_ratings, relative_life)
 from .lubrication import bearing_film
-from .results.summary import DIMENSIONLESS_KEYS, SUMMARY_WORDS, UNIT_SUFFIXES, unit_of_key   # re-exported: the results module owns them
+# the words and units of summary keys: owned by the results module, re-exported here
+from .results.summary import DIMENSIONLESS_KEYS, SUMMARY_WORDS, UNIT_SUFFIXES, unit_of_key
 
 __all__ = ["FAMILY", "MESH_FAMILY", "BearingSeries", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
            "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life",

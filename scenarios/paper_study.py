@@ -22,9 +22,8 @@ from pathlib import Path
 import numpy as np
 
 import mbd
-from components.outputs import SUMMARY_WORDS
 from components.outputs import relative_life as iso_relative_life
-from components.results import Summary, json_attr, open_run
+from components.results import SUMMARY_WORDS, Summary, json_attr, open_run
 from components.results.io import atomic_write_text, write_summary
 
 from .integrity import read_summary
@@ -35,7 +34,7 @@ from . import args
 from .command import command
 from .lock import holds_out_folder
 
-# the summary keys the comparison shows, with their units (words: components.outputs.SUMMARY_WORDS)
+# the summary keys the comparison shows, with their units (words: components.results.SUMMARY_WORDS)
 QUANTITIES = [(k, SUMMARY_WORDS[k][1]) for k in (
     "roller_cage_rms_N", "roller_cage_max_N", "cage_guide_rms_N", "cage_guide_max_N", "roller_inner_race_rms_N",
     "roller_inner_race_max_N", "roller_outer_race_rms_N", "roller_outer_race_max_N", "cage_acc_radial_rms_m_s2",
