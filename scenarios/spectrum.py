@@ -206,7 +206,7 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     return summary
 
 
-# summary.json's numeric keys without a unit suffix (components.outputs.UNIT_SUFFIXES): ratios and counts
+# summary.json's numeric keys without a unit suffix (components.results.UNIT_SUFFIXES): ratios and counts
 DIMENSIONLESS_KEYS = frozenset({"over_median", "k", "distance_bins", *(f"{p}_over_floor" for p in PATHS)})
 
 

@@ -208,12 +208,12 @@ def execute_case(case: Case, cfg, overwrite: bool = False) -> Outcome:
         return Outcome(case, Status.FINISHED, summary=s)
     except Exception as exc:  # reported, never hidden; the sweep goes on
         out.mkdir(parents=True, exist_ok=True)
-        info = {"case": case.label, "error": f"{type(exc).__name__}: {exc}", "traceback": traceback.format_exc()}
+        info = Summary.failure(case.label, f"{type(exc).__name__}: {exc}", traceback.format_exc())
         try:
             atomic_write_text(out / "error.json", json.dumps(info, indent=2))
         except OSError:       # disk full or unwritable: the caller still gets the report
             pass
-        return Outcome(case, Status.FAILED, error=info["error"], traceback=info["traceback"])
+        return Outcome(case, Status.FAILED, error=info.error, traceback=info.get("traceback", ""))
 
 
 class _RunBars:
