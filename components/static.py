@@ -75,21 +75,29 @@ def rate_groups(scene) -> list:
 
 
 def snapshot_times(scene, n: int) -> np.ndarray:
-    """``n`` instants after the load ramp spread over the mesh and roller positions: one cage revolution
-    relative to the carrier (every roller passes every position), at an irrational fraction of a mesh period
-    apart (the golden ratio), so no mesh or roller phase repeats before the others are visited."""
+    """``n`` instants after the load ramp spread over one carrier revolution — gravity and the ring (its teeth
+    and runout) turn once relative to the carrier in it, the sun and planets whole times plus a fraction, each
+    cage about twice — and over the mesh cycle: instant k sits at (k + ½)/n of the revolution, moved on by less
+    than a mesh period to the mesh phase (j_k + ½)/n, j_k = k·p mod n with p coprime to n near n/φ (a Fibonacci
+    lattice: the pairs (revolution, mesh phase) fill the unit square evenly; every mesh phase stratum once).
+    Without a turning carrier: one revolution of the slowest cage."""
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise mbd.ModelError(f"snapshots must be an integer >= 1, got {n!r}")
     sp, b = scene.speeds, scene.bearing
-    T = max((cage_period(b, sp.carrier, sp.planet(k)) for k in ("inner", "outer")), default=math.inf)
+    T = 2.0 * math.pi / abs(sp.carrier) if sp.carrier != 0.0 else \
+        max((cage_period(b, sp.carrier, sp.planet(k)) for k in ("inner", "outer")), default=math.inf)
     f_m = scene.f_m
     t0 = float(scene.ramp)
     if not np.isfinite(T):
         T = 1.0 / f_m if f_m > 0 else 1.0
     k = np.arange(n)
     t = t0 + (k + 0.5) / n * T
-    if f_m > 0:    # shift each instant by a golden-ratio fraction of a mesh period: mesh phases spread too
-        t += ((k * 0.6180339887498949) % 1.0) / f_m
+    if f_m > 0:
+        p = max(1, round(n / 1.618033988749895))
+        while math.gcd(p, n) != 1:
+            p += 1
+        phase = ((k * p) % n + 0.5) / n
+        t += ((phase - t * f_m) % 1.0) / f_m
     return t
 
 
