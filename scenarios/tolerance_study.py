@@ -43,7 +43,8 @@ import mbd
 from components.tolerance_sampling import (DISTRIBUTIONS, TOLERANCE_DEFAULTS, ToleranceSpec, coordinates, draw_errors,
                                            sobol_points, teeth_seed)
 from components.units import ParameterError
-from mbd.recorder import atomic_write_text
+from components.results import Summary
+from components.results.io import atomic_write_text
 
 from . import args
 from .command import command
@@ -253,7 +254,7 @@ def quantities_of(s: dict) -> dict:
     return q
 
 
-def solve_static_task(task: StaticTask) -> dict:
+def solve_static_task(task: StaticTask) -> Summary:
     """Solve one machine (on whichever process) and write its result file atomically. A failure is written too
     (with its error): the solution is deterministic, so the same parameters and code fail again — a re-run does
     not try it again unless the code changed."""
@@ -271,10 +272,10 @@ def solve_static_task(task: StaticTask) -> dict:
             scene = build_dpgt(params)
         s = static_summary(scene, task.snapshots)
         op = params.si().operating
-        rec = {**head, "summary": _kept(s), "output_torque_N_m": op.output_power / abs(op.carrier_speed),
-               "static_solver": s["static_solver"], "snapshots": s["snapshots"]}
+        rec = Summary({**head, "summary": _kept(s), "output_torque_N_m": op.output_power / abs(op.carrier_speed),
+                       "static_solver": s["static_solver"], "snapshots": s["snapshots"]})
     except Exception as exc:      # reported in the tables, never hidden; the others go on
-        rec = {**head, "error": f"{type(exc).__name__}: {' '.join(str(exc).split())}"}
+        rec = Summary({**head, "error": f"{type(exc).__name__}: {' '.join(str(exc).split())}"})
     Path(task.path).parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(Path(task.path), json.dumps(rec, indent=1, default=float))
     return rec
@@ -293,8 +294,8 @@ def _kept(s: dict) -> dict:
     return out
 
 
-def _with_quantities(rec: dict) -> dict:
-    return {**rec, "quantities": quantities_of(rec["summary"])} if "summary" in rec else rec
+def _with_quantities(rec: Summary) -> Summary:
+    return Summary({**rec, "quantities": quantities_of(rec["summary"])}) if "summary" in rec else rec
 
 
 def _earlier(tasks: list[StaticTask], overwrite: bool) -> tuple[dict, list[StaticTask]]:
@@ -343,7 +344,7 @@ def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None
         now = time.perf_counter()
         if progress and not bars and (now - last > 10.0 or len(out) == len(todo)):
             last = now
-            failed = sum("error" in r for r in out.values())
+            failed = sum(r.failed for r in out.values())
             print(f"static: {len(out)}/{len(todo)} solved ({failed} failed), {now - t0:.0f} s", file=sys.stderr,
                   flush=True)
 
@@ -437,8 +438,8 @@ def statistics(records: dict, seed: int, dynamic: dict | None = None) -> list[di
         ok = [r for r in e["samples"] if "quantities" in r]
         g = {"class": c, "condition": cond, "direction": d, "torque_fraction": f,
              "output_torque_N_m": (ok or [e["perfect"] or {}])[0].get("output_torque_N_m"),
-             "samples": len(ok), "failed": [{"sample": r["sample"], "error": r["error"]}
-                                            for r in e["samples"] if "error" in r],
+             "samples": len(ok), "failed": [{"sample": r["sample"], "error": r.error}
+                                            for r in map(Summary.of, e["samples"]) if r.failed],
              "perfect_machine": (e["perfect"] or {}).get("quantities"), "quantities": {}}
         for key in QUANTITIES:
             x = _column(ok, key)
@@ -472,7 +473,7 @@ def sample_rows(records: dict) -> list[dict]:
                "output_torque_N_m": r.get("output_torque_N_m"),
                "sample": "perfect" if r["sample"] is None else r["sample"], **r.get("drawn", {}),
                **r.get("quantities", {k: None for k in QUANTITIES}),
-               "static_solve_s": (r.get("static_solver") or {}).get("wall_s"), "error": r.get("error", "")}
+               "static_solve_s": (r.get("static_solver") or {}).get("wall_s"), "error": Summary.of(r).error or ""}
         rows.append(row)
     return rows
 
@@ -722,7 +723,7 @@ class ToleranceStudy(Study):
         with contextlib.redirect_stdout(io.StringIO()) if cases else contextlib.nullcontext():
             validate_cases(list(firsts.values()))
         done, todo = _earlier(self.tasks, self.a.overwrite)
-        failed = sum("error" in r for r in done.values())
+        failed = sum(r.failed for r in done.values())
         print(f"static: {len(todo)} solutions to solve, {len(done)} reused (same parameters and code"
               + (f"; {failed} of them failed, and fail again with them" if failed else "") + f"); "
               f"{len(self.tasks)} machines × operating points", flush=True)
@@ -732,7 +733,7 @@ class ToleranceStudy(Study):
         self.records = {k: _with_quantities(r) for k, r in {**done, **new}.items()}
         solved = [r["static_solver"]["wall_s"] for r in new.values() if "static_solver" in r]
         self.cost = {"solved_now": len(solved), "reused": len(done),
-                     "failed": sum("error" in r for r in self.records.values()),
+                     "failed": sum(r.failed for r in self.records.values()),
                      "wall_s": wall, "per_machine_s_median": float(np.median(solved)) if solved else None,
                      "per_snapshot_s_median": float(np.median(solved)) / self.a.snapshots if solved else None}
         if solved:
@@ -771,7 +772,7 @@ class ToleranceStudy(Study):
 
     @staticmethod
     def exit_code(r: dict) -> int:
-        failed = bool(r["failed"]) or any("error" in x for x in r["static"].values())
+        failed = bool(r["failed"]) or any(x.failed for x in r["static"].values())
         return 1 if failed else 0
 
 
