@@ -278,7 +278,14 @@ def _evaluator(system: System, engine: str):
         if engine == "compiled":
             raise ModelError(f"solve_static: the compiled path cannot evaluate this model: {exc}") from None
         return system.evaluate
-    return lambda t, q, v, z, jac: cs.evaluate(t, q, v, z, jac)
+    loaded = [None]
+
+    def evaluate(t, q, v, z, jac):      # the internal states are loaded once per dict, not at every call
+        if z is loaded[0]:
+            return cs.evaluate(t, q, v, None, jac)
+        loaded[0] = z
+        return cs.evaluate(t, q, v, z, jac)
+    return evaluate
 
 
 def _directions(model: Model, motion: SteadyMotion, t: float, held: np.ndarray, tangential: bool):
