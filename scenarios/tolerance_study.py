@@ -641,8 +641,10 @@ def plots(records: dict, stats: list[dict], out: Path) -> list[Path]:
     dist = {(cond, f): {} for (_, cond, _, f) in groups}
     for (c, cond, d, f), e in groups.items():
         dist[(cond, f)][(c, d)] = _column(e["samples"], HEADLINE)
+    failed = sum(1 for e in groups.values() for r in e["samples"] if "quantities" not in r)
     files = [tolerance_distributions(dist, out / "k_gamma_distribution.png",
-                                     title="Mesh load sharing K_γ of machines drawn from their tolerances")]
+                                     title="Mesh load sharing K_γ of machines drawn from their tolerances"
+                                           + (f" ({failed} without a static solution left out)" if failed else ""))]
     bands = {}
     for g in stats:
         k = g["quantities"][HEADLINE]
