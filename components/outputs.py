@@ -40,6 +40,8 @@ from .families import FAMILY, MESH_FAMILY
 from .life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
                    iso281_rating, lundberg_palmgren_life, raceway_ratings, relative_life)
 from .lubrication import bearing_film
+# the words and units of summary keys: owned by the results module, re-exported here
+from .results.summary import DIMENSIONLESS_KEYS, SUMMARY_WORDS, UNIT_SUFFIXES, unit_of_key
 
 __all__ = ["FAMILY", "MESH_FAMILY", "BearingSeries", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
            "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life",
@@ -139,109 +141,6 @@ def contact_film(race: dict, bearing, lubricant, inner: bool) -> dict[str, np.nd
     the pin's raceway."""
     film = bearing_film(race["load"], race["rolling_speed"], bearing, lubricant, inner)
     return {**film, "film_lambda": film["film_min"] / lubricant.roughness}
-
-
-# what each summary key means, in words and units (for tables and plot axes; README: What summary.json holds).
-# Every key of :meth:`WindowStatistics.summary` is here. A key with a unit ends in its suffix (UNIT_SUFFIXES);
-# a key without one is dimensionless ("1": a count, a ratio, a factor) and is listed in DIMENSIONLESS_KEYS.
-UNIT_SUFFIXES = {"_N": "N", "_m": "m", "_m_s": "m/s", "_m_s2": "m/s^2", "_s": "s", "_h": "h", "_W": "W", "_pct": "%",
-                 "_Mrev": "10^6 rev", "_hz": "Hz", "_rpm": "r/min", "_rad": "rad"}
-
-
-def _cage_acc_words() -> dict:
-    views = {"": "cage acc.", "rel_": "cage acc. rel. planet"}
-    stats = {"rms": "RMS", "max": "max"}
-    out = {f"cage_acc_{v}{c}_{s}_m_s2": (f"{w} {stats[s]}, {c}", "m/s^2")
-           for v, w in views.items() for c in ("radial", "tangential", "magnitude") for s in stats}
-    out.update({f"cage_acc_{c}_rms_m_s2": (f"cage acc. rel. planet RMS, {c} (model axes)", "m/s^2") for c in ("x", "y")})
-    return out
-
-
-SUMMARY_WORDS = {
-    "window_s": ("statistics window, start and end", "s"),
-    "window_duration_s": ("length of the mesh statistics window", "s"),
-    "carrier_speed_error_mean_pct": ("carrier speed against its drive's reference, time mean", "%"),
-    "whole_revolutions": ("bearing windows end after whole cage revolutions", "1"),
-    "bearing_load_mean_N": ("planet bearing load, mean", "N"),
-    "bearing_load_mean_all_N": ("planet bearing load, mean of the bearings of the type", "N"),
-    "bearing_load_mean_per_planet_N": ("planet bearing load, mean, per planet", "N"),
-    "bearing_load_radial_mean_N": ("planet bearing load, mean, radial", "N"),
-    "bearing_load_tangential_mean_N": ("planet bearing load, mean, tangential", "N"),
-    "bearing_load_max_N": ("planet bearing load, max", "N"),
-    "bearing_load_max_per_planet_N": ("planet bearing load, max, per planet", "N"),
-    "load_sharing_factor": ("load sharing K_γ: most loaded planet over the mean", "1"),
-    "equivalent_load_N": ("planet bearing equivalent load (ISO 281)", "N"),
-    "dynamic_load_rating_N": ("basic dynamic load rating C_r (ISO 281)", "N"),
-    "life_L10_relative": ("L10 life relative to forward", "1"),
-    "life_iso281_Mrev": ("L10 life, ISO 281 from the bearing load", "10^6 rev"),
-    "life_iso281_h": ("L10 life, ISO 281 from the bearing load", "h"),
-    "life_iso16281_Mrev": ("L10 life, ISO/TS 16281-style from the roller loads", "10^6 rev"),
-    "life_iso16281_h": ("L10 life, ISO/TS 16281-style from the roller loads", "h"),
-    "life_iso281_per_planet_h": ("L10 life, ISO 281 from the bearing load, per planet", "h"),
-    "life_iso16281_per_planet_h": ("L10 life, ISO/TS 16281-style from the roller loads, per planet", "h"),
-    "roller_equivalent_load_pin_N": ("equivalent roller load on the pin (ISO/TS 16281)", "N"),
-    "roller_equivalent_load_bore_N": ("equivalent roller load on the bore (ISO/TS 16281)", "N"),
-    "roller_inner_race_rms_N": ("roller–inner race load RMS", "N"),
-    "roller_inner_race_max_N": ("roller–inner race load max", "N"),
-    "roller_inner_race_mean_N": ("roller–inner race load mean", "N"),
-    "roller_inner_race_mean_spread": ("spread of the rollers' mean inner-race loads, (max − min)/mean", "1"),
-    "roller_outer_race_rms_N": ("roller–outer race load RMS", "N"),
-    "roller_outer_race_max_N": ("roller–outer race load max", "N"),
-    "roller_outer_race_mean_N": ("roller–outer race load mean", "N"),
-    "roller_cage_rms_N": ("roller–cage force RMS", "N"),
-    "roller_cage_max_N": ("roller–cage force max", "N"),
-    "cage_guide_rms_N": ("cage–guide force RMS", "N"),
-    "cage_guide_max_N": ("cage–guide force max", "N"),
-    "cage_guide_mean_N": ("cage–guide force mean", "N"),
-    **_cage_acc_words(),
-    "cage_slip_pct": ("cage slip", "%"),
-    "cage_slip_all_pct": ("cage slip, mean of the bearings of the type", "%"),
-    "cage_revolutions": ("cage revolutions relative to the carrier in the window", "1"),
-    "pocket_impacts": ("pocket impacts in the window", "1"),
-    "pocket_impacts_per_rev": ("pocket impacts per cage revolution", "1"),
-    "pocket_touches_per_rev": ("gentle pocket contacts (below the impact speed floor) per cage revolution", "1"),
-    "pocket_impact_speed_max_m_s": ("pocket impact speed max", "m/s"),
-    "pocket_impact_speed_mean_m_s": ("pocket impact speed mean", "m/s"),
-    "pocket_impact_peak_max_N": ("pocket impact peak force max", "N"),
-    "pocket_impact_peak_mean_N": ("pocket impact peak force mean", "N"),
-    "heat_traction_W": ("heat from roller–raceway traction, mean", "W"),
-    "heat_traction_all_W": ("heat from roller–raceway traction, mean of the bearings of the type", "W"),
-    "heat_land_W": ("heat from the cage land's friction, mean", "W"),
-    "heat_land_all_W": ("heat from the cage land's friction, mean of the bearings of the type", "W"),
-    "traction_coefficient_max": ("largest traction coefficient of a loaded contact", "1"),
-    "film_min_m": ("thinnest EHL film h_min", "m"),
-    "film_mean_m": ("thinnest EHL film, time mean", "m"),
-    "film_min_isothermal_m": ("thinnest EHL film without the thermal reduction", "m"),
-    "lambda_min": ("film parameter Λ = h_min/σ, smallest", "1"),
-    "lambda_mean": ("film parameter Λ = h_min/σ, time mean", "1"),
-    "film_min_thermal_loading": ("thermal loading L at the thinnest film", "1"),
-    "film_thermal_loading_max": ("thermal loading L, largest", "1"),
-    "film_thermal_factor_min": ("thermal reduction φ_T, smallest", "1"),
-    "film_load_parameter_max": ("load parameter W′ = w′/(E′R), largest", "1"),
-    "film_central_ratio_min": ("h_c/h_min, smallest", "1"),
-    "drive_flank": ("the flank the torque path loads (+1/−1)", "1"),
-    **{f"{f}_force_{s}_N": (f"{f} flank force {s}", "N") for f in ("drive", "coast") for s in ("mean", "max")},
-    **{f"{f}_deflection_{s}_m": (f"{f} flank deflection {s}", "m") for f in ("drive", "coast") for s in ("mean", "max")},
-    **{f"{f}_force_mean_per_pair_N": (f"{f} flank force mean, per pair", "N") for f in ("drive", "coast")},
-    "te_peak_to_peak_m": ("loaded transmission error peak-to-peak, largest pair", "m"),
-    "te_peak_to_peak_per_pair_m": ("loaded transmission error peak-to-peak, per pair", "m"),
-    "dynamic_factor": ("dynamic factor K_v, largest pair", "1"),
-    "dynamic_factor_per_pair": ("dynamic factor K_v, per pair", "1"),
-}
-
-# numeric summary keys without a unit (counts, ratios, factors, signs): the only ones without a UNIT_SUFFIXES suffix
-DIMENSIONLESS_KEYS = frozenset(k for k, (_, unit) in SUMMARY_WORDS.items() if unit == "1") | {
-    # what the runner adds (scenarios.runner): counts and the error estimate in units of the tolerance
-    "condition", "planets", "rollers", "rows", "samples", "steps", "rejected_steps", "newton_per_step",
-    "error_estimate.rms", "error_estimate.max", "integration.alpha"}
-
-
-def unit_of_key(key: str) -> str | None:
-    """The unit a summary key's suffix names (None: no unit suffix)."""
-    for suffix in sorted(UNIT_SUFFIXES, key=len, reverse=True):
-        if key.endswith(suffix):
-            return UNIT_SUFFIXES[suffix]
-    return None
 
 
 def radial_tangential(vec, planet_xy, carrier_xy):

@@ -14,7 +14,7 @@ from .modal import linearize, modal_analysis
 from .model import BodyRef, Frame, FrameState, Model, ModelBuilder, State, to_fixed, to_reference
 from . import protocols
 from .protocols import Controller, Observer
-from .recorder import BodyMotion, DerivedOutput, ElementOutput, Recorder
+from .recorder import BodyMotion, DerivedOutput, ElementOutput, Recorder, atomic_write_bytes, atomic_write_text
 from .scipy_adapter import FirstOrderSystem, solve_scipy
 from .settings import PRODUCTION, IntegratorSettings
 from .simulate import Checkpoint, Counters, SimResult, TimeMean, load_state, output_evaluator, save_state, simulate
@@ -23,6 +23,6 @@ __all__ = [
     "Adaptive", "BodyMotion", "BodyRef", "Checkpoint", "Controller", "Counters", "DerivedOutput", "Element", "ElementOutput", "Evaluation",
     "FirstOrderSystem", "FixedStep", "Frame", "FrameState", "HHT", "IntegratorSettings", "PRODUCTION", "IntegrationError", "Model",
     "ModelBuilder", "ModelError", "Observer", "Recorder", "SimResult", "State", "System", "TimeMean", "Tolerance",
-    "body_dofs", "hht_coefficients", "protocols", "linearize", "load_state", "marker", "marker_velocity",
+    "atomic_write_bytes", "atomic_write_text", "body_dofs", "hht_coefficients", "protocols", "linearize", "load_state", "marker", "marker_velocity",
     "modal_analysis", "output_evaluator", "point_force", "save_state", "simulate", "solve_scipy", "to_fixed", "to_reference",
 ]

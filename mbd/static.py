@@ -54,21 +54,29 @@ class SteadyMotion:
     ``orbit`` (n_bodies,): the rate [rad/s] in R at which a body's centre circles a point of R (0: the centre
     rests in R); the circle's centre follows from the velocity, v = ω k × (x − c). ``host`` (n_bodies,): the body
     (index, −1: none) that carries the body's place on its circle when it is displaced (a roller keeps its pocket
-    whatever the cage does; a host rests in R). Velocities and accelerations are those of the circle about the
-    fixed centre. Spin rates are the angular velocities' θ entries."""
+    whatever the cage does; a host rests in R). ``placed`` (n_bodies,): resting bodies that keep their place on a
+    circle about their ``centre`` all the same — displaced only along its radius (a roller in a held cage).
+    Velocities and accelerations are those of the circle about the fixed centre. Spin rates are the angular
+    velocities' θ entries."""
     t0: float
     q0: np.ndarray      # (nb, 3) poses in R at t0
     spin: np.ndarray    # (nb,) angular rate in R [rad/s]
     orbit: np.ndarray   # (nb,) orbital rate in R [rad/s]
     centre: np.ndarray  # (nb, 2) orbit centre in R [m], its host at its steady pose
     host: np.ndarray    # (nb,) host body index or −1
+    placed: np.ndarray  # (nb,) bool: resting, but kept on a circle about its centre
+
+    def circling(self, model: Model) -> np.ndarray:
+        """Indices of the free bodies moved only along (and, optionally, around) a circle: orbiting or placed."""
+        return np.flatnonzero(((self.orbit != 0.0) | self.placed) & ~model.fixed)
 
     @staticmethod
     def from_state(model: Model, q0: np.ndarray, v0: np.ndarray, orbit, host=None, t0: float = 0.0,
-                   rest_tol: float = 1e-9) -> "SteadyMotion":
+                   rest_tol: float = 1e-9, circles=None) -> "SteadyMotion":
         """``q0``, ``v0``: the free DOFs in R at ``t0`` (a built scene's kinematic initial state); ``orbit``: the
-        bodies' orbital rates in R; ``host``: their hosts (default none). A body declared resting must not move
-        in R (speed below ``rest_tol`` [m/s]): its steady motion would be unknown, and it is refused."""
+        bodies' orbital rates in R; ``host``: their hosts (default none); ``circles``: {body index: centre (x, y)}
+        for resting bodies kept on a circle about that centre (placed). A body declared resting must not move in
+        R (speed below ``rest_tol`` [m/s]): its steady motion would be unknown, and it is refused."""
         qf, vf = model.full(t0, q0, v0)
         P, V = qf.reshape(-1, 3), vf.reshape(-1, 3)
         nb = model.n_bodies
@@ -86,13 +94,19 @@ class SteadyMotion:
         moving = np.flatnonzero(w != 0.0)
         centre[moving, 0] -= V[moving, 1] / w[moving]        # v = ω k × (x − c)  ⇒  x − c = (v_y, −v_x)/ω
         centre[moving, 1] += V[moving, 0] / w[moving]
+        placed = np.zeros(nb, bool)
+        for b, c in (circles or {}).items():
+            if not (0 <= int(b) < nb) or w[int(b)] != 0.0 or model.fixed[int(b)]:
+                raise ModelError(f"circles: body {b!r} must be a free body without an orbit rate")
+            placed[int(b)] = True
+            centre[int(b)] = np.asarray(c, float)
         still = (w == 0.0) & ~model.fixed & (np.hypot(V[:, 0], V[:, 1]) > rest_tol)
         if still.any():
             i = int(np.flatnonzero(still)[0])
             raise ModelError(f"steady motion: body {model.body_names[i]!r} moves in the reference frame "
                              f"({np.hypot(*V[i, :2]):.3g} m/s) but has no orbit rate; a static solution needs every "
                              "body's centre at rest in R or circling a point of R")
-        return SteadyMotion(float(t0), P.copy(), np.where(model.fixed, 0.0, V[:, 2]), w, centre, host)
+        return SteadyMotion(float(t0), P.copy(), np.where(model.fixed, 0.0, V[:, 2]), w, centre, host, placed)
 
     def poses(self, t: float) -> np.ndarray:
         """(nb, 3) steady poses at time t."""
@@ -160,7 +174,7 @@ class _Problem:
         self._rows = sysm._indices.astype(np.int64)
         self._cols = np.repeat(np.arange(m.ndof), np.diff(sysm._indptr))
         self.nB, self.nu = B.shape[1], len(groups)
-        self.orbiting = np.flatnonzero((motion.orbit != 0.0) & ~m.fixed)
+        self.orbiting = motion.circling(m)
         self.ix, self.iy = f2f[3 * self.orbiting], f2f[3 * self.orbiting + 1]
         # rate groups flattened: spinning bodies (group, body); orbiting members (group, body)
         self.spin_g = np.array([j for j, (sb, _) in enumerate(groups) if sb >= 0], np.int64)
@@ -278,7 +292,14 @@ def _evaluator(system: System, engine: str):
         if engine == "compiled":
             raise ModelError(f"solve_static: the compiled path cannot evaluate this model: {exc}") from None
         return system.evaluate
-    return lambda t, q, v, z, jac: cs.evaluate(t, q, v, z, jac)
+    loaded = [None]
+
+    def evaluate(t, q, v, z, jac):      # the internal states are loaded once per dict, not at every call
+        if z is loaded[0]:
+            return cs.evaluate(t, q, v, None, jac)
+        loaded[0] = z
+        return cs.evaluate(t, q, v, z, jac)
+    return evaluate
 
 
 def _directions(model: Model, motion: SteadyMotion, t: float, held: np.ndarray, tangential: bool):
@@ -288,7 +309,7 @@ def _directions(model: Model, motion: SteadyMotion, t: float, held: np.ndarray, 
     and tangential columns (−1: none)."""
     n, f2f = model.ndof, model.full_to_free
     keep = ~held.copy()
-    orbiting = np.flatnonzero((motion.orbit != 0.0) & ~model.fixed)
+    orbiting = motion.circling(model)
     keep[f2f[3 * orbiting]] = keep[f2f[3 * orbiting + 1]] = False
     solved = np.flatnonzero(keep)
     col_of = -np.ones(n, np.int64)
@@ -380,8 +401,9 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
     x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization)
     if not ok:
         worst = int(np.argmax(np.abs(prob.residual(x)[0]) / np.maximum(prob.floor, 1e-300)))
-        raise ModelError(f"solve_static: no static state at t = {t:.6g} s within {max_steps} steps (worst unknown: "
-                         f"{prob.label(worst)}): a body without support, or a load no contact can carry?")
+        raise ModelError(f"solve_static: no static state at t = {t:.6g} s after {steps} steps (worst unknown: "
+                         f"{prob.label(worst)}): a body without support, a load no contact can carry, or a state "
+                         f"resting on a force's jump (a contact's damping at its onset)?")
     q, v, a = prob.state(x)
     return StaticSolution(float(t), q, v, a, z, prob.full_residual(x), x[nB:].copy(), steps, time.perf_counter() - t_wall)
 
@@ -397,7 +419,7 @@ def carry(model: Model, motion: SteadyMotion, sol: StaticSolution, t: float, rat
     X.ravel()[model.free] = sol.q
     D = X - P0
     D[model.fixed] = 0.0
-    orb = np.flatnonzero((motion.orbit != 0.0) & ~model.fixed)
+    orb = motion.circling(model)
     rates = [(int(sb), list(ob)) for sb, ob in rates]
     u = np.asarray(sol.rates, float).copy() if len(rates) else np.zeros(0)
     own = {sb: j for j, (sb, ob) in enumerate(rates) if sb >= 0 and not ob}
@@ -488,9 +510,10 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
     Schur complement of the local blocks and μ = 1/Δτ. μ starts where no unknown moves more than its ``cap``
     and follows the residual, μ ← μ·|g_new|/|g| (halved again while it falls; |g|² = Σ g²/M over the outer
     unknowns), down to ``regularization``·max K/M: the last steps are Newton's. A step that more than doubles
-    |g| is retried with a tenfold μ; steps are clipped to their caps. Converged when every unknown's residual
+    |g| is retried with a tenfold μ, and so is any growth once |g| is a hundredth of its start or μ at its floor
+    (Newton's steps can cycle across a kink of the forces); steps are clipped to their caps. Converged when every unknown's residual
     would move it less than its tolerance under its own stiffness, |g_i| ≤ (|K_ii| + μ_min M_i)·tol_i.
-    Returns (x, steps, converged)."""
+    Stops, unconverged, when μ has grown 10⁴-fold over its start (no step lowers |g|). Returns (x, steps, converged)."""
     M = prob.M
     loc = np.sort(local[local >= 0])
     outer = np.setdiff1d(np.arange(M.size), loc)
@@ -504,11 +527,12 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
     x, g, local_ok = _local_solve(prob, x, local, cap)
     g, K = prob.residual(x, jac=True)
     mu = max(float(np.max(np.abs(g[outer]) / (Mo * cap[outer]))), mu_min)
+    g_start, mu_start = norm(g), mu
     for k in range(max_steps + 1):
         prob.floor = np.maximum((np.abs(np.diagonal(K)) + mu_min * M) * tol, prob.force_floor)
         if np.all(np.abs(g[outer]) <= prob.floor[outer]) and local_ok:
             return x, k, True
-        if k == max_steps:
+        if k == max_steps or mu > 1e4 * mu_start:   # no step, however short, lowers |g|: resting on a force's jump
             break
         Koo, Kol = K[np.ix_(outer, outer)], K[np.ix_(outer, loc)]
         Klo, Kll = K[np.ix_(loc, outer)], K[np.ix_(loc, loc)]
@@ -528,9 +552,12 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
         ratio = norm(g_new) / max(norm(g), 1e-300) if np.all(np.isfinite(g_new)) else np.inf
         if _TRACE:
             top = outer[np.argsort(-np.abs(g[outer]) / np.sqrt(Mo))[:3]]
-            print(f"{k} mu {mu:.2e} |g| {norm(g):.3e} -> {norm(g_new):.3e} largest: "
+            print(f"{k} mu {mu:.2e} local {ok_new} |g| {norm(g):.3e} -> {norm(g_new):.3e} largest: "
                   + ", ".join(f"{prob.label(int(i))} {g[i]:.3g}" for i in top))
-        if ratio > 2.0:
+        # a step that doubles |g| is refused; so is any growth once |g| is a hundredth of its start (the contacts
+        # are in: what remains is Newton's end game) or μ at its floor — near a kink of the forces (a tooth pair's
+        # stiffness edge, a contact closing) Newton's steps can cycle between two states on either side of it
+        if ratio > 2.0 or (ratio > 1.0 and (mu <= mu_min or norm(g) < 1e-2 * g_start)):
             mu = max(10.0 * mu, 10.0 * mu_min)
             continue
         x, local_ok = x_new, ok_new

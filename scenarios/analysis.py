@@ -2,7 +2,6 @@
 components.outputs)."""
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -98,15 +97,14 @@ def sensor_paths(path: Path, sensor=None) -> tuple[np.ndarray, dict]:
     :func:`components.sensor.paths` from the recorded outer planets' angles and ring-mesh forces and the loads on
     the housing. ``sensor`` (:class:`components.params.SensorSI`): the run's own (stored with it) unless given.
     The one place a run's file becomes the sensor's signals: the spectrum and the fault study read through it."""
-    import xarray as xr
-
     from components.families import MESH_FAMILY
+    from components.results import json_attr, open_dataset
     from components.sensor import paths, sensor_from_dict
 
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
+    with open_dataset(path) as ds:
         if "housing.force_x" not in ds:
             raise ValueError(f"{path}: the run recorded no loads on the housing (run it with RunConfig(sensor=True))")
-        sensor = sensor if sensor is not None else sensor_from_dict(json.loads(ds.attrs["sensor"]))
+        sensor = sensor if sensor is not None else sensor_from_dict(json_attr(ds.attrs, "sensor", path))
         t = ds["time"].values
         bodies = list(ds["motion.body"].values)
         phi = (ds["fixed.angle"].values[:, list(ds["fixed.body"].values).index("carrier")]

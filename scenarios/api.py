@@ -20,6 +20,8 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
+from components.results import Summary
+
 __all__ = ["Run", "run", "parameters"]
 
 
@@ -28,7 +30,7 @@ class Run:
     """A finished run: its folder, its summary (summary.json) and whether it ran now (``"finished"``) or was
     taken from an earlier run of the same parameters, settings and code (``"reused"``)."""
     out: Path
-    summary: dict
+    summary: Summary
     status: str
 
     @property
@@ -43,9 +45,9 @@ class Run:
 
     def dataset(self):
         """results.nc as an :class:`xarray.Dataset` (close it when done, or use it in a ``with``)."""
-        import xarray as xr
+        from components.results import open_dataset
 
-        return xr.open_dataset(self.results, engine="h5netcdf")
+        return open_dataset(self.results)
 
     def __repr__(self) -> str:
         return f"Run({str(self.out)!r}, {self.status}, {self.summary.get('wall_s', float('nan')):.1f} s wall)"

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
-from mbd.recorder import atomic_write_text
+from components.results.io import atomic_write_text
 from . import args
 from .command import command
 from .runner import accuracy_line

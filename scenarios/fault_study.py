@@ -31,7 +31,7 @@ import numpy as np
 import mbd
 from components.names import did_you_mean
 from components.units import ParameterError
-from mbd.recorder import atomic_write_text
+from components.results.io import atomic_write_text
 
 from . import args
 from .command import command
@@ -183,8 +183,8 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
     rows, spectra = [], {}
     perfect = {c.direction: results.get(c.label, {}) for c in cases if c.tag == "perfect"}
     for case in cases:
-        s = results.get(case.label, {})
-        if not s or "error" in s:
+        s = results.get(case.label)
+        if s is None or s.failed:
             continue
         si = build_params(case).si()
         fr = characteristic_frequencies(si)

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
-from mbd.recorder import atomic_write_text
+from components.results.io import atomic_write_text
 
 from . import args
 from .command import command
@@ -114,8 +114,8 @@ def rows_of(cases: list[Case], results: dict) -> list[dict]:
     """A row per finished run and bearing type (module docstring)."""
     rows = []
     for case in cases:
-        s = results.get(case.label, {})
-        if not s or "error" in s:
+        s = results.get(case.label)
+        if s is None or s.failed:
             continue
         g, seed = _grade_seed(case)
         mesh = {}

@@ -9,11 +9,12 @@
 """
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
 from pathlib import Path
+
+from components.results import DamagedResults, Summary, count_samples, load_summary
 
 __all__ = ["OtherResults", "move_aside", "read_summary", "results_intact", "checkpoint_usable", "claim_folder", "differences",
            "DAMAGED"]
@@ -43,20 +44,13 @@ def move_aside(path, why: str, into=None) -> Path:
     return dest
 
 
-def read_summary(path) -> dict | None:
+def read_summary(path) -> Summary | None:
     """The summary at ``path``; None when absent or damaged (a damaged one is moved aside)."""
-    path = Path(path)
-    if not path.exists():
-        return None
     try:
-        s = json.loads(path.read_text())
-    except (OSError, ValueError, UnicodeDecodeError) as exc:
-        move_aside(path, f"not readable JSON: {type(exc).__name__}")
+        return load_summary(path)
+    except DamagedResults as exc:
+        move_aside(exc.path, exc.why)
         return None
-    if not isinstance(s, dict):
-        move_aside(path, "not a JSON object")
-        return None
-    return s
 
 
 def results_intact(path, samples: int | None = None) -> bool:
@@ -64,13 +58,10 @@ def results_intact(path, samples: int | None = None) -> bool:
     path = Path(path)
     if not path.exists():
         return False
-    import h5py
-
     try:
-        with h5py.File(path, "r") as f:
-            n = int(f["time"].shape[0])
-    except Exception as exc:        # h5py raises OSError, KeyError, ValueError... for a broken file
-        move_aside(path, f"does not open as netCDF4/HDF5: {type(exc).__name__}")
+        n = count_samples(path)
+    except DamagedResults as exc:
+        move_aside(path, exc.why)
         return False
     if samples is not None and n != samples:
         move_aside(path, f"{n} time samples where its summary says {samples}")

@@ -37,7 +37,7 @@ from components.presets import OIL_GRADES, oil_grade
 DEFAULT_GRADES = ("VG32", "VG68", "VG150")     # thin, the reference oil, thick: the study's default span
 from components.units import ParameterError, quantity, to_si
 from mbd.elements.ehl import FILM_MIN_U_EXPONENT, thermal_factor
-from mbd.recorder import atomic_write_text
+from components.results.io import atomic_write_text
 
 from .runner import RunConfig
 from .study import Study, StudyRun
@@ -129,8 +129,8 @@ def make_cases(a, out: Path) -> list[Case]:
 def rows_of(cases: list[Case], results: dict) -> list[dict]:
     rows = []
     for case in cases:
-        s = results.get(case.label, {})
-        if "error" in s or not s:
+        s = results.get(case.label)
+        if s is None or s.failed:
             continue
         eta = build_params(case).si().lubricant.oil_viscosity
         for kind in ("inner", "outer"):

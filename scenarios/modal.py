@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mbd.recorder import atomic_write_text
+from components.results.io import atomic_write_text
 from . import args
 from .command import command
 

@@ -16,16 +16,16 @@ import argparse
 import dataclasses
 import csv
 import io
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
 import mbd
-from components.outputs import SUMMARY_WORDS
+from components.static import DEFAULT_SNAPSHOTS
 from components.outputs import relative_life as iso_relative_life
-from mbd.recorder import atomic_write_text
+from components.results import SUMMARY_WORDS, Summary, json_attr, open_run
+from components.results.io import atomic_write_text, write_summary
 
 from .integrity import read_summary
 from .runner import RunConfig
@@ -35,7 +35,7 @@ from . import args
 from .command import command
 from .lock import holds_out_folder
 
-# the summary keys the comparison shows, with their units (words: components.outputs.SUMMARY_WORDS)
+# the summary keys the comparison shows, with their units (words: components.results.SUMMARY_WORDS)
 QUANTITIES = [(k, SUMMARY_WORDS[k][1]) for k in (
     "roller_cage_rms_N", "roller_cage_max_N", "cage_guide_rms_N", "cage_guide_max_N", "roller_inner_race_rms_N",
     "roller_inner_race_max_N", "roller_outer_race_rms_N", "roller_outer_race_max_N", "cage_acc_radial_rms_m_s2",
@@ -80,8 +80,9 @@ def build_parser(name: str = "paper_study", out: str = "results/study", doc: str
                    help="dynamic: time integration (default); static: the quasi-static solution of the same model "
                         "(mean loads, load sharing, lives in seconds; quantities only a dynamic run gives — cage "
                         "motion, impacts, RMS values, time histories — are left out and said so)")
-    p.add_argument("--snapshots", type=args.count(1), default=8,
-                   help="static mode: instants over the mesh and roller positions averaged (default 8)")
+    p.add_argument("--snapshots", type=args.count(1), default=DEFAULT_SNAPSHOTS,
+                   help=f"static mode: instants over a carrier revolution and the mesh cycle averaged (default "
+                        f"{DEFAULT_SNAPSHOTS})")
     p.add_argument("--animate", action=argparse.BooleanOptionalAction, default=animate,
                    help="write a cage-orbit animation per condition (forward beside reverse)"
                         + (" (default: on)" if animate else ""))
@@ -97,7 +98,7 @@ def build_config(a) -> RunConfig:
     return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate,
                      integration=dataclasses.replace(mbd.PRODUCTION, method=a.method, h=a.h, alpha=a.alpha),
                      options=args.scene_options(a.option), progress=not a.no_progress,
-                     mode=getattr(a, "mode", "dynamic"), snapshots=getattr(a, "snapshots", 8))
+                     mode=getattr(a, "mode", "dynamic"), snapshots=getattr(a, "snapshots", DEFAULT_SNAPSHOTS))
 
 
 def make_cases(a, out: Path) -> list[Case]:
@@ -118,11 +119,11 @@ def make_cases(a, out: Path) -> list[Case]:
 def relative_life(results: dict) -> None:
     """Fill life_L10_relative = (P_fwd / P)^(10/3) per condition and bearing kind (forward = 1)."""
     for label, s in results.items():
-        if "error" in s:
+        if s.failed:
             continue
         fwd = results.get(f"c{s['condition']}_forward")
         for kind in ("inner", "outer"):
-            if fwd is None or "error" in fwd:
+            if fwd is None or fwd.failed:
                 s[kind]["life_L10_relative"] = None
                 continue
             P, Pf = s[kind]["equivalent_load_N"], fwd[kind]["equivalent_load_N"]
@@ -131,13 +132,13 @@ def relative_life(results: dict) -> None:
 
 def comparison_rows(results: dict) -> list[dict]:
     rows = []
-    conds = sorted({s["condition"] for s in results.values() if "error" not in s})
+    conds = sorted({s["condition"] for s in results.values() if not s.failed})
     for c in conds:
-        f, r = results.get(f"c{c}_forward", {}), results.get(f"c{c}_reverse", {})
+        f, r = results.get(f"c{c}_forward", Summary()), results.get(f"c{c}_reverse", Summary())
         for kind in ("inner", "outer"):
             for q, unit in QUANTITIES:
-                fv = f.get(kind, {}).get(q) if "error" not in f else None
-                rv = r.get(kind, {}).get(q) if "error" not in r else None
+                fv = f.get(kind, {}).get(q) if not f.failed else None
+                rv = r.get(kind, {}).get(q) if not r.failed else None
                 diff = (rv - fv) / fv * 100.0 if (fv not in (None, 0) and rv is not None) else None
                 rows.append({"condition": c, "bearing": kind, "quantity": q, "description": SUMMARY_WORDS[q][0],
                              "unit": unit, "forward": fv, "reverse": rv, "difference_pct": diff})
@@ -196,7 +197,8 @@ def _runs_of(results: dict, out: Path, c: int) -> dict[str, Path]:
     runs = {}
     for d in ("forward", "reverse"):
         p = out / f"c{c}_{d}" / "results.nc"
-        if p.exists() and "error" not in results.get(f"c{c}_{d}", {"error": 1}):
+        s = results.get(f"c{c}_{d}")
+        if p.exists() and s is not None and not s.failed:
             runs[d] = p
     return runs
 
@@ -215,8 +217,6 @@ def history_groups(runs: dict[str, Path]) -> dict[str, tuple[list, list[str]]]:
     """The time histories of one condition's runs in readable groups (:data:`HISTORY_GROUPS`): group -> (rows of
     :func:`viz.plots.time_history_group`, its columns). SI values from results.nc; the cage accelerations
     relative to the planet are split radial/tangential here (physics stays out of viz)."""
-    import xarray as xr
-
     from components.families import MESH_FAMILY
     from components.outputs import FAMILY, radial_tangential
 
@@ -227,10 +227,10 @@ def history_groups(runs: dict[str, Path]) -> dict[str, tuple[list, list[str]]]:
 
     for d, p in runs.items():
         # the flank the torque path loads, per mesh, as the run recorded it (reverse loads the other flanks)
-        drive = {k: m.get("drive_flank") for k, m in ((read_summary(p.parent / "summary.json") or {}).get("meshes")
-                                                     or {}).items()}
-        with xr.open_dataset(p, engine="h5netcdf") as ds:
-            bmap = json.loads(ds.attrs["bearings"])
+        run = open_run(p)
+        drive = {k: m.get("drive_flank") for k, m in (read_summary(run.summary_path) or Summary()).meshes.items()}
+        with run.dataset() as ds:
+            bmap = json_attr(ds.attrs, "bearings", p)
             t = np.asarray(ds["time"].values, float)
             bodies = list(ds["motion.body"].values)
             for i, b in enumerate(bmap):
@@ -284,7 +284,7 @@ def headline_values(results: dict) -> dict[tuple, float | None]:
 
     vals = {}
     for s in results.values():
-        if "error" in s or "inner" not in s:
+        if not s.has_bearings:
             continue
         for kind in ("inner", "outer"):
             for key, _, _ in HEADLINE_QUANTITIES:
@@ -297,7 +297,7 @@ def plots(results: dict, out: Path) -> list[Path]:
     from viz.results import study_cage_pictures
 
     paths = []
-    conds = sorted({s["condition"] for s in results.values() if "error" not in s})
+    conds = sorted({s["condition"] for s in results.values() if not s.failed})
     for c in conds:
         runs = _runs_of(results, out, c)
         if not runs:
@@ -324,9 +324,9 @@ def plots(results: dict, out: Path) -> list[Path]:
             bar_units[key] = unit
             ylabels[key] = SUMMARY_WORDS[q][0]
             for c in conds:
-                f, r = results.get(f"c{c}_forward", {}), results.get(f"c{c}_reverse", {})
-                fv = f.get(kind, {}).get(q) if "error" not in f else None
-                rv = r.get(kind, {}).get(q) if "error" not in r else None
+                f, r = results.get(f"c{c}_forward", Summary()), results.get(f"c{c}_reverse", Summary())
+                fv = f.get(kind, {}).get(q) if not f.failed else None
+                rv = r.get(kind, {}).get(q) if not r.failed else None
                 table[key][c] = (fv, rv)
     if conds and table:
         paths.append(vp.bar_chart([f"condition {c}" for c in conds], {k: {f"condition {c}": v for c, v in by.items()}
@@ -343,7 +343,7 @@ def static_plots(results: dict, out: Path) -> list[Path]:
     vals = headline_values(results)
     if not vals:
         return []
-    conds = sorted({s["condition"] for s in results.values() if "error" not in s})
+    conds = sorted({s["condition"] for s in results.values() if not s.failed})
     one = f", condition {conds[0]}" if len(conds) == 1 else ""
     return [vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
                                         title=f"Planet bearings (pair 1), quasi-static: mean load and L10 life, "
@@ -363,7 +363,7 @@ def animate(results: dict, out: Path) -> list[Path]:
     if not ok:
         print(f"animation skipped: {msg}")
         return paths
-    for c in sorted({s["condition"] for s in results.values() if "error" not in s}):
+    for c in sorted({s["condition"] for s in results.values() if not s.failed}):
         f, r = out / f"c{c}_forward" / "results.nc", out / f"c{c}_reverse" / "results.nc"
         if f.exists() and r.exists():
             paths.append(Path(study_cage_animation(f, r, out / f"c{c}_cage_orbits.gif", max_frames=150)))
@@ -392,8 +392,7 @@ class PaperStudy(Study):
         relative_life(results)
         for label, s in results.items():   # store the relative life in each run's summary (atomic rewrite)
             if "stale_after_failure" not in s:
-                atomic_write_text(Path(run.outcomes[label].case.out_dir) / "summary.json",
-                                  json.dumps(s, indent=2, default=str))
+                write_summary(run.outcomes[label].case.out_dir, s)
         static = getattr(self.a, "mode", "dynamic") == "static"
         rows = comparison_rows(results)
         if static:         # a quantity only a dynamic run gives is not in the tables at all (not a row of dashes)

@@ -83,7 +83,7 @@ def main(argv=None) -> int:
     a = parse_args(sys.argv[1:] if argv is None else argv)
     if a.reference is not None:
         from components.parameter_reference import reference_markdown
-        from mbd.recorder import atomic_write_text
+        from components.results.io import atomic_write_text
 
         atomic_write_text(Path(a.reference), reference_markdown())
         print(f"written: {a.reference}")

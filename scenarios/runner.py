@@ -6,7 +6,7 @@ Results layout of a run directory:
                    sun/carrier/ring in the fixed frame ("fixed.*", same names), and element outputs
                    "<family>.<key>" (e.g. race_inner.load, pocket.force, guide.force, mesh_sa.force) along
                    "<family>.instance", whose coordinates name each instance ("a1.pb.roller3", "sun-a1")
-                   with its bearing, planet, pair, bearing_kind, roller (components.results_schema);
+                   with its bearing, planet, pair, bearing_kind, roller (components.results.schema);
                    with RunConfig.sensor what the supports put on the housing ("housing.force_x/force_y/torque",
                    fixed frame) and the sensor's parameters (attrs "sensor"), from which the housing
                    accelerometer's paths are computed (docs/model.md §12, scenarios.spectrum.sensor_paths);
@@ -33,11 +33,14 @@ from components.dpgt import build_dpgt
 from components.lubrication import BOUNDARY_LAMBDA
 from components.params import DPGTParams
 from components.scene import SceneOptions
-from mbd.recorder import BodyMotion, Recorder, atomic_write_text
+from components.static import DEFAULT_SNAPSHOTS
+from mbd.recorder import BodyMotion, Recorder
 
 from components.outputs import BearingSeries, WindowStatistics, bearing_map, cage_period, default_window
 from components.sensor import HousingLoads
-from components.results_schema import drawing_geometry, element_probes
+from components.results import Summary
+from components.results.io import atomic_write_text, write_summary
+from components.results.schema import drawing_geometry, element_probes
 
 from .integrity import checkpoint_usable, claim_folder, read_summary, results_intact
 from .lock import folder_lock
@@ -115,7 +118,7 @@ class RunConfig:
     checkpoint_every: int = 2000
     sensor: bool = False          # record what the housing accelerometer needs (rig.sensor, docs/model.md §12)
     mode: str = "dynamic"         # "static": the quasi-static solution of the same model (components.static)
-    snapshots: int = 8            # static mode: instants over the mesh and roller positions
+    snapshots: int = DEFAULT_SNAPSHOTS    # static mode: instants over a carrier revolution and the mesh cycle
 
     def __post_init__(self):
         if self.mode not in ("dynamic", "static"):
@@ -145,7 +148,7 @@ def statistics_window(scene, base: float = 0.02) -> float:
 
 def _probes(scene, sensor: bool = False) -> list:
     """Body motion in R (all bodies) and in the fixed frame (sun, carrier, ring), the element outputs of
-    :mod:`components.results_schema` (units, long names, instance coordinates), and with ``sensor`` the
+    :mod:`components.results.schema` (units, long names, instance coordinates), and with ``sensor`` the
     loads on the housing (:class:`components.sensor.HousingLoads`)."""
     return [BodyMotion("motion", frame="reference"),
             BodyMotion("fixed", bodies=["sun", "carrier", "ring"], frame="fixed"),
@@ -153,7 +156,7 @@ def _probes(scene, sensor: bool = False) -> list:
             *(HousingLoads(scene).probes() if sensor else [])]
 
 
-def finished_run(out_dir, params: DPGTParams, cfg: RunConfig) -> dict | None:
+def finished_run(out_dir, params: DPGTParams, cfg: RunConfig) -> Summary | None:
     """The summary of ``out_dir`` if a run of these parameters, settings and code finished there and its results.nc
     is intact (it is then reused, not recomputed), else None."""
     out = Path(out_dir)
@@ -165,7 +168,7 @@ def finished_run(out_dir, params: DPGTParams, cfg: RunConfig) -> dict | None:
     return s if results_intact(out / "results.nc", s.get("samples")) else None
 
 
-def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None, overwrite: bool = False) -> dict:
+def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None, overwrite: bool = False) -> Summary:
     """Run one operating point; write results.nc and summary.json atomically into out_dir.
     An interrupted run resumes from out_dir/checkpoint.npz. One run at a time per folder (scenarios.lock).
     A folder holding finished results of other parameters is refused unless ``overwrite``
@@ -180,7 +183,7 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
         return _run_case(params, cfg, Path(out_dir), label)
 
 
-def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> dict:
+def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> Summary:
     """The quasi-static solution (:mod:`components.static`) of one operating point: summary.json in the dynamic
     run's keys, those only a dynamic run gives left out (listed in ``omitted``); no results.nc."""
     from components.static import static_summary
@@ -198,8 +201,8 @@ def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict |
                     "fingerprint": run_fingerprint(params, cfg),
                     "parameters_fingerprint": parameters_fingerprint(params, cfg),
                     "run_description": run_description(params, cfg)})
-    atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2, default=_json_default))
-    return summary
+    write_summary(out_dir, summary)
+    return Summary(summary)
 
 
 def _earlier_wall(out_dir: Path, resuming: bool) -> float:
@@ -210,7 +213,7 @@ def _earlier_wall(out_dir: Path, resuming: bool) -> float:
         return 0.0
 
 
-def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> dict:
+def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> Summary:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
         scene = build_dpgt(params, cfg.options)
@@ -269,8 +272,8 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
         "fingerprint": fp, "parameters_fingerprint": parameters_fingerprint(params, cfg),
         "run_description": run_description(params, cfg),
     })
-    atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2, default=_json_default))
-    return summary
+    write_summary(out_dir, summary)
+    return Summary(summary)
 
 
 # the unit of each IntegratorSettings field, as summary.json's key suffix (README: What summary.json holds)
@@ -367,18 +370,10 @@ def sweep_report(results: dict) -> list[str]:
     """Run time, error estimate and warnings of every finished run of a sweep ({label: summary}), a line each."""
     lines = []
     for k, s in sorted(results.items()):
-        if "error" not in s and ("error_estimate" in s or s.get("mode") == "static"):
+        if not Summary.of(s).failed and ("error_estimate" in s or s.get("mode") == "static"):
             first, *warns = run_report(s)
             lines += [f"  {k}: {first}", *(f"  {k}: {w}" for w in warns)]
     return lines
-
-
-def _json_default(o):
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    return str(o)
 
 
 def _run_info(params: DPGTParams, scene, stats: WindowStatistics) -> dict:

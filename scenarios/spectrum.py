@@ -40,7 +40,7 @@ import numpy as np
 
 import mbd
 from components.sensor import PATHS as SENSOR_PATHS
-from mbd.recorder import atomic_write_text
+from components.results.io import atomic_write_text
 
 from .analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution
 from .analysis import whole_revolutions as _whole_revolutions
@@ -206,7 +206,7 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     return summary
 
 
-# summary.json's numeric keys without a unit suffix (components.outputs.UNIT_SUFFIXES): ratios and counts
+# summary.json's numeric keys without a unit suffix (components.results.UNIT_SUFFIXES): ratios and counts
 DIMENSIONLESS_KEYS = frozenset({"over_median", "k", "distance_bins", *(f"{p}_over_floor" for p in PATHS)})
 
 
@@ -231,10 +231,10 @@ def _as_text(params) -> dict:
 def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
     """Sample times and the signals of a run: "amplitude" (the sensor read), every path of the housing sensor
     and their sum, and the axis sensor's x and y."""
-    import xarray as xr
+    from components.results import open_dataset
 
     t, signals = sensor_paths(path)
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
+    with open_dataset(path) as ds:
         acc = ds["fixed.acceleration"].values[:, list(ds["fixed.body"].values).index("carrier")]
     signals.update({"axis_x": acc[:, 0], "axis_y": acc[:, 1]})
     return t, {"amplitude": signals["axis_x" if sensor == "axis" else sensor], **signals}

@@ -28,7 +28,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, ClassVar
 
-from mbd.recorder import atomic_write_text
+from components.results import Summary
+from components.results.io import atomic_write_text
 
 from .integrity import read_summary
 from .plausibility import check_runs
@@ -48,11 +49,11 @@ class StudyRun:
     kept: dict[str, dict] = field(default_factory=dict)    # failed now, but finished before: the earlier summary
 
     @property
-    def results(self) -> dict[str, dict]:
+    def results(self) -> dict[str, Summary]:
         """{label: summary} of every run the tables can use: finished and reused ones, and a failed one's earlier
         summary (marked ``stale_after_failure`` with the error) when the study keeps those."""
-        out = {k: o.summary for k, o in self.outcomes.items() if o.ok}
-        out.update({k: {**s, "stale_after_failure": self.outcomes[k].error} for k, s in self.kept.items()})
+        out = {k: Summary.of(o.summary) for k, o in self.outcomes.items() if o.ok}
+        out.update({k: Summary({**s, "stale_after_failure": self.outcomes[k].error}) for k, s in self.kept.items()})
         return out
 
     @property
@@ -162,7 +163,7 @@ class Study(abc.ABC):
         for k, o in run.outcomes.items():
             if not o.ok:
                 old = read_summary(Path(o.case.out_dir) / "summary.json")
-                if old is not None and "error" not in old and "inner" in old:
+                if old is not None and old.has_bearings:
                     kept[k] = old
         return kept
 

@@ -20,7 +20,8 @@ from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
 
-from mbd.recorder import atomic_write_text
+from components.results import Summary
+from components.results.io import atomic_write_text
 
 from .integrity import OtherResults, claim_folder, differences, read_summary
 
@@ -57,7 +58,7 @@ class Outcome:
     the wall time of the run that made it) or what went wrong (failed)."""
     case: Case
     status: Status
-    summary: dict | None = None
+    summary: Summary | None = None
     error: str | None = None
     traceback: str = ""
 
@@ -74,12 +75,13 @@ class Outcome:
         """Wall time of the run that made the results (for a reused one: when it ran)."""
         return None if self.summary is None else self.summary.get("wall_s")
 
-    def as_dict(self) -> dict:
-        """The summary (reused: with ``"skipped": True``), or ``{"case", "error", "traceback"}`` for a failed case:
-        :func:`run_sweep`'s plain-dict form."""
+    def as_dict(self) -> Summary:
+        """The summary (reused: with ``"skipped": True``), or the failed-run form :meth:`Summary.failure`
+        (``{"case", "error", "traceback"}``): :func:`run_sweep`'s form."""
         if self.status is Status.FAILED:
-            return {"case": self.label, "error": self.error, **({"traceback": self.traceback} if self.traceback else {})}
-        return {**self.summary, "skipped": True} if self.status is Status.REUSED else self.summary
+            return Summary.failure(self.label, self.error, self.traceback)
+        s = Summary.of(self.summary)
+        return Summary({**s, "skipped": True}) if self.status is Status.REUSED else s
 
 
 # the parameters every study's sweep sets itself (its axes), and the option that sets them
@@ -153,7 +155,7 @@ def _case_cfg(case: Case, cfg):
     return cfg if case.window is None else _replace(cfg, window=case.window)
 
 
-def _finished(case: Case, params, cfg) -> dict | None:
+def _finished(case: Case, params, cfg) -> Summary | None:
     """The case's summary if it was finished from the same parameters, settings and code and its results.nc
     is intact, else None (then recomputed, not reused; damaged files are moved aside, scenarios.integrity)."""
     from .runner import finished_run
@@ -206,12 +208,12 @@ def execute_case(case: Case, cfg, overwrite: bool = False) -> Outcome:
         return Outcome(case, Status.FINISHED, summary=s)
     except Exception as exc:  # reported, never hidden; the sweep goes on
         out.mkdir(parents=True, exist_ok=True)
-        info = {"case": case.label, "error": f"{type(exc).__name__}: {exc}", "traceback": traceback.format_exc()}
+        info = Summary.failure(case.label, f"{type(exc).__name__}: {exc}", traceback.format_exc())
         try:
             atomic_write_text(out / "error.json", json.dumps(info, indent=2))
         except OSError:       # disk full or unwritable: the caller still gets the report
             pass
-        return Outcome(case, Status.FAILED, error=info["error"], traceback=info["traceback"])
+        return Outcome(case, Status.FAILED, error=info.error, traceback=info.get("traceback", ""))
 
 
 class _RunBars:
@@ -251,8 +253,9 @@ class _RunBars:
 
 
 def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | None = None,
-              progress: bool = True, overwrite: bool = False) -> dict[str, dict]:
-    """:func:`sweep` with plain dicts: {label: summary (reused: ``"skipped": True``) or {"case", "error"}}."""
+              progress: bool = True, overwrite: bool = False) -> dict[str, Summary]:
+    """:func:`sweep` as summaries: {label: summary (reused: ``"skipped": True``) or the failed-run form
+    (:meth:`Summary.failure`)}."""
     return {k: o.as_dict() for k, o in sweep(cases, cfg, workers, scheduler, progress, overwrite).items()}
 
 

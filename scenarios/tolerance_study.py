@@ -3,13 +3,13 @@ and lives over machines drawn from stated tolerances (docs/tolerances.md).
 
     python -m scenarios.tolerance_study [--samples 64] [--torques 0.25,0.5,1] [--conditions 3]
         [--directions forward,reverse] [--classes 5,7] [--pinhole-tolerance "10 um"] [--clearance-tolerance "5 um"]
-        [--roller-lot "2 um"] [--dynamic 16] [--snapshots 8] [--seed 1] [--settle S] [--window S]
+        [--roller-lot "2 um"] [--dynamic 16] [--snapshots 16] [--seed 1] [--settle S] [--window S]
         [--params FILE.toml] [--set KEY=VALUE ...] [--workers N | --scheduler ADDR] [--force] [--overwrite] [--out DIR]
 
 Every sample is one machine: its gears' teeth and runouts for an ISO 1328 class, its 2N pinholes, each bearing's
 clearance and each roller's diameter drawn from their tolerances (:mod:`components.tolerance_sampling`: the
 distributions, a scrambled Sobol sequence of ``--seed``). Each machine is solved quasi-statically
-(:mod:`components.static`, ``--snapshots`` instants over the mesh and roller positions) at every class, condition,
+(:mod:`components.static`, ``--snapshots`` instants over a carrier revolution and the mesh cycle) at every class, condition,
 direction and torque (``--torques``: fractions of the condition's rated output torque); the first ``--dynamic``
 machines, and the perfect machine, also run dynamically (the runner of the other studies, on Dask) at the largest
 torque, for the static solution's agreement and the dynamic increment. Each static solution is its own small file
@@ -40,10 +40,12 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.static import DEFAULT_SNAPSHOTS
 from components.tolerance_sampling import (DISTRIBUTIONS, TOLERANCE_DEFAULTS, ToleranceSpec, coordinates, draw_errors,
                                            sobol_points, teeth_seed)
 from components.units import ParameterError
-from mbd.recorder import atomic_write_text
+from components.results import Summary
+from components.results.io import atomic_write_text
 
 from . import args
 from .command import command
@@ -151,8 +153,9 @@ def parse_args(argv):
     p.add_argument("--dynamic", type=args.count(0), default=16, metavar="N",
                    help="the first N machines of each class, condition and direction also run dynamically (with the "
                         "perfect machine) at the largest torque, resumable (default 16; 0: static only)")
-    p.add_argument("--snapshots", type=args.count(1), default=8, metavar="N",
-                   help="static solutions per machine over the mesh and roller positions (default 8)")
+    p.add_argument("--snapshots", type=args.count(1), default=DEFAULT_SNAPSHOTS, metavar="N",
+                   help=f"static solutions per machine over a carrier revolution and the mesh cycle (default "
+                        f"{DEFAULT_SNAPSHOTS})")
     p.add_argument("--seed", type=args.count(0), default=1, help="seed of the Sobol sequence and of the teeth (default 1)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="dynamic runs: seconds discarded (default 0.03)")
     p.add_argument("--window", type=args.positive("s"), default=None,
@@ -253,7 +256,7 @@ def quantities_of(s: dict) -> dict:
     return q
 
 
-def solve_static_task(task: StaticTask) -> dict:
+def solve_static_task(task: StaticTask) -> Summary:
     """Solve one machine (on whichever process) and write its result file atomically. A failure is written too
     (with its error): the solution is deterministic, so the same parameters and code fail again — a re-run does
     not try it again unless the code changed."""
@@ -271,10 +274,10 @@ def solve_static_task(task: StaticTask) -> dict:
             scene = build_dpgt(params)
         s = static_summary(scene, task.snapshots)
         op = params.si().operating
-        rec = {**head, "summary": _kept(s), "output_torque_N_m": op.output_power / abs(op.carrier_speed),
-               "static_solver": s["static_solver"], "snapshots": s["snapshots"]}
+        rec = Summary({**head, "summary": _kept(s), "output_torque_N_m": op.output_power / abs(op.carrier_speed),
+                       "static_solver": s["static_solver"], "snapshots": s["snapshots"]})
     except Exception as exc:      # reported in the tables, never hidden; the others go on
-        rec = {**head, "error": f"{type(exc).__name__}: {' '.join(str(exc).split())}"}
+        rec = Summary({**head, "error": f"{type(exc).__name__}: {' '.join(str(exc).split())}"})
     Path(task.path).parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(Path(task.path), json.dumps(rec, indent=1, default=float))
     return rec
@@ -293,8 +296,8 @@ def _kept(s: dict) -> dict:
     return out
 
 
-def _with_quantities(rec: dict) -> dict:
-    return {**rec, "quantities": quantities_of(rec["summary"])} if "summary" in rec else rec
+def _with_quantities(rec: Summary) -> Summary:
+    return Summary({**rec, "quantities": quantities_of(rec["summary"])}) if "summary" in rec else rec
 
 
 def _earlier(tasks: list[StaticTask], overwrite: bool) -> tuple[dict, list[StaticTask]]:
@@ -343,7 +346,7 @@ def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None
         now = time.perf_counter()
         if progress and not bars and (now - last > 10.0 or len(out) == len(todo)):
             last = now
-            failed = sum("error" in r for r in out.values())
+            failed = sum(r.failed for r in out.values())
             print(f"static: {len(out)}/{len(todo)} solved ({failed} failed), {now - t0:.0f} s", file=sys.stderr,
                   flush=True)
 
@@ -437,8 +440,8 @@ def statistics(records: dict, seed: int, dynamic: dict | None = None) -> list[di
         ok = [r for r in e["samples"] if "quantities" in r]
         g = {"class": c, "condition": cond, "direction": d, "torque_fraction": f,
              "output_torque_N_m": (ok or [e["perfect"] or {}])[0].get("output_torque_N_m"),
-             "samples": len(ok), "failed": [{"sample": r["sample"], "error": r["error"]}
-                                            for r in e["samples"] if "error" in r],
+             "samples": len(ok), "failed": [{"sample": r["sample"], "error": r.error}
+                                            for r in map(Summary.of, e["samples"]) if r.failed],
              "perfect_machine": (e["perfect"] or {}).get("quantities"), "quantities": {}}
         for key in QUANTITIES:
             x = _column(ok, key)
@@ -472,7 +475,7 @@ def sample_rows(records: dict) -> list[dict]:
                "output_torque_N_m": r.get("output_torque_N_m"),
                "sample": "perfect" if r["sample"] is None else r["sample"], **r.get("drawn", {}),
                **r.get("quantities", {k: None for k in QUANTITIES}),
-               "static_solve_s": (r.get("static_solver") or {}).get("wall_s"), "error": r.get("error", "")}
+               "static_solve_s": (r.get("static_solver") or {}).get("wall_s"), "error": Summary.of(r).error or ""}
         rows.append(row)
     return rows
 
@@ -638,8 +641,10 @@ def plots(records: dict, stats: list[dict], out: Path) -> list[Path]:
     dist = {(cond, f): {} for (_, cond, _, f) in groups}
     for (c, cond, d, f), e in groups.items():
         dist[(cond, f)][(c, d)] = _column(e["samples"], HEADLINE)
+    failed = sum(1 for e in groups.values() for r in e["samples"] if "quantities" not in r)
     files = [tolerance_distributions(dist, out / "k_gamma_distribution.png",
-                                     title="Mesh load sharing K_γ of machines drawn from their tolerances")]
+                                     title="Mesh load sharing K_γ of machines drawn from their tolerances"
+                                           + (f" ({failed} without a static solution left out)" if failed else ""))]
     bands = {}
     for g in stats:
         k = g["quantities"][HEADLINE]
@@ -722,7 +727,7 @@ class ToleranceStudy(Study):
         with contextlib.redirect_stdout(io.StringIO()) if cases else contextlib.nullcontext():
             validate_cases(list(firsts.values()))
         done, todo = _earlier(self.tasks, self.a.overwrite)
-        failed = sum("error" in r for r in done.values())
+        failed = sum(r.failed for r in done.values())
         print(f"static: {len(todo)} solutions to solve, {len(done)} reused (same parameters and code"
               + (f"; {failed} of them failed, and fail again with them" if failed else "") + f"); "
               f"{len(self.tasks)} machines × operating points", flush=True)
@@ -732,7 +737,7 @@ class ToleranceStudy(Study):
         self.records = {k: _with_quantities(r) for k, r in {**done, **new}.items()}
         solved = [r["static_solver"]["wall_s"] for r in new.values() if "static_solver" in r]
         self.cost = {"solved_now": len(solved), "reused": len(done),
-                     "failed": sum("error" in r for r in self.records.values()),
+                     "failed": sum(r.failed for r in self.records.values()),
                      "wall_s": wall, "per_machine_s_median": float(np.median(solved)) if solved else None,
                      "per_snapshot_s_median": float(np.median(solved)) / self.a.snapshots if solved else None}
         if solved:
@@ -771,7 +776,7 @@ class ToleranceStudy(Study):
 
     @staticmethod
     def exit_code(r: dict) -> int:
-        failed = bool(r["failed"]) or any("error" in x for x in r["static"].values())
+        failed = bool(r["failed"]) or any(x.failed for x in r["static"].values())
         return 1 if failed else 0
 
 

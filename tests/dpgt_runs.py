@@ -29,6 +29,11 @@ def cage_revolution(params) -> float:
     return max(cage_period(si.bearing, op.carrier_speed, w) for w in (op.inner_planet_speed, op.outer_planet_speed))
 
 
+def carrier_revolution(params) -> float:
+    """One carrier revolution [s]: gravity and the ring turn once relative to the carrier in it."""
+    return 2.0 * math.pi / abs(params.si().operating.carrier_speed)
+
+
 def build(params, **options):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DesignWarning)

@@ -80,16 +80,22 @@ def test_the_engine_knows_nothing_of_the_domain():
             assert not [d for d in deps if not d.startswith("mbd")], (mod, deps)
 
 
+# what viz reads results through (issue 27 §2): the results module's namespace, summary and reader
+RESULTS = "components.results"
+RESULTS_ENGINE_FREE = {RESULTS, f"{RESULTS}.summary", f"{RESULTS}.reader"}
+
+
 def test_viz_reads_results_only_and_scenarios_build_without_viz():
     """viz draws from files (no engine, no parameters); the simulation side builds without viz (the
-    scenarios that plot import it, the runner and the scene builders do not). The one exception: the
-    did-you-mean of every command (components.names), which imports nothing of the project."""
+    scenarios that plot import it, the runner and the scene builders do not). The exceptions: the
+    did-you-mean of every command (components.names), which imports nothing of the project, and the results
+    module's reader (RESULTS_ENGINE_FREE), which imports nothing beyond itself."""
     graph = import_graph()
     assert graph["components.names"] == set()
     for mod, deps in graph.items():
         if mod.startswith("viz"):
             assert not [d for d in deps if d.split(".")[0] in ("mbd", "components", "scenarios")
-                        and d != "components.names"], (mod, deps)
+                        and d not in {"components.names", *RESULTS_ENGINE_FREE}], (mod, deps)
         if mod.startswith(("components", "mbd")) or mod == "scenarios.runner":
             assert not [d for d in deps if d.startswith("viz")], (mod, deps)
 
@@ -476,3 +482,115 @@ def test_every_family_of_the_shipped_scenes_has_a_compiled_twin():
     assert not missing, "families without a compiled twin: " + "; ".join(
         f"{cls} (in {len(s)} scenes, e.g. {s[0]})" for cls, s in missing.items())
     assert not refused, f"{len(refused)} scenes the compiled path cannot build, e.g. {refused[:3]}"
+
+
+# ------------------------------------------------------------------------------------------ one results module
+
+
+def test_the_results_module_imports_no_engine_internals_and_viz_reads_through_it():
+    """components.results (issue 27 §2): its namespace, the summary and the reader import nothing of the project
+    (viz reads through them without the engine); its writer and schema take the engine only through ``mbd``'s
+    public API (never ``mbd.<module>``); viz enters the project through components.results alone (and the
+    did-you-mean, components.names)."""
+    graph = import_graph()
+    assert RESULTS_ENGINE_FREE | {f"{RESULTS}.io", f"{RESULTS}.schema"} <= set(graph)
+    for mod in RESULTS_ENGINE_FREE:
+        assert graph[mod] <= RESULTS_ENGINE_FREE, (mod, graph[mod])
+    for mod, deps in graph.items():
+        if mod.startswith(RESULTS):
+            assert not [d for d in deps if d.startswith("mbd.")], (mod, deps)
+        if mod.startswith("viz"):
+            assert {d for d in deps if d.split(".")[0] == "components"} <= {"components.names", *RESULTS_ENGINE_FREE}, \
+                (mod, deps)
+
+
+def _calls(tree) -> list[tuple[str, ast.Call]]:
+    """(dotted name of the callee, call) of every call in a module ("json.load", "xr.open_dataset", "File")."""
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call):
+            f, parts = node.func, []
+            while isinstance(f, ast.Attribute):
+                parts.append(f.attr)
+                f = f.value
+            if isinstance(f, ast.Name):
+                parts.append(f.id)
+            out.append((".".join(reversed(parts)), node))
+    return out
+
+
+# the engine writes results.nc (its Recorder: a generic file of probes), the results module reads it
+OPENS_RESULTS = {"mbd.recorder"}
+# what opens a netCDF4/HDF5 file, by its module's name (however the module or the function was imported)
+OPENERS = {"xarray.open_dataset", "xarray.load_dataset", "xarray.open_mfdataset", "h5py.File", "h5netcdf.File",
+           "netCDF4.Dataset"}
+RUN_FILES = ("summary.json", "results.nc", "SUMMARY_NAME", "RESULTS_NAME")
+
+
+def _imported_as(tree) -> dict[str, str]:
+    """{local name: dotted name it stands for} of every import in a module ("xr" -> "xarray", "File" -> "h5py.File")."""
+    out = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out.update({a.asname or a.name: a.name for a in node.names})
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            out.update({a.asname or a.name: f"{node.module}.{a.name}" for a in node.names})
+    return out
+
+
+def _results_reads(mod: str, tree) -> dict[str, list[str]]:
+    """What a module (not the results module) does that only components.results may: open a netCDF4/HDF5 file,
+    read a summary or a run file by its name, ask a summary for its "error" (``Summary.failed``/``.error`` own the
+    failed-run form), take the atomic writes from mbd.recorder."""
+    found = {"opened": [], "summaries": [], "run files": [], "error key": [], "writes": []}
+    alias = _imported_as(tree)
+    for name, call in _calls(tree):
+        head, _, rest = name.partition(".")
+        full = ".".join(x for x in (alias.get(head, head), rest) if x)
+        last = name.rsplit(".", 1)[-1]
+        text = ast.unparse(call)
+        if (last in ("open_dataset", "load_dataset", "open_mfdataset") and name != "open_dataset"
+                or name in ("h5py.File", "h5netcdf.File") or full in OPENERS) and mod not in OPENS_RESULTS:
+            found["opened"].append(f"{mod}: {name}")
+        if name in ("json.load", "json.loads") and "summary" in text.lower():
+            found["summaries"].append(f"{mod}: {text}")
+        if (last in ("read_text", "read_bytes", "open", "load") or name == "open") and any(f in text for f in RUN_FILES):
+            found["run files"].append(f"{mod}: {text}")
+        if last == "get" and call.args and isinstance(call.args[0], ast.Constant) and call.args[0].value == "error":
+            found["error key"].append(f"{mod}: {text}")
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Compare) and isinstance(node.left, ast.Constant) and node.left.value == "error" \
+                and any(isinstance(op, (ast.In, ast.NotIn)) for op in node.ops):
+            found["error key"].append(f"{mod}: {ast.unparse(node)}")
+        if not mod.startswith("mbd") and isinstance(node, ast.ImportFrom) and node.module == "mbd.recorder" \
+                and any(a.name.startswith("atomic_write") for a in node.names):
+            found["writes"].append(mod)
+    return found
+
+
+def test_results_files_are_opened_only_in_the_results_module():
+    """results.nc and summary.json are opened for reading only in components.results: no other module calls
+    xarray's open_dataset/load_dataset or h5py/h5netcdf's File (under whatever name it was imported), reads a file
+    it names summary.json or results.nc, or json.load(s) a summary (an argument that names one); no module asks a
+    summary for "error" (Summary.failed); the atomic writes come from components.results.io (mbd keeps its own).
+    The detector is shown first to find each of these in a module written to break them."""
+    bad = ast.parse("import json\nfrom xarray import open_dataset as od\nimport h5py as h\n"
+                    "from mbd.recorder import atomic_write_text\n"
+                    "def f(p, s):\n    od(p)\n    h.File(p)\n    json.loads((p / 'summary.json').read_text())\n"
+                    "    open(p / 'results.nc', 'rb')\n    return 'error' in s or s.get('error')\n")
+    caught = _results_reads("scenarios.bad", bad)
+    assert {k: len(v) for k, v in caught.items()} == {"opened": 2, "summaries": 1, "run files": 2, "error key": 2,
+                                                      "writes": 1}, caught
+    found: dict[str, list[str]] = {}
+    for pkg in PACKAGES:
+        for path in (ROOT / pkg).rglob("*.py"):
+            mod = _module_name(path)
+            if mod.startswith(RESULTS):
+                continue
+            for k, v in _results_reads(mod, ast.parse(path.read_text(encoding="utf-8"))).items():
+                found.setdefault(k, []).extend(v)
+    assert not found["opened"], f"results files opened outside components.results: {found['opened']}"
+    assert not found["summaries"], f"summaries read outside components.results: {found['summaries']}"
+    assert not found["run files"], f"run files read by name outside components.results: {found['run files']}"
+    assert not found["error key"], f"a summary's error asked by its key, not Summary.failed: {found['error key']}"
+    assert not found["writes"], f"atomic writes taken from mbd.recorder, not components.results.io: {found['writes']}"

@@ -239,21 +239,26 @@ def test_no_load_forward_and_reverse_of_one_machine(runs):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("case", CASES)
-def test_the_static_solution_is_the_dynamic_runs_mean(runs, case):
-    """The quasi-static solution of the same model (components.static, 8 snapshots over the mesh and roller
-    positions) against the dynamic run's window means (one cage revolution after 8 ms):
+def test_the_static_solution_is_the_dynamic_runs_mean(case):
+    """The quasi-static solution of the same model (components.static, 16 snapshots over one carrier revolution)
+    against a dynamic run's window means over one carrier revolution after 8 ms — the same span: gravity and the
+    ring turn once relative to the carrier in it, and means over half a revolution differ by its share:
 
-    * every planet bearing's mean pin reaction, as a vector, within 1 % of its magnitude (measured: 0.41, 0.63,
-      0.30, 0.23 % at 3 fwd, 3 rev, 4 fwd, 4 rev);
-    * the mean roller loads on the pin and on the bore of every bearing within 1.5 % (measured 0.83, 1.27, 0.91,
-      0.80 %: the issue's 1 % is not met in reverse; more snapshots do not change it, so it is the dynamics');
-    * every mesh's drive-flank force, averaged over the planet pairs, within 1.5 % (measured up to 1.2 %, the
-      outer planets' ring mesh: the static state has no pocket contacts, so the bearings' friction torque on the
-      planets differs; per pair the dynamic window's own load-sharing scatter adds ~1 %). At no load (condition
-      4) no drive flank carries anything in either."""
+    * every planet bearing's mean pin reaction, as a vector, within 1 % of its magnitude (measured: 0.23, 0.38,
+      0.31, 0.19 % at 3 fwd, 3 rev, 4 fwd, 4 rev);
+    * the mean roller loads on the pin and on the bore of every bearing within 1.5 % (measured 0.95, 1.20, 0.88,
+      0.69 %: the issue's 1 % is not met in reverse; 32 snapshots give 0.97 %: each bearing's 12 rollers are seen
+      at 16 positions in the load zone);
+    * every mesh's drive-flank force, averaged over the planet pairs, within 1.5 % (measured per pair up to 1.14 %,
+      the outer planets' ring mesh: the static state has no pocket contacts, so the bearings' friction torque on
+      the planets differs). At no load (condition 4) the static drive flanks carry nothing (< 1 mN); in
+      the dynamic run the floating sun touches either flank of its meshes now and then (sun–inner pair means
+      ≤ 1.5 N over the revolution, measured; the planets' meshes carry the bearings' losses, 36–80 N, on their
+      coast flanks and nothing on their drive flanks), asserted below 5 N — at condition 3 they are ≈ 2.1 kN."""
     from components.static import static_statistics
-    bs, dyn, _, _ = runs[case]
-    st, _ = static_statistics(bs, 8)
+    from dpgt_runs import carrier_revolution
+    bs, dyn, _, _ = run(*case, window=carrier_revolution(reference_dpgt(*case)))
+    st, _ = static_statistics(bs, 16)
     vec = lambda s: np.stack([s.stats("load_radial")["mean"], s.stats("load_tangential")["mean"]], axis=1)
     Fd, Fs = vec(dyn), vec(st)
     np.testing.assert_array_less(np.hypot(*(Fs - Fd).T), 0.01 * np.hypot(*Fd.T))
@@ -264,6 +269,12 @@ def test_the_static_solution_is_the_dynamic_runs_mean(runs, case):
     for key in MESH_FAMILY:
         d, s = dyn.stats(f"{key}_drive_force")["mean"], st.stats(f"{key}_drive_force")["mean"]
         if case[0] == 4:
-            assert d.max() == 0.0 and s.max() < 1e-3, (key, d, s)
+            assert d.max() < 5.0 and s.max() < 1e-3, (key, d, s)
+        else:
+            np.testing.assert_allclose(s.mean(), d.mean(), rtol=0.015, err_msg=key)
+    for key in MESH_FAMILY:
+        d, s = dyn.stats(f"{key}_drive_force")["mean"], st.stats(f"{key}_drive_force")["mean"]
+        if case[0] == 4:
+            assert d.max() < 5.0 and s.max() < 1e-3, (key, d, s)
         else:
             np.testing.assert_allclose(s.mean(), d.mean(), rtol=0.015, err_msg=key)

@@ -173,8 +173,8 @@ def test_the_hydrodynamic_land_carries_the_cage_in_oil():
 
 
 def _race_film(scene, state):
-    """The film the runner records for every contact (components.results_schema's probes), at ``state``."""
-    from components.results_schema import element_probes
+    """The film the runner records for every contact (components.results.schema's probes), at ``state``."""
+    from components.results.schema import element_probes
     out = mbd.System(scene.model).outputs(state.t, state.q, state.v, state.z)
     return {p.element: p.evaluate(out[p.element]) for p in element_probes(scene)
             if p.element in ("race_inner", "race_outer")}
@@ -212,7 +212,7 @@ def test_the_film_of_every_contact_agrees_with_the_bearing_statistics(loaded_sta
 
 
 def test_no_film_is_recorded_without_a_lubricant(loaded_state):
-    from components.results_schema import element_probes
+    from components.results.schema import element_probes
     sc, _ = loaded_state
     keys = {k for p in element_probes(dataclasses.replace(sc, lubricant=None)) for k in p.keys}
     assert "load" in keys and not {k for k in keys if k.startswith("film_")}

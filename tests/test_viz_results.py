@@ -107,7 +107,7 @@ def test_load_run_layout(runs, fwd):
 
 def test_geometry_comes_from_the_file_or_is_given(runs, fwd, tmp_path):
     from components.presets import reference_dpgt
-    from components.results_schema import drawing_geometry
+    from components.results.schema import drawing_geometry
     assert fwd.geometry["source"] == "file"          # the runner stores the drawing geometry
     bare = tmp_path / "bare.nc"                       # a file without it needs the caller's geometry
     shutil.copy(runs["forward"], bare)
@@ -135,7 +135,7 @@ def test_geometry_comes_from_the_file_or_is_given(runs, fwd, tmp_path):
 
 def test_geometry_mismatch_warns(runs, tmp_path):
     from components.presets import reference_dpgt
-    from components.results_schema import drawing_geometry
+    from components.results.schema import drawing_geometry
     path = tmp_path / "results.nc"
     shutil.copy(runs["forward"], path)
     with h5py.File(path, "r+") as f:
@@ -424,7 +424,7 @@ def test_results_file_describes_itself(runs, fwd):
 def test_linear_bearing_instances_are_named():
     from components.dpgt import build_dpgt
     from components.presets import reference_dpgt
-    from components.results_schema import OUTPUTS, instance_coords
+    from components.results.schema import OUTPUTS, instance_coords
     from components.scene import SceneOptions
 
     with warnings.catch_warnings():

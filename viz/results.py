@@ -12,12 +12,13 @@ element outputs, the bearing map and the run metadata.  The helpers turn a run i
 
 Geometry (tooth counts, pitch radii, bearing d_m, D, guide clearance) is not part of the motion data.
 It is read from the file's ``geometry`` attribute (or ``meta["geometry"]``), in the layout of
-:func:`components.results_schema.drawing_geometry`, which the runner stores there. A caller may pass
+:func:`components.results.schema.drawing_geometry`, which the runner stores there. A caller may pass
 ``fallback_geometry`` for whatever a file lacks; ``run.geometry["source"]`` says which was used
 ("file", "file+given" or "given"), and given geometry is checked against the recorded motion (planet
 centre distances, roller pitch radius): a :class:`GeometryWarning` is issued when they disagree.
 
-viz reads results only: it imports neither mbd nor components — only numpy, xarray and matplotlib/pyvista.
+viz reads results only, through :mod:`components.results` (which opens the files and imports nothing of the
+engine): it imports neither mbd nor the rest of components — only numpy, xarray and matplotlib/pyvista.
 """
 from __future__ import annotations
 
@@ -29,16 +30,14 @@ from pathlib import Path
 
 import numpy as np
 
+from components.results import ResultsError, json_attr, open_dataset, results_path
+
 __all__ = ["ResultsError", "GeometryWarning", "Run", "load_run", "attribute_name", "attribute_names", "open_results", "cage_orbits", "roller_offsets", "train_bodies", "study_cage_animation",
            "study_cage_pictures",
            "cage_panels", "view_angle"]
 
 _REQUIRED_VARS = ("time", "motion.position", "motion.angle")
 _REQUIRED_ATTRS = ("bearings", "meta")
-
-
-class ResultsError(ValueError):
-    """A results file that is missing, unreadable or not a DPGT results file (the message says which)."""
 
 
 class GeometryWarning(UserWarning):
@@ -137,19 +136,6 @@ class Run:
         return sorted({int(b["pair"]) for b in self.bearings})
 
 
-def _json_attr(attrs: Mapping, key: str, path: Path):
-    val = attrs[key]
-    if isinstance(val, bytes):
-        val = val.decode()
-    if isinstance(val, str):
-        try:
-            return json.loads(val)
-        except json.JSONDecodeError as exc:
-            raise ResultsError(f"{path} is not a DPGT results file: attribute {key!r} is not JSON "
-                               f"({exc})") from None
-    return val
-
-
 def _pose(ds, probe: str, linear: str, angular: str) -> np.ndarray | None:
     """(n_t, n_bodies, 3) array (x, y, θ) from the file's ``<probe>.<linear>`` (time, body, axis) and
     ``<probe>.<angular>`` (time, body) variables; None when the file lacks them."""
@@ -163,28 +149,14 @@ def _pose(ds, probe: str, linear: str, angular: str) -> np.ndarray | None:
 def load_run(path, fallback_geometry: Mapping | None = None) -> Run:
     """Read a DPGT results file (netCDF4 written by scenarios.runner) or a run directory holding one.
 
-    ``fallback_geometry`` (the layout of :func:`components.results_schema.drawing_geometry`) supplies
+    ``fallback_geometry`` (the layout of :func:`components.results.schema.drawing_geometry`) supplies
     whatever drawing geometry the file lacks; it is checked against the recorded motion.
 
     Raises :class:`ResultsError` with a clear message for a missing file, a file that is not
     netCDF4/HDF5, or a netCDF file without the DPGT layout (time, motion.position, motion.angle,
     bearings, meta)."""
-    import xarray as xr
-
-    path = Path(path)
-    if path.is_dir():
-        if not (path / "results.nc").is_file():
-            raise ResultsError(f"{path} is a directory without a results.nc")
-        path = path / "results.nc"
-    if not path.exists():
-        raise ResultsError(f"no such results file: {path}")
-    if not path.is_file():
-        raise ResultsError(f"{path} is not a file")
-    try:
-        ds = xr.open_dataset(path, engine="h5netcdf")
-    except Exception as exc:  # h5py/h5netcdf raise OSError, ValueError, ... for foreign files
-        raise ResultsError(f"{path} is not a netCDF4/HDF5 results file "
-                           f"({type(exc).__name__}: {exc})") from None
+    path = results_path(path)
+    ds = open_dataset(path)
     with ds:
         missing = [v for v in _REQUIRED_VARS if v not in ds.variables]
         missing += [f"attribute {a!r}" for a in _REQUIRED_ATTRS if a not in ds.attrs]
@@ -205,13 +177,13 @@ def load_run(path, fallback_geometry: Mapping | None = None) -> Run:
         outputs = {k: np.asarray(ds[k].values, float) for k in ds.data_vars
                    if not (k.startswith("motion.") or k.startswith("fixed."))}
         attrs = dict(ds.attrs)
-    bearings = _json_attr(attrs, "bearings", path)
-    meta = _json_attr(attrs, "meta", path)
+    bearings = json_attr(attrs, "bearings", path)
+    meta = json_attr(attrs, "meta", path)
     if not isinstance(bearings, list) or not isinstance(meta, dict):
         raise ResultsError(f"{path} is not a DPGT results file: 'bearings' must be a list and 'meta' "
                            "a mapping")
-    label = _json_attr(attrs, "label", path) if "label" in attrs else {}
-    info = _json_attr(attrs, "run", path) if "run" in attrs else {}
+    label = json_attr(attrs, "label", path) if "label" in attrs else {}
+    info = json_attr(attrs, "run", path) if "run" in attrs else {}
     index = {b: i for i, b in enumerate(bodies)}
     for b in bearings:
         for nm in [b.get("planet"), b.get("cage"), *b.get("rollers", [])]:
@@ -286,14 +258,7 @@ def attribute_names(ds):
 def open_results(path, attribute_access: bool = True):
     """``xarray.open_dataset`` of a results.nc (or a run directory holding one), with :func:`attribute_names`
     applied unless ``attribute_access`` is false."""
-    import xarray as xr
-
-    path = Path(path)
-    if path.is_dir():
-        path = path / "results.nc"
-    if not path.is_file():
-        raise ResultsError(f"no such results file: {path}")
-    ds = xr.open_dataset(path, engine="h5netcdf")
+    ds = open_dataset(path)
     return attribute_names(ds) if attribute_access else ds
 
 
@@ -301,13 +266,13 @@ def _resolve_geometry(path: Path, attrs: Mapping, meta: Mapping, given: Mapping 
     """The file's drawing geometry, completed from ``given``; ``source`` says which was used."""
     g_file = None
     if "geometry" in attrs:
-        g_file = _json_attr(attrs, "geometry", path)
+        g_file = json_attr(attrs, "geometry", path)
     elif isinstance(meta.get("geometry"), Mapping):
         g_file = meta["geometry"]
     if given is None:
         if not g_file:
             raise ResultsError(f"{path} has no drawing geometry (attribute 'geometry'); pass load_run(..., "
-                               "fallback_geometry=components.results_schema.drawing_geometry(params))")
+                               "fallback_geometry=components.results.schema.drawing_geometry(params))")
         return {**json.loads(json.dumps(g_file)), "source": "file"}
     geometry, filled = _merge(json.loads(json.dumps(dict(given))), g_file or {})
     geometry["source"] = ("file+given" if filled else "file") if g_file else "given"

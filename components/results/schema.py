@@ -21,10 +21,10 @@ from functools import partial
 
 import numpy as np
 
-from mbd.recorder import ElementOutput
+from mbd import ElementOutput
 
-from .families import FAMILY, MESH_FAMILY
-from .outputs import bearing_map, contact_film
+from ..families import FAMILY, MESH_FAMILY
+from ..outputs import bearing_map, contact_film
 
 __all__ = ["OUTPUTS", "FILM_OUTPUTS", "MESH_WORDS", "instance_coords", "element_probes", "drawing_geometry",
            "loaded_transmission_error"]
