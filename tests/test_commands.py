@@ -292,6 +292,28 @@ def test_bench_statistics_takes_one_condition_through_the_shared_grammar(capsys)
     assert "--conditions C, --condition C" in text and "examples:" in text
 
 
+def test_bench_statistics_profile_splits_the_observers_time(capsys):
+    """--profile: the observer's parts each a share of its time, the parts inside snapshots and the accumulators
+    together no more than all of it, the contacts' outputs from the compiled kernels (the meshes' from numpy, inside
+    that call), and the observer's time over the engine's in the same runs."""
+    import json
+
+    from scenarios import bench_statistics
+
+    assert bench_statistics.main(["--settle", "5e-4", "--window", "2e-4", "--repeats", "1", "--profile"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    prof = r["profile"]
+    share = lambda k: prof[k]["share"]                                      # noqa: E731
+    assert share("on_block") == 1.0 and 0.0 < r["overhead_in_run"] and 40 <= r["steps"] <= 41
+    inside = [k for k in prof if k not in ("on_block", "snapshots (every per-step quantity of the block's states)",
+                                           "accumulators (concatenation, compiled loop)", "element outputs, numpy kernels")]
+    assert all(0.0 < share(k) < 1.0 for k in prof if k != "on_block")
+    assert sum(share(k) for k in inside) <= share("snapshots (every per-step quantity of the block's states)")
+    assert share("snapshots (every per-step quantity of the block's states)") + share(
+        "accumulators (concatenation, compiled loop)") <= 1.0
+    assert share("element outputs, numpy kernels") < share("element outputs, compiled kernels (the contacts)")
+
+
 
 def test_dpgt_params_lists_every_key_with_value_unit_source_and_meaning(capsys):
     from components.params import parameter_names
