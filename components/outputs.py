@@ -93,13 +93,13 @@ def default_window(base: float, periods) -> float:
 # ----------------------------------------------------------------------------------------------
 # kinematics in the carrier frame
 # ----------------------------------------------------------------------------------------------
-def carrier_frame_motion(model, t, q, v, a, omega_c: float):
+def carrier_frame_motion(model, t, q, v, a, omega_c: float, full=None):
     """(x, v, a) of every body, (K, nb, 3) each, at K states (``t`` (K,), ``q``, ``v``, ``a`` (K, n_free)), in the
     frame turning at the nominal carrier speed ``omega_c`` (its orientation at t is immaterial: only lengths
-    and projections are read)."""
+    and projections are read); ``full``: ``model.full_batch(t, q, v)`` if the caller has it."""
     t = np.asarray(t, float)
     K = t.size
-    qf, vf = model.full_batch(t, q, v)
+    qf, vf = model.full_batch(t, q, v) if full is None else full
     af = np.zeros_like(qf)
     af[:, model.free] = a
     X, V, A = (x.reshape(K, -1, 3) for x in (qf, vf, af))
@@ -341,8 +341,9 @@ class WindowStatistics(mbd.Observer):
         arrays (K, per bearing / roller / mesh), each from vectorised expressions over the K states; until the
         reference rollers are chosen also the rollers' angles about their planets ("_roller_angle")."""
         p, m = self.plan, self.model
-        out = self._outputs.outputs_batch(t, q, v, z, families=self._families)
-        X, V, A = carrier_frame_motion(m, t, q, v, a, self.omega_c)
+        full = m.full_batch(t, q, v)         # once for the outputs and the motion (≈ 2 µs a state)
+        out = self._outputs.outputs_batch(t, q, v, z, families=self._families, full=full)
+        X, V, A = carrier_frame_motion(m, t, q, v, a, self.omega_c, full=full)
         radial = lambda vec: radial_tangential(vec, X[:, p.planet, :2], X[:, p.carrier, :2][:, None, :])
         K, nb = t.size, p.planet.size
         snap: dict[str, np.ndarray] = {}

@@ -76,17 +76,22 @@ class CompiledOutputs:
         if cold:
             print(f"mbd: output kernels compiled in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
 
-    def outputs_batch(self, t, q, v, z, families=None) -> dict[str, dict[str, np.ndarray]]:
+    def outputs_batch(self, t, q, v, z, families=None, full=None) -> dict[str, dict[str, np.ndarray]]:
         """Every family's outputs at K states (those named in ``families``, when given), as
-        :meth:`mbd.System.outputs_batch`: ``t`` (K,), ``q``, ``v`` (K, n_free), ``z`` {family: (K, ...)}."""
+        :meth:`mbd.System.outputs_batch`: ``t`` (K,), ``q``, ``v`` (K, n_free), ``z`` {family: (K, ...)},
+        ``full`` the full coordinates if the caller has them."""
         m = self.model
         t = np.ascontiguousarray(t, dtype=float)
         K = t.size
         wanted = lambda parts: families is None or any(name in families for name, _ in parts)
         todo = [rec for rec in self._compiled if wanted(rec[0])]
+        rest = {name for name, how in self.engines.items() if how == "numpy"
+                and (families is None or name in families)}
         res = {}
+        if not (todo or rest):
+            return res
+        qf, vf = m.full_batch(t, q, v) if full is None else full
         if todo:
-            qf, vf = m.full_batch(t, q, v)
             fs = m.frame_batch(t)
             phi, omega, domega = (np.ascontiguousarray(np.broadcast_to(x, (K, 1))[:, 0], dtype=float)
                                   for x in (fs.phi, fs.omega, fs.domega))
@@ -102,8 +107,6 @@ class CompiledOutputs:
             O = O.transpose(0, 2, 1)
             for name, sl in parts:
                 res[name] = dict(zip(names, O if len(parts) == 1 else O[:, :, sl]))
-        rest = {name for name, how in self.engines.items() if how == "numpy"
-                and (families is None or name in families)}
         if rest:
-            res.update(self.system.outputs_batch(t, q, v, z, families=rest))
+            res.update(self.system.outputs_batch(t, q, v, z, families=rest, full=(qf, vf)))
         return res
