@@ -173,7 +173,7 @@ def test_the_parameter_package_is_entered_through_components_params():
 
 def test_every_si_class_is_written_out_next_to_its_parameter_class():
     """No SI class is made at run time (a type checker would not see it): each is a class statement in its
-    parameter class's module, declaring every field (issue 27 §4; tests/test_params_typing.py runs mypy)."""
+    parameter class's module, declaring every field (issue 27 §4; tests/components/test_params_typing.py runs mypy)."""
     import components.params as P
 
     def subclasses(cls):
@@ -243,7 +243,7 @@ def test_each_scene_builder_returns_a_frozen_typed_scene():
 # a string-keyed read or write of a scene's metadata or handles dict: by a literal key ([], get, setdefault, pop), update
 _STRING_KEYED = re.compile(r"""\b(meta|handles)\s*(\[\s*["']|\.(get|setdefault|pop)\(\s*["']|\.update\()""")
 # files that read results.nc's own "meta" attribute (a file format: JSON written from DPGTScene.run_metadata)
-_RESULTS_FILE_META = {"viz/results.py", "tests/test_viz_results.py"}
+_RESULTS_FILE_META = {"viz/results.py", "tests/viz/test_viz_results.py"}
 
 
 def test_no_string_keyed_scene_metadata_or_handles():

@@ -4,7 +4,7 @@ Each check builds only what it needs (SceneOptions), runs the engine and asserts
 1 kinematics, 2 mesh invariants at the scene level, 3 the quasi-static force polygon of every planet
 bearing, 4 the bearing alone on its rig, 5 frame invariance, 6 mirror symmetry, 7 properties over
 random valid designs, 8 clear errors for bad input. (check §15.7, conservation, is the engine's:
-tests/test_engine_conservation.py.)
+tests/mbd/test_engine_conservation.py.)
 """
 from __future__ import annotations
 
@@ -439,9 +439,9 @@ def test_frame_invariance_full_roller_model():
     The loads' floor: the impact damping c = λ(e)/v₀ takes v₀ at each contact onset,
     and a pocket contact that chatters open for one step in one run and not in the other gets a different
     v₀ (seen: 95 % apart for one of 38 pocket contacts at 0.5 µs), which moves that bearing's load by ≈
-    10–20 N. The derived outputs themselves are frame-independent to round-off (tests/test_outputs.py
-    compares both frames on one state). An earlier "floor" of 20–50 nm in the gears that did not shrink
-    with h came from a Newton defect (see tests/test_newton.py)."""
+    10–20 N. The derived outputs themselves are frame-independent to round-off
+    (tests/components/test_outputs.py compares both frames on one state). An earlier "floor" of 20–50 nm in the gears that did not shrink
+    with h came from a Newton defect (see tests/mbd/test_newton.py)."""
     d = {h: _frame_differences(_compare_frames("rollers", 1.5e-3, h)) for h in (4e-6, 5e-7)}
     assert np.all(d[5e-7] < [5e-7, 9e-6, 2e-5, 6e-3]), d[5e-7]
     ratio = d[4e-6] / d[5e-7]

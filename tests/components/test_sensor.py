@@ -24,7 +24,7 @@ from scenarios.analysis import amplitude_spectrum
 from scenarios.runner import RunConfig, run_case
 from scenarios.spectrum import _whole_revolutions, sensor_paths
 
-from dpgt_runs import build
+from tests.support.dpgt_runs import build
 
 widths = st.floats(0.05, 2 * math.pi)
 angles = st.floats(-20.0, 20.0)

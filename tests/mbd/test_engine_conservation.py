@@ -8,7 +8,7 @@ from hypothesis import given, settings, strategies as st
 import mbd
 from mbd.hht import NewtonCache
 
-from strategies import build_network, fixed_frame_momenta, networks
+from tests.support.strategies import build_network, fixed_frame_momenta, networks
 
 
 def _initial(spec, seed):

@@ -14,8 +14,8 @@ from components.outputs import WindowStatistics, default_window
 from components.presets import reference_dpgt
 from scenarios.runner import RunConfig, run_case
 
-import dpgt_runs
-from dpgt_runs import CONTROLLER, build
+from tests.support import dpgt_runs
+from tests.support.dpgt_runs import CONTROLLER, build
 
 RADIAL_KEYS = ("load_radial", "load_tangential", "load_magnitude", "cage_acc_radial", "cage_acc_tangential",
                "cage_acc_magnitude", "cage_acc_rel_radial", "cage_acc_rel_tangential", "cage_acc_rel_magnitude",

@@ -20,8 +20,8 @@ from components.params import with_overrides
 from components.presets import reference_dpgt, typical_errors
 from components.scene import SceneOptions
 from scenarios.fault_study import FAULTS
-from test_engine_frames import spinning_scene
-from strategies import accelerating_profile
+from tests.mbd.test_engine_frames import spinning_scene
+from tests.support.strategies import accelerating_profile
 
 
 # numpy's SIMD math functions may round the last bit differently for arrays of other shapes; a contact's

@@ -13,7 +13,7 @@ from components.geometry import mesh_damping
 from components.units import ParameterError
 from mbd.elements.gear_mesh import STIFFNESS_SHAPES, GearMesh, StiffnessShape, contact_ratio_to_fraction, mesh_u0
 from mbd.model import Frame, FrameState, to_reference
-from strategies import assert_jacobians_match, assert_third_law
+from tests.support.strategies import assert_jacobians_match, assert_third_law
 
 # Table-1 gears: module 3 mm, 20°; sun 31, planets 24, ring 82
 M_ = 3e-3

@@ -37,8 +37,8 @@ from mbd.element import evaluate
 from mbd.model import FrameState
 from mbd.elements.contact import (IMPACT_LAWS, EHLTraction, GuideContact, HydrodynamicLand, LubricantDrag,
                                   PocketContact, RaceContact, SlideRollTraction, TanhTraction, Traction)
-from strategies import frame_states
-from test_contact import (C_G, DM, DR, EHL, FILM, K_G, K_HZ, M_ROLLER, N, TANH, drag_scene, drag_states, guide_scene,
+from tests.support.strategies import frame_states
+from tests.mbd.test_contact import (C_G, DM, DR, EHL, FILM, K_G, K_HZ, M_ROLLER, N, TANH, drag_scene, drag_states, guide_scene,
                           guide_states, pocket_scene, pocket_states, race_scene, race_states, stored_speeds)
 
 RTOL = 1e-10           # of the largest entry of the instance's block

@@ -17,9 +17,9 @@ from components.params import to_toml, with_overrides
 from components.presets import load_toml, reference_dpgt
 from components.units import ParameterError
 
-import dpgt_runs
+from tests.support import DATA, dpgt_runs
 
-REF = "tests/data/perfect_machine_a223f98.npz"
+REF = DATA / "perfect_machine_a223f98.npz"
 PINHOLE_B1 = {"errors.pinhole": [{"planet": "b1", "radial": "0 um", "tangential": "30 um"}]}
 
 

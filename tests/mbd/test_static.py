@@ -1,5 +1,5 @@
 """The quasi-static solution (mbd.static): closed forms on small scenes, its exact Jacobian, bad input.
-The DPGT's static solution against the dynamic runs' means is in tests/test_load_path.py (same runs)."""
+The DPGT's static solution against the dynamic runs' means is in tests/components/test_load_path.py (same runs)."""
 from __future__ import annotations
 
 import warnings
@@ -180,8 +180,8 @@ def test_the_rig_s_static_state_is_the_classical_load_distribution(clearance, lo
     """The bearing rig with its cage held and its ring at rest (components.rig): its static state — the rollers kept
     on their circles about the pin (``circles``: each moves only radially, as the held pockets hold them), the ring
     free — is the classical discrete load distribution (Stribeck 4.08 at zero clearance; the values the dynamic rig
-    is held to in tests/test_scenes.py, within 2e-3): every roller's load within 1e-3 of the largest (measured
-    3.3e-4 to 6.3e-4; against the settled dynamic rig 5.3e-4 at 0 µm, 7.9e-4 at 20 µm), the ring's deflection
+    is held to in tests/components/test_scenes.py, within 2e-3): every roller's load within 1e-3 of the largest
+    (measured 3.3e-4 to 6.3e-4; against the settled dynamic rig 5.3e-4 at 0 µm, 7.9e-4 at 20 µm), the ring's deflection
     within 1e-3 (measured 2.4e-4 to 3.2e-4 short), inner and outer raceway loads equal, and the rollers' loads on
     the pin summing to the load (2.1e-4 to 2.7e-4 short)."""
     from components.presets import reference_bearing

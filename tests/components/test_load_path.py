@@ -14,7 +14,7 @@ from components.bearing import bearing_kinematics
 from components.outputs import MESH_FAMILY, bearing_map
 from components.presets import reference_dpgt
 
-from dpgt_runs import line_of_action, run
+from tests.support.dpgt_runs import line_of_action, run
 
 CASES = [(3, "forward"), (3, "reverse"), (4, "forward"), (4, "reverse")]
 
@@ -256,7 +256,7 @@ def test_the_static_solution_is_the_dynamic_runs_mean(case):
       ≤ 1.5 N over the revolution, measured; the planets' meshes carry the bearings' losses, 36–80 N, on their
       coast flanks and nothing on their drive flanks), asserted below 5 N — at condition 3 they are ≈ 2.1 kN."""
     from components.static import static_statistics
-    from dpgt_runs import carrier_revolution
+    from tests.support.dpgt_runs import carrier_revolution
     bs, dyn, _, _ = run(*case, window=carrier_revolution(reference_dpgt(*case)))
     st, _ = static_statistics(bs, 16)
     vec = lambda s: np.stack([s.stats("load_radial")["mean"], s.stats("load_tangential")["mean"]], axis=1)

@@ -7,7 +7,6 @@ from __future__ import annotations
 import math
 import re
 import warnings
-from pathlib import Path
 
 import pytest
 
@@ -16,7 +15,8 @@ from components.params import ErrorsParams, flatten, parameter_names
 from components.presets import reference_bearing_rig, reference_dpgt
 from components.units import KINDS, quantity, to_si, ureg
 
-ROOT = Path(__file__).resolve().parent.parent
+from tests.support import ROOT
+
 REFERENCE = ROOT / "docs" / "parameters.md"
 TAGS = {"[paper]", "[derived]", "[assumed]"}
 

@@ -11,7 +11,7 @@ from mbd.elements import BodySpring, GroundSupport, SpeedDrive, TorsionalSpring
 from mbd.hht import NewtonCache
 from mbd.model import FrameState
 
-from strategies import accelerating_profile, frame_states, full_states
+from tests.support.strategies import accelerating_profile, frame_states, full_states
 
 
 def spinning_scene(frame, gravity=(0.0, 0.0), damping=True, fixed_body=False):

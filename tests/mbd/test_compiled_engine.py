@@ -16,7 +16,7 @@ import pytest
 
 import mbd
 from components.planetary import build_single_planetary
-from dpgt_runs import ramp_state
+from tests.support.dpgt_runs import ramp_state
 from mbd.compiled.system import CompiledSystem
 
 H = 5e-6

@@ -100,7 +100,7 @@ def test_accepted_steps_are_converged_on_the_loaded_dpgt():
     settled benchmark window, 0.13 with the adaptive production setting). Each DOF at its own rate: worst
     0.0032 here (1 step above 3e-3), 0.0040 in 2000 steps (measured). Iterations per step: 4.98 (4.88 with
     the max-norm test); the bound 5.4 catches a policy that stops reusing the LU well or iterates to no end."""
-    from dpgt_runs import ramp_state
+    from tests.support.dpgt_runs import ramp_state
 
     sc, s = ramp_state(0.003, "compiled")
     st = mbd.PRODUCTION.stepper()

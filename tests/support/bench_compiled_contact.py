@@ -2,7 +2,7 @@
 72 race contacts (36 inner + 36 outer, fused) and 144 (72 + 72), 72 pockets, 6 guides, 72 drags, on random
 states of the test scenes (about half the contacts closed). Median of interleaved repeats.
 
-    python tests/bench_compiled_contact.py [--repeats 300]
+    python -m tests.support.bench_compiled_contact [--repeats 300]     (from the repository's root)
 
 "compiled" includes gathering the local coordinates q_full[dofs] (as evaluate does); outputs preallocated.
 """
@@ -10,20 +10,16 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
-_HERE = Path(__file__).resolve().parent
-sys.path[:0] = [str(_HERE.parent), str(_HERE)]   # this checkout's packages first, then the test scenes
+from mbd.compiled.registry import kind_of
+from mbd.element import evaluate
+from mbd.elements.contact import RaceContact
+from mbd.model import FrameState
 
-from mbd.compiled.registry import kind_of  # noqa: E402
-from mbd.element import evaluate  # noqa: E402
-from mbd.elements.contact import RaceContact  # noqa: E402
-from mbd.model import FrameState  # noqa: E402
-from test_contact import EHL, drag_scene, guide_scene, pocket_scene, race_element, race_scene, C_P, C_G  # noqa: E402
+from tests.mbd.test_contact import EHL, drag_scene, guide_scene, pocket_scene, race_element, race_scene, C_P, C_G
 
 FS = FrameState(0.3, 40.0, 0.0)
 

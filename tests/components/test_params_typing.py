@@ -8,7 +8,6 @@ import subprocess
 import sys
 import textwrap
 from dataclasses import dataclass
-from pathlib import Path
 from typing import ClassVar
 
 import pytest
@@ -18,7 +17,8 @@ from components import geometry as geo
 from components.params._machinery import SI, Params, computed, param, positive, si_extends, si_of
 from components.units import Quantity
 
-ROOT = Path(__file__).resolve().parent.parent
+from tests.support import ROOT
+
 
 # every public name the single module components/params.py defined before the split (its __all__ listed 55;
 # ErrorsSI, FlankClassParams, FlankClassSI, PinholeErrorSI, RollerDiameterErrorSI, RunoutSI, SpallSI,

@@ -1,5 +1,5 @@
 """Gear-mesh eccentricity (docs/model.md §6.4, §11.2): the law on the geometric centres, in the numpy reference and
-the compiled kernel. (Tooth faults and deviations: the tooth-pair law, tests/test_tooth_pairs.py.)
+the compiled kernel. (Tooth faults and deviations: the tooth-pair law, tests/mbd/test_tooth_pairs.py.)
 
 (a) reference vs compiled forces and Jacobians, and Jacobians vs finite differences, with offsets, also
     with the line of centres near ±π;
@@ -17,10 +17,10 @@ from mbd import ModelError
 from mbd.compiled import mesh
 from mbd.element import evaluate
 from mbd.elements import GearMesh, StiffnessShape
-from test_compiled_mesh import assert_matches_reference, compiled, libm_arctan2
-from test_gear_mesh import (ALPHA, FS0, K_MEAN, PAIRS, a0_of, far_from_kinks, full, jac_check, make_mesh, nominal,
+from tests.mbd.test_compiled_mesh import assert_matches_reference, compiled, libm_arctan2
+from tests.mbd.test_gear_mesh import (ALPHA, FS0, K_MEAN, PAIRS, a0_of, far_from_kinks, full, jac_check, make_mesh, nominal,
                             perturbed_state, rb)
-from strategies import assert_third_law
+from tests.support.strategies import assert_third_law
 
 ECC = 2e-5               # eccentricity [m] (20 µm)
 EPS, SMOOTH = 1.6, 0.05  # contact ratio and ramp width of the mesh

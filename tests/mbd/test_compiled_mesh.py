@@ -31,8 +31,8 @@ from mbd.elements.gear_mesh import RectangularStiffness
 from mbd.model import FrameState
 
 from components.geometry import mesh_damping
-from strategies import dampings, frame_states, full_states, stiffnesses
-from test_gear_mesh import K_MEAN, PAIRS, SHAPES, make_mesh, perturbed_state, rb
+from tests.support.strategies import dampings, frame_states, full_states, stiffnesses
+from tests.mbd.test_gear_mesh import K_MEAN, PAIRS, SHAPES, make_mesh, perturbed_state, rb
 
 RTOL = 1e-10          # of the largest entry of each instance's block (F row, J_q, J_v matrices)
 ATOL = 1e-300         # only so that an all-zero block must be matched by (signed) zeros
