@@ -20,7 +20,8 @@ from components.params import with_overrides
 from components.presets import reference_dpgt, typical_errors
 from components.scene import SceneOptions
 from scenarios.fault_study import FAULTS
-from tests.mbd.test_engine_frames import spinning_scene
+
+from tests.support.scenes import spinning_scene
 from tests.support.strategies import accelerating_profile
 
 

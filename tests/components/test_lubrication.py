@@ -16,6 +16,7 @@ from components.outputs import WindowStatistics
 from components.params import with_overrides
 from components.presets import OIL_GRADES, oil_grade, reference_dpgt
 from components.units import ParameterError
+
 from tests.support.dpgt_runs import ramp_state
 
 E_STEEL = reduced_modulus(210e9, 0.3, 210e9, 0.3)

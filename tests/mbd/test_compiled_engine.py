@@ -16,6 +16,7 @@ import pytest
 
 import mbd
 from components.planetary import build_single_planetary
+
 from tests.support.dpgt_runs import ramp_state
 from mbd.compiled.system import CompiledSystem
 

@@ -11,16 +11,11 @@ bounds the difference to the unchanged reference by that round-off.
 """
 from __future__ import annotations
 
-import contextlib
-import math
-from unittest import mock
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mbd import ad
 import mbd.elements
 from mbd.compiled import generic, mesh
 from mbd.compiled.registry import kind_of
@@ -31,71 +26,15 @@ from mbd.elements.gear_mesh import RectangularStiffness
 from mbd.model import FrameState
 
 from components.geometry import mesh_damping
-from tests.support.strategies import dampings, frame_states, full_states, stiffnesses
-from tests.mbd.test_gear_mesh import K_MEAN, PAIRS, SHAPES, make_mesh, perturbed_state, rb
 
-RTOL = 1e-10          # of the largest entry of each instance's block (F row, J_q, J_v matrices)
-ATOL = 1e-300         # only so that an all-zero block must be matched by (signed) zeros
+from tests.support.mesh import (ATOL, K_MEAN, PAIRS, SHAPES, assert_matches_reference, libm_arctan2, make_mesh,
+                                perturbed_state, rb)
+from tests.support.strategies import dampings, frame_states, full_states, stiffnesses
+
 RTOL_UPDATE = 1e-14
 NB = 4                # bodies of the generic-family states
 # the mesh suite's shapes, plus a Fourier series with unequal numbers of cosine and sine terms
 MESH_SHAPES = {**SHAPES, "fourier_uneven": StiffnessShape.fourier(a=[0.1], b=[0.05, 0.02, -0.01])}
-
-
-# ------------------------------------------------------------------------------------------ helpers
-_atan2 = np.frompyfunc(math.atan2, 2, 1)
-_ad_arctan2 = ad.arctan2
-
-
-def _arctan2_libm(y, x):
-    """ad.arctan2 with the C library's value (numba's); derivatives unchanged."""
-    out = _ad_arctan2(y, x)
-    val = _atan2(ad.value(y), ad.value(x)).astype(float)
-    if isinstance(out, ad.Dual):
-        return ad.Dual(val, out.der)
-    return val
-
-
-@contextlib.contextmanager
-def libm_arctan2():
-    with mock.patch.object(ad, "arctan2", _arctan2_libm):
-        yield
-
-
-def compiled(elem, t, fs, q, v, z=None, jac=True):
-    """F, J_q, J_v of a family from its compiled kernel (and a check that jac=False gives the same F)."""
-    twin = kind_of(type(elem))
-    pack, kern = twin.pack, twin.evaluate
-    P, G = pack(elem)
-    n, k = elem.dofs.shape
-    ql, vl = np.ascontiguousarray(q[elem.dofs]), np.ascontiguousarray(v[elem.dofs])
-    zz = np.zeros((n, 0)) if z is None else np.ascontiguousarray(np.reshape(z, (n, -1)), dtype=float)
-    F, Jq, Jv = np.full((n, k), np.nan), np.full((n, k, k), np.nan), np.full((n, k, k), np.nan)
-    kern(t, fs.phi, fs.omega, fs.domega, ql, vl, zz, P, G, F, Jq, Jv, jac)
-    F0 = np.full((n, k), np.nan)
-    kern(t, fs.phi, fs.omega, fs.domega, ql, vl, zz, P, G, F0, Jq[:0], Jv[:0], False)
-    np.testing.assert_array_equal(F0, F, err_msg=f"{elem.name}: forces differ between jac=True and jac=False")
-    return F, Jq, Jv
-
-
-def assert_block_close(name, A, B, rtol=RTOL, atol=0.0):
-    """Per instance: |A − B| <= rtol·max|B| + ATOL (+ atol, (n,), when given) over the instance's block."""
-    n = B.shape[0]
-    a, b = A.reshape(n, -1), B.reshape(n, -1)
-    assert np.all(np.isfinite(a)), f"{name}: non-finite (unwritten?) entries"
-    err = np.abs(a - b).max(axis=1)
-    bound = rtol * np.abs(b).max(axis=1) + ATOL + atol
-    bad = err > bound
-    assert not bad.any(), (f"{name}: instances {np.flatnonzero(bad)} differ by {err[bad]} "
-                           f"(bound {bound[bad]}, scale {np.abs(b).max(axis=1)[bad]})")
-
-
-def assert_matches_reference(elem, t, fs, q, v, z=None, F_atol=0.0):
-    F, _, Jq, Jv = evaluate(elem, t, fs, q, v, z, jac=True)
-    Fc, Jqc, Jvc = compiled(elem, t, fs, q, v, z)
-    assert_block_close(f"{elem.name} F", Fc, F, atol=F_atol)
-    assert_block_close(f"{elem.name} J_q", Jqc, Jq)
-    assert_block_close(f"{elem.name} J_v", Jvc, Jv)
 
 
 # --------------------------------------------------------------------------------------- mesh states

@@ -12,7 +12,7 @@ from mbd.elements import BodySpring, GroundSupport, Ramp, SpeedDrive, TorqueSour
 from mbd.model import FrameState
 
 from tests.support.strategies import (accelerating_profile, assert_jacobians_match, assert_third_law, dampings,
-                        fd_jacobians_full, frame_states, full_states, stiffnesses)
+                                      fd_jacobians_full, frame_states, full_states, stiffnesses)
 
 NB = 4   # bodies in the element tests; instances share bodies, which the full-vector checks handle
 

@@ -17,9 +17,9 @@ from mbd import ModelError
 from mbd.compiled import mesh
 from mbd.element import evaluate
 from mbd.elements import GearMesh, StiffnessShape
-from tests.mbd.test_compiled_mesh import assert_matches_reference, compiled, libm_arctan2
-from tests.mbd.test_gear_mesh import (ALPHA, FS0, K_MEAN, PAIRS, a0_of, far_from_kinks, full, jac_check, make_mesh, nominal,
-                            perturbed_state, rb)
+
+from tests.support.mesh import (ALPHA, FS0, K_MEAN, PAIRS, a0_of, assert_matches_reference, compiled, far_from_kinks,
+                                full, jac_check, libm_arctan2, make_mesh, nominal, perturbed_state, rb)
 from tests.support.strategies import assert_third_law
 
 ECC = 2e-5               # eccentricity [m] (20 µm)

@@ -20,8 +20,9 @@ from mbd import ModelError
 from mbd.element import evaluate
 from mbd.elements import GearMesh, StiffnessShape
 from mbd.elements.tooth_pairs import ToothPairs, tooth_table
-from tests.mbd.test_compiled_mesh import assert_matches_reference, libm_arctan2
-from tests.mbd.test_gear_mesh import FS0, K_MEAN, PAIRS, fd_jacobians, full, make_mesh, nominal, perturbed_state, rb
+
+from tests.support.mesh import (FS0, K_MEAN, PAIRS, assert_matches_reference, fd_jacobians, full, libm_arctan2,
+                                make_mesh, nominal, perturbed_state, rb)
 
 EPS, SMOOTH, RATIO = 1.6, 0.05, 1.5
 RECT = StiffnessShape.rectangular(EPS, ratio=RATIO, smoothing=SMOOTH)

@@ -65,14 +65,6 @@ def _red_centroid(img: np.ndarray) -> np.ndarray:
 
 
 @pytest.fixture(scope="module")
-def offscreen():
-    ok, msg = render_check.check_offscreen()
-    if not ok:
-        pytest.skip(msg)
-    return msg
-
-
-@pytest.fixture(scope="module")
 def animate(offscreen):
     from viz import animate
     return animate

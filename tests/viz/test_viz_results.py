@@ -50,14 +50,6 @@ def fwd(runs) -> vr.Run:
     return vr.load_run(runs["forward"])
 
 
-@pytest.fixture(scope="module")
-def offscreen():
-    ok, msg = render_check.check_offscreen()
-    if not ok:
-        pytest.skip(msg)
-    return msg
-
-
 def _frames(path: Path) -> np.ndarray:
     return np.asarray(iio.imread(path, index=None))[..., :3]
 
