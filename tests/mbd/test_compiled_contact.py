@@ -1,29 +1,10 @@
 """The compiled contact kernels (mbd.compiled.contact) equal the reference kernels (mbd.element.evaluate over
 mbd.elements.contact) to round-off: forces, J_q and J_v to 1e-10 of each instance's largest entry of the block
-(F row, J_q or J_v matrix), on random physical states (the scenes and strategies of test_contact); update_*
-equals update_internal.
+(F row, J_q or J_v matrix), on random physical states (the contact scenes and strategies of tests.support.contact);
+update_* equals update_internal.
 
-F and J_q are held to the relative bound alone (an all-zero reference block must be matched by zeros). J_v has a
-floor per instance, JV_FLOOR·|F| (|F| the instance's largest force entry; JV_FLOOR_FILM with the EHL film law):
-the reference's own round-off, which sets the error where the exact derivative is zero or a small difference of
-larger terms and no other term fills the block (no contact damping, ∂F/∂ẋ = 0 at an onset):
-- at the onset of an impact (v₀ = ẋ of the iterate) F = K x (1 + λ) does not depend on ẋ: the compiled ∂F/∂ẋ
-  is exactly 0, the reference's dual numbers give λẋ/ẋ − λ ≠ 0 (an ulp of λ, times K x/v₀);
-- a saturated friction law's sech² = 1 − tanh² (numpy's SIMD tanh and libm's differ by an ulp);
-- the slide-to-roll traction at |s| ≫ s_eps: the reference differentiates s/a with the cancellation 1 − (s/a)²,
-  the compiled kernel uses the exact s_eps²/a³.
-Each is an ulp of a force over the law's speed scale, so the floor scales with the instance's force, as F's own
-floor does. Impacts: v₀ ≥ v_min = 0.0137 m/s, at most 1.6e-14 s/m per newton; friction: v_mu = 0.05 m/s. Largest
-error beyond the relative bound seen, per newton of |F| (1500 examples of every test, 96 000 instances): 2.7e-15
-s/m (pocket, guide), none where F = 0: JV_FLOOR = 1e-13. The EHL film law saturates at the slip speed
-v_ref = h_c·τ_L/η_eff, which at the heaviest drawn contacts (5 GPa, η_eff at its elastic limit G_e·b/u) is
-5e-7 m/s: an ulp of the traction (≈ 0.07 |F| there) over it is 3e-11 s/m per newton of |F|. Seen: 8.2e-15 (J_v
-5.1e-6 N·s/m on 1.9e4 N, off by 1.6e-10) and 6.7e-12 (J_v 7.7 on 2.3e4 N, off by 1.5e-7, 2e-8 of the block;
-found by hypothesis while the planted error below was in, which it does not touch: ζ = 0), two draws that an
-absolute floor of 1e-10 did not cover: JV_FLOOR_FILM = 3e-10. A real error (a wrong term, sign or branch) shows
-in the blocks of ordinary states, many orders above it (a factor 2 on the race's damping Jacobian fails every
-race test).
-"""
+The comparison (compiled, assert_matches_reference) and its tolerances, with why they are what they are
+(J_v's floor per newton of force, the EHL film law's bounds), are in tests/support/contact.py beside their constants."""
 from __future__ import annotations
 
 import numpy as np
@@ -35,72 +16,18 @@ from mbd.compiled.contact import TRACTION_IDS, pack_race
 from mbd.compiled.registry import kind_of
 from mbd.element import evaluate
 from mbd.model import FrameState
-from mbd.elements.contact import (IMPACT_LAWS, EHLTraction, GuideContact, HydrodynamicLand, LubricantDrag,
+from mbd.elements.contact import (IMPACT_LAWS, GuideContact, HydrodynamicLand, LubricantDrag,
                                   PocketContact, RaceContact, SlideRollTraction, TanhTraction, Traction)
-from tests.support.strategies import frame_states
-from tests.mbd.test_contact import (C_G, DM, DR, EHL, FILM, K_G, K_HZ, M_ROLLER, N, TANH, drag_scene, drag_states, guide_scene,
-                          guide_states, pocket_scene, pocket_states, race_scene, race_states, stored_speeds)
 
-RTOL = 1e-10           # of the largest entry of the instance's block
-RTOL_FILM = 1e-8       # Jacobians with the EHL traction law (see assert_matches_reference)
-ATOL = 1e-300          # F and J_q: an all-zero reference block must be matched by zeros
-JV_FLOOR = 1e-13       # J_v's floor per newton of the instance's force [s/m in SI] (module docstring)
-JV_FLOOR_FILM = 3e-10  # the same with the EHL film traction law (module docstring)
+from tests.support.contact import (C_G, DM, DR, EHL, FILM, K_G, K_HZ, M_ROLLER, N, TANH, assert_matches_reference,
+                                   compiled, drag_scene, drag_states, guide_scene, guide_states, pocket_scene,
+                                   pocket_states, race_scene, race_states, stored_speeds)
+from tests.support.strategies import frame_states
+
 SETTINGS = settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 TRACTIONS = {"tanh": TANH, "ehl": EHL, "film": FILM}
 LAWS = st.sampled_from(sorted(IMPACT_LAWS))
 MULTS = st.one_of(st.just(1), st.lists(st.integers(1, 3), min_size=N, max_size=N))
-
-
-def compiled(elem, fs, qf, vf, z, jac, t=0.0):
-    """(F, J_q, J_v) of the compiled kernel; outputs start as NaN so that every entry must be written."""
-    twin = kind_of(type(elem))
-    pack, kernel = twin.pack, twin.evaluate
-    P, G = pack(elem)
-    ql, vl = np.ascontiguousarray(qf[elem.dofs]), np.ascontiguousarray(vf[elem.dofs])
-    n, k = ql.shape
-    zz = np.zeros((n, 0)) if z is None else np.ascontiguousarray(z, dtype=float)
-    F, Jq, Jv = np.full((n, k), np.nan), np.full((n, k, k), np.nan), np.full((n, k, k), np.nan)
-    kernel(t, fs.phi, fs.omega, fs.domega, ql, vl, zz, P, G, F, Jq, Jv, jac)
-    return F, Jq, Jv
-
-
-def assert_blocks_close(name, A, B, atol, rtol=RTOL):
-    """|A − B| <= rtol·max|B| + atol per instance block (``atol`` one number or one per instance)."""
-    assert A.shape == B.shape and np.all(np.isfinite(A)), name
-    atol = np.broadcast_to(atol, (B.shape[0],))
-    for i in range(B.shape[0]):
-        err = np.abs(A[i] - B[i]).max()
-        scale = np.abs(B[i]).max()
-        assert err <= rtol * scale + atol[i], f"{name} instance {i}: max error {err:.3e}, scale {scale:.3e}\n{A[i]}\n{B[i]}"
-
-
-def assert_matches_reference(elem, fs, qf, vf, z=None):
-    """Compiled and reference kernels agree; an impact family's all-zero z is the reference's z = None."""
-    t = 0.25
-    zr = None if z is not None and not np.any(z) else z
-    Fr, _, Jqr, Jvr = evaluate(elem, t, fs, qf, vf, zr, True)
-    F0r, _, _, _ = evaluate(elem, t, fs, qf, vf, zr, False)
-    F, Jq, Jv = compiled(elem, fs, qf, vf, z, True, t)
-    F0, _, _ = compiled(elem, fs, qf, vf, z, False, t)
-    # the EHL film law's Jacobian passes through exp(−α_p p) (α_p p up to ≈ 40) and a saturating tanh, whose
-    # 1 − tanh² the reference's dual numbers form with cancellation: seen up to 2.4e-10 of the block
-    film = isinstance(getattr(elem, "traction", None), EHLTraction)
-    rj = RTOL_FILM if film else RTOL
-    # F's floor: the round-off of its inputs carried through the law, eps·(|J_q||q| + |J_v||v|) per instance —
-    # a force that is the tiny difference of large terms (a centred cage's film force, seen 1.5e-10 N from
-    # terms of 1e-2 N, compiled and reference apart by 1.4e-18 N) cannot agree to 1e-10 of itself
-    q_loc, v_loc = (np.abs(x[elem.dofs]).max(axis=1) for x in (qf, vf))
-    floor = 1e-13 * (np.abs(Jqr).max(axis=(1, 2)) * q_loc + np.abs(Jvr).max(axis=(1, 2)) * v_loc) + ATOL
-    for A, B, what in ((F, Fr, "F"), (F0, F0r, "F (no jac)")):
-        for i in range(B.shape[0]):
-            assert_blocks_close(f"{elem.name} {what} [{i}]", A[i:i + 1], B[i:i + 1], floor[i])
-    assert_blocks_close(f"{elem.name} J_q", Jq, Jqr, ATOL, rj)
-    # J_v's floor: its round-off is a force over a speed (module docstring), so it scales with the force
-    floor_v = (JV_FLOOR_FILM if film else JV_FLOOR) * np.abs(Fr).max(axis=1)
-    assert_blocks_close(f"{elem.name} J_v", Jv, Jvr, floor_v, rj)
-    np.testing.assert_array_equal(F0, F)     # the value path does not depend on jac
-    return Fr
 
 
 def race(kind, mk, R, traction, *, exponent=10.0 / 9.0, zeta=0.05, multiplicity=1, name="race", bodies=None):

@@ -18,9 +18,10 @@ from mbd.element import evaluate
 from mbd.elements import GroundSupport, SpeedDrive
 from mbd.elements.contact import RaceContact
 from mbd.errors import ModelError
-from tests.mbd.test_compiled_contact import assert_matches_reference, compiled
-from tests.mbd.test_contact import (DR, EHL, FILM, FS, K_HZ, LAW, M_ROLLER, N, R_IN, R_OUT, SETTINGS, TANH, assert_balanced,
-                          assert_jacobians, race_scene, race_states)
+
+from tests.support.contact import (DR, EHL, FILM, FS, K_HZ, LAW, M_ROLLER, N, R_IN, R_OUT, SETTINGS, TANH,
+                                   assert_balanced, assert_jacobians, assert_matches_reference, compiled, race_scene,
+                                   race_states)
 
 P = 10.0 / 9.0
 LAWS = {"tanh": TANH, "ehl": EHL, "film": FILM}

@@ -19,7 +19,7 @@ from mbd.element import evaluate
 from mbd.elements.contact import RaceContact
 from mbd.model import FrameState
 
-from tests.mbd.test_contact import EHL, drag_scene, guide_scene, pocket_scene, race_element, race_scene, C_P, C_G
+from tests.support.contact import C_G, C_P, EHL, drag_scene, guide_scene, pocket_scene, race_element, race_scene
 
 FS = FrameState(0.3, 40.0, 0.0)
 
