@@ -3,7 +3,7 @@
 (:data:`.registry.OUTPUT_NAMES`: the roller–race, pocket and guide-land contacts), the numpy kernels'
 (``System.outputs_batch``) for the others. An output is written by the compiled force law where it computes
 that value for the residual (one definition of each law); ``System.outputs_batch`` stays the reference the
-tests hold this to (tests/test_compiled_outputs.py)."""
+tests hold this to (tests/mbd/test_compiled_outputs.py)."""
 from __future__ import annotations
 
 import sys
