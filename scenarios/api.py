@@ -7,7 +7,7 @@
     run.summary["outer"]["bearing_load_mean_N"]                    # summary.json (README: what it holds)
     ds = run.dataset()                                              # results.nc, opened with xarray
 
-The run is the one every study makes (:func:`scenarios.runner.run_case`: the production integrator, statistics
+The run is the one every study makes (:func:`scenarios.core.runner.run_case`: the production integrator, statistics
 on every accepted step, results.nc and summary.json written atomically, checkpoints, resume). A folder holding
 the finished run of the same parameters, settings and code is reused (``run.status == "reused"``); one holding
 results of other parameters is refused unless ``overwrite=True``.
@@ -82,7 +82,7 @@ def run(params=None, out=None, *, condition: int = 3, direction: str = "forward"
     from components.params import with_overrides
     from components.scene import SceneOptions
 
-    from .runner import RunConfig, finished_run, run_case
+    from .core.runner import RunConfig, finished_run, run_case
 
     label = {}
     if params is None:

@@ -21,9 +21,9 @@ import numpy as np
 
 import mbd
 from components.results.io import atomic_write_text
-from . import args
-from .command import command
-from .runner import accuracy_line
+from .core import args
+from .core.command import command
+from .core.runner import accuracy_line
 
 ATOL = mbd.PRODUCTION.atol_pos     # the rig runs the production stepper (components.rig.rig_static_solution)
 

@@ -33,13 +33,13 @@ from components.names import did_you_mean
 from components.units import ParameterError
 from components.results.io import atomic_write_text
 
-from . import args
-from .command import command
-from .lock import holds_out_folder
-from .runner import RunConfig
-from .analysis import line_table
-from .study import Study, StudyRun
-from .sweep import Case, build_params, user_overrides
+from .core import args
+from .core.command import command
+from .core.lock import holds_out_folder
+from .core.runner import RunConfig
+from .core.analysis import line_table
+from .core.study import Study, StudyRun
+from .core.sweep import Case, build_params, user_overrides
 
 __all__ = ["FAULTS", "main", "run", "characteristic_frequencies", "COLUMNS"]
 
@@ -172,7 +172,7 @@ def _own_frequency(case: Case, si, fr: dict) -> float | None:
 def sensor_spectrum(run_dir: Path, f_c: float):
     """(f, amplitude, why) of the recorded housing sensor of a run (scenarios.spectrum's definition); ``why`` says
     why its lines mean nothing (too few carrier revolutions), None when they do."""
-    from .analysis import amplitude_spectrum, sensor_signal, sideband_resolution
+    from .core.analysis import amplitude_spectrum, sensor_signal, sideband_resolution
 
     t, x = sensor_signal(run_dir / "results.nc", f_c)
     f, amp, _ = amplitude_spectrum(t, x)
@@ -307,7 +307,7 @@ def _spectrum_panels(spectra: dict) -> list[tuple]:
 
 class FaultStudy(Study):
     """The perfect machine, each fault and each damaged machine in every direction
-    (:class:`scenarios.study.Study`): per damaged machine a line first, then the tables and the figures."""
+    (:class:`scenarios.core.study.Study`): per damaged machine a line first, then the tables and the figures."""
 
     def config(self) -> RunConfig:
         a = self.a

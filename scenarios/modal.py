@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from components.results.io import atomic_write_text
-from . import args
-from .command import command
+from .core import args
+from .core.command import command
 
 
 EXAMPLES = ["{prog} --params my_planetary.toml --out results/modal", "{prog} --set planets=4",

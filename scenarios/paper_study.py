@@ -26,13 +26,13 @@ from components.outputs import relative_life as iso_relative_life
 from components.results import SUMMARY_WORDS, Summary, json_attr, open_run
 from components.results.io import atomic_write_text, write_summary
 
-from .integrity import read_summary
-from .runner import RunConfig
-from .study import Study, StudyRun
-from .sweep import OPERATING_AXES, Case, user_overrides
-from . import args
-from .command import command
-from .lock import holds_out_folder
+from .core.integrity import read_summary
+from .core.runner import RunConfig
+from .core.study import Study, StudyRun
+from .core.sweep import OPERATING_AXES, Case, user_overrides
+from .core import args
+from .core.command import command
+from .core.lock import holds_out_folder
 
 # the summary keys the comparison shows, with their units (words: components.results.SUMMARY_WORDS)
 QUANTITIES = [(k, SUMMARY_WORDS[k][1]) for k in (
@@ -372,7 +372,7 @@ def animate(results: dict, out: Path) -> list[Path]:
 
 
 class PaperStudy(Study):
-    """Forward vs reverse per condition (:class:`scenarios.study.Study`): the comparison table first, then its
+    """Forward vs reverse per condition (:class:`scenarios.core.study.Study`): the comparison table first, then its
     files, the figures and (``--animate``) the cage-orbit animations. A run that fails now but finished before
     keeps its summary in the tables."""
 

@@ -17,8 +17,8 @@ import sys
 import warnings
 from pathlib import Path
 
-from . import args
-from .command import command
+from .core import args
+from .core.command import command
 
 EXAMPLES = ["{prog}", "{prog} --grep clearance", "{prog} --grep bearing.cage --set bearing.cage.mass=\"0.05 kg\"",
             "{prog} --params my_machine.toml --grep user", "{prog} --reference"]

@@ -42,12 +42,12 @@ import mbd
 from components.sensor import PATHS as SENSOR_PATHS
 from components.results.io import atomic_write_text
 
-from .analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution
-from .analysis import whole_revolutions as _whole_revolutions
-from .plausibility import check_runs
-from .runner import RunConfig, finished_run, run_case, run_report
-from . import args
-from .command import command
+from .core.analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution
+from .core.analysis import whole_revolutions as _whole_revolutions
+from .core.plausibility import check_runs
+from .core.runner import RunConfig, finished_run, run_case, run_report
+from .core import args
+from .core.command import command
 
 SENSORS = {
     "housing": "housing accelerometer (docs/model.md §12): the sum of its mesh, torque and bearing paths, along the "

@@ -46,13 +46,13 @@ from components.units import ParameterError
 from components.results import Summary
 from components.results.io import atomic_write_text
 
-from . import args
-from .command import command
-from .integrity import OtherResults, read_summary
-from .lock import holds_out_folder
-from .runner import RunConfig, code_digest
-from .study import Study, StudyRun
-from .sweep import OPERATING_AXES, Case, build_params, dask_client, user_overrides, validate_cases
+from .core import args
+from .core.command import command
+from .core.integrity import OtherResults, read_summary
+from .core.lock import holds_out_folder
+from .core.runner import RunConfig, code_digest
+from .core.study import Study, StudyRun
+from .core.sweep import OPERATING_AXES, Case, build_params, dask_client, user_overrides, validate_cases
 
 __all__ = ["main", "run", "parse_args", "QUANTITIES", "MESHES", "quantities_of", "percentile_ci", "statistics",
            "agreement_rows", "sample_rows", "sample_columns", "answer", "StaticTask", "static_tasks", "solve_static_task"]

@@ -96,7 +96,7 @@ def test_viz_reads_results_only_and_scenarios_build_without_viz():
         if mod.startswith("viz"):
             assert not [d for d in deps if d.split(".")[0] in ("mbd", "components", "scenarios")
                         and d not in {"components.names", *RESULTS_ENGINE_FREE}], (mod, deps)
-        if mod.startswith(("components", "mbd")) or mod == "scenarios.runner":
+        if mod.startswith(("components", "mbd")) or mod == "scenarios.core.runner":
             assert not [d for d in deps if d.startswith("viz")], (mod, deps)
 
 
@@ -275,9 +275,10 @@ def test_scene_touches_no_private_attribute_of_the_model_builder():
 
 
 # the modules every scenario builds on; a scenario borrows nothing from another scenario (issue 24 §3)
-SCENARIO_INFRASTRUCTURE = {"scenarios", "scenarios.args", "scenarios.command", "scenarios.runner", "scenarios.sweep",
-                           "scenarios.study", "scenarios.integrity", "scenarios.lock", "scenarios.plausibility",
-                           "scenarios.analysis", "scenarios.numerics_common"}
+SCENARIO_INFRASTRUCTURE = {"scenarios", *(f"scenarios.core.{m}" for m in ("args", "command", "runner", "sweep", "study",
+                                                                          "integrity", "lock", "plausibility",
+                                                                          "analysis")), "scenarios.core",
+                           "scenarios.numerics", "scenarios.numerics.common"}
 
 
 def test_no_scenario_borrows_from_another_scenario():
@@ -411,7 +412,7 @@ def _shipped_scenes():
     from components.rig import build_bearing_rig
     from components.scene import SceneOptions
     from scenarios.fault_study import FAULTS
-    from scenarios.stability import CASES, case_overrides
+    from scenarios.numerics.stability import CASES, case_overrides
 
     def dpgt(overrides=None, options=None, condition=3, direction="forward", strict=True):
         with warnings.catch_warnings():

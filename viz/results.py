@@ -1,4 +1,4 @@
-"""Saved DPGT results (``results.nc`` of scenarios.runner) → the arrays the animations draw.
+"""Saved DPGT results (``results.nc`` of scenarios.core.runner) → the arrays the animations draw.
 
 :func:`load_run` reads one results file (or a run directory holding ``results.nc``) into a :class:`Run`:
 times, body names, body motion in the reference frame R, the fixed-frame motion of sun/carrier/ring,
@@ -147,7 +147,7 @@ def _pose(ds, probe: str, linear: str, angular: str) -> np.ndarray | None:
 
 
 def load_run(path, fallback_geometry: Mapping | None = None) -> Run:
-    """Read a DPGT results file (netCDF4 written by scenarios.runner) or a run directory holding one.
+    """Read a DPGT results file (netCDF4 written by scenarios.core.runner) or a run directory holding one.
 
     ``fallback_geometry`` (the layout of :func:`components.results.schema.drawing_geometry`) supplies
     whatever drawing geometry the file lacks; it is checked against the recorded motion.

@@ -9,7 +9,7 @@
 
 A missing or foreign file is a :class:`ResultsError` whose message says which; a file that exists but does not
 read (broken JSON, not a JSON object, not HDF5) is a :class:`DamagedResults` with the reason in the words the run
-folder's integrity checks print (:mod:`scenarios.integrity` moves such a file aside). Imports nothing of the
+folder's integrity checks print (:mod:`scenarios.core.integrity` moves such a file aside). Imports nothing of the
 project but the summary (viz reads through it without the engine); xarray and h5py are imported when used.
 """
 from __future__ import annotations

@@ -20,8 +20,8 @@ from components import static
 from components.dpgt import build_dpgt
 from components.presets import reference_dpgt
 
-from . import args
-from .command import command
+from ..core import args
+from ..core.command import command
 
 EXAMPLES = ["{prog}", "{prog} --conditions 2 --directions reverse --snapshots 16 --repeats 5"]
 WRITES = ("one JSON object on the screen: first_s, warm_s (medians over --repeats), steps_first, steps_warm, "

@@ -9,7 +9,7 @@ hardest stretch numerically, so a short window from t = 0 is a fair stress test 
 table to minutes.
 
 Integrators per case: HHT α = −0.3, adaptive (atol 10 nm, h0 = 5 µs, h_max = 10 µs: the default of
-scenarios.runner), and scipy Radau (rtol 1e-5, sparse analytic Jacobian) with a wall-time cap (--cap).
+scenarios.core.runner), and scipy Radau (rtol 1e-5, sparse analytic Jacobian) with a wall-time cap (--cap).
 A failure is reported with its cause — for HHT the IntegrationError message names the time, the step
 size and the element family with the largest force; a scene the design checks refuse is reported
 as such — never hidden.
@@ -40,10 +40,10 @@ import mbd
 from components.outputs import FAMILY
 from components.units import Q_
 
-from .numerics_common import (Problem, StateSampler, design_verdict, dpgt_problem, machine_note, run_scipy,
-                              warm_up)
-from . import args
-from .command import command
+from .common import (Problem, StateSampler, design_verdict, dpgt_problem, machine_note, run_scipy,
+                     warm_up)
+from ..core import args
+from ..core.command import command
 
 __all__ = ["CASES", "case_overrides", "run_case_stability", "main", "FIELDS"]
 

@@ -43,10 +43,10 @@ import numpy as np
 import mbd
 from components.outputs import FAMILY
 
-from .numerics_common import (dpgt_problem, error_metrics, eval_costs, machine_note, observables, peak_rss_mb,
-                              rig_problem, run_hht, run_scipy, settled_state, warm_up, hht_reference)
-from . import args
-from .command import command
+from .common import (dpgt_problem, error_metrics, eval_costs, machine_note, observables, peak_rss_mb,
+                     rig_problem, run_hht, run_scipy, settled_state, warm_up, hht_reference)
+from ..core import args
+from ..core.command import command
 
 __all__ = ["main", "study", "FIELDS"]
 

@@ -1,7 +1,7 @@
 """Command-line arguments checked where they are read, before any simulation starts (issue 17).
 
 :class:`Parser` is argparse with one-line errors (``error: argument --window: must be > 0 s, got '-1'``,
-exit 2 through :func:`scenarios.command.command`). The ``type=`` callables below check one argument each
+exit 2 through :func:`scenarios.core.command.command`). The ``type=`` callables below check one argument each
 and say what is expected; every scenario's parser uses them, so a bad value never reaches a run.
 """
 from __future__ import annotations

@@ -23,7 +23,7 @@ import tempfile
 import time
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parents[1]
+HERE = Path(__file__).resolve().parents[2]      # the repository (this file: scenarios/numerics/bench_study.py)
 JOBS = {
     "study": ["-m", "scenarios.paper_study", "--conditions", "1,2,3,4", "--directions", "forward,reverse",
               "--workers", "2", "--no-progress"],

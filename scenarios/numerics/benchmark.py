@@ -50,10 +50,10 @@ import mbd
 from components.outputs import FAMILY
 from components.presets import reference_dpgt
 
-from .numerics_common import (design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note,
-                              observables, peak_rss_mb, run_hht, run_scipy, settled_state, warm_up, hht_reference)
-from . import args
-from .command import command
+from .common import (design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note,
+                     observables, peak_rss_mb, run_hht, run_scipy, settled_state, warm_up, hht_reference)
+from ..core import args
+from ..core.command import command
 
 __all__ = ["main", "benchmark", "scaling", "profile_window"]
 

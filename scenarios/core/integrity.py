@@ -110,7 +110,7 @@ def claim_folder(folder, parameters_fp: str, full_fp: str | None, overwrite: boo
     """Check that ``folder`` may take a run of these parameters: "new" (nothing finished there), "same"
     (finished from the same parameters and code), "recompute" (same parameters, other code) or "overwrite"
     (other parameters, ``overwrite`` given). Other parameters without ``overwrite``: :class:`OtherResults`,
-    naming what differs (``description``: the run's :func:`scenarios.runner.run_description`, against the one
+    naming what differs (``description``: the run's :func:`scenarios.core.runner.run_description`, against the one
     the finished summary keeps)."""
     s = read_summary(Path(folder) / "summary.json")
     if s is None:

@@ -19,8 +19,8 @@ from components.dpgt import build_dpgt
 from components.outputs import WindowStatistics
 from components.presets import reference_dpgt
 
-from . import args
-from .command import command
+from ..core import args
+from ..core.command import command
 
 EXAMPLES = ["{prog}", "{prog} --conditions 3 --settle 0.01 --window 0.005 --repeats 5"]
 WRITES = ("one JSON object on the screen: wall_plain_s, wall_stats_s (medians over --repeats), overhead "

@@ -34,8 +34,8 @@ import numpy as np
 
 import mbd
 from mbd.elements import BodySpring, ForceSource, GroundSupport, Ramp, TorqueSource, TorsionalSpring
-from . import args
-from .command import command
+from ..core import args
+from ..core.command import command
 
 ROLLER_D = 7.5e-3                      # m
 ROLLER_M = 3.1e-3                      # kg

@@ -157,14 +157,14 @@ def _case_cfg(case: Case, cfg):
 
 def _finished(case: Case, params, cfg) -> Summary | None:
     """The case's summary if it was finished from the same parameters, settings and code and its results.nc
-    is intact, else None (then recomputed, not reused; damaged files are moved aside, scenarios.integrity)."""
+    is intact, else None (then recomputed, not reused; damaged files are moved aside, scenarios.core.integrity)."""
     from .runner import finished_run
 
     return finished_run(case.out_dir, params, cfg)
 
 
 def check_folders(cases: list[Case], cfg, overwrite: bool = False) -> None:
-    """Before any run starts: refuse (:class:`~scenarios.integrity.OtherResults`) when a case's folder holds
+    """Before any run starts: refuse (:class:`~scenarios.core.integrity.OtherResults`) when a case's folder holds
     finished results of other parameters or settings and ``overwrite`` is not given; list every such folder."""
     from .runner import parameters_fingerprint, run_description, run_fingerprint
 
