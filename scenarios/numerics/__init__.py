@@ -6,8 +6,8 @@ stiff bodies, the compiled mesh kernel, the statistics observer, a static soluti
 one-off compile of the engine's kernels (:mod:`.warm`); :mod:`.common` holds what the first three share (the test
 problems, the settled state, the contender runs, the error metrics).
 
-Each script is run as its documented command, ``python -m scenarios.NAME`` (a three-line module of that name at the
-top of :mod:`scenarios` calls this package's ``main``) or ``dpgt NAME``. What belongs here: a script whose answer is
-about the numerics or the cost of the code. A script imports :mod:`scenarios.core` and :mod:`.common`, never a study
-(tests/test_architecture.py holds the walls); results of these scripts are in docs/numerics.md.
+Each script runs as its documented command, ``python -m scenarios.NAME`` (a shim of that name at the top of
+:mod:`scenarios` imports the script's ``main``; the code is here) or ``dpgt NAME``. What belongs here: a script
+whose answer is about the numerics or the cost of the code. A script imports :mod:`scenarios.core` and
+:mod:`.common`, never a study (tests/test_architecture.py holds the walls); their results are in docs/numerics.md.
 """
