@@ -31,12 +31,13 @@ import numpy as np
 import mbd
 from components.dpgt import build_dpgt
 from components.lubrication import BOUNDARY_LAMBDA
-from components.params import DPGTParams
+from components.params import DPGTParams, flatten
 from components.scene import SceneOptions
 from mbd.recorder import BodyMotion, Recorder
 
 from components.outputs import BearingSeries, WindowStatistics, bearing_map, cage_period, default_window
 from components.sensor import HousingLoads
+from components.static import static_summary
 from components.results import Summary
 from components.results.io import atomic_write_text, write_summary
 from components.results.schema import drawing_geometry, element_probes
@@ -93,8 +94,6 @@ def run_fingerprint(params: DPGTParams, cfg: "RunConfig") -> str:
 def run_description(params: DPGTParams, cfg: "RunConfig") -> dict[str, str]:
     """Every parameter (dotted key) and run setting as text: what summary.json keeps so that a refusal to replace
     a folder's results can name what differs."""
-    from components.params import flatten
-
     out = {k: str(v) for k, v in flatten(params).items()}
     out.update({f"settings.{k}": repr(v) for k, v in _settings(cfg).items()})
     return out
@@ -185,8 +184,6 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
 def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> Summary:
     """The quasi-static solution (:mod:`components.static`) of one operating point: summary.json in the dynamic
     run's keys, those only a dynamic run gives left out (listed in ``omitted``); no results.nc."""
-    from components.static import static_summary
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
         scene = build_dpgt(params, cfg.options)
