@@ -54,21 +54,29 @@ class SteadyMotion:
     ``orbit`` (n_bodies,): the rate [rad/s] in R at which a body's centre circles a point of R (0: the centre
     rests in R); the circle's centre follows from the velocity, v = ω k × (x − c). ``host`` (n_bodies,): the body
     (index, −1: none) that carries the body's place on its circle when it is displaced (a roller keeps its pocket
-    whatever the cage does; a host rests in R). Velocities and accelerations are those of the circle about the
-    fixed centre. Spin rates are the angular velocities' θ entries."""
+    whatever the cage does; a host rests in R). ``placed`` (n_bodies,): resting bodies that keep their place on a
+    circle about their ``centre`` all the same — displaced only along its radius (a roller in a held cage).
+    Velocities and accelerations are those of the circle about the fixed centre. Spin rates are the angular
+    velocities' θ entries."""
     t0: float
     q0: np.ndarray      # (nb, 3) poses in R at t0
     spin: np.ndarray    # (nb,) angular rate in R [rad/s]
     orbit: np.ndarray   # (nb,) orbital rate in R [rad/s]
     centre: np.ndarray  # (nb, 2) orbit centre in R [m], its host at its steady pose
     host: np.ndarray    # (nb,) host body index or −1
+    placed: np.ndarray  # (nb,) bool: resting, but kept on a circle about its centre
+
+    def circling(self, model: Model) -> np.ndarray:
+        """Indices of the free bodies moved only along (and, optionally, around) a circle: orbiting or placed."""
+        return np.flatnonzero(((self.orbit != 0.0) | self.placed) & ~model.fixed)
 
     @staticmethod
     def from_state(model: Model, q0: np.ndarray, v0: np.ndarray, orbit, host=None, t0: float = 0.0,
-                   rest_tol: float = 1e-9) -> "SteadyMotion":
+                   rest_tol: float = 1e-9, circles=None) -> "SteadyMotion":
         """``q0``, ``v0``: the free DOFs in R at ``t0`` (a built scene's kinematic initial state); ``orbit``: the
-        bodies' orbital rates in R; ``host``: their hosts (default none). A body declared resting must not move
-        in R (speed below ``rest_tol`` [m/s]): its steady motion would be unknown, and it is refused."""
+        bodies' orbital rates in R; ``host``: their hosts (default none); ``circles``: {body index: centre (x, y)}
+        for resting bodies kept on a circle about that centre (placed). A body declared resting must not move in
+        R (speed below ``rest_tol`` [m/s]): its steady motion would be unknown, and it is refused."""
         qf, vf = model.full(t0, q0, v0)
         P, V = qf.reshape(-1, 3), vf.reshape(-1, 3)
         nb = model.n_bodies
@@ -86,13 +94,19 @@ class SteadyMotion:
         moving = np.flatnonzero(w != 0.0)
         centre[moving, 0] -= V[moving, 1] / w[moving]        # v = ω k × (x − c)  ⇒  x − c = (v_y, −v_x)/ω
         centre[moving, 1] += V[moving, 0] / w[moving]
+        placed = np.zeros(nb, bool)
+        for b, c in (circles or {}).items():
+            if not (0 <= int(b) < nb) or w[int(b)] != 0.0 or model.fixed[int(b)]:
+                raise ModelError(f"circles: body {b!r} must be a free body without an orbit rate")
+            placed[int(b)] = True
+            centre[int(b)] = np.asarray(c, float)
         still = (w == 0.0) & ~model.fixed & (np.hypot(V[:, 0], V[:, 1]) > rest_tol)
         if still.any():
             i = int(np.flatnonzero(still)[0])
             raise ModelError(f"steady motion: body {model.body_names[i]!r} moves in the reference frame "
                              f"({np.hypot(*V[i, :2]):.3g} m/s) but has no orbit rate; a static solution needs every "
                              "body's centre at rest in R or circling a point of R")
-        return SteadyMotion(float(t0), P.copy(), np.where(model.fixed, 0.0, V[:, 2]), w, centre, host)
+        return SteadyMotion(float(t0), P.copy(), np.where(model.fixed, 0.0, V[:, 2]), w, centre, host, placed)
 
     def poses(self, t: float) -> np.ndarray:
         """(nb, 3) steady poses at time t."""
@@ -160,7 +174,7 @@ class _Problem:
         self._rows = sysm._indices.astype(np.int64)
         self._cols = np.repeat(np.arange(m.ndof), np.diff(sysm._indptr))
         self.nB, self.nu = B.shape[1], len(groups)
-        self.orbiting = np.flatnonzero((motion.orbit != 0.0) & ~m.fixed)
+        self.orbiting = motion.circling(m)
         self.ix, self.iy = f2f[3 * self.orbiting], f2f[3 * self.orbiting + 1]
         # rate groups flattened: spinning bodies (group, body); orbiting members (group, body)
         self.spin_g = np.array([j for j, (sb, _) in enumerate(groups) if sb >= 0], np.int64)
@@ -278,7 +292,14 @@ def _evaluator(system: System, engine: str):
         if engine == "compiled":
             raise ModelError(f"solve_static: the compiled path cannot evaluate this model: {exc}") from None
         return system.evaluate
-    return lambda t, q, v, z, jac: cs.evaluate(t, q, v, z, jac)
+    loaded = [None]
+
+    def evaluate(t, q, v, z, jac):      # the internal states are loaded once per dict, not at every call
+        if z is loaded[0]:
+            return cs.evaluate(t, q, v, None, jac)
+        loaded[0] = z
+        return cs.evaluate(t, q, v, z, jac)
+    return evaluate
 
 
 def _directions(model: Model, motion: SteadyMotion, t: float, held: np.ndarray, tangential: bool):
@@ -288,7 +309,7 @@ def _directions(model: Model, motion: SteadyMotion, t: float, held: np.ndarray, 
     and tangential columns (−1: none)."""
     n, f2f = model.ndof, model.full_to_free
     keep = ~held.copy()
-    orbiting = np.flatnonzero((motion.orbit != 0.0) & ~model.fixed)
+    orbiting = motion.circling(model)
     keep[f2f[3 * orbiting]] = keep[f2f[3 * orbiting + 1]] = False
     solved = np.flatnonzero(keep)
     col_of = -np.ones(n, np.int64)
@@ -398,7 +419,7 @@ def carry(model: Model, motion: SteadyMotion, sol: StaticSolution, t: float, rat
     X.ravel()[model.free] = sol.q
     D = X - P0
     D[model.fixed] = 0.0
-    orb = np.flatnonzero((motion.orbit != 0.0) & ~model.fixed)
+    orb = motion.circling(model)
     rates = [(int(sb), list(ob)) for sb, ob in rates]
     u = np.asarray(sol.rates, float).copy() if len(rates) else np.zeros(0)
     own = {sb: j for j, (sb, ob) in enumerate(rates) if sb >= 0 and not ob}

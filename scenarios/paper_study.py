@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.static import DEFAULT_SNAPSHOTS
 from components.outputs import relative_life as iso_relative_life
 from components.results import SUMMARY_WORDS, Summary, json_attr, open_run
 from components.results.io import atomic_write_text, write_summary
@@ -79,8 +80,9 @@ def build_parser(name: str = "paper_study", out: str = "results/study", doc: str
                    help="dynamic: time integration (default); static: the quasi-static solution of the same model "
                         "(mean loads, load sharing, lives in seconds; quantities only a dynamic run gives — cage "
                         "motion, impacts, RMS values, time histories — are left out and said so)")
-    p.add_argument("--snapshots", type=args.count(1), default=8,
-                   help="static mode: instants over the mesh and roller positions averaged (default 8)")
+    p.add_argument("--snapshots", type=args.count(1), default=DEFAULT_SNAPSHOTS,
+                   help=f"static mode: instants over a carrier revolution and the mesh cycle averaged (default "
+                        f"{DEFAULT_SNAPSHOTS})")
     p.add_argument("--animate", action=argparse.BooleanOptionalAction, default=animate,
                    help="write a cage-orbit animation per condition (forward beside reverse)"
                         + (" (default: on)" if animate else ""))
@@ -96,7 +98,7 @@ def build_config(a) -> RunConfig:
     return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate,
                      integration=dataclasses.replace(mbd.PRODUCTION, method=a.method, h=a.h, alpha=a.alpha),
                      options=args.scene_options(a.option), progress=not a.no_progress,
-                     mode=getattr(a, "mode", "dynamic"), snapshots=getattr(a, "snapshots", 8))
+                     mode=getattr(a, "mode", "dynamic"), snapshots=getattr(a, "snapshots", DEFAULT_SNAPSHOTS))
 
 
 def make_cases(a, out: Path) -> list[Case]:

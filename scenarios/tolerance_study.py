@@ -3,13 +3,13 @@ and lives over machines drawn from stated tolerances (docs/tolerances.md).
 
     python -m scenarios.tolerance_study [--samples 64] [--torques 0.25,0.5,1] [--conditions 3]
         [--directions forward,reverse] [--classes 5,7] [--pinhole-tolerance "10 um"] [--clearance-tolerance "5 um"]
-        [--roller-lot "2 um"] [--dynamic 16] [--snapshots 8] [--seed 1] [--settle S] [--window S]
+        [--roller-lot "2 um"] [--dynamic 16] [--snapshots 16] [--seed 1] [--settle S] [--window S]
         [--params FILE.toml] [--set KEY=VALUE ...] [--workers N | --scheduler ADDR] [--force] [--overwrite] [--out DIR]
 
 Every sample is one machine: its gears' teeth and runouts for an ISO 1328 class, its 2N pinholes, each bearing's
 clearance and each roller's diameter drawn from their tolerances (:mod:`components.tolerance_sampling`: the
 distributions, a scrambled Sobol sequence of ``--seed``). Each machine is solved quasi-statically
-(:mod:`components.static`, ``--snapshots`` instants over the mesh and roller positions) at every class, condition,
+(:mod:`components.static`, ``--snapshots`` instants over a carrier revolution and the mesh cycle) at every class, condition,
 direction and torque (``--torques``: fractions of the condition's rated output torque); the first ``--dynamic``
 machines, and the perfect machine, also run dynamically (the runner of the other studies, on Dask) at the largest
 torque, for the static solution's agreement and the dynamic increment. Each static solution is its own small file
@@ -40,6 +40,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.static import DEFAULT_SNAPSHOTS
 from components.tolerance_sampling import (DISTRIBUTIONS, TOLERANCE_DEFAULTS, ToleranceSpec, coordinates, draw_errors,
                                            sobol_points, teeth_seed)
 from components.units import ParameterError
@@ -152,8 +153,9 @@ def parse_args(argv):
     p.add_argument("--dynamic", type=args.count(0), default=16, metavar="N",
                    help="the first N machines of each class, condition and direction also run dynamically (with the "
                         "perfect machine) at the largest torque, resumable (default 16; 0: static only)")
-    p.add_argument("--snapshots", type=args.count(1), default=8, metavar="N",
-                   help="static solutions per machine over the mesh and roller positions (default 8)")
+    p.add_argument("--snapshots", type=args.count(1), default=DEFAULT_SNAPSHOTS, metavar="N",
+                   help=f"static solutions per machine over a carrier revolution and the mesh cycle (default "
+                        f"{DEFAULT_SNAPSHOTS})")
     p.add_argument("--seed", type=args.count(0), default=1, help="seed of the Sobol sequence and of the teeth (default 1)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="dynamic runs: seconds discarded (default 0.03)")
     p.add_argument("--window", type=args.positive("s"), default=None,
@@ -639,8 +641,10 @@ def plots(records: dict, stats: list[dict], out: Path) -> list[Path]:
     dist = {(cond, f): {} for (_, cond, _, f) in groups}
     for (c, cond, d, f), e in groups.items():
         dist[(cond, f)][(c, d)] = _column(e["samples"], HEADLINE)
+    failed = sum(1 for e in groups.values() for r in e["samples"] if "quantities" not in r)
     files = [tolerance_distributions(dist, out / "k_gamma_distribution.png",
-                                     title="Mesh load sharing K_γ of machines drawn from their tolerances")]
+                                     title="Mesh load sharing K_γ of machines drawn from their tolerances"
+                                           + (f" ({failed} without a static solution left out)" if failed else ""))]
     bands = {}
     for g in stats:
         k = g["quantities"][HEADLINE]

@@ -175,6 +175,39 @@ def test_an_instant_resting_on_a_force_jump_is_moved_within_its_mesh_phase():
     assert np.abs(d1 - d0).max() < 0.01 * np.abs(d0).max(), (d0, d1)
 
 
+@pytest.mark.parametrize("clearance, load_deg", [("0 um", -90.0), ("20 um", -90.0), ("40 um", -90.0), ("10 um", 100.0)])
+def test_the_rig_s_static_state_is_the_classical_load_distribution(clearance, load_deg):
+    """The bearing rig with its cage held and its ring at rest (components.rig): its static state — the rollers kept
+    on their circles about the pin (``circles``: each moves only radially, as the held pockets hold them), the ring
+    free — is the classical discrete load distribution (Stribeck 4.08 at zero clearance; the values the dynamic rig
+    is held to in tests/test_scenes.py, within 2e-3): every roller's load within 1e-3 of the largest (measured
+    3.3e-4 to 6.3e-4; against the settled dynamic rig 5.3e-4 at 0 µm, 7.9e-4 at 20 µm), the ring's deflection
+    within 1e-3 (measured 2.4e-4 to 3.2e-4 short), inner and outer raceway loads equal, and the rollers' loads on
+    the pin summing to the load (2.1e-4 to 2.7e-4 short)."""
+    from components.presets import reference_bearing
+    from components.rig import build_bearing_rig, rig_loads
+    from components.scene import SceneOptions
+    from mbd.ad import wrap_angle
+    F, a = 5000.0, np.radians(load_deg)
+    rig = build_bearing_rig(reference_bearing().replace(clearance=clearance), radial_load=F, load_angle=a,
+                            options=SceneOptions(cage="held"))
+    m = rig.model
+    rollers = [m.body(r).index for r in rig.bearing_handles.rollers]
+    motion = SteadyMotion.from_state(m, rig.q0, rig.v0, np.zeros(m.n_bodies), circles={r: (0.0, 0.0) for r in rollers})
+    sol = solve_static(m, motion, 1.01 * rig.ramp)
+    r = rig_loads(rig, mbd.System(m), mbd.State(sol.t, sol.q, sol.v, sol.a, np.zeros_like(sol.q), sol.z))
+    ref = rig.reference
+    # each roller against the reference roller at its angle (both from the load-zone centre)
+    match = np.argmin(np.abs(wrap_angle(r["angle"][:, None] - ref.angles[None, :])), axis=1)
+    assert np.abs(wrap_angle(r["angle"] - ref.angles[match])).max() < 1e-9
+    np.testing.assert_allclose(r["load_inner"], ref.loads[match], atol=1e-3 * ref.q_max)
+    np.testing.assert_allclose(r["load_outer"], r["load_inner"], atol=1e-5 * ref.q_max)
+    np.testing.assert_allclose(r["load_sum"], F * np.array([np.cos(a), np.sin(a)]), atol=1e-3 * F)
+    u = np.array([np.cos(a), np.sin(a)])
+    assert r["ring"] @ u == pytest.approx(ref.deflection, rel=1e-3)
+    assert r["ring"] @ np.array([-u[1], u[0]]) == pytest.approx(ref.sideways, abs=1e-2 * ref.deflection)
+
+
 def test_bad_input_is_refused_in_one_line():
     mb = mbd.ModelBuilder()
     b = mb.add_body("b", M, 0.1)

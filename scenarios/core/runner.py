@@ -33,11 +33,11 @@ from components.dpgt import build_dpgt
 from components.lubrication import BOUNDARY_LAMBDA
 from components.params import DPGTParams, flatten
 from components.scene import SceneOptions
+from components.static import DEFAULT_SNAPSHOTS, static_summary
 from mbd.recorder import BodyMotion, Recorder
 
 from components.outputs import BearingSeries, WindowStatistics, bearing_map, cage_period, default_window
 from components.sensor import HousingLoads
-from components.static import static_summary
 from components.results import Summary
 from components.results.io import atomic_write_text, write_summary
 from components.results.schema import drawing_geometry, element_probes
@@ -116,7 +116,7 @@ class RunConfig:
     checkpoint_every: int = 2000
     sensor: bool = False          # record what the housing accelerometer needs (rig.sensor, docs/model.md §12)
     mode: str = "dynamic"         # "static": the quasi-static solution of the same model (components.static)
-    snapshots: int = 8            # static mode: instants over the mesh and roller positions
+    snapshots: int = DEFAULT_SNAPSHOTS    # static mode: instants over a carrier revolution and the mesh cycle
 
     def __post_init__(self):
         if self.mode not in ("dynamic", "static"):

@@ -31,7 +31,8 @@ WRITES = ("one JSON object on the screen: first_s, warm_s (medians over --repeat
 def parse_args(argv):
     p = args.parser("bench_static", __doc__, examples=EXAMPLES, writes=WRITES, out=None)
     p.add_argument("--directions", default="forward", choices=["forward", "reverse"], help="one direction")
-    p.add_argument("--snapshots", type=args.count(1), default=8, help="snapshots per repeat (default 8)")
+    p.add_argument("--snapshots", type=args.count(1), default=static.DEFAULT_SNAPSHOTS,
+                   help=f"snapshots per repeat (default {static.DEFAULT_SNAPSHOTS})")
     p.add_argument("--repeats", type=args.count(1), default=3, help="timed repeats (default 3)")
     args.add_shared(p, "conditions", conditions="3", one_condition_only=True)
     return p.parse_args(argv)
