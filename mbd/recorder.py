@@ -360,8 +360,9 @@ class Recorder:
         return self.path
 
     def _write(self, tmp: Path, total: int, allattrs: dict) -> None:
-        import h5netcdf  # deferred: HDF5 (≈ 0.1 s) only when results.nc is written, not in every `import mbd`
-        import h5py  # deferred: as h5netcdf
+        # deferred: HDF5 (≈ 0.1 s) only when results.nc is written, not in every `import mbd`
+        import h5netcdf
+        import h5py
 
         with h5netcdf.File(tmp, "w") as f:
             f.dimensions["time"] = total

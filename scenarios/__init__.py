@@ -17,8 +17,8 @@ from __future__ import annotations
 __all__ = ["run", "parameters", "Run"]
 
 
-def __getattr__(name):          # lazily: `python -m scenarios.NAME` does not pay for it
+def __getattr__(name):
     if name in __all__:
-        from . import api
+        from . import api  # deferred: the runner (≈ 1 s) only for scenarios.run; every command imports this package
         return getattr(api, name)
     raise AttributeError(f"module 'scenarios' has no attribute {name!r}")

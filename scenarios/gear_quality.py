@@ -220,7 +220,7 @@ def write_tables(rows: list[dict], out: Path) -> list[Path]:
 
 def plot(rows: list[dict], out: Path) -> list[Path]:
     """quality.png."""
-    from viz.plots import gear_quality
+    from viz.plots import gear_quality  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     return [gear_quality(by_grade(rows), out / "quality.png",
                          title="Gear tooth quality (ISO 1328 flank class) against perfect teeth: planet bearings and the ring mesh")]

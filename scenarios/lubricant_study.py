@@ -219,7 +219,7 @@ def write_tables(rows: list[dict], out: Path) -> list[Path]:
 def plot(rows: list[dict], out: Path) -> list[Path]:
     """film_and_slip.png: Λ, film, cage slip and traction heat against the viscosity, a line per condition and
     direction (the conditions' own markers when there are several)."""
-    from viz.plots import against_viscosity
+    from viz.plots import against_viscosity  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     conds = sorted({r["condition"] for r in rows})
     series = {}

@@ -18,8 +18,10 @@ import time
 import warnings
 
 import numpy as np
+from numba import njit
 
 from components.dpgt import build_dpgt
+from components.params import with_overrides
 from components.presets import reference_dpgt
 from mbd.compiled.mesh import evaluate_gear_mesh, pack_gear_mesh
 from mbd.element import evaluate
@@ -83,8 +85,6 @@ def main(argv=None) -> int:
 
 def _teeth_cost(a, q, v, fs):
     """Compiled cost per evaluation of the DPGT's fused mesh family: rectangular law vs tooth-pair law."""
-    from components.params import with_overrides
-
     grade = with_overrides(reference_dpgt(a.condition, "forward"), {"errors.flank_class": [
         {"gear": "all", "grade": 6, "seed": 1, "systematic_share": 0.5}]})
     fams = {}
@@ -95,7 +95,6 @@ def _teeth_cost(a, q, v, fs):
             e = GearMesh.fuse([x for x in build_dpgt(params).model.elements if isinstance(x, GearMesh)])
         fams[label] = (q[e.dofs], v[e.dofs], *pack_gear_mesh(e),
                        (np.empty((e.n, 6)), np.empty((e.n, 6, 6)), np.empty((e.n, 6, 6)), np.zeros((e.n, 0))))
-    from numba import njit
 
     @njit
     def loop(n, phi, omega, ql, vl, z, P, G, F, Jq, Jv, jac):   # as the compiled assembly calls it (no dispatch)

@@ -38,6 +38,7 @@ import numpy as np
 
 import mbd
 from components.outputs import FAMILY
+from components.presets import reference_dpgt
 from components.units import Q_
 
 from .common import (Problem, StateSampler, design_verdict, dpgt_problem, machine_note, run_scipy,
@@ -50,7 +51,6 @@ __all__ = ["CASES", "case_overrides", "run_case_stability", "main", "FIELDS"]
 
 def _contact_stiffness(factor):
     def f():
-        from components.presets import reference_dpgt
         K = reference_dpgt(3).si().bearing.contact_stiffness
         return {"bearing.contact_stiffness": Q_(factor * K, "N/m**(10/9)")}
     return f

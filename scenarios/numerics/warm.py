@@ -12,14 +12,17 @@ import sys
 import time
 import warnings
 
+import numpy as np
+
+import mbd
+from components.accumulate import accumulate_steps
+from components.dpgt import build_dpgt
+from components.presets import reference_dpgt
+from mbd.compiled import kernels_cached
+from mbd.compiled.runner import CompiledRunner
+
 
 def main(argv=None) -> int:
-    import mbd
-    from mbd.compiled import kernels_cached
-    from mbd.compiled.runner import CompiledRunner
-    from components.dpgt import build_dpgt
-    from components.presets import reference_dpgt
-
     cached = kernels_cached()
     t0 = time.perf_counter()
     with warnings.catch_warnings():
@@ -35,9 +38,6 @@ def main(argv=None) -> int:
 
 def _warm_accumulators() -> None:
     """The statistics' compiled accumulators (components.accumulate), on a one-step toy window."""
-    import numpy as np
-    from components.accumulate import accumulate_steps
-
     i0, f0 = np.zeros(0, np.int64), np.zeros(0)
     accumulate_steps(np.array([0.0, 1.0]), np.zeros((2, 1)), np.array([-1]), np.zeros((4, 1)), np.zeros(2), np.zeros(1),
                      np.ones(1, bool), np.zeros(1), np.ones(1), False, 0.0, 1.0, i0, i0, i0, np.zeros((2, 0)), f0,

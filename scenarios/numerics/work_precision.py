@@ -216,7 +216,7 @@ def _label(r) -> str:
 
 
 def _plots(out: Path, problem: str, rows: list, ref_check: dict) -> None:
-    from viz.plots import work_precision
+    from viz.plots import work_precision  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
     title = {"dpgt": "full DPGT, condition 3", "rig": "one planet bearing on the rig"}[problem]
     ok = [r for r in rows if r["completed"] is True and r["err_pin_rel"] != ""]
     floor = 1e-12
