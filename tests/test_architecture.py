@@ -379,6 +379,57 @@ def test_every_numerics_script_has_its_command_and_every_shim_is_one_import():
             f"from .numerics.{name} import main", "if __name__ == '__main__':\n    raise SystemExit(main())"], name
 
 
+# a function-local import says why it is not at the top of its module (issue 27): it breaks an import cycle
+# ("# cycle: ..."), or it defers a heavy or optional import that a start-up path does not need ("# deferred: ...":
+# numba's kernels, VTK, Dask, matplotlib, xarray/HDF5, the runner in dpgt's start-up). The reason is on the import's
+# line, or on a comment line right above the block of imports it belongs to.
+LOCAL_IMPORT_REASON = re.compile(r"#\s*(?:deferred|cycle):\s*\S")
+_IMPORT_LINE = re.compile(r"\s*(?:from\s+\S+\s+import\s|import\s)")
+
+
+def local_imports_without_reason(source: str) -> list[str]:
+    """The function-local imports of a module's source that give no reason (their lines)."""
+    lines = source.splitlines()
+
+    def reasoned(lineno: int) -> bool:
+        if LOCAL_IMPORT_REASON.search(lines[lineno - 1]):
+            return True
+        above = lineno - 2
+        while above >= 0 and _IMPORT_LINE.match(lines[above]):          # the block of imports it belongs to
+            above -= 1
+        return above >= 0 and lines[above].lstrip().startswith("#") and bool(LOCAL_IMPORT_REASON.search(lines[above]))
+
+    bad = []
+
+    def visit(node, in_function: bool):
+        for child in ast.iter_child_nodes(node):
+            if in_function and isinstance(child, (ast.Import, ast.ImportFrom)) and not reasoned(child.lineno):
+                bad.append(lines[child.lineno - 1].strip())
+            visit(child, in_function or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)))
+
+    visit(ast.parse(source), False)
+    return bad
+
+
+def test_every_function_local_import_says_why_it_is_not_at_the_top():
+    """A module's imports are at its top; one inside a function carries its reason (LOCAL_IMPORT_REASON), so a new
+    one must say why. Shown first on a module written to break it: an untagged import inside a function (and in a
+    method) is caught; a tagged one, a tagged block and the module's own top-level and TYPE_CHECKING imports pass."""
+    probe = ("import os\nif TYPE_CHECKING:\n    import numpy\n"
+             "def f():\n    import json\n    from math import pi  # deferred: a reason\n"
+             "    # cycle: a.b imports this module\n    from a import b\n    from a import c\n    x = 1\n    import re\n"
+             "class C:\n    def g(self):\n        from pathlib import Path\n")
+    assert local_imports_without_reason(probe) == ["import json", "import re", "from pathlib import Path"]
+    bad = {}
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            found = local_imports_without_reason(path.read_text(encoding="utf-8"))
+            if found:
+                bad[str(path.relative_to(ROOT))] = found
+    assert not bad, "function-local imports without a '# deferred:' or '# cycle:' reason: " + "; ".join(
+        f"{f}: {', '.join(v)}" for f, v in bad.items())
+
+
 # what a clone does not have: the specification files the project was started from, which lived beside the
 # repository, and paths of the machine it was written on (patterns split so that this file does not match itself)
 OUTSIDE = re.compile("|".join([re.escape("shared" + "/spec"), re.escape("../" + "shared"), re.escape("/" + "work/"),
