@@ -102,8 +102,8 @@ def snapshot_times(scene, n: int) -> np.ndarray:
 
 
 # snapshots a static solution averages unless asked otherwise: over one carrier revolution, 16 put the bearings' mean
-# roller loads within 1.2 % of a dynamic run's (8: 1.5 %; tests/test_load_path.py) and halve the tooth errors' noise in
-# a machine's K_γ (class 7: ±0.02 at 8 snapshots)
+# roller loads within 1.2 % of a dynamic run's (8: 1.5 %; tests/components/test_load_path.py) and halve the tooth
+# errors' noise in a machine's K_γ (class 7: ±0.02 at 8 snapshots)
 DEFAULT_SNAPSHOTS = 16
 
 # a rate unknown's largest step [rad/s]: a roller whose tractions saturate (large slip) has a spin torque with no

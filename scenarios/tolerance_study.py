@@ -604,7 +604,8 @@ def answer(stats: list[dict], agree: list[dict], a_record: dict) -> str:
                 words = (f"- condition {cond}, {d}: over {len(rs)} machine{'s' if len(rs) > 1 else ''} the dynamic mesh "
                          f"K_γ minus the static one is {inc.mean():+.4f} on average (from {inc.min():+.4f} to "
                          f"{inc.max():+.4f}, RMS {np.sqrt(np.mean(inc ** 2)):.4f}) — the dynamic increment and the static "
-                         f"estimate's error together: its snapshots see the teeth and runouts at a few instants only; "
+                         f"estimate's error together (its snapshots see each mesh's teeth at a few instants of a carrier "
+                         f"revolution, a dynamic run at every one); "
                          f"the most loaded bearings' mean loads differ by {np.abs(loads).max():.2f} % at most"
                          if rs else f"- condition {cond}, {d}:")
                 if p:

@@ -7,15 +7,8 @@ for numpy/scipy warm-up and would trip hypothesis' timing check on a loaded 2-co
 from __future__ import annotations
 
 import os
-import sys
-from pathlib import Path
 
 from hypothesis import HealthCheck, settings
-
-# make ``import strategies`` work whatever pytest's import mode or the working directory
-_here = str(Path(__file__).resolve().parent)
-if _here not in sys.path:
-    sys.path.insert(0, _here)
 
 settings.register_profile("default", max_examples=20, deadline=None,
                           suppress_health_check=[HealthCheck.too_slow])

@@ -173,7 +173,7 @@ def test_the_parameter_package_is_entered_through_components_params():
 
 def test_every_si_class_is_written_out_next_to_its_parameter_class():
     """No SI class is made at run time (a type checker would not see it): each is a class statement in its
-    parameter class's module, declaring every field (issue 27 §4; tests/test_params_typing.py runs mypy)."""
+    parameter class's module, declaring every field (issue 27 §4; tests/components/test_params_typing.py runs mypy)."""
     import components.params as P
 
     def subclasses(cls):
@@ -243,7 +243,7 @@ def test_each_scene_builder_returns_a_frozen_typed_scene():
 # a string-keyed read or write of a scene's metadata or handles dict: by a literal key ([], get, setdefault, pop), update
 _STRING_KEYED = re.compile(r"""\b(meta|handles)\s*(\[\s*["']|\.(get|setdefault|pop)\(\s*["']|\.update\()""")
 # files that read results.nc's own "meta" attribute (a file format: JSON written from DPGTScene.run_metadata)
-_RESULTS_FILE_META = {"viz/results.py", "tests/test_viz_results.py"}
+_RESULTS_FILE_META = {"viz/results.py", "tests/viz/test_viz_results.py"}
 
 
 def test_no_string_keyed_scene_metadata_or_handles():
@@ -719,3 +719,69 @@ def test_results_files_are_opened_only_in_the_results_module():
     assert not found["run files"], f"run files read by name outside components.results: {found['run files']}"
     assert not found["error key"], f"a summary's error asked by its key, not Summary.failed: {found['error key']}"
     assert not found["writes"], f"atomic writes taken from mbd.recorder, not components.results.io: {found['writes']}"
+
+
+# ------------------------------------------------------------------------------------------ the tests' layout
+# the test modules that check what crosses the packages (the layout, the documents, the commands of every study,
+# the output files' names, the tour notebook); every other test module lives in the folder of the package it tests
+CROSS_CUTTING_TESTS = {"test_architecture.py", "test_commands.py", "test_docs.py", "test_summary_keys.py",
+                       "test_tour_notebook.py"}
+
+
+def _test_layout_problems(files: dict[str, str]) -> list[str]:
+    """What breaks the tests' layout in ``files`` (path under tests/ -> source): a test module at the top that is
+    not cross-cutting, a folder that is not a package's (or tests/support) or has no __init__.py, a test module in
+    tests/support, an import of another test module or of a shared helper other than as tests.support.*, a change
+    to sys.path."""
+    problems = []
+    folders = {p.split("/")[0] for p in files if "/" in p}
+    local = {p.rsplit("/", 1)[-1].removesuffix(".py") for p in files}      # names a sys.path hack would import
+    for folder in sorted(folders):
+        if folder not in (*PACKAGES, "support"):
+            problems.append(f"tests/{folder}/: not the folder of a package ({', '.join(PACKAGES)}) or support")
+        if f"{folder}/__init__.py" not in files:
+            problems.append(f"tests/{folder}/: no __init__.py (test modules are imported as tests.{folder}.NAME)")
+    for path, source in sorted(files.items()):
+        name = path.rsplit("/", 1)[-1]
+        if "/" not in path and name.startswith("test_") and name not in CROSS_CUTTING_TESTS:
+            problems.append(f"tests/{path}: a test module at the top (it belongs in the folder of its package)")
+        if path.startswith("support/") and name.startswith("test_"):
+            problems.append(f"tests/{path}: a test module among the shared helpers")
+        for node in ast.walk(ast.parse(source)):
+            mods = ([a.name for a in node.names] if isinstance(node, ast.Import)
+                    else [node.module or ""] if isinstance(node, ast.ImportFrom) and not node.level else [])
+            for m in mods:
+                parts = m.split(".")
+                if (parts[0] == "tests" and parts[1:2] != ["support"] and len(parts) > 1) or parts[0] in local \
+                        or any(p.startswith("test_") for p in parts):
+                    problems.append(f"tests/{path}:{node.lineno}: imports {m} (shared helpers: tests.support.*)")
+            if isinstance(node, ast.Attribute) and node.attr == "path" and isinstance(node.value, ast.Name) \
+                    and node.value.id == "sys":
+                problems.append(f"tests/{path}:{node.lineno}: changes or reads sys.path (import as tests.support.*)")
+    return problems
+
+
+def test_tests_mirror_the_packages_and_share_only_through_tests_support():
+    """Test modules live in tests/mbd, tests/components, tests/scenarios and tests/viz, the cross-cutting ones at
+    the top; every folder is a package, so a test module is imported by its dotted name wherever pytest runs from;
+    what tests share lives in tests/support and is imported as tests.support.* — never from another test module,
+    never through a sys.path entry. The detector is shown first to find each of these in a tree written to break
+    them."""
+    bad = {"__init__.py": "", "test_new_thing.py": "", "support/__init__.py": "", "support/test_helper.py": "",
+           "mbd/__init__.py": "", "extra/test_x.py": "",
+           "mbd/test_a.py": "import sys\nsys.path.insert(0, 'tests')\nfrom strategies import networks\n"
+                            "from tests.mbd.test_b import helper\nimport test_c\nfrom tests.support.mesh import rb\n",
+           "strategies.py": ""}
+    caught = _test_layout_problems(bad)
+    for words in ("test_new_thing.py: a test module at the top", "tests/extra/: not the folder",
+                  "tests/extra/: no __init__.py", "support/test_helper.py: a test module among",
+                  "imports strategies", "imports tests.mbd.test_b", "imports test_c", "mbd/test_a.py:2: changes"):
+        assert any(words in c for c in caught), (words, caught)
+    assert len(caught) == 8 and not any("tests.support.mesh" in c for c in caught), caught
+    tests = ROOT / "tests"
+    files = {p.relative_to(tests).as_posix(): p.read_text(encoding="utf-8") for p in tests.rglob("*.py")}
+    assert {"__init__.py", "support/__init__.py", "support/strategies.py", "support/dpgt_runs.py"} <= set(files)
+    assert {p.split("/")[0] for p in files if "/" in p} == {*PACKAGES, "support"}
+    assert CROSS_CUTTING_TESTS <= set(files), CROSS_CUTTING_TESTS - set(files)
+    problems = _test_layout_problems(files)
+    assert not problems, "the tests' layout:\n" + "\n".join(problems)

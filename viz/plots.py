@@ -671,7 +671,7 @@ def tolerance_against_torque(bands: Mapping[tuple, Mapping[int, Sequence[tuple]]
                     t, p50, p90 = (np.array(v, float) for v in zip(*pts))
                     color = _CLASS_COLORS[classes.index(cl) % len(_CLASS_COLORS)]
                     ax.fill_between(t, p50, p90, color=color, alpha=0.18, lw=0)
-                    ax.plot(t, p90, color=color, lw=0.8)
+                    ax.plot(t, p90, color=color, lw=0.8, marker="_", ms=9, mew=1.4)   # marked: one torque has no band
                     ax.plot(t, p50, color=color, lw=1.4, marker="o", ms=4)
                 ax.axhline(table, color=_MARK_COLOR, ls=":", lw=0.9)
                 ax.set_xlim(0.0, 1.06 * ax.get_xlim()[1])        # from zero torque, the last marker inside
@@ -680,7 +680,7 @@ def tolerance_against_torque(bands: Mapping[tuple, Mapping[int, Sequence[tuple]]
                 if k == 0:
                     ax.set_ylabel(_axis_label("mesh load sharing K_γ", None))
         extra = [Line2D([], [], color="#444444", lw=1.4, marker="o", ms=4, label="median (P50)"),
-                 Line2D([], [], color="#444444", lw=0.8, label="P90 (band: P50–P90)"),
+                 Line2D([], [], color="#444444", lw=0.8, marker="_", ms=9, mew=1.4, label="P90 (band: P50–P90)"),
                  Line2D([], [], color=_MARK_COLOR, ls=":", label=f"rating tables, 3 planets ({table:g})")]
         handles = [Line2D([], [], color=_CLASS_COLORS[i % len(_CLASS_COLORS)], lw=2, label=f"ISO 1328 class {c}")
                    for i, c in enumerate(classes)]

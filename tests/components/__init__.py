@@ -1,0 +1,1 @@
+"""Tests of the domain (components): parameters, geometry, scenes, contact laws in the machine, outputs, statistics."""

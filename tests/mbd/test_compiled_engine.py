@@ -1,0 +1,183 @@
+"""The compiled engine path (mbd.compiled) against the numpy reference path: the same forces and
+Jacobians, the same steps (counters) and states, and a fallback that says why.
+
+From a DPGT state the roller spins of the unloaded zone are chaotic (pocket impacts with friction):
+two runs whose only difference is round-off — numpy against numpy with the start velocities changed by
+1e-15 relative — agree to 1e-11 m for ~150 steps of 5 µs and then drift apart, to 1e-2 rad/s of roller
+spin after 300 steps. So the engines are held together over 150 steps exactly (counters) and to
+1e-8 (states), and over 400 steps no further apart than round-off alone drives the reference.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import mbd
+from components.planetary import build_single_planetary
+
+from tests.support.dpgt_runs import ramp_state
+from mbd.compiled.system import CompiledSystem
+
+H = 5e-6
+
+
+@pytest.fixture(scope="module")
+def dpgt_state():
+    """The DPGT 3 ms into its load ramp (every contact family active), by the compiled engine."""
+    sc, s = ramp_state(0.003, "compiled")
+    return sc.model, s
+
+
+def _run(model, state, n, engine, observers=(), stepper=None):
+    return mbd.simulate(model, t_end=state.t + n * H, state=state.copy(), stepper=stepper or mbd.PRODUCTION.stepper(),
+                        controller=mbd.FixedStep(H), progress=False, engine=engine, observers=list(observers))
+
+
+def test_compiled_assembly_equals_the_reference(dpgt_state):
+    model, s = dpgt_state
+    system = mbd.System(model)
+    ref = system.evaluate(s.t, s.q, s.v, s.z, jac=True)
+    got = CompiledSystem(system).evaluate(s.t, s.q, s.v, s.z, jac=True)
+    for name in ("F", "Jq", "Jv"):
+        a, b = getattr(got, name), getattr(ref, name)
+        assert np.abs(a - b).max() <= 1e-10 * np.abs(b).max(), name
+    assert np.count_nonzero(ref.Jq) > 1000               # contacts, meshes and pockets are in the picture
+
+
+@pytest.mark.parametrize("per_component", [True, False], ids=["per-component test", "max-norm test"])
+def test_the_engines_take_the_same_steps_to_the_same_states(dpgt_state, per_component):
+    """Both Newton convergence tests (the production one and the one before issue 23) are compiled."""
+    model, s = dpgt_state
+    st = dataclasses.replace(mbd.PRODUCTION.stepper(), per_component=per_component)
+    c, r = _run(model, s, 150, "compiled", stepper=st), _run(model, s, 150, "numpy", stepper=st)
+    assert (c.engine, r.engine) == ("compiled", "numpy")
+    assert c.counters == r.counters and c.counters["rejected"] + c.counters["accepted"] >= 150
+    np.testing.assert_allclose(c.state.q, r.state.q, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(c.state.v, r.state.v, rtol=0, atol=1e-8 / H)
+    for k in r.state.z:
+        np.testing.assert_allclose(c.state.z[k], r.state.z[k], rtol=0, atol=1e-6)
+
+
+class _Log(mbd.Observer):
+    def bind(self, *a):
+        self.q = []
+
+    def step(self, s0, s1):
+        self.q.append(s1.q.copy())
+
+
+def test_over_longer_runs_the_engines_differ_only_as_round_off_drives_the_reference(dpgt_state):
+    model, s = dpgt_state
+    logs = {k: _Log() for k in ("compiled", "numpy", "perturbed")}
+    _run(model, s, 400, "compiled", [logs["compiled"]])
+    _run(model, s, 400, "numpy", [logs["numpy"]])
+    p = s.copy()
+    p.v[:] = s.v * (1 + 1e-15 * np.random.default_rng(0).standard_normal(s.v.size))
+    _run(model, p, 400, "numpy", [logs["perturbed"]])
+    n = min(len(x.q) for x in logs.values())
+    gap = lambda a, b: np.array([np.abs(a.q[i] - b.q[i]).max() for i in range(n)])
+    engines, noise = gap(logs["compiled"], logs["numpy"]), gap(logs["perturbed"], logs["numpy"])
+    # within a decade of what 1e-15 of round-off does to the reference, at every step (floor: 1e-12 m)
+    assert np.all(engines <= 10 * np.maximum.accumulate(noise) + 1e-12)
+
+
+def test_a_planetary_scene_runs_identically_on_both_engines():
+    built = build_single_planetary()
+    v0 = built.v0.copy()
+    v0[2] = 30.0
+    kw = dict(stepper=mbd.PRODUCTION.stepper(), controller=mbd.Adaptive(h0=1e-4, h_max=1e-4, h_min=1e-12),
+              progress=False)
+    c = mbd.simulate(built.model, built.q0, v0, 0.004, engine="compiled", **kw)
+    r = mbd.simulate(built.model, built.q0, v0, 0.004, engine="numpy", **kw)
+    assert c.counters == r.counters and c.counters["rejected"] > 0   # rejections and step changes included
+    tol = mbd.PRODUCTION.stepper().tol.scale(built.model, None, None)   # the local error the controller holds
+    assert np.all(np.abs(c.state.q - r.state.q) <= 0.05 * tol)       # Newton-tolerance round-off, 905 steps
+
+
+def test_what_cannot_be_compiled_falls_back_or_says_why(capsys):
+    """"auto" falls back to the numpy path and says so in one line on stderr, with the reason, which the result
+    (and so summary.json) keeps; "compiled" refuses; a compiled run has no note."""
+    mb = mbd.ModelBuilder()
+    mb.add_body("wheel", 1.0, 0.01)
+    mb.add(mbd.elements.TorqueSource("motor", [0], torque=lambda t: np.array([np.sin(t)])))
+    model = mb.build()
+    kw = dict(stepper=mbd.PRODUCTION.stepper(), controller=mbd.FixedStep(1e-3), progress=False)
+    res = mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="auto", **kw)
+    assert res.engine == "numpy" and "motor" in res.engine_note and res.summary()["engine_note"] == res.engine_note
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("mbd: running the numpy engine path") and "motor" in err[0]
+    mb2 = mbd.ModelBuilder()
+    mb2.add_body("wheel", 1.0, 0.01)
+    mb2.add(mbd.elements.TorqueSource("motor", [0], torque=1.0))
+    ok = mbd.simulate(mb2.build(), np.zeros(3), np.zeros(3), 0.01, engine="auto", **kw)
+    assert ok.engine == "compiled" and ok.engine_note is None
+    with pytest.raises(mbd.ModelError, match="compiled engine cannot run.*motor.*callable"):
+        mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="compiled", **kw)
+    with pytest.raises(mbd.ModelError, match="engine must be one of"):
+        mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="fast", **kw)
+
+
+def test_a_family_without_a_compiled_twin_falls_back_and_says_so(capsys):
+    """A family that declares no compiled twin (here a subclass: it does not inherit its parent's, since its law
+    may differ) runs on the numpy path under "auto", announced in one line naming the family; "compiled" refuses."""
+    class HandTorque(mbd.elements.TorqueSource):
+        pass
+
+    mb = mbd.ModelBuilder()
+    mb.add_body("wheel", 1.0, 0.01)
+    mb.add(HandTorque("hand", [0], torque=1.0))
+    model = mb.build()
+    kw = dict(stepper=mbd.PRODUCTION.stepper(), controller=mbd.FixedStep(1e-3), progress=False)
+    res = mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="auto", **kw)
+    assert res.engine == "numpy" and "'hand' (HandTorque declares no compiled_twin)" in res.engine_note
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("mbd: running the numpy engine path") and "HandTorque" in err[0]
+    assert res.state.v[2] == pytest.approx(1.0 * 0.01 / 0.01)       # ω = τ·t/J: the numpy path ran the inherited law
+    with pytest.raises(mbd.ModelError, match="compiled engine cannot run.*HandTorque declares no compiled_twin"):
+        mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="compiled", **kw)
+
+
+def test_the_kernel_cache_is_dropped_when_any_compiled_source_changes(tmp_path, monkeypatch):
+    """numba caches a function against its own file only: the compiled package keeps a hash of all its
+    sources beside the cache and drops every cached kernel when it changes (a stale dispatch once kept
+    an old race kernel)."""
+    import importlib
+
+    import mbd.compiled as mc
+    from numba import config
+    monkeypatch.setattr(config, "CACHE_DIR", str(tmp_path))
+    stale = tmp_path / "registry.evaluate_kind-45.py311.nbi"
+    stale.write_text("old")
+    keep = tmp_path / "other_module.f-1.py311.nbi"
+    keep.write_text("not ours")
+    importlib.reload(mc)                       # the hash in tmp_path is missing: a change
+    assert not stale.exists() and keep.exists()
+    stamp = (tmp_path / "compiled_sources.sha256").read_text()
+    stale.write_text("fresh")                  # same sources: nothing is dropped
+    importlib.reload(mc)
+    assert stale.exists() and (tmp_path / "compiled_sources.sha256").read_text() == stamp
+
+
+def test_a_run_that_must_compile_says_so_before_its_first_step(capsys, monkeypatch):
+    """When numba's cache does not hold the step loop, building the compiled runner says so in one line, compiles
+    before any step (a progress bar's ETA then leaves it out) and gives the time; with the cache warm it is
+    silent. (The compile is faked cold: the cache answers, so the test stays fast.)"""
+    import mbd.compiled as mc
+    from mbd.compiled.runner import CompiledRunner
+
+    mb = mbd.ModelBuilder()
+    mb.add_body("wheel", 1.0, 0.01)
+    mb.add(mbd.elements.TorqueSource("motor", [0], torque=1.0))
+    system = mbd.System(mb.build())
+    args = (system, mbd.PRODUCTION.stepper(), mbd.FixedStep(1e-3))
+    CompiledRunner(*args)
+    assert mc.kernels_cached()
+    capsys.readouterr()
+    CompiledRunner(*args)
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(mc, "kernels_cached", lambda: False)
+    CompiledRunner(*args)
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("mbd: compiling the engine's kernels") and err[1].startswith("mbd: kernels compiled in ")

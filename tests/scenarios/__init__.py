@@ -1,0 +1,1 @@
+"""Tests of the studies and their machinery (scenarios): runner, sweeps, integrity, locks, each study end to end."""

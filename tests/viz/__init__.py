@@ -1,0 +1,1 @@
+"""Tests of the plots, animations and results reading (viz)."""
