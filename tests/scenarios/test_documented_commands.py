@@ -15,11 +15,11 @@ import subprocess
 import sys
 import tomllib
 import warnings
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
+from tests.support import ROOT
+
 DOCUMENTS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), *sorted((ROOT / "docs").glob("*.ipynb")),
              ROOT / "Makefile", ROOT / ".ci" / "run"]
 PYTHON_M = re.compile(r"-m\s+scenarios\.([a-z_]+)\b")           # "python -m", "$(PY) -m", across a line break
