@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import teeth
+from .geometry import centre_distance_limit
 from .units import ParameterError
 
 __all__ = ["check_errors", "pin_position", "roller_diameters", "spall_args", "mesh_error_args", "GEAR_OF"]
@@ -94,8 +95,6 @@ def _check_pinholes(si) -> None:
     """A pinhole error moves its planet, and so its centre distances, by its size (plus the bearing's play c/2):
     the gears must take that (no tip striking a root, ε_α ≥ 1; :func:`geometry.centre_distance_limit`), as the
     clearance check asks of the play alone."""
-    from .geometry import centre_distance_limit
-
     e, lay = si.errors, si.layout
     play = 0.5 * si.bearing.clearance
     moved: dict[str, float] = {}

@@ -12,10 +12,13 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+import warnings
 from dataclasses import dataclass
 from fractions import Fraction
 
+from .geometry import kinematics
 from .params import Params, flatten, parameter_rows
+from .presets import CONDITIONS, OIL_GRADES, reference_bearing_rig, reference_dpgt, reference_gears
 from .units import KINDS, Q_, ParameterError, quantity, ureg
 
 __all__ = ["Row", "reference_rows", "entry_rows", "unit_text", "reference_markdown", "NON_QUANTITY_KINDS"]
@@ -169,9 +172,6 @@ def _first_paragraph(doc: str | None) -> str:
 
 def _conditions() -> list[str]:
     """The study's operating conditions, with the speeds and frequencies the reference gears give them."""
-    from .geometry import kinematics
-    from .presets import CONDITIONS, reference_gears
-
     g = reference_gears().si()
     z = (g.sun.teeth, g.inner_planet.teeth, g.outer_planet.teeth, g.ring.teeth)
     lines = ["| condition | carrier n_c | output power P | sun | f_c | f_m = z_r f_c | sun torque T_s (forward) |",
@@ -212,8 +212,6 @@ def _derived(params) -> list[str]:
 
 
 def _oil_grades() -> list[str]:
-    from .presets import OIL_GRADES
-
     lines = ["| grade | viscosity at 40 °C | at 100 °C | source |", "|---|---|---|---|"]
     for name, d in OIL_GRADES.items():
         v40, v100 = d["viscosity_40"], d["viscosity_100"]
@@ -241,10 +239,6 @@ model: [`model.md`](model.md)."""
 
 def reference_markdown() -> str:
     """The whole reference (``docs/parameters.md``) of the reference machine at its defaults."""
-    import warnings
-
-    from .presets import reference_bearing_rig, reference_dpgt
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")          # the reference design's two known tip-circle warnings
         params = reference_dpgt()

@@ -17,6 +17,7 @@ contact (4.083 for Z = 12 with a roller on the load line), larger with clearance
 from __future__ import annotations
 
 import dataclasses
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,6 +31,7 @@ from .bearing import BearingHandles, add_planet_bearing
 from .families import FAMILY
 from .outputs import pin_reactions
 from .params import BearingParams, BearingRigParams, BearingRigSI, BearingSI, LubricantParams, LubricantSI
+from .presets import reference_bearing_rig
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError
 
@@ -215,7 +217,6 @@ def _rig_inputs(bearing, lubricant, rig) -> tuple[BearingSI, LubricantSI | None,
     if lubricant is not None and not isinstance(lubricant, LubricantSI):
         raise ParameterError.at("lubricant", f"expected LubricantParams or None, got {type(lubricant).__name__}")
     if rig is None:
-        from .presets import reference_bearing_rig
         rig = reference_bearing_rig()
     if not isinstance(rig, BearingRigParams):
         raise ParameterError.at("rig", f"expected BearingRigParams, got {type(rig).__name__}")
@@ -369,7 +370,6 @@ def rig_static_solution(built: BearingRigScene, *, t_settle: float | None = None
 
     Defaults: t_settle = ``built.t_settle``, window = 10 periods of the ring's radial mode, ``samples``
     equally spaced samples in it; ``controller`` Adaptive (h0 = 1 µs, h_max = period/20)."""
-    import time
     F, a, Z = built.radial_load, built.load_angle, built.bearing.rollers
     t_settle = built.t_settle if t_settle is None else float(t_settle)
     window = 10.0 * built.period if window is None else float(window)

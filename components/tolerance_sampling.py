@@ -32,6 +32,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.stats import norm, qmc
 
 from .tolerances import radial_runout
 from .units import ParameterError
@@ -116,8 +117,6 @@ def coordinates(N: int, Z: int) -> list[str]:
 def sobol_points(n: int, d: int, seed: int) -> np.ndarray:
     """(n, d) points of the unit cube: the first n of the scrambled Sobol sequence of ``seed`` (drawn as a power of
     two, so its balance holds and any n keeps the same first points)."""
-    from scipy.stats import qmc
-
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise ParameterError.at("samples", f"must be a whole number >= 1, got {n!r}")
     m = max(0, math.ceil(math.log2(n)))
@@ -141,8 +140,6 @@ def draw_errors(si, spec: ToleranceSpec, u, tooth_seed: int) -> tuple[dict, dict
     lengths as strings with their unit: plain data for any worker), ``drawn`` the drawn values by name for a table
     (µm, degrees). ``si``: the nominal machine's SI parameters; ``u``: its point of the unit cube
     (:func:`coordinates` order)."""
-    from scipy.stats import norm
-
     N, Z = si.layout.planets, si.bearing.rollers
     names = coordinates(N, Z)
     u = np.asarray(u, float)

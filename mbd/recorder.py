@@ -24,6 +24,7 @@ Layout of the file (every variable and coordinate carries CF-style ``units`` and
 from __future__ import annotations
 
 import contextlib
+import io
 import json
 import os
 import shutil
@@ -313,7 +314,6 @@ class Recorder:
         arrays = {"time": np.array(self._times)}
         for k, lst in self._buf.items():
             arrays[k] = np.stack(lst)
-        import io
         bio = io.BytesIO()
         np.savez(bio, **{f"v{i}": a for i, a in enumerate(arrays.values())}, names=np.array(list(arrays)))
         atomic_write_bytes(self.parts / f"chunk_{self.n_chunks:06d}.npz", bio.getvalue())
@@ -360,6 +360,7 @@ class Recorder:
         return self.path
 
     def _write(self, tmp: Path, total: int, allattrs: dict) -> None:
+        # deferred: HDF5 (≈ 0.1 s) only when results.nc is written, not in every `import mbd`
         import h5netcdf
         import h5py
 

@@ -31,7 +31,7 @@ class FirstOrderSystem:
         self.evaluator, self.engine = self.system, "numpy"
         if engine != "numpy":
             try:
-                from .compiled.system import CompiledSystem
+                from .compiled.system import CompiledSystem  # deferred: numba kernels, optional (numpy falls back)
                 self.evaluator, self.engine = CompiledSystem(self.system), "compiled"
                 self.evaluator.set_internal(self.z)
             except (ImportError, NotImplementedError):

@@ -25,6 +25,7 @@ from .hht import HHT, NewtonCache, StepInfo
 from .model import Model, State
 from .protocols import Controller, Observer, Recorder, require
 from .recorder import atomic_write_bytes
+from .settings import PRODUCTION
 
 __all__ = ["simulate", "SimResult", "Checkpoint", "Counters", "TimeMean", "save_state", "load_state",
            "output_evaluator"]
@@ -162,7 +163,6 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
         raise ModelError("simulate: pass controller=FixedStep(h) or Adaptive(h0=..., ...)")
     observers = _check_arguments(controller, recorder, observers)
     if stepper is None:
-        from .settings import PRODUCTION
         stepper = PRODUCTION.stepper()
     system = system or System(model)
     runner, engine, engine_note = _engine(engine, system, stepper, controller)
@@ -232,7 +232,7 @@ def _engine(engine: str, system: System, stepper, controller):
     if engine == "numpy":
         return None, "numpy", None
     try:
-        from .compiled.runner import CompiledRunner
+        from .compiled.runner import CompiledRunner  # deferred: numba kernels, optional (numpy falls back)
         return CompiledRunner(system, stepper, controller), "compiled", None
     except (ImportError, NotImplementedError) as exc:
         if engine == "compiled":
@@ -253,7 +253,7 @@ def output_evaluator(system: System, engine: str = "auto"):
     if engine == "numpy":
         return system
     try:
-        from .compiled.outputs import CompiledOutputs
+        from .compiled.outputs import CompiledOutputs  # deferred: numba kernels, optional (numpy falls back)
     except ImportError as exc:
         if engine == "compiled":
             raise ModelError(f"output_evaluator: the compiled outputs cannot run: {exc}") from None
@@ -435,7 +435,7 @@ class _Progress:
                     print(f"simulating: t = {t:.4g} of {self.t_end:.4g} s, {self._steps / (now - self._start):.0f} "
                           f"steps/s, about {left:.0f} s left", file=sys.stderr, flush=True)
                 return
-            from tqdm.auto import tqdm
+            from tqdm.auto import tqdm  # deferred: ≈ 45 ms (probes Jupyter), only for a bar on a terminal
             self.bar = tqdm(total=self.total, unit="s", unit_scale=True, desc="simulating",
                             bar_format="{desc}: {percentage:3.0f}%|{bar}| t={n:.4g}/{total:.4g} s [{elapsed}<{remaining}{postfix}]")
         self.bar.update(t - self.t_last)

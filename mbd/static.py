@@ -286,7 +286,7 @@ def _evaluator(system: System, engine: str):
     if engine == "numpy":
         return system.evaluate
     try:
-        from .compiled.system import CompiledSystem
+        from .compiled.system import CompiledSystem  # deferred: numba kernels, optional (numpy falls back)
         cs = CompiledSystem(system)
     except (ImportError, NotImplementedError) as exc:
         if engine == "compiled":

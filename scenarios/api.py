@@ -7,7 +7,7 @@
     run.summary["outer"]["bearing_load_mean_N"]                    # summary.json (README: what it holds)
     ds = run.dataset()                                              # results.nc, opened with xarray
 
-The run is the one every study makes (:func:`scenarios.runner.run_case`: the production integrator, statistics
+The run is the one every study makes (:func:`scenarios.core.runner.run_case`: the production integrator, statistics
 on every accepted step, results.nc and summary.json written atomically, checkpoints, resume). A folder holding
 the finished run of the same parameters, settings and code is reused (``run.status == "reused"``); one holding
 results of other parameters is refused unless ``overwrite=True``.
@@ -20,7 +20,15 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-from components.results import Summary
+import mbd
+from components import faults
+from components.geometry import check_design
+from components.params import with_overrides
+from components.presets import load_toml, reference_dpgt
+from components.results import Summary, open_dataset
+from components.scene import SceneOptions
+
+from .core.runner import RunConfig, finished_run, run_case
 
 __all__ = ["Run", "run", "parameters"]
 
@@ -45,8 +53,6 @@ class Run:
 
     def dataset(self):
         """results.nc as an :class:`xarray.Dataset` (close it when done, or use it in a ``with``)."""
-        from components.results import open_dataset
-
         return open_dataset(self.results)
 
     def __repr__(self) -> str:
@@ -56,9 +62,6 @@ class Run:
 def parameters(condition: int = 3, direction: str = "forward", set: dict | None = None, params_file=None):
     """The reference machine at an operating condition (docs/parameters.md) and direction, with a TOML file's and then
     ``set``'s dotted overrides (the keys `dpgt params` lists): a :class:`components.params.DPGTParams`."""
-    from components.params import with_overrides
-    from components.presets import load_toml, reference_dpgt
-
     params = reference_dpgt(condition, direction)
     if params_file is not None:
         params = load_toml(params_file, base=params)
@@ -76,14 +79,6 @@ def run(params=None, out=None, *, condition: int = 3, direction: str = "forward"
     e.g. ``{"drag": False}``); ``integration``: :class:`mbd.IntegratorSettings` (default ``mbd.PRODUCTION``);
     ``sensor``: record what the housing accelerometer needs. The design is checked first (its warnings are
     Python warnings); bad parameters raise :class:`components.units.ParameterError`."""
-    import mbd
-    from components import faults
-    from components.geometry import check_design
-    from components.params import with_overrides
-    from components.scene import SceneOptions
-
-    from .runner import RunConfig, finished_run, run_case
-
     label = {}
     if params is None:
         params = parameters(condition, direction, set)

@@ -20,10 +20,16 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.params import overrides_from_toml, with_overrides
+from components.presets import reference_dpgt
 from components.results.io import atomic_write_text
-from . import args
-from .command import command
-from .runner import accuracy_line
+from components.rig import build_bearing_rig, discrete_load_distribution, rig_static_solution
+from components.scene import SceneOptions
+from components.units import ParameterError, quantity, to_si
+
+from .core import args
+from .core.command import command
+from .core.runner import accuracy_line
 
 ATOL = mbd.PRODUCTION.atol_pos     # the rig runs the production stepper (components.rig.rig_static_solution)
 
@@ -51,9 +57,6 @@ def parse_args(argv):
 
 
 def _file_overrides(path) -> dict:
-    from components.params import overrides_from_toml
-    from components.units import ParameterError
-
     try:
         return overrides_from_toml(Path(path).read_text(encoding="utf-8")) if path else {}
     except (ParameterError, ValueError) as exc:          # not TOML, not UTF-8
@@ -61,12 +64,6 @@ def _file_overrides(path) -> dict:
 
 
 def run(a) -> dict:
-    from components.params import with_overrides
-    from components.presets import reference_dpgt
-    from components.rig import build_bearing_rig, discrete_load_distribution, rig_static_solution
-    from components.scene import SceneOptions
-    from components.units import ParameterError, quantity, to_si
-
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     ov = {k: v for k, v in {"bearing.clearance": a.clearance, "bearing.rollers": a.rollers,
@@ -108,7 +105,7 @@ def run(a) -> dict:
                             "note": "rigid rings, discrete rollers, no centrifugal force or traction"},
     }
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
-    from viz import plots as vp
+    from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     fig = vp.load_distribution(sol.angles[order], {"simulated (time mean)": sol.loads[order]},
                                out / "load_distribution.png", zero="the load-zone centre",

@@ -11,8 +11,8 @@ import sys
 
 from components.names import did_you_mean
 
-from . import args
-from .command import command
+from .core import args
+from .core.command import command
 
 SCENARIOS = {
     "params": "every parameter key with its value, unit, source tag and meaning (--grep WORD)",
@@ -33,11 +33,19 @@ SCENARIOS = {
 }
 
 
+def module(name: str) -> str:
+    """The module whose ``main`` the command ``dpgt NAME`` runs: a numerics script's in scenarios.numerics (its
+    ``python -m scenarios.NAME`` is a shim importing the same ``main``), a study's scenarios.NAME."""
+    if name == "animate":
+        return "viz.cli"
+    numerics = f"scenarios.numerics.{name}"
+    return numerics if importlib.util.find_spec(numerics) is not None else f"scenarios.{name}"
+
+
 def available() -> dict[str, str]:
     out = {}
     for name, doc in SCENARIOS.items():
-        mod = "viz.cli" if name == "animate" else f"scenarios.{name}"
-        if importlib.util.find_spec(mod) is not None:
+        if importlib.util.find_spec(module(name)) is not None:
             out[name] = doc
     return out
 
@@ -54,7 +62,7 @@ def main(argv=None) -> int:
     if name not in have:
         print(f"dpgt: unknown scenario {name!r}{did_you_mean(name, have)}; available: {', '.join(have)}", file=sys.stderr)
         return 2
-    mod = importlib.import_module("viz.cli" if name == "animate" else f"scenarios.{name}")
+    mod = importlib.import_module(module(name))
     main = mod.main if hasattr(mod.main, "__wrapped__") else command(mod.main)   # viz's too: one-line errors
     with args.invoked_as("dpgt"):        # usage lines and examples say `dpgt NAME`
         return main(rest)

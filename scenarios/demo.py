@@ -9,7 +9,7 @@ from __future__ import annotations
 import sys
 
 from . import paper_study
-from .command import command
+from .core.command import command
 
 EXAMPLES = ["{prog}", "{prog} --out results/demo --workers 2", '{prog} --set bearing.clearance="30 um" --out results/demo_30um']
 

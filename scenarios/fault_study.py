@@ -29,17 +29,18 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.bearing import bearing_kinematics
 from components.names import did_you_mean
 from components.units import ParameterError
 from components.results.io import atomic_write_text
 
-from . import args
-from .command import command
-from .lock import holds_out_folder
-from .runner import RunConfig
-from .analysis import line_table
-from .study import Study, StudyRun
-from .sweep import Case, build_params, user_overrides
+from .core import args
+from .core.command import command
+from .core.lock import holds_out_folder
+from .core.runner import RunConfig
+from .core.analysis import amplitude_spectrum, line_table, sensor_signal, sideband_resolution
+from .core.study import Study, StudyRun
+from .core.sweep import Case, build_params, user_overrides
 
 __all__ = ["FAULTS", "main", "run", "characteristic_frequencies", "COLUMNS"]
 
@@ -139,8 +140,6 @@ def characteristic_frequencies(si) -> dict[str, float]:
     """[Hz] the frequencies faults excite, in the fixed frame: carrier f_c, mesh f_m, each gear's rotation
     relative to the carrier, and per bearing type the cage's revolution relative to the carrier and the
     roller-pass frequencies over the pin (Z·|ω_cage − ω_c|) and over the bore (Z·|ω_cage − ω_planet|)."""
-    from components.bearing import bearing_kinematics
-
     op, b = si.operating, si.bearing
     wc = op.carrier_speed
     hz = lambda w: abs(w) / (2 * np.pi)
@@ -172,8 +171,6 @@ def _own_frequency(case: Case, si, fr: dict) -> float | None:
 def sensor_spectrum(run_dir: Path, f_c: float):
     """(f, amplitude, why) of the recorded housing sensor of a run (scenarios.spectrum's definition); ``why`` says
     why its lines mean nothing (too few carrier revolutions), None when they do."""
-    from .analysis import amplitude_spectrum, sensor_signal, sideband_resolution
-
     t, x = sensor_signal(run_dir / "results.nc", f_c)
     f, amp, _ = amplitude_spectrum(t, x)
     return f, amp, sideband_resolution(t, f_c)
@@ -235,7 +232,7 @@ def write_tables(rows: list[dict], out: Path) -> list[Path]:
 
 def plots(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
     """loads.png and (with a perfect machine to compare against) spectra.png."""
-    from viz.plots import fault_loads, fault_spectra
+    from viz.plots import fault_loads, fault_spectra  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     files = [fault_loads(rows, out / "loads.png", title="What each fault does to the planet bearings (pair 1)")]
     panels = _spectrum_panels(spectra)
@@ -307,7 +304,7 @@ def _spectrum_panels(spectra: dict) -> list[tuple]:
 
 class FaultStudy(Study):
     """The perfect machine, each fault and each damaged machine in every direction
-    (:class:`scenarios.study.Study`): per damaged machine a line first, then the tables and the figures."""
+    (:class:`scenarios.core.study.Study`): per damaged machine a line first, then the tables and the figures."""
 
     def config(self) -> RunConfig:
         a = self.a

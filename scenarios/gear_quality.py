@@ -29,12 +29,12 @@ import numpy as np
 import mbd
 from components.results.io import atomic_write_text
 
-from . import args
-from .command import command
-from .lock import holds_out_folder
-from .runner import RunConfig
-from .study import Study, StudyRun
-from .sweep import OPERATING_AXES, Case, user_overrides
+from .core import args
+from .core.command import command
+from .core.lock import holds_out_folder
+from .core.runner import RunConfig
+from .core.study import Study, StudyRun
+from .core.sweep import OPERATING_AXES, Case, user_overrides
 
 __all__ = ["main", "run", "make_cases", "rows_of", "by_grade", "findings", "QUANTITIES", "MESHES"]
 
@@ -220,7 +220,7 @@ def write_tables(rows: list[dict], out: Path) -> list[Path]:
 
 def plot(rows: list[dict], out: Path) -> list[Path]:
     """quality.png."""
-    from viz.plots import gear_quality
+    from viz.plots import gear_quality  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     return [gear_quality(by_grade(rows), out / "quality.png",
                          title="Gear tooth quality (ISO 1328 flank class) against perfect teeth: planet bearings and the ring mesh")]
@@ -232,7 +232,7 @@ def write_outputs(rows: list[dict], out: Path) -> list[Path]:
 
 
 class GearQualityStudy(Study):
-    """Perfect teeth and every class × seed at every condition and direction (:class:`scenarios.study.Study`):
+    """Perfect teeth and every class × seed at every condition and direction (:class:`scenarios.core.study.Study`):
     the findings first, then the tables and the figure."""
 
     def config(self) -> RunConfig:

@@ -39,12 +39,12 @@ from components.units import ParameterError, quantity, to_si
 from mbd.elements.ehl import FILM_MIN_U_EXPONENT, thermal_factor
 from components.results.io import atomic_write_text
 
-from .runner import RunConfig
-from .study import Study, StudyRun
-from .sweep import OPERATING_AXES, Case, build_params, user_overrides
-from . import args
-from .command import command
-from .lock import holds_out_folder
+from .core.runner import RunConfig
+from .core.study import Study, StudyRun
+from .core.sweep import OPERATING_AXES, Case, build_params, user_overrides
+from .core import args
+from .core.command import command
+from .core.lock import holds_out_folder
 
 __all__ = ["main", "run", "LAMBDA_LEVELS", "SKID_PCT", "COLUMNS", "regime", "least_viscosity"]
 
@@ -219,7 +219,7 @@ def write_tables(rows: list[dict], out: Path) -> list[Path]:
 def plot(rows: list[dict], out: Path) -> list[Path]:
     """film_and_slip.png: Λ, film, cage slip and traction heat against the viscosity, a line per condition and
     direction (the conditions' own markers when there are several)."""
-    from viz.plots import against_viscosity
+    from viz.plots import against_viscosity  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     conds = sorted({r["condition"] for r in rows})
     series = {}
@@ -274,7 +274,7 @@ def write_outputs(rows: list[dict], out: Path) -> list[Path]:
 
 
 class LubricantStudy(Study):
-    """Every condition × direction × oil (:class:`scenarios.study.Study`): the answer first, then the tables and
+    """Every condition × direction × oil (:class:`scenarios.core.study.Study`): the answer first, then the tables and
     the figure."""
 
     def config(self) -> RunConfig:

@@ -23,9 +23,18 @@ from pathlib import Path
 
 import numpy as np
 
+import mbd
+from components.dpgt import build_dpgt
+from components.params import with_overrides
+from components.planetary import (EXAMPLE_PLANETARY, build_single_planetary, classify_modes, load_planetary_toml,
+                                  planetary_modes)
+from components.presets import reference_dpgt
 from components.results.io import atomic_write_text
-from . import args
-from .command import command
+from components.scene import SceneOptions
+from components.units import ParameterError
+
+from .core import args
+from .core.command import command
 
 
 EXAMPLES = ["{prog} --params my_planetary.toml --out results/modal", "{prog} --set planets=4",
@@ -55,9 +64,6 @@ def _multiplicity(groups, n):
 
 
 def planetary(a):
-    from components.planetary import EXAMPLE_PLANETARY, build_single_planetary, load_planetary_toml, planetary_modes
-    from components.units import ParameterError
-
     try:
         spec = load_planetary_toml(a.params, args.parse_sets(a.set)) if a.params else None
         built = build_single_planetary(spec if spec is not None else EXAMPLE_PLANETARY,
@@ -69,15 +75,6 @@ def planetary(a):
 
 
 def dpgt(a):
-    import mbd
-    from components.dpgt import build_dpgt
-    from components.planetary import classify_modes
-    from components.presets import reference_dpgt
-    from components.scene import SceneOptions
-
-    from components.params import with_overrides
-    from components.units import ParameterError
-
     if a.params:      # the file is a single planetary set's; the DPGT takes its own parameters through --set
         raise SystemExit(f"error: --params {a.params} describes a single planetary set; with --dpgt give DPGT "
                          "parameters with --set KEY=VALUE")
@@ -117,7 +114,7 @@ def run(a) -> dict:
     radius = 0.05
     scale = np.where(m.free % 3 == 2, radius, 1.0)[:, None]
     nz = np.flatnonzero(f > 0)
-    from viz import plots as vp
+    from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     fig = vp.mode_shapes(f[nz], (X[:, nz] * scale).T, labels, out / "mode_shapes.png", numbers=nz + 1,
                          title="Mode shapes (θ scaled by 50 mm; the rigid-body modes at 0 Hz left out)")

@@ -22,18 +22,20 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.families import MESH_FAMILY
 from components.static import DEFAULT_SNAPSHOTS
+from components.outputs import FAMILY, radial_tangential
 from components.outputs import relative_life as iso_relative_life
 from components.results import SUMMARY_WORDS, Summary, json_attr, open_run
 from components.results.io import atomic_write_text, write_summary
 
-from .integrity import read_summary
-from .runner import RunConfig
-from .study import Study, StudyRun
-from .sweep import OPERATING_AXES, Case, user_overrides
-from . import args
-from .command import command
-from .lock import holds_out_folder
+from .core.integrity import read_summary
+from .core.runner import RunConfig
+from .core.study import Study, StudyRun
+from .core.sweep import OPERATING_AXES, Case, user_overrides
+from .core import args
+from .core.command import command
+from .core.lock import holds_out_folder
 
 # the summary keys the comparison shows, with their units (words: components.results.SUMMARY_WORDS)
 QUANTITIES = [(k, SUMMARY_WORDS[k][1]) for k in (
@@ -217,9 +219,6 @@ def history_groups(runs: dict[str, Path]) -> dict[str, tuple[list, list[str]]]:
     """The time histories of one condition's runs in readable groups (:data:`HISTORY_GROUPS`): group -> (rows of
     :func:`viz.plots.time_history_group`, its columns). SI values from results.nc; the cage accelerations
     relative to the planet are split radial/tangential here (physics stays out of viz)."""
-    from components.families import MESH_FAMILY
-    from components.outputs import FAMILY, radial_tangential
-
     rows: dict[str, dict[tuple, dict]] = {g: {} for g in HISTORY_GROUPS}   # group -> (words, unit) -> col -> run
 
     def put(group, words, unit, col, run, t, y):
@@ -280,7 +279,7 @@ def history_groups(runs: dict[str, Path]) -> dict[str, tuple[list, list[str]]]:
 def headline_values(results: dict) -> dict[tuple, float | None]:
     """(quantity, condition, bearing, direction) -> value of :data:`viz.plots.HEADLINE_QUANTITIES`, from the runs
     that finished (a failed or missing run has no entry)."""
-    from viz.plots import HEADLINE_QUANTITIES
+    from viz.plots import HEADLINE_QUANTITIES  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     vals = {}
     for s in results.values():
@@ -293,6 +292,7 @@ def headline_values(results: dict) -> dict[tuple, float | None]:
 
 
 def plots(results: dict, out: Path) -> list[Path]:
+    # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
     from viz import plots as vp
     from viz.results import study_cage_pictures
 
@@ -338,7 +338,7 @@ def plots(results: dict, out: Path) -> list[Path]:
 
 def static_plots(results: dict, out: Path) -> list[Path]:
     """Static mode's figure: the headline (mean load and lives, forward vs reverse); the others need time series."""
-    from viz import plots as vp
+    from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     vals = headline_values(results)
     if not vals:
@@ -353,11 +353,11 @@ def static_plots(results: dict, out: Path) -> list[Path]:
 def animate(results: dict, out: Path) -> list[Path]:
     paths = []
     try:
-        from viz.results import study_cage_animation
+        from viz.results import study_cage_animation  # deferred: matplotlib and VTK (viz), only for --animate
     except ImportError as exc:   # pragma: no cover - viz integration missing
         print(f"animation skipped: {exc}")
         return paths
-    from viz.render_check import check_offscreen
+    from viz.render_check import check_offscreen  # deferred: matplotlib (viz), only for --animate
 
     ok, msg = check_offscreen()
     if not ok:
@@ -374,7 +374,7 @@ def animate(results: dict, out: Path) -> list[Path]:
 
 
 class PaperStudy(Study):
-    """Forward vs reverse per condition (:class:`scenarios.study.Study`): the comparison table first, then its
+    """Forward vs reverse per condition (:class:`scenarios.core.study.Study`): the comparison table first, then its
     files, the figures and (``--animate``) the cage-orbit animations. A run that fails now but finished before
     keeps its summary in the tables."""
 

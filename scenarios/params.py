@@ -17,8 +17,14 @@ import sys
 import warnings
 from pathlib import Path
 
-from . import args
-from .command import command
+from components.parameter_reference import reference_markdown
+from components.params import overrides_from_toml, parameter_rows, with_overrides
+from components.presets import reference_dpgt
+from components.results.io import atomic_write_text
+from components.units import ParameterError
+
+from .core import args
+from .core.command import command
 
 EXAMPLES = ["{prog}", "{prog} --grep clearance", "{prog} --grep bearing.cage --set bearing.cage.mass=\"0.05 kg\"",
             "{prog} --params my_machine.toml --grep user", "{prog} --reference"]
@@ -47,10 +53,6 @@ def parse_args(argv):
 def rows(a) -> list[dict[str, str]]:
     """The table's rows (:func:`components.params.parameter_rows`) of the machine the options describe, those
     matching ``--grep``."""
-    from components.params import overrides_from_toml, parameter_rows, with_overrides
-    from components.presets import reference_dpgt
-    from components.units import ParameterError
-
     try:
         from_file = overrides_from_toml(Path(a.params).read_text(encoding="utf-8")) if a.params else {}
     except (ParameterError, ValueError) as exc:           # not TOML, not UTF-8
@@ -82,9 +84,6 @@ def table(rs: list[dict[str, str]]) -> str:
 def main(argv=None) -> int:
     a = parse_args(sys.argv[1:] if argv is None else argv)
     if a.reference is not None:
-        from components.parameter_reference import reference_markdown
-        from components.results.io import atomic_write_text
-
         atomic_write_text(Path(a.reference), reference_markdown())
         print(f"written: {a.reference}")
         return 0

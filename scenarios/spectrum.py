@@ -39,15 +39,20 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.geometry import sideband_origin
+from components.params import flatten, overrides_from_toml, with_overrides
+from components.presets import reference_dpgt, typical_errors
+from components.results import open_dataset
 from components.sensor import PATHS as SENSOR_PATHS
 from components.results.io import atomic_write_text
+from components.units import ParameterError
 
-from .analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution
-from .analysis import whole_revolutions as _whole_revolutions
-from .plausibility import check_runs
-from .runner import RunConfig, finished_run, run_case, run_report
-from . import args
-from .command import command
+from .core.analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution
+from .core.analysis import whole_revolutions as _whole_revolutions
+from .core.plausibility import check_runs
+from .core.runner import RunConfig, finished_run, run_case, run_report
+from .core import args
+from .core.command import command
 
 SENSORS = {
     "housing": "housing accelerometer (docs/model.md §12): the sum of its mesh, torque and bearing paths, along the "
@@ -107,10 +112,6 @@ def machine(a):
     given (``--set errors.X`` / the TOML file), else the typical errors of ``--gear-grade``, none with
     ``--perfect``. The operating point belongs to this command's options: a file or ``--set`` that sets it is
     refused, as is ``--perfect`` with errors given."""
-    from components.params import overrides_from_toml, with_overrides
-    from components.presets import reference_dpgt, typical_errors
-    from components.units import ParameterError
-
     try:
         from_file = overrides_from_toml(Path(a.params).read_text(encoding="utf-8")) if a.params else {}
     except (ParameterError, ValueError) as exc:          # not TOML, not UTF-8, or a bad value
@@ -218,8 +219,6 @@ def _renamed(row: dict, names: dict) -> dict:
 def _as_text(params) -> dict:
     """{dotted key: value with its unit, as text} of a parameter group (a dimensionless one as its number's text):
     what the parameters say, with units, in summary.json."""
-    from components.params import flatten
-
     out = {}
     for k, v in flatten(params).items():
         if hasattr(v, "unitless"):               # a pint quantity (an angle keeps its degree)
@@ -231,8 +230,6 @@ def _as_text(params) -> dict:
 def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
     """Sample times and the signals of a run: "amplitude" (the sensor read), every path of the housing sensor
     and their sum, and the axis sensor's x and y."""
-    from components.results import open_dataset
-
     t, signals = sensor_paths(path)
     with open_dataset(path) as ds:
         acc = ds["fixed.acceleration"].values[:, list(ds["fixed.body"].values).index("carrier")]
@@ -245,8 +242,6 @@ def _lines(f, spectra, f_m, f_c, z_r: int, planets: int, sensor: str) -> list[di
     whether a perfect machine shows it to this sensor (:data:`SEEN`), and per path of the housing sensor (and
     their sum) its amplitude and amplitude over its own band median; ``carried_by``: the path with the largest
     amplitude at the line. ``spectra``: name -> (f, amplitude, df) with "amplitude" the sensor read."""
-    from components.geometry import sideband_origin
-
     ks = range(-SIDEBANDS, SIDEBANDS + 1)
     marks = {f"f_m{k:+d}f_c" if k else "f_m": f_m + k * f_c for k in ks}
     band = (f_m - (SIDEBANDS + 0.5) * f_c, f_m + (SIDEBANDS + 0.5) * f_c)
@@ -273,7 +268,7 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
 
 
 def _plot(f, spectra, f_m, f_c, s, sensor, out):
-    from viz import plots as vp
+    from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     shown = {"housing": ["housing", *SENSOR_PATHS], "axis": ["axis_x", "axis_y"]}.get(sensor, [sensor, "housing"])
     names = {"housing": "housing sensor", "mesh": "mesh path", "torque": "torque path", "bearing": "bearing path",

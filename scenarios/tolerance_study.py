@@ -31,6 +31,7 @@ import hashlib
 import io
 import json
 import math
+import os
 import sys
 import time
 import warnings
@@ -38,22 +39,25 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+from scipy.stats import bootstrap
+from tqdm.auto import tqdm
 
 import mbd
-from components.static import DEFAULT_SNAPSHOTS
+from components.dpgt import build_dpgt
+from components.static import DEFAULT_SNAPSHOTS, static_summary
 from components.tolerance_sampling import (DISTRIBUTIONS, TOLERANCE_DEFAULTS, ToleranceSpec, coordinates, draw_errors,
                                            sobol_points, teeth_seed)
-from components.units import ParameterError
+from components.units import ParameterError, quantity, to_si
 from components.results import Summary
 from components.results.io import atomic_write_text
 
-from . import args
-from .command import command
-from .integrity import OtherResults, read_summary
-from .lock import holds_out_folder
-from .runner import RunConfig, code_digest
-from .study import Study, StudyRun
-from .sweep import OPERATING_AXES, Case, build_params, dask_client, user_overrides, validate_cases
+from .core import args
+from .core.command import command
+from .core.integrity import OtherResults, read_summary
+from .core.lock import holds_out_folder
+from .core.runner import RunConfig, code_digest
+from .core.study import Study, StudyRun
+from .core.sweep import OPERATING_AXES, Case, build_params, dask_client, user_overrides, validate_cases
 
 __all__ = ["main", "run", "parse_args", "QUANTITIES", "MESHES", "quantities_of", "percentile_ci", "statistics",
            "agreement_rows", "sample_rows", "sample_columns", "answer", "StaticTask", "static_tasks", "solve_static_task"]
@@ -94,8 +98,6 @@ WRITES = ("static/class{C}/c{condition}_{direction}_t{torque}/sample_NNNN.json a
 # ---------------------------------------------------------------------------------------------------------------
 def _tolerance(text: str) -> float:
     """A tolerance: a length >= 0 with its unit -> m."""
-    from components.units import quantity, to_si
-
     try:
         x = to_si(quantity("value", text, "length"))
     except ParameterError as exc:
@@ -260,9 +262,6 @@ def solve_static_task(task: StaticTask) -> Summary:
     """Solve one machine (on whichever process) and write its result file atomically. A failure is written too
     (with its error): the solution is deterministic, so the same parameters and code fail again — a re-run does
     not try it again unless the code changed."""
-    from components.dpgt import build_dpgt
-    from components.static import static_summary
-
     asked, full = task.fingerprints()
     head = {"class": task.flank_class, "condition": task.case.condition, "direction": task.case.direction,
             "torque_fraction": task.torque, "sample": task.sample, "drawn": task.drawn,
@@ -328,10 +327,6 @@ def _earlier(tasks: list[StaticTask], overwrite: bool) -> tuple[dict, list[Stati
 def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None, progress: bool) -> dict:
     """{key: record} of ``todo`` solved in this process (one worker) or on Dask; a line every 10 s (or a bar on a
     terminal) says how far it is."""
-    import os
-
-    from tqdm.auto import tqdm
-
     out: dict = {}
     if not todo:
         return out
@@ -355,7 +350,7 @@ def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None
         for t in todo:
             took(solve_static_task(t))
     else:
-        from dask.distributed import as_completed
+        from dask.distributed import as_completed  # deferred: Dask (≈ 0.2–0.4 s) only when solving on it
 
         with dask_client(n, scheduler) as client:
             futs = []
@@ -376,8 +371,6 @@ def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None
 def percentile_ci(x, q: float | None, seed: int, resamples: int = BOOTSTRAP_RESAMPLES) -> dict:
     """{"value", "ci95"}: the mean (``q`` None) or the q-th percentile of ``x`` and its bootstrap 95 % interval
     (``scipy.stats.bootstrap``, percentile method); no interval from fewer than 2 distinct values."""
-    from scipy.stats import bootstrap
-
     x = np.asarray(x, float)
     x = x[np.isfinite(x)]
     if x.size == 0:
@@ -636,6 +629,7 @@ def answer(stats: list[dict], agree: list[dict], a_record: dict) -> str:
 # figures
 # ---------------------------------------------------------------------------------------------------------------
 def plots(records: dict, stats: list[dict], out: Path) -> list[Path]:
+    # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
     from viz.plots import tolerance_against_torque, tolerance_distributions, tolerance_life_cdf
 
     groups = _groups(records)

@@ -96,7 +96,7 @@ def test_viz_reads_results_only_and_scenarios_build_without_viz():
         if mod.startswith("viz"):
             assert not [d for d in deps if d.split(".")[0] in ("mbd", "components", "scenarios")
                         and d not in {"components.names", *RESULTS_ENGINE_FREE}], (mod, deps)
-        if mod.startswith(("components", "mbd")) or mod == "scenarios.runner":
+        if mod.startswith(("components", "mbd")) or mod == "scenarios.core.runner":
             assert not [d for d in deps if d.startswith("viz")], (mod, deps)
 
 
@@ -274,21 +274,160 @@ def test_scene_touches_no_private_attribute_of_the_model_builder():
     assert {"_pose", "_mass", "_inertia"} <= builder        # what Scene used to write and read
 
 
+# scenarios/ in three kinds (issue 27 §5): the studies a user runs at the top of the package, beside the two entrances
+# (the console command, the Python entry point) and the shims that keep the numerics scripts' documented
+# `python -m scenarios.NAME`; the numerics and benchmark scripts in scenarios.numerics; the machinery they share in
+# scenarios.core. The kinds are read from the layout, so a new module is walled in by where it is put.
+ENTRANCES = {"scenarios", "scenarios.cli", "scenarios.api"}
+
+
+def scenario_kinds(graph: dict[str, set[str]]) -> dict[str, str]:
+    """scenarios module -> "core", "numerics", "shim" (a top-level module named as a numerics script), "entrance" or
+    "study"."""
+    kinds = {}
+    for mod in graph:
+        parts = mod.split(".")
+        if parts[0] != "scenarios":
+            continue
+        kinds[mod] = ("entrance" if mod in ENTRANCES else parts[1] if parts[1] in ("core", "numerics")
+                      else "shim" if f"scenarios.numerics.{parts[1]}" in graph else "study")
+    return kinds
+
+
 # the modules every scenario builds on; a scenario borrows nothing from another scenario (issue 24 §3)
-SCENARIO_INFRASTRUCTURE = {"scenarios", "scenarios.args", "scenarios.command", "scenarios.runner", "scenarios.sweep",
-                           "scenarios.study", "scenarios.integrity", "scenarios.lock", "scenarios.plausibility",
-                           "scenarios.analysis", "scenarios.numerics_common"}
+def scenario_infrastructure(graph: dict[str, set[str]]) -> set[str]:
+    return {"scenarios", "scenarios.numerics", "scenarios.numerics.common",
+            *(m for m, k in scenario_kinds(graph).items() if k == "core")}
 
 
 def test_no_scenario_borrows_from_another_scenario():
     """Shared helpers (--set parsing, scene switches, the reference HHT run, the housing sensor's signals) live in
     the infrastructure modules, not in the study that wrote them first; only the demo is another study (the paper
-    study with its own defaults)."""
+    study with its own defaults), and a shim is its numerics script's command."""
     graph = import_graph()
+    infrastructure = scenario_infrastructure(graph)
+    assert {"scenarios.core.args", "scenarios.core.runner", "scenarios.core.study"} <= infrastructure
+    shims = {(m, m.replace("scenarios.", "scenarios.numerics.", 1))
+             for m, k in scenario_kinds(graph).items() if k == "shim"}
     borrowed = {(mod, d) for mod, deps in graph.items() if mod.startswith("scenarios.")
-                and mod not in SCENARIO_INFRASTRUCTURE for d in deps
-                if d.startswith("scenarios.") and d not in SCENARIO_INFRASTRUCTURE}
-    assert borrowed <= {("scenarios.demo", "scenarios.paper_study")}, sorted(borrowed)
+                and mod not in infrastructure for d in deps
+                if d.startswith("scenarios.") and d not in infrastructure}
+    assert borrowed <= {("scenarios.demo", "scenarios.paper_study")} | shims, sorted(borrowed)
+
+
+# what each kind may import of the project: a study the machinery (and viz to draw), never a numerics script; the
+# machinery no command and no viz; a numerics script the machinery and its own package's common code, never a study;
+# an entrance the machinery (the console command finds the commands by name at run time; the package re-exports the
+# Python entry point); mbd and components nothing of scenarios. The packages scenarios and scenarios.numerics, which
+# every import of their modules passes through, are no wall's business.
+MAY_IMPORT = {"study": {"study", "core", "mbd", "components", "viz"}, "core": {"core", "mbd", "components"},
+              "numerics": {"numerics", "core", "mbd", "components", "viz"}, "entrance": {"entrance", "core", "mbd", "components"},
+              "mbd": {"mbd"}, "components": {"components", "mbd"}}
+
+
+def walls_broken(graph: dict[str, set[str]]) -> list[str]:
+    kinds = scenario_kinds(graph)
+    kind_of = lambda mod: kinds.get(mod, mod.split(".")[0])
+    bad = []
+    for mod, deps in graph.items():
+        kind = kind_of(mod)
+        if kind == "shim":       # exactly its numerics script
+            if deps != {mod.replace("scenarios.", "scenarios.numerics.", 1)}:
+                bad.append(f"{mod} (a shim) imports {sorted(deps)}")
+            continue
+        if kind in MAY_IMPORT:
+            bad += [f"{mod} ({kind}) imports {d} ({kind_of(d)})" for d in sorted(deps)
+                    if kind_of(d) not in MAY_IMPORT[kind] and d not in ("scenarios", "scenarios.numerics")]
+    return bad
+
+
+def test_scenarios_show_their_three_kinds_and_the_walls_between_them():
+    """The layout holds the studies at the top, the numerics scripts in scenarios.numerics and the shared machinery in
+    scenarios.core, and each kind imports only what MAY_IMPORT lets it (the walls are shown first to catch a study
+    importing a numerics script, the machinery importing a study, a numerics script a study, components the
+    machinery and a shim more than its script)."""
+    graph = import_graph()
+    kinds = scenario_kinds(graph)
+    by_kind = {k: sorted(m for m, kk in kinds.items() if kk == k) for k in ("study", "core", "numerics", "shim")}
+    assert {"scenarios.paper_study", "scenarios.demo", "scenarios.spectrum", "scenarios.params"} <= set(by_kind["study"])
+    assert {f"scenarios.core.{m}" for m in ("args", "command", "lock", "sweep", "runner", "study", "integrity",
+                                            "plausibility", "analysis")} <= set(by_kind["core"])
+    assert {f"scenarios.numerics.{m}" for m in ("benchmark", "bench_engine", "work_precision", "stability", "warm",
+                                                "common")} <= set(by_kind["numerics"])
+    assert not [m for m in by_kind["study"] + by_kind["core"] + by_kind["numerics"] if m.count(".") > 2]
+    broken = {"scenarios.paper_study": {"scenarios.numerics.common"}, "scenarios.core.sweep": {"scenarios.spectrum"},
+              "scenarios.numerics.stability": {"scenarios.fault_study"}, "components.outputs": {"scenarios.core.args"},
+              "scenarios.warm": {"scenarios.numerics.warm", "scenarios.core.args"}}
+    assert len(walls_broken({**graph, **{m: graph[m] | d for m, d in broken.items()}})) == len(broken)
+    assert not walls_broken(graph), "\n".join(walls_broken(graph))
+
+
+def test_every_numerics_script_has_its_command_and_every_shim_is_one_import():
+    """A numerics script with a ``main`` is run as ``python -m scenarios.NAME`` through a shim of that name, which
+    holds no code of its own (no second copy): its docstring, ``from .numerics.NAME import main`` and the
+    ``__main__`` guard."""
+    graph = import_graph()
+    kinds = scenario_kinds(graph)
+    scripts = {m.rsplit(".", 1)[1] for m, k in kinds.items() if k == "numerics" and m != "scenarios.numerics"
+               and "def main(" in (ROOT / (m.replace(".", "/") + ".py")).read_text(encoding="utf-8")}
+    shims = {m.rsplit(".", 1)[1] for m, k in kinds.items() if k == "shim"}
+    assert len(scripts) >= 9 and scripts == shims, (scripts ^ shims)
+    for name in shims:
+        body = ast.parse((ROOT / "scenarios" / f"{name}.py").read_text(encoding="utf-8")).body
+        assert isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant), name      # docstring
+        assert [ast.unparse(n) for n in body[1:]] == [
+            f"from .numerics.{name} import main", "if __name__ == '__main__':\n    raise SystemExit(main())"], name
+
+
+# a function-local import says why it is not at the top of its module (issue 27): it breaks an import cycle
+# ("# cycle: ..."), or it defers a heavy or optional import that a start-up path does not need ("# deferred: ...":
+# numba's kernels, VTK, Dask, matplotlib, xarray/HDF5, the runner in dpgt's start-up). The reason is on the import's
+# line, or on a comment line right above the block of imports it belongs to.
+LOCAL_IMPORT_REASON = re.compile(r"#\s*(?:deferred|cycle):\s*\S")
+_IMPORT_LINE = re.compile(r"\s*(?:from\s+\S+\s+import\s|import\s)")
+
+
+def local_imports_without_reason(source: str) -> list[str]:
+    """The function-local imports of a module's source that give no reason (their lines)."""
+    lines = source.splitlines()
+
+    def reasoned(lineno: int) -> bool:
+        if LOCAL_IMPORT_REASON.search(lines[lineno - 1]):
+            return True
+        above = lineno - 2
+        while above >= 0 and _IMPORT_LINE.match(lines[above]):          # the block of imports it belongs to
+            above -= 1
+        return above >= 0 and lines[above].lstrip().startswith("#") and bool(LOCAL_IMPORT_REASON.search(lines[above]))
+
+    bad = []
+
+    def visit(node, in_function: bool):
+        for child in ast.iter_child_nodes(node):
+            if in_function and isinstance(child, (ast.Import, ast.ImportFrom)) and not reasoned(child.lineno):
+                bad.append(lines[child.lineno - 1].strip())
+            visit(child, in_function or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)))
+
+    visit(ast.parse(source), False)
+    return bad
+
+
+def test_every_function_local_import_says_why_it_is_not_at_the_top():
+    """A module's imports are at its top; one inside a function carries its reason (LOCAL_IMPORT_REASON), so a new
+    one must say why. Shown first on a module written to break it: an untagged import inside a function (and in a
+    method) is caught; a tagged one, a tagged block and the module's own top-level and TYPE_CHECKING imports pass."""
+    probe = ("import os\nif TYPE_CHECKING:\n    import numpy\n"
+             "def f():\n    import json\n    from math import pi  # deferred: a reason\n"
+             "    # cycle: a.b imports this module\n    from a import b\n    from a import c\n    x = 1\n    import re\n"
+             "class C:\n    def g(self):\n        from pathlib import Path\n")
+    assert local_imports_without_reason(probe) == ["import json", "import re", "from pathlib import Path"]
+    bad = {}
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            found = local_imports_without_reason(path.read_text(encoding="utf-8"))
+            if found:
+                bad[str(path.relative_to(ROOT))] = found
+    assert not bad, "function-local imports without a '# deferred:' or '# cycle:' reason: " + "; ".join(
+        f"{f}: {', '.join(v)}" for f, v in bad.items())
 
 
 # what a clone does not have: the specification files the project was started from, which lived beside the
@@ -425,7 +564,7 @@ def _shipped_scenes():
     from components.rig import build_bearing_rig
     from components.scene import SceneOptions
     from scenarios.fault_study import FAULTS
-    from scenarios.stability import CASES, case_overrides
+    from scenarios.numerics.stability import CASES, case_overrides
 
     def dpgt(overrides=None, options=None, condition=3, direction="forward", strict=True):
         with warnings.catch_warnings():

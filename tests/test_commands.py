@@ -1,4 +1,4 @@
-"""How commands end (scenarios.command): one line and an exit code, a traceback only with --debug."""
+"""How commands end (scenarios.core.command): one line and an exit code, a traceback only with --debug."""
 from __future__ import annotations
 
 import pytest
@@ -6,7 +6,7 @@ import pytest
 import mbd
 from components.units import ParameterError
 from scenarios import cli, paper_study
-from scenarios.command import FAILED, INTERRUPTED, USAGE, command
+from scenarios.core.command import FAILED, INTERRUPTED, USAGE, command
 
 
 def _raising(exc):
@@ -46,8 +46,8 @@ def test_a_bad_condition_through_the_dpgt_command(tmp_path, capsys):
 def test_a_failed_rerun_keeps_the_finished_summaries_in_the_tables(tmp_path):
     import json
 
-    from scenarios.study import Study, StudyRun
-    from scenarios.sweep import Case, Outcome, Status
+    from scenarios.core.study import Study, StudyRun
+    from scenarios.core.sweep import Case, Outcome, Status
     good, damaged = tmp_path / "c4_forward", tmp_path / "c4_reverse"
     good.mkdir()
     damaged.mkdir()
@@ -208,7 +208,7 @@ def _help(name, capsys):
 
 @pytest.mark.parametrize("name", STUDIES)
 def test_every_study_takes_the_shared_options_with_one_help_text(name, capsys):
-    from scenarios.args import SHARED
+    from scenarios.core.args import SHARED
 
     text = _help(name, capsys)
     assert text.startswith(f"usage: dpgt {name} ")             # under the console command it names itself so
@@ -252,7 +252,7 @@ def test_bench_engine_says_once_in_one_line_what_falls_back_and_why(tmp_path, ca
     import json
 
     import mbd
-    from scenarios import bench_engine
+    from scenarios.numerics import bench_engine
 
     model, q0, v0 = bench_engine.ring_model(4)
     with pytest.raises(mbd.ModelError, match="Python callable of time"):     # the truth: it cannot be compiled
@@ -275,7 +275,7 @@ def test_bench_statistics_takes_one_condition_through_the_shared_grammar(capsys)
     """--conditions with one value (the studies' spelling), --condition still accepted; a list of two, a condition
     out of range and a bad window are one-line usage errors before anything runs; no advice about an --out it
     does not have."""
-    from scenarios import bench_statistics
+    from scenarios.numerics import bench_statistics
 
     assert bench_statistics.parse_args(["--conditions", "2"]).conditions == 2
     assert bench_statistics.parse_args(["--condition", "1"]).conditions == 1
@@ -342,7 +342,7 @@ def test_a_study_says_what_happens_and_marks_reused_runs(tmp_path, capsys):
     run taken from an earlier one is reported as reused, with the wall time of the run that made it."""
     import json
 
-    from scenarios.sweep import Status
+    from scenarios.core.sweep import Status
 
     r = paper_study.run(paper_study.parse_args([*TINY_STUDY, "--out", str(tmp_path)]))
     assert r["outcomes"]["c4_forward"].status is Status.FINISHED and not r["failed"]
@@ -366,8 +366,8 @@ def test_a_study_says_what_happens_and_marks_reused_runs(tmp_path, capsys):
 
 
 def test_a_failed_run_is_an_outcome_not_a_dict(tmp_path):
-    from scenarios.runner import RunConfig
-    from scenarios.sweep import Case, Status, sweep
+    from scenarios.core.runner import RunConfig
+    from scenarios.core.sweep import Case, Status, sweep
 
     bad = Case(4, "reverse", str(tmp_path / "bad"), {"bearing.rollers": 8, "gears.planets": 0})
     o = sweep([bad], RunConfig(settle=0.0005, window=0.0005, progress=False), workers=1, progress=False)["c4_reverse"]
@@ -395,7 +395,7 @@ def test_the_python_entry_point_runs_reuses_and_opens_a_run(tmp_path, capsys):
 def test_params_files_reach_every_case_of_the_studies_that_gained_them(tmp_path):
     """--params in the fault study (beside each machine's own file) and in the gear-quality study."""
     from scenarios import fault_study, gear_quality
-    from scenarios.sweep import build_params
+    from scenarios.core.sweep import build_params
 
     common, dent = tmp_path / "common.toml", tmp_path / "dent.toml"
     common.write_text('[bearing]\nclearance = "30 um"\n')

@@ -17,7 +17,7 @@ import pytest
 from components.outputs import DIMENSIONLESS_KEYS, SUMMARY_WORDS, UNIT_SUFFIXES, unit_of_key
 from components.params import with_overrides
 from components.presets import reference_dpgt
-from scenarios.runner import RunConfig, integration_record, run_case
+from scenarios.core.runner import RunConfig, integration_record, run_case
 
 README = Path(__file__).resolve().parent.parent / "README.md"
 

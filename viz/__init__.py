@@ -18,6 +18,6 @@ _LAZY = {"cage_orbit_animation", "train_animation"}
 
 def __getattr__(name: str):
     if name in _LAZY:
-        from . import animate
+        from . import animate  # deferred: pyvista/VTK only when an animation is made
         return getattr(animate, name)
     raise AttributeError(f"module 'viz' has no attribute {name!r}")

@@ -10,12 +10,18 @@ Inputs are plain numpy arrays in SI units; nothing here knows about the engine.
 from __future__ import annotations
 
 import math
+import sys
+import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+import imageio.v2 as iio2
 import numpy as np
 import pyvista as pv
+from PIL import Image
+from tqdm.auto import tqdm
 
+from .plots import display_unit
 from .render_check import require_offscreen
 
 pv.OFF_SCREEN = True  # before any plotter exists: never try to open a window
@@ -116,7 +122,6 @@ class _Writer:
         self._frames: list[np.ndarray] = []
         self._mp4 = None
         if not self._gif:
-            import imageio.v2 as iio2
             self._mp4 = iio2.get_writer(str(path), format="FFMPEG", mode="I", fps=self.fps,
                                         codec="libx264", pixelformat="yuv420p", quality=8,
                                         macro_block_size=2, ffmpeg_log_level="error")
@@ -148,8 +153,6 @@ def _write_gif(path: Path, frames: list[np.ndarray], fps: float) -> None:
     from eight frames spread over the film (these figures have few colours): mapping each frame to it is
     ≈ 20× faster than Pillow's per-frame median-cut quantisation (1.5 s instead of 20 s for 150 frames of
     1600×460) and keeps colours steady from frame to frame."""
-    from PIL import Image
-
     pick = np.unique(np.linspace(0, len(frames) - 1, 8).astype(int))
     palette = Image.fromarray(np.concatenate([frames[i] for i in pick], axis=0)).quantize(
         colors=255, method=Image.Quantize.FASTOCTREE)
@@ -255,8 +258,6 @@ class _Progress:
     PLAIN_EVERY = 10.0
 
     def __init__(self, total: int, path: Path, show: bool = True):
-        import sys
-        import time
         self.total, self.path, self.show, self.n = int(total), path, bool(show), 0
         self._time = time.perf_counter
         self._start = self._last = self._time()
@@ -264,7 +265,6 @@ class _Progress:
         if not self.show:
             return
         if sys.stderr.isatty():
-            from tqdm.auto import tqdm
             self.bar = tqdm(total=self.total, desc=f"animating {path.name}", unit="frame", leave=False)
         else:
             print(f"animating {path.name}: {self.total} frames", file=sys.stderr, flush=True)
@@ -278,7 +278,6 @@ class _Progress:
             return
         now = self._time()
         if now - self._last >= self.PLAIN_EVERY and self.n < self.total:
-            import sys
             self._last = now
             left = (self.total - self.n) * (now - self._start) / self.n
             print(f"animating {self.path.name}: frame {self.n} of {self.total}, about {left:.0f} s left",
@@ -287,7 +286,6 @@ class _Progress:
     def close(self) -> None:
         if not self.show:
             return
-        import sys
         if self.bar is not None:
             self.bar.close()
         print(f"animating {self.path.name}: {self.n} frames in {self._time() - self._start:.1f} s",
@@ -671,8 +669,6 @@ def force_colour_scale(forces_N, words: str) -> tuple[float, str, list[float], i
     """The colour bar of roller forces [N]: (factor to the unit shown — kN from 1 kN on, as the figures
     (:func:`viz.plots.display_unit`) —, the bar's title ``words (unit)``, colour limits in that unit from 0 (or a
     negative least force) to a round top, the number of labels that puts a label on every round step)."""
-    from .plots import display_unit
-
     f = np.asarray(forces_N, float)
     f = f[np.isfinite(f)]
     lo, hi = (min(0.0, float(f.min())), float(f.max())) if f.size else (0.0, 0.0)

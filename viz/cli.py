@@ -130,7 +130,7 @@ def main(argv=None) -> int:
     if not ok:
         return _fail(f"cannot render offscreen: {msg}")
 
-    from . import animate  # loads VTK
+    from . import animate  # deferred: pyvista/VTK only when an animation is made
     try:
         if args.kind == "cage":
             size = args.size or _DEFAULT_SIZE["cage-compare" if other else "cage"]

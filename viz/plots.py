@@ -9,14 +9,19 @@ every axis carries a unit in square brackets ("[–]" for dimensionless quantiti
 """
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import matplotlib as mpl
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection
+from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
-from matplotlib.ticker import FuncFormatter
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator
 
 __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution", "against_viscosity",
            "mode_shapes", "fault_spectra", "fault_loads", "FAULT_QUANTITIES", "gear_quality", "forward_reverse_headline",
@@ -253,7 +258,6 @@ def load_distribution(angles_rad, loads_N, path, *, title: str | None = None, ze
     as open markers, e.g. the classical discrete-roller solution. Each roller is a stem from the centre plus a
     marker; the envelope is closed around the bearing. The radial labels sit opposite the loaded rollers, where
     they collide with nothing."""
-    from matplotlib.ticker import MaxNLocator
 
     ang = np.asarray(angles_rad, float)
     curves = dict(loads_N) if isinstance(loads_N, Mapping) else {None: loads_N}
@@ -342,7 +346,6 @@ def mode_shapes(freqs_hz, shapes, labels: Sequence[str], path, *, max_modes: int
 def _plain_log(axis, decades: float = 2.0) -> None:
     """Tick labels of a log axis as plain numbers (0.3, 2, 40), not powers of ten; 1-2-3-5 ticks over a
     span of up to ``decades`` decades, one per decade beyond (they would crowd)."""
-    from matplotlib.ticker import LogLocator
     lo, hi = axis.get_view_interval()
     wide = lo > 0 and hi / lo > 10.0 ** decades
     axis.set_major_locator(LogLocator(subs=(1.0,) if wide else (1.0, 2.0, 3.0, 5.0)))
@@ -365,7 +368,6 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
     each inside its panel with its words (below the line where there is no room above it); names: oil name ->
     its viscosity [Pa·s], written under the bottom row's ticks at the oils. Bearings, directions and groups are
     read from the series' keys."""
-    from matplotlib.lines import Line2D
 
     bearings = sorted({k[1] for k in series})
     present = sorted({k[2] for k in series}, key=lambda d: {"forward": 0, "reverse": 1}.get(d, 2))
@@ -444,7 +446,6 @@ def fault_spectra(panels: Sequence[tuple], path, *, quantity: str = "sensor acce
     the mesh frequency, with its characteristic frequencies marked; one legend for the figure.
 
     panels: (title, freq_hz, amplitude, reference amplitude, marks {label: Hz}, (f_lo, f_hi))."""
-    from matplotlib.lines import Line2D
     shown = display_unit(unit)[1]
     with mpl.rc_context(STYLE):
         fig = Figure(figsize=(7.5, 2.4 * len(panels) + 0.9), layout="constrained")
@@ -605,7 +606,6 @@ def _ecdf(x) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _class_direction_legend(fig: Figure, classes: Sequence, directions: Sequence[str], extra=()) -> None:
-    from matplotlib.lines import Line2D
     handles = [Line2D([], [], color=_CLASS_COLORS[i % len(_CLASS_COLORS)], lw=2, label=f"ISO 1328 class {c}")
                for i, c in enumerate(classes)]
     handles += [Line2D([], [], color="#444444", ls=(FWD if d == "forward" else REV)["linestyle"], label=d)
@@ -620,7 +620,6 @@ def tolerance_distributions(dist: Mapping[tuple, Mapping[tuple, Sequence[float]]
     """The distribution of the mesh K_γ over the machines (empirical CDF, a step per machine): a panel per
     (condition, torque fraction), a colour per class, solid forward and dashed reverse; the rating tables' value
     and the P90 level dotted. ``dist``: {(condition, torque fraction): {(class, direction): K_γ values}}."""
-    from matplotlib.lines import Line2D
     conds = sorted({k[0] for k in dist})
     torques = sorted({k[1] for k in dist})
     classes = sorted({c for v in dist.values() for c, _ in v})
@@ -656,7 +655,6 @@ def tolerance_against_torque(bands: Mapping[tuple, Mapping[int, Sequence[tuple]]
     """The mesh K_γ against the output torque: the machines' median (line and markers) and the band up to their
     P90 (shaded, its edge thin), a panel per (condition, direction), a colour per class. ``bands``:
     {(condition, direction): {class: [(output torque N·m, P50, P90), ...]}}."""
-    from matplotlib.lines import Line2D
     conds = sorted({k[0] for k in bands})
     directions = [d for d in ("forward", "reverse") if any(k[1] == d for k in bands)]
     classes = sorted({c for v in bands.values() for c in v})
@@ -698,7 +696,6 @@ def tolerance_life_cdf(cdfs: Mapping[tuple, Mapping[tuple, tuple]], path, *, tit
     machine's (a dotted vertical line per direction, black forward, grey reverse): a row per (condition, bearing
     type), a column per life standard, a colour per class. ``cdfs``: {(condition, bearing type, standard):
     {(class, direction): (lives in h, the perfect machine's life in h)}}."""
-    from matplotlib.lines import Line2D
     rows = sorted({(k[0], k[1]) for k in cdfs})
     stds = sorted({k[2] for k in cdfs}, key=lambda s: "16281" in s)
     classes = sorted({c for v in cdfs.values() for c, _ in v})
@@ -760,7 +757,6 @@ def display_unit(unit: str | None, values=()) -> tuple[float, str]:
 
 
 def _wrap(text: str, width: int) -> str:
-    import textwrap
     return "\n".join(textwrap.wrap(text, width, break_long_words=False)) or text
 
 
@@ -779,8 +775,6 @@ def format_pct(p: float) -> str:
 
 def _direction_legend(fig: Figure, present: Sequence[str], *, hatch: bool = False) -> None:
     """One legend for the whole figure, above the panels, naming only the directions that were drawn."""
-    from matplotlib.patches import Patch
-    from matplotlib.lines import Line2D
     handles = []
     for d, st in (("forward", FWD), ("reverse", REV)):
         if d in present:
@@ -904,9 +898,6 @@ def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = Non
     panels: (label, t [s] (n,), offset of the cage centre from the bore centre [m] (n, 2), guide clearance
     C_g [m]) — the offset as :func:`viz.results.cage_orbits` gives it (carrier axes). A cage pressed into its
     land sits beyond the circle by the land contact's deflection."""
-    from matplotlib.collections import LineCollection
-    from matplotlib.colors import Normalize
-    from matplotlib.lines import Line2D
 
     if not panels:
         raise ValueError("panels is empty")

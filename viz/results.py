@@ -1,4 +1,4 @@
-"""Saved DPGT results (``results.nc`` of scenarios.runner) → the arrays the animations draw.
+"""Saved DPGT results (``results.nc`` of scenarios.core.runner) → the arrays the animations draw.
 
 :func:`load_run` reads one results file (or a run directory holding ``results.nc``) into a :class:`Run`:
 times, body names, body motion in the reference frame R, the fixed-frame motion of sun/carrier/ring,
@@ -23,6 +23,8 @@ engine): it imports neither mbd nor the rest of components — only numpy, xarra
 from __future__ import annotations
 
 import json
+import keyword
+import re
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -31,6 +33,8 @@ from pathlib import Path
 import numpy as np
 
 from components.results import ResultsError, json_attr, open_dataset, results_path
+
+from .plots import cage_orbit_picture
 
 __all__ = ["ResultsError", "GeometryWarning", "Run", "load_run", "attribute_name", "attribute_names", "open_results", "cage_orbits", "roller_offsets", "train_bodies", "study_cage_animation",
            "study_cage_pictures",
@@ -147,7 +151,7 @@ def _pose(ds, probe: str, linear: str, angular: str) -> np.ndarray | None:
 
 
 def load_run(path, fallback_geometry: Mapping | None = None) -> Run:
-    """Read a DPGT results file (netCDF4 written by scenarios.runner) or a run directory holding one.
+    """Read a DPGT results file (netCDF4 written by scenarios.core.runner) or a run directory holding one.
 
     ``fallback_geometry`` (the layout of :func:`components.results.schema.drawing_geometry`) supplies
     whatever drawing geometry the file lacks; it is checked against the recorded motion.
@@ -220,9 +224,6 @@ def attribute_name(name: str) -> str:
     """The name :func:`attribute_names` gives a results.nc variable, coordinate or dimension: every character that
     cannot stand in a Python identifier becomes "_" ("race_inner.load" → "race_inner_load", "motion.body" →
     "motion_body", "bearing.load_radial.instance" → "bearing_load_radial_instance")."""
-    import keyword
-    import re
-
     out = re.sub(r"\W", "_", str(name))
     if not out or out[0].isdigit():
         out = "v_" + out
@@ -236,7 +237,7 @@ def attribute_names(ds):
     each renamed variable keeps its name in the file as ``attrs["results_name"]``, and the dataset the whole
     mapping as ``attrs["results_names"]`` (JSON, new → file name). Raises :class:`ResultsError` if two names would
     meet or a name would hide behind a Dataset attribute (``ds.mean``)."""
-    import xarray as xr
+    import xarray as xr  # deferred: ≈ 0.4 s; ds comes from xarray, `dpgt animate` need not pay for it
 
     names = list(dict.fromkeys([*ds.variables, *ds.dims]))
     mapping = {n: attribute_name(n) for n in names if attribute_name(n) != n}
@@ -559,7 +560,7 @@ def study_cage_animation(run_fwd_path, run_rev_path, out_path, *, pair: int = 0,
     args = cage_panels([fwd, rev], pair=pair, rollers=rollers)
     if title is None:
         title = f"Cage orbits in the guide clearance, planet pair {pair + 1}, carrier {_rpm(fwd)}"
-    from .animate import cage_orbit_animation  # loads VTK: only when rendering
+    from .animate import cage_orbit_animation  # deferred: pyvista/VTK only when an animation is made
     return cage_orbit_animation(out_path, args["t"], args["orbits"], args["clearance_m"],
                                 magnify=magnify, rollers=args["rollers"], fps=fps, size=size,
                                 title=title, max_frames=max_frames)
@@ -571,8 +572,6 @@ def study_cage_pictures(runs: Mapping[str, object], out_dir, *, pair: int = 0, p
     in ``out_dir``): a panel per run (label -> results file, run directory or :class:`Run`, e.g. forward and
     reverse) with the guide clearance circle and the cage centre's trail coloured by time
     (:func:`viz.plots.cage_orbit_picture`). Runs without a cage are left out; no runs with one: no picture."""
-    from .plots import cage_orbit_picture
-
     loaded = {label: _as_run(r) for label, r in runs.items()}
     paths = []
     for kind in ("inner", "outer"):

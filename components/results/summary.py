@@ -108,7 +108,7 @@ SUMMARY_WORDS = {
 
 # numeric summary keys without a unit (counts, ratios, factors, signs): the only ones without a UNIT_SUFFIXES suffix
 DIMENSIONLESS_KEYS = frozenset(k for k, (_, unit) in SUMMARY_WORDS.items() if unit == "1") | {
-    # what the runner adds (scenarios.runner): counts and the error estimate in units of the tolerance
+    # what the runner adds (scenarios.core.runner): counts and the error estimate in units of the tolerance
     "condition", "planets", "rollers", "rows", "samples", "steps", "rejected_steps", "newton_per_step",
     "error_estimate.rms", "error_estimate.max", "integration.alpha"}
 

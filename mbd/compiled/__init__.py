@@ -30,6 +30,8 @@ import hashlib as _hashlib
 import os as _os
 from pathlib import Path as _Path
 
+from numba import config as _numba_config
+
 
 def _drop_stale_kernels() -> None:
     """numba's disk cache keys a function on its own source file only: a kernel compiled into the
@@ -39,8 +41,7 @@ def _drop_stale_kernels() -> None:
     here = _Path(__file__).resolve().parent
     sources = sorted(here.glob("*.py")) + [here.parent / "rules.py", here.parent / "elements" / "ehl.py"]
     digest = _hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()
-    from numba import config
-    roots = [_Path(config.CACHE_DIR)] if config.CACHE_DIR else [here / "__pycache__", here.parent / "__pycache__"]
+    roots = [_Path(_numba_config.CACHE_DIR)] if _numba_config.CACHE_DIR else [here / "__pycache__", here.parent / "__pycache__"]
     stamp = roots[0] / "compiled_sources.sha256"
     try:
         if stamp.is_file() and stamp.read_text().strip() == digest:
@@ -63,9 +64,8 @@ def kernels_cached(function: str = "stepper.advance") -> bool:
     """Does numba's disk cache hold the compiled ``function`` ("module.name" in this package; by default the step
     loop) of this code, so that a run loads it in about a second instead of compiling it? Checked by its index
     file (:func:`_drop_stale_kernels` removes stale ones)."""
-    from numba import config
     here = _Path(__file__).resolve().parent
-    root = _Path(config.CACHE_DIR) if config.CACHE_DIR else here / "__pycache__"
+    root = _Path(_numba_config.CACHE_DIR) if _numba_config.CACHE_DIR else here / "__pycache__"
     return any(root.rglob(f"{function}-*.nbi")) if root.is_dir() else False
 
 

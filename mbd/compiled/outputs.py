@@ -14,6 +14,7 @@ from numba import njit
 
 from ..assembly import System
 from .registry import OUTPUT_NAMES, kind_of, outputs_kind
+from .. import compiled as _compiled     # kernels_cached is read through the package when called
 
 __all__ = ["CompiledOutputs", "family_outputs"]
 
@@ -62,11 +63,10 @@ class CompiledOutputs:
     def _compile(self) -> None:
         """Compile (or load) the kernels now, on an empty block: a run that must compile them says so before its
         first step, as the engine does (:class:`.runner.CompiledRunner`)."""
-        from . import kernels_cached
 
         if not self._compiled:
             return
-        cold = not kernels_cached("outputs.family_outputs")
+        cold = not _compiled.kernels_cached("outputs.family_outputs")
         if cold:
             print("mbd: compiling the element output kernels (the first run of this code on this machine; about "
                   "10 s, then cached)", file=sys.stderr, flush=True)

@@ -13,6 +13,7 @@ from ..assembly import System
 from ..control import Adaptive, FixedStep
 from ..hht import HHT, StepInfo
 from ..model import State
+from .. import compiled as _compiled     # kernels_cached is read through the package when called
 from .sparse_lu import FixedPatternLU
 from .stepper import FAIL_REASONS, advance
 from .system import CompiledSystem
@@ -119,9 +120,7 @@ class CompiledRunner:
     def _compile(self) -> None:
         """Compile (or load) the step loop now, before any step: a progress bar's ETA then leaves the compile
         out, and a first run on a machine says what it is doing instead of looking stuck."""
-        from . import kernels_cached
-
-        cold = not kernels_cached()
+        cold = not _compiled.kernels_cached()
         if cold:
             print("mbd: compiling the engine's kernels (the first run of this code on this machine; about a "
                   "minute, then cached)", file=sys.stderr, flush=True)

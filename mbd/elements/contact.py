@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 import numpy as np
+from scipy.optimize import brentq
 
 from .. import ad
 from . import ehl
@@ -61,8 +62,6 @@ def _restitution_lambda_one(e: float) -> float:
     Root of h(λ) = g(λ)/λ², g the residual: h(0) = (e² − 1)/2 < 0 and h → +∞ as λ → 1/e. Near λ = 0
     h is summed from its series Σ_{k≥2} λ^(k−2)(e^k − (−1)^k)/k (no cancellation as e → 1); the unknown is
     y = −ln(1 − λe) ∈ (0, ∞), which keeps λ → 1/e resolvable for small e."""
-    from scipy.optimize import brentq
-
     k = np.arange(2, 40)
     ck = np.where(k % 2 == 0, np.expm1(k * np.log(e)), e ** k + 1.0) / k
 

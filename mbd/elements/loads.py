@@ -6,6 +6,7 @@ from typing import Callable
 import numpy as np
 
 from ..element import Element, body_dofs
+from ..errors import ModelError
 
 
 class ForceSource(Element):
@@ -25,7 +26,6 @@ class ForceSource(Element):
         self.ramp = ramp
 
     def check(self):
-        from ..errors import ModelError
         if self.force is not None and not np.all(np.isfinite(self.force)):
             raise ModelError(f"{self.name}: force must be finite [N], got {self.force!r}")
 

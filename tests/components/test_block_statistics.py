@@ -149,7 +149,7 @@ def test_a_block_is_recorded_as_its_steps_are(tmp_path):
     same sample times), for the study's probes (bodies in both frames, element outputs with films, the
     bearing-load and cage-slip series, the housing loads) and samples falling anywhere in the steps."""
     import xarray as xr
-    from scenarios.runner import _probes
+    from scenarios.core.runner import _probes
 
     bs = build(faulty_machine())
     blocks = []

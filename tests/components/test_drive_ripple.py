@@ -18,7 +18,7 @@ from components.units import ParameterError
 from mbd.compiled import generic
 from mbd.element import evaluate
 from mbd.elements import SpeedDrive
-from scenarios.runner import RunConfig, run_case
+from scenarios.core.runner import RunConfig, run_case
 
 
 def _drive(params):

@@ -197,7 +197,7 @@ def _repeats(t, x, t_ref, x_ref, period):
 
 def _line(t, x, f0):
     """Amplitude of x(t) (resampled uniformly, Hann window) at f0."""
-    from scenarios.analysis import amplitude_spectrum
+    from scenarios.core.analysis import amplitude_spectrum
 
     tu = np.linspace(t[0], t[-1], 4096)
     f, a, _ = amplitude_spectrum(tu, np.interp(tu, t, x))

@@ -115,7 +115,7 @@ def test_ehl_traction_is_selectable_and_runs_on_the_rig():
     """bearing.traction_law = "ehl" builds the EHL law from the lubricant; a loaded rig runs with it on
     the compiled engine."""
     from mbd.elements import EHLTraction
-    from scenarios.numerics_common import rig_problem
+    from scenarios.numerics.common import rig_problem
     prob = rig_problem(overrides={"bearing.traction_law": "ehl"})
     law = prob.model.element("race_inner").traction
     lub = reference_dpgt(3, "forward").si().lubricant
@@ -157,7 +157,7 @@ def test_the_hydrodynamic_land_carries_the_cage_in_oil():
     engines) and the land's friction is the film's shear, Petroff's η v_t 2πRL/C up to the eccentricity
     factor 1/√(1−ε²)."""
     from mbd.elements import HydrodynamicLand
-    from scenarios.numerics_common import rig_problem
+    from scenarios.numerics.common import rig_problem
     prob = rig_problem(overrides={"bearing.cage.land_law": "hydrodynamic"})
     land = prob.model.element("guide").land
     assert isinstance(land, HydrodynamicLand)
@@ -222,7 +222,7 @@ def test_no_film_is_recorded_without_a_lubricant(loaded_state):
 @pytest.fixture(scope="module")
 def short_run(tmp_path_factory):
     """A 1 ms DPGT run (runner, reference oil): its results.nc and summary."""
-    from scenarios.runner import RunConfig, run_case
+    from scenarios.core.runner import RunConfig, run_case
     out = tmp_path_factory.mktemp("film_run")
     summary = run_case(reference_dpgt(3, "forward"), RunConfig(settle=0.0005, window=0.0005, progress=False), out)
     return out / "results.nc", summary
@@ -367,7 +367,7 @@ def test_pan_hamrock_crosses_its_own_films_at_heavy_load():
     """h_c/h_min = 1.705 G^(−0.098) W'^(−0.038) U^(−0.002) from the published exponents falls below 1 at
     W' = (1.705 G^(−0.098) U^(−0.002))^(1/0.038): ≈ 1.15e-3 for the reference oil (G = 5077) at U = 1.2e-10
     (condition 1). The run warns once, naming the bearing types, when its contacts get there."""
-    from scenarios.runner import validity_warnings
+    from scenarios.core.runner import validity_warnings
     R, eta, alpha = 3e-3, 0.0241, 2.2e-8
     G, U = alpha * E_STEEL, 1.2e-10
     u = U * E_STEEL * R / eta

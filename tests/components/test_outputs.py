@@ -12,7 +12,7 @@ import pytest
 import mbd
 from components.outputs import WindowStatistics, default_window
 from components.presets import reference_dpgt
-from scenarios.runner import RunConfig, run_case
+from scenarios.core.runner import RunConfig, run_case
 
 from tests.support import dpgt_runs
 from tests.support.dpgt_runs import CONTROLLER, build

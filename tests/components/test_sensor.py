@@ -20,8 +20,8 @@ from components.scene import SceneOptions
 from components.sensor import (HousingLoads, hann_window, housing_paths, mesh_path, mode_acceleration, rocking_lever,
                                sensor_axis, sensor_from_dict)
 from components.units import ParameterError
-from scenarios.analysis import amplitude_spectrum
-from scenarios.runner import RunConfig, run_case
+from scenarios.core.analysis import amplitude_spectrum
+from scenarios.core.runner import RunConfig, run_case
 from scenarios.spectrum import _whole_revolutions, sensor_paths
 
 from tests.support.dpgt_runs import build

@@ -11,7 +11,7 @@ import scipy.sparse.linalg as spla
 
 import mbd
 from mbd.hht import NewtonCache
-from scenarios.numerics_common import rig_problem
+from scenarios.numerics.common import rig_problem
 
 
 @pytest.mark.parametrize("h", [5e-6, 1e-5])

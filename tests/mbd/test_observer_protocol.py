@@ -129,7 +129,7 @@ def test_an_observer_of_blocks_only_is_refused_by_the_numpy_path_before_a_step()
 
 def test_the_engine_s_own_objects_satisfy_the_protocols_and_a_duck_typed_observer_runs():
     from components.outputs import WindowStatistics
-    from scenarios.numerics_common import StateSampler
+    from scenarios.numerics.common import StateSampler
 
     assert isinstance(mbd.FixedStep(1e-3), mbd.Controller) and isinstance(mbd.Adaptive(h0=1e-3), mbd.Controller)
     assert issubclass(mbd.Recorder, mbd.protocols.Recorder)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from components.presets import reference_dpgt
-from scenarios.runner import RunConfig, run_case
+from scenarios.core.runner import RunConfig, run_case
 
 
 @pytest.mark.slow

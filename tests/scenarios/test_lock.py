@@ -1,4 +1,4 @@
-"""One run per output folder (scenarios.lock): a second run refuses, a dead holder's lock is taken over."""
+"""One run per output folder (scenarios.core.lock): a second run refuses, a dead holder's lock is taken over."""
 from __future__ import annotations
 
 import json
@@ -9,7 +9,7 @@ import sys
 import pytest
 
 from scenarios import paper_study
-from scenarios.lock import LOCK_NAME, FolderLocked, folder_lock
+from scenarios.core.lock import LOCK_NAME, FolderLocked, folder_lock
 
 
 def _hold(folder, pid):

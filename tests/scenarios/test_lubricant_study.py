@@ -88,7 +88,7 @@ def test_a_thin_film_is_flagged_outside_the_ehl_laws_validity(study, capsys):
 
     from components.params import with_overrides
     from components.presets import reference_dpgt
-    from scenarios.runner import validity_warnings
+    from scenarios.core.runner import validity_warnings
 
     ehl = with_overrides(reference_dpgt(1), {"bearing.traction_law": "ehl"}).si()
     thin = {"inner": {"lambda_min": 0.32, "film_min_m": 4.8e-8}, "outer": {"lambda_min": 1.7, "film_min_m": 2.6e-7}}

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from components.presets import reference_dpgt
-from scenarios.analysis import MIN_REVOLUTIONS, sideband_resolution
+from scenarios.core.analysis import MIN_REVOLUTIONS, sideband_resolution
 from scenarios.fault_study import findings
-from scenarios.runner import SETTLED_SPEED_ERROR_PCT, RunConfig, run_case, statistics_warnings
+from scenarios.core.runner import SETTLED_SPEED_ERROR_PCT, RunConfig, run_case, statistics_warnings
 
 
 def _summary(revs=3.0, err=0.0, span=0.021):

@@ -8,8 +8,8 @@ import json
 import numpy as np
 import pytest
 
-from scenarios import benchmark, stability, work_precision
-from scenarios.numerics_common import StateSampler
+from scenarios.numerics import benchmark, stability, work_precision
+from scenarios.numerics.common import StateSampler
 
 
 def test_state_sampler_hermite_is_exact_for_cubics():

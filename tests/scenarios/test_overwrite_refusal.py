@@ -7,8 +7,8 @@ import pytest
 
 from components.params import with_overrides
 from components.presets import reference_dpgt
-from scenarios.integrity import OtherResults, differences
-from scenarios.runner import RunConfig, run_case
+from scenarios.core.integrity import OtherResults, differences
+from scenarios.core.runner import RunConfig, run_case
 
 
 def test_differences_lists_the_changed_keys_with_both_values():

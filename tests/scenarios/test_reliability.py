@@ -12,9 +12,9 @@ import pytest
 from components.dpgt import build_dpgt
 from components.presets import reference_dpgt
 from scenarios import paper_study
-from scenarios.integrity import DAMAGED, OtherResults, checkpoint_usable
-from scenarios.runner import RunConfig
-from scenarios.sweep import Case, _finished, build_params, check_folders, run_sweep
+from scenarios.core.integrity import DAMAGED, OtherResults, checkpoint_usable
+from scenarios.core.runner import RunConfig
+from scenarios.core.sweep import Case, _finished, build_params, check_folders, run_sweep
 
 CFG = RunConfig(settle=0.0005, window=0.0005, progress=False)
 TINY = ["--conditions", "4", "--directions", "forward", "--settle", "0.0005", "--window", "0.0005",
@@ -122,8 +122,8 @@ def _leftovers(folder):
 
 
 def test_disk_full_keeps_earlier_results_and_leaves_no_temporary_files(finished, tmp_path, monkeypatch, capsys):
-    from scenarios.command import FAILED, command
-    from scenarios.runner import run_case
+    from scenarios.core.command import FAILED, command
+    from scenarios.core.runner import run_case
 
     run = _copy(finished, tmp_path)
     before = {n: (run / n).read_bytes() for n in ("results.nc", "summary.json")}
@@ -145,7 +145,7 @@ def test_an_unwritable_output_folder_is_one_line(tmp_path, monkeypatch, capsys):
     import errno
     import os
 
-    from scenarios.command import FAILED, command
+    from scenarios.core.command import FAILED, command
     from mbd.recorder import atomic_write_text
 
     blocker = tmp_path / "a_file"
@@ -222,7 +222,7 @@ def test_an_interrupted_sweep_cancels_its_runs_and_stops_local_workers(scheduler
 
 
 def test_a_fixed_step_run_beyond_its_tolerance_warns(finished, tmp_path, capsys):
-    from scenarios.runner import FIXED_STEP_ERROR_FACTOR
+    from scenarios.core.runner import FIXED_STEP_ERROR_FACTOR
 
     # (the tiny run's start-up impacts also take Pan & Hamrock's film fit beyond its range: a validity warning)
     accuracy = lambda s: [w for w in s["warnings"] if "fixed step" in w]        # noqa: E731
@@ -241,7 +241,7 @@ def test_wall_time_of_a_resumed_run_counts_every_segment(tmp_path, monkeypatch):
     import time
 
     import mbd
-    from scenarios import runner
+    from scenarios.core import runner
 
     real = mbd.simulate
     calls = []
@@ -268,7 +268,7 @@ def test_wall_time_of_a_resumed_run_counts_every_segment(tmp_path, monkeypatch):
 
 
 def test_colliding_gears_are_refused_unless_forced(tmp_path, capsys):
-    from scenarios.plausibility import check_runs
+    from scenarios.core.plausibility import check_runs
 
     code = paper_study.main(TINY + ["--planets", "4", "--out", str(tmp_path)])      # 4 pairs do not fit
     err = capsys.readouterr().err
@@ -280,7 +280,7 @@ def test_colliding_gears_are_refused_unless_forced(tmp_path, capsys):
 
 
 def test_output_size_is_estimated_and_checked_before_starting(tmp_path, monkeypatch, capsys):
-    from scenarios import plausibility
+    from scenarios.core import plausibility
 
     # 1 GHz over 0.5 ms: 5e5 samples of every recorded value (12 rollers: ~2000), 8 bytes, twice while joined
     assert paper_study.main(TINY + ["--sample-rate", "1e9", "--out", str(tmp_path)]) == 2

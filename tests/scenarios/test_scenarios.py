@@ -155,8 +155,8 @@ def test_sweep_resume_skips_finished_runs(zero_power_study, capsys):
 
 
 def test_failing_run_is_reported_and_others_finish(tmp_path):
-    from scenarios.runner import RunConfig
-    from scenarios.sweep import Case, run_sweep
+    from scenarios.core.runner import RunConfig
+    from scenarios.core.sweep import Case, run_sweep
 
     cfg = RunConfig(settle=0.0005, window=0.0005, progress=False)
     good = Case(4, "forward", str(tmp_path / "good"), {"bearing.rollers": 8})
@@ -301,8 +301,8 @@ def test_stale_results_are_recomputed_not_reused(zero_power_study, tmp_path):
     fingerprint in summary.json decides (changing a parameter into the same folder recomputes, with --overwrite)."""
     from dataclasses import replace
 
-    from scenarios.runner import run_fingerprint
-    from scenarios.sweep import _case_cfg, _finished, build_params
+    from scenarios.core.runner import run_fingerprint
+    from scenarios.core.sweep import _case_cfg, _finished, build_params
 
     import shutil
 
@@ -319,7 +319,7 @@ def test_stale_results_are_recomputed_not_reused(zero_power_study, tmp_path):
     other = replace(case, overrides={**case.overrides, "bearing.rollers": "10"})
     assert _finished(other, build_params(other), cfg) is None
     # a checkpoint left by another run is not resumed: run_case starts afresh (and says so); the finished
-    # results of other parameters are replaced only when asked (--overwrite, scenarios.integrity)
+    # results of other parameters are replaced only when asked (--overwrite, scenarios.core.integrity)
     a2 = paper_study.parse_args(["--conditions", "4", "--directions", "forward", "--out", str(out), "--settle", "0.002",
                                  "--window", "0.001", "--set", "bearing.rollers=10", "--no-progress", "--workers", "1",
                                  "--overwrite"])

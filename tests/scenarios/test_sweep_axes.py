@@ -48,7 +48,7 @@ def test_other_overrides_still_pass(files, tmp_path):
     a = paper_study.parse_args(["--params", str(files["dent"]), "--set", "bearing.clearance=30 um", "--out",
                                 str(tmp_path / "o")])
     case = paper_study.make_cases(a, tmp_path / "o")[0]
-    from scenarios.sweep import build_params
+    from scenarios.core.sweep import build_params
     p = build_params(case)
     assert p.si().bearing.clearance == pytest.approx(30e-6) and p.si().errors.pinhole[0].tangential == pytest.approx(30e-6)
     assert p.si().operating.direction == case.direction

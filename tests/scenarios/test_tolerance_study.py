@@ -19,7 +19,7 @@ from components.tolerance_sampling import (RUNOUT_SIGMAS, ToleranceSpec, coordin
                                            sobol_points, teeth_seed)
 from components.tolerances import radial_runout
 from scenarios import cli, tolerance_study
-from scenarios.command import USAGE
+from scenarios.core.command import USAGE
 
 # no gravity and a mesh stiffness that does not vary along the mesh cycle: the three planets of a perfect machine are
 # then the same at every instant (the 120° symmetry), whatever the mesh phases of the sequentially phased meshes

@@ -1,7 +1,7 @@
 """viz.results and `dpgt animate`: saved DPGT results → cage orbits, train bodies, animations.
 
 One short forward and one short reverse DPGT run (1 ms simulated, 13 samples each) are made once per
-session with scenarios.runner.run_case; everything else reads their results files.  The derived
+session with scenarios.core.runner.run_case; everything else reads their results files.  The derived
 quantities are checked against independent outputs the engine recorded in the same file (guide
 eccentricity and force, pocket offset, inner-race deflection, fixed-frame poses).  Animations are tiny
 and skip, with the probe's reason, where this machine cannot render offscreen.
@@ -32,7 +32,7 @@ N_FRAMES = 5
 def _short_run(out_dir: Path, direction: str) -> Path:
     from components.presets import reference_dpgt
     from components.scene import SceneOptions
-    from scenarios.runner import RunConfig, run_case
+    from scenarios.core.runner import RunConfig, run_case
 
     run_case(reference_dpgt(3, direction),
              RunConfig(settle=0.0005, window=0.0005, progress=False, options=SceneOptions()), out_dir)

@@ -16,6 +16,12 @@ import tempfile
 import warnings
 from pathlib import Path
 
+import numpy as np
+
+import mbd
+from components.geometry import design_findings
+from mbd.recorder import Recorder
+
 __all__ = ["Implausible", "check_runs", "output_bytes", "MAX_OUTPUT_BYTES"]
 
 MAX_OUTPUT_BYTES = 5e9    # [assumed] more than 5 GB of histories is a mistaken --sample-rate, not a study
@@ -26,20 +32,13 @@ class Implausible(Exception):
 
 
 def _collisions(params) -> list[str]:
-    from components.geometry import design_findings
-
     return [str(f) for f in design_findings(params) if f.collides]
 
 
 def output_bytes(scene, window: float, sample_rate: float) -> float:
     """Peak disk use of one run's recording [bytes]: chunks and the results file both exist while it is
     joined. Values per sample from the recorder bound to the scene (the file's own layout)."""
-    import numpy as np
-
-    import mbd
-    from mbd.recorder import Recorder
-
-    from .runner import _probes
+    from .runner import _probes  # deferred: the runner (≈ 1 s, scene builders, outputs) stays out of dpgt's start-up
 
     with tempfile.TemporaryDirectory() as d:
         rec = Recorder(Path(d) / "probe.nc", dt=1.0 / sample_rate, probes=_probes(scene))
@@ -60,8 +59,8 @@ def _free(folder) -> float:
 def check_runs(runs, out, force: bool = False) -> list[str]:
     """``runs``: (label, params, RunConfig) of every run to start into ``out``. Raises :class:`Implausible`
     for colliding gears or too much output (unless ``force``); returns what ``force`` let through."""
+    # deferred: the scene builders and the runner (≈ 1 s) stay out of dpgt's start-up (command.py imports Implausible)
     from components.dpgt import build_dpgt
-
     from .runner import statistics_window
 
     problems, total, sizes = [], 0.0, {}

@@ -9,15 +9,15 @@ words in every study:
 1. every case's parameters converted and its design checked before anything runs (design warnings once);
 2. the recordings checked against the limit and the disk (``--force``), the folders against results of other
    parameters (``--overwrite``); then the study's own work before its sweep, if any (:meth:`Study.prepare`);
-3. the sweep (:func:`scenarios.sweep.sweep`): each case an :class:`~scenarios.sweep.Outcome`, finished, reused
+3. the sweep (:func:`scenarios.core.sweep.sweep`): each case an :class:`~scenarios.core.sweep.Outcome`, finished, reused
    or failed;
 4. the study's report: its headline table first, then one line per post-processing step (:meth:`StudyRun.step`:
    tables, figures, animation);
 5. the epilogue: each run's wall time and error estimate (a reused run marked "reused", with the wall time of
    the run that made it), its warnings, the failed runs, the files written.
 
-A new study writes those four methods and a parser (:func:`scenarios.args.parser` and
-:func:`scenarios.args.add_shared` for the shared options).
+A new study writes those four methods and a parser (:func:`scenarios.core.args.parser` and
+:func:`scenarios.core.args.add_shared` for the shared options).
 """
 from __future__ import annotations
 

@@ -31,9 +31,9 @@ import numpy as np
 import mbd
 from components.dpgt import build_dpgt
 from components.lubrication import BOUNDARY_LAMBDA
-from components.params import DPGTParams
+from components.params import DPGTParams, flatten
 from components.scene import SceneOptions
-from components.static import DEFAULT_SNAPSHOTS
+from components.static import DEFAULT_SNAPSHOTS, static_summary
 from mbd.recorder import BodyMotion, Recorder
 
 from components.outputs import BearingSeries, WindowStatistics, bearing_map, cage_period, default_window
@@ -53,7 +53,7 @@ __all__ = ["RunConfig", "run_case", "finished_run", "run_fingerprint", "paramete
 # docs/numerics.md) 2.7-7.0 x atol; h = 2 us 0.85 x; h = 10 us ("do not use") 33 x.
 FIXED_STEP_ERROR_FACTOR = 10.0
 
-_ROOT = Path(__file__).resolve().parent.parent
+_ROOT = Path(__file__).resolve().parents[2]      # the repository (this file: scenarios/core/runner.py)
 _CODE_DIGEST = None
 
 
@@ -63,7 +63,7 @@ def code_digest() -> str:
     if _CODE_DIGEST is None:
         h = hashlib.sha256()
         files = sorted([*(_ROOT / "mbd").rglob("*.py"), *(_ROOT / "components").rglob("*.py"),
-                        _ROOT / "scenarios" / "runner.py"])
+                        _ROOT / "scenarios" / "core" / "runner.py"])
         for f in files:
             h.update(str(f.relative_to(_ROOT)).encode())
             h.update(f.read_bytes())
@@ -94,8 +94,6 @@ def run_fingerprint(params: DPGTParams, cfg: "RunConfig") -> str:
 def run_description(params: DPGTParams, cfg: "RunConfig") -> dict[str, str]:
     """Every parameter (dotted key) and run setting as text: what summary.json keeps so that a refusal to replace
     a folder's results can name what differs."""
-    from components.params import flatten
-
     out = {k: str(v) for k, v in flatten(params).items()}
     out.update({f"settings.{k}": repr(v) for k, v in _settings(cfg).items()})
     return out
@@ -103,7 +101,7 @@ def run_description(params: DPGTParams, cfg: "RunConfig") -> dict[str, str]:
 
 def parameters_fingerprint(params: DPGTParams, cfg: "RunConfig") -> str:
     """Identifies what a user asked for: parameters and run settings, not the code (a folder holding results
-    of another one is refused unless --overwrite, :func:`scenarios.integrity.claim_folder`)."""
+    of another one is refused unless --overwrite, :func:`scenarios.core.integrity.claim_folder`)."""
     return _digest(params, cfg, code=False)
 
 
@@ -170,9 +168,9 @@ def finished_run(out_dir, params: DPGTParams, cfg: RunConfig) -> Summary | None:
 
 def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None, overwrite: bool = False) -> Summary:
     """Run one operating point; write results.nc and summary.json atomically into out_dir.
-    An interrupted run resumes from out_dir/checkpoint.npz. One run at a time per folder (scenarios.lock).
+    An interrupted run resumes from out_dir/checkpoint.npz. One run at a time per folder (scenarios.core.lock).
     A folder holding finished results of other parameters is refused unless ``overwrite``
-    (:func:`scenarios.integrity.claim_folder`); damaged files there are moved aside and recomputed."""
+    (:func:`scenarios.core.integrity.claim_folder`); damaged files there are moved aside and recomputed."""
     with folder_lock(out_dir):
         how = claim_folder(out_dir, parameters_fingerprint(params, cfg), run_fingerprint(params, cfg), overwrite,
                            description=run_description(params, cfg))
@@ -186,8 +184,6 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
 def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> Summary:
     """The quasi-static solution (:mod:`components.static`) of one operating point: summary.json in the dynamic
     run's keys, those only a dynamic run gives left out (listed in ``omitted``); no results.nc."""
-    from components.static import static_summary
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
         scene = build_dpgt(params, cfg.options)

@@ -16,14 +16,23 @@ import os
 import sys
 import time
 import traceback
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass, field, replace
 from enum import Enum
 from pathlib import Path
 
+from tqdm.auto import tqdm
+
+from components import faults
+from components.geometry import check_design
+from components.params import overrides_from_toml, with_overrides
+from components.presets import load_toml, reference_dpgt
 from components.results import Summary
 from components.results.io import atomic_write_text
+from components.units import ParameterError
 
 from .integrity import OtherResults, claim_folder, differences, read_summary
+from .runner import finished_run, parameters_fingerprint, run_case, run_description, run_fingerprint
 
 __all__ = ["Case", "Status", "Outcome", "sweep", "run_sweep", "execute_case", "check_folders", "user_overrides",
            "validate_cases", "dask_client", "OPERATING_AXES"]
@@ -96,9 +105,6 @@ def user_overrides(sets: dict, params_file: str | None, owned: dict[str, str], m
     naming the key, where it came from and the option to use. A file that is not UTF-8 TOML is a usage error
     naming the file. ``merge_file``: the file's overrides are returned too (under the ``--set`` ones), for a study
     whose cases carry their own files."""
-    from components.params import overrides_from_toml
-    from components.units import ParameterError
-
     from_file = {}
     if params_file:
         try:
@@ -118,12 +124,6 @@ def validate_cases(cases: list[Case], check=None) -> None:
     is checked (``check(case)``, optional, adds a study's own checks). A ParameterError ends the study with its
     one line; each distinct design warning (the reference machine's known tip-circle overlaps) is said once for
     the whole study, not once per run."""
-    import warnings
-
-    from components import faults
-    from components.geometry import check_design
-    from components.units import ParameterError
-
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -140,10 +140,6 @@ def validate_cases(cases: list[Case], check=None) -> None:
 
 
 def build_params(case: Case):
-    from components.params import with_overrides
-    from components.presets import load_toml
-    from components.presets import reference_dpgt
-
     base = reference_dpgt(case.condition, case.direction)
     if case.params_file:
         base = load_toml(case.params_file, base=base)
@@ -151,23 +147,18 @@ def build_params(case: Case):
 
 
 def _case_cfg(case: Case, cfg):
-    from dataclasses import replace as _replace
-    return cfg if case.window is None else _replace(cfg, window=case.window)
+    return cfg if case.window is None else replace(cfg, window=case.window)
 
 
 def _finished(case: Case, params, cfg) -> Summary | None:
     """The case's summary if it was finished from the same parameters, settings and code and its results.nc
-    is intact, else None (then recomputed, not reused; damaged files are moved aside, scenarios.integrity)."""
-    from .runner import finished_run
-
+    is intact, else None (then recomputed, not reused; damaged files are moved aside, scenarios.core.integrity)."""
     return finished_run(case.out_dir, params, cfg)
 
 
 def check_folders(cases: list[Case], cfg, overwrite: bool = False) -> None:
-    """Before any run starts: refuse (:class:`~scenarios.integrity.OtherResults`) when a case's folder holds
+    """Before any run starts: refuse (:class:`~scenarios.core.integrity.OtherResults`) when a case's folder holds
     finished results of other parameters or settings and ``overwrite`` is not given; list every such folder."""
-    from .runner import parameters_fingerprint, run_description, run_fingerprint
-
     others = []
     for c in cases:
         params, ccfg = build_params(c), _case_cfg(c, cfg)
@@ -191,8 +182,6 @@ def _is_finished(case: Case, cfg) -> bool:
 def execute_case(case: Case, cfg, overwrite: bool = False) -> Outcome:
     """Run one case (on whichever process), or reuse its finished results. Never raises: a failure is an
     :class:`Outcome` of status failed (and error.json in the case's folder)."""
-    from .runner import run_case
-
     out = Path(case.out_dir)
     try:
         params = build_params(case)
@@ -220,8 +209,6 @@ class _RunBars:
     """One bar per running case, fed from the progress.json each worker writes (simulated time)."""
 
     def __init__(self, cases, show):
-        from tqdm.auto import tqdm
-
         self.show = show
         self.bars = {}
         if show:
@@ -264,8 +251,6 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
     """Run every case; returns {label: :class:`Outcome`}. One case runs in-process (no cluster).
     ``overwrite``: replace finished results of other parameters (else :func:`check_folders` refuses);
     ``announce``: say first how many runs will run and how many are reused."""
-    from tqdm.auto import tqdm
-
     todo = [c for c in cases if not _is_finished(c, cfg)]
     if announce:
         print(f"runs: {len(todo)} to run, {len(cases) - len(todo)} reused (finished earlier with the same parameters, "
@@ -283,8 +268,6 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
             if plain:
                 print(f"runs: {i + 1}/{len(todo)} done ({c.label})", file=sys.stderr, flush=True)
         return results
-    from dataclasses import replace
-
     wcfg = replace(cfg, progress=False)   # per-run bars would interleave; the sweep bar shows progress
     futs = {}
     with dask_client(n_workers, scheduler) as client:
@@ -325,7 +308,7 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
 def dask_client(n_workers: int, scheduler: str | None = None):
     """A Dask client of the scheduler at ``scheduler``, or of a local cluster of ``n_workers`` single-threaded
     processes that stops with it (its workers with it)."""
-    from dask.distributed import Client, LocalCluster
+    from dask.distributed import Client, LocalCluster  # deferred: Dask (≈ 0.2–0.4 s) only when a sweep runs on it
 
     cluster = None
     if scheduler is None:

@@ -14,7 +14,10 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 from components.results import DamagedResults, Summary, count_samples, load_summary
+from mbd.simulate import load_state
 
 __all__ = ["OtherResults", "move_aside", "read_summary", "results_intact", "checkpoint_usable", "claim_folder", "differences",
            "DAMAGED"]
@@ -70,8 +73,6 @@ def results_intact(path, samples: int | None = None) -> bool:
 
 
 def _npz_loads(path) -> bool:
-    import numpy as np
-
     try:
         with np.load(path) as d:
             for k in d.files:
@@ -84,8 +85,6 @@ def _npz_loads(path) -> bool:
 def checkpoint_usable(ckpt, parts) -> bool:
     """Whether the checkpoint and the recorder chunks it relies on load. A damaged checkpoint is moved
     aside; a damaged chunk too, and with it the checkpoint (it cannot resume without the chunk's samples)."""
-    from mbd.simulate import load_state
-
     ckpt, parts = Path(ckpt), Path(parts)
     if not ckpt.exists():
         return False
@@ -110,7 +109,7 @@ def claim_folder(folder, parameters_fp: str, full_fp: str | None, overwrite: boo
     """Check that ``folder`` may take a run of these parameters: "new" (nothing finished there), "same"
     (finished from the same parameters and code), "recompute" (same parameters, other code) or "overwrite"
     (other parameters, ``overwrite`` given). Other parameters without ``overwrite``: :class:`OtherResults`,
-    naming what differs (``description``: the run's :func:`scenarios.runner.run_description`, against the one
+    naming what differs (``description``: the run's :func:`scenarios.core.runner.run_description`, against the one
     the finished summary keeps)."""
     s = read_summary(Path(folder) / "summary.json")
     if s is None:

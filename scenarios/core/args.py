@@ -1,7 +1,7 @@
 """Command-line arguments checked where they are read, before any simulation starts (issue 17).
 
 :class:`Parser` is argparse with one-line errors (``error: argument --window: must be > 0 s, got '-1'``,
-exit 2 through :func:`scenarios.command.command`). The ``type=`` callables below check one argument each
+exit 2 through :func:`scenarios.core.command.command`). The ``type=`` callables below check one argument each
 and say what is expected; every scenario's parser uses them, so a bad value never reaches a run.
 """
 from __future__ import annotations
@@ -10,9 +10,12 @@ import argparse
 import math
 import os
 import re
+import textwrap
 from pathlib import Path
 
 from components.names import argparse_hint, did_you_mean
+from components.scene import SceneOptions
+from components.units import ParameterError, quantity, to_si
 
 __all__ = ["Parser", "parser", "add_shared", "SHARED", "positive", "nonnegative", "count", "alpha", "conditions",
            "one_condition", "directions", "existing_file", "quantity_of", "key_value", "scheduler", "out_folder",
@@ -197,8 +200,6 @@ def existing_file(text):
 def quantity_of(dimension: str, positive_only: bool = False):
     """A quantity with its unit, e.g. "200 kW" (checked for its dimension; the string is passed on)."""
     def conv(text):
-        from components.units import ParameterError, quantity, to_si
-
         try:
             x = to_si(quantity("value", text, dimension))
         except ParameterError as exc:
@@ -314,8 +315,6 @@ def parser(name: str, doc: str, *, examples: list[str], writes: str, out: str | 
 
 
 def _wrap(text: str, width: int = 100) -> list[str]:
-    import textwrap
-
     return textwrap.wrap(" ".join(text.split()), width - 2)
 
 
@@ -347,6 +346,4 @@ def switch_value(v: str):
 
 def scene_options(items: list[str]):
     """``--option KEY=VALUE`` items -> :class:`components.scene.SceneOptions`."""
-    from components.scene import SceneOptions
-
     return SceneOptions.from_dict({k: switch_value(str(v)) for k, v in parse_sets(items).items()})

@@ -19,6 +19,10 @@
 from __future__ import annotations
 
 import dataclasses
+import hashlib
+import os
+import platform
+import resource
 import statistics
 import time
 import warnings
@@ -29,10 +33,14 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import mbd
+from mbd.compiled.system import CompiledSystem
 from mbd.recorder import hermite
+from components.dpgt import build_dpgt
+from components.geometry import design_findings
 from components.outputs import FAMILY, pin_reactions
 from components.params import with_overrides
 from components.presets import reference_dpgt
+from components.rig import build_bearing_rig
 
 __all__ = ["Problem", "dpgt_problem", "rig_problem", "settled_state", "StateSampler", "RunResult",
            "run_hht", "run_scipy", "observables", "error_metrics", "scipy_atol", "peak_rss_mb",
@@ -63,7 +71,6 @@ def dpgt_problem(condition: int = 3, direction: str = "forward", overrides: dict
     first inner planet's bearing, reference roller = its roller 0. ``strict=False`` builds a machine the
     design check refuses (e.g. overlapping planets: no planet–planet contact is modelled, so such a
     machine is non-physical, but its equations can still be integrated for cost and stability numbers)."""
-    from components.dpgt import build_dpgt
     params = with_overrides(reference_dpgt(condition, direction), overrides or {})
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # design warnings (tip overlap, N not assemblable) are known
@@ -79,7 +86,6 @@ def rig_problem(radial_load: float = 5000.0, overrides: dict | None = None, oute
     """One planet bearing on the rig: the reference bearing under ``radial_load`` [N] with the outer
     ring turning at the inner planet's speed relative to the carrier at condition 3 (the bearing's own
     operating point in the DPGT), lubricant drag on, cage free."""
-    from components.rig import build_bearing_rig
     params = with_overrides(reference_dpgt(3, "forward"), overrides or {})
     if outer_speed is None:
         op = params.si().operating
@@ -113,7 +119,6 @@ def settled_state(prob: Problem, cache: Path | None = None, h: float = 5e-6) -> 
 def model_fingerprint(model: mbd.Model) -> str:
     """Hash of the bodies and every element family's numeric parameters (a cached settled state is
     reused only for the same model: the builders change while the project evolves)."""
-    import hashlib
     h = hashlib.sha1()
     for a in (model.mass, model.inertia, model.pose0, model.mdiag, np.asarray(model.gravity)):
         h.update(np.ascontiguousarray(a, float).tobytes())
@@ -365,7 +370,6 @@ def error_metrics(obs: dict, ref: dict) -> dict:
 def eval_costs(model: mbd.Model, state: mbd.State, n: int = 200) -> dict:
     """Median wall time [s] of one residual and of one residual+Jacobian evaluation (batches of 20), on
     the numpy path (``residual_s``, ``jacobian_s``) and the compiled one (``compiled_…``), interleaved."""
-    from mbd.compiled.system import CompiledSystem
     system = mbd.System(model)
     paths = {"": system, "compiled_": CompiledSystem(system)}
     batches = {f"{p}{k}": [] for p in paths for k in ("residual_s", "jacobian_s")}
@@ -383,13 +387,10 @@ def eval_costs(model: mbd.Model, state: mbd.State, n: int = 200) -> dict:
 
 
 def peak_rss_mb() -> float:
-    import resource
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0   # Linux: kB
 
 
 def machine_note() -> str:
-    import os
-    import platform
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     return (f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
             f"numpy {np.__version__}; 1-min load average at start {load:.2f} (machine shared with other jobs)")
@@ -397,7 +398,6 @@ def machine_note() -> str:
 
 def load1() -> float:
     """1-min load average (nan where the OS has none)."""
-    import os
     return os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
 
 
@@ -407,7 +407,6 @@ def design_verdict(overrides: dict | None = None, condition: int = 3, direction:
     overlap — the check only warns, but such a machine cannot exist: no planet–planet contact is
     modelled, so its simulation is non-physical), ``assembly`` (a warning that equally spaced pairs
     do not assemble), and the messages."""
-    from components.geometry import design_findings
     params = with_overrides(reference_dpgt(condition, direction), overrides or {})
     found = design_findings(params)
     msgs = [f"{f.severity}: {' '.join(str(f).split())}" for f in found]

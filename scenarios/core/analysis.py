@@ -6,6 +6,10 @@ from pathlib import Path
 
 import numpy as np
 
+from components.families import MESH_FAMILY
+from components.results import json_attr, open_dataset
+from components.sensor import paths as sensor_path_signals, sensor_from_dict
+
 __all__ = ["amplitude_spectrum", "peak_table", "line_table", "sideband_resolution", "MIN_REVOLUTIONS",
            "sensor_paths", "sensor_signal", "whole_revolutions"]
 
@@ -97,10 +101,6 @@ def sensor_paths(path: Path, sensor=None) -> tuple[np.ndarray, dict]:
     :func:`components.sensor.paths` from the recorded outer planets' angles and ring-mesh forces and the loads on
     the housing. ``sensor`` (:class:`components.params.SensorSI`): the run's own (stored with it) unless given.
     The one place a run's file becomes the sensor's signals: the spectrum and the fault study read through it."""
-    from components.families import MESH_FAMILY
-    from components.results import json_attr, open_dataset
-    from components.sensor import paths, sensor_from_dict
-
     with open_dataset(path) as ds:
         if "housing.force_x" not in ds:
             raise ValueError(f"{path}: the run recorded no loads on the housing (run it with RunConfig(sensor=True))")
@@ -117,7 +117,7 @@ def sensor_paths(path: Path, sensor=None) -> tuple[np.ndarray, dict]:
         ring = np.stack([c * fx - s * fy, s * fx + c * fy], axis=-1)
         force = np.column_stack([ds["housing.force_x"].values.sum(axis=1), ds["housing.force_y"].values.sum(axis=1)])
         torque = ds["housing.torque"].values.sum(axis=1)
-        return t, paths(t, psi, ring, force, torque, sensor)
+        return t, sensor_path_signals(t, psi, ring, force, torque, sensor)
 
 
 def sensor_signal(path: Path, f_c: float, sensor: str = "housing") -> tuple[np.ndarray, np.ndarray]:

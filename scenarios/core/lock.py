@@ -3,6 +3,7 @@ with a clear message; a lock left by a process that no longer exists (on this ho
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import socket
@@ -63,8 +64,6 @@ def folder_lock(folder):
 
 def holds_out_folder(run):
     """A study's ``run(args)`` holding the lock of ``args.out`` throughout (one study per folder at a time)."""
-    import functools
-
     @functools.wraps(run)
     def locked(a):
         with folder_lock(a.out):
