@@ -559,7 +559,8 @@ def answer(stats: list[dict], agree: list[dict], a_record: dict) -> str:
                 sub = g.get("dynamic_subset")
                 if sub:
                     st, dy = sub[HEADLINE]["static"], sub[HEADLINE]["dynamic"]
-                    L.append(f"  - the {sub['samples']} machines also run dynamically: mesh K_γ mean {_ci(dy['mean'])}, "
+                    runs = "s also run" if sub["samples"] != 1 else " also runs"
+                    L.append(f"  - the {sub['samples']} machine{runs} dynamically: mesh K_γ mean {_ci(dy['mean'])}, "
                              f"P90 {_ci(dy['p90'])} dynamic against mean {_ci(st['mean'])}, P90 {_ci(st['p90'])} "
                              f"static (the same machines)")
                 for kind in KINDS:
