@@ -122,7 +122,8 @@ def solve_snapshots(scene, times, engine: str = "auto", system: mbd.System | Non
 
     Some instants have no static state: a body rests on a force's jump — a tooth pair's damping switches on with
     its closing gap's rate (docs/model.md §7.1), so the force has no root there. Such a snapshot is moved on by a
-    small fraction of a mesh period (:data:`MOVES`, within its mesh-phase stratum for fewer than 25 snapshots);
+    small fraction of a mesh period (:data:`MOVES`; a snapshot sits at the middle of its mesh-phase stratum, 1/n of
+    a mesh period wide, so a 2 % move stays inside it for n < 25 snapshots, a 5 % move for n < 10);
     the solutions' ``t`` say where each was taken, and a snapshot that no move solves raises the first error."""
     m = scene.model
     system = system if system is not None else mbd.System(m)
