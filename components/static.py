@@ -25,7 +25,8 @@ from mbd.static import SteadyMotion, _evaluator, carry, solve_static
 
 from .outputs import WindowStatistics, cage_period
 
-__all__ = ["steady_motion", "held_dofs", "snapshot_times", "solve_snapshots", "static_statistics", "static_summary", "rate_groups", "DYNAMIC_ONLY", "DEFAULT_SNAPSHOTS", "MOVES", "RATE_STEP"]
+__all__ = ["steady_motion", "held_dofs", "snapshot_times", "solve_snapshots", "static_statistics", "static_summary",
+           "rate_groups", "DYNAMIC_ONLY", "DEFAULT_SNAPSHOTS", "MOVES", "RATE_STEP"]
 
 # summary keys a static solution cannot give (they need the motion's transients)
 DYNAMIC_ONLY = ("cage_", "pocket_", "guide_", "heat_land", "whole_revolutions", "carrier_speed_error",

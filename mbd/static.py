@@ -510,10 +510,11 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
     Schur complement of the local blocks and μ = 1/Δτ. μ starts where no unknown moves more than its ``cap``
     and follows the residual, μ ← μ·|g_new|/|g| (halved again while it falls; |g|² = Σ g²/M over the outer
     unknowns), down to ``regularization``·max K/M: the last steps are Newton's. A step that more than doubles
-    |g| is retried with a tenfold μ, and so is any growth once |g| is a hundredth of its start or μ at its floor
-    (Newton's steps can cycle across a kink of the forces); steps are clipped to their caps. Converged when every unknown's residual
-    would move it less than its tolerance under its own stiffness, |g_i| ≤ (|K_ii| + μ_min M_i)·tol_i.
-    Stops, unconverged, when μ has grown 10⁴-fold over its start (no step lowers |g|). Returns (x, steps, converged)."""
+    |g| is retried with a tenfold μ, and so is any growth once |g| is a hundredth of its start or μ at its
+    floor (Newton's steps can cycle across a kink of the forces); steps are clipped to their caps. Converged
+    when every unknown's residual would move it less than its tolerance under its own stiffness,
+    |g_i| ≤ (|K_ii| + μ_min M_i)·tol_i. Stops, unconverged, when μ has grown 10⁴-fold over its start (no step
+    lowers |g|). Returns (x, steps, converged)."""
     M = prob.M
     loc = np.sort(local[local >= 0])
     outer = np.setdiff1d(np.arange(M.size), loc)
