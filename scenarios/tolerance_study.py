@@ -29,6 +29,7 @@ import contextlib
 import csv
 import hashlib
 import io
+import itertools
 import json
 import math
 import os
@@ -353,13 +354,19 @@ def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None
         from dask.distributed import as_completed  # deferred: Dask (≈ 0.2–0.4 s) only when solving on it
 
         with dask_client(n, scheduler) as client:
-            futs = []
+            # a few tasks per worker in flight, the next submitted as one finishes: thousands of machines at once
+            # made a graph of 50 MB (Dask warned) and held every task's parameters on the scheduler
+            queue = iter(todo)
+            running = as_completed()
             try:
-                futs = client.map(solve_static_task, todo, pure=False)
-                for fut in as_completed(futs):
+                for t in itertools.islice(queue, 4 * n):
+                    running.add(client.submit(solve_static_task, t, pure=False))
+                for fut in running:
                     took(fut.result())
+                    for t in itertools.islice(queue, 1):
+                        running.add(client.submit(solve_static_task, t, pure=False))
             except BaseException:        # Ctrl-C: take the solutions off the scheduler (finished files stay)
-                client.cancel(futs, force=True)
+                client.cancel(list(running.futures), force=True)
                 raise
     bar.close()
     return out

@@ -312,8 +312,10 @@ def dask_client(n_workers: int, scheduler: str | None = None):
 
     cluster = None
     if scheduler is None:
+        # ":0": the scheduler's HTTP server on a free port (None still asks for 8787, and a second study running
+        # beside the first warned that it was taken)
         cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=40)
+                               dashboard_address=":0", silence_logs=40)
         client = Client(cluster)
     else:
         client = Client(scheduler)
