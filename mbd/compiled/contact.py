@@ -148,16 +148,24 @@ def _d_cross(rx, ry, drx, dry, fx, fy, dfx, dfy):
 
 
 @njit(cache=True)
+def _col(J, i, c, m, f0, f1, f2, f3, f4, f5):
+    """Column c of instance i's block of J, times m. (Its own function: choosing J_q or J_v by a branch inside one
+    function, ``J = Jq if j < 6 else Jv``, made every column write cost ≈ 50–60 ns of array bookkeeping — most of
+    the contact families' Jacobians, measured: docs/numerics.md §5.)"""
+    J[i, 0, c], J[i, 1, c], J[i, 2, c] = f0 * m, f1 * m, f2 * m
+    J[i, 3, c], J[i, 4, c], J[i, 5, c] = f3 * m, f4 * m, f5 * m
+
+
+@njit(cache=True)
 def _write(F, Jq, Jv, i, j, m, f0, f1, f2, f3, f4, f5):
     """Generalized forces (j < 0) or the derivative column j of instance i, times the multiplicity m."""
     if j < 0:
         F[i, 0], F[i, 1], F[i, 2] = f0 * m, f1 * m, f2 * m
         F[i, 3], F[i, 4], F[i, 5] = f3 * m, f4 * m, f5 * m
-        return
-    J = Jq if j < 6 else Jv
-    c = j % 6
-    J[i, 0, c], J[i, 1, c], J[i, 2, c] = f0 * m, f1 * m, f2 * m
-    J[i, 3, c], J[i, 4, c], J[i, 5, c] = f3 * m, f4 * m, f5 * m
+    elif j < 6:
+        _col(Jq, i, j, m, f0, f1, f2, f3, f4, f5)
+    else:
+        _col(Jv, i, j - 6, m, f0, f1, f2, f3, f4, f5)
 
 
 @njit(cache=True)
