@@ -27,13 +27,10 @@ import time
 from pathlib import Path
 
 import numpy as np
-from numba import njit
-
 import mbd
-from mbd.compiled.registry import evaluate_kind
+from mbd.compiled.probe import repeat_assemble, repeat_kernel, repeat_lu, repeat_solve, repeat_update, replay
 from mbd.compiled.runner import CompiledRunner
-from mbd.compiled.sparse_lu import _factor, _solve
-from mbd.compiled.system import _full, assemble, update_internal
+from mbd.compiled.system import _full
 
 from .common import dpgt_problem, load1, machine_note, settled_state, warm_up
 from ..core import args
@@ -50,70 +47,6 @@ FAMILY_ROWS = {"contact.race": "race", "contact.pocket": "pocket", "contact.guid
                "mesh.gear_mesh": "meshes"}
 OTHER = "other families"
 BLOCK = 256     # accepted steps per compiled call, as mbd.simulate runs them
-
-
-# ------------------------------------------------------------------------ compiled timing loops (reps calls each)
-@njit(cache=True)
-def _repeat_kernel(reps, kind, t, phi, omega, ql, vl, z, P, G, F, Jq, Jv, jac):
-    for _ in range(reps):
-        evaluate_kind(kind, t, phi, omega, 0.0, ql, vl, z, P, G, F, Jq, Jv, jac)
-
-
-@njit(cache=True)
-def _repeat_assemble(reps, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
-    for _ in range(reps):
-        assemble(t, q, v, fams, zs, jac, sysd, F, Jq, Jv)
-
-
-@njit(cache=True)
-def _repeat_lu(reps, c_C, c_K, Mdata, Jq, Jv, A, n, indptr, indices, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, x):
-    """The Newton matrix M − c_C J_v − c_K J_q formed and factored, as the step loop's refresh does."""
-    ok = True
-    for _ in range(reps):
-        for e in range(A.size):
-            A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
-        ok = _factor(n, indptr, indices, A, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, x)
-    return ok
-
-
-@njit(cache=True)
-def _repeat_solve(reps, n, perm, Lp, Li, Lx, Up, Ui, Ux, b, y):
-    s = 0.0
-    for _ in range(reps):
-        s += _solve(n, perm, Lp, Li, Lx, Up, Ui, Ux, b, y)[0]
-    return s
-
-
-@njit(cache=True)
-def _repeat_update(reps, t0, t1, q0, v0, q1, v1, fams, zs, sysd):
-    for _ in range(reps):
-        update_internal(t0, t1, q0, v0, q1, v1, fams, zs, sysd)
-
-
-@njit(cache=True)
-def _replay(steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c_K, Mdata, A, n, indptr, indices, iperm,
-            perm, Lp, Li, Lx, Up, Ui, Ux, xw, b, yw, t0, q0, v0):
-    """The parts in a step's mix and order (per step: a Jacobian + LU when their count per step has accrued to one,
-    then the residuals and solves accrued, then the internal-state update), without the loop's own arithmetic."""
-    aj, ar, asol = 0.0, 0.0, 0.0
-    for _ in range(steps):
-        aj += cj
-        if aj >= 1.0:
-            aj -= 1.0
-            assemble(t, q, v, fams, zs, True, sysd, F, Jq, Jv)
-            for e in range(A.size):
-                A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
-            _factor(n, indptr, indices, A, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, xw)
-        ar += cr
-        asol += cs
-        while ar >= 1.0 or asol >= 1.0:
-            if ar >= 1.0:
-                ar -= 1.0
-                assemble(t, q, v, fams, zs, False, sysd, F, Jq, Jv)
-            if asol >= 1.0:
-                asol -= 1.0
-                _solve(n, perm, Lp, Li, Lx, Up, Ui, Ux, b, yw)
-        update_internal(t0, t, q0, v0, q, v, fams, zs, sysd)
 
 
 # CPU time of this thread, not wall: on a shared machine a long run is descheduled for a share of its wall that
@@ -158,14 +91,14 @@ class _Parts:
             F, Jq, Jv = np.empty((n, k)), np.empty((n, k, k)), np.empty((n, k, k))
             zz = self.cs.zs[zi]
             for jac in (False, True):
-                out[idx, jac] = _timed(_repeat_kernel, reps, kind, float(t), self.omega * t, self.omega, ql, vl, zz,
+                out[idx, jac] = _timed(repeat_kernel, reps, kind, float(t), self.omega * t, self.omega, ql, vl, zz,
                                        P, G, F, Jq, Jv, jac)
         return out
 
     def assembly(self, t, q, v, z, reps) -> dict:
         self.cs.set_internal(z)
         F, Jq, Jv = np.empty(self.cs.ndof), np.empty(self.cs.nnz), np.empty(self.cs.nnz)
-        return {jac: _timed(_repeat_assemble, reps, float(t), q, v, self.cs.fams, self.cs.zs, jac, self.cs.sysd,
+        return {jac: _timed(repeat_assemble, reps, float(t), q, v, self.cs.fams, self.cs.zs, jac, self.cs.sysd,
                             F, Jq, Jv) for jac in (False, True)}
 
     def lu_and_solve(self, t, q, v, z, reps) -> tuple[float, float]:
@@ -174,31 +107,31 @@ class _Parts:
         perm, iperm, Lp, Li, Lx, Up, Ui, Ux, xw, yw = self.r.lu[:10]
         A = np.empty(self.cs.nnz)
         n = self.cs.ndof
-        t_lu = _timed(_repeat_lu, reps, self.c_C, self.c_K, Mdata, ev.Jq, ev.Jv, A, n, indptr, indices, iperm, perm,
+        t_lu = _timed(repeat_lu, reps, self.c_C, self.c_K, Mdata, ev.Jq, ev.Jv, A, n, indptr, indices, iperm, perm,
                       Lp, Li, Lx, Up, Ui, Ux, xw)
-        if not _repeat_lu(1, self.c_C, self.c_K, Mdata, ev.Jq, ev.Jv, A, n, indptr, indices, iperm, perm, Lp, Li,
+        if not repeat_lu(1, self.c_C, self.c_K, Mdata, ev.Jq, ev.Jv, A, n, indptr, indices, iperm, perm, Lp, Li,
                           Lx, Up, Ui, Ux, xw):
             raise mbd.IntegrationError("bench_breakdown: a zero pivot in the sparse LU at a sampled state")
         b = np.ascontiguousarray(ev.F)
-        t_solve = _timed(_repeat_solve, reps, n, perm, Lp, Li, Lx, Up, Ui, Ux, b, yw)
+        t_solve = _timed(repeat_solve, reps, n, perm, Lp, Li, Lx, Up, Ui, Ux, b, yw)
         return t_lu, t_solve
 
     def replay(self, s0, s1, calls, steps) -> float:
-        """s per step of :func:`_replay` at s1 (s0: the state before, for the update)."""
+        """s per step of :func:`mbd.compiled.probe.replay` at s1 (s0: the state before, for the update)."""
         self.cs.set_internal(s1["z"])
         ev = self.cs.evaluate(s1["t"], s1["q"], s1["v"], s1["z"], jac=True)
         indptr, indices, Mdata, _ = self.r.pat
         perm, iperm, Lp, Li, Lx, Up, Ui, Ux, xw, yw = self.r.lu[:10]
         n = self.cs.ndof
         F, Jq, Jv, A = np.empty(n), np.empty(self.cs.nnz), np.empty(self.cs.nnz), np.empty(self.cs.nnz)
-        return _timed(_replay, steps, calls["residual"], calls["jacobian"], calls["solve"], float(s1["t"]), s1["q"],
+        return _timed(replay, steps, calls["residual"], calls["jacobian"], calls["solve"], float(s1["t"]), s1["q"],
                       s1["v"], self.cs.fams, self.cs.zs, self.cs.sysd, F, Jq, Jv, self.c_C, self.c_K, Mdata, A, n,
                       indptr, indices, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, xw, np.ascontiguousarray(ev.F), yw,
                       float(s0["t"]), s0["q"], s0["v"])
 
     def update(self, s0, s1, reps) -> float:
         self.cs.set_internal(s0["z"])
-        dt = _timed(_repeat_update, reps, float(s0["t"]), float(s1["t"]), s0["q"], s0["v"], s1["q"], s1["v"],
+        dt = _timed(repeat_update, reps, float(s0["t"]), float(s1["t"]), s0["q"], s0["v"], s1["q"], s1["v"],
                     self.cs.fams, self.cs.zs, self.cs.sysd)
         return dt
 
