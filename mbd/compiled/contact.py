@@ -24,7 +24,10 @@ operation order (values agree with numpy to an ulp of the transcendental functio
 nonlinear scalar laws give their partial derivatives once per instance (traction μ(v_s, u), Hertz load
 Q(δ, δ̇), impact force F(x, ẋ), friction tanh), and the hand-written differential of every line is then
 evaluated along each of the 12 unit directions (6 local coordinates q, then 6 velocities v): a direction
-is one column of J_q (j < 6) or J_v (j ≥ 6). All scalars, no temporaries, exact (no differencing).
+is one column of J_q (j < 6) or J_v (j ≥ 6). All scalars, no temporaries, exact (no differencing). The race law,
+the costliest, uses its structure: the forces see the two centres only through their difference (the race body's
+translation columns are the roller's negated, exactly; the roller's angle column is zero), and the velocity
+directions leave the geometry (ρ, e, t, the contact point) unchanged, so their columns carry only the rate terms.
 
 Regularisations and branches mirror the reference: the safe norm sqrt(x² + y² + η²); ad.where / ad.pos
 semantics (the branch is chosen on values, an inactive branch contributes a zero derivative); the impact
@@ -148,16 +151,24 @@ def _d_cross(rx, ry, drx, dry, fx, fy, dfx, dfy):
 
 
 @njit(cache=True)
+def _col(J, i, c, m, f0, f1, f2, f3, f4, f5):
+    """Column c of instance i's block of J, times m. (Its own function: choosing J_q or J_v by a branch inside one
+    function, ``J = Jq if j < 6 else Jv``, made every column write cost ≈ 50–60 ns of array bookkeeping — most of
+    the contact families' Jacobians, measured: docs/numerics.md §5.)"""
+    J[i, 0, c], J[i, 1, c], J[i, 2, c] = f0 * m, f1 * m, f2 * m
+    J[i, 3, c], J[i, 4, c], J[i, 5, c] = f3 * m, f4 * m, f5 * m
+
+
+@njit(cache=True)
 def _write(F, Jq, Jv, i, j, m, f0, f1, f2, f3, f4, f5):
     """Generalized forces (j < 0) or the derivative column j of instance i, times the multiplicity m."""
     if j < 0:
         F[i, 0], F[i, 1], F[i, 2] = f0 * m, f1 * m, f2 * m
         F[i, 3], F[i, 4], F[i, 5] = f3 * m, f4 * m, f5 * m
-        return
-    J = Jq if j < 6 else Jv
-    c = j % 6
-    J[i, 0, c], J[i, 1, c], J[i, 2, c] = f0 * m, f1 * m, f2 * m
-    J[i, 3, c], J[i, 4, c], J[i, 5, c] = f3 * m, f4 * m, f5 * m
+    elif j < 6:
+        _col(Jq, i, j, m, f0, f1, f2, f3, f4, f5)
+    else:
+        _col(Jv, i, j - 6, m, f0, f1, f2, f3, f4, f5)
 
 
 @njit(cache=True)
@@ -402,29 +413,33 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
             continue
         Q_d = K * p * delta ** (p - 1.0) + c0 * pe * delta ** (pe - 1.0) * delta_dot   # ∂Q/∂δ
         Q_r = c0 * dpe                                                                  # ∂Q/∂δ̇
-        for j in range(12):
-            dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, dvr2, dvb0, dvb1, dvb2 = _unit(j)
+        rho2 = dx * dx + dy * dy + _ETA2
+        num = dx * wy - dy * wx
+        # Positions: the law sees the roller's and the race body's centres only through (dx, dy), so a shift of the
+        # race body is a shift of the roller reversed (J_q columns 3, 4 = −columns 0, 1, exactly), and not the
+        # roller's angle (column 2 = 0); only θ_race also turns the marker. No velocity moves along these.
+        for j in (0, 1, 5):
+            dxr, dyr, dthb = _u(j, 0), _u(j, 1), _u(j, 5)
             drcx, drcy = -dthb * rcy, dthb * rcx
-            ddx, ddy = dxr - dxb - drcx, dyr - dyb - drcy
+            ddx, ddy = dxr - drcx, dyr - drcy
             drho = (dx * ddx + dy * ddy) / rho
             dex, dey = (ddx - ex * drho) / rho, (ddy - ey * drho) / rho
             dtx, dty = -dey, dex
-            dVcx, dVcy = dvb0 - dvb2 * rcy - vb2 * drcy, dvb1 + dvb2 * rcx + vb2 * drcx
-            dwx, dwy = dvr0 - dVcx, dvr1 - dVcy
+            dVcx, dVcy = -vb2 * drcy, vb2 * drcx
+            dwx, dwy = -dVcx, -dVcy
             ddelta = -kap * drho
             ddelta_dot = -kap * (dex * wx + ex * dwx + dey * wy + ey * dwy)
             if spall:                            # chain rule through s (the marker turns with θ_race too)
                 ds = R * ((dx * ddy - dy * ddx) / (dx * dx + dy * dy) - dthb)     # ad.arctan2: no η
-                rho2 = dx * dx + dy * dy + _ETA2
                 dnum = ddx * wy + dx * dwy - ddy * wx - dy * dwx
-                ds_dot = R * ((dnum - (dx * wy - dy * wx) * 2.0 * (dx * ddx + dy * ddy) / rho2) / rho2 - dvb2)
+                ds_dot = R * ((dnum - num * 2.0 * (dx * ddx + dy * ddy) / rho2) / rho2)
                 ddelta -= hBs * ds
                 ddelta_dot -= hBss * ds * s_dot + hBs * ds_dot
             dQ = Q_d * ddelta + Q_r * ddelta_dot
             drrx, drry = -drho * ex + rl * dex, -drho * ey + rl * dey
             drbx, drby = drcx + R * dex, drcy + R * dey
-            dVrx, dVry = dvr0 - dvr2 * rry - vr2 * drry, dvr1 + dvr2 * rrx + vr2 * drrx
-            dVbx, dVby = dvb0 - dvb2 * rby - vb2 * drby, dvb1 + dvb2 * rbx + vb2 * drbx
+            dVrx, dVry = -vr2 * drry, vr2 * drrx
+            dVbx, dVby = -vb2 * drby, vb2 * drbx
             dur = dVrx * tx + Vrx * dtx + dVry * ty + Vry * dty
             dub = dVbx * tx + Vbx * dtx + dVby * ty + Vby * dty
             dmu = mu_s * (dur - dub) + mu_Q * dQ
@@ -435,8 +450,33 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
             dFt = -(dmu * Q + mu * dQ)
             dFx = kap * (dQ * ex + Q * dex) + dFt * tx + Ft * dtx
             dFy = kap * (dQ * ey + Q * dey) + dFt * ty + Ft * dty
-            _write(F, Jq, Jv, i, j, mult, dFx, dFy, _d_cross(rrx, rry, drrx, drry, Fx, Fy, dFx, dFy),
-                   -dFx, -dFy, -_d_cross(rbx, rby, drbx, drby, Fx, Fy, dFx, dFy))
+            dMr = _d_cross(rrx, rry, drrx, drry, Fx, Fy, dFx, dFy)
+            dMb = -_d_cross(rbx, rby, drbx, drby, Fx, Fy, dFx, dFy)
+            _write(F, Jq, Jv, i, j, mult, dFx, dFy, dMr, -dFx, -dFy, dMb)
+            if j < 2:
+                _write(F, Jq, Jv, i, j + 3, mult, -dFx, -dFy, -dMr, dFx, dFy, -dMb)
+        _write(F, Jq, Jv, i, 2, mult, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        # Velocities: they move δ̇ and the surface speeds only (not ρ, e, t or the contact point)
+        for j in range(6, 12):
+            dvr0, dvr1, dvr2, dvb0, dvb1, dvb2 = _u(j, 6), _u(j, 7), _u(j, 8), _u(j, 9), _u(j, 10), _u(j, 11)
+            dVcx, dVcy = dvb0 - dvb2 * rcy, dvb1 + dvb2 * rcx
+            dwx, dwy = dvr0 - dVcx, dvr1 - dVcy
+            ddelta_dot = -kap * (ex * dwx + ey * dwy)
+            if spall:
+                ddelta_dot -= hBs * (R * ((dx * dwy - dy * dwx) / rho2 - dvb2))
+            dQ = Q_r * ddelta_dot
+            dVrx, dVry = dvr0 - dvr2 * rry, dvr1 + dvr2 * rrx
+            dVbx, dVby = dvb0 - dvb2 * rby, dvb1 + dvb2 * rbx
+            dur = dVrx * tx + dVry * ty
+            dub = dVbx * tx + dVby * ty
+            dmu = mu_s * (dur - dub) + mu_Q * dQ
+            if law != TANH:
+                dvP = dVcx * tx + dVcy * ty + R * (dwx * tx + dwy * ty) / rho
+                dmu += mu_u * (0.5 * (dur + dub) - dvP)
+            dFt = -(dmu * Q + mu * dQ)
+            dFx = kap * (dQ * ex) + dFt * tx
+            dFy = kap * (dQ * ey) + dFt * ty
+            _write(F, Jq, Jv, i, j, mult, dFx, dFy, rrx * dFy - rry * dFx, -dFx, -dFy, -(rbx * dFy - rby * dFx))
 
 
 # ----------------------------------------------------------------------------------- pocket contact

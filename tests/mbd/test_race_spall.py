@@ -22,6 +22,7 @@ from mbd.errors import ModelError
 from tests.support.contact import (DR, EHL, FILM, FS, K_HZ, LAW, M_ROLLER, N, R_IN, R_OUT, SETTINGS, TANH,
                                    assert_balanced, assert_jacobians, assert_matches_reference, compiled, race_scene,
                                    race_states)
+from tests.support.dpgt_runs import build, faulty_machine
 
 P = 10.0 / 9.0
 LAWS = {"tanh": TANH, "ehl": EHL, "film": FILM}
@@ -379,3 +380,28 @@ def test_a_spalled_family_runs_in_both_engines():
           f"{((I_PINCH - H_SP) / I_PINCH) ** P:.5f}")
     assert load[0] / load_plain[0] == pytest.approx(law, rel=2e-3)
     np.testing.assert_allclose(load[1:], load_plain[1:], rtol=0.02)
+
+
+def test_the_race_kernels_match_the_reference_on_the_faulty_machines_loaded_states():
+    """The compiled race law's structured Jacobian (the race body's translation columns are the roller's negated,
+    the roller's angle column is left zero, the velocity columns carry no geometry terms) against the reference's
+    dual numbers, at real loaded states: the faulty machine (a spall on b1's pin, class-6 teeth, a cracked tooth)
+    2–2.5 ms into its load ramp, every race family, forces and both Jacobians (tests.support.contact's bounds)."""
+    bs = build(faulty_machine())
+    kept = []
+
+    class Keep(mbd.Observer):
+        def on_block(self, blk):
+            t, q, v, _, _ = blk.arrays()
+            kept.extend((t[i], q[i], v[i]) for i in range(1, t.size) if t[i] > 2e-3)
+
+    mbd.simulate(bs.model, bs.q0, bs.v0, 2.5e-3, stepper=mbd.PRODUCTION.stepper(),
+                 controller=mbd.PRODUCTION.controller(), progress=False, engine="compiled", observers=[Keep()])
+    races = [e for e in bs.model.elements if isinstance(e, RaceContact)]
+    assert any(e.has_spall for e in races) and len(kept) >= 10
+    loaded = 0
+    for t, q, v in kept[::max(1, len(kept) // 10)]:
+        qf, vf = bs.model.full(t, q, v)
+        for e in races:
+            loaded += int(np.count_nonzero(np.abs(assert_matches_reference(e, FS, qf, vf)).max(axis=1) > 1.0))
+    assert loaded > 100                     # most contacts of the loaded zones carry load (N), not a test of zeros

@@ -8,8 +8,10 @@ import json
 import numpy as np
 import pytest
 
-from scenarios.numerics import benchmark, stability, work_precision
-from scenarios.numerics.common import StateSampler
+import mbd
+
+from scenarios.numerics import bench_breakdown, benchmark, stability, work_precision
+from scenarios.numerics.common import StateSampler, dpgt_problem, settled_state
 
 
 def test_state_sampler_hermite_is_exact_for_cubics():
@@ -97,3 +99,28 @@ def test_benchmark_json_last_line(tmp_path, capsys):
     assert d["per_step_over_eval"] > 0 and d["wall_s"] > 0
     assert d["scipy_best_method"] in ("Radau", "BDF", "LSODA", "RK45")
     assert (tmp_path / "benchmark.json").exists()
+
+
+def test_bench_breakdown_counts_the_engines_work_and_splits_its_time(tmp_path, capsys):
+    """The breakdown's calls per step are the engine's own counters over the same window (an independent
+    mbd.simulate from the same settled state), every contact family has its row, and the target's µs per step is
+    3 s over the steps of 0.1 s."""
+    window, h = 2e-4, 1e-5
+    assert bench_breakdown.main(["--json", "--settle", "2e-4", "--window", str(window), "--h", str(h), "--samples", "2",
+                                 "--rounds", "1", "--reps", "1", "--out", str(tmp_path)]) == 0
+    d = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    prob = dpgt_problem(settle=2e-4)
+    s0, _ = settled_state(prob, tmp_path / "dpgt_settled.npz")
+    res = mbd.simulate(prob.model, t_end=s0.t + window, state=s0.copy(), stepper=mbd.HHT(alpha=-0.3),
+                       controller=mbd.FixedStep(h), progress=False)
+    c = res.counters
+    assert d["steps"] == res.steps >= round(window / h)
+    assert d["calls_per_step"]["residual"] == pytest.approx(c["residual"] / res.steps)
+    assert d["calls_per_step"]["jacobian"] == pytest.approx(c["jacobian"] / res.steps)
+    assert d["calls_per_step"]["solve"] == pytest.approx(c["newton"] / res.steps)
+    parts = {r["part"]: r for r in d["rows"]}
+    assert {"race", "pocket", "guide", "drag", "meshes"} <= set(parts)
+    assert all(parts[f]["jacobian_us"] > 0 and parts[f]["residual_us"] > 0 for f in ("race", "pocket", "drag"))
+    assert sum(r["us_per_step"] for r in d["rows"]) == pytest.approx(d["cpu_per_step_us"])
+    assert d["target_us_per_step"] == pytest.approx(3.0 / (res.steps * 0.1 / window) * 1e6)
+    assert (tmp_path / "breakdown.json").exists()
