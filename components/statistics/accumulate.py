@@ -1,7 +1,7 @@
-"""The statistics' accumulators, compiled: one loop over a run's accepted steps that turns the per-step
-quantities (:meth:`components.outputs.WindowStatistics.snapshot`) into time-weighted sums, maxima, minima,
-window ends and pocket-impact counts. :class:`~components.outputs.WindowStatistics` owns what they mean (its
-docstring); this module owns only the arithmetic, so that a block of a few hundred steps costs one call.
+"""The statistics' accumulators: the running sums of every per-step quantity (:mod:`.quantities`) over its window
+— time-weighted Σx dt and Σx² dt, maxima, minima — each window's length, the cages' angles and the pocket-impact
+counts, in :class:`Accumulators`; the arithmetic is one compiled loop over a block of steps
+(:func:`accumulate_steps`), so that a block of a few hundred steps costs one call.
 
 Per step [t_a, t_b] of size h, a quantity x is taken linear in the step (the trapezoid rule) between the
 step fractions w_a (the window's start inside the step, else 0) and w_1 (its window's end inside the step,
@@ -9,7 +9,9 @@ else 1): Σx += ½(x(w_a) + x(w_1))·dt, Σx² += ½(x(w_a)² + x(w_1)²)·dt, d
 its two ends over steps with dt > 0. A mesh quantity's window ends at t1; a bearing's when its cage has
 turned its whole number of revolutions relative to the carrier (its angle integrated by the same rule).
 
-Without numba the same functions run as plain Python (slowly, but the results are the same).
+The kernels compile (or load from numba's cache) before a run's first step, announced when they must compile
+(:func:`compile_accumulators`). Without numba the same functions run as plain Python (slowly, but the results
+are the same).
 """
 from __future__ import annotations
 
@@ -19,12 +21,15 @@ import numpy as np
 
 try:
     from numba import njit as _njit
+    from mbd import compiled as _compiled      # kernels_cached is read through the package when called
     jit = _njit(cache=True)
 except ImportError:      # pragma: no cover - numba is a dependency; this keeps the module importable
+    _compiled = None
+
     def jit(fn):
         return fn
 
-__all__ = ["accumulate_steps", "IMPACT_ROWS"]
+__all__ = ["Accumulators", "accumulate_steps", "compile_accumulators", "IMPACT_ROWS"]
 
 # rows of the impact accumulator (one column per pocket contact)
 IMPACT_ROWS = ("count", "touches", "speed_sum", "speed_max", "peak_sum", "peak_max", "peak_now", "active")
@@ -157,3 +162,150 @@ def accumulate_steps(t, V, own, acc, T, angle, is_open, t_close, target, has_tar
         T[nb] += max(wg - wa, 0.0) * h
         if pocket_cols.size:
             _impacts(i, t_b, t0, t_a, h, wb, V, Z, pocket_cols, pocket_bearing, v_floor, imp)
+
+
+class Accumulators:
+    """The running sums of every quantity over its window: per instance Σx dt, Σx² dt, max and min (one flat
+    (4, n) array; :meth:`stats` reads it back), the time each bearing's window and the global (mesh) one have
+    covered, the cages' angles relative to the carrier, and the pocket impacts (:data:`IMPACT_ROWS`).
+
+    ``n_bearings``; ``t0``, ``t1`` the nominal window [s]; ``target`` (n_b,) the whole cage revolutions that end
+    each bearing's window, or None (the nominal window); ``pocket_bearing`` (n_p,) each pocket's bearing and
+    ``v_floor`` (n_p,) the impact law's approach-speed floor (slower onsets are touches)."""
+
+    def __init__(self, n_bearings: int, t0: float, t1: float, target, pocket_bearing, v_floor):
+        self.t0, self.t1 = float(t0), float(t1)
+        self.has_target = target is not None
+        self.target = np.asarray(target if target is not None else np.zeros(n_bearings), float)
+        self.pocket_bearing = np.asarray(pocket_bearing, np.int64)
+        self.v_floor = np.asarray(v_floor, float)
+        self.flat, self.acc, self.keys, self.owners = None, {}, (), {}
+        self.T = np.zeros(n_bearings + 1)                   # time covered by each bearing's window, the global one
+        self.angle = np.zeros(n_bearings)                   # cage angle relative to the carrier since t0
+        self.open = np.ones(n_bearings, bool)               # bearing windows still open
+        self.t_close = np.full(n_bearings, np.nan)
+        self.imp = np.zeros((len(IMPACT_ROWS), self.pocket_bearing.size))
+        self.impact = dict(zip(IMPACT_ROWS, self.imp)) if self.imp.size else None    # row views
+
+    def layout(self, sizes: dict, owners: dict, cage_speed: str, pocket_force: str) -> None:
+        """Lay the flat accumulator out (zeros; ±inf extrema) for the quantities ``sizes`` {key: instances}, in that
+        order, each instance tagged with its bearing (``owners`` {key: (n,) or None: the global window}); if it
+        holds sums already (a checkpoint), only its views. ``cage_speed``, ``pocket_force``: the keys whose
+        columns the kernel reads for the cages' angles and the impact peaks."""
+        keys = list(sizes)
+        edges = np.concatenate([[0], np.cumsum([sizes[k] for k in keys])]).astype(int)
+        self.keys, self.owners = keys, dict(owners)
+        self._own_flat = np.concatenate([owners[k] if owners[k] is not None else np.full(sizes[k], -1)
+                                         for k in keys]).astype(np.int64)
+        if self.flat is None:
+            n = int(edges[-1])
+            self.flat = np.stack([np.zeros(n), np.zeros(n), np.full(n, -np.inf), np.full(n, np.inf)])
+        self.acc = {k: self.flat[:, a:b] for k, a, b in zip(keys, edges[:-1], edges[1:])}
+        col = dict(zip(keys, edges[:-1]))
+        self._cage_cols = (col[cage_speed] + np.arange(self.angle.size)).astype(np.int64) \
+            if cage_speed in col else np.zeros(0, np.int64)
+        npk = self.imp.shape[1]
+        self._pocket_cols = (col[pocket_force] + np.arange(npk)).astype(np.int64) if npk else np.zeros(0, np.int64)
+
+    def closed(self, t_start: float) -> bool:
+        """Has every window ended before ``t_start``?"""
+        return t_start >= self.t1 and not self.open.any()
+
+    def _flatten(self, rows, K: int) -> np.ndarray:
+        return np.concatenate([np.asarray(rows[k], float).reshape(K, -1) for k in self.keys], axis=1)
+
+    def add_steps(self, t, rows, Z) -> None:
+        """K steps: their K+1 ends ``t``, each quantity at them (``rows``), the pockets' stored approach speeds
+        ``Z`` (K+1, n_p)."""
+        V = self._flatten(rows, t.size)
+        Zf = np.ascontiguousarray(Z, float) if self.imp.size else np.zeros((t.size, 0))
+        accumulate_steps(t, V, self._own_flat, self.flat, self.T, self.angle, self.open, self.t_close, self.target,
+                         self.has_target, self.t0, self.t1, self._cage_cols, self._pocket_cols, self.pocket_bearing,
+                         Zf, self.v_floor, self.imp)
+
+    def add_samples(self, rows) -> None:
+        """K equally weighted states (``rows`` as for :meth:`add_steps`): each counts one unit of time in every
+        window, so means are plain averages and max/min the extremes over the states."""
+        K = len(rows[self.keys[0]])
+        V = self._flatten(rows, K)
+        self.flat[0] += V.sum(axis=0)
+        self.flat[1] += (V * V).sum(axis=0)
+        np.maximum(self.flat[2], V.max(axis=0), out=self.flat[2])
+        np.minimum(self.flat[3], V.min(axis=0), out=self.flat[3])
+        self.T += K
+
+    def close_impacts(self) -> None:
+        """Impacts still in progress when their window ended count with the peak they reached."""
+        im = self.impact
+        if im is None:
+            return
+        act = im["active"] > 0
+        im["peak_sum"] += np.where(act, im["peak_now"], 0.0)
+        np.maximum(im["peak_max"], np.where(act, im["peak_now"], 0.0), out=im["peak_max"])
+        im["active"][act] = 0.0
+        im["peak_now"][act] = 0.0
+
+    # reading back ---------------------------------------------------------------------------------
+    def stats(self, key: str) -> dict[str, np.ndarray]:
+        """mean, rms, max, min of a quantity over its window (arrays per instance)."""
+        acc = self.acc[key]
+        own = self.owners[key]
+        T = self.T[:-1][own] if own is not None else self.T[-1]
+        T = np.where(np.asarray(T) > 0, T, np.nan)
+        return {"mean": acc[0] / T, "rms": np.sqrt(np.maximum(acc[1], 0.0) / T), "max": acc[2], "min": acc[3]}
+
+    def aggregate_rms(self, key: str, bearings) -> float:
+        """RMS of a quantity over every instance that belongs to ``bearings`` (time-weighted, all windows)."""
+        own = self.owners[key]
+        mine = np.isin(own, bearings)
+        T = self.T[:-1][own[mine]]
+        return float(np.sqrt(self.acc[key][1][mine].sum() / T.sum()))
+
+    @property
+    def duration(self) -> float:
+        """Length of the global (mesh) window covered so far [s]."""
+        return self.T[-1]
+
+    def window_length(self, bearing: int) -> float:
+        """Length of bearing ``bearing``'s window covered so far [s]."""
+        return float(self.T[bearing])
+
+    def cage_revolutions(self, sel) -> float:
+        """Cage revolutions relative to the carrier in the windows of the bearings ``sel``, summed."""
+        return float(np.abs(self.angle[sel]).sum() / (2 * math.pi))
+
+    # checkpoints ---------------------------------------------------------------------------------
+    def state_dict(self) -> dict:
+        d = {"acc": self.flat} if self.flat is not None else {}
+        d.update({f"imp__{k}": v for k, v in (self.impact or {}).items()})
+        d.update({"T_global": np.array(self.T[-1]), "T_bearing": self.T[:-1], "angle": self.angle,
+                  "open": self.open, "t_close": self.t_close})
+        return d
+
+    def load_state_dict(self, d: dict) -> None:
+        """The sums of :meth:`state_dict` (lay them out again with :meth:`layout`)."""
+        self.acc, self.flat = {}, (d["acc"].copy() if "acc" in d else None)
+        for k in IMPACT_ROWS:
+            if f"imp__{k}" in d:
+                self.impact[k][:] = d[f"imp__{k}"]
+        if "T_global" in d:
+            self.T[:-1], self.T[-1] = d["T_bearing"], float(d["T_global"])
+            self.angle[:], self.open[:], self.t_close[:] = d["angle"], d["open"].astype(bool), d["t_close"]
+
+
+def accumulators_cached() -> bool:
+    """Does numba's disk cache hold the accumulators of this code (plain Python without numba: nothing to compile)?"""
+    return _compiled is None or _compiled.kernels_cached(accumulate_steps)
+
+
+def compile_accumulators() -> None:
+    """Compile (or load) the accumulators now, on a one-step toy window: a run does it before its first step (a
+    progress bar's ETA then leaves the compile out), saying so when it must compile, as the engine's kernels."""
+    if _compiled is None:      # pragma: no cover - plain Python
+        return
+    i0, f0 = np.zeros(0, np.int64), np.zeros(0)
+    toy = lambda: accumulate_steps(np.array([0.0, 1.0]), np.zeros((2, 1)), np.array([-1]), np.zeros((4, 1)),
+                                   np.zeros(2), np.zeros(1), np.ones(1, bool), np.zeros(1), np.ones(1), False, 0.0,
+                                   1.0, i0, i0, i0, np.zeros((2, 0)), f0, np.zeros((8, 0)))
+    _compiled.compile_announced(toy, cold=not accumulators_cached(), what="the statistics' accumulator kernels",
+                                done="accumulator kernels", about="a few seconds")
