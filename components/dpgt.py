@@ -66,7 +66,7 @@ class Speeds:
 
 @dataclass(frozen=True, eq=False, kw_only=True)
 class PlanetBearingScene(BuiltScene):
-    """Planet bearings on a carrier, what the statistics and results read (:mod:`components.outputs`,
+    """Planet bearings on a carrier, what the statistics and results read (:mod:`components.statistics`,
     :mod:`components.results.schema`, :mod:`components.static`): the DPGT, or a rig of planet bearings."""
     pairs: tuple[PairHandles, ...]
     speeds: Speeds

@@ -1,6 +1,7 @@
 """Fatigue life of a planet bearing (docs/model.md §14): the laws, defined once. The statistics that feed them
 (the bearing load and every roller's raceway loads on every accepted step) are taken by
-:class:`components.outputs.WindowStatistics`.
+:class:`components.outputs.WindowStatistics` (:mod:`components.statistics`; the lives from them in
+:mod:`components.statistics.summaries`).
 
 Two lives, both the basic rating life L10 (90 % reliability, a_1 = a_ISO = 1), in 10^6 revolutions of the
 planet relative to its pin and in hours at that relative speed:

@@ -5,8 +5,8 @@ as before), with typed access on top: the bearing kinds' sections (:attr:`Summar
 the mesh types' (:attr:`Summary.meshes`), each a :class:`Section` whose :meth:`~Section.quantity` gives a value with
 its unit and words; :attr:`Summary.failed` instead of ``"error" in s``; :meth:`Summary.failure` for a run that failed.
 
-The words and units of every statistic (:data:`SUMMARY_WORDS`) are owned here; :mod:`components.outputs` computes
-the statistics and re-exports the table. Imports nothing of the project (viz reads through it without the engine).
+The words and units of every statistic (:data:`SUMMARY_WORDS`) are owned here; :mod:`components.statistics` computes
+the statistics, :mod:`components.outputs` re-exports the table. Imports nothing of the project (viz reads through it without the engine).
 """
 from __future__ import annotations
 

@@ -28,6 +28,8 @@ see :mod:`.registry`):
 
 import hashlib as _hashlib
 import os as _os
+import sys as _sys
+import time as _time
 from pathlib import Path as _Path
 
 from numba import config as _numba_config
@@ -60,13 +62,33 @@ def _drop_stale_kernels() -> None:
 
 
 
-def kernels_cached(function: str = "stepper.advance") -> bool:
-    """Does numba's disk cache hold the compiled ``function`` ("module.name" in this package; by default the step
-    loop) of this code, so that a run loads it in about a second instead of compiling it? Checked by its index
-    file (:func:`_drop_stale_kernels` removes stale ones)."""
+def kernels_cached(function="stepper.advance") -> bool:
+    """Does numba's disk cache hold the compiled ``function`` of this code, so that a run loads it in about a second
+    instead of compiling it? ``function``: "module.name" in this package (by default the step loop; checked by its
+    index file, :func:`_drop_stale_kernels` removes stale ones), or a cached numba function of another package (a
+    kernel depending on its own file only: its index file for its current first line, newer than its source)."""
+    if not isinstance(function, str):
+        code = function.py_func.__code__
+        index = _Path(function.stats.cache_path) / (f"{_Path(code.co_filename).stem}.{function.py_func.__qualname__}-"
+                                                    f"{code.co_firstlineno}.py{_sys.version_info[0]}{_sys.version_info[1]}.nbi")
+        return index.is_file() and index.stat().st_mtime >= _Path(code.co_filename).stat().st_mtime
     here = _Path(__file__).resolve().parent
     root = _Path(_numba_config.CACHE_DIR) if _numba_config.CACHE_DIR else here / "__pycache__"
     return any(root.rglob(f"{function}-*.nbi")) if root.is_dir() else False
+
+
+def compile_announced(compile, cold: bool, what: str, done: str, about: str) -> None:
+    """Call ``compile`` (it compiles or loads numba kernels) now, before a run's first step: a progress bar's ETA then
+    leaves the compile out. When ``cold`` (:func:`kernels_cached` says numba's cache does not hold them) a first run
+    says what it is doing instead of looking stuck, in one line before ("mbd: compiling ``what`` (...; ``about``,
+    then cached)") and one after ("mbd: ``done`` compiled in N s")."""
+    if cold:
+        print(f"mbd: compiling {what} (the first run of this code on this machine; {about}, then cached)",
+              file=_sys.stderr, flush=True)
+    t0 = _time.perf_counter()
+    compile()
+    if cold:
+        print(f"mbd: {done} compiled in {_time.perf_counter() - t0:.0f} s", file=_sys.stderr, flush=True)
 
 
 _drop_stale_kernels()

@@ -6,15 +6,12 @@ that value for the residual (one definition of each law); ``System.outputs_batch
 tests hold this to (tests/mbd/test_compiled_outputs.py)."""
 from __future__ import annotations
 
-import sys
-import time
-
 import numpy as np
 from numba import njit
 
 from ..assembly import System
 from .registry import OUTPUT_NAMES, kind_of, outputs_kind
-from .. import compiled as _compiled     # kernels_cached is read through the package when called
+from .. import compiled as _compiled     # kernels_cached, compile_announced: read through the package when called
 
 __all__ = ["CompiledOutputs", "family_outputs"]
 
@@ -66,15 +63,12 @@ class CompiledOutputs:
 
         if not self._compiled:
             return
-        cold = not _compiled.kernels_cached("outputs.family_outputs")
-        if cold:
-            print("mbd: compiling the element output kernels (the first run of this code on this machine; about "
-                  "10 s, then cached)", file=sys.stderr, flush=True)
-        t0 = time.perf_counter()
-        self.outputs_batch(np.zeros(0), np.zeros((0, self.model.ndof)), np.zeros((0, self.model.ndof)), {},
-                           families={name for rec in self._compiled for name, _ in rec[0]})
-        if cold:
-            print(f"mbd: output kernels compiled in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
+        empty = np.zeros((0, self.model.ndof))
+        _compiled.compile_announced(
+            lambda: self.outputs_batch(np.zeros(0), empty, empty, {},
+                                       families={name for rec in self._compiled for name, _ in rec[0]}),
+            cold=not _compiled.kernels_cached("outputs.family_outputs"), what="the element output kernels",
+            done="output kernels", about="about 10 s")
 
     def outputs_batch(self, t, q, v, z, families=None, full=None) -> dict[str, dict[str, np.ndarray]]:
         """Every family's outputs at K states (those named in ``families``, when given), as

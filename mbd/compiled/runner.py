@@ -3,8 +3,6 @@ accepted steps in compiled code and hands each block back as states, so that the
 observers, checkpoints and the progress bar work unchanged."""
 from __future__ import annotations
 
-import sys
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -13,7 +11,7 @@ from ..assembly import System
 from ..control import Adaptive, FixedStep
 from ..hht import HHT, StepInfo
 from ..model import State
-from .. import compiled as _compiled     # kernels_cached is read through the package when called
+from .. import compiled as _compiled     # kernels_cached, compile_announced: read through the package when called
 from .sparse_lu import FixedPatternLU
 from .stepper import FAIL_REASONS, advance
 from .system import CompiledSystem
@@ -120,18 +118,13 @@ class CompiledRunner:
     def _compile(self) -> None:
         """Compile (or load) the step loop now, before any step: a progress bar's ETA then leaves the compile
         out, and a first run on a machine says what it is doing instead of looking stuck."""
-        cold = not _compiled.kernels_cached()
-        if cold:
-            print("mbd: compiling the engine's kernels (the first run of this code on this machine; about a "
-                  "minute, then cached)", file=sys.stderr, flush=True)
-        t0 = time.perf_counter()
         n = self.n
         z = np.zeros(n)
-        advance(0.0, z.copy(), z.copy(), z.copy(), z.copy(), 1e-6, 0.0, 0, self.prm, self.ctrl, self.atol, self.rtol,
-                self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu, self.cache, self.work,
-                np.zeros(6, np.int64), self.out, np.empty((1, 3 + 4 * n + self.n_z)))
-        if cold:
-            print(f"mbd: kernels compiled in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
+        _compiled.compile_announced(
+            lambda: advance(0.0, z.copy(), z.copy(), z.copy(), z.copy(), 1e-6, 0.0, 0, self.prm, self.ctrl, self.atol,
+                            self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu,
+                            self.cache, self.work, np.zeros(6, np.int64), self.out, np.empty((1, 3 + 4 * n + self.n_z))),
+            cold=not _compiled.kernels_cached(), what="the engine's kernels", done="kernels", about="about a minute")
 
     def drop_lu(self) -> None:
         """Forget the LU (the numpy path drops it at checkpoints: both refactorise at the same step)."""

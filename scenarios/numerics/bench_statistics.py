@@ -34,15 +34,15 @@ WRITES = ("one JSON object on the screen: wall_plain_s, wall_stats_s (medians ov
 
 # the observer's parts the profile reports: label -> (file, function); nested ones after the part they are in
 PARTS = {
-    "on_block": ("components/outputs.py", "on_block"),
-    "snapshots (every per-step quantity of the block's states)": ("components/outputs.py", "snapshots"),
+    "on_block": ("components/statistics/observer.py", "on_block"),
+    "snapshots (every per-step quantity of the block's states)": ("components/statistics/quantities.py", "quantities"),
     "element outputs, compiled kernels (the contacts)": ("mbd/compiled/outputs.py", "outputs_batch"),
     "element outputs, numpy kernels": ("mbd/assembly.py", "outputs_batch"),
-    "EHL film and its per-bearing extremes": ("components/outputs.py", "_film"),
-    "traction heat and coefficient": ("components/outputs.py", "_traction_heat"),
-    "carrier-frame motion": ("components/outputs.py", "carrier_frame_motion"),
-    "pin reactions": ("components/outputs.py", "pin_reactions"),
-    "accumulators (concatenation, compiled loop)": ("components/outputs.py", "_accumulate"),
+    "EHL film and its per-bearing extremes": ("components/statistics/quantities.py", "film_extremes"),
+    "traction heat and coefficient": ("components/statistics/quantities.py", "traction_heat"),
+    "carrier-frame motion": ("components/statistics/quantities.py", "carrier_frame_motion"),
+    "pin reactions": ("components/statistics/quantities.py", "pin_reactions"),
+    "accumulators (concatenation, compiled loop)": ("components/statistics/observer.py", "_accumulate"),
 }
 
 

@@ -15,15 +15,15 @@ import warnings
 import numpy as np
 
 import mbd
-from components.accumulate import accumulate_steps
 from components.dpgt import build_dpgt
 from components.presets import reference_dpgt
+from components.statistics.accumulate import accumulators_cached, compile_accumulators
 from mbd.compiled import kernels_cached
 from mbd.compiled.runner import CompiledRunner
 
 
 def main(argv=None) -> int:
-    cached = kernels_cached()
+    cached = kernels_cached() and kernels_cached("outputs.family_outputs") and accumulators_cached()
     t0 = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")        # the reference machine's known design warnings
@@ -32,7 +32,7 @@ def main(argv=None) -> int:
     system = mbd.System(scene.model)
     CompiledRunner(system, s.stepper(), s.controller())
     _warm_outputs(system, scene)
-    _warm_accumulators()
+    compile_accumulators()
     what = "loaded from the cache" if cached else "compiled and cached"
     print(f"engine kernels: {what} in {time.perf_counter() - t0:.0f} s", flush=True)
     return 0
@@ -42,14 +42,6 @@ def _warm_outputs(system, scene) -> None:
     """The compiled element outputs the statistics read (mbd.compiled.outputs), at the scene's start state."""
     z = {k: np.asarray(x)[None] for k, x in system.init_internal().items()}
     mbd.output_evaluator(system, "compiled").outputs_batch(np.zeros(1), scene.q0[None], scene.v0[None], z)
-
-
-def _warm_accumulators() -> None:
-    """The statistics' compiled accumulators (components.accumulate), on a one-step toy window."""
-    i0, f0 = np.zeros(0, np.int64), np.zeros(0)
-    accumulate_steps(np.array([0.0, 1.0]), np.zeros((2, 1)), np.array([-1]), np.zeros((4, 1)), np.zeros(2), np.zeros(1),
-                     np.ones(1, bool), np.zeros(1), np.ones(1), False, 0.0, 1.0, i0, i0, i0, np.zeros((2, 0)), f0,
-                     np.zeros((8, 0)))
 
 
 if __name__ == "__main__":

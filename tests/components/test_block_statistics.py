@@ -17,6 +17,7 @@ import pytest
 import mbd
 from components.dpgt import build_dpgt
 from components.outputs import WindowStatistics
+from components.presets import reference_dpgt
 from components.scene import SceneOptions
 
 from tests.support.dpgt_runs import OUTPUT_ROUND_OFF, faulty_machine, summary_numbers
@@ -182,3 +183,25 @@ def test_a_block_is_recorded_as_its_steps_are(tmp_path):
         x = a[name].values
         np.testing.assert_allclose(x, b[name].values, rtol=1e-12, atol=OUTPUT_ROUND_OFF * np.nanmax(np.abs(x), initial=0.0),
                                    err_msg=name)
+
+
+def test_the_accumulators_compile_when_the_statistics_are_bound_and_say_so_when_cold(capsys, monkeypatch):
+    """Binding the statistics (before a run's first step and its progress bar) compiles or loads the accumulators:
+    silent when numba's cache holds them, one line before and one with the time after when it must compile (faked
+    cold: the cache answers, so the test stays fast), as the engine's and the output kernels do."""
+    import mbd.compiled as mc
+    from components.statistics.accumulate import accumulate_steps, accumulators_cached
+
+    bs = build(reference_dpgt(3, "forward"))
+    system = mbd.System(bs.model)
+    bind = lambda: WindowStatistics(bs, 0.0, 1.0, outputs="numpy").bind(bs.model, system, None)
+    bind()
+    assert accumulate_steps.signatures and accumulators_cached()      # compiled (or loaded) at bind, before a step
+    capsys.readouterr()
+    bind()
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(mc, "kernels_cached", lambda function="stepper.advance": False)
+    bind()
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 2 and err[0].startswith("mbd: compiling the statistics' accumulator kernels (") \
+        and err[1].startswith("mbd: accumulator kernels compiled in ")

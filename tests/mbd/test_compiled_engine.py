@@ -160,6 +160,28 @@ def test_the_kernel_cache_is_dropped_when_any_compiled_source_changes(tmp_path, 
     assert stale.exists() and (tmp_path / "compiled_sources.sha256").read_text() == stamp
 
 
+def test_the_cache_of_a_kernel_outside_the_package_is_read_from_its_own_index(tmp_path, monkeypatch):
+    """kernels_cached(f) for a cached numba function of another package (the statistics' accumulators): false before
+    its first call, true once numba has written its index, false again when its source is newer than the index (an
+    edit: numba would compile it again)."""
+    import importlib
+    import os
+    import sys
+
+    import mbd.compiled as mc
+    src = tmp_path / "probe_kernel.py"
+    src.write_text("from numba import njit\n\n\n@njit(cache=True)\ndef twice(x):\n    return 2.0 * x\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "probe_kernel", raising=False)
+    twice = importlib.import_module("probe_kernel").twice
+    assert not mc.kernels_cached(twice)
+    assert twice(1.5) == 3.0
+    assert mc.kernels_cached(twice)
+    later = os.stat(src).st_mtime + 10.0
+    os.utime(src, (later, later))
+    assert not mc.kernels_cached(twice)
+
+
 def test_a_run_that_must_compile_says_so_before_its_first_step(capsys, monkeypatch):
     """When numba's cache does not hold the step loop, building the compiled runner says so in one line, compiles
     before any step (a progress bar's ETA then leaves it out) and gives the time; with the cache warm it is

@@ -1,0 +1,311 @@
+"""The statistics' accumulators: the running sums of every per-step quantity (:mod:`.quantities`) over its window
+— time-weighted Σx dt and Σx² dt, maxima, minima — each window's length, the cages' angles and the pocket-impact
+counts, in :class:`Accumulators`; the arithmetic is one compiled loop over a block of steps
+(:func:`accumulate_steps`), so that a block of a few hundred steps costs one call.
+
+Per step [t_a, t_b] of size h, a quantity x is taken linear in the step (the trapezoid rule) between the
+step fractions w_a (the window's start inside the step, else 0) and w_1 (its window's end inside the step,
+else 1): Σx += ½(x(w_a) + x(w_1))·dt, Σx² += ½(x(w_a)² + x(w_1)²)·dt, dt = (w_1 − w_a)·h; max and min of
+its two ends over steps with dt > 0. A mesh quantity's window ends at t1; a bearing's when its cage has
+turned its whole number of revolutions relative to the carrier (its angle integrated by the same rule).
+
+The kernels compile (or load from numba's cache) before a run's first step, announced when they must compile
+(:func:`compile_accumulators`). Without numba the same functions run as plain Python (slowly, but the results
+are the same).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+try:
+    from numba import njit as _njit
+    from mbd import compiled as _compiled      # kernels_cached is read through the package when called
+    jit = _njit(cache=True)
+except ImportError:      # pragma: no cover - numba is a dependency; this keeps the module importable
+    _compiled = None
+
+    def jit(fn):
+        return fn
+
+__all__ = ["Accumulators", "accumulate_steps", "compile_accumulators", "IMPACT_ROWS"]
+
+# rows of the impact accumulator (one column per pocket contact)
+IMPACT_ROWS = ("count", "touches", "speed_sum", "speed_max", "peak_sum", "peak_max", "peak_now", "active")
+
+
+@jit
+def _max(a, b):
+    """max with NaN winning (as numpy's maximum)."""
+    if a != a or b != b:
+        return np.nan
+    return a if a >= b else b
+
+
+@jit
+def _min(a, b):
+    if a != a or b != b:
+        return np.nan
+    return a if a <= b else b
+
+
+@jit
+def _bearing_ends(i, wa, t_a, h, V, cage_cols, has_target, target, t1, angle, is_open, t_close, end):
+    """Fraction of step i at which each bearing's window ends, into ``end`` (1: still open after it; wa:
+    closed before it); the cage angles, open flags and closing times are updated."""
+    nb = end.size
+    if not has_target:             # the nominal window for every bearing
+        w = min(1.0, (t1 - t_a) / h)
+        for b in range(nb):
+            end[b] = max(w, wa) if is_open[b] else wa
+        if cage_cols.size:         # still count the cage's revolutions (impacts per revolution)
+            for b in range(nb):
+                w0, w1 = V[i, cage_cols[b]], V[i + 1, cage_cols[b]]
+                ws_a = w0 + wa * (w1 - w0)
+                ws_b = w0 + end[b] * (w1 - w0)
+                angle[b] = angle[b] + 0.5 * (ws_a + ws_b) * (end[b] - wa) * h
+        if w < 1.0:
+            for b in range(nb):
+                is_open[b] = False
+        return
+    for b in range(nb):
+        w0, w1 = V[i, cage_cols[b]], V[i + 1, cage_cols[b]]
+        ws_a = w0 + wa * (w1 - w0)
+        new = angle[b] + 0.5 * (ws_a + w1) * (1.0 - wa) * h
+        phi_a, phi_b = abs(angle[b]), abs(new)
+        goal = 2.0 * math.pi * target[b]
+        closing = is_open[b] and phi_b >= goal
+        frac = 1.0
+        if closing:
+            frac = (goal - phi_a) / (phi_b - phi_a if phi_b > phi_a else 1.0)
+        if is_open[b]:
+            end[b] = wa + min(max(frac, 0.0), 1.0) * (1.0 - wa)
+            angle[b] = math.copysign(goal, new) if closing else new
+        else:
+            end[b] = wa
+        if closing:
+            t_close[b] = t_a + end[b] * h
+            is_open[b] = False
+
+
+@jit
+def _impacts(i, t_b, t0, t_a, h, wb, V, Z, pocket_cols, pocket_bearing, v_floor, imp):
+    """Pocket impacts of step i: onsets (the pocket's stored approach speed turning > 0) faster than the
+    element's speed floor, their speed and peak force (up to each bearing's window end); slower onsets are
+    touches. ``imp``: rows :data:`IMPACT_ROWS`."""
+    for k in range(pocket_cols.size):
+        b = pocket_bearing[k]
+        z0, z1 = Z[i, k], Z[i + 1, k]
+        in_window = t_b > t0 and t_b <= t_a + wb[b] * h
+        contact = z0 <= 0.0 and z1 > 0.0 and in_window
+        touch = contact and z1 <= v_floor[k]
+        onset = contact and not touch
+        if touch:
+            imp[1, k] += 1.0
+        ended = imp[7, k] > 0.0 and (z1 <= 0.0 or not in_window)
+        f0, f1 = V[i, pocket_cols[k]], V[i + 1, pocket_cols[k]]
+        force = abs(f0 + wb[b] * (f1 - f0))
+        if imp[7, k] > 0.0:
+            imp[6, k] = _max(imp[6, k], force)
+        if ended:
+            imp[4, k] += imp[6, k]
+            imp[5, k] = _max(imp[5, k], imp[6, k])
+            imp[7, k] = 0.0
+            imp[6, k] = 0.0
+        if onset:
+            imp[0, k] += 1.0
+            imp[2, k] += z1
+            imp[3, k] = _max(imp[3, k], z1)
+            imp[7, k] = 1.0
+            imp[6, k] = force
+
+
+@jit
+def accumulate_steps(t, V, own, acc, T, angle, is_open, t_close, target, has_target, t0, t1, cage_cols,
+                     pocket_cols, pocket_bearing, Z, v_floor, imp):
+    """Accumulate the steps between consecutive rows of ``t`` (K+1,) / ``V`` (K+1, n_q) (every quantity,
+    flattened) into ``acc`` (4, n_q): Σx dt, Σx² dt, max, min; ``own`` (n_q,): each column's bearing or −1
+    (the mesh window [t0, t1]); ``T`` (n_b + 1,): time covered by each bearing's window, then the global
+    one; ``angle``, ``is_open``, ``t_close``, ``target`` (n_b,): the cages' angles, open windows, closing
+    times and whole revolutions (``has_target`` false: the nominal window); ``cage_cols`` (n_b,): the
+    columns of the cage speed relative to the carrier (empty without cages); ``pocket_cols``,
+    ``pocket_bearing``, ``v_floor`` (n_p,), ``Z`` (K+1, n_p): the pocket forces' columns, their bearings,
+    speed floors and stored approach speeds; ``imp`` (8, n_p) the impact rows. All updated in place."""
+    K = t.size - 1
+    nb = angle.size
+    nq = own.size
+    wb = np.empty(nb)
+    for i in range(K):
+        t_a, t_b = t[i], t[i + 1]
+        any_open = False
+        for b in range(nb):
+            any_open = any_open or is_open[b]
+        if t_b <= t0 or (t_a >= t1 and not any_open):
+            continue
+        h = t_b - t_a
+        wa = (max(t_a, t0) - t_a) / h
+        wg = (min(t_b, t1) - t_a) / h
+        _bearing_ends(i, wa, t_a, h, V, cage_cols, has_target, target, t1, angle, is_open, t_close, wb)
+        for j in range(nq):
+            w1 = wb[own[j]] if own[j] >= 0 else wg
+            x0, x1 = V[i, j], V[i + 1, j]
+            va, vb = x0 + wa * (x1 - x0), x0 + w1 * (x1 - x0)
+            dt = max(w1 - wa, 0.0) * h
+            acc[0, j] += 0.5 * (va + vb) * dt
+            acc[1, j] += 0.5 * (va * va + vb * vb) * dt
+            if dt > 0.0:
+                acc[2, j] = _max(acc[2, j], _max(va, vb))
+                acc[3, j] = _min(acc[3, j], _min(va, vb))
+        for b in range(nb):
+            T[b] += max(wb[b] - wa, 0.0) * h
+        T[nb] += max(wg - wa, 0.0) * h
+        if pocket_cols.size:
+            _impacts(i, t_b, t0, t_a, h, wb, V, Z, pocket_cols, pocket_bearing, v_floor, imp)
+
+
+class Accumulators:
+    """The running sums of every quantity over its window: per instance Σx dt, Σx² dt, max and min (one flat
+    (4, n) array; :meth:`stats` reads it back), the time each bearing's window and the global (mesh) one have
+    covered, the cages' angles relative to the carrier, and the pocket impacts (:data:`IMPACT_ROWS`).
+
+    ``n_bearings``; ``t0``, ``t1`` the nominal window [s]; ``target`` (n_b,) the whole cage revolutions that end
+    each bearing's window, or None (the nominal window); ``pocket_bearing`` (n_p,) each pocket's bearing and
+    ``v_floor`` (n_p,) the impact law's approach-speed floor (slower onsets are touches)."""
+
+    def __init__(self, n_bearings: int, t0: float, t1: float, target, pocket_bearing, v_floor):
+        self.t0, self.t1 = float(t0), float(t1)
+        self.has_target = target is not None
+        self.target = np.asarray(target if target is not None else np.zeros(n_bearings), float)
+        self.pocket_bearing = np.asarray(pocket_bearing, np.int64)
+        self.v_floor = np.asarray(v_floor, float)
+        self.flat, self.acc, self.keys, self.owners = None, {}, (), {}
+        self.T = np.zeros(n_bearings + 1)                   # time covered by each bearing's window, the global one
+        self.angle = np.zeros(n_bearings)                   # cage angle relative to the carrier since t0
+        self.open = np.ones(n_bearings, bool)               # bearing windows still open
+        self.t_close = np.full(n_bearings, np.nan)
+        self.imp = np.zeros((len(IMPACT_ROWS), self.pocket_bearing.size))
+        self.impact = dict(zip(IMPACT_ROWS, self.imp)) if self.imp.size else None    # row views
+
+    def layout(self, sizes: dict, owners: dict, cage_speed: str, pocket_force: str) -> None:
+        """Lay the flat accumulator out (zeros; ±inf extrema) for the quantities ``sizes`` {key: instances}, in that
+        order, each instance tagged with its bearing (``owners`` {key: (n,) or None: the global window}); if it
+        holds sums already (a checkpoint), only its views. ``cage_speed``, ``pocket_force``: the keys whose
+        columns the kernel reads for the cages' angles and the impact peaks."""
+        keys = list(sizes)
+        edges = np.concatenate([[0], np.cumsum([sizes[k] for k in keys])]).astype(int)
+        self.keys, self.owners = keys, dict(owners)
+        self._own_flat = np.concatenate([owners[k] if owners[k] is not None else np.full(sizes[k], -1)
+                                         for k in keys]).astype(np.int64)
+        if self.flat is None:
+            n = int(edges[-1])
+            self.flat = np.stack([np.zeros(n), np.zeros(n), np.full(n, -np.inf), np.full(n, np.inf)])
+        self.acc = {k: self.flat[:, a:b] for k, a, b in zip(keys, edges[:-1], edges[1:])}
+        col = dict(zip(keys, edges[:-1]))
+        self._cage_cols = (col[cage_speed] + np.arange(self.angle.size)).astype(np.int64) \
+            if cage_speed in col else np.zeros(0, np.int64)
+        npk = self.imp.shape[1]
+        self._pocket_cols = (col[pocket_force] + np.arange(npk)).astype(np.int64) if npk else np.zeros(0, np.int64)
+
+    def closed(self, t_start: float) -> bool:
+        """Has every window ended before ``t_start``?"""
+        return t_start >= self.t1 and not self.open.any()
+
+    def _flatten(self, rows, K: int) -> np.ndarray:
+        return np.concatenate([np.asarray(rows[k], float).reshape(K, -1) for k in self.keys], axis=1)
+
+    def add_steps(self, t, rows, Z) -> None:
+        """K steps: their K+1 ends ``t``, each quantity at them (``rows``), the pockets' stored approach speeds
+        ``Z`` (K+1, n_p)."""
+        V = self._flatten(rows, t.size)
+        Zf = np.ascontiguousarray(Z, float) if self.imp.size else np.zeros((t.size, 0))
+        accumulate_steps(t, V, self._own_flat, self.flat, self.T, self.angle, self.open, self.t_close, self.target,
+                         self.has_target, self.t0, self.t1, self._cage_cols, self._pocket_cols, self.pocket_bearing,
+                         Zf, self.v_floor, self.imp)
+
+    def add_samples(self, rows) -> None:
+        """K equally weighted states (``rows`` as for :meth:`add_steps`): each counts one unit of time in every
+        window, so means are plain averages and max/min the extremes over the states."""
+        K = len(rows[self.keys[0]])
+        V = self._flatten(rows, K)
+        self.flat[0] += V.sum(axis=0)
+        self.flat[1] += (V * V).sum(axis=0)
+        np.maximum(self.flat[2], V.max(axis=0), out=self.flat[2])
+        np.minimum(self.flat[3], V.min(axis=0), out=self.flat[3])
+        self.T += K
+
+    def close_impacts(self) -> None:
+        """Impacts still in progress when their window ended count with the peak they reached."""
+        im = self.impact
+        if im is None:
+            return
+        act = im["active"] > 0
+        im["peak_sum"] += np.where(act, im["peak_now"], 0.0)
+        np.maximum(im["peak_max"], np.where(act, im["peak_now"], 0.0), out=im["peak_max"])
+        im["active"][act] = 0.0
+        im["peak_now"][act] = 0.0
+
+    # reading back ---------------------------------------------------------------------------------
+    def stats(self, key: str) -> dict[str, np.ndarray]:
+        """mean, rms, max, min of a quantity over its window (arrays per instance)."""
+        acc = self.acc[key]
+        own = self.owners[key]
+        T = self.T[:-1][own] if own is not None else self.T[-1]
+        T = np.where(np.asarray(T) > 0, T, np.nan)
+        return {"mean": acc[0] / T, "rms": np.sqrt(np.maximum(acc[1], 0.0) / T), "max": acc[2], "min": acc[3]}
+
+    def aggregate_rms(self, key: str, bearings) -> float:
+        """RMS of a quantity over every instance that belongs to ``bearings`` (time-weighted, all windows)."""
+        own = self.owners[key]
+        mine = np.isin(own, bearings)
+        T = self.T[:-1][own[mine]]
+        return float(np.sqrt(self.acc[key][1][mine].sum() / T.sum()))
+
+    @property
+    def duration(self) -> float:
+        """Length of the global (mesh) window covered so far [s]."""
+        return self.T[-1]
+
+    def window_length(self, bearing: int) -> float:
+        """Length of bearing ``bearing``'s window covered so far [s]."""
+        return float(self.T[bearing])
+
+    def cage_revolutions(self, sel) -> float:
+        """Cage revolutions relative to the carrier in the windows of the bearings ``sel``, summed."""
+        return float(np.abs(self.angle[sel]).sum() / (2 * math.pi))
+
+    # checkpoints ---------------------------------------------------------------------------------
+    def state_dict(self) -> dict:
+        d = {"acc": self.flat} if self.flat is not None else {}
+        d.update({f"imp__{k}": v for k, v in (self.impact or {}).items()})
+        d.update({"T_global": np.array(self.T[-1]), "T_bearing": self.T[:-1], "angle": self.angle,
+                  "open": self.open, "t_close": self.t_close})
+        return d
+
+    def load_state_dict(self, d: dict) -> None:
+        """The sums of :meth:`state_dict` (lay them out again with :meth:`layout`)."""
+        self.acc, self.flat = {}, (d["acc"].copy() if "acc" in d else None)
+        for k in IMPACT_ROWS:
+            if f"imp__{k}" in d:
+                self.impact[k][:] = d[f"imp__{k}"]
+        if "T_global" in d:
+            self.T[:-1], self.T[-1] = d["T_bearing"], float(d["T_global"])
+            self.angle[:], self.open[:], self.t_close[:] = d["angle"], d["open"].astype(bool), d["t_close"]
+
+
+def accumulators_cached() -> bool:
+    """Does numba's disk cache hold the accumulators of this code (plain Python without numba: nothing to compile)?"""
+    return _compiled is None or _compiled.kernels_cached(accumulate_steps)
+
+
+def compile_accumulators() -> None:
+    """Compile (or load) the accumulators now, on a one-step toy window: a run does it before its first step (a
+    progress bar's ETA then leaves the compile out), saying so when it must compile, as the engine's kernels."""
+    if _compiled is None:      # pragma: no cover - plain Python
+        return
+    i0, f0 = np.zeros(0, np.int64), np.zeros(0)
+    toy = lambda: accumulate_steps(np.array([0.0, 1.0]), np.zeros((2, 1)), np.array([-1]), np.zeros((4, 1)),
+                                   np.zeros(2), np.zeros(1), np.ones(1, bool), np.zeros(1), np.ones(1), False, 0.0,
+                                   1.0, i0, i0, i0, np.zeros((2, 0)), f0, np.zeros((8, 0)))
+    _compiled.compile_announced(toy, cold=not accumulators_cached(), what="the statistics' accumulator kernels",
+                                done="accumulator kernels", about="a few seconds")

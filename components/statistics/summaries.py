@@ -1,0 +1,235 @@
+"""The numbers users read (summary.json, README), as functions of the accumulated sums (:class:`.accumulate.
+Accumulators`: time means, RMS values, extrema over each window): per bearing kind its load, rollers, pocket
+impacts, heat, film, lives and cage; per mesh type its flanks. Nothing here sees a state.
+
+Bearing lives (:mod:`components.life` owns the laws): ISO 281's from the bearing load's equivalent
+(mean P^(10/3)), and the ISO/TS 16281-style one from every roller's raceway loads, accumulated as
+(Q/Q_c)^4.5 on the pin (stationary relative to the load) and (Q/Q_c)^4 on the bore (rotating).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from mbd.elements.ehl import thermal_factor
+
+from ..life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
+                    iso281_rating, lundberg_palmgren_life)
+from .quantities import cage_slip_pct
+
+__all__ = ["run_summary", "bearing_summary", "load_summary", "roller_summary", "impact_summary", "life_summary",
+           "heat_summary", "film_summary", "cage_summary", "mesh_summary"]
+
+
+def run_summary(sums, p, ref_roller, w_rel: dict, loaded: bool) -> dict:
+    """The statistics users read (see README: summary.json): the windows, the drive's speed error, per bearing kind
+    :func:`bearing_summary`, per mesh type :func:`mesh_summary`. ``sums``: the :class:`~.accumulate.Accumulators`
+    (impacts closed); ``p``: the :class:`~.quantities.Plan`; ``ref_roller``: the (inner, outer) reference rollers;
+    ``w_rel``: {kind: the planet's speed relative to its pin [rad/s]} (a life's revolutions); ``loaded``: does the
+    train transmit torque?"""
+    out: dict = {"window_s": [sums.t0, sums.t1], "window_duration_s": sums.duration}
+    if "carrier_speed_error" in sums.acc:
+        # the time mean: a settled drive oscillates about its reference (mesh dynamics), an unsettled one is off
+        out["carrier_speed_error_mean_pct"] = float(100.0 * sums.stats("carrier_speed_error")["mean"][0])
+    for kind in ("inner", "outer"):
+        out[kind] = bearing_summary(sums, p, kind, ref_roller, w_rel[kind])
+    out["meshes"] = mesh_summary(sums, p, loaded)
+    return out
+
+
+def bearing_summary(sums, p, kind: str, ref_roller, w_rel: float) -> dict:
+    """Every statistic of the bearings of ``kind`` ("inner"/"outer"): pair 1's (the reference) and all of this
+    kind (arguments as :func:`run_summary`'s); ``whole_revolutions`` says whether every window of this kind
+    ended on its cage's whole revolutions (not given for windows of the nominal length)."""
+    sel = np.flatnonzero(p.kinds == kind)
+    ref = int(sel[0])
+    d: dict = {"window_s": [sums.t0, float(sums.t0 + sums.window_length(ref))]}
+    if sums.has_target:
+        d["whole_revolutions"] = bool(not sums.open[sel].any())
+    load_summary(d, sums, ref, sel)
+    if p.rollers:
+        roller_summary(d, sums, p, ref_roller[0 if kind == "inner" else 1], sel)
+        heat_summary(d, sums, ref, sel)
+        if p.lubricant is not None:
+            film_summary(d, sums, sel)
+    life_summary(d, sums, p, w_rel, ref, sel)
+    if p.cage is not None:
+        cage_summary(d, sums, p, ref, sel)
+    d["life_L10_relative"] = None     # filled by a study relative to its forward run
+    return d
+
+
+def load_summary(d, sums, ref, sel) -> None:
+    """The bearing load (pin reaction): its time-mean vector's length, components and maximum, per planet; the
+    load sharing between the planets of this row (ISO 6336's K_γ: the most loaded over the mean); the ISO 281
+    equivalent load (mean P^(10/3))^(3/10)."""
+    lr, lt, lm = sums.stats("load_radial"), sums.stats("load_tangential"), sums.stats("load_magnitude")
+    mean_vec = np.hypot(lr["mean"], lt["mean"])
+    d["bearing_load_mean_N"] = float(mean_vec[ref])
+    d["bearing_load_mean_all_N"] = float(mean_vec[sel].mean())
+    d["bearing_load_mean_per_planet_N"] = [float(x) for x in mean_vec[sel]]
+    d["load_sharing_factor"] = float(mean_vec[sel].max() / mean_vec[sel].mean())
+    d["bearing_load_radial_mean_N"] = float(lr["mean"][ref])
+    d["bearing_load_tangential_mean_N"] = float(lt["mean"][ref])
+    d["bearing_load_max_N"] = float(lm["max"][ref])
+    d["bearing_load_max_per_planet_N"] = [float(x) for x in lm["max"][sel]]
+    d["equivalent_load_N"] = float(sums.stats("load_life")["mean"][ref] ** (1.0 / LIFE_EXPONENT))
+
+
+def roller_summary(d, sums, p, r: int, sel) -> None:
+    """Raceway and pocket forces of the reference roller ``r`` (RMS, max, mean) and, in ``all_rollers``, of every
+    roller of the bearings ``sel``; the spread of the rollers' mean loads (0 over whole cage revolutions)."""
+    mine = np.isin(p.roller_bearing, sel)
+    al = {}
+    for name, key in (("inner_race", "roller_inner_load"), ("outer_race", "roller_outer_load")):
+        st = sums.stats(key)
+        d[f"roller_{name}_rms_N"] = float(st["rms"][r])
+        d[f"roller_{name}_max_N"] = float(st["max"][r])
+        d[f"roller_{name}_mean_N"] = float(st["mean"][r])
+        al[f"roller_{name}_rms_N"] = sums.aggregate_rms(key, sel)
+        al[f"roller_{name}_max_N"] = float(st["max"][mine].max())
+    mean_loads = sums.stats("roller_inner_load")["mean"][p.roller_bearing == p.roller_bearing[r]]
+    d["roller_inner_race_mean_spread"] = float((mean_loads.max() - mean_loads.min()) / mean_loads.mean())
+    if p.pocket_bearing is not None:
+        st = sums.stats("pocket_force")
+        pk = np.isin(p.pocket_bearing, sel)
+        # pocket instances follow the rollers one to one
+        d["roller_cage_rms_N"] = float(st["rms"][r])
+        d["roller_cage_max_N"] = float(max(st["max"][r], -st["min"][r]))
+        al["roller_cage_rms_N"] = sums.aggregate_rms("pocket_force", sel)
+        al["roller_cage_max_N"] = float(max(st["max"][pk].max(), -st["min"][pk].min()))
+        if sums.impact is not None:
+            impact_summary(d, sums, pk, sel)
+    d["all_rollers"] = al
+
+
+def impact_summary(d, sums, pk, sel) -> None:
+    """Pocket impacts of the pockets ``pk`` (a mask) in the windows of the bearings ``sel``: their count, per cage
+    revolution relative to the carrier (touches too), approach speed and peak force (max and mean)."""
+    im = sums.impact
+    count = im["count"][pk].sum()
+    revs = sums.cage_revolutions(sel)
+    d["pocket_impacts"] = int(count)
+    d["pocket_impacts_per_rev"] = float(count / revs) if revs > 0 else None
+    d["pocket_touches_per_rev"] = float(im["touches"][pk].sum() / revs) if revs > 0 else None
+    d["pocket_impact_speed_max_m_s"] = float(im["speed_max"][pk].max())
+    d["pocket_impact_speed_mean_m_s"] = float(im["speed_sum"][pk].sum() / count) if count else 0.0
+    d["pocket_impact_peak_max_N"] = float(im["peak_max"][pk].max())
+    d["pocket_impact_peak_mean_N"] = float(im["peak_sum"][pk].sum() / count) if count else 0.0
+
+
+def life_summary(d, sums, p, w_rel, ref, sel) -> None:
+    """ISO 281 L10 from the bearing load and the ISO/TS 16281-style L10 from the roller loads
+    (:mod:`components.life`), in 10^6 revolutions of the planet relative to its pin and in hours at the
+    nominal relative speed ``w_rel``: pair 1's bearing, in ``all_rollers`` every bearing of this kind pooled,
+    and each planet's own."""
+    b = p.bearing
+    d["dynamic_load_rating_N"] = iso281_rating(b)
+    cases = [(d, np.array([ref]))]
+    if p.rollers:
+        cases.append((d["all_rollers"], sel))
+    # each planet's own bearing: the most loaded one's life is what unequal load sharing costs
+    each = [({}, np.array([i])) for i in sel]
+    for out, bearings in cases + each:
+        P = float(np.mean(sums.stats("load_life")["mean"][bearings]) ** (1.0 / LIFE_EXPONENT))
+        out["life_iso281_Mrev"] = iso281_life(P, b)
+        out["life_iso281_h"] = hours(out["life_iso281_Mrev"], w_rel)
+        if not p.rollers:
+            continue
+        mine = np.isin(p.roller_bearing, bearings)
+        q_pin = p.qc[0] * float(equivalent_load(sums.stats("roller_inner_fatigue")["mean"][mine].mean(),
+                                                STATIONARY_EXPONENT))
+        q_bore = p.qc[1] * float(equivalent_load(sums.stats("roller_outer_fatigue")["mean"][mine].mean(),
+                                                 ROTATING_EXPONENT))
+        out["roller_equivalent_load_pin_N"], out["roller_equivalent_load_bore_N"] = q_pin, q_bore
+        out["life_iso16281_Mrev"] = lundberg_palmgren_life(q_pin, q_bore, b)
+        out["life_iso16281_h"] = hours(out["life_iso16281_Mrev"], w_rel)
+    d["life_iso281_per_planet_h"] = [e["life_iso281_h"] for e, _ in each]
+    if p.rollers:
+        d["life_iso16281_per_planet_h"] = [e["life_iso16281_h"] for e, _ in each]
+
+
+def heat_summary(d, sums, ref, sel) -> None:
+    """Heat from traction and land friction (time means, W): the reference bearing's and the mean of its
+    kind; the largest traction coefficient of a loaded contact."""
+    for key, name in (("heat_traction", "traction"), ("heat_land", "land")):
+        if key in sums.acc:
+            m = sums.stats(key)["mean"]
+            d[f"heat_{name}_W"] = float(m[ref])
+            d[f"heat_{name}_all_W"] = float(m[sel].mean())
+    d["traction_coefficient_max"] = float(sums.stats("traction_coefficient")["max"][sel].max())
+
+
+def film_summary(d, sums, sel) -> None:
+    """The thinnest EHL film of the bearings ``sel`` (every bearing of this kind): its smallest value in
+    the window and its time mean (the worst bearing's), in metres and as Λ = h_min/σ; the smallest
+    isothermal film; the largest thermal loading L at the thinnest film's contact, and of any loaded
+    contact with its factor φ_T(L) (the smallest); the largest load parameter W' and the smallest h_c/h_min
+    of Pan & Hamrock's fit."""
+    h, lam = sums.stats("film_thinnest"), sums.stats("film_lambda")
+    d["film_min_m"] = float(h["min"][sel].min())
+    d["film_mean_m"] = float(h["mean"][sel].min())
+    d["lambda_min"] = float(lam["min"][sel].min())
+    d["lambda_mean"] = float(lam["mean"][sel].min())
+    d["film_min_isothermal_m"] = float(sums.stats("film_thinnest_isothermal")["min"][sel].min())
+    d["film_min_thermal_loading"] = float(sums.stats("film_thinnest_loading")["max"][sel].max())
+    L = float(sums.stats("film_thermal_loading")["max"][sel].max())
+    d["film_thermal_loading_max"] = L
+    d["film_thermal_factor_min"] = float(thermal_factor(L))      # φ_T falls as L grows
+    d["film_load_parameter_max"] = float(sums.stats("film_load_parameter")["max"][sel].max())
+    d["film_central_ratio_min"] = float(sums.stats("film_central_ratio")["min"][sel].min())
+
+
+def cage_summary(d, sums, p, ref, sel) -> None:
+    """The cage's acceleration in the carrier frame (own and relative to its planet: RMS and largest magnitude
+    of each component) of the reference bearing and, in ``all_cages``, RMS over every cage of this kind; its slip
+    below the epicyclic speed (time-mean speeds) and revolutions; the guide-land force."""
+    for view in ("", "rel_"):
+        for comp in ("radial", "tangential", "magnitude"):
+            st = sums.stats(f"cage_acc_{view}{comp}")
+            d[f"cage_acc_{view}{comp}_rms_m_s2"] = float(st["rms"][ref])
+            d[f"cage_acc_{view}{comp}_max_m_s2"] = float(max(st["max"][ref], -st["min"][ref]))
+    for comp in ("x", "y"):
+        d[f"cage_acc_{comp}_rms_m_s2"] = float(sums.stats(f"cage_acc_{comp}")["rms"][ref])
+    # every cage of this bearing type: RMS over all their windows (steadier than one cage's)
+    d["all_cages"] = {f"cage_acc_{view}{comp}_rms_m_s2": sums.aggregate_rms(f"cage_acc_{view}{comp}", sel)
+                      for view in ("", "rel_") for comp in ("radial", "tangential", "magnitude")}
+    slip = cage_slip_pct(sums.stats("cage_speed_rel")["mean"], sums.stats("planet_speed_rel")["mean"], p.pitch_ratio)
+    d["cage_slip_pct"] = float(slip[ref])
+    d["cage_slip_all_pct"] = float(slip[sel].mean())
+    d["cage_revolutions"] = float(abs(sums.angle[ref]) / (2 * math.pi))
+    if p.guide is not None:
+        st = sums.stats("guide_force")
+        d["cage_guide_rms_N"] = float(st["rms"][ref])
+        d["cage_guide_max_N"] = float(st["max"][ref])
+        d["cage_guide_mean_N"] = float(st["mean"][ref])
+        d.setdefault("all_rollers", {})["cage_guide_rms_N"] = sums.aggregate_rms("guide_force", sel)
+        d["all_cages"]["cage_guide_rms_N"] = d["all_rollers"]["cage_guide_rms_N"]
+
+
+def mesh_summary(sums, p, loaded: bool) -> dict:
+    """Per mesh type, over all planet pairs: mean (average of the pairs) and max of each flank; the loaded
+    transmission error's peak-to-peak (the drive flank's compression, max − min over the window) and the
+    dynamic factor K_v = max / mean of the drive flank's force (ISO 6336-1's notion, from the run; None when
+    the train transmits no torque, ``loaded`` false), the largest of the pairs and per pair."""
+    out = {}
+    for key in p.meshes:
+        d = {"drive_flank": int(p.flanks.get(key, 1))}
+        for flank in ("drive", "coast"):
+            f, x = sums.stats(f"{key}_{flank}_force"), sums.stats(f"{key}_{flank}_deflection")
+            d[f"{flank}_force_mean_N"] = float(f["mean"].mean())
+            d[f"{flank}_force_max_N"] = float(f["max"].max())
+            d[f"{flank}_deflection_mean_m"] = float(x["mean"].mean())
+            d[f"{flank}_deflection_max_m"] = float(x["max"].max())
+            d[f"{flank}_force_mean_per_pair_N"] = [float(y) for y in f["mean"]]
+        f, x = sums.stats(f"{key}_drive_force"), sums.stats(f"{key}_drive_deflection")
+        te = x["max"] - x["min"]
+        # K_v has no meaning where the train transmits no torque (condition 4): no nominal load to scale
+        kv = f["max"] / np.where(loaded & (f["mean"] > 0), f["mean"], np.nan)
+        d["te_peak_to_peak_m"] = float(te.max())
+        d["te_peak_to_peak_per_pair_m"] = [float(y) for y in te]
+        d["dynamic_factor"] = float(np.nanmax(kv)) if np.any(np.isfinite(kv)) else None
+        d["dynamic_factor_per_pair"] = [float(y) if np.isfinite(y) else None for y in kv]
+        out[key] = d
+    return out
