@@ -355,6 +355,7 @@ class RigSolution:
     steps: int = 0
     error_rms: float = float("nan")   # HHT local error estimate over the accepted steps, in units of atol
     error_max: float = float("nan")
+    runs: tuple = ()                  # the mbd.SimResult of each piece (which engine ran, its counters)
 
     def summary(self) -> dict:
         return {"radial_load_N": self.radial_load, "q_max_N": self.q_max, "stribeck": self.stribeck,
@@ -415,4 +416,4 @@ def rig_static_solution(built: BearingRigScene, *, t_settle: float | None = None
                        deflection=defl, sideways=side, load_sum=mean("load_sum"), pin_force=mean("pin_force"),
                        ring_force=mean("ring_force"), radial_load=F, load_vector=F * u, wall_s=wall,
                        zone_tol=zone_tol, steps=steps, error_rms=err_rms,
-                       error_max=max((r.error_max for r in pieces), default=0.0))
+                       error_max=max((r.error_max for r in pieces), default=0.0), runs=tuple(pieces))

@@ -45,7 +45,7 @@ from components.results.schema import drawing_geometry, element_probes
 from .integrity import checkpoint_usable, claim_folder, read_summary, results_intact
 from .lock import folder_lock
 
-__all__ = ["RunConfig", "run_case", "finished_run", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
+__all__ = ["RunConfig", "run_case", "engine_record", "finished_run", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
            "accuracy_line", "code_digest", "FIXED_STEP_ERROR_FACTOR"]
 
 # A fixed-step run whose RMS local error estimate exceeds its tolerance (atol) by more than this factor ends
@@ -256,7 +256,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
                      + validity_warnings(params.si(), summary)),
         "wall_s": wall, "steps": res.steps, "rejected_steps": res.counters["rejected"],
         "newton_per_step": res.counters["newton"] / max(res.steps, 1),
-        "engine": res.engine, "engine_note": res.engine_note,    # which path ran, and why it fell back
+        **engine_record([res]),
         "resumed_from_s": res.resumed_from,
         "error_estimate": {
             "kind": "HHT local displacement error estimate (Zienkiewicz-Xie, (beta-1/6) h^2 (a1-a0)), "
@@ -270,6 +270,18 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     })
     write_summary(out_dir, summary)
     return Summary(summary)
+
+
+def engine_record(results) -> dict:
+    """summary.json's ``engine`` (which engine path ran: "compiled" or "numpy") and ``engine_note`` (why "auto" fell
+    back to numpy; None when it did not), from the :class:`mbd.SimResult` of each ``simulate`` call of one run (one
+    for :func:`run_case`, one per sampled piece for the bearing rig). The pieces of a run share its system and
+    settings, so one path ran; a mix would be a bug, and is refused rather than reported as one of them."""
+    paths = {(r.engine, r.engine_note) for r in results}
+    if len(paths) != 1:
+        raise mbd.ModelError(f"engine_record: expected the results of one engine path, got {sorted(paths, key=str)}")
+    engine, note = paths.pop()
+    return {"engine": engine, "engine_note": note}
 
 
 # the unit of each IntegratorSettings field, as summary.json's key suffix (README: What summary.json holds)

@@ -277,8 +277,31 @@ def test_bearing_rig_scenario(tmp_path, capsys):
     e = s["error_estimate"]
     assert s["steps"] > 0 and 0 < e["rms"] <= e["max"] <= 1.5 and e["atol_m"] == 1e-8
     assert "run time and accuracy: " in capsys.readouterr().out
+    # which engine ran, in run_case's keys (numba is installed here: the compiled path, no fallback to explain)
+    assert s["engine"] == "compiled" and s["engine_note"] is None
+    assert json.loads((tmp_path / "summary.json").read_text())["engine"] == "compiled"
     with pytest.raises(SystemExit, match="radial-load: expected a force"):
         bearing_rig.parse_args(["--radial-load", "5 m", "--out", str(tmp_path)])
+
+
+def test_bearing_rig_says_it_fell_back_when_numba_is_missing(tmp_path):
+    """With numba hidden (``import numba`` raising, as on a machine where it does not install) the rig runs the
+    numpy path and its summary.json says so: engine "numpy" and the reason (numba's import) in engine_note."""
+    import os
+    import subprocess
+    import sys
+
+    from tests.support import ROOT
+
+    code = ('import sys; sys.modules["numba"] = None\n'
+            'from scenarios import bearing_rig\n'
+            f'bearing_rig.run(bearing_rig.parse_args(["--radial-load", "5 kN", "--out", {str(tmp_path)!r}]))\n')
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
+    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["engine"] == "numpy" and "numba" in s["engine_note"]
+    assert "mbd: running the numpy engine path" in r.stderr         # said on screen, not only in the file
 
 
 def test_modal_scenario_single_planetary(tmp_path):
