@@ -14,8 +14,12 @@ Without numba the same functions run as plain Python (slowly, but the results ar
 from __future__ import annotations
 
 import math
+import sys
+import time
 
 import numpy as np
+
+from mbd.compile_time import compiling
 
 try:
     from numba import njit as _njit
@@ -24,7 +28,7 @@ except ImportError:      # pragma: no cover - numba is a dependency; this keeps 
     def jit(fn):
         return fn
 
-__all__ = ["accumulate_steps", "IMPACT_ROWS"]
+__all__ = ["accumulate_steps", "warm_accumulators", "IMPACT_ROWS"]
 
 # rows of the impact accumulator (one column per pocket contact)
 IMPACT_ROWS = ("count", "touches", "speed_sum", "speed_max", "peak_sum", "peak_max", "peak_now", "active")
@@ -157,3 +161,20 @@ def accumulate_steps(t, V, own, acc, T, angle, is_open, t_close, target, has_tar
         T[nb] += max(wg - wa, 0.0) * h
         if pocket_cols.size:
             _impacts(i, t_b, t0, t_a, h, wb, V, Z, pocket_cols, pocket_bearing, v_floor, imp)
+
+
+def warm_accumulators() -> None:
+    """Compile (or load) the accumulators now, on a one-step toy window with the argument types of the statistics'
+    calls, timed as compile time (:mod:`mbd.compile_time`): the statistics call it when they are bound, so a run
+    that must compile them does so before its first step (not inside its progress bar and wall time) and says so."""
+    i0, f0 = np.zeros(0, np.int64), np.zeros(0)
+    # numba's count of compiles (cache misses) in this process; none without numba (plain Python: nothing compiles)
+    misses = lambda: sum(accumulate_steps.stats.cache_misses.values()) if hasattr(accumulate_steps, "stats") else 0
+    m0, t0 = misses(), time.perf_counter()
+    with compiling():
+        accumulate_steps(np.array([0.0, 1.0]), np.zeros((2, 1)), np.array([-1]), np.zeros((4, 1)), np.zeros(2),
+                         np.zeros(1), np.ones(1, bool), np.zeros(1), np.ones(1), False, 0.0, 1.0, i0, i0, i0,
+                         np.zeros((2, 0)), f0, np.zeros((8, 0)))
+    if misses() > m0:
+        print(f"components: statistics' accumulators compiled in {time.perf_counter() - t0:.0f} s (the first run of "
+              "this code on this machine; then cached)", file=sys.stderr, flush=True)

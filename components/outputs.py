@@ -34,7 +34,7 @@ from mbd.ad import wrap_angle
 from mbd.simulate import ENGINES
 from mbd.elements.ehl import thermal_factor
 
-from .accumulate import IMPACT_ROWS, accumulate_steps
+from .accumulate import IMPACT_ROWS, accumulate_steps, warm_accumulators
 from .bearing import bearing_kinematics
 from .families import FAMILY, MESH_FAMILY
 from .life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
@@ -274,6 +274,7 @@ class WindowStatistics(mbd.Observer):
     def bind(self, model, system, state) -> None:
         self.model, self.system = model, system
         self._outputs = mbd.output_evaluator(system, self.outputs)
+        warm_accumulators()      # compiled (or loaded) before the first step, not inside the run's time
         fams = {e.name for e in model.elements}
         bm = self.bmap
         idx = lambda name: model.body(name).index

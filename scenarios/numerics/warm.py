@@ -20,9 +20,10 @@ import warnings
 import numpy as np
 
 import mbd
-from components.accumulate import accumulate_steps
+from components.accumulate import accumulate_steps, warm_accumulators
 from components.dpgt import build_dpgt
 from components.presets import reference_dpgt
+from mbd.compile_time import compiled_here
 from mbd.compiled.outputs import family_outputs
 from mbd.compiled.runner import CompiledRunner
 from mbd.compiled.stepper import advance
@@ -37,18 +38,10 @@ def main(argv=None) -> int:
     system = mbd.System(scene.model)
     CompiledRunner(system, s.stepper(), s.controller())
     _warm_outputs(system, scene)
-    _warm_accumulators()
+    warm_accumulators()
     print(warm_line({"engine": advance, "outputs": family_outputs, "accumulators": accumulate_steps},
                     time.perf_counter() - t0), flush=True)
     return 0
-
-
-def compiled_here(kernel) -> bool:
-    """Did this process compile ``kernel`` (a numba dispatcher) instead of loading it from the disk cache? True when
-    numba counted a cache miss, or no hit at all (a kernel not called, or a cache that could not be read, was not
-    loaded from it)."""
-    st = kernel.stats
-    return sum(st.cache_misses.values()) > 0 or sum(st.cache_hits.values()) == 0
 
 
 def warm_line(groups: dict, seconds: float) -> str:
@@ -66,14 +59,6 @@ def _warm_outputs(system, scene) -> None:
     """The compiled element outputs the statistics read (mbd.compiled.outputs), at the scene's start state."""
     z = {k: np.asarray(x)[None] for k, x in system.init_internal().items()}
     mbd.output_evaluator(system, "compiled").outputs_batch(np.zeros(1), scene.q0[None], scene.v0[None], z)
-
-
-def _warm_accumulators() -> None:
-    """The statistics' compiled accumulators (components.accumulate), on a one-step toy window."""
-    i0, f0 = np.zeros(0, np.int64), np.zeros(0)
-    accumulate_steps(np.array([0.0, 1.0]), np.zeros((2, 1)), np.array([-1]), np.zeros((4, 1)), np.zeros(2), np.zeros(1),
-                     np.ones(1, bool), np.zeros(1), np.ones(1), False, 0.0, 1.0, i0, i0, i0, np.zeros((2, 0)), f0,
-                     np.zeros((8, 0)))
 
 
 if __name__ == "__main__":

@@ -129,7 +129,7 @@ def test_warm_reads_numba_s_own_count_of_compiles(tmp_path):
     from tests.support import ROOT
 
     (tmp_path / "tiny_kernel.py").write_text("from numba import njit\n\n@njit(cache=True)\ndef f(x):\n    return 2 * x\n")
-    code = ("import tiny_kernel\nfrom scenarios.numerics.warm import compiled_here\n"
+    code = ("import tiny_kernel\nfrom mbd.compile_time import compiled_here\n"
             "tiny_kernel.f(1.0)\nprint(compiled_here(tiny_kernel.f))\n")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)]),
            "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
