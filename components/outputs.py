@@ -35,7 +35,7 @@ from mbd.simulate import ENGINES
 from mbd.elements.ehl import thermal_factor
 
 from .accumulate import IMPACT_ROWS, accumulate_steps, warm_accumulators
-from .bearing import bearing_kinematics
+from .bearing import bearing_kinematics, cage_slip_pct
 from .families import FAMILY, MESH_FAMILY
 from .life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
                    iso281_rating, lundberg_palmgren_life, raceway_ratings, relative_life)
@@ -173,9 +173,7 @@ class BearingSeries:
         else:
             self.spring = np.array([b["spring"] for b in self.bmap])
         self.cage = np.array([idx(b["cage"]) for b in self.bmap]) if self.rollers and "cage" in self.bmap[0] else None
-        bs = scene.bearing
-        Ri, Ro = 0.5 * (bs.pitch_diameter - bs.roller_diameter), 0.5 * (bs.pitch_diameter + bs.roller_diameter)
-        self.pitch_ratio = Ro / (Ri + Ro)
+        self.bearing = scene.bearing
         self.names = tuple(b["name"] for b in self.bmap)
 
     def load(self, t, X, V, A, outputs) -> np.ndarray:
@@ -188,9 +186,8 @@ class BearingSeries:
         return np.array(radial_tangential(pin, X[self.planet, :2], X[self.carrier, :2]))
 
     def slip(self, t, X, V, A, outputs) -> np.ndarray:
-        w_cage = V[self.cage, 2] - V[self.carrier, 2]
-        w_epi = self.pitch_ratio * (V[self.planet, 2] - V[self.carrier, 2])
-        return 100.0 * (1.0 - w_cage / np.where(w_epi != 0.0, w_epi, np.nan))
+        """Cage slip per bearing [%] (``cage_slip_pct``'s definition) from the body speeds ``V`` (bodies, 3)."""
+        return cage_slip_pct(self.bearing, V[self.cage, 2] - V[self.carrier, 2], V[self.planet, 2] - V[self.carrier, 2])
 
     def probes(self) -> list:
         where = "radial: from the carrier axis through the planet; tangential 90 deg ahead"
@@ -223,7 +220,6 @@ class _Plan:
     guide: np.ndarray | None     # guide instance per bearing
     spring: np.ndarray | None    # bearing_linear instance per bearing
     rows: int
-    pitch_ratio: float           # R_o/(R_i + R_o): epicyclic cage speed / planet speed, relative to the pin
 
 
 class WindowStatistics(mbd.Observer):
@@ -280,7 +276,6 @@ class WindowStatistics(mbd.Observer):
         idx = lambda name: model.body(name).index
         rollers = bm[0]["type"] == "rollers"
         b = self.scene.bearing
-        Ri, Ro = 0.5 * (b.pitch_diameter - b.roller_diameter), 0.5 * (b.pitch_diameter + b.roller_diameter)
         cage = np.array([idx(x["cage"]) for x in bm]) if rollers and "cage" in bm[0] else None
         rb = np.concatenate([np.full(x["race_inner"][1] - x["race_inner"][0], i) for i, x in enumerate(bm)]) \
             if rollers else None
@@ -292,7 +287,7 @@ class WindowStatistics(mbd.Observer):
             cage=cage, carrier=idx("carrier"), roller_bearing=rb, roller_body=rbody, pocket_bearing=pb,
             guide=np.array([x["guide"] for x in bm]) if rollers and "guide" in bm[0] else None,
             spring=np.array([x["spring"] for x in bm]) if not rollers else None,
-            rows=int(getattr(b, "rows", 1)), pitch_ratio=Ro / (Ri + Ro))
+            rows=int(getattr(b, "rows", 1)))
         self.meshes = {k: f for k, f in MESH_FAMILY.items() if f in fams}
         self._families = {FAMILY[k] for k in ("race_inner", "race_outer", "pocket", "guide", "linear")} \
             | set(self.meshes.values())
@@ -757,9 +752,7 @@ class WindowStatistics(mbd.Observer):
         # every cage of this bearing type: RMS over all their windows (steadier than one cage's)
         d["all_cages"] = {f"cage_acc_{view}{comp}_rms_m_s2": self.aggregate_rms(f"cage_acc_{view}{comp}", sel)
                           for view in ("", "rel_") for comp in ("radial", "tangential", "magnitude")}
-        w_cage = self.stats("cage_speed_rel")["mean"]
-        w_epi = p.pitch_ratio * self.stats("planet_speed_rel")["mean"]
-        slip = 100.0 * (1.0 - w_cage / w_epi)
+        slip = cage_slip_pct(self.scene.bearing, self.stats("cage_speed_rel")["mean"], self.stats("planet_speed_rel")["mean"])
         d["cage_slip_pct"] = float(slip[ref])
         d["cage_slip_all_pct"] = float(slip[sel].mean())
         d["cage_revolutions"] = float(abs(self._angle[ref]) / (2 * math.pi))
