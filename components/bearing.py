@@ -79,6 +79,15 @@ def bearing_kinematics(b: BearingSI, omega_inner: float, omega_outer: float) -> 
     return wm, wm - 2.0 * (omega_inner - wm) * Ri / D
 
 
+def cage_slip_pct(b: BearingSI, cage_speed_rel, planet_speed_rel):
+    """Cage slip [%], the one definition (results.nc's series and summary.json's ``cage_slip_pct``): how far the cage
+    turns below its pure-rolling speed, both speeds relative to the pin (the carrier), 100 (1 − ω_cage/ω_m) with ω_m
+    from :func:`bearing_kinematics` (pin at rest, the planet's bore at ``planet_speed_rel``). Arrays or scalars;
+    NaN where the planet does not turn relative to its pin (no rolling speed to slip from)."""
+    w_m, _ = bearing_kinematics(b, 0.0, np.asarray(planet_speed_rel, float))
+    return 100.0 * (1.0 - np.asarray(cage_speed_rel, float) / np.where(w_m != 0.0, w_m, np.nan))
+
+
 def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, outer_body: str, bearing: BearingSI,
                        lubricant: LubricantSI | None, pin_xy, pin_vel, omega_pin: float, omega_outer: float,
                        damage: dict) -> BearingHandles:

@@ -28,13 +28,13 @@ import numpy as np
 
 import mbd
 
+from .bearing import cage_slip_pct
 from .families import FAMILY, MESH_FAMILY
 from .life import LIFE_EXPONENT, relative_life
 # the words and units of summary keys: owned by the results module, re-exported here
 from .results.summary import DIMENSIONLESS_KEYS, SUMMARY_WORDS, UNIT_SUFFIXES, unit_of_key
 from .statistics import (WindowStatistics, bearing_map, cage_period, carrier_frame_motion, contact_film,
                          default_window, pin_reactions, radial_tangential)
-from .statistics.quantities import cage_slip_pct, pitch_ratio
 
 __all__ = ["FAMILY", "MESH_FAMILY", "BearingSeries", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
            "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life",
@@ -61,7 +61,7 @@ class BearingSeries:
         else:
             self.spring = np.array([b["spring"] for b in self.bmap])
         self.cage = np.array([idx(b["cage"]) for b in self.bmap]) if self.rollers and "cage" in self.bmap[0] else None
-        self.pitch_ratio = pitch_ratio(scene.bearing)
+        self.bearing = scene.bearing
         self.names = tuple(b["name"] for b in self.bmap)
 
     def load(self, t, X, V, A, outputs) -> np.ndarray:
@@ -74,9 +74,8 @@ class BearingSeries:
         return np.array(radial_tangential(pin, X[self.planet, :2], X[self.carrier, :2]))
 
     def slip(self, t, X, V, A, outputs) -> np.ndarray:
-        """Cage slip per bearing [%] (:func:`~components.statistics.quantities.cage_slip_pct`)."""
-        return cage_slip_pct(V[self.cage, 2] - V[self.carrier, 2], V[self.planet, 2] - V[self.carrier, 2],
-                             self.pitch_ratio)
+        """Cage slip per bearing [%] (:func:`components.bearing.cage_slip_pct`) from the body speeds ``V``."""
+        return cage_slip_pct(self.bearing, V[self.cage, 2] - V[self.carrier, 2], V[self.planet, 2] - V[self.carrier, 2])
 
     def probes(self) -> list:
         where = "radial: from the carrier axis through the planet; tangential 90 deg ahead"

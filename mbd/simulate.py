@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .assembly import System
+from .compile_time import compiling
 from .errors import IntegrationError, ModelError
 from .hht import HHT, NewtonCache, StepInfo
 from .model import Model, State
@@ -233,7 +234,8 @@ def _engine(engine: str, system: System, stepper, controller):
         return None, "numpy", None
     try:
         from .compiled.runner import CompiledRunner  # deferred: numba kernels, optional (numpy falls back)
-        return CompiledRunner(system, stepper, controller), "compiled", None
+        with compiling():        # its twin of the system and its step loop compile or load here, before any step
+            return CompiledRunner(system, stepper, controller), "compiled", None
     except (ImportError, NotImplementedError) as exc:
         if engine == "compiled":
             raise ModelError(f"simulate: the compiled engine cannot run this model: {exc}") from None
@@ -258,7 +260,8 @@ def output_evaluator(system: System, engine: str = "auto"):
         if engine == "compiled":
             raise ModelError(f"output_evaluator: the compiled outputs cannot run: {exc}") from None
         return system
-    return CompiledOutputs(system)
+    with compiling():            # the output kernels compile or load here
+        return CompiledOutputs(system)
 
 
 class _Loop:

@@ -7,7 +7,8 @@ presses the rollers onto the pin (the ring is pulled along the load, so that cen
 pull, on the pin's far side).
 Writes DIR/summary.json (radial_load_N, clearance_m, roller_angle_deg from the load-zone centre,
 roller_load_N time-mean per roller, q_max_N, stribeck_ratio = Q_max·Z/F_r, load_zone_deg, ring_deflection_m,
-and the classical discrete-roller solution for comparison) and DIR/load_distribution.png (polar: the
+the classical discrete-roller solution for comparison, and how it ran: steps, error estimate, wall_s without the
+kernels' compile, compile_s, engine and engine_note as a study's run gives them) and DIR/load_distribution.png (polar: the
 angle in degrees from the load-zone centre, the roller loads in kN, the discrete-roller solution beside them).
 """
 from __future__ import annotations
@@ -29,7 +30,7 @@ from components.units import ParameterError, quantity, to_si
 
 from .core import args
 from .core.command import command
-from .core.runner import accuracy_line
+from .core.runner import accuracy_line, engine_record, time_record
 
 ATOL = mbd.PRODUCTION.atol_pos     # the rig runs the production stepper (components.rig.rig_static_solution)
 
@@ -96,7 +97,8 @@ def run(a) -> dict:
         "ring_deflection_m": sol.deflection,
         "load_vector_sum_N": sol.load_sum.tolist(),
         "load_balance_error": float(np.hypot(*(sol.load_sum - sol.load_vector)) / F),
-        "window_s": [sol.t0, sol.t1], "wall_s": sol.wall_s, "steps": sol.steps,
+        "window_s": [sol.t0, sol.t1], **time_record(sol.wall_s, sol.compile_s), "steps": sol.steps,
+        **engine_record(sol.runs),
         "error_estimate": {"kind": "HHT local displacement error estimate, scaled by atol; RMS and max over "
                                    "accepted steps", "rms": sol.error_rms, "max": sol.error_max, "atol_m": ATOL},
         "discrete_theory": {"q_max_N": theory.q_max, "stribeck_ratio": theory.stribeck,
@@ -116,7 +118,8 @@ def run(a) -> dict:
           f"ring deflection {sol.deflection * 1e6:.2f} um, Σ roller loads vs F_r: {summary['load_balance_error']:.2e}")
     print(f"discrete-roller theory: Q_max = {theory.q_max:.0f} N, Q_max·Z/F_r = {theory.stribeck:.2f}, "
           f"ring deflection {theory.deflection * 1e6:.2f} um")
-    print("run time and accuracy: " + accuracy_line(sol.wall_s, sol.steps, sol.error_rms, sol.error_max, ATOL))
+    print("run time and accuracy: " + accuracy_line(sol.wall_s, sol.steps, sol.error_rms, sol.error_max, ATOL,
+                                                         sol.compile_s))
     print(f"written: {out / 'summary.json'}, {fig}")
     return summary
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import imageio.v2 as iio2
 import numpy as np
 import pyvista as pv
-from PIL import Image
+from PIL import GifImagePlugin, Image
 from tqdm.auto import tqdm
 
 from .plots import display_unit
@@ -112,58 +112,103 @@ def _font(h_px: int, frac: float = 0.025, text: str | None = None, w_px: int | N
     return int(max(6, round(fs)))
 
 
-class _Writer:
-    """Collects frames and writes a GIF (Pillow) or an MP4 (ffmpeg/H.264)."""
+GIF_PALETTE_FRAMES = 8     # frames spread over a GIF's film that its one palette is taken from
+_CLEAR = 255               # the palette index a GIF's delta frames mark unchanged pixels with (255 colours: free)
+
+
+def _write_film(path: Path, fps: float, idx: np.ndarray, render, bar: "_Progress | None" = None) -> None:
+    """Render the frames ``idx`` (``render(i)``: frame i as an RGB array; it sets everything the frame shows, so frames
+    can be rendered in any order) and write them one at a time: memory holds a frame or two, whatever the film's
+    length. A GIF's one 255-colour palette is taken from GIF_PALETTE_FRAMES frames spread over the film, rendered
+    first (a few more renders instead of every frame kept until the palette can be taken); an MP4 goes to ffmpeg."""
+    if path.suffix.lower() == ".gif":
+        pick = np.unique(np.linspace(0, idx.size - 1, GIF_PALETTE_FRAMES).astype(int))
+        writer = _GifStream(path, fps, _gif_palette([render(idx[k]) for k in pick]))
+    else:
+        writer = _Mp4Stream(path, fps)
+    with writer:
+        for i in idx:
+            writer.append(render(i))
+            if bar is not None:
+                bar.update()
+
+
+def _gif_palette(frames: Sequence[np.ndarray]) -> Image.Image:
+    """One palette for a film (these figures have few colours): mapping each frame to it is ≈ 20× faster than
+    Pillow's per-frame median-cut quantisation and keeps colours steady from frame to frame."""
+    return Image.fromarray(np.concatenate([_rgb(f) for f in frames], axis=0)).quantize(
+        colors=255, method=Image.Quantize.FASTOCTREE)
+
+
+def _rgb(img: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(img[..., :3], dtype=np.uint8)
+
+
+class _Mp4Stream:
+    """Frames to an MP4 (ffmpeg/H.264) as they come."""
 
     def __init__(self, path: Path, fps: float):
-        self.path, self.fps = _output_path(path, fps), float(fps)
         path.parent.mkdir(parents=True, exist_ok=True)
-        self._gif = path.suffix.lower() == ".gif"
-        self._frames: list[np.ndarray] = []
-        self._mp4 = None
-        if not self._gif:
-            self._mp4 = iio2.get_writer(str(path), format="FFMPEG", mode="I", fps=self.fps,
-                                        codec="libx264", pixelformat="yuv420p", quality=8,
-                                        macro_block_size=2, ffmpeg_log_level="error")
+        self._mp4 = iio2.get_writer(str(path), format="FFMPEG", mode="I", fps=float(fps), codec="libx264",
+                                    pixelformat="yuv420p", quality=8, macro_block_size=2, ffmpeg_log_level="error")
 
-    def __enter__(self) -> "_Writer":
+    def __enter__(self) -> "_Mp4Stream":
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
-        self.close(write=exc_type is None)
+        self._mp4.close()
 
     def append(self, img: np.ndarray) -> None:
-        img = np.ascontiguousarray(img[..., :3], dtype=np.uint8)
-        if self._gif:
-            self._frames.append(img)  # Pillow needs all frames to build the GIF
+        self._mp4.append_data(_rgb(img))
+
+
+class _GifStream:
+    """A looping GIF written frame by frame (Pillow's GIF frame encoder), atomically (a temporary file replaced at
+    the end; removed if the film fails). Every frame is mapped to ``palette`` (the global colour table); after the
+    first, a frame is written as the box around the pixels that changed, the unchanged ones inside it transparent
+    (as Pillow's optimize=True writes a film it holds whole)."""
+
+    def __init__(self, path: Path, fps: float, palette: Image.Image):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self.path, self.palette, self.ms = path, palette, 1000.0 / float(fps)
+        self.tmp = path.with_name(f".{path.name}.tmp")
+        self._fp = open(self.tmp, "wb")
+        self._prev: np.ndarray | None = None
+
+    def __enter__(self) -> "_GifStream":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        try:
+            if exc_type is None and self._prev is not None:
+                self._fp.write(b";")          # trailer
+                self._fp.close()
+                self.tmp.replace(self.path)
+        finally:
+            self._fp.close()
+            self.tmp.unlink(missing_ok=True)
+
+    def append(self, img: np.ndarray) -> None:
+        im = Image.fromarray(_rgb(img)).quantize(palette=self.palette, dither=Image.Dither.NONE)
+        cur = np.asarray(im)
+        if self._prev is None:     # duration in ms per frame; loop=0 repeats forever
+            header, _ = GifImagePlugin.getheader(im, info={"loop": 0, "duration": self.ms})
+            self._write(header + GifImagePlugin.getdata(im, (0, 0), duration=self.ms))
         else:
-            self._mp4.append_data(img)
+            changed = cur != self._prev
+            rows, cols = np.flatnonzero(changed.any(axis=1)), np.flatnonzero(changed.any(axis=0))
+            if rows.size == 0:     # the same picture: one pixel, unchanged, keeps the frame's time
+                rows, cols = np.zeros(1, int), np.zeros(1, int)
+            box = (slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1))
+            delta = Image.fromarray(np.where(changed[box], cur[box], _CLEAR).astype(np.uint8), "P")
+            delta.putpalette(im.getpalette())
+            self._write(GifImagePlugin.getdata(delta, (int(cols[0]), int(rows[0])), duration=self.ms,
+                                               transparency=_CLEAR))
+        self._prev = cur
 
-    def close(self, write: bool = True) -> None:
-        if self._gif:
-            if not (write and self._frames):
-                return
-            _write_gif(self.path, self._frames, self.fps)
-        else:
-            self._mp4.close()
-
-
-def _write_gif(path: Path, frames: list[np.ndarray], fps: float) -> None:
-    """A looping GIF of RGB ``frames``, written atomically. One 255-colour palette for every frame, taken
-    from eight frames spread over the film (these figures have few colours): mapping each frame to it is
-    ≈ 20× faster than Pillow's per-frame median-cut quantisation (1.5 s instead of 20 s for 150 frames of
-    1600×460) and keeps colours steady from frame to frame."""
-    pick = np.unique(np.linspace(0, len(frames) - 1, 8).astype(int))
-    palette = Image.fromarray(np.concatenate([frames[i] for i in pick], axis=0)).quantize(
-        colors=255, method=Image.Quantize.FASTOCTREE)
-    images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
-    tmp = path.with_name(f".{path.name}.tmp")
-    try:        # duration in ms per frame; loop=0 repeats forever
-        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], duration=1000.0 / fps, loop=0,
-                       optimize=True)
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    def _write(self, chunks) -> None:
+        for c in chunks:
+            self._fp.write(c)
 
 
 def _lines_cells(segments: Sequence[Sequence[int]]) -> np.ndarray:
@@ -542,20 +587,20 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
                             ("ring", _PANEL_COLORS[0], f"roller, offset ×{mag:.3g}")]
             _legend_strip(p, leg_row, (W, int(round(H * leg))), entries, fs_small)
 
+        def render(i):
+            for j, lab in enumerate(labels):
+                seg = np.arange(i + 1) if i > 0 else np.zeros(2, int)  # orbit so far
+                trails[j].lines = np.r_[seg.size, seg]
+                markers[j].points = _xyz(orb[lab][i:i + 1], 3 * views[j].z_step)
+                time_actors[j].input = tfmt(t[i])
+            for moving, ideal, ring_pts, lab in roller_meshes:
+                c = ideal + mag * rol[lab][i]
+                moving.points = _xyz((c[:, None, :] + ring_pts[None]).reshape(-1, 2),
+                                     2 * views[labels.index(lab)].z_step)
+            return _screenshot(p, (W, H))
+
         bar = _Progress(idx.size, path, progress)
-        with _Writer(path, fps) as writer:
-            for i in idx:
-                for j, lab in enumerate(labels):
-                    seg = np.arange(i + 1) if i > 0 else np.zeros(2, int)  # orbit so far
-                    trails[j].lines = np.r_[seg.size, seg]
-                    markers[j].points = _xyz(orb[lab][i:i + 1], 3 * views[j].z_step)
-                    time_actors[j].input = tfmt(t[i])
-                for moving, ideal, ring_pts, lab in roller_meshes:
-                    c = ideal + mag * rol[lab][i]
-                    moving.points = _xyz((c[:, None, :] + ring_pts[None]).reshape(-1, 2),
-                                         2 * views[labels.index(lab)].z_step)
-                writer.append(_screenshot(p, (W, H)))
-                bar.update()
+        _write_film(path, fps, idx, render, bar)
         bar.close()
     finally:
         p.close()
@@ -777,18 +822,19 @@ def train_animation(path, t, bodies: Sequence[Mapping], magnify: float = 1.0, fp
         view.scale_bar(fx0=0.04, fy0=0.04, frac=0.22, size=fs)
         time_actor = view.text(tfmt(t[idx[0]]), (band_x1, 0.02), fs, justify="right")
 
-        with _Writer(path, fps) as writer:
-            for i in idx:
-                for g in groups:
-                    g["mesh"].points = _place_outline(g, i, _LAYER[g["kind"]] * z)
-                if disc is not None:
-                    c = disc_xy[:, i, :]
-                    pts = (c[:, None, :] + rr[:, None, None] * unit[None]).reshape(-1, 2)
-                    disc.points = _xyz(pts, z)
-                    if has_force:
-                        disc.cell_data["force"] = fr[:, i]
-                time_actor.input = tfmt(t[i])
-                writer.append(_screenshot(p, (W, H)))
+        def render(i):
+            for g in groups:
+                g["mesh"].points = _place_outline(g, i, _LAYER[g["kind"]] * z)
+            if disc is not None:
+                c = disc_xy[:, i, :]
+                pts = (c[:, None, :] + rr[:, None, None] * unit[None]).reshape(-1, 2)
+                disc.points = _xyz(pts, z)
+                if has_force:
+                    disc.cell_data["force"] = fr[:, i]
+            time_actor.input = tfmt(t[i])
+            return _screenshot(p, (W, H))
+
+        _write_film(path, fps, idx, render)
     finally:
         p.close()
     return path

@@ -22,7 +22,7 @@ from ..life import LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, racewa
 from ..lubrication import bearing_film
 
 __all__ = ["bearing_map", "Plan", "plan_of", "owner", "quantities", "carrier_frame_motion", "to_carrier",
-           "radial_tangential", "pin_reactions", "contact_film", "traction_heat", "film_extremes", "cage_slip_pct",
+           "radial_tangential", "pin_reactions", "contact_film", "traction_heat", "film_extremes",
            "reference_rollers", "CAGE_SPEED", "POCKET_FORCE"]
 
 # the quantities the accumulators read beyond their sums: the cage speed (its window's revolutions) and the
@@ -71,7 +71,6 @@ class Plan:
     guide: np.ndarray | None     # guide instance per bearing
     spring: np.ndarray | None    # bearing_linear instance per bearing
     rows: int
-    pitch_ratio: float           # R_o/(R_i + R_o): epicyclic cage speed / planet speed, relative to the pin
     omega_c: float               # nominal carrier speed [rad/s]: the carrier frame's
     meshes: dict                 # mesh type -> its family, those the model has
     flanks: dict                 # mesh type -> its loaded flank (+1/−1)
@@ -105,7 +104,7 @@ def plan_of(scene, model) -> Plan:
         if rollers and FAMILY["pocket"] in fams else None,
         guide=np.array([x["guide"] for x in bm]) if rollers and "guide" in bm[0] else None,
         spring=np.array([x["spring"] for x in bm]) if not rollers else None,
-        rows=int(getattr(b, "rows", 1)), pitch_ratio=pitch_ratio(b), omega_c=float(scene.speeds.carrier),
+        rows=int(getattr(b, "rows", 1)), omega_c=float(scene.speeds.carrier),
         meshes=meshes, flanks=dict(scene.flanks), bearing=b, lubricant=scene.lubricant, qc=raceway_ratings(b),
         families=frozenset({FAMILY[k] for k in ("race_inner", "race_outer", "pocket", "guide", "linear")}
                            | set(meshes.values())))
@@ -347,20 +346,8 @@ def film_extremes(race_inner, race_outer, bearing, lubricant, n_bearings: int) -
 
 
 # ----------------------------------------------------------------------------------------------
-# cage slip, reference rollers
+# reference rollers
 # ----------------------------------------------------------------------------------------------
-def pitch_ratio(bearing) -> float:
-    """R_o/(R_i + R_o): the cage's epicyclic speed over the planet's, both relative to the pin (pure rolling)."""
-    return bearing_kinematics(bearing, 0.0, 1.0)[0]
-
-
-def cage_slip_pct(w_cage, w_planet, ratio: float):
-    """How far the cage turns below its epicyclic speed [%]: 100 (1 − ω_cage/(ratio·ω_planet)), speeds relative
-    to the carrier (NaN where the planet stands still); ``ratio``: :func:`pitch_ratio`."""
-    w_epi = ratio * np.asarray(w_planet, float)
-    return 100.0 * (1.0 - w_cage / np.where(w_epi != 0.0, w_epi, np.nan))
-
-
 def reference_rollers(p: Plan, x0, x1, w) -> tuple[int, int]:
     """Reference roller of each bearing kind (race_inner instances): the roller of pair 1's bearing (index 0)
     nearest its load-zone centre (opposite the pin force: the loaded rollers press the pin away from them) at

@@ -14,9 +14,9 @@ import numpy as np
 
 from mbd.elements.ehl import thermal_factor
 
+from ..bearing import cage_slip_pct
 from ..life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
                     iso281_rating, lundberg_palmgren_life)
-from .quantities import cage_slip_pct
 
 __all__ = ["run_summary", "bearing_summary", "load_summary", "roller_summary", "impact_summary", "life_summary",
            "heat_summary", "film_summary", "cage_summary", "mesh_summary"]
@@ -195,7 +195,7 @@ def cage_summary(d, sums, p, ref, sel) -> None:
     # every cage of this bearing type: RMS over all their windows (steadier than one cage's)
     d["all_cages"] = {f"cage_acc_{view}{comp}_rms_m_s2": sums.aggregate_rms(f"cage_acc_{view}{comp}", sel)
                       for view in ("", "rel_") for comp in ("radial", "tangential", "magnitude")}
-    slip = cage_slip_pct(sums.stats("cage_speed_rel")["mean"], sums.stats("planet_speed_rel")["mean"], p.pitch_ratio)
+    slip = cage_slip_pct(p.bearing, sums.stats("cage_speed_rel")["mean"], sums.stats("planet_speed_rel")["mean"])
     d["cage_slip_pct"] = float(slip[ref])
     d["cage_slip_all_pct"] = float(slip[sel].mean())
     d["cage_revolutions"] = float(abs(sums.angle[ref]) / (2 * math.pi))

@@ -34,6 +34,8 @@ from pathlib import Path as _Path
 
 from numba import config as _numba_config
 
+from ..compile_time import compiling
+
 
 def _drop_stale_kernels() -> None:
     """numba's disk cache keys a function on its own source file only: a kernel compiled into the
@@ -86,7 +88,8 @@ def compile_announced(compile, cold: bool, what: str, done: str, about: str) -> 
         print(f"mbd: compiling {what} (the first run of this code on this machine; {about}, then cached)",
               file=_sys.stderr, flush=True)
     t0 = _time.perf_counter()
-    compile()
+    with compiling():           # a run's wall time leaves it out (mbd.compile_time)
+        compile()
     if cold:
         print(f"mbd: {done} compiled in {_time.perf_counter() - t0:.0f} s", file=_sys.stderr, flush=True)
 

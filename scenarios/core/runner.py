@@ -34,6 +34,7 @@ from components.lubrication import BOUNDARY_LAMBDA
 from components.params import DPGTParams, flatten
 from components.scene import SceneOptions
 from components.static import DEFAULT_SNAPSHOTS, static_summary
+from mbd.compile_time import compile_seconds
 from mbd.recorder import BodyMotion, Recorder
 
 from components.outputs import BearingSeries, WindowStatistics, bearing_map, cage_period, default_window
@@ -45,7 +46,7 @@ from components.results.schema import drawing_geometry, element_probes
 from .integrity import checkpoint_usable, claim_folder, read_summary, results_intact
 from .lock import folder_lock
 
-__all__ = ["RunConfig", "run_case", "finished_run", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
+__all__ = ["RunConfig", "run_case", "engine_record", "time_record", "TIME_NOTE", "finished_run", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
            "accuracy_line", "code_digest", "FIXED_STEP_ERROR_FACTOR"]
 
 # A fixed-step run whose RMS local error estimate exceeds its tolerance (atol) by more than this factor ends
@@ -201,15 +202,32 @@ def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict |
     return Summary(summary)
 
 
-def _earlier_wall(out_dir: Path, resuming: bool) -> float:
-    """Wall time [s] of the earlier segments of a resumed run (progress.json keeps the running total)."""
+def _earlier_times(out_dir: Path, resuming: bool) -> tuple[float, float]:
+    """(wall, compile) time [s] of the earlier segments of a resumed run (progress.json keeps the running totals)."""
     try:
-        return float(json.loads((out_dir / "progress.json").read_text())["wall_s"]) if resuming else 0.0
-    except (OSError, ValueError, KeyError, TypeError):
-        return 0.0
+        d = json.loads((out_dir / "progress.json").read_text()) if resuming else {}
+        return float(d.get("wall_s", 0.0)), float(d.get("compile_s", 0.0))
+    except (OSError, ValueError, TypeError, AttributeError):
+        return 0.0, 0.0
+
+
+TIME_NOTE = ("wall_s: the run's wall time without compiling or loading the compiled kernels; compile_s: that compile "
+             "or load (numba: about a second from its cache, a minute or more on the first run of the code on a machine)")
+
+
+def time_record(wall_s: float, compile_s: float) -> dict:
+    """summary.json's run times: ``wall_s`` the run without the kernels' compile or load, ``compile_s`` that (timed
+    where it happens, :mod:`mbd.compile_time`), and ``time_note`` saying which is which."""
+    return {"wall_s": wall_s, "compile_s": compile_s, "time_note": TIME_NOTE}
 
 
 def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> Summary:
+    start, compile0 = time.perf_counter(), compile_seconds()
+
+    def times():     # (wall, compile) of this segment [s]: the compile is timed where it happens, and taken out
+        c = compile_seconds() - compile0
+        return time.perf_counter() - start - c, c
+
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
         scene = build_dpgt(params, cfg.options)
@@ -234,11 +252,12 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
         ckpt.unlink()
     resuming = checkpoint_usable(ckpt, rec.parts)     # a damaged checkpoint or chunk is moved aside
     atomic_write_text(fp_file, fp)
-    wall0 = time.perf_counter() - _earlier_wall(out_dir, resuming)   # wall_s counts every segment
+    earlier = _earlier_times(out_dir, resuming)      # wall_s and compile_s count every segment
 
     def report(t, t_end, counters):   # read by a sweep's progress display (another process) and a resume
+        wall, comp = (a + b for a, b in zip(times(), earlier))
         atomic_write_text(out_dir / "progress.json", json.dumps(
-            {"t": t, "t_end": t_end, "wall_s": time.perf_counter() - wall0, "steps": counters.accepted}))
+            {"t": t, "t_end": t_end, "wall_s": wall, "compile_s": comp, "steps": counters.accepted}))
 
     res = mbd.simulate(scene.model, scene.q0, scene.v0, t_end, stepper=integ.stepper(), controller=integ.controller(),
                        engine=integ.engine,
@@ -246,7 +265,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
                        resume=True, progress=cfg.progress, failed_state_path=out_dir / "failed_state.npz",
                        on_progress=report, observers=[stats])
     (out_dir / "progress.json").unlink(missing_ok=True)
-    wall = time.perf_counter() - wall0
+    wall, compile_s = (a + b for a, b in zip(times(), earlier))
     summary = _run_info(params, scene, stats)
     summary.update(stats.summary())
     summary["samples"] = int(rec.next_index)      # recorded (for plots); the statistics use every step
@@ -254,9 +273,9 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     summary.update({
         "warnings": (accuracy_warnings(integ, res.error_rms) + statistics_warnings(summary, scene.ramp, cfg.settle)
                      + validity_warnings(params.si(), summary)),
-        "wall_s": wall, "steps": res.steps, "rejected_steps": res.counters["rejected"],
+        **time_record(wall, compile_s), "steps": res.steps, "rejected_steps": res.counters["rejected"],
         "newton_per_step": res.counters["newton"] / max(res.steps, 1),
-        "engine": res.engine, "engine_note": res.engine_note,    # which path ran, and why it fell back
+        **engine_record([res]),
         "resumed_from_s": res.resumed_from,
         "error_estimate": {
             "kind": "HHT local displacement error estimate (Zienkiewicz-Xie, (beta-1/6) h^2 (a1-a0)), "
@@ -270,6 +289,18 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     })
     write_summary(out_dir, summary)
     return Summary(summary)
+
+
+def engine_record(results) -> dict:
+    """summary.json's ``engine`` (which engine path ran: "compiled" or "numpy") and ``engine_note`` (why "auto" fell
+    back to numpy; None when it did not), from the :class:`mbd.SimResult` of each ``simulate`` call of one run (one
+    for :func:`run_case`, one per sampled piece for the bearing rig). The pieces of a run share its system and
+    settings, so one path ran; a mix would be a bug, and is refused rather than reported as one of them."""
+    paths = {(r.engine, r.engine_note) for r in results}
+    if len(paths) != 1:
+        raise mbd.ModelError(f"engine_record: expected the results of one engine path, got {sorted(paths, key=str)}")
+    engine, note = paths.pop()
+    return {"engine": engine, "engine_note": note}
 
 
 # the unit of each IntegratorSettings field, as summary.json's key suffix (README: What summary.json holds)
@@ -344,9 +375,12 @@ def validity_warnings(si, summary: dict) -> list[str]:
     return out
 
 
-def accuracy_line(wall_s: float, steps: int, error_rms: float, error_max: float, atol_m: float) -> str:
-    """Run time and error estimate, as every scenario prints them."""
-    return (f"{wall_s:.1f} s wall, {steps} steps, local error estimate rms {error_rms:.2f} / max {error_max:.2f} "
+def accuracy_line(wall_s: float, steps: int, error_rms: float, error_max: float, atol_m: float,
+                  compile_s: float | None = None) -> str:
+    """Run time and error estimate, as every scenario prints them; with ``compile_s`` the kernels' compile or load
+    beside the wall time, which leaves it out."""
+    comp = f" (+ {compile_s:.1f} s compiling or loading the kernels)" if compile_s is not None else ""
+    return (f"{wall_s:.1f} s wall{comp}, {steps} steps, local error estimate rms {error_rms:.2f} / max {error_max:.2f} "
             f"x {atol_m:.0e} m")
 
 
@@ -358,7 +392,7 @@ def run_report(s: dict) -> list[str]:
                 f"{s['static_solver']['steps']} continuation steps")
     else:
         e = s["error_estimate"]
-        head = accuracy_line(s["wall_s"], s["steps"], e["rms"], e["max"], e["atol_m"])
+        head = accuracy_line(s["wall_s"], s["steps"], e["rms"], e["max"], e["atol_m"], s.get("compile_s"))
     return [head, *(f"warning: {w}" for w in s.get("warnings", []))]
 
 

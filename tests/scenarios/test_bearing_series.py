@@ -34,3 +34,29 @@ def test_bearing_load_and_cage_slip_series(tmp_path):
                                                                       abs=5e-3 * d["bearing_load_mean_N"])
             assert mean("bearing.cage_slip", i) == pytest.approx(d["cage_slip_pct"], abs=0.01)
         assert np.all(np.isfinite(ds["bearing.cage_slip"].values))
+
+
+def test_cage_slip_series_against_pure_rolling():
+    """results.nc's slip series at a state whose cages turn at known speeds: a cage's pure-rolling speed relative to
+    the carrier (the pin) is that of its roller centres at d_m/2, which move at half the bore's surface speed
+    (ω_p − ω_c)(d_m + D)/2 (the pin's surface is at rest), i.e. (ω_p − ω_c)(d_m + D)/(2 d_m); a cage turning at
+    (1 − s) times that slips 100 s %. A sign or a factor wrong in the series' formula fails here (the statistic
+    calls the same function, components.bearing.cage_slip_pct)."""
+    from components.outputs import BearingSeries
+    from tests.support.dpgt_runs import build
+
+    scene = build(reference_dpgt(3))
+    series = BearingSeries(scene)
+    b, m = scene.bearing, scene.model
+    w_c = 440.0                                                    # rad/s, carrier
+    w_p = np.array([-1500.0, 900.0, -1400.0, 950.0, -1300.0, 1000.0])   # rad/s, each bearing's planet
+    s = np.array([0.007, -0.02, 0.0, 0.05, 0.2, 0.0071])           # the slips given to the cages
+    rolling = (w_p - w_c) * (b.pitch_diameter + b.roller_diameter) / (2.0 * b.pitch_diameter)
+    V = np.zeros((m.n_bodies, 3))
+    V[series.carrier, 2] = w_c
+    V[series.planet, 2] = w_p
+    V[series.cage, 2] = w_c + (1.0 - s) * rolling
+    np.testing.assert_allclose(series.slip(0.0, np.zeros_like(V), V, np.zeros_like(V), {}), 100.0 * s,
+                               rtol=0, atol=1e-11)
+    V[series.planet, 2] = w_c                                     # a planet at rest on its pin: nothing to slip from
+    assert np.all(np.isnan(series.slip(0.0, np.zeros_like(V), V, np.zeros_like(V), {})))

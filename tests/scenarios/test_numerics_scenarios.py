@@ -124,3 +124,42 @@ def test_bench_breakdown_counts_the_engines_work_and_splits_its_time(tmp_path, c
     assert sum(r["us_per_step"] for r in d["rows"]) == pytest.approx(d["cpu_per_step_us"])
     assert d["target_us_per_step"] == pytest.approx(3.0 / (res.steps * 0.1 / window) * 1e6)
     assert (tmp_path / "breakdown.json").exists()
+
+
+def test_warm_says_loaded_only_when_every_group_was_loaded():
+    """scenarios.warm's line: "loaded from the cache" only when numba loaded the engine, output and accumulator
+    kernels all three; a single group compiled makes it "compiled", naming that group (numba's hit/miss counts)."""
+    from collections import Counter
+    from types import SimpleNamespace
+
+    from scenarios.numerics.warm import warm_line
+
+    sig = ("float64[:]",)
+    hit = SimpleNamespace(stats=SimpleNamespace(cache_hits=Counter({sig: 1}), cache_misses=Counter()))
+    miss = SimpleNamespace(stats=SimpleNamespace(cache_hits=Counter(), cache_misses=Counter({sig: 1})))
+    never = SimpleNamespace(stats=SimpleNamespace(cache_hits=Counter(), cache_misses=Counter()))   # not called
+    assert warm_line({"engine": hit, "outputs": hit, "accumulators": hit}, 1.2) == \
+        "engine kernels: loaded from the cache in 1 s"
+    assert warm_line({"engine": hit, "outputs": miss, "accumulators": hit}, 14.6) == \
+        "engine kernels: compiled in 15 s (outputs compiled; engine, accumulators loaded from the cache)"
+    assert warm_line({"engine": miss, "outputs": miss, "accumulators": never}, 70) == \
+        "engine kernels: compiled in 70 s (engine, outputs, accumulators compiled)"
+
+
+def test_warm_reads_numba_s_own_count_of_compiles(tmp_path):
+    """compiled_here against numba itself: a cached kernel in a scratch NUMBA_CACHE_DIR is compiled by the first
+    process and loaded by the second (a one-line kernel: cheap, unlike the engine's)."""
+    import os
+    import subprocess
+    import sys
+
+    from tests.support import ROOT
+
+    (tmp_path / "tiny_kernel.py").write_text("from numba import njit\n\n@njit(cache=True)\ndef f(x):\n    return 2 * x\n")
+    code = ("import tiny_kernel\nfrom mbd.compile_time import compiled_here\n"
+            "tiny_kernel.f(1.0)\nprint(compiled_here(tiny_kernel.f))\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)]),
+           "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    said = [subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True,
+                           timeout=300).stdout.strip() for _ in range(2)]
+    assert said == ["True", "False"]

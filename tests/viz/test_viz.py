@@ -326,3 +326,88 @@ def test_probe_finds_a_working_backend(fresh_probe):
     assert "works via" in msg
     import os
     assert os.environ["VTK_DEFAULT_OPENGL_WINDOW"] in msg  # exported for in-process renders
+
+
+# ----------------------------------------------------------------------------------- GIF streaming
+def _film(n: int, size=(240, 160)) -> list[np.ndarray]:
+    """Synthetic frames of few colours: a square moving over a white ground, a bar growing, one frame repeated and
+    one differing from its predecessor in a single pixel (the delta encoder's edge cases)."""
+    W, H = size
+    out = []
+    for k in range(n):
+        f = np.full((H, W, 3), 255, np.uint8)
+        x = 5 + 3 * k % (W - 30)
+        f[40:60, x:x + 20] = (213, 0, 0)
+        f[H - 10:H - 4, 5:5 + 2 * k % (W - 10)] = (31, 95, 168)
+        out.append(f)
+    out[7] = out[6].copy()                    # the same picture twice
+    out[9] = out[8].copy()
+    out[9][0, 0] = (213, 0, 0)                # one pixel changed (to a colour of the palette)
+    return out
+
+
+def test_gif_stream_writes_what_pillow_writes_from_the_whole_film(tmp_path):
+    """The GIF written frame by frame decodes to the same pictures as Pillow's own writer given every frame at once
+    (the earlier path): same palette frames, frame count, duration and loop."""
+    from PIL import Image, ImageSequence
+
+    from viz import animate
+
+    frames = _film(30)
+    idx = np.arange(len(frames))
+    animate._write_film(tmp_path / "s.gif", 20.0, idx, lambda i: frames[i])
+    pick = np.unique(np.linspace(0, len(frames) - 1, animate.GIF_PALETTE_FRAMES).astype(int))
+    pal = animate._gif_palette([frames[i] for i in pick])
+    ims = [Image.fromarray(f).quantize(palette=pal, dither=Image.Dither.NONE) for f in frames]
+    ims[0].save(tmp_path / "p.gif", format="GIF", save_all=True, append_images=ims[1:], duration=50.0, loop=0,
+                optimize=True)
+
+    def decoded(path):
+        with Image.open(path) as im:
+            return ([np.asarray(f.convert("RGB")).copy() for f in ImageSequence.Iterator(im)],
+                    [f.info.get("duration") for f in ImageSequence.Iterator(im)], im.info.get("loop"))
+
+    mine, durations, loop = decoded(tmp_path / "s.gif")
+    assert len(mine) == len(frames) and set(durations) == {50} and loop == 0
+    # Pillow merges the repeated frame into its predecessor's duration: compare picture by picture in time
+    ref, ref_durations, _ = decoded(tmp_path / "p.gif")
+    ref_in_time = [f for f, d in zip(ref, ref_durations) for _ in range(round(d / 50))]
+    assert len(ref_in_time) == len(mine)
+    for k, (a, b) in enumerate(zip(mine, ref_in_time)):
+        np.testing.assert_array_equal(a, b, err_msg=f"frame {k}")
+    np.testing.assert_array_equal(mine[8][0, 0], (255, 255, 255))      # the one changed pixel is there
+    np.testing.assert_array_equal(mine[9][0, 0], (213, 0, 0))
+    assert not (tmp_path / ".s.gif.tmp").exists()
+
+
+def test_gif_stream_keeps_a_few_frames_not_the_film(tmp_path):
+    """Memory: the frames are written as they are rendered, so the peak holds the palette's frames and one or two
+    more, not the film (the earlier writer kept every frame until the end: here 60)."""
+    import tracemalloc
+
+    from viz import animate
+
+    frames = _film(60, size=(400, 300))
+    one = frames[0].nbytes
+    render = lambda i: frames[i].copy()       # a new array per render, as a screenshot is
+    tracemalloc.start()
+    try:
+        animate._write_film(tmp_path / "m.gif", 20.0, np.arange(len(frames)), render)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < (2 * animate.GIF_PALETTE_FRAMES + 4) * one < len(frames) * one
+
+
+def test_a_failed_film_leaves_no_file(tmp_path):
+    from viz import animate
+
+    frames = _film(12)
+
+    def render(i):
+        if i == 10:
+            raise RuntimeError("renderer died")
+        return frames[i]
+    with pytest.raises(RuntimeError, match="renderer died"):
+        animate._write_film(tmp_path / "f.gif", 20.0, np.arange(12), render)
+    assert list(tmp_path.iterdir()) == []
