@@ -57,12 +57,14 @@ def test_free_network_conserves_angular_momentum(spec, seed):
     q0, v0 = _initial(spec, seed)
     drift = []
     # h = 2e-4 → 1e-4 over 0.02 s: hypothesis found a network (stiff offset-marker spring) still pre-asymptotic
-    # at 4e-4 → 2e-4 (drift ratio 2.93; then 3.75 and 3.94 at the next halvings, so order 2 holds)
+    # at 4e-4 → 2e-4 (drift ratio 2.93; then 3.75 and 3.94 at the next halvings, so order 2 holds).
+    # The drift is the largest |L − L0| over the run, not at its end: the error oscillates, and at one instant it
+    # can nearly cancel — hypothesis found a network whose end-point drift fell only 1.85× from 2e-4 to 1e-4
+    # (4.4e-10 → 2.4e-10; then 3.53, 3.89), while the largest drift fell 4.04, 4.01, 4.00× at 4e-4 … 5e-5.
     for h, n in ((2e-4, 100), (1e-4, 200)):
         states = _run(model, q0.ravel(), v0.ravel(), h, n, 0.0)
         _, L0 = fixed_frame_momenta(model, 0.0, states[0].q, states[0].v)
-        _, L1 = fixed_frame_momenta(model, states[-1].t, states[-1].q, states[-1].v)
-        drift.append(abs(L1 - L0))
+        drift.append(max(abs(fixed_frame_momenta(model, s.t, s.q, s.v)[1] - L0) for s in states[1:]))
     m, J = np.array(spec.mass), np.array(spec.inertia)
     Lscale = np.sum(J * np.abs(v0[:, 2])) + np.sum(m * 0.3 * np.abs(v0[:, :2]).sum(axis=1))
     # the drift is discretization error: second order in h (or already at round-off) ...
