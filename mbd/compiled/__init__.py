@@ -69,4 +69,20 @@ def kernels_cached(function: str = "stepper.advance") -> bool:
     return any(root.rglob(f"{function}-*.nbi")) if root.is_dir() else False
 
 
+# seconds this process spent compiling or loading kernels in their own step (CompiledRunner._compile,
+# CompiledOutputs._compile): a run's share is the difference around it (scenarios.core.runner's ``timing``)
+_KERNEL_S = [0.0]
+
+
+def kernel_seconds() -> float:
+    """Seconds this process has spent so far compiling or loading the engine's and the element outputs' kernels
+    (each in its own step before any step is taken; the statistics' accumulators load on their first block)."""
+    return _KERNEL_S[0]
+
+
+def count_kernel_seconds(seconds: float) -> None:
+    """Add one compile-or-load step's duration to :func:`kernel_seconds`."""
+    _KERNEL_S[0] += seconds
+
+
 _drop_stale_kernels()

@@ -73,6 +73,7 @@ class CompiledOutputs:
         t0 = time.perf_counter()
         self.outputs_batch(np.zeros(0), np.zeros((0, self.model.ndof)), np.zeros((0, self.model.ndof)), {},
                            families={name for rec in self._compiled for name, _ in rec[0]})
+        _compiled.count_kernel_seconds(time.perf_counter() - t0)
         if cold:
             print(f"mbd: output kernels compiled in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
 

@@ -130,6 +130,7 @@ class CompiledRunner:
         advance(0.0, z.copy(), z.copy(), z.copy(), z.copy(), 1e-6, 0.0, 0, self.prm, self.ctrl, self.atol, self.rtol,
                 self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu, self.cache, self.work,
                 np.zeros(6, np.int64), self.out, np.empty((1, 3 + 4 * n + self.n_z)))
+        _compiled.count_kernel_seconds(time.perf_counter() - t0)
         if cold:
             print(f"mbd: kernels compiled in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import sys
 import time
 import warnings
 from dataclasses import asdict, dataclass, field, replace
@@ -44,6 +45,7 @@ from components.results.schema import drawing_geometry, element_probes
 
 from .integrity import checkpoint_usable, claim_folder, read_summary, results_intact
 from .lock import folder_lock
+from .memory import RunPeak
 
 __all__ = ["RunConfig", "run_case", "finished_run", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
            "accuracy_line", "code_digest", "FIXED_STEP_ERROR_FACTOR"]
@@ -181,9 +183,28 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
         return _run_case(params, cfg, Path(out_dir), label)
 
 
+def _kernel_seconds() -> float:
+    """Seconds this process has spent compiling or loading the compiled kernels (none while mbd.compiled was never
+    imported; read through sys.modules so that the numpy path does not import numba's side for it)."""
+    mod = sys.modules.get("mbd.compiled")
+    return mod.kernel_seconds() if mod is not None else 0.0
+
+
+def run_timing(parts: dict, total: float, peak: RunPeak) -> dict:
+    """summary.json's ``timing``: wall seconds of this segment of the run by part (README: What summary.json holds),
+    the rest of ``total`` as ``other_s``, and the run's peak resident memory."""
+    out = {k: float(v) for k, v in parts.items()}
+    out["other_s"] = max(total - sum(out.values()), 0.0)
+    out["total_s"] = total
+    out["peak_rss_MB"] = peak.mb()
+    out["peak_rss_per_run"] = peak.per_run
+    return out
+
+
 def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> Summary:
     """The quasi-static solution (:mod:`components.static`) of one operating point: summary.json in the dynamic
     run's keys, those only a dynamic run gives left out (listed in ``omitted``); no results.nc."""
+    t0, peak = time.perf_counter(), RunPeak()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
         scene = build_dpgt(params, cfg.options)
@@ -197,6 +218,7 @@ def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict |
                     "fingerprint": run_fingerprint(params, cfg),
                     "parameters_fingerprint": parameters_fingerprint(params, cfg),
                     "run_description": run_description(params, cfg)})
+    summary["timing"] = run_timing({"static_s": summary["static_solver"]["wall_s"]}, time.perf_counter() - t0, peak)
     write_summary(out_dir, summary)
     return Summary(summary)
 
@@ -210,6 +232,7 @@ def _earlier_wall(out_dir: Path, resuming: bool) -> float:
 
 
 def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> Summary:
+    t_start, k_start, peak = time.perf_counter(), _kernel_seconds(), RunPeak()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
         scene = build_dpgt(params, cfg.options)
@@ -234,6 +257,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
         ckpt.unlink()
     resuming = checkpoint_usable(ckpt, rec.parts)     # a damaged checkpoint or chunk is moved aside
     atomic_write_text(fp_file, fp)
+    scene_s = time.perf_counter() - t_start       # scene, statistics and recorder built, the folder checked
     wall0 = time.perf_counter() - _earlier_wall(out_dir, resuming)   # wall_s counts every segment
 
     def report(t, t_end, counters):   # read by a sweep's progress display (another process) and a resume
@@ -247,8 +271,10 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
                        on_progress=report, observers=[stats])
     (out_dir / "progress.json").unlink(missing_ok=True)
     wall = time.perf_counter() - wall0
+    t_stats = time.perf_counter()
     summary = _run_info(params, scene, stats)
     summary.update(stats.summary())
+    stats_summary_s = time.perf_counter() - t_stats
     summary["samples"] = int(rec.next_index)      # recorded (for plots); the statistics use every step
     summary.update(label or {})
     summary.update({
@@ -268,6 +294,12 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
         "fingerprint": fp, "parameters_fingerprint": parameters_fingerprint(params, cfg),
         "run_description": run_description(params, cfg),
     })
+    tm, kernels = res.timing, _kernel_seconds() - k_start
+    summary["timing"] = run_timing({
+        "scene_s": scene_s, "runner_setup_s": tm["setup_s"] + tm["bind_s"] - kernels, "kernels_s": kernels,
+        "engine_s": tm["engine_s"], "statistics_s": tm["observers_s"] + stats_summary_s,
+        "recording_s": tm["recording_s"], "results_write_s": tm["results_s"], "checkpoints_s": tm["checkpoints_s"]},
+        time.perf_counter() - t_start, peak)
     write_summary(out_dir, summary)
     return Summary(summary)
 
