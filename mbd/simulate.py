@@ -14,7 +14,7 @@ import json
 import os
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -29,7 +29,14 @@ from .recorder import atomic_write_bytes
 from .settings import PRODUCTION
 
 __all__ = ["simulate", "SimResult", "Checkpoint", "Counters", "TimeMean", "save_state", "load_state",
-           "output_evaluator"]
+           "output_evaluator", "TIMING_PARTS"]
+
+# SimResult.timing: wall seconds of one simulate call by part — "setup_s" choosing and building the engine path
+# (the compiled runner: its kernels' load or compile included), "bind_s" binding the recorder and observers (the
+# statistics load their output kernels here), "engine_s" the steps, "recording_s" the recorder's sampling and
+# chunks, "observers_s" the observers, "checkpoints_s", "results_s" writing the results file, "other_s" the rest
+# (progress, step statistics). A perf_counter pair per block (compiled) or per step (numpy: ms per step).
+TIMING_PARTS = ("setup_s", "bind_s", "engine_s", "recording_s", "observers_s", "checkpoints_s", "results_s", "other_s")
 
 
 @dataclass
@@ -77,6 +84,7 @@ class SimResult:
     resumed_from: float | None = None
     engine: str = "numpy"      # which engine path ran ("compiled" or "numpy")
     engine_note: str | None = None   # why "auto" ran the numpy path (None: it did not fall back)
+    timing: dict = field(default_factory=dict)   # wall seconds per part of this call (:data:`TIMING_PARTS`)
 
     def summary(self) -> dict:
         return {"wall_s": self.wall_s, "steps": self.steps, "error_estimate_max": self.error_max,
@@ -165,8 +173,10 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
     observers = _check_arguments(controller, recorder, observers)
     if stepper is None:
         stepper = PRODUCTION.stepper()
+    call0 = time.perf_counter()
     system = system or System(model)
     runner, engine, engine_note = _engine(engine, system, stepper, controller)
+    setup_s = time.perf_counter() - call0
     counters = Counters()
     if state is None:
         if q0 is None or v0 is None:
@@ -180,8 +190,10 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
             if type(ob).step is Observer.step:
                 raise ModelError(f"simulate: observers[{i}] ({type(ob).__name__}) does not define step(s0, s1), "
                                  "which the numpy engine path calls")
+    bind0 = time.perf_counter()
     h, stats, counters, state, resumed_from = _begin(model, system, state, controller, counters, recorder,
                                                      observers, checkpoint, resume)
+    bind_s = time.perf_counter() - bind0
     show = progress if progress is not None else os.environ.get("DPGT_PROGRESS", "1") != "0"
     loop = _Loop(recorder, observers, stats, counters, _Progress(state.t, t_end, show, on_progress), checkpoint)
     wall0 = time.perf_counter()
@@ -201,8 +213,11 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
                     error_max=float(stats["err_max"]), error_rms=float(np.sqrt(stats["err_sq"] / n)),
                     h_min_used=float(stats["h_lo"]), h_max_used=float(stats["h_hi"]), resumed_from=resumed_from,
                     engine=engine, engine_note=engine_note)
+    t_res = time.perf_counter()
     if recorder is not None:
         res.results_path = recorder.finalize(attrs={"run": res.summary()})
+    res.timing = {"setup_s": setup_s, "bind_s": bind_s, **loop.timing, "results_s": time.perf_counter() - t_res}
+    res.timing["other_s"] = max(time.perf_counter() - call0 - sum(res.timing.values()), 0.0)
     if checkpoint is not None and Path(checkpoint.path).exists():
         Path(checkpoint.path).unlink()
     return res
@@ -271,6 +286,7 @@ class _Loop:
     def __init__(self, recorder, observers, stats, counters, bar, checkpoint):
         self.recorder, self.observers, self.stats, self.counters = recorder, observers, stats, counters
         self.bar, self.checkpoint = bar, checkpoint
+        self.timing = dict.fromkeys(("engine_s", "recording_s", "observers_s", "checkpoints_s"), 0.0)
 
     def steps_to_checkpoint(self) -> int | None:
         ck = self.checkpoint
@@ -278,19 +294,25 @@ class _Loop:
 
     def accepted(self, s0: State, s1: State, error: float, h_try: float, h_next: float) -> bool:
         """Hand the step to everyone; True when a checkpoint was written (the LU is then dropped)."""
+        t0 = time.perf_counter()
         if self.recorder is not None:
             self.recorder.record(s0, s1)
+        t1 = time.perf_counter()
         for ob in self.observers:
             ob.step(s0, s1)
+        self._time(t0, t1)
         return self._count(s1, error, h_try, h_next)
 
     def accepted_block(self, blk) -> bool:
         """The same for a compiled block of steps: the recorder and each observer take the block in one call;
         a checkpoint can only fall on the block's last step (the runner ends blocks there)."""
+        t0 = time.perf_counter()
         if self.recorder is not None:
             self.recorder.record_block(blk)
+        t1 = time.perf_counter()
         for ob in self.observers:
             ob.on_block(blk)
+        self._time(t0, t1)
         last = len(blk) - 1
         for i in range(last):
             t1, h_try, err = (float(x) for x in blk.log[i, :3])
@@ -298,11 +320,18 @@ class _Loop:
             self.bar.update(t1, self.counters)
         return self._count(blk.state, float(blk.log[last, 2]), float(blk.log[last, 1]), blk.h)
 
+    def _time(self, t0: float, t1: float) -> None:
+        """The recorder took t0..t1, the observers t1..now."""
+        self.timing["recording_s"] += t1 - t0
+        self.timing["observers_s"] += time.perf_counter() - t1
+
     def _count(self, s1: State, error: float, h_try: float, h_next: float) -> bool:
         _add_step(self.stats, error, h_try)
         self.bar.update(s1.t, self.counters)
         if self.checkpoint is not None and self.stats["steps"] % self.checkpoint.every == 0:
+            t0 = time.perf_counter()
             _save_checkpoint(self.checkpoint, s1, h_next, self.stats, self.counters, self.recorder, self.observers)
+            self.timing["checkpoints_s"] += time.perf_counter() - t0
             return True
         return False
 
@@ -313,7 +342,9 @@ def _numpy_steps(loop: _Loop, system, stepper, controller, state, h, t_end, fail
     span = max(abs(t_end), 1.0)
     while state.t < t_end - 1e-12 * span:
         h_try = min(h, t_end - state.t)
+        t0 = time.perf_counter()
         new, info = stepper.step(system, state, h_try, cache)
+        loop.timing["engine_s"] += time.perf_counter() - t0
         loop.counters.add(info)
         ok, h_next = controller.decide(h_try, info.converged, info.error)
         if not ok:
@@ -336,7 +367,9 @@ def _compiled_steps(loop: _Loop, system, runner, state, h, t_end, failed_state_p
     span = max(abs(t_end), 1.0)
     while state.t < t_end - 1e-12 * span:
         todo = loop.steps_to_checkpoint()
+        t0 = time.perf_counter()
         blk = runner.advance(state, h, t_end, BLOCK if todo is None else min(BLOCK, todo))
+        loop.timing["engine_s"] += time.perf_counter() - t0
         for k, val in blk.counters.items():
             setattr(loop.counters, k, getattr(loop.counters, k) + val)
         if len(blk) and loop.accepted_block(blk):

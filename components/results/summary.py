@@ -22,7 +22,8 @@ BEARING_KINDS = ("inner", "outer")     # a summary's per-bearing-kind sections (
 # Every key of :meth:`WindowStatistics.summary` is here. A key with a unit ends in its suffix (UNIT_SUFFIXES);
 # a key without one is dimensionless ("1": a count, a ratio, a factor) and is listed in DIMENSIONLESS_KEYS.
 UNIT_SUFFIXES = {"_N": "N", "_m": "m", "_m_s": "m/s", "_m_s2": "m/s^2", "_s": "s", "_h": "h", "_W": "W", "_pct": "%",
-                 "_Mrev": "10^6 rev", "_hz": "Hz", "_rpm": "r/min", "_rad": "rad"}
+                 "_Mrev": "10^6 rev", "_hz": "Hz", "_rpm": "r/min", "_rad": "rad",
+                 "_MB": "MiB"}
 
 
 def _cage_acc_words() -> dict:

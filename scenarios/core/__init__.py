@@ -2,7 +2,7 @@
 
 One run end to end (:mod:`.runner`), sweeps of runs on Dask (:mod:`.sweep`) and the skeleton every sweep study
 follows (:mod:`.study`); the argument grammar (:mod:`.args`) and how every command ends (:mod:`.command`); one run
-per output folder (:mod:`.lock`), what a run folder holds checked before it is used (:mod:`.integrity`), requests
+per output folder (:mod:`.lock`), a run's own peak memory (:mod:`.memory`), what a run folder holds checked before it is used (:mod:`.integrity`), requests
 refused before they run (:mod:`.plausibility`); spectra and the housing sensor's signals (:mod:`.analysis`).
 
 What belongs here: code that two or more commands (studies at the top of :mod:`scenarios`, scripts of

@@ -45,6 +45,7 @@ from components.results.schema import drawing_geometry, element_probes
 
 from .integrity import checkpoint_usable, claim_folder, read_summary, results_intact
 from .lock import folder_lock
+from .memory import RunPeak
 
 __all__ = ["RunConfig", "run_case", "engine_record", "time_record", "TIME_NOTE", "finished_run", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
            "accuracy_line", "code_digest", "FIXED_STEP_ERROR_FACTOR"]
@@ -182,9 +183,21 @@ def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = N
         return _run_case(params, cfg, Path(out_dir), label)
 
 
+def run_timing(parts: dict, total: float, peak: RunPeak) -> dict:
+    """summary.json's ``timing``: wall seconds of this segment of the run by part (README: What summary.json holds),
+    the rest of ``total`` as ``other_s``, and the run's peak resident memory."""
+    out = {k: float(v) for k, v in parts.items()}
+    out["other_s"] = max(total - sum(out.values()), 0.0)
+    out["total_s"] = total
+    out["peak_rss_MB"] = peak.mb()
+    out["peak_rss_per_run"] = peak.per_run
+    return out
+
+
 def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> Summary:
     """The quasi-static solution (:mod:`components.static`) of one operating point: summary.json in the dynamic
     run's keys, those only a dynamic run gives left out (listed in ``omitted``); no results.nc."""
+    t0, peak = time.perf_counter(), RunPeak()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
         scene = build_dpgt(params, cfg.options)
@@ -198,6 +211,7 @@ def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict |
                     "fingerprint": run_fingerprint(params, cfg),
                     "parameters_fingerprint": parameters_fingerprint(params, cfg),
                     "run_description": run_description(params, cfg)})
+    summary["timing"] = run_timing({"static_s": summary["static_solver"]["wall_s"]}, time.perf_counter() - t0, peak)
     write_summary(out_dir, summary)
     return Summary(summary)
 
@@ -222,7 +236,7 @@ def time_record(wall_s: float, compile_s: float) -> dict:
 
 
 def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> Summary:
-    start, compile0 = time.perf_counter(), compile_seconds()
+    start, compile0, peak = time.perf_counter(), compile_seconds(), RunPeak()
 
     def times():     # (wall, compile) of this segment [s]: the compile is timed where it happens, and taken out
         c = compile_seconds() - compile0
@@ -253,6 +267,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     resuming = checkpoint_usable(ckpt, rec.parts)     # a damaged checkpoint or chunk is moved aside
     atomic_write_text(fp_file, fp)
     earlier = _earlier_times(out_dir, resuming)      # wall_s and compile_s count every segment
+    scene_s, c_scene = times()      # the scene, statistics, recorder and folder (and any kernels they loaded)
 
     def report(t, t_end, counters):   # read by a sweep's progress display (another process) and a resume
         wall, comp = (a + b for a, b in zip(times(), earlier))
@@ -266,8 +281,10 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
                        on_progress=report, observers=[stats])
     (out_dir / "progress.json").unlink(missing_ok=True)
     wall, compile_s = (a + b for a, b in zip(times(), earlier))
+    t_stats = time.perf_counter()
     summary = _run_info(params, scene, stats)
     summary.update(stats.summary())
+    stats_summary_s = time.perf_counter() - t_stats
     summary["samples"] = int(rec.next_index)      # recorded (for plots); the statistics use every step
     summary.update(label or {})
     summary.update({
@@ -287,6 +304,15 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
         "fingerprint": fp, "parameters_fingerprint": parameters_fingerprint(params, cfg),
         "run_description": run_description(params, cfg),
     })
+    tm, kernels = res.timing, compile_seconds() - compile0
+    # this segment's parts; kernels_s is the compile or load of every kernel group, which happened in simulate's
+    # set-up (the runner) and binding (the outputs, the statistics' accumulators): taken out of those
+    summary["timing"] = run_timing({
+        "scene_s": scene_s, "runner_setup_s": tm["setup_s"] + tm["bind_s"] - (kernels - c_scene),
+        "kernels_s": kernels,
+        "engine_s": tm["engine_s"], "statistics_s": tm["observers_s"] + stats_summary_s,
+        "recording_s": tm["recording_s"], "results_write_s": tm["results_s"], "checkpoints_s": tm["checkpoints_s"]},
+        time.perf_counter() - start, peak)
     write_summary(out_dir, summary)
     return Summary(summary)
 

@@ -24,6 +24,8 @@ from __future__ import annotations
 import abc
 import dataclasses
 import json
+import os
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, ClassVar
@@ -32,11 +34,16 @@ from components.results import Summary
 from components.results.io import atomic_write_text
 
 from .integrity import read_summary
+from .memory import process_peak_mb
 from .plausibility import check_runs
 from .runner import RunConfig, run_report
 from .sweep import Case, Outcome, Status, _case_cfg, build_params, check_folders, sweep, validate_cases
 
-__all__ = ["Study", "StudyRun", "run_lines", "runs_line"]
+__all__ = ["Study", "StudyRun", "run_lines", "runs_line", "TIMING_ENV"]
+
+# a file name: Study.run writes there where the study's time went (wall seconds of the checks, the sweep and its
+# phases, the report and each of its steps; the study process's peak memory; each run's process and span)
+TIMING_ENV = "DPGT_TIMING"
 
 
 @dataclass
@@ -47,6 +54,7 @@ class StudyRun:
     outcomes: dict[str, Outcome]
     files: list[Path] = field(default_factory=list)
     kept: dict[str, dict] = field(default_factory=dict)    # failed now, but finished before: the earlier summary
+    step_s: dict[str, float] = field(default_factory=dict)  # wall seconds of each post-processing step
 
     @property
     def results(self) -> dict[str, Summary]:
@@ -63,7 +71,9 @@ class StudyRun:
 
     def step(self, what: str, make: Callable[..., list], *a, **kw) -> list[Path]:
         """One post-processing step (tables, figures, animation): make its files and say so in one line."""
+        t0 = time.perf_counter()
         paths = [Path(p) for p in (make(*a, **kw) or [])]
+        self.step_s[what] = self.step_s.get(what, 0.0) + time.perf_counter() - t0
         self.files += paths
         names = ", ".join(p.name for p in paths)
         print(f"{what}: {names if paths else 'nothing to write'}", flush=True)
@@ -129,8 +139,11 @@ class Study(abc.ABC):
     # -- the skeleton -----------------------------------------------------------------------------------------
     def run(self) -> dict:
         """Cases → validate → check runs and folders → sweep → report → epilogue; returns {"results",
-        "outcomes", "failed", "files", ...the report's}."""
+        "outcomes", "failed", "files", ...the report's}. With the environment variable ``DPGT_TIMING`` set to a file
+        name, where the study's time went is written there as JSON (:data:`TIMING_ENV`; ``scenarios.bench_study
+        --profile`` reads it)."""
         a = self.a
+        t0 = time.perf_counter()
         cfg = self.config()
         cases = self.cases()
         validate_cases(cases, lambda c: self.check(c, cfg))      # every parameter checked before any run starts
@@ -138,14 +151,23 @@ class Study(abc.ABC):
         for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], self.out, a.force):
             print(f"warning (--force): {w}")
         check_folders(cases, cfg, a.overwrite)                  # never replace results of other parameters silently
+        t_prepare = time.perf_counter()
         self.prepare(cfg, cases)
+        t_sweep, sweep_timing = time.perf_counter(), {}
         outcomes = sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
-                         overwrite=a.overwrite, announce=True)
+                         overwrite=a.overwrite, announce=True, timing=sweep_timing)
         run = StudyRun(self.out, cases, outcomes)
         print(runs_line(outcomes), flush=True)
+        t_report = time.perf_counter()
         if self.keep_earlier:
             run.kept = self._earlier(run)
         extra = self.report(run)
+        t_end = time.perf_counter()
+        if os.environ.get(TIMING_ENV):
+            atomic_write_text(Path(os.environ[TIMING_ENV]), json.dumps({
+                "checks_s": t_prepare - t0, "prepare_s": t_sweep - t_prepare, "sweep_s": t_report - t_sweep,
+                "sweep": sweep_timing, "report_s": t_end - t_report, "steps_s": run.step_s, "total_s": t_end - t0,
+                "peak_rss_MB": process_peak_mb(), "runs": {k: o.span for k, o in outcomes.items()}}, indent=1))
         if self.record:
             atomic_write_text(self.out / "study.json", json.dumps(
                 {"cases": [dataclasses.asdict(c) for c in cases], **self.study_record(), "failed": run.failed},

@@ -70,6 +70,7 @@ class Outcome:
     summary: Summary | None = None
     error: str | None = None
     traceback: str = ""
+    span: dict = field(default_factory=dict)    # where and when it ran: {"pid", "start_unix_s", "end_unix_s"}
 
     @property
     def label(self) -> str:
@@ -181,7 +182,15 @@ def _is_finished(case: Case, cfg) -> bool:
 
 def execute_case(case: Case, cfg, overwrite: bool = False) -> Outcome:
     """Run one case (on whichever process), or reuse its finished results. Never raises: a failure is an
-    :class:`Outcome` of status failed (and error.json in the case's folder)."""
+    :class:`Outcome` of status failed (and error.json in the case's folder). Its ``span`` says which process ran it
+    and when (wall clock: a study's profile relates the runs to the Dask phases)."""
+    start = time.time()
+    o = _execute(case, cfg, overwrite)
+    o.span = {"pid": os.getpid(), "start_unix_s": start, "end_unix_s": time.time()}
+    return o
+
+
+def _execute(case: Case, cfg, overwrite: bool) -> Outcome:
     out = Path(case.out_dir)
     try:
         params = build_params(case)
@@ -247,18 +256,26 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
 
 
 def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | None = None,
-          progress: bool = True, overwrite: bool = False, announce: bool = False) -> dict[str, Outcome]:
+          progress: bool = True, overwrite: bool = False, announce: bool = False,
+          timing: dict | None = None) -> dict[str, Outcome]:
     """Run every case; returns {label: :class:`Outcome`}. One case runs in-process (no cluster).
     ``overwrite``: replace finished results of other parameters (else :func:`check_folders` refuses);
-    ``announce``: say first how many runs will run and how many are reused."""
+    ``announce``: say first how many runs will run and how many are reused; ``timing``: a dict to fill with the
+    sweep's phases (wall seconds: ``reuse_check_s``, on Dask ``cluster_start_s`` — Dask imported, scheduler and
+    workers started —, ``runs_s`` from the first submission to the last result, ``cluster_close_s``; the runs'
+    phase as wall-clock stamps ``runs_start_unix_s``, ``runs_end_unix_s``; ``workers``, ``dask``)."""
+    timing = {} if timing is None else timing
+    t0 = time.perf_counter()
     todo = [c for c in cases if not _is_finished(c, cfg)]
     if announce:
         print(f"runs: {len(todo)} to run, {len(cases) - len(todo)} reused (finished earlier with the same parameters, "
               f"settings and code)", flush=True)
     results = {c.label: execute_case(c, cfg) for c in cases if c not in todo}   # finished: just load
+    timing["reuse_check_s"] = time.perf_counter() - t0
     if not todo:
         return results
     n_workers = workers or min(len(todo), os.cpu_count() or 1)
+    timing.update(workers=n_workers, dask=not (scheduler is None and n_workers <= 1), runs_start_unix_s=time.time())
     # bars on a terminal; a log file or a pipe gets one plain line per finished run instead of escape codes
     plain = progress and not sys.stderr.isatty()
     bars = progress and not plain
@@ -267,10 +284,15 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
             results[c.label] = execute_case(c, cfg, overwrite)
             if plain:
                 print(f"runs: {i + 1}/{len(todo)} done ({c.label})", file=sys.stderr, flush=True)
+        timing["runs_end_unix_s"] = time.time()
+        timing["runs_s"] = timing["runs_end_unix_s"] - timing["runs_start_unix_s"]
         return results
     wcfg = replace(cfg, progress=False)   # per-run bars would interleave; the sweep bar shows progress
     futs = {}
+    t_start = time.perf_counter()
     with dask_client(n_workers, scheduler) as client:
+        timing["cluster_start_s"] = time.perf_counter() - t_start
+        timing["runs_start_unix_s"] = time.time()
         try:
             futs = {client.submit(execute_case, c, wcfg, overwrite, pure=False, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
             bar = tqdm(total=len(futs), desc="runs", disable=not bars, position=0)
@@ -301,6 +323,10 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
         except BaseException:       # Ctrl-C or a failure of the client: take its runs off the scheduler
             client.cancel(list(futs), force=True)
             raise
+        timing["runs_end_unix_s"] = time.time()
+        timing["runs_s"] = timing["runs_end_unix_s"] - timing["runs_start_unix_s"]
+        t_close = time.perf_counter()
+    timing["cluster_close_s"] = time.perf_counter() - t_close
     return results
 
 

@@ -3,19 +3,38 @@ Dask workers) and `make demo`'s job, each a fresh process writing into a tempora
 kernels' first compile kept apart (a warm-up process loads or compiles them first; its time is reported
 on its own).
 
-    python -m scenarios.bench_study [--repeats 1] [--compare PATH] [--skip study|demo]
+    python -m scenarios.bench_study [--repeats 1] [--compare PATH] [--skip study|demo] [--profile]
+    python -m scenarios.bench_study --fresh-clone [--skip demo]
 
 ``--compare PATH``: a second checkout (e.g. the code before a change, `git worktree add`); both are run
-interleaved — A, B, A, B — so a busy machine slows both alike; medians are reported with every sample.
-Peak RSS is the largest of any process the runs started (getrusage of the waited-for children).
-Prints a line per run and one JSON object last.
+interleaved — A, B, A, B — so a busy machine slows both alike; medians are reported with every sample, and the
+before/after ratio of each pair run back to back.
+
+``--profile``: where each job's wall time went, from what the study writes when ``DPGT_TIMING`` names a file
+(:data:`scenarios.core.study.TIMING_ENV`: its checks, Dask phases, each run's span on its worker, the report's
+steps) and each run's ``timing`` in its summary.json (engine, statistics, recording, set-up, kernels); the time
+outside the study's own clock is the interpreter's start, the imports and the exit. On Dask the runs' parts are
+worker-seconds shared out over the workers, so the rows add up to the wall time.
+
+Memory: each run's own peak resident memory (``timing.peak_rss_MB`` of its summary.json: the worker's high-water
+mark reset when the run starts), max and median over the runs; the study process's own peak; and the largest of the
+job's process and the descendants it reaped (``wait4``), the only one a checkout without per-run timing gives.
+
+``--fresh-clone``: ``git clone`` of this checkout's HEAD (uncommitted changes are not in it) into a temporary
+folder, its virtual environment made by its own Makefile (``make install``: venv, pip, ``pip install -e
+.[test]``; wheels from ``PIP_FIND_LINKS`` if set) with the interpreter found on PATH outside any active venv, an
+empty ``NUMBA_CACHE_DIR``; then timed apart: the install, the kernels' compile (``make warm``) and the demo's job
+(``python -m scenarios.demo``, what ``make demo`` runs after warm). Their sum is a fresh clone's ``make demo``.
+
+Prints a line per run, the tables asked for, and one JSON object last.
 """
 from __future__ import annotations
 
 import argparse
+import glob
 import json
 import os
-import resource
+import shutil
 import statistics
 import subprocess
 import sys
@@ -23,25 +42,233 @@ import tempfile
 import time
 from pathlib import Path
 
+from scenarios.core.study import TIMING_ENV
+
 HERE = Path(__file__).resolve().parents[2]      # the repository (this file: scenarios/numerics/bench_study.py)
 JOBS = {
     "study": ["-m", "scenarios.paper_study", "--conditions", "1,2,3,4", "--directions", "forward,reverse",
               "--workers", "2", "--no-progress"],
     "demo": ["-m", "scenarios.demo", "--no-progress"],
 }
+# a run's timing parts (summary.json "timing", scenarios.core.runner) -> the profile's group and words
+RUN_PARTS = {
+    "engine_s": ("engine", "engine: the integration steps"),
+    "statistics_s": ("statistics", "statistics: the observer on every block, the summary"),
+    "recording_s": ("recording", "recording: sampling at 25 kHz, its chunks"),
+    "results_write_s": ("recording", "recording: writing results.nc"),
+    "scene_s": ("set-up", "set-up: scene, statistics, recorder"),
+    "runner_setup_s": ("set-up", "set-up: engine path (compiled system, LU pattern), binding"),
+    "kernels_s": ("kernels", "loading (or compiling) the kernels: engine, outputs, accumulators"),
+    "checkpoints_s": ("other", "checkpoints"),
+    "other_s": ("other", "run: the rest (progress, step statistics, warnings, summary.json)"),
+}
 
 
-def _timed(repo: Path, args: list[str], out: Path | None) -> tuple[float, int]:
-    """(wall [s], exit code) of ``python args [--out out]`` run in checkout ``repo``."""
-    env = {**os.environ, "PYTHONPATH": str(repo), "DPGT_PROGRESS": "0", "MPLBACKEND": "Agg"}
-    cmd = [sys.executable, *args] + (["--out", str(out)] if out is not None else [])
-    t = time.perf_counter()
-    rc = subprocess.run(cmd, cwd=repo, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    wall = time.perf_counter() - t
-    if rc.returncode:
-        print(f"bench_study: {' '.join(args)} in {repo} failed ({rc.returncode}): {rc.stderr.strip()[-500:]}",
-              file=sys.stderr)
-    return wall, rc.returncode
+def _rusage_run(cmd: list[str], cwd: Path, env: dict, log: Path) -> tuple[float, int, float]:
+    """(wall [s], exit code, peak RSS [MiB] of the process and the descendants it reaped) of ``cmd``; its stderr
+    goes to ``log``."""
+    with open(log, "w") as err:
+        t = time.perf_counter()
+        p = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.DEVNULL, stderr=err)
+        _, status, ru = os.wait4(p.pid, 0)
+        wall = time.perf_counter() - t
+    p.returncode = os.waitstatus_to_exitcode(status)
+    return wall, p.returncode, ru.ru_maxrss / 1024.0
+
+
+def _env(repo: Path, **extra) -> dict:
+    return {**os.environ, "PYTHONPATH": str(repo), "DPGT_PROGRESS": "0", "MPLBACKEND": "Agg", **extra}
+
+
+def _job(repo: Path, args: list[str], tmp: Path, python: str = sys.executable, env: dict | None = None) -> dict:
+    """One job in a fresh process: its wall time, exit code, the study's timing file and its runs' summaries."""
+    out, timing = tmp / "out", tmp / "timing.json"
+    env = {**(env or _env(repo)), TIMING_ENV: str(timing)}
+    wall, rc, tree_mb = _rusage_run([python, *args, "--out", str(out)], repo, env, tmp / "stderr.txt")
+    if rc:
+        err = (tmp / "stderr.txt").read_text(errors="replace").strip()[-800:]
+        print(f"bench_study: {' '.join(args)} in {repo} failed ({rc}): {err}", file=sys.stderr)
+    runs = {}
+    for f in sorted(glob.glob(str(out / "*" / "summary.json"))):
+        try:
+            runs[Path(f).parent.name] = json.loads(Path(f).read_text()).get("timing")
+        except (OSError, ValueError):
+            pass
+    study = json.loads(timing.read_text()) if timing.exists() else None
+    return {"wall_s": wall, "rc": rc, "tree_peak_rss_MB": tree_mb, "study": study, "runs": runs}
+
+
+def memory(job: dict) -> dict:
+    """Peak RSS per run (max, median over the runs), the study process's own, the job's process tree's largest."""
+    peaks = [r["peak_rss_MB"] for r in job["runs"].values() if r and "peak_rss_MB" in r]
+    return {"run_peak_rss_max_MB": max(peaks) if peaks else None,
+            "run_peak_rss_median_MB": statistics.median(peaks) if peaks else None,
+            "runs_with_peak": len(peaks),
+            "study_process_peak_rss_MB": (job["study"] or {}).get("peak_rss_MB"),
+            "largest_process_MB": job["tree_peak_rss_MB"]}
+
+
+def profile(job: dict) -> list[tuple[str, str, float]]:
+    """(group, part, wall seconds) of one job, adding up to its wall time (module docstring: --profile)."""
+    W, T = job["wall_s"], job["study"]
+    if T is None:
+        return []
+    sw, rows = T["sweep"], []
+    add = lambda g, what, s: rows.append((g, what, float(s)))
+    add("python", "interpreter start, imports, exit", W - T["total_s"])
+    add("checks", "parameters, designs, folders, reuse check", T["checks_s"] + T["prepare_s"] + sw.get("reuse_check_s", 0))
+    if sw.get("dask"):
+        add("dask", "cluster start: Dask imported, scheduler and 2 worker processes", sw["cluster_start_s"])
+        add("dask", "cluster close", sw["cluster_close_s"])
+    R, n = sw.get("runs_s", 0.0), max(int(sw.get("workers", 1)), 1)
+    spans = {k: v for k, v in T["runs"].items() if v}
+    by_pid: dict[int, list] = {}
+    for k, v in spans.items():
+        by_pid.setdefault(v["pid"], []).append((v["start_unix_s"], v["end_unix_s"], k))
+    first = gaps = tail = 0.0
+    for pid, sp in by_pid.items():
+        sp.sort()
+        first += sp[0][0] - sw["runs_start_unix_s"]
+        gaps += sum(b[0] - a[1] for a, b in zip(sp, sp[1:]))
+        tail += sw["runs_end_unix_s"] - sp[-1][1]
+    tail += (n - len(by_pid)) * R           # a worker that ran nothing waited the whole phase
+    parts = dict.fromkeys(RUN_PARTS, 0.0)
+    outside = 0.0
+    for k, v in spans.items():
+        t = job["runs"].get(k) or {}
+        for p in RUN_PARTS:
+            parts[p] += t.get(p, 0.0)
+        outside += (v["end_unix_s"] - v["start_unix_s"]) - t.get("total_s", 0.0)
+    for p, (g, what) in RUN_PARTS.items():
+        add(g, what, parts[p] / n)
+    add("other", "a run's case outside the runner (parameters, lock, folder checks)", outside / n)
+    if sw.get("dask"):
+        add("dask", "a worker's first task: the imports, transfer, start", first / n)
+        add("dask", "between a worker's tasks: scheduling, transfer", gaps / n)
+        add("dask", "idle at the end: waiting for the other worker's last run, the client's 0.5 s poll", tail / n)
+    else:
+        add("other", "between runs (in-process)", (first + gaps + tail) / n)
+    steps = T.get("steps_s", {})
+    for what, s in steps.items():
+        add("study I/O", f"report: {what}", s)
+    add("study I/O", "report: relative lives into each summary.json, headline tables", T["report_s"] - sum(steps.values()))
+    sweep_rest = T["sweep_s"] - sw.get("reuse_check_s", 0) - sw.get("cluster_start_s", 0) - R - sw.get("cluster_close_s", 0)
+    add("other", "the study's rest (sweep bookkeeping, epilogue)", T["total_s"] - T["checks_s"] - T["prepare_s"]
+        - T["sweep_s"] - T["report_s"] + sweep_rest)
+    return rows
+
+
+def profile_table(name: str, jobs: list[dict]) -> str:
+    """Markdown table of :func:`profile` summed over ``jobs`` (repeats), grouped, with shares of the wall time."""
+    total = sum(j["wall_s"] for j in jobs)
+    acc: dict[tuple[str, str], float] = {}
+    for j in jobs:
+        for g, what, s in profile(j):
+            acc[(g, what)] = acc.get((g, what), 0.0) + s
+    if not acc:
+        return f"{name}: no profile (the checkout writes no timing)"
+    groups: dict[str, float] = {}
+    for (g, _), s in acc.items():
+        groups[g] = groups.get(g, 0.0) + s
+    k = len(jobs)
+    lines = [f"{name}: wall {total / k:.1f} s (mean of {k}); parts in s per job and % of the wall time",
+             "| group | part | s | % |", "|---|---|---|---|"]
+    for g in sorted(groups, key=groups.get, reverse=True):
+        lines.append(f"| **{g}** | | **{groups[g] / k:.1f}** | **{100 * groups[g] / total:.1f}** |")
+        for (gg, what), s in sorted(acc.items(), key=lambda x: -x[1]):
+            if gg == g:
+                lines.append(f"| | {what} | {s / k:.2f} | {100 * s / total:.1f} |")
+    return "\n".join(lines)
+
+
+def compare_runs(a, repos: dict[str, Path]) -> dict:
+    result: dict = {}
+    for name, r in repos.items():
+        with tempfile.TemporaryDirectory() as tmp:
+            wall, rc, _ = _rusage_run([sys.executable, "-m", "scenarios.warm"], r, _env(r), Path(tmp) / "err")
+        result[name] = {"repo": str(r), "warm_s": wall if rc == 0 else None, "jobs": {}}
+        print(f"{name} warm: {wall:.1f} s", flush=True)
+    for _ in range(a.repeats):
+        for job in (j for j in JOBS if j not in a.skip):
+            for name, repo in repos.items():          # interleaved: a busy machine slows both alike
+                with tempfile.TemporaryDirectory() as tmp:
+                    d = _job(repo, JOBS[job], Path(tmp))
+                d["load_1min"] = os.getloadavg()[0]
+                d["memory"] = memory(d)
+                result[name]["jobs"].setdefault(job, []).append(d)
+                m = d["memory"]
+                mem = (f"; run peak RSS max {m['run_peak_rss_max_MB']:.0f} / median {m['run_peak_rss_median_MB']:.0f} MB"
+                       f" over {m['runs_with_peak']} runs" if m["runs_with_peak"] else "")
+                print(f"{name} {job}: {d['wall_s']:.1f} s" + ("" if d["rc"] == 0 else f" (failed, exit {d['rc']})")
+                      + f" (load {d['load_1min']:.1f}{mem}; largest process {m['largest_process_MB']:.0f} MB)", flush=True)
+    return result
+
+
+def summarise(result: dict, names: list[str]) -> dict:
+    out = {}
+    for name in names:
+        o = out[name] = {"repo": result[name]["repo"], "warm_s": result[name]["warm_s"]}
+        for job, ds in result[name]["jobs"].items():
+            ok = [d["wall_s"] for d in ds if d["rc"] == 0]
+            o[f"{job}_s"] = [d["wall_s"] if d["rc"] == 0 else None for d in ds]
+            o[f"{job}_median_s"] = statistics.median(ok) if ok else None
+            o[f"{job}_memory"] = [d["memory"] for d in ds]
+            o[f"{job}_load_1min"] = [d["load_1min"] for d in ds]
+    if "compare" in names:
+        for job in result["this"]["jobs"]:
+            pairs = [b / a for a, b in zip(out["this"][f"{job}_s"], out["compare"][f"{job}_s"]) if a and b]
+            out[f"{job}_before_over_after"] = pairs
+            out[f"{job}_before_over_after_median"] = statistics.median(pairs) if pairs else None
+    return out
+
+
+def _outside_venv_env(extra: dict) -> dict:
+    """The environment without an active virtual environment or this checkout on the path (a fresh machine's)."""
+    env = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME")}
+    venv = os.environ.get("VIRTUAL_ENV")
+    if venv:
+        env["PATH"] = os.pathsep.join(p for p in env.get("PATH", "").split(os.pathsep)
+                                      if not Path(p).resolve().is_relative_to(Path(venv).resolve()))
+    return {**env, "DPGT_PROGRESS": "0", "MPLBACKEND": "Agg", **extra}
+
+
+def fresh_clone(a) -> dict:
+    """Clone, install (make install), compile (make warm), demo: each timed apart (module docstring)."""
+    tmp = Path(tempfile.mkdtemp(prefix="bench_fresh_"))
+    try:
+        repo, cache = tmp / "repo", tmp / "numba_cache"
+        cache.mkdir()
+        head = subprocess.run(["git", "-C", str(HERE), "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", str(HERE), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True).stdout.strip()
+        print(f"fresh clone of {HERE} at {head[:10]}" + (" (uncommitted changes are not in it)" if dirty else ""),
+              flush=True)
+        t = time.perf_counter()
+        subprocess.run(["git", "clone", "--quiet", str(HERE), str(repo)], check=True)
+        out = {"commit": head, "clone_s": time.perf_counter() - t, "load_1min": [os.getloadavg()[0]]}
+        env = _outside_venv_env({"NUMBA_CACHE_DIR": str(cache)})
+        for step, cmd in (("install", ["make", "install"]), ("warm", ["make", "warm"])):
+            wall, rc, _ = _rusage_run(cmd, repo, env, tmp / f"{step}.err")
+            out[f"{step}_s"], out["load_1min"] = wall, out["load_1min"] + [os.getloadavg()[0]]
+            print(f"fresh clone {' '.join(cmd)}: {wall:.1f} s" + ("" if rc == 0 else f" (failed, exit {rc})"), flush=True)
+            if rc:
+                print((tmp / f"{step}.err").read_text(errors="replace")[-1500:], file=sys.stderr)
+                return out
+        out["python"] = subprocess.run([str(repo / ".venv/bin/python"), "-V"], capture_output=True, text=True).stdout.strip()
+        if "demo" not in a.skip:
+            (tmp / "demo").mkdir()
+            d = _job(repo, JOBS["demo"], tmp / "demo", python=str(repo / ".venv/bin/python"), env=env)
+            out.update(demo_s=d["wall_s"], demo_rc=d["rc"], demo_memory=memory(d))
+            out["load_1min"].append(os.getloadavg()[0])
+            print(f"fresh clone demo's job: {d['wall_s']:.1f} s" + ("" if d["rc"] == 0 else f" (failed, exit {d['rc']})"),
+                  flush=True)
+            out["make_demo_s"] = out["install_s"] + out["warm_s"] + d["wall_s"]
+            if a.profile:
+                print(profile_table("fresh clone demo's job", [d]))
+        out["numba_cache_files"] = sum(1 for _ in cache.rglob("*.nbi"))
+        return out
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 def main(argv=None) -> int:
@@ -49,24 +276,26 @@ def main(argv=None) -> int:
     p.add_argument("--repeats", type=int, default=1)
     p.add_argument("--compare", type=Path, default=None, help="a second checkout to time interleaved with this one")
     p.add_argument("--skip", choices=sorted(JOBS), action="append", default=[])
+    p.add_argument("--profile", action="store_true", help="where each job's wall time went (this checkout's runs)")
+    p.add_argument("--fresh-clone", action="store_true",
+                   help="time a fresh clone's install, compile and demo (empty NUMBA_CACHE_DIR) instead")
     a = p.parse_args(argv)
+    if a.repeats < 1:
+        p.error(f"--repeats must be an integer >= 1, got {a.repeats}")
+    if a.compare is not None and not (a.compare / "scenarios").is_dir():
+        p.error(f"--compare must be a checkout of this project (a folder with scenarios/), got {a.compare}")
+    if a.fresh_clone:
+        print(json.dumps({"fresh_clone": fresh_clone(a)}))
+        return 0
     repos = {"this": HERE} | ({"compare": a.compare.resolve()} if a.compare else {})
-    result: dict = {name: {"repo": str(r), "warm_s": _timed(r, ["-m", "scenarios.warm"], None)[0]}
-                    for name, r in repos.items()}
-    for _ in range(a.repeats):
-        for job in (j for j in JOBS if j not in a.skip):
-            for name, repo in repos.items():          # interleaved: a busy machine slows both alike
-                with tempfile.TemporaryDirectory() as tmp:
-                    wall, rc = _timed(repo, JOBS[job], Path(tmp) / "out")
-                result[name].setdefault(f"{job}_s", []).append(wall if rc == 0 else None)
-                print(f"{name} {job}: {wall:.1f} s" + ("" if rc == 0 else f" (failed, exit {rc})"), flush=True)
-    for d in result.values():
-        for k in [k for k in d if k.endswith("_s") and isinstance(d[k], list)]:
-            ok = [x for x in d[k] if x is not None]
-            d[k.replace("_s", "_median_s")] = statistics.median(ok) if ok else None
-    result["peak_rss_MB"] = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0
-    result["load_1min"] = os.getloadavg()[0]
-    print(json.dumps(result))
+    result = compare_runs(a, repos)
+    if a.profile:
+        for job, ds in result["this"]["jobs"].items():
+            print("\n" + profile_table(f"{job} ({HERE})", [d for d in ds if d["rc"] == 0]))
+    summary = summarise(result, list(repos))
+    if a.profile:
+        summary["profile"] = {job: profile(ds[-1]) for job, ds in result["this"]["jobs"].items()}
+    print(json.dumps(summary))
     return 0
 
 
