@@ -25,12 +25,15 @@ def family_outputs(kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O):
     coordinates, ``phi``, ``omega``, ``domega`` (K,) the frame's state, ``Z`` (K, n, n_z) the internal states."""
     n, k = dofs.shape
     ql, vl = np.empty((n, k)), np.empty((n, k))
+    # the kernels write a C-contiguous (n_outputs, n) buffer: O[:, :, s] (layout 'A') would compile them once more
+    Os = np.empty((O.shape[0], n))
     for s in range(t.size):
         for i in range(n):
             for j in range(k):
                 ql[i, j] = qf[s, dofs[i, j]]
                 vl[i, j] = vf[s, dofs[i, j]]
-        outputs_kind(kind, t[s], phi[s], omega[s], domega[s], ql, vl, Z[s], P, G, O[:, :, s])
+        outputs_kind(kind, t[s], phi[s], omega[s], domega[s], ql, vl, Z[s], P, G, Os)
+        O[:, :, s] = Os
 
 
 class CompiledOutputs:
