@@ -60,13 +60,34 @@ def _drop_stale_kernels() -> None:
 
 
 
-def kernels_cached(function: str = "stepper.advance") -> bool:
+def kernels_cached(function: str = "stepper.advance", groups: int | None = None) -> bool:
     """Does numba's disk cache hold the compiled ``function`` ("module.name" in this package; by default the step
-    loop) of this code, so that a run loads it in about a second instead of compiling it? Checked by its index
-    file (:func:`_drop_stale_kernels` removes stale ones)."""
+    loop) of this code, so that a run loads it in about a second instead of compiling it? With ``groups`` (a
+    :data:`.registry.GROUPS` mask): compiled for that set of families (:func:`cached_groups`); without, for any
+    (checked by its index file; :func:`_drop_stale_kernels` removes stale ones)."""
+    if groups is not None:
+        return groups in cached_groups(function)
     here = _Path(__file__).resolve().parent
     root = _Path(_numba_config.CACHE_DIR) if _numba_config.CACHE_DIR else here / "__pycache__"
     return any(root.rglob(f"{function}-*.nbi")) if root.is_dir() else False
+
+
+def cached_groups(function: str = "stepper.advance") -> set:
+    """The family-group masks (:data:`.registry.GROUPS`) for which numba's disk cache holds ``function`` (whose
+    first argument is ``groups``) of this code: the entries numba itself would load (same code, same machine)."""
+    import importlib
+
+    from numba.core import types
+
+    module, _, name = function.partition(".")
+    disp = getattr(importlib.import_module(f"{__name__}.{module}"), name)
+    try:                    # numba's cache index (private API, read only): an unreadable one counts as empty
+        cache = disp._cache
+        codegen = disp.targetctx.codegen()
+        return {key[0][0].literal_value for key in cache._cache_file._load_index()
+                if isinstance(key[0][0], types.IntegerLiteral) and cache._index_key(key[0], codegen) == key}
+    except Exception:       # noqa: BLE001 — e.g. a numba whose cache internals differ: compile the exact set
+        return set()
 
 
 _drop_stale_kernels()

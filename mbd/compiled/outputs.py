@@ -10,19 +10,21 @@ import sys
 import time
 
 import numpy as np
-from numba import njit
+from numba import literally, njit
 
 from ..assembly import System
-from .registry import OUTPUT_NAMES, kind_of, outputs_kind
+from .registry import OUTPUT_NAMES, groups_to_compile, kind_of, outputs_for
 from .. import compiled as _compiled     # kernels_cached is read through the package when called
 
 __all__ = ["CompiledOutputs", "family_outputs"]
 
 
 @njit(cache=True)
-def family_outputs(kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O):
+def family_outputs(groups, kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O):
     """One family's outputs at K states into O (n_outputs, n, K): ``qf``, ``vf`` (K, n_full) the full
-    coordinates, ``phi``, ``omega``, ``domega`` (K,) the frame's state, ``Z`` (K, n, n_z) the internal states."""
+    coordinates, ``phi``, ``omega``, ``domega`` (K,) the frame's state, ``Z`` (K, n, n_z) the internal states;
+    ``groups`` (a literal) the family groups compiled (:func:`.registry.groups_of`)."""
+    literally(groups)
     n, k = dofs.shape
     ql, vl = np.empty((n, k)), np.empty((n, k))
     # the kernels write a C-contiguous (n_outputs, n) buffer: O[:, :, s] (layout 'A') would compile them once more
@@ -32,7 +34,7 @@ def family_outputs(kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O):
             for j in range(k):
                 ql[i, j] = qf[s, dofs[i, j]]
                 vl[i, j] = vf[s, dofs[i, j]]
-        outputs_kind(kind, t[s], phi[s], omega[s], domega[s], ql, vl, Z[s], P, G, Os)
+        outputs_for(groups, kind, t[s], phi[s], omega[s], domega[s], ql, vl, Z[s], P, G, Os)
         O[:, :, s] = Os
 
 
@@ -46,6 +48,7 @@ class CompiledOutputs:
     def __init__(self, system: System):
         self.system, self.model = system, system.model
         self._compiled, self.engines = [], {}
+        self.groups = 0        # the kernel groups of the compiled families (registry.GROUPS): compiled for these only
         for e, parts in system._evals:
             names = OUTPUT_NAMES.get(type(e).compiled_twin)
             packed = None
@@ -59,8 +62,10 @@ class CompiledOutputs:
             if packed is not None:
                 z0 = e.init_internal()          # a family with internal state is never fused: parts[0] is it
                 state = (parts[0][0], int(np.size(z0)) // e.n) if z0 is not None else (None, 0)
+                self.groups |= kind_of(type(e)).group
                 self._compiled.append((parts, kind_of(type(e)).id, np.ascontiguousarray(e.dofs, dtype=np.int64),
                                        *packed, names, state))
+        self.groups = groups_to_compile(self.groups, _compiled.cached_groups("outputs.family_outputs"))
         self._compile()
 
     def _compile(self) -> None:
@@ -69,7 +74,7 @@ class CompiledOutputs:
 
         if not self._compiled:
             return
-        cold = not _compiled.kernels_cached("outputs.family_outputs")
+        cold = not _compiled.kernels_cached("outputs.family_outputs", self.groups)
         if cold:
             print("mbd: compiling the element output kernels (the first run of this code on this machine; about "
                   "10 s, then cached)", file=sys.stderr, flush=True)
@@ -106,7 +111,7 @@ class CompiledOutputs:
             # instance-major, as the numpy kernels' (K, n) results lie: a fused family's slice [:, sl] is then one
             # contiguous block, and the statistics' numpy expressions over it run ≈ 1.5× faster than over strided rows
             O = np.empty((len(names), n, K))
-            family_outputs(kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O)
+            family_outputs(self.groups, kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O)
             O = O.transpose(0, 2, 1)
             for name, sl in parts:
                 res[name] = dict(zip(names, O if len(parts) == 1 else O[:, :, sl]))

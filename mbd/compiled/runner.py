@@ -120,14 +120,14 @@ class CompiledRunner:
     def _compile(self) -> None:
         """Compile (or load) the step loop now, before any step: a progress bar's ETA then leaves the compile
         out, and a first run on a machine says what it is doing instead of looking stuck."""
-        cold = not _compiled.kernels_cached()
+        cold = not _compiled.kernels_cached(groups=self.cs.groups)
         if cold:
             print("mbd: compiling the engine's kernels (the first run of this code on this machine; about a "
                   "minute, then cached)", file=sys.stderr, flush=True)
         t0 = time.perf_counter()
         n = self.n
         z = np.zeros(n)
-        advance(0.0, z.copy(), z.copy(), z.copy(), z.copy(), 1e-6, 0.0, 0, self.prm, self.ctrl, self.atol, self.rtol,
+        advance(self.cs.groups, 0.0, z.copy(), z.copy(), z.copy(), z.copy(), 1e-6, 0.0, 0, self.prm, self.ctrl, self.atol, self.rtol,
                 self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu, self.cache, self.work,
                 np.zeros(6, np.int64), self.out, np.empty((1, 3 + 4 * n + self.n_z)))
         if cold:
@@ -144,7 +144,7 @@ class CompiledRunner:
         log = np.empty((max(int(max_steps), 1), 3 + 4 * self.n + self.n_z))
         counters = np.zeros(6, np.int64)
         t, h, acc, status, it, rate, reason = advance(
-            float(state.t), q, v, a, f, float(h), float(t_end), int(max_steps), self.prm, self.ctrl, self.atol,
+            self.cs.groups, float(state.t), q, v, a, f, float(h), float(t_end), int(max_steps), self.prm, self.ctrl, self.atol,
             self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu, self.cache,
             self.work, counters, self.out, log)
         keys = ("residual", "jacobian", "factor", "newton", "accepted", "rejected")
