@@ -13,7 +13,7 @@ import numpy as np
 from numba import literally, njit
 
 from ..assembly import System
-from .registry import OUTPUT_NAMES, groups_to_compile, kind_of, outputs_for
+from .registry import OUTPUT_NAMES, call, groups_to_compile, kind_of, outputs_for
 from .. import compiled as _compiled     # kernels_cached is read through the package when called
 
 __all__ = ["CompiledOutputs", "family_outputs"]
@@ -111,7 +111,7 @@ class CompiledOutputs:
             # instance-major, as the numpy kernels' (K, n) results lie: a fused family's slice [:, sl] is then one
             # contiguous block, and the statistics' numpy expressions over it run ≈ 1.5× faster than over strided rows
             O = np.empty((len(names), n, K))
-            family_outputs(self.groups, kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O)
+            call(family_outputs, self.groups, kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O)
             O = O.transpose(0, 2, 1)
             for name, sl in parts:
                 res[name] = dict(zip(names, O if len(parts) == 1 else O[:, :, sl]))

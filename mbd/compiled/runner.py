@@ -14,6 +14,7 @@ from ..control import Adaptive, FixedStep
 from ..hht import HHT, StepInfo
 from ..model import State
 from .. import compiled as _compiled     # kernels_cached is read through the package when called
+from .registry import call
 from .sparse_lu import FixedPatternLU
 from .stepper import FAIL_REASONS, advance
 from .system import CompiledSystem
@@ -127,9 +128,9 @@ class CompiledRunner:
         t0 = time.perf_counter()
         n = self.n
         z = np.zeros(n)
-        advance(self.cs.groups, 0.0, z.copy(), z.copy(), z.copy(), z.copy(), 1e-6, 0.0, 0, self.prm, self.ctrl, self.atol, self.rtol,
-                self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu, self.cache, self.work,
-                np.zeros(6, np.int64), self.out, np.empty((1, 3 + 4 * n + self.n_z)))
+        call(advance, self.cs.groups, 0.0, z.copy(), z.copy(), z.copy(), z.copy(), 1e-6, 0.0, 0, self.prm, self.ctrl,
+             self.atol, self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu, self.cache,
+             self.work, np.zeros(6, np.int64), self.out, np.empty((1, 3 + 4 * n + self.n_z)))
         if cold:
             print(f"mbd: kernels compiled in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
 
@@ -143,10 +144,10 @@ class CompiledRunner:
         q, v, a, f = (np.array(x, float) for x in (state.q, state.v, state.a, state.f))
         log = np.empty((max(int(max_steps), 1), 3 + 4 * self.n + self.n_z))
         counters = np.zeros(6, np.int64)
-        t, h, acc, status, it, rate, reason = advance(
-            self.cs.groups, float(state.t), q, v, a, f, float(h), float(t_end), int(max_steps), self.prm, self.ctrl, self.atol,
-            self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu, self.cache,
-            self.work, counters, self.out, log)
+        t, h, acc, status, it, rate, reason = call(
+            advance, self.cs.groups, float(state.t), q, v, a, f, float(h), float(t_end), int(max_steps), self.prm,
+            self.ctrl, self.atol, self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu,
+            self.cache, self.work, counters, self.out, log)
         keys = ("residual", "jacobian", "factor", "newton", "accepted", "rejected")
         failed = StepInfo(False, int(it), float(rate), reason=FAIL_REASONS[reason]) if status == 2 else None
         blk = Block(log[:acc], state, self.z_shapes, dict(zip(keys, (int(c) for c in counters))), state, float(h),

@@ -23,9 +23,6 @@ __all__ = ["advance", "FAIL_REASONS"]
 FAIL_REASONS = ("", "singular Newton matrix", "non-finite forces", "non-finite Newton correction",
                 "Newton diverged", "Newton did not converge in max_iter")
 _SINGULAR, _NONFINITE_F, _NONFINITE_DA, _DIVERGED, _MAX_ITER = 1, 2, 3, 4, 5
-# ``jac`` for assemble as numpy bools: numba types a Python True/False as Literal[bool] and would compile the
-# assembly and every family kernel twice (jac True and False); np.bool_ types as plain bool, one specialisation
-_WITH_JACOBIAN, _FORCES_ONLY = np.True_, np.False_
 
 
 @njit(cache=True)
@@ -74,7 +71,7 @@ def _refresh(groups, t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F, Jq, Jv, A
     indptr, indices, Mdata, mdiag = pat
     n = mdiag.size
     perm, iperm, Lp, Li, Lx, Up, Ui, Ux, xw, yw, D, dpiv = lu
-    assemble(groups, t1, q1, v1, fams, zs, _WITH_JACOBIAN, sysd, F, Jq, Jv)
+    assemble(groups, t1, q1, v1, fams, zs, True, sysd, F, Jq, Jv)
     for e in range(A.size):
         A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
         if not np.isfinite(A[e]):
@@ -149,7 +146,7 @@ def _newton(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, 
             q1[i] = qp[i] + bh2 * a1[i]
             v1[i] = vp[i] + gh * a1[i]
         if not have_F:
-            assemble(groups, t + h, q1, v1, fams, zs, _FORCES_ONLY, sysd, F1, Jq, Jv)
+            assemble(groups, t + h, q1, v1, fams, zs, False, sysd, F1, Jq, Jv)
             cnt[0] += 1
         have_F = False
         for i in range(n):
@@ -207,7 +204,8 @@ def _step(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, ca
         qp[i] = q[i] + h * v[i] + h * h * (0.5 - beta) * a[i]
         vp[i] = v[i] + h * (1.0 - gamma) * a[i]
         a1[i] = a[i]
-    conv, it, rate, reason = _newton(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, work, cnt)
+    conv, it, rate, reason = _newton(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, work,
+                                     cnt)
     if not conv:
         cache[0] = 0.0
         return False, it, rate, reason, np.nan

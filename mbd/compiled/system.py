@@ -12,7 +12,7 @@ from numba import literally, njit
 from numba.typed import List
 
 from ..assembly import Evaluation, System
-from .registry import evaluate_for, groups_of, groups_to_compile, kind_of, update_for
+from .registry import call, evaluate_for, groups_of, groups_to_compile, kind_of, update_for
 from .. import compiled as _compiled     # cached_groups is read through the package when called
 
 __all__ = ["CompiledSystem", "assemble"]
@@ -181,6 +181,6 @@ class CompiledSystem:
             self.set_internal(z)
         F = np.empty(self.ndof)
         Jq, Jv = (np.empty(self.nnz), np.empty(self.nnz)) if jac else (np.empty(0), np.empty(0))
-        assemble(self.groups, float(t), np.ascontiguousarray(q, float), np.ascontiguousarray(v, float), self.fams, self.zs,
-                 jac, self.sysd, F, Jq, Jv)
+        call(assemble, self.groups, float(t), np.ascontiguousarray(q, float), np.ascontiguousarray(v, float), self.fams,
+             self.zs, jac, self.sysd, F, Jq, Jv)
         return Evaluation(F, Jq if jac else None, Jv if jac else None)
