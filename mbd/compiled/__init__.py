@@ -27,10 +27,12 @@ see :mod:`.registry`):
 """
 
 import hashlib as _hashlib
+import importlib as _importlib
 import os as _os
 from pathlib import Path as _Path
 
 from numba import config as _numba_config
+from numba.core import types as _nbtypes
 
 
 def _drop_stale_kernels() -> None:
@@ -75,17 +77,13 @@ def kernels_cached(function: str = "stepper.advance", groups: int | None = None)
 def cached_groups(function: str = "stepper.advance") -> set:
     """The family-group masks (:data:`.registry.GROUPS`) for which numba's disk cache holds ``function`` (whose
     first argument is ``groups``) of this code: the entries numba itself would load (same code, same machine)."""
-    import importlib
-
-    from numba.core import types
-
     module, _, name = function.partition(".")
-    disp = getattr(importlib.import_module(f"{__name__}.{module}"), name)
+    disp = getattr(_importlib.import_module(f"{__name__}.{module}"), name)
     try:                    # numba's cache index (private API, read only): an unreadable one counts as empty
         cache = disp._cache
         codegen = disp.targetctx.codegen()
         return {key[0][0].literal_value for key in cache._cache_file._load_index()
-                if isinstance(key[0][0], types.IntegerLiteral) and cache._index_key(key[0], codegen) == key}
+                if isinstance(key[0][0], _nbtypes.IntegerLiteral) and cache._index_key(key[0], codegen) == key}
     except Exception:       # noqa: BLE001 — e.g. a numba whose cache internals differ: compile the exact set
         return set()
 
