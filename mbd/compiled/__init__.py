@@ -27,12 +27,14 @@ see :mod:`.registry`):
 """
 
 import hashlib as _hashlib
+import importlib as _importlib
 import os as _os
 import sys as _sys
 import time as _time
 from pathlib import Path as _Path
 
 from numba import config as _numba_config
+from numba.core import types as _nbtypes
 
 from ..compile_time import compiling
 
@@ -64,16 +66,20 @@ def _drop_stale_kernels() -> None:
 
 
 
-def kernels_cached(function="stepper.advance") -> bool:
+def kernels_cached(function="stepper.advance", groups: int | None = None) -> bool:
     """Does numba's disk cache hold the compiled ``function`` of this code, so that a run loads it in about a second
     instead of compiling it? ``function``: "module.name" in this package (by default the step loop; checked by its
-    index file, :func:`_drop_stale_kernels` removes stale ones), or a cached numba function of another package (a
-    kernel depending on its own file only: its index file for its current first line, newer than its source)."""
+    index file, :func:`_drop_stale_kernels` removes stale ones) — with ``groups`` (a :data:`.registry.GROUPS` mask)
+    compiled for that set of families (:func:`cached_groups`), without for any —, or a cached numba function of
+    another package (a kernel depending on its own file only: its index file for its current first line, newer than
+    its source)."""
     if not isinstance(function, str):
         code = function.py_func.__code__
         index = _Path(function.stats.cache_path) / (f"{_Path(code.co_filename).stem}.{function.py_func.__qualname__}-"
                                                     f"{code.co_firstlineno}.py{_sys.version_info[0]}{_sys.version_info[1]}.nbi")
         return index.is_file() and index.stat().st_mtime >= _Path(code.co_filename).stat().st_mtime
+    if groups is not None:
+        return groups in cached_groups(function)
     here = _Path(__file__).resolve().parent
     root = _Path(_numba_config.CACHE_DIR) if _numba_config.CACHE_DIR else here / "__pycache__"
     return any(root.rglob(f"{function}-*.nbi")) if root.is_dir() else False
@@ -92,6 +98,20 @@ def compile_announced(compile, cold: bool, what: str, done: str, about: str) -> 
         compile()
     if cold:
         print(f"mbd: {done} compiled in {_time.perf_counter() - t0:.0f} s", file=_sys.stderr, flush=True)
+
+
+def cached_groups(function: str = "stepper.advance") -> set:
+    """The family-group masks (:data:`.registry.GROUPS`) for which numba's disk cache holds ``function`` (whose
+    first argument is ``groups``) of this code: the entries numba itself would load (same code, same machine)."""
+    module, _, name = function.partition(".")
+    disp = getattr(_importlib.import_module(f"{__name__}.{module}"), name)
+    try:                    # numba's cache index (private API, read only): an unreadable one counts as empty
+        cache = disp._cache
+        codegen = disp.targetctx.codegen()
+        return {key[0][0].literal_value for key in cache._cache_file._load_index()
+                if isinstance(key[0][0], _nbtypes.IntegerLiteral) and cache._index_key(key[0], codegen) == key}
+    except Exception:       # noqa: BLE001 — e.g. a numba whose cache internals differ: compile the exact set
+        return set()
 
 
 _drop_stale_kernels()

@@ -7,27 +7,32 @@ tests hold this to (tests/mbd/test_compiled_outputs.py)."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import literally, njit
 
 from ..assembly import System
-from .registry import OUTPUT_NAMES, kind_of, outputs_kind
+from .registry import OUTPUT_NAMES, call, groups_to_compile, kind_of, outputs_for
 from .. import compiled as _compiled     # kernels_cached, compile_announced: read through the package when called
 
 __all__ = ["CompiledOutputs", "family_outputs"]
 
 
 @njit(cache=True)
-def family_outputs(kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O):
+def family_outputs(groups, kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O):
     """One family's outputs at K states into O (n_outputs, n, K): ``qf``, ``vf`` (K, n_full) the full
-    coordinates, ``phi``, ``omega``, ``domega`` (K,) the frame's state, ``Z`` (K, n, n_z) the internal states."""
+    coordinates, ``phi``, ``omega``, ``domega`` (K,) the frame's state, ``Z`` (K, n, n_z) the internal states;
+    ``groups`` (a literal) the family groups compiled (:func:`.registry.groups_of`)."""
+    literally(groups)
     n, k = dofs.shape
     ql, vl = np.empty((n, k)), np.empty((n, k))
+    # the kernels write a C-contiguous (n_outputs, n) buffer: O[:, :, s] (layout 'A') would compile them once more
+    Os = np.empty((O.shape[0], n))
     for s in range(t.size):
         for i in range(n):
             for j in range(k):
                 ql[i, j] = qf[s, dofs[i, j]]
                 vl[i, j] = vf[s, dofs[i, j]]
-        outputs_kind(kind, t[s], phi[s], omega[s], domega[s], ql, vl, Z[s], P, G, O[:, :, s])
+        outputs_for(groups, kind, t[s], phi[s], omega[s], domega[s], ql, vl, Z[s], P, G, Os)
+        O[:, :, s] = Os
 
 
 class CompiledOutputs:
@@ -40,6 +45,7 @@ class CompiledOutputs:
     def __init__(self, system: System):
         self.system, self.model = system, system.model
         self._compiled, self.engines = [], {}
+        self.groups = 0        # the kernel groups of the compiled families (registry.GROUPS): compiled for these only
         for e, parts in system._evals:
             names = OUTPUT_NAMES.get(type(e).compiled_twin)
             packed = None
@@ -53,8 +59,10 @@ class CompiledOutputs:
             if packed is not None:
                 z0 = e.init_internal()          # a family with internal state is never fused: parts[0] is it
                 state = (parts[0][0], int(np.size(z0)) // e.n) if z0 is not None else (None, 0)
+                self.groups |= kind_of(type(e)).group
                 self._compiled.append((parts, kind_of(type(e)).id, np.ascontiguousarray(e.dofs, dtype=np.int64),
                                        *packed, names, state))
+        self.groups = groups_to_compile(self.groups, _compiled.cached_groups("outputs.family_outputs"))
         self._compile()
 
     def _compile(self) -> None:
@@ -67,7 +75,7 @@ class CompiledOutputs:
         _compiled.compile_announced(
             lambda: self.outputs_batch(np.zeros(0), empty, empty, {},
                                        families={name for rec in self._compiled for name, _ in rec[0]}),
-            cold=not _compiled.kernels_cached("outputs.family_outputs"), what="the element output kernels",
+            cold=not _compiled.kernels_cached("outputs.family_outputs", self.groups), what="the element output kernels",
             done="output kernels", about="about 10 s")
 
     def outputs_batch(self, t, q, v, z, families=None, full=None) -> dict[str, dict[str, np.ndarray]]:
@@ -97,7 +105,7 @@ class CompiledOutputs:
             # instance-major, as the numpy kernels' (K, n) results lie: a fused family's slice [:, sl] is then one
             # contiguous block, and the statistics' numpy expressions over it run ≈ 1.5× faster than over strided rows
             O = np.empty((len(names), n, K))
-            family_outputs(kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O)
+            call(family_outputs, self.groups, kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O)
             O = O.transpose(0, 2, 1)
             for name, sl in parts:
                 res[name] = dict(zip(names, O if len(parts) == 1 else O[:, :, sl]))

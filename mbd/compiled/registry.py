@@ -1,5 +1,5 @@
-"""Which compiled kernel evaluates which element family, and the compiled dispatch on it (a static if-chain:
-numba can cache it, no first-class functions needed).
+"""Which compiled kernel evaluates which element family, and the compiled dispatch on it (static if-chains,
+compiled per set of family groups: numba caches each, no first-class functions needed).
 
 Each family declares its twin where it is defined (``Element.compiled_twin = "module.name"``: the kernels
 ``pack_name``, ``evaluate_name`` and, with internal state, ``update_name`` of ``mbd.compiled.module``); here
@@ -9,18 +9,31 @@ branches (tests/test_architecture.py checks that they agree).
 
 A twin may also give its family's outputs (``outputs_name`` and the names of its rows, ``NAME_OUTPUTS``, in its
 module; a branch of :func:`outputs_kind`): :class:`mbd.compiled.outputs.CompiledOutputs` evaluates them for K
-states at once. The others' outputs come from the numpy kernels."""
+states at once. The others' outputs come from the numpy kernels.
+
+Lazy compile per family group. The kernel modules are the groups (:data:`GROUPS`, a bit each); a compiled system
+passes the set it uses (``groups``, a bit mask, :func:`groups_of`) down the step loop as a literal, so numba
+compiles the loop, the assembly and the dispatch once per set (and caches each on disk): the if-chains below are
+templates, each set's dispatch is a copy of them in which an absent group's module is a stand-in that compiles
+to nothing (:func:`evaluate_for`, :func:`update_for`, :func:`outputs_for`). The bearing rig (no gears) then never
+compiles the mesh and tooth-pair kernels; a set already cached that contains a system's is loaded instead of
+compiling the system's own (:func:`groups_to_compile`)."""
 from __future__ import annotations
 
+import types
 from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 from numba import njit
+from numba.core import types as nbtypes
+from numba.core.errors import TypingError
+from numba.extending import overload
 
 from . import contact, generic, mesh
 
-__all__ = ["Kind", "KIND_IDS", "OUTPUT_NAMES", "kind_of", "evaluate_kind", "update_kind", "outputs_kind"]
+__all__ = ["Kind", "KIND_IDS", "GROUPS", "OUTPUT_NAMES", "kind_of", "groups_of", "groups_to_compile", "call",
+           "evaluate_for", "update_for", "outputs_for"]
 
 
 @dataclass(frozen=True)
@@ -29,6 +42,7 @@ class Kind:
     pack: Callable            # element -> (P, G)
     evaluate: Callable
     update: Callable | None   # None: the family has no internal state
+    group: int                # its kernel module's bit in GROUPS
 
 
 _RACE, _POCKET, _GUIDE, _DRAG, _MESH, _SUPPORT, _BODY_SPRING, _TORSION, _TORQUE, _FORCE, _SPEED = range(11)
@@ -41,6 +55,8 @@ KIND_IDS = {
     "generic.torque_source": _TORQUE, "generic.force_source": _FORCE, "generic.speed_drive": _SPEED,
 }
 _MODULES = {"contact": contact, "generic": generic, "mesh": mesh}
+# kernel module -> its bit in a system's ``groups`` (the unit of the lazy compile)
+GROUPS = {"contact": 1, "generic": 2, "mesh": 4}
 # twins that give their outputs (outputs_kind) -> the reference's names of the rows they write
 # (the meshes' are not among them: numpy's batched mesh kernel takes as long over a block as the compiled one)
 OUTPUT_NAMES = {"contact.race": contact.RACE_OUTPUTS, "contact.pocket": contact.POCKET_OUTPUTS,
@@ -59,11 +75,110 @@ def kind_of(cls) -> Kind | None:
                           f"(mbd.compiled.registry.KIND_IDS has {sorted(KIND_IDS)})")
     mod = _MODULES[module]
     return Kind(KIND_IDS[twin], getattr(mod, f"pack_{name}"), getattr(mod, f"evaluate_{name}"),
-                getattr(mod, f"update_{name}", None))
+                getattr(mod, f"update_{name}", None), GROUPS[module])
+
+
+def groups_of(kinds) -> int:
+    """The ``groups`` mask (:data:`GROUPS`) of the families of these :class:`Kind` s."""
+    mask = 0
+    for k in kinds:
+        mask |= k.group
+    return mask
+
+
+def groups_to_compile(needed: int, cached) -> int:
+    """The family groups to run with: ``needed`` when cached, else the smallest ``cached`` set that contains it
+    (loading a superset takes a second, compiling the exact set most of a minute), else ``needed`` (compiled)."""
+    if needed in cached:
+        return needed
+    supersets = [g for g in cached if g & needed == needed]
+    return min(supersets, key=lambda g: (bin(g).count("1"), g)) if supersets else needed
+
+
+_ENTRIES: dict = {}
+
+
+def call(dispatcher, groups: int, *args):
+    """``dispatcher(groups, *args)`` compiled (or loaded) for ``groups`` as a literal. A plain call would type
+    groups as int64, which has no compiled copy: numba would then retry a compile of the entry point on every
+    call before numba.literally sends it to the literal one (≈ 50 ms a block: the engine ran 40 % slower)."""
+    sig = (nbtypes.literal(int(groups)),) + tuple(dispatcher.typeof_pyval(a) for a in args)
+    entry = _ENTRIES.get((dispatcher, sig))
+    if entry is None:
+        entry = _ENTRIES[(dispatcher, sig)] = dispatcher.compile(sig)
+    return entry(groups, *args)
 
 
 @njit(cache=True)
-def evaluate_kind(kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+def _absent(*args):
+    """The stand-in of an absent group's kernels (never called: no family of that group is in the system)."""
+
+
+@njit(cache=True)
+def _absent_update(z, *args):
+    return np.copy(z)
+
+
+def _stand_in(module) -> types.ModuleType:
+    """A module whose every kernel is the no-op :func:`_absent` (numba compiles nothing of ``module``)."""
+    stub = types.ModuleType(f"absent {module.__name__}")
+    for name in dir(module):
+        if name.startswith(("evaluate_", "outputs_")):
+            setattr(stub, name, _absent)
+        elif name.startswith("update_"):
+            setattr(stub, name, _absent_update)
+    return stub
+
+
+_STAND_INS = {name: _stand_in(mod) for name, mod in _MODULES.items()}
+_VARIANTS: dict = {}
+
+
+def _variant(template, groups):
+    """``template`` (an if-chain below) with the modules of the groups not in ``groups`` (a literal int type)
+    replaced by stand-ins: the implementation :func:`evaluate_for` etc. compile for that set."""
+    if not isinstance(groups, nbtypes.IntegerLiteral):
+        raise TypingError(f"{template.__name__}: groups must be a literal int (numba.literally at the entry point)")
+    key = (template.__name__, groups.literal_value)
+    if key not in _VARIANTS:
+        env = dict(template.__globals__)
+        env.update({name: (_MODULES[name] if key[1] & bit else _STAND_INS[name]) for name, bit in GROUPS.items()})
+        _VARIANTS[key] = types.FunctionType(template.__code__, env, template.__name__, template.__defaults__)
+    return _VARIANTS[key]
+
+
+# What the compiled code calls, with groups a literal: the template compiled for that set. Explicit arguments, not
+# *args: a literal jac (True / False) must reach the kernels, whose residual-only copy (jac False) then drops the
+# derivative work (through a *args tuple it arrived as a plain bool and the engine ran ≈ 40 % slower).
+def evaluate_for(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    raise NotImplementedError("compiled code only")
+
+
+@overload(evaluate_for, prefer_literal=True)
+def _evaluate_for(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    return _variant(evaluate_kind, groups)
+
+
+def update_for(groups, kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):
+    raise NotImplementedError("compiled code only")
+
+
+@overload(update_for, prefer_literal=True)
+def _update_for(groups, kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):
+    return _variant(update_kind, groups)
+
+
+def outputs_for(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, O):
+    raise NotImplementedError("compiled code only")
+
+
+@overload(outputs_for, prefer_literal=True)
+def _outputs_for(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, O):
+    return _variant(outputs_kind, groups)
+
+
+def evaluate_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    """The forces (and Jacobians) of one family (the template of :func:`evaluate_for`; ``groups`` selects the copy)."""
     if kind == _RACE:
         contact.evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     elif kind == _POCKET:
@@ -88,8 +203,7 @@ def evaluate_kind(kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         generic.evaluate_speed_drive(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
 
 
-@njit(cache=True)
-def update_kind(kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):
+def update_kind(groups, kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):
     """The internal state after an accepted step (families without state keep z)."""
     if kind == _POCKET:
         return contact.update_pocket(z, t0, t1, ql0, vl0, ql1, vl1, P, G)
@@ -100,8 +214,7 @@ def update_kind(kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):
     return np.copy(z)
 
 
-@njit(cache=True)
-def outputs_kind(kind, t, phi, omega, domega, ql, vl, z, P, G, O):
+def outputs_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, O):
     """The outputs of a family whose twin gives them (:data:`OUTPUT_NAMES`) into the rows of O."""
     if kind == _RACE:
         contact.outputs_race(t, phi, omega, domega, ql, vl, z, P, G, O)
@@ -109,3 +222,4 @@ def outputs_kind(kind, t, phi, omega, domega, ql, vl, z, P, G, O):
         contact.outputs_pocket(t, phi, omega, domega, ql, vl, z, P, G, O)
     elif kind == _GUIDE:
         contact.outputs_guide(t, phi, omega, domega, ql, vl, z, P, G, O)
+

@@ -12,6 +12,7 @@ from ..control import Adaptive, FixedStep
 from ..hht import HHT, StepInfo
 from ..model import State
 from .. import compiled as _compiled     # kernels_cached, compile_announced: read through the package when called
+from .registry import call
 from .sparse_lu import FixedPatternLU
 from .stepper import FAIL_REASONS, advance
 from .system import CompiledSystem
@@ -121,10 +122,12 @@ class CompiledRunner:
         n = self.n
         z = np.zeros(n)
         _compiled.compile_announced(
-            lambda: advance(0.0, z.copy(), z.copy(), z.copy(), z.copy(), 1e-6, 0.0, 0, self.prm, self.ctrl, self.atol,
-                            self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu,
-                            self.cache, self.work, np.zeros(6, np.int64), self.out, np.empty((1, 3 + 4 * n + self.n_z))),
-            cold=not _compiled.kernels_cached(), what="the engine's kernels", done="kernels", about="about a minute")
+            lambda: call(advance, self.cs.groups, 0.0, z.copy(), z.copy(), z.copy(), z.copy(), 1e-6, 0.0, 0, self.prm,
+                         self.ctrl, self.atol, self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat,
+                         self.lu, self.cache, self.work, np.zeros(6, np.int64), self.out,
+                         np.empty((1, 3 + 4 * n + self.n_z))),
+            cold=not _compiled.kernels_cached(groups=self.cs.groups), what="the engine's kernels", done="kernels",
+            about="about a minute")
 
     def drop_lu(self) -> None:
         """Forget the LU (the numpy path drops it at checkpoints: both refactorise at the same step)."""
@@ -136,10 +139,10 @@ class CompiledRunner:
         q, v, a, f = (np.array(x, float) for x in (state.q, state.v, state.a, state.f))
         log = np.empty((max(int(max_steps), 1), 3 + 4 * self.n + self.n_z))
         counters = np.zeros(6, np.int64)
-        t, h, acc, status, it, rate, reason = advance(
-            float(state.t), q, v, a, f, float(h), float(t_end), int(max_steps), self.prm, self.ctrl, self.atol,
-            self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu, self.cache,
-            self.work, counters, self.out, log)
+        t, h, acc, status, it, rate, reason = call(
+            advance, self.cs.groups, float(state.t), q, v, a, f, float(h), float(t_end), int(max_steps), self.prm,
+            self.ctrl, self.atol, self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu,
+            self.cache, self.work, counters, self.out, log)
         keys = ("residual", "jacobian", "factor", "newton", "accepted", "rejected")
         failed = StepInfo(False, int(it), float(rate), reason=FAIL_REASONS[reason]) if status == 2 else None
         blk = Block(log[:acc], state, self.z_shapes, dict(zip(keys, (int(c) for c in counters))), state, float(h),

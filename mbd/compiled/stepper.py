@@ -11,7 +11,7 @@ reports with the last good state). A zero diagonal pivot falls back to a dense L
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import literally, njit
 
 from .. import rules
 from .sparse_lu import _factor, _solve
@@ -65,13 +65,13 @@ def _dense_solve(A, piv, b):
 
 
 @njit(cache=True)
-def _refresh(t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F, Jq, Jv, A):
+def _refresh(groups, t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F, Jq, Jv, A):
     """New Jacobian + LU at (q1, v1): the forces there in F; 0 = sparse LU, 1 = dense fallback,
     -1 = unusable Newton matrix."""
     indptr, indices, Mdata, mdiag = pat
     n = mdiag.size
     perm, iperm, Lp, Li, Lx, Up, Ui, Ux, xw, yw, D, dpiv = lu
-    assemble(t1, q1, v1, fams, zs, True, sysd, F, Jq, Jv)
+    assemble(groups, t1, q1, v1, fams, zs, True, sysd, F, Jq, Jv)
     for e in range(A.size):
         A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
         if not np.isfinite(A[e]):
@@ -90,13 +90,13 @@ def _refresh(t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F, Jq, Jv, A):
 
 
 @njit(cache=True)
-def _refresh_at(t1, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
+def _refresh_at(groups, t1, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
     """Jacobian + LU at the current iterate a₁ (its forces left in work's F1); False when unusable."""
     qp, vp, a1, q1, v1, F1, r, sc, x, xp, Jq, Jv, A = work
     for i in range(a1.size):
         q1[i] = qp[i] + bh2 * a1[i]
         v1[i] = vp[i] + gh * a1[i]
-    kind = _refresh(t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F1, Jq, Jv, A)
+    kind = _refresh(groups, t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F1, Jq, Jv, A)
     cnt[1] += 1
     cache[1] = h
     if kind < 0:
@@ -121,7 +121,7 @@ def _scale(atol, rtol, q0, q1, out):
 
 
 @njit(cache=True)
-def _newton(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, work, cnt):
+def _newton(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, work, cnt):
     """Newton on a₁ (returns it in work's a1); (converged, iterations, rate, reason). ``cache``:
     [LU valid (1/0), h of the LU, LU kind (0 sparse, 1 dense)]; ``cnt``: this step's residuals, Jacobians."""
     alpha, beta, gamma = prm[0], prm[1], prm[2]
@@ -136,7 +136,7 @@ def _newton(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, w
     refreshes = 0
     rate = 0.0
     if cache[0] == 0.0 or cache[1] != h or not reuse:
-        if not _refresh_at(t + h, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
+        if not _refresh_at(groups, t + h, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
             return False, 0, np.inf, _SINGULAR
         have_F = True
     has_prev = False
@@ -146,7 +146,7 @@ def _newton(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, w
             q1[i] = qp[i] + bh2 * a1[i]
             v1[i] = vp[i] + gh * a1[i]
         if not have_F:
-            assemble(t + h, q1, v1, fams, zs, False, sysd, F1, Jq, Jv)
+            assemble(groups, t + h, q1, v1, fams, zs, False, sysd, F1, Jq, Jv)
             cnt[0] += 1
         have_F = False
         for i in range(n):
@@ -180,7 +180,7 @@ def _newton(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, w
             if action == rules.REFRESH_AT_PREVIOUS:
                 for i in range(n):
                     a1[i] += da[i]
-            if not _refresh_at(t + h, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
+            if not _refresh_at(groups, t + h, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
                 return False, it, rate, _SINGULAR
             have_F = True
             refreshes += 1
@@ -194,7 +194,7 @@ def _newton(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, w
 
 
 @njit(cache=True)
-def _step(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, work, cnt, out):
+def _step(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, work, cnt, out):
     """One HHT step of size h from (t, q, v, a, f) into ``out`` = (q1, v1, a1, f1) without touching the
     start; (converged, iterations, rate, reason, error)."""
     alpha, beta, gamma, errc = prm[0], prm[1], prm[2], prm[3]
@@ -204,7 +204,8 @@ def _step(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, wor
         qp[i] = q[i] + h * v[i] + h * h * (0.5 - beta) * a[i]
         vp[i] = v[i] + h * (1.0 - gamma) * a[i]
         a1[i] = a[i]
-    conv, it, rate, reason = _newton(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, work, cnt)
+    conv, it, rate, reason = _newton(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, work,
+                                     cnt)
     if not conv:
         cache[0] = 0.0
         return False, it, rate, reason, np.nan
@@ -224,14 +225,16 @@ def _step(t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, wor
 
 
 @njit(cache=True)
-def advance(t, q, v, a, f, h, t_end, max_steps, prm, ctrl, atol, rtol, freeze, fams, zs, sysd, pat, lu, cache,
+def advance(groups, t, q, v, a, f, h, t_end, max_steps, prm, ctrl, atol, rtol, freeze, fams, zs, sysd, pat, lu, cache,
             work, counters, out, log):
     """Steps from (t, q, v, a, f) (updated in place, with zs) until t_end, ``max_steps`` accepted steps or a
     step size below the floor. ``ctrl`` = [kind (0 fixed, 1 adaptive), h_fixed | h_max, reject_error |
     safety, grow_max, shrink_min, fail_factor, hold, h_floor]. ``counters`` (int64): residual, jacobian,
     factor, newton, accepted, rejected. ``log`` (K, 3 + 4n + n_z): per accepted step t₁, h, error, then
     q₁, v₁, a₁, f₁ and the internal states (the observers' states). Returns (t, h, accepted, status, iterations, rate, reason):
-    status 0 = t_end reached, 1 = max_steps, 2 = step size below the floor."""
+    status 0 = t_end reached, 1 = max_steps, 2 = step size below the floor. ``groups``: the system's family
+    groups (:func:`.registry.groups_of`), a literal: the loop is compiled once per set of families."""
+    literally(groups)
     n = q.size
     span = max(abs(t_end), 1.0)
     cnt = np.zeros(2, np.int64)
@@ -243,7 +246,7 @@ def advance(t, q, v, a, f, h, t_end, max_steps, prm, ctrl, atol, rtol, freeze, f
             return t, h, acc, 1, it, rate, reason
         h_try = min(h, t_end - t)
         cnt[0], cnt[1] = 0, 0
-        conv, it, rate, reason, error = _step(t, q, v, a, f, h_try, prm, atol, rtol, fams, zs, sysd, pat, lu,
+        conv, it, rate, reason, error = _step(groups, t, q, v, a, f, h_try, prm, atol, rtol, fams, zs, sysd, pat, lu,
                                               cache, work, cnt, out)
         counters[0] += cnt[0]
         counters[1] += cnt[1]
@@ -262,7 +265,7 @@ def advance(t, q, v, a, f, h, t_end, max_steps, prm, ctrl, atol, rtol, freeze, f
             continue
         counters[4] += 1
         if not freeze:
-            update_internal(t, t + h_try, q, v, q1, v1, fams, zs, sysd)
+            update_internal(groups, t, t + h_try, q, v, q1, v1, fams, zs, sysd)
         t = t + h_try
         for i in range(n):
             q[i], v[i], a[i], f[i] = q1[i], v1[i], a1[i], f1[i]

@@ -8,11 +8,12 @@ compiled :func:`assemble` loops over the records and dispatches on the family's 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import literally, njit
 from numba.typed import List
 
 from ..assembly import Evaluation, System
-from .registry import evaluate_kind, kind_of, update_kind
+from .registry import call, evaluate_for, groups_of, groups_to_compile, kind_of, update_for
+from .. import compiled as _compiled     # cached_groups is read through the package when called
 
 __all__ = ["CompiledSystem", "assemble"]
 
@@ -51,8 +52,10 @@ def _push(items, item):
 
 
 @njit(cache=True)
-def assemble(t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
-    """Generalized forces F on the free DOFs and, with ``jac``, J_q, J_v on the pattern (in place)."""
+def assemble(groups, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
+    """Generalized forces F on the free DOFs and, with ``jac``, J_q, J_v on the pattern (in place). ``groups``: the
+    family groups of ``fams`` (:func:`.registry.groups_of`), compiled as a literal (one specialisation per set)."""
+    literally(groups)
     (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full) = sysd
     qf, vf = _full(t, q, v, free, fixed_idx, fixed_q_I, omega, n_full)
     phi = omega * t
@@ -67,7 +70,7 @@ def assemble(t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
             for j in range(k):
                 ql[i, j] = qf[dofs[i, j]]
                 vl[i, j] = vf[dofs[i, j]]
-        evaluate_kind(kind, t, phi, omega, 0.0, ql, vl, zs[zi], P, G, Fl, Jql, Jvl, jac)
+        evaluate_for(groups, kind, t, phi, omega, 0.0, ql, vl, zs[zi], P, G, Fl, Jql, Jvl, jac)
         for i in range(n):
             for j in range(k):
                 Ffull[dofs[i, j]] += Fl[i, j]
@@ -97,8 +100,9 @@ def assemble(t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
 
 
 @njit(cache=True)
-def update_internal(t0, t1, q0, v0, q1, v1, fams, zs, sysd):
+def update_internal(groups, t0, t1, q0, v0, q1, v1, fams, zs, sysd):
     """Every stateful family's internal state after an accepted step (in place in zs)."""
+    literally(groups)
     (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full) = sysd
     q0f, v0f = _full(t0, q0, v0, free, fixed_idx, fixed_q_I, omega, n_full)
     q1f, v1f = _full(t1, q1, v1, free, fixed_idx, fixed_q_I, omega, n_full)
@@ -112,7 +116,7 @@ def update_internal(t0, t1, q0, v0, q1, v1, fams, zs, sysd):
             for j in range(k):
                 ql0[i, j], vl0[i, j] = q0f[dofs[i, j]], v0f[dofs[i, j]]
                 ql[i, j], vl[i, j] = q1f[dofs[i, j]], v1f[dofs[i, j]]
-        zs[zi][:, :] = update_kind(kind, zs[zi], t0, t1, omega * t0, omega * t1, ql0, vl0, ql, vl, P, G)
+        zs[zi][:, :] = update_for(groups, kind, zs[zi], t0, t1, omega * t0, omega * t1, ql0, vl0, ql, vl, P, G)
 
 
 class CompiledSystem:
@@ -128,13 +132,14 @@ class CompiledSystem:
         self.system, self.model, self.ndof, self.nnz = system, m, system.ndof, system.nnz
         self.state_names: list[str] = []
         self.state_shapes: list[tuple] = []
-        fams, zs = [], _list_of(np.zeros((0, 0)))      # zs slot 0: families without internal state
+        fams, zs, kinds = [], _list_of(np.zeros((0, 0))), []      # zs slot 0: families without internal state
         for (e, parts), (keep, mp) in zip(system._evals, system._maps):
             kind = kind_of(type(e))
             if kind is None:
                 raise NotImplementedError(f"compiled path: no compiled kernel for family {e.name!r} "
                                           f"({type(e).__name__} declares no compiled_twin)")
             P, G = kind.pack(e)
+            kinds.append(kind)
             zi = 0
             z0 = e.init_internal()
             if z0 is not None:                     # kept (n, n_z) here, the element's own shape in a State
@@ -149,6 +154,8 @@ class CompiledSystem:
         if not fams:      # numba cannot type an empty list of families: nothing to compile for
             raise NotImplementedError("compiled path: the model has no element families")
         self.fams, self.zs = _list_of(fams[0]), zs
+        # the kernel groups (registry.GROUPS) this system compiles: its own, or a cached set containing them
+        self.groups = groups_to_compile(groups_of(kinds), _compiled.cached_groups("stepper.advance"))
         for rec in fams[1:]:
             _push(self.fams, rec)
         fixed = np.flatnonzero(m.fixed)
@@ -174,6 +181,6 @@ class CompiledSystem:
             self.set_internal(z)
         F = np.empty(self.ndof)
         Jq, Jv = (np.empty(self.nnz), np.empty(self.nnz)) if jac else (np.empty(0), np.empty(0))
-        assemble(float(t), np.ascontiguousarray(q, float), np.ascontiguousarray(v, float), self.fams, self.zs,
-                 jac, self.sysd, F, Jq, Jv)
+        call(assemble, self.groups, float(t), np.ascontiguousarray(q, float), np.ascontiguousarray(v, float), self.fams,
+             self.zs, jac, self.sysd, F, Jq, Jv)
         return Evaluation(F, Jq if jac else None, Jv if jac else None)

@@ -194,12 +194,50 @@ def test_a_run_that_must_compile_says_so_before_its_first_step(capsys, monkeypat
     mb.add(mbd.elements.TorqueSource("motor", [0], torque=1.0))
     system = mbd.System(mb.build())
     args = (system, mbd.PRODUCTION.stepper(), mbd.FixedStep(1e-3))
-    CompiledRunner(*args)
-    assert mc.kernels_cached()
+    runner = CompiledRunner(*args)
+    assert mc.kernels_cached(groups=runner.cs.groups) and runner.cs.groups in mc.cached_groups()
     capsys.readouterr()
     CompiledRunner(*args)
     assert capsys.readouterr().err == ""
-    monkeypatch.setattr(mc, "kernels_cached", lambda: False)
+    monkeypatch.setattr(mc, "kernels_cached", lambda function="stepper.advance", groups=None: False)
     CompiledRunner(*args)
     err = capsys.readouterr().err.splitlines()
     assert err[0].startswith("mbd: compiling the engine's kernels") and err[1].startswith("mbd: kernels compiled in ")
+
+
+def test_a_system_runs_a_cached_set_of_family_groups_that_contains_its_own():
+    """The groups to compile (registry.groups_to_compile): the system's own set when cached, else the smallest
+    cached set containing it (loaded in a second), else its own (compiled)."""
+    from mbd.compiled.registry import GROUPS, groups_to_compile
+
+    c, g, m = GROUPS["contact"], GROUPS["generic"], GROUPS["mesh"]
+    assert len({c, g, m}) == 3 and c | g | m == c + g + m             # one bit per kernel module
+    assert groups_to_compile(c | g, {c | g, c | g | m}) == c | g
+    assert groups_to_compile(c | g, {c | g | m, g, m | g}) == c | g | m
+    assert groups_to_compile(g, {c | g | m, c | g, m | g}) in (c | g, m | g)
+    assert groups_to_compile(g, {c | g | m, c | g}) == c | g
+    assert groups_to_compile(c | g, {g, m | g}) == c | g              # no superset cached: its own
+    assert groups_to_compile(c | g, set()) == c | g
+
+
+def test_a_set_of_family_groups_compiles_only_those_groups_kernels():
+    """The dispatch compiled for a set of groups holds the kernels of those groups and none of the others (the
+    bearing rig never compiles the meshes): read from the compiled code of the internal-state update dispatch
+    (its kernels are small), for the generic families alone and with the contacts."""
+    from numba import njit
+
+    from mbd.compiled.registry import GROUPS, update_for
+
+    def symbols(groups):
+        @njit
+        def update(z, q, P, G):
+            return update_for(groups, 0, z, 0.0, 1.0, 0.0, 0.0, q, q, q, q, P, G)
+        z = np.zeros((1, 4))
+        update(z, np.zeros((1, 6)), np.zeros((1, 10)), np.zeros(0))
+        return update.inspect_llvm(update.signatures[0])
+
+    generic_only = symbols(GROUPS["generic"])
+    with_contacts = symbols(GROUPS["generic"] | GROUPS["contact"])
+    assert "update_speed_drive" in generic_only and "update_speed_drive" in with_contacts
+    assert "update_pocket" not in generic_only and "update_guide" not in generic_only
+    assert "update_pocket" in with_contacts and "update_guide" in with_contacts

@@ -117,7 +117,7 @@ def test_the_outputs_engine_is_checked_and_a_compile_is_announced(capsys, monkey
     capsys.readouterr()
     CompiledOutputs(system)
     assert capsys.readouterr().err == ""
-    monkeypatch.setattr(mc, "kernels_cached", lambda function="stepper.advance": False)
+    monkeypatch.setattr(mc, "kernels_cached", lambda function="stepper.advance", groups=None: False)
     CompiledOutputs(system)
     err = capsys.readouterr().err.splitlines()
     assert err[0].startswith("mbd: compiling the element output kernels") and err[1].startswith(
