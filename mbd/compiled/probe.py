@@ -1,12 +1,13 @@
 """Timing loops over the compiled engine's parts (``scenarios.bench_breakdown``): each calls one part ``reps`` times
 in compiled code, so a timing holds no Python. They live here, beside the kernels they inline, so that the kernel
 cache's staleness guard (:func:`mbd.compiled._drop_stale_kernels`) drops them with the kernels: a loop cached
-elsewhere would keep timing a changed kernel's old code."""
+elsewhere would keep timing a changed kernel's old code. Those that reach the family kernels take the system's
+kernel groups first, a literal (:func:`.registry.call`), as the engine's own loop does."""
 from __future__ import annotations
 
-from numba import njit
+from numba import literally, njit
 
-from .registry import evaluate_kind
+from .registry import evaluate_for
 from .sparse_lu import _factor, _solve
 from .system import assemble, update_internal
 
@@ -14,15 +15,17 @@ __all__ = ["repeat_kernel", "repeat_assemble", "repeat_lu", "repeat_solve", "rep
 
 
 @njit(cache=True)
-def repeat_kernel(reps, kind, t, phi, omega, ql, vl, z, P, G, F, Jq, Jv, jac):
+def repeat_kernel(groups, reps, kind, t, phi, omega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    literally(groups)
     for _ in range(reps):
-        evaluate_kind(kind, t, phi, omega, 0.0, ql, vl, z, P, G, F, Jq, Jv, jac)
+        evaluate_for(groups, kind, t, phi, omega, 0.0, ql, vl, z, P, G, F, Jq, Jv, jac)
 
 
 @njit(cache=True)
-def repeat_assemble(reps, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
+def repeat_assemble(groups, reps, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
+    literally(groups)
     for _ in range(reps):
-        assemble(t, q, v, fams, zs, jac, sysd, F, Jq, Jv)
+        assemble(groups, t, q, v, fams, zs, jac, sysd, F, Jq, Jv)
 
 
 @njit(cache=True)
@@ -45,22 +48,24 @@ def repeat_solve(reps, n, perm, Lp, Li, Lx, Up, Ui, Ux, b, y):
 
 
 @njit(cache=True)
-def repeat_update(reps, t0, t1, q0, v0, q1, v1, fams, zs, sysd):
+def repeat_update(groups, reps, t0, t1, q0, v0, q1, v1, fams, zs, sysd):
+    literally(groups)
     for _ in range(reps):
-        update_internal(t0, t1, q0, v0, q1, v1, fams, zs, sysd)
+        update_internal(groups, t0, t1, q0, v0, q1, v1, fams, zs, sysd)
 
 
 @njit(cache=True)
-def replay(steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c_K, Mdata, A, n, indptr, indices, iperm,
+def replay(groups, steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c_K, Mdata, A, n, indptr, indices, iperm,
             perm, Lp, Li, Lx, Up, Ui, Ux, xw, b, yw, t0, q0, v0):
     """The parts in a step's mix and order (per step: a Jacobian + LU when their count per step has accrued to one,
     then the residuals and solves accrued, then the internal-state update), without the loop's own arithmetic."""
+    literally(groups)
     aj, ar, asol = 0.0, 0.0, 0.0
     for _ in range(steps):
         aj += cj
         if aj >= 1.0:
             aj -= 1.0
-            assemble(t, q, v, fams, zs, True, sysd, F, Jq, Jv)
+            assemble(groups, t, q, v, fams, zs, True, sysd, F, Jq, Jv)
             for e in range(A.size):
                 A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
             _factor(n, indptr, indices, A, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, xw)
@@ -69,8 +74,8 @@ def replay(steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c_K, Mdat
         while ar >= 1.0 or asol >= 1.0:
             if ar >= 1.0:
                 ar -= 1.0
-                assemble(t, q, v, fams, zs, False, sysd, F, Jq, Jv)
+                assemble(groups, t, q, v, fams, zs, False, sysd, F, Jq, Jv)
             if asol >= 1.0:
                 asol -= 1.0
                 _solve(n, perm, Lp, Li, Lx, Up, Ui, Ux, b, yw)
-        update_internal(t0, t, q0, v0, q, v, fams, zs, sysd)
+        update_internal(groups, t0, t, q0, v0, q, v, fams, zs, sysd)
