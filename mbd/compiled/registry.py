@@ -98,28 +98,34 @@ def groups_to_compile(needed: int, cached) -> int:
 _ENTRIES: dict = {}
 
 
-def _fingerprint(a):
+def fingerprint(a):
     """What numba's type of an argument depends on (an array's dtype, ndim, layout, writeability, alignment; a
     typed container's numba type; else the Python type), at a fraction of the cost of numba's typeof."""
     if isinstance(a, np.ndarray):
         f = a.flags
         return a.dtype.str, a.ndim, f.c_contiguous, f.f_contiguous, f.writeable, f.aligned
     if isinstance(a, tuple):
-        return tuple(_fingerprint(x) for x in a)
+        return tuple(fingerprint(x) for x in a)
     return getattr(a, "_numba_type_", type(a))
+
+
+def entry(dispatcher, groups: int, *args):
+    """The compiled (or loaded) ``dispatcher`` for ``groups`` as a literal and these arguments' types, kept per
+    argument fingerprint (numba's typeof of every argument cost ≈ 0.1 ms a call). Call it as
+    ``entry(...)(groups, *args)``; a caller whose arguments keep their types may keep it (:func:`call` does not)."""
+    key = (dispatcher, groups, tuple(fingerprint(a) for a in args))
+    found = _ENTRIES.get(key)
+    if found is None:
+        sig = (nbtypes.literal(int(groups)),) + tuple(dispatcher.typeof_pyval(a) for a in args)
+        found = _ENTRIES[key] = dispatcher.compile(sig)
+    return found
 
 
 def call(dispatcher, groups: int, *args):
     """``dispatcher(groups, *args)`` compiled (or loaded) for ``groups`` as a literal. A plain call would type
     groups as int64, which has no compiled copy: numba would then retry a compile of the entry point on every
-    call before numba.literally sends it to the literal one (≈ 50 ms a block: the engine ran 40 % slower). The
-    entry is kept per argument fingerprint (numba's typeof of every argument cost ≈ 0.1 ms a call)."""
-    key = (dispatcher, groups, tuple(_fingerprint(a) for a in args))
-    entry = _ENTRIES.get(key)
-    if entry is None:
-        sig = (nbtypes.literal(int(groups)),) + tuple(dispatcher.typeof_pyval(a) for a in args)
-        entry = _ENTRIES[key] = dispatcher.compile(sig)
-    return entry(groups, *args)
+    call before numba.literally sends it to the literal one (≈ 50 ms a block: the engine ran 40 % slower)."""
+    return entry(dispatcher, groups, *args)(groups, *args)
 
 
 @njit(cache=True)

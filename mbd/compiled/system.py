@@ -12,7 +12,7 @@ from numba import literally, njit
 from numba.typed import List
 
 from ..assembly import Evaluation, System
-from .registry import call, evaluate_for, groups_of, groups_to_compile, kind_of, update_for
+from .registry import entry, evaluate_for, fingerprint, groups_of, groups_to_compile, kind_of, update_for
 from .. import compiled as _compiled     # cached_groups is read through the package when called
 
 __all__ = ["CompiledSystem", "assemble"]
@@ -165,6 +165,7 @@ class CompiledSystem:
                      np.asarray(system._mx, float), np.asarray(system._J, float), system._bx.astype(np.int64),
                      system._by.astype(np.int64), system._bt.astype(np.int64), np.asarray(frame_map, np.int64),
                      3 * m.n_bodies)
+        self._assemble: dict = {}     # the compiled assembly per fingerprint of q and v (:meth:`evaluate`)
 
     def set_internal(self, z: dict) -> None:
         """Load the element internal states of a :class:`mbd.State` into the compiled slots."""
@@ -181,6 +182,13 @@ class CompiledSystem:
             self.set_internal(z)
         F = np.empty(self.ndof)
         Jq, Jv = (np.empty(self.nnz), np.empty(self.nnz)) if jac else (np.empty(0), np.empty(0))
-        call(assemble, self.groups, float(t), np.ascontiguousarray(q, float), np.ascontiguousarray(v, float), self.fams,
-             self.zs, jac, self.sysd, F, Jq, Jv)
+        q, v = np.ascontiguousarray(q, float), np.ascontiguousarray(v, float)
+        args = (float(t), q, v, self.fams, self.zs, bool(jac), self.sysd, F, Jq, Jv)
+        # the compiled entry per q, v fingerprint, the system's own arguments keeping their types: fingerprinting the
+        # family tuples at every call cost ≈ 20 µs, half of an evaluation (a static solve makes thousands)
+        key = (fingerprint(q), fingerprint(v))
+        run = self._assemble.get(key)
+        if run is None:
+            run = self._assemble[key] = entry(assemble, self.groups, *args)
+        run(self.groups, *args)
         return Evaluation(F, Jq if jac else None, Jv if jac else None)
