@@ -33,7 +33,7 @@ from mbd.compiled.registry import call
 from mbd.compiled.runner import CompiledRunner
 from mbd.compiled.system import _full
 
-from .common import dpgt_problem, load1, machine_note, settled_state, warm_up
+from .common import dpgt_problem, load1, machine_note, progress_log, settled_state, warm_up
 from ..core import args
 from ..core.command import command
 
@@ -298,7 +298,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    log = (lambda m: print(m, file=sys.stderr, flush=True)) if a.json else (lambda m: print(m, flush=True))
+    log = progress_log(a.json)
     log(machine_note())
     res = breakdown(out, a.window, a.samples, a.rounds, a.reps, a.h, a.alpha, a.settle, a.target, log)
     (out / "breakdown.json").write_text(json.dumps(res, indent=2, default=str))

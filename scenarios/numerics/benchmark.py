@@ -50,7 +50,7 @@ import mbd
 from components.outputs import FAMILY
 from components.presets import reference_dpgt
 
-from .common import (design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note,
+from .common import (design_verdict, dpgt_problem, error_metrics, eval_costs, load1, machine_note, progress_log,
                      observables, peak_rss_mb, run_hht, run_scipy, settled_state, warm_up, hht_reference)
 from ..core import args
 from ..core.command import command
@@ -328,7 +328,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    log = (lambda m: print(m, file=sys.stderr, flush=True)) if a.json else (lambda m: print(m, flush=True))
+    log = progress_log(a.json)
     log(machine_note())
     res = benchmark(out, a.window, a.ref_window, a.h, a.alpha, a.scipy_cap,
                     a.scipy_tols, log, a.settle,

@@ -24,6 +24,7 @@ import os
 import platform
 import resource
 import statistics
+import sys
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -394,6 +395,12 @@ def machine_note() -> str:
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     return (f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
             f"numpy {np.__version__}; 1-min load average at start {load:.2f} (machine shared with other jobs)")
+
+
+def progress_log(json_out: bool):
+    """The scripts' progress printer: to stderr when stdout carries the JSON result (``--json``), else stdout."""
+    stream = sys.stderr if json_out else sys.stdout
+    return lambda m: print(m, file=stream, flush=True)
 
 
 def load1() -> float:
