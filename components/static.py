@@ -166,7 +166,7 @@ def static_statistics(scene, n_snapshots: int = DEFAULT_SNAPSHOTS, engine: str =
     sols = solve_snapshots(scene, times, engine=engine, system=system)
     ts = np.array([s.t for s in sols])
     stats = WindowStatistics(scene, float(ts.min()), float(ts.max()) + 1e-9, whole_revolutions=False)
-    stats.bind(m, system, None)
+    stats.prepare(m, system)      # samples, not steps: no accumulators to compile
     z = {k: np.stack([np.asarray(s.z[k]) for s in sols]) for k in sols[0].z}
     rows = stats.snapshots(ts, np.stack([s.q for s in sols]),
                            np.stack([s.v for s in sols]), np.stack([s.a for s in sols]), z)

@@ -78,12 +78,16 @@ class WindowStatistics(mbd.Observer):
 
     # setup -------------------------------------------------------------------------------------
     def bind(self, model, system, state) -> None:
-        """Build the plan and the output evaluator, and compile the accumulators (before the run's first step)."""
+        """Before a run's first step: :meth:`prepare`, and compile the accumulators the steps will use."""
+        self.prepare(model, system)
+        compile_accumulators()
+
+    def prepare(self, model, system) -> None:
+        """Build the plan and the output evaluator (enough for samples, :meth:`add_samples`, without steps)."""
         self.model, self.system = model, system
         self._outputs = mbd.output_evaluator(system, self.outputs)
         self.plan = Q.plan_of(self.scene, model)
         self.meshes = self.plan.meshes
-        compile_accumulators()
         self.reset()
 
     def reset(self) -> None:
