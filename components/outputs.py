@@ -34,7 +34,7 @@ from .life import LIFE_EXPONENT, relative_life
 # the words and units of summary keys: owned by the results module, re-exported here
 from .results.summary import DIMENSIONLESS_KEYS, SUMMARY_WORDS, UNIT_SUFFIXES, unit_of_key
 from .statistics import (WindowStatistics, bearing_map, cage_period, carrier_frame_motion, contact_film,
-                         default_window, pin_reactions, radial_tangential)
+                         default_window, pin_reactions, plan_of, radial_tangential)
 
 __all__ = ["FAMILY", "MESH_FAMILY", "BearingSeries", "LIFE_EXPONENT", "bearing_map", "default_window", "cage_period",
            "WindowStatistics", "carrier_frame_motion", "radial_tangential", "pin_reactions", "relative_life",
@@ -48,34 +48,23 @@ class BearingSeries:
     below its epicyclic speed, both relative to the carrier, as ``cage_slip_pct``."""
 
     def __init__(self, scene):
-        model = scene.model
-        self.bmap = bearing_map(scene)
-        idx = lambda name: model.body(name).index
-        self.planet = np.array([idx(b["planet"]) for b in self.bmap])
-        self.carrier = idx("carrier")
-        self.rows = int(scene.bearing.rows)
-        self.rollers = self.bmap[0]["type"] == "rollers"
-        if self.rollers:
-            self.roller_bearing = np.concatenate([np.full(b["race_inner"][1] - b["race_inner"][0], i)
-                                                  for i, b in enumerate(self.bmap)])
-        else:
-            self.spring = np.array([b["spring"] for b in self.bmap])
-        self.cage = np.array([idx(b["cage"]) for b in self.bmap]) if self.rollers and "cage" in self.bmap[0] else None
-        self.bearing = scene.bearing
-        self.names = tuple(b["name"] for b in self.bmap)
+        self.plan = plan_of(scene, scene.model)        # the bodies and families, as the statistics index them
+        self.names = tuple(b["name"] for b in bearing_map(scene))
 
     def load(self, t, X, V, A, outputs) -> np.ndarray:
         """(radial, tangential) pin reaction per bearing [N], (2, nb)."""
-        if self.rollers:
-            pin = pin_reactions(outputs[FAMILY["race_inner"]], slice(None), self.roller_bearing, len(self.bmap), self.rows)
+        p = self.plan
+        if p.rollers:
+            pin = pin_reactions(outputs[FAMILY["race_inner"]], slice(None), p.roller_bearing, p.planet.size, p.rows)
         else:
             lin = outputs[FAMILY["linear"]]
-            pin = -np.column_stack([lin["fx"][self.spring], lin["fy"][self.spring]])
-        return np.array(radial_tangential(pin, X[self.planet, :2], X[self.carrier, :2]))
+            pin = -np.column_stack([lin["fx"][p.spring], lin["fy"][p.spring]])
+        return np.array(radial_tangential(pin, X[p.planet, :2], X[p.carrier, :2]))
 
     def slip(self, t, X, V, A, outputs) -> np.ndarray:
         """Cage slip per bearing [%] (:func:`components.bearing.cage_slip_pct`) from the body speeds ``V``."""
-        return cage_slip_pct(self.bearing, V[self.cage, 2] - V[self.carrier, 2], V[self.planet, 2] - V[self.carrier, 2])
+        p = self.plan
+        return cage_slip_pct(p.bearing, V[p.cage, 2] - V[p.carrier, 2], V[p.planet, 2] - V[p.carrier, 2])
 
     def probes(self) -> list:
         where = "radial: from the carrier axis through the planet; tangential 90 deg ahead"
@@ -84,7 +73,7 @@ class BearingSeries:
                mbd.DerivedOutput("bearing.load_tangential", lambda *a: self.load(*a)[1], "N",
                                  f"planet bearing load (pin reaction), tangential component ({where})",
                                  instances=self.names)]
-        if self.cage is not None:
+        if self.plan.cage is not None:
             out.append(mbd.DerivedOutput("bearing.cage_slip", self.slip, "percent",
                                          "cage speed below its epicyclic speed, relative to the carrier",
                                          instances=self.names))

@@ -9,7 +9,7 @@
 * :mod:`.observer` — :class:`WindowStatistics`, the observer of the simulation loop, and the window's size.
 """
 from .observer import WindowStatistics, cage_period, default_window
-from .quantities import bearing_map, carrier_frame_motion, contact_film, pin_reactions, radial_tangential
+from .quantities import bearing_map, carrier_frame_motion, contact_film, pin_reactions, plan_of, radial_tangential
 
 __all__ = ["WindowStatistics", "bearing_map", "cage_period", "carrier_frame_motion", "contact_film", "default_window",
-           "pin_reactions", "radial_tangential"]
+           "pin_reactions", "plan_of", "radial_tangential"]

@@ -53,10 +53,10 @@ def test_cage_slip_series_against_pure_rolling():
     s = np.array([0.007, -0.02, 0.0, 0.05, 0.2, 0.0071])           # the slips given to the cages
     rolling = (w_p - w_c) * (b.pitch_diameter + b.roller_diameter) / (2.0 * b.pitch_diameter)
     V = np.zeros((m.n_bodies, 3))
-    V[series.carrier, 2] = w_c
-    V[series.planet, 2] = w_p
-    V[series.cage, 2] = w_c + (1.0 - s) * rolling
+    V[series.plan.carrier, 2] = w_c
+    V[series.plan.planet, 2] = w_p
+    V[series.plan.cage, 2] = w_c + (1.0 - s) * rolling
     np.testing.assert_allclose(series.slip(0.0, np.zeros_like(V), V, np.zeros_like(V), {}), 100.0 * s,
                                rtol=0, atol=1e-11)
-    V[series.planet, 2] = w_c                                     # a planet at rest on its pin: nothing to slip from
+    V[series.plan.planet, 2] = w_c                                     # a planet at rest on its pin: nothing to slip from
     assert np.all(np.isnan(series.slip(0.0, np.zeros_like(V), V, np.zeros_like(V), {})))
