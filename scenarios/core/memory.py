@@ -12,7 +12,7 @@ from __future__ import annotations
 import resource
 import sys
 
-__all__ = ["RunPeak", "process_peak_mb"]
+__all__ = ["RunPeak", "process_peak_mb", "maxrss_kb"]
 
 _STATUS, _CLEAR = "/proc/self/status", "/proc/self/clear_refs"
 _earlier_kb = [0.0]       # the largest high-water mark a reset has wiped in this process [KiB]
@@ -27,8 +27,12 @@ def _hwm_kb() -> float:
                     return float(line.split()[1])
     except OSError:
         pass
-    kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return kb / 1024.0 if sys.platform == "darwin" else float(kb)     # macOS reports bytes
+    return maxrss_kb(resource.getrusage(resource.RUSAGE_SELF))
+
+
+def maxrss_kb(usage) -> float:
+    """A ``resource.struct_rusage``'s (or ``os.wait4``'s) peak resident memory [KiB] (macOS reports bytes)."""
+    return usage.ru_maxrss / 1024.0 if sys.platform == "darwin" else float(usage.ru_maxrss)
 
 
 def process_peak_mb() -> float:

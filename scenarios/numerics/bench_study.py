@@ -42,6 +42,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from scenarios.core.memory import maxrss_kb
 from scenarios.core.study import TIMING_ENV
 
 HERE = Path(__file__).resolve().parents[2]      # the repository (this file: scenarios/numerics/bench_study.py)
@@ -73,7 +74,7 @@ def _rusage_run(cmd: list[str], cwd: Path, env: dict, log: Path) -> tuple[float,
         _, status, ru = os.wait4(p.pid, 0)
         wall = time.perf_counter() - t
     p.returncode = os.waitstatus_to_exitcode(status)
-    return wall, p.returncode, ru.ru_maxrss / 1024.0
+    return wall, p.returncode, maxrss_kb(ru) / 1024.0
 
 
 def _env(repo: Path, **extra) -> dict:
@@ -294,7 +295,8 @@ def main(argv=None) -> int:
             print("\n" + profile_table(f"{job} ({HERE})", [d for d in ds if d["rc"] == 0]))
     summary = summarise(result, list(repos))
     if a.profile:
-        summary["profile"] = {job: profile(ds[-1]) for job, ds in result["this"]["jobs"].items()}
+        summary["profile"] = {job: profile([d for d in ds if d["rc"] == 0][-1]) if any(d["rc"] == 0 for d in ds) else []
+                              for job, ds in result["this"]["jobs"].items()}
     print(json.dumps(summary))
     return 0
 
