@@ -168,7 +168,7 @@ def typical_errors(params: DPGTParams, grade: int) -> ErrorsParams:
     by default (docs/model.md §11.8)."""
     si = params.si()
     G, N = si.gears, si.layout.planets
-    note = f"ISO 1328 grade {grade}: eccentricity = F_r/2 (ISO 1328-2 Annex B); phase arbitrary"
+    note = f"ISO 1328-1:2013 class {grade}: eccentricity = F_rT/2, F_rT = 0.9 F_pT; phase arbitrary"
 
     def runout(gear, g, phase_deg):
         e = 0.5 * radial_runout(g.module, g.pitch_radius * 2.0, grade)

@@ -8,8 +8,9 @@ teeth: its meshes use the rectangular law, which the pair law reduces to exactly
 
 Deviations are material excess along the line of action per tooth flank face (ccw = the face towards
 the gear's +θ side, index 0; cw index 1), as one cubic in x = 2ξ − 1 over the active profile
-(ξ = 0 its start, 1 the tip): a pitch deviation p turns the tooth forward, +p on the ccw face and −p on
-the cw face; slope f_Hα gives f_Hα·x/2; a barrel form of range f gives f·(1 − 3x²)/3, an s-form
+(ξ = 0 its start, 1 the tip): a pitch deviation p (an ISO 1328-1 arc on the reference circle) turns the tooth
+forward by p/r, which moves its flank by p·cos α along the line of action: +p·cos α on the ccw face and
+−p·cos α on the cw face; slope f_Hα gives f_Hα·x/2; a barrel form of range f gives f·(1 − 3x²)/3, an s-form
 f·(5x³ − 3x)/4 (Legendre P2, P3 scaled to range 1: no straight-line part, as ISO's form deviation).
 """
 from __future__ import annotations
@@ -73,12 +74,13 @@ def gear_table(si, name: str) -> np.ndarray:
     """The flat tooth table of gear ``name`` (:func:`mbd.elements.tooth_pairs.tooth_table`)."""
     g = si.gears[_type(name)]
     z, N = int(g.teeth), si.layout.planets
+    base = np.cos(g.pressure_angle)        # a pitch arc on the reference circle -> along the line of action
     ex = np.zeros((z, 2, 4))
     for c in si.errors.flank_class:
         if name in _class_gears(c.gear, N):
             d = draw_teeth(name, z, flank_tolerances(g.module, 2.0 * g.pitch_radius, c.grade), c.seed,
                            c.systematic_share)
-            ex += _excess(d["pitch"], d["slope"], d["form"], "barrel")
+            ex += _excess(base * d["pitch"], d["slope"], d["form"], "barrel")
     for x in si.errors.tooth:
         if x.gear != name:
             continue
@@ -87,7 +89,7 @@ def gear_table(si, name: str) -> np.ndarray:
         faces = list(_FACES[x.flank])
         mask = np.zeros(2)
         mask[faces] = 1.0
-        ex[rows] += _excess(one + x.pitch, one + x.slope, one + x.form, x.form_shape) * mask[:, None]
+        ex[rows] += _excess(one + base * x.pitch, one + x.slope, one + x.form, x.form_shape) * mask[:, None]
     factor = np.ones(z)
     for f in si.errors.tooth_fault:
         if f.gear == name:

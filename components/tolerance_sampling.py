@@ -9,8 +9,8 @@ teeth (every gear)        ISO 1328-1:2013 flank tolerance class ``flank_class``:
                           of teeth: plain Monte Carlo)
 runout (every gear)       eccentricity vector (x, y) in the gear's axes, each component normal with
                           σ = F_r / (2 · 3.44): 99.73 % of gears have a total indicator reading 2e ≤ F_r (the
-                          Rayleigh quantile √(−2 ln 0.0027) = 3.44); F_r of ISO 1328-2 Annex B for the grade of
-                          the same number as the flank class (:func:`components.tolerances.radial_runout`)
+                          Rayleigh quantile √(−2 ln 0.0027) = 3.44); F_r the runout tolerance F_rT = 0.9 F_pT of
+                          the flank class (:func:`components.tolerances.radial_runout`)
 pinhole (all 2N pins)     radial and tangential position error, each normal with the tolerance ``pinhole`` at 3σ
 clearance (each bearing)  diametral clearance uniform in nominal ± ``clearance`` (a band, no shape known inside it);
                           a bearing's clearance deviation ΔP_d is every one of its rollers ΔP_d/2 smaller: the
@@ -66,7 +66,7 @@ DISTRIBUTIONS = {
     "teeth": "ISO 1328-1:2013 flank class per gear: pitch, profile slope and form deviation per tooth flank, "
              "normal with the tolerance at 3σ (components.tolerances), a per-sample seed",
     "runout": "eccentricity vector per gear, each component normal, σ = F_r/(2·3.44): 99.73 % within the "
-              "ISO 1328-2 Annex B runout F_r of the same grade",
+              "runout tolerance F_rT = 0.9 F_pT of the flank class (ISO 1328-1:2013)",
     "pinhole": "radial and tangential position per pin (all 2N), each normal with the tolerance at 3σ",
     "clearance": "diametral clearance per bearing, uniform in nominal ± the tolerance",
     "roller": "diameter per roller, uniform within ± half the lot's diameter variation",
@@ -76,7 +76,7 @@ DISTRIBUTIONS = {
 @dataclass(frozen=True)
 class ToleranceSpec:
     """The tolerances of one machine class. Lengths in m."""
-    flank_class: int            # ISO 1328-1:2013 flank tolerance class 1..11 (runout: ISO 1328-2 grade of that number)
+    flank_class: int            # ISO 1328-1:2013 flank tolerance class 1..11 (its runout tolerance F_rT = 0.9 F_pT)
     pinhole: float              # pin position tolerance per component, ± at 3σ
     clearance: float            # half-width of each bearing's diametral clearance band about the nominal
     roller_lot: float           # diameter variation V_DwL of a bearing's rollers (its lot)

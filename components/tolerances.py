@@ -22,8 +22,22 @@ capability C_p = 1: 99.7 % of the teeth within the class):
   variance common to every tooth of that flank face (one grinding set-up), the rest tooth to tooth; the
   form deviation is a barrel of signed range (``ToothDeviationParams``).
 
-The runout of :func:`radial_runout` is ISO 1328-2:1997 Annex B's F_r = 0.8 F_p with ISO 1328-1:1995's
-F_p = (0.3 m + 1.25 √d + 7) √2^(Q−5) µm (grades 1..12).
+A class is an inspected lot: a gear is shipped only if its measured deviations are within the class, so
+:func:`draw_teeth` draws whole gears from the process until one passes (:func:`inspect`; rejection, not
+truncation of single teeth: the gear is what is accepted or scrapped, and rejection keeps the process's
+tooth-to-tooth correlations inside the shipped gears). Inspection covers every tooth and both flank faces:
+the single pitch deviations |f_pt| ≤ f_pT (differences of neighbouring positions about their mean), the
+cumulative pitch range F_p ≤ F_pT, every |f_Hα| ≤ f_HαT and |f_fα| ≤ f_fαT. :func:`pass_rate` is the
+share of drawn gears that pass.
+
+Pitch deviations are ISO 1328-1 quantities: arcs on the reference circle. A tooth displaced by f_pt moves its
+flank along the line of action by f_pt·cos α (the base-pitch deviation of ISO 6336-1); the conversion is made
+where the deviations become the mesh law's data (:mod:`components.teeth`). Profile deviations are measured
+along the line of action already.
+
+The runout of :func:`radial_runout` is the runout tolerance that belongs with the 2013 flank classes,
+F_rT = 0.9 F_pT (ISO 1328-1:2013's runout guidance, identical to ANSI/AGMA 2015-1-A01's), at the flank class of
+the same number.
 """
 from __future__ import annotations
 
@@ -35,7 +49,11 @@ import numpy as np
 
 from .units import ParameterError
 
-__all__ = ["FlankTolerances", "flank_tolerances", "radial_runout", "draw_teeth"]
+__all__ = ["FlankTolerances", "flank_tolerances", "radial_runout", "draw_teeth", "inspect", "pass_rate",
+           "MAX_DRAWS"]
+
+# a class the process cannot make: no gear of this many draws passes inspection (a pass rate below 1 / MAX_DRAWS)
+MAX_DRAWS = 1000
 
 
 @dataclass(frozen=True)
@@ -66,22 +84,13 @@ def flank_tolerances(module: float, diameter: float, grade: int) -> FlankToleran
 
 
 def radial_runout(module: float, diameter: float, grade: int) -> float:
-    """Radial runout tolerance F_r [m] of ISO 1328 accuracy ``grade`` (module, reference diameter in m):
-    ISO 1328-2:1997 Annex B, F_r = 0.8 F_p, with ISO 1328-1:1995's F_p at grade 5 × √2 per grade."""
-    if not (isinstance(grade, (int, np.integer)) and 1 <= grade <= 12):
-        raise ParameterError.at("grade", f"ISO 1328 accuracy grade must be an integer 1..12, got {grade!r}")
-    m, d = 1e3 * module, 1e3 * diameter
-    F_p = (0.3 * m + 1.25 * d ** 0.5 + 7.0) * 2.0 ** (0.5 * (grade - 5))
-    return 0.8 * F_p * 1e-6
+    """Radial runout tolerance F_rT [m] of ISO 1328-1:2013 flank class ``grade`` (module, reference diameter in m):
+    F_rT = 0.9 F_pT (module docstring)."""
+    return 0.9 * flank_tolerances(module, diameter, grade).total_pitch
 
 
-def draw_teeth(name: str, teeth: int, tol: FlankTolerances, seed: int, systematic: float) -> dict:
-    """Deviations of every tooth flank of gear ``name`` (module docstring): {"pitch", "slope", "form"}, each
-    (teeth, 2) [m] for faces (ccw, cw). The stream depends on the seed and the gear's name only, so every
-    gear (every planet) draws its own teeth and adding a gear changes no other's."""
-    rng = np.random.default_rng([int(seed), zlib.crc32(name.encode())])
-    z = int(teeth)
-
+def _process(rng, z: int, tol: FlankTolerances, systematic: float) -> dict:
+    """One gear from the process (module docstring), before inspection."""
     def profile(sigma):
         common = rng.normal(0.0, sigma * math.sqrt(systematic), (1, 2))
         return common + rng.normal(0.0, sigma * math.sqrt(1.0 - systematic), (z, 2))
@@ -90,3 +99,33 @@ def draw_teeth(name: str, teeth: int, tol: FlankTolerances, seed: int, systemati
     slope = profile(tol.profile_slope / 3.0)
     form = profile(tol.profile_form / 3.0)
     return {"pitch": pitch, "slope": slope, "form": form}
+
+
+def inspect(teeth: dict, tol: FlankTolerances) -> bool:
+    """Does a gear (:func:`draw_teeth`'s dict) pass its class: every tooth and flank face within f_pT, F_pT, f_HαT,
+    f_fαT? Pitch: positions about their mean per face, single pitch = neighbours' difference around the gear."""
+    p = teeth["pitch"] - teeth["pitch"].mean(axis=0)
+    fpt = p - np.roll(p, 1, axis=0)
+    return bool(np.abs(fpt).max() <= tol.single_pitch and np.ptp(p, axis=0).max() <= tol.total_pitch
+                and np.abs(teeth["slope"]).max() <= tol.profile_slope and np.abs(teeth["form"]).max() <= tol.profile_form)
+
+
+def draw_teeth(name: str, teeth: int, tol: FlankTolerances, seed: int, systematic: float) -> dict:
+    """Deviations of every tooth flank of a shipped gear ``name`` (module docstring): {"pitch", "slope", "form"},
+    each (teeth, 2) [m] for faces (ccw, cw), pitch as an arc on the reference circle, and "draws", how many gears
+    the process made until this one passed inspection. The stream depends on the seed and the gear's name only,
+    so every gear (every planet) draws its own teeth and adding a gear changes no other's."""
+    rng = np.random.default_rng([int(seed), zlib.crc32(name.encode())])
+    for n in range(1, MAX_DRAWS + 1):
+        d = _process(rng, int(teeth), tol, systematic)
+        if inspect(d, tol):
+            return {**d, "draws": n}
+    raise ParameterError.at("errors.flank_class", f"no gear {name!r} ({int(teeth)} teeth) of {MAX_DRAWS} drawn at the "
+                                                  f"class's tolerances at 3σ passes inspection: the process cannot "
+                                                  f"make this class for this gear")
+
+
+def pass_rate(teeth: int, tol: FlankTolerances, systematic: float, gears: int, seed: int) -> float:
+    """The share of ``gears`` gears from the process that pass inspection (:func:`inspect`)."""
+    rng = np.random.default_rng(int(seed))
+    return sum(inspect(_process(rng, int(teeth), tol, systematic), tol) for _ in range(int(gears))) / int(gears)

@@ -142,8 +142,8 @@ def parse_args(argv):
                    help="fractions > 0 of each condition's rated output torque (default 1)")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     p.add_argument("--classes", type=args.int_list(1, 11, "ISO 1328 classes"), default=d["classes"][0],
-                   help=f"ISO 1328-1:2013 flank tolerance classes 1..11, the runout of ISO 1328-2's grade of the same "
-                        f"number (default {d['classes'][0]})")
+                   help=f"ISO 1328-1:2013 flank tolerance classes 1..11, each with its runout tolerance 0.9 F_pT "
+                        f"(default {d['classes'][0]})")
     p.add_argument("--pinhole-tolerance", type=_tolerance, default=d["pinhole"][0], metavar="LENGTH",
                    help=f"carrier pinhole position tolerance, radial and tangential, ± at 3σ, with its unit (default "
                         f"{d['pinhole'][0]} {d['pinhole'][1]})")

@@ -120,8 +120,9 @@ _TOOTH_GEAR_TEXT = "a gear name: 'sun', 'ring', 'a1'..'aN' or 'b1'..'bN'"
 
 @dataclass(frozen=True, kw_only=True)
 class ToothDeviationParams(Params["ToothDeviationSI"]):
-    """Deviations of one tooth's flank (or of every tooth) from the perfect involute, ISO 1328-1 quantities,
-    along the line of action. ``flank`` "ccw" is the tooth flank that faces the gear's counter-clockwise
+    """Deviations of one tooth's flank (or of every tooth) from the perfect involute, ISO 1328-1 quantities:
+    the pitch as an arc on the reference circle (the model puts pitch·cos α on the line of action), the
+    profile deviations along the line of action. ``flank`` "ccw" is the tooth flank that faces the gear's counter-clockwise
     (+θ, forward) side, "cw" the other; "both" sets both. Signs: ``pitch`` + = the flank sits ahead of its
     theoretical position in the counter-clockwise sense (a tooth with "both" at +5 µm is turned 5 µm
     forward: the single pitch deviations f_pt are the differences of neighbouring teeth's values);
@@ -132,8 +133,8 @@ class ToothDeviationParams(Params["ToothDeviationSI"]):
     gear: str = named(_GEAR, _TOOTH_GEAR_TEXT, "the gear whose tooth deviates")
     tooth: int | str = param("tooth", 'tooth index 0..z-1 (tooth 0 on the gear\'s body x axis) or "all"')
     flank: str = param("choice", "which flank of the tooth", choices=("ccw", "cw", "both"))
-    pitch: Quantity = param("length", "cumulative pitch deviation F_pk: where the flank sits, + ahead "
-                                      "counter-clockwise", default="0 um")
+    pitch: Quantity = param("length", "cumulative pitch deviation F_pk, an arc on the reference circle: where the "
+                                      "flank sits, + ahead counter-clockwise", default="0 um")
     slope: Quantity = param("length", "profile slope deviation f_Ha (+: material towards the tip)", default="0 um")
     form: Quantity = param("length", "profile form deviation f_fa, the range of the curved part (+: material "
                                      "mid-profile for 'barrel', towards the tip for 's')", default="0 um")

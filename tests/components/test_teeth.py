@@ -1,6 +1,6 @@
 """Tooth deviations of the machine (components.teeth, components.tolerances): ISO 1328-1:2013 tolerances,
 the class draws, the parameters' validation, and the conversion from TOML entries to the mesh law checked
-against kinematics (every tooth turned by p is the gear turned by p/r_b)."""
+against kinematics (every tooth turned by an arc p on the reference circle is the gear turned by p/r)."""
 from __future__ import annotations
 
 import math
@@ -13,7 +13,8 @@ from components.dpgt import build_dpgt
 from components.families import MESH_FAMILY
 from components.params import with_overrides
 from components.presets import reference_dpgt, typical_errors
-from components.tolerances import draw_teeth, flank_tolerances, radial_runout
+from components.teeth import gear_table
+from components.tolerances import _process, draw_teeth, flank_tolerances, pass_rate, radial_runout
 from components.scene import SceneOptions
 from components.units import ParameterError
 
@@ -40,18 +41,20 @@ def test_flank_tolerances_by_hand():
 
 
 def test_radial_runout_by_hand():
-    """ISO 1328-1:1995 F_p = 0.3 m + 1.25 √d + 7 at grade 5 (m = 3, d = 100: 0.9 + 12.5 + 7 = 20.4 µm), F_r = 0.8 F_p."""
-    assert radial_runout(3e-3, 0.1, 5) == pytest.approx(0.8 * 20.4e-6, rel=1e-12)
-    assert radial_runout(3e-3, 0.1, 7) == pytest.approx(2 * 0.8 * 20.4e-6, rel=1e-12)
+    """The runout tolerance of the 2013 classes: F_rT = 0.9 F_pT (m = 2, d = 100, class 5: F_pT = 19.1 µm by hand)."""
+    assert radial_runout(2e-3, 0.1, 5) == pytest.approx(0.9 * 19.1e-6, rel=1e-12)
+    assert radial_runout(2e-3, 0.1, 7) == pytest.approx(2 * 0.9 * 19.1e-6, rel=1e-12)
 
 
-def test_drawn_teeth_have_the_stated_distribution():
-    """Single pitch deviations (neighbour differences of the positions) with σ = f_pT/3; profile slope and
-    form with σ = T/3 per tooth, ``systematic`` of their variance common to a gear's flank: across many gears
-    the variance of each gear's mean is ≈ share·σ² and the within-gear variance ≈ (1 − share)·σ²."""
+def test_the_process_has_the_stated_distribution():
+    """Before inspection (the process): single pitch deviations (neighbour differences of the positions) with
+    σ = f_pT/3; profile slope and form with σ = T/3 per tooth, ``systematic`` of their variance common to a gear's
+    flank: across many gears the variance of each gear's mean is ≈ share·σ² and the within-gear variance
+    ≈ (1 − share)·σ²."""
     tol = flank_tolerances(3e-3, 0.072, 6)
     share, z = 0.5, 24
-    draws = [draw_teeth(f"g{i}", z, tol, seed=4, systematic=share) for i in range(600)]
+    rng = np.random.default_rng(4)
+    draws = [_process(rng, z, tol, share) for i in range(600)]
     fpt = np.concatenate([np.diff(np.r_[d["pitch"], d["pitch"][:1]], axis=0).ravel() for d in draws])
     assert np.std(fpt) == pytest.approx(tol.single_pitch / 3, rel=0.03)
     for key, T in (("slope", tol.profile_slope), ("form", tol.profile_form)):
@@ -60,10 +63,54 @@ def test_drawn_teeth_have_the_stated_distribution():
         assert np.var(x) == pytest.approx(sigma2, rel=0.05)
         assert np.var(x.mean(axis=1)) == pytest.approx(share * sigma2 + (1 - share) * sigma2 / z, rel=0.12)
         assert np.mean(np.var(x, axis=1, ddof=1)) == pytest.approx((1 - share) * sigma2, rel=0.05)
+
+
+def test_the_pass_rate_of_inspection_by_hand():
+    """With nothing systematic every checked deviation is an independent normal at T/3, which stays within T with
+    P3 = erf(3/√2) = 0.99730: one tooth passes when its 2 faces' slope and form do (P3⁴: its pitch about the
+    mean is zero), two teeth when also each face's single pitch |p1 − p2| does (P3^(8 + 2); F_p = |p1 − p2|
+    < F_pT). A σ off by √2 or a wrong bound moves these by > 10 standard errors."""
+    tol = flank_tolerances(3e-3, 0.072, 6)
+    P3 = math.erf(3 / math.sqrt(2))
+    for z, k in ((1, 4), (2, 10)):
+        n = 20000
+        got = pass_rate(z, tol, 0.0, n, seed=z)
+        want = P3 ** k
+        assert abs(got - want) < 4 * math.sqrt(want * (1 - want) / n), (z, got, want)
+
+
+def test_shipped_gears_pass_their_class():
+    """Every drawn gear is within its class (every tooth and face), and it is reproducible: the same seed and name
+    give the same gear, another planet its own teeth. The reference ring (82 teeth) passes ≈ 44 % of the time, so
+    draws that skip inspection would fail here for most seeds."""
+    tol = flank_tolerances(3e-3, 0.246, 6)
+    share, z = 0.5, 82
+    draws = [draw_teeth(f"g{i}", z, tol, seed=4, systematic=share) for i in range(40)]
+    for d in draws:
+        p = d["pitch"] - d["pitch"].mean(axis=0)
+        assert np.abs(p - np.roll(p, 1, axis=0)).max() <= tol.single_pitch
+        assert np.ptp(p, axis=0).max() <= tol.total_pitch
+        assert np.abs(d["slope"]).max() <= tol.profile_slope and np.abs(d["form"]).max() <= tol.profile_form
+    assert sum(d["draws"] > 1 for d in draws) >= 10          # inspection scrapped gears of this lot
     a, b = draw_teeth("b1", z, tol, 4, share), draw_teeth("b1", z, tol, 4, share)
     assert all(np.array_equal(a[k], b[k]) for k in a)                       # reproducible
     c = draw_teeth("b2", z, tol, 4, share)
     assert not np.allclose(a["slope"], c["slope"])                           # every planet its own teeth
+
+
+def test_drawn_pitch_goes_on_the_line_of_action_with_cos_alpha():
+    """A class's drawn pitch deviations are arcs on the reference circle; the mesh law's table carries them along
+    the line of action, cos α times as large (the base-pitch deviation): so the base-pitch σ is f_pT·cos α/3.
+    The table's constant coefficient of face f is ±p·cos α + form/3 and its x² coefficient −form."""
+    params = with_overrides(reference_dpgt(3), {"errors.flank_class": [
+        {"gear": "sun", "grade": 6, "seed": 11, "systematic_share": 0.5}]})
+    si = params.si()
+    g = si.gears.sun
+    table = gear_table(si, "sun").reshape(g.teeth, 2, 5)
+    d = draw_teeth("sun", g.teeth, flank_tolerances(g.module, 2 * g.pitch_radius, 6), 11, 0.5)
+    along = (table[:, :, 0] + table[:, :, 2] / 3.0) * np.array([1.0, -1.0])
+    np.testing.assert_allclose(along, math.cos(math.radians(20.0)) * d["pitch"], rtol=1e-12, atol=1e-18)
+    assert g.pressure_angle == pytest.approx(math.radians(20.0))
 
 
 # ----------------------------------------------------------------------------------------------------
@@ -127,7 +174,7 @@ def _mesh_forces(params, turns):
 def test_every_tooth_turned_is_the_gear_turned(gear, gear_type):
     """``[[errors.tooth]] gear = X, tooth = "all", flank = "both", pitch = p`` turns every tooth of X forward by p
     along its base circle: every mesh of the machine then carries what it carries with perfect teeth and
-    gear X turned by p/r_b (to 1e-9 of the largest force), in a loaded state (no backlash, every gear turned by
+    gear X turned by p/r (p an arc on the reference circle; to 1e-9 of the largest force), in a loaded state (no backlash, every gear turned by
     a few µm: one flank of every mesh compressed), through both kinds of mesh that X enters. A sign or face
     slip would turn X backwards."""
     p = 3e-6
@@ -141,7 +188,7 @@ def test_every_tooth_turned_is_the_gear_turned(gear, gear_type):
                                              for n in (1, 2, 3)}}
     load = {g: rng.uniform(-6e-6, 6e-6) / si.gears[t].base_radius for g, t in types.items()}
     got = _mesh_forces(dev, load)
-    want = _mesh_forces(base, {**load, gear: load[gear] + p / si.gears[gear_type].base_radius})
+    want = _mesh_forces(base, {**load, gear: load[gear] + p / si.gears[gear_type].pitch_radius})
     ref = _mesh_forces(base, load)
     scale = max(np.abs(v).max() for v in want.values())
     assert scale > 1e3

@@ -143,23 +143,23 @@ def test_a_larger_clearance_solves_and_leaves_the_bearing_loads_where_the_gears_
 
 
 def test_an_instant_resting_on_a_force_jump_is_moved_within_its_mesh_phase():
-    """Class-7 gears (tolerance study machine 1 of seed 1, condition 3): at its second snapshot the sun rests on a
-    tooth pair's damping jump and has no static state. solve_snapshots moves the snapshot by 2 % of a mesh period
+    """Class-7 gears (tolerance study machine 4 of seed 1, condition 3): at its third snapshot of eight a gear rests
+    on a tooth pair's damping jump and has no static state. solve_snapshots moves the snapshot by 2 % of a mesh period
     (MOVES), where it solves; the moved state stands for the instant — the gears' displacements agree with those
-    5 % of a mesh period on within 1 % of the largest (measured 0.2 %)."""
+    5 % of a mesh period on within 1 % of the largest (measured 0.36 %)."""
     from pathlib import Path
 
     from components import static
     from components.dpgt import build_dpgt
     from scenarios import tolerance_study as ts
-    a = ts.parse_args(["--samples", "2", "--classes", "7", "--conditions", "3", "--directions", "forward"])
-    task = next(t for t in ts.static_tasks(a, Path("unused"), {}) if t.sample == 1)
+    a = ts.parse_args(["--samples", "5", "--classes", "7", "--conditions", "3", "--directions", "forward"])
+    task = next(t for t in ts.static_tasks(a, Path("unused"), {}) if t.sample == 4)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         sc = build_dpgt(ts.build_params(task.case))
     m, motion = sc.model, static.steady_motion(sc)
     kw = dict(hold=static.held_dofs(sc), rates=static.rate_groups(sc), max_rate_step=static.RATE_STEP)
-    t, period = static.snapshot_times(sc, 8)[1], 1.0 / sc.f_m
+    t, period = static.snapshot_times(sc, 8)[2], 1.0 / sc.f_m
     with pytest.raises(mbd.ModelError, match="no static state"):
         solve_static(m, motion, t, **kw)
     moved = static.solve_snapshots(sc, [t])[0]
