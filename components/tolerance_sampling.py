@@ -20,11 +20,14 @@ roller (each roller)      diameter uniform within ± ``roller_lot``/2 about its 
                           grades: a bearing's rollers from one lot whose diameter variation V_DwL is the grade)
 ========================  =====================================================================================
 
-The coordinates of one machine (everything but the teeth) are a point of the unit cube: a scrambled Sobol
-sequence (:func:`sobol_points`, ``scipy.stats.qmc``) turned into each distribution by its inverse CDF
-(``scipy.stats``' ``ppf``). The first n points of a seed's sequence are the same whatever n is, so a study
-grown from 64 to 1024 samples keeps its first 64 machines. Two classes draw from the same points (the
-same machines, their gears finer or coarser: common random numbers).
+The coordinates of one machine (everything but the teeth) are a point of the unit cube, turned into each
+distribution by its inverse CDF (``scipy.stats``' ``ppf``). The points are randomised quasi-Monte Carlo
+(:func:`sobol_points`, ``scipy.stats.qmc``): R independent scramblings of the Sobol sequence (replicates), machine i
+the (i // R)-th point of replicate i mod R. The points of one scrambled sequence are not independent, so a
+statistic's interval comes from the spread of its R replicate estimates, which are (:func:`replicate_of`; the
+tolerance study's ``--replicates``). The first n machines are the same whatever n is, so a study grown from 64 to
+1024 samples keeps its first 64 machines. Two classes draw from the same points (the same machines, their gears
+finer or coarser: common random numbers).
 """
 from __future__ import annotations
 
@@ -38,6 +41,7 @@ from .tolerances import radial_runout
 from .units import ParameterError
 
 __all__ = ["ToleranceSpec", "TOLERANCE_DEFAULTS", "DISTRIBUTIONS", "RUNOUT_SIGMAS", "coordinates", "sobol_points",
+           "replicate_of",
            "teeth_seed", "draw_errors", "pin_names", "gear_names_of"]
 
 # the Rayleigh quantile that 99.73 % of gears stay within (the 3σ coverage of a normal, in 2-D)
@@ -114,13 +118,26 @@ def coordinates(N: int, Z: int) -> list[str]:
     return out
 
 
-def sobol_points(n: int, d: int, seed: int) -> np.ndarray:
-    """(n, d) points of the unit cube: the first n of the scrambled Sobol sequence of ``seed`` (drawn as a power of
-    two, so its balance holds and any n keeps the same first points)."""
+def replicate_of(sample, replicates: int):
+    """The replicate (independent scrambling) that machine ``sample`` belongs to (module docstring)."""
+    return np.asarray(sample) % int(replicates)
+
+
+def sobol_points(n: int, d: int, seed: int, replicates: int) -> np.ndarray:
+    """(n, d) points of the unit cube: machine i is the (i // R)-th point of the scrambled Sobol sequence of replicate
+    i mod R (``replicates`` = R independent scramblings from ``seed``; each drawn as a power of two, so its balance
+    holds and any n keeps the same first points)."""
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise ParameterError.at("samples", f"must be a whole number >= 1, got {n!r}")
-    m = max(0, math.ceil(math.log2(n)))
-    u = qmc.Sobol(d, scramble=True, seed=np.random.default_rng(int(seed))).random_base2(m)[:n]
+    if not (isinstance(replicates, (int, np.integer)) and replicates >= 1):
+        raise ParameterError.at("replicates", f"must be a whole number >= 1, got {replicates!r}")
+    R = int(replicates)
+    u = np.empty((n, d))
+    for r in range(min(R, n)):
+        count = len(range(r, n, R))
+        m = max(0, math.ceil(math.log2(count)))
+        seq = np.random.default_rng(np.random.SeedSequence([int(seed), r]))
+        u[r::R] = qmc.Sobol(d, scramble=True, seed=seq).random_base2(m)[:count]
     # a scrambled point is never exactly 0 or 1 in exact arithmetic; keep the inverse CDFs finite all the same
     return np.clip(u, 1e-12, 1.0 - 1e-12)
 

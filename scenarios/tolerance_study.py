@@ -18,7 +18,7 @@ parameters and code, and refuses, without ``--overwrite``, a folder holding ones
 
 Writes ``samples.csv`` (a row per machine, class, condition, direction and torque: the drawn errors, K_γ per planet
 row and per mesh, bearing mean and largest load per bearing type, the weakest bearing's ISO 281 and ISO/TS 16281-style
-lives), ``statistics.json`` (mean, P50, P90, P99 of K_γ and the loads, P10 of the lives, each with a bootstrap 95 %
+lives), ``statistics.json`` (mean, P50, P90, P99 of K_γ and the loads, P10 of the lives, each with a 95 %
 interval; the P90 of K_γ against the number of samples), ``agreement.csv`` (static against dynamic), the figures
 ``k_gamma_distribution.png``, ``k_gamma_torque.png``, ``life_cdf.png`` and ``answer.md`` (the answer in words).
 """
@@ -40,14 +40,14 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.stats import bootstrap
+from scipy.stats import t as student_t
 from tqdm.auto import tqdm
 
 import mbd
 from components.dpgt import build_dpgt
 from components.static import DEFAULT_SNAPSHOTS, static_summary
 from components.tolerance_sampling import (DISTRIBUTIONS, TOLERANCE_DEFAULTS, ToleranceSpec, coordinates, draw_errors,
-                                           sobol_points, teeth_seed)
+                                           replicate_of, sobol_points, teeth_seed)
 from components.units import ParameterError, quantity, to_si
 from components.results import Summary
 from components.results.io import atomic_write_text
@@ -80,7 +80,6 @@ HEADLINE = "k_gamma_mesh"
 AGREE = ("k_gamma_mesh", "k_gamma_inner", "k_gamma_outer", "bearing_load_mean_inner_N", "bearing_load_mean_outer_N",
          "bearing_load_max_inner_N", "bearing_load_max_outer_N")
 PERCENTILES = {"p50": 50.0, "p90": 90.0, "p99": 99.0}
-BOOTSTRAP_RESAMPLES = 2000
 RECORD_VERSION = 1       # what a static result file holds (_kept); another version is solved again
 TABLE_K_GAMMA = 1.0      # the rating tables' K_γ for up to three planets (docs/tolerances.md: what was found, cited)
 
@@ -137,7 +136,8 @@ def parse_args(argv):
     d = TOLERANCE_DEFAULTS
     p = args.parser("tolerance_study", __doc__, examples=EXAMPLES, writes=WRITES, out="results/tolerances")
     p.add_argument("--samples", type=args.count(1), default=64, metavar="N",
-                   help="machines drawn per class (a scrambled Sobol sequence: the first N of --seed's; default 64)")
+                   help="machines drawn per class (randomised QMC: --replicates scrambled Sobol sequences of --seed; "
+                        "default 64)")
     p.add_argument("--torques", type=_fractions, default=[1.0], metavar="F[,F...]",
                    help="fractions > 0 of each condition's rated output torque (default 1)")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
@@ -159,7 +159,10 @@ def parse_args(argv):
     p.add_argument("--snapshots", type=args.count(1), default=DEFAULT_SNAPSHOTS, metavar="N",
                    help=f"static solutions per machine over a carrier revolution and the mesh cycle (default "
                         f"{DEFAULT_SNAPSHOTS})")
-    p.add_argument("--seed", type=args.count(0), default=1, help="seed of the Sobol sequence and of the teeth (default 1)")
+    p.add_argument("--seed", type=args.count(0), default=1, help="seed of the Sobol sequences and of the teeth (default 1)")
+    p.add_argument("--replicates", type=args.count(2), default=8, metavar="R",
+                   help="independent scramblings of the Sobol sequence (randomised QMC): machine i belongs to replicate "
+                        "i mod R, and every interval comes from the R replicates' spread (default 8)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="dynamic runs: seconds discarded (default 0.03)")
     p.add_argument("--window", type=args.positive("s"), default=None,
                    help="dynamic runs: seconds analysed (default: the paper study's, whole cage revolutions)")
@@ -214,7 +217,7 @@ def _nominal_power(condition: int, direction: str, params_file, user: dict) -> f
 def machines(a, si) -> dict[int, tuple[dict, dict]]:
     """{class: [(overrides, drawn) per sample]}: every sample's errors (the same Sobol points for every class)."""
     N, Z = si.layout.planets, si.bearing.rollers
-    u = sobol_points(a.samples, len(coordinates(N, Z)), a.seed)
+    u = sobol_points(a.samples, len(coordinates(N, Z)), a.seed, a.replicates)
     return {c: [draw_errors(si, a.spec[c], u[i], teeth_seed(a.seed, i)) for i in range(a.samples)] for c in a.classes}
 
 
@@ -375,23 +378,27 @@ def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None
 # ---------------------------------------------------------------------------------------------------------------
 # statistics
 # ---------------------------------------------------------------------------------------------------------------
-def percentile_ci(x, q: float | None, seed: int, resamples: int = BOOTSTRAP_RESAMPLES) -> dict:
-    """{"value", "ci95"}: the mean (``q`` None) or the q-th percentile of ``x`` and its bootstrap 95 % interval
-    (``scipy.stats.bootstrap``, percentile method); no interval from fewer than 2 distinct values."""
-    x = np.asarray(x, float)
-    x = x[np.isfinite(x)]
+def percentile_ci(x, q: float | None, replicate) -> dict:
+    """{"value", "ci95"}: the mean (``q`` None) or the q-th percentile of ``x`` by randomised QMC: the statistic of each
+    independent replicate (``replicate`` the replicate of each value,
+    :func:`components.tolerance_sampling.replicate_of`) holding 2 or more values, their mean as the estimate and
+    mean ± t(0.975, R − 1)·s_R/√R as its 95 % interval. Percentiles are Hazen's ((i − ½)/n plotting positions:
+    unbiased on the evenly spread points of a Sobol net, where numpy's default is biased by half a point spacing).
+    Fewer than 2 such replicates: the statistic of all values, no interval; equal values: no interval."""
+    x, rep = np.asarray(x, float), np.asarray(replicate)
+    ok = np.isfinite(x)
+    x, rep = x[ok], rep[ok]
     if x.size == 0:
         return {"value": None, "ci95": None}
-    stat = (lambda v, axis=-1: np.mean(v, axis=axis)) if q is None else \
-        (lambda v, axis=-1: np.percentile(v, q, axis=axis))
-    value = float(stat(x))
+    stat = np.mean if q is None else (lambda v: np.percentile(v, q, method="hazen"))
+    est = [stat(x[rep == r]) for r in np.unique(rep) if np.count_nonzero(rep == r) >= 2]
+    if len(est) < 2:
+        return {"value": float(stat(x)), "ci95": None}
+    value = float(np.mean(est))
     if np.unique(x).size < 2:
         return {"value": value, "ci95": None}
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        r = bootstrap((x,), stat, vectorized=True, n_resamples=resamples, method="percentile",
-                      confidence_level=0.95, random_state=np.random.default_rng(seed))
-    return {"value": value, "ci95": [float(r.confidence_interval.low), float(r.confidence_interval.high)]}
+    half = float(student_t.ppf(0.975, len(est) - 1) * np.std(est, ddof=1) / math.sqrt(len(est)))
+    return {"value": value, "ci95": [value - half, value + half]}
 
 
 def _order(key: tuple) -> tuple:
@@ -414,12 +421,19 @@ def _column(samples: list[dict], key: str) -> np.ndarray:
     return np.array([r["quantities"][key] for r in samples if "quantities" in r], float)
 
 
-def convergence(x, seed: int) -> dict:
-    """The P90 of ``x`` (in sample order: a Sobol prefix) with its interval at 8, 16, 32, … samples and all of them,
-    and the smallest of those counts from which every later estimate lies inside the final interval."""
-    x = np.asarray(x, float)
-    ns = [n for n in (2 ** k for k in range(3, 30)) if n < x.size] + [x.size]
-    steps = [{"samples": int(n), **percentile_ci(x[:n], 90.0, seed, resamples=1000)} for n in ns]
+def _replicates(samples: list[dict], replicates: int) -> np.ndarray:
+    """The replicate of every sample of ``samples`` that has quantities (as :func:`_column` orders them)."""
+    return replicate_of(np.array([r["sample"] for r in samples if "quantities" in r], int), replicates)
+
+
+def convergence(x, replicate, replicates: int) -> dict:
+    """The P90 of ``x`` (in sample order) with its interval at 2R, 4R, 8R, … samples (R = ``replicates``: every
+    replicate as many) and all of them, and the smallest of those counts from which every later estimate lies inside
+    the final interval."""
+    x, rep = np.asarray(x, float), np.asarray(replicate)
+    R = int(replicates)
+    ns = [n for n in (R * 2 ** k for k in range(1, 30)) if n < x.size] + [x.size]
+    steps = [{"samples": int(n), **percentile_ci(x[:n], 90.0, rep[:n])} for n in ns]
     final = steps[-1]["ci95"]
     settled = None
     if final is not None:
@@ -430,9 +444,10 @@ def convergence(x, seed: int) -> dict:
     return {"p90": steps, "settled_at_samples": settled}
 
 
-def statistics(records: dict, seed: int, dynamic: dict | None = None) -> list[dict]:
+def statistics(records: dict, replicates: int, dynamic: dict | None = None) -> list[dict]:
     """Per class, condition, direction and torque: the perfect machine's quantities, the samples' mean, P50, P90 and
-    P99 of every K_γ and load and the P10 of every life, each with its bootstrap 95 % interval, and the P90 of the
+    P99 of every K_γ and load and the P10 of every life, each with its 95 % interval over the ``replicates``
+    independent replicates (:func:`percentile_ci`), and the P90 of the
     mesh K_γ against the number of samples; where machines ran dynamically too (``dynamic``: {task key: summary}),
     the mean and P90 of K_γ over those machines, static and dynamic side by side."""
     out = []
@@ -443,22 +458,24 @@ def statistics(records: dict, seed: int, dynamic: dict | None = None) -> list[di
              "samples": len(ok), "failed": [{"sample": r["sample"], "error": r.error}
                                             for r in map(Summary.of, e["samples"]) if r.failed],
              "perfect_machine": (e["perfect"] or {}).get("quantities"), "quantities": {}}
+        rep = _replicates(ok, replicates)
         for key in QUANTITIES:
             x = _column(ok, key)
             if key in LIVES:
-                g["quantities"][key] = {"p10": percentile_ci(x, 10.0, seed)}
+                g["quantities"][key] = {"p10": percentile_ci(x, 10.0, rep)}
             else:
-                g["quantities"][key] = {"mean": percentile_ci(x, None, seed),
-                                        **{k: percentile_ci(x, q, seed) for k, q in PERCENTILES.items()}}
-        g["convergence"] = {HEADLINE: convergence(_column(ok, HEADLINE), seed)} if ok else {}
+                g["quantities"][key] = {"mean": percentile_ci(x, None, rep),
+                                        **{k: percentile_ci(x, q, rep) for k, q in PERCENTILES.items()}}
+        g["convergence"] = {HEADLINE: convergence(_column(ok, HEADLINE), rep, replicates)} if ok else {}
         both = [(r, dynamic[(c, cond, d, f, r["sample"])]) for r in ok if (c, cond, d, f, r["sample"]) in (dynamic or {})]
         if both:
             g["dynamic_subset"] = {"samples": len(both)}
+            sub = replicate_of(np.array([r["sample"] for r, _ in both], int), replicates)
             for key in ("k_gamma_mesh", "k_gamma_inner", "k_gamma_outer"):
                 st = np.array([r["quantities"][key] for r, _ in both])
                 dy = np.array([quantities_of(sm)[key] for _, sm in both])
                 g["dynamic_subset"][key] = {
-                    way: {"mean": percentile_ci(x, None, seed), "p90": percentile_ci(x, 90.0, seed)}
+                    way: {"mean": percentile_ci(x, None, sub), "p90": percentile_ci(x, 90.0, sub)}
                     for way, x in (("static", st), ("dynamic", dy))}
         out.append(g)
     return out
@@ -536,7 +553,8 @@ def answer(stats: list[dict], agree: list[dict], a_record: dict) -> str:
          f"{a_record['samples']} machines per class drawn from: {a_record['tolerances']}. K_γ of a mesh: the most loaded "
          "planet pair's mean drive-flank force over the mean of the pairs (ISO 6336's mesh load factor); of a "
          "bearing row: the most loaded planet bearing's mean load over the row's mean (the bearing load includes "
-         "the planets' centrifugal load). Values: the statistic with its bootstrap 95 % interval in brackets.", ""]
+         "the planets' centrifugal load). Values: the statistic with its 95 % interval (over the independent "
+         "replicates) in brackets.", ""]
     top = max(g["torque_fraction"] for g in stats)
     for cond in sorted({g["condition"] for g in stats}):
         L.append(f"## Condition {cond}")
@@ -708,9 +726,11 @@ class ToleranceStudy(Study):
 
     def study_record(self) -> dict:
         a = self.a
-        return {"samples": a.samples, "seed": a.seed, "snapshots": a.snapshots, "torques": a.torques,
+        return {"samples": a.samples, "seed": a.seed, "replicates": a.replicates, "snapshots": a.snapshots,
+                "torques": a.torques,
                 "classes": a.classes, "tolerances": self._tolerance_words(),
-                "distributions": DISTRIBUTIONS, "sampler": "scipy.stats.qmc.Sobol, scrambled, seed --seed; inverse CDFs",
+                "distributions": DISTRIBUTIONS, "sampler": "randomised QMC: --replicates independently scrambled scipy.stats.qmc.Sobol "
+                                                       "sequences of --seed, machine i in replicate i mod R; inverse CDFs",
                 "defaults": {k: {"value": v[0], "source": v[1], "basis": v[2]} for k, v in TOLERANCE_DEFAULTS.items()},
                 "static_cost": self.cost}
 
@@ -752,7 +772,7 @@ class ToleranceStudy(Study):
         a = self.a
         by_label = {c.label: t.key() for c, t in zip(run.cases, self._dynamic_tasks())}
         dynamic = {by_label[k]: s for k, s in run.results.items() if k in by_label}
-        stats = statistics(self.records, a.seed, dynamic)
+        stats = statistics(self.records, a.replicates, dynamic)
         agree = agreement_rows(self.records, dynamic)
         record = {"samples": a.samples, "tolerances": self._tolerance_words(), "static_cost": self.cost}
         text = answer(stats, agree, record)
@@ -762,8 +782,9 @@ class ToleranceStudy(Study):
         def tables():
             files = [_write_csv(self.out / "samples.csv", rows, sample_columns(rows))]
             atomic_write_text(self.out / "statistics.json", json.dumps(
-                {"method": {**self.study_record(), "bootstrap": f"scipy.stats.bootstrap, percentile method, "
-                                                                f"{BOOTSTRAP_RESAMPLES} resamples, 95 %"},
+                {"method": {**self.study_record(), "intervals": "95 %: the statistic over all machines ± "
+                                                                "t(0.975, R − 1)·s_R/√R, s_R its spread over the R "
+                                                                "replicates"},
                  "quantities": {k: {"words": w, "unit": u} for k, (w, u) in QUANTITIES.items()},
                  "groups": stats}, indent=1, default=float))
             files.append(self.out / "statistics.json")
