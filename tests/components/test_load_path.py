@@ -222,10 +222,11 @@ def test_no_load_forward_and_reverse_of_one_machine(runs):
     """The same machine at no load, forward vs reverse. The mesh forces are not zero — the planet
     bearings' traction and drag losses (≈ 40 N on the inner–outer, ≈ 80 N on the ring mesh's flanks,
     measured) go through the meshes, whose geometry the handedness sets — so the two directions are mirror
-    images only approximately. Forces agree within 2 % (measured ≤ 0.7 %). The cage accelerations' RMS
-    is printed, not asserted: over one cage revolution after this short settling the outer cages differ by
-    ≈ 11 % (all three alike: they share one carrier and sun), over the study's 3 revolutions after 30 ms by
-    1–6 % with the opposite sign: variability of the cage motion between runs, no consistent direction effect."""
+    images only approximately. Forces agree within 2 % (measured ≤ 0.7 %). The cage accelerations' RMS agree
+    within 20 %: over one cage revolution after this short settling the outer cages differ by ≈ 11 % (all three
+    alike: they share one carrier and sun), over the study's 3 revolutions after 30 ms by 1–6 % with the opposite
+    sign: variability of the cage motion between runs, no consistent direction effect; a direction effect of the
+    size the loads show at condition 3 (tens of %) would fail it."""
     f, r = runs[4, "forward"][1].summary(), runs[4, "reverse"][1].summary()
     for kind in ("inner", "outer"):
         for k in ("roller_inner_race_rms_N", "roller_outer_race_rms_N", "cage_guide_rms_N", "bearing_load_mean_N"):
@@ -233,7 +234,7 @@ def test_no_load_forward_and_reverse_of_one_machine(runs):
         for k in ("roller_inner_race_rms_N", "roller_outer_race_rms_N", "roller_cage_rms_N"):
             assert r[kind]["all_rollers"][k] == pytest.approx(f[kind]["all_rollers"][k], rel=0.02), (kind, k)
         a, b = f[kind]["cage_acc_magnitude_rms_m_s2"], r[kind]["cage_acc_magnitude_rms_m_s2"]
-        print(f"no load, {kind} cage acceleration RMS: forward {a:.0f}, reverse {b:.0f} m/s^2 ({(b / a - 1) * 100:+.1f} %)")
+        assert b == pytest.approx(a, rel=0.2), (kind, a, b)     # no direction effect beyond the runs' variability
     assert runs[4, "forward"][1].stats("outer_ring_coast_force")["mean"].min() > 10.0   # the loss torque path
 
 

@@ -13,7 +13,7 @@ from components.dpgt import build_dpgt
 from components.families import MESH_FAMILY
 from components.params import with_overrides
 from components.presets import reference_dpgt, typical_errors
-from components.teeth import gear_table
+from components.teeth import gear_table, mesh_pairs
 from components.tolerances import _process, draw_teeth, flank_tolerances, pass_rate, radial_runout
 from components.scene import SceneOptions
 from components.units import ParameterError
@@ -197,3 +197,60 @@ def test_every_tooth_turned_is_the_gear_turned(gear, gear_type):
     changed = [k for k in want if np.abs(want[k] - ref[k]).max() > 1e-3 * scale]
     assert sorted(changed) == sorted({"sun": ["sun_inner"], "b2": ["inner_outer", "outer_ring"],
                                       "ring": ["outer_ring"]}[gear])           # X's meshes felt the turn
+
+
+# ----------------------------------------------------------------------------------------------------
+# from the parameters to the shapes ISO 1328-1 and the relief define
+# ----------------------------------------------------------------------------------------------------
+def _profile(si, gear, tooth, face, x):
+    g = si.gears[{"sun": "sun", "ring": "ring"}.get(gear, "outer_planet")]
+    c = gear_table(si, gear).reshape(g.teeth, 2, 5)[tooth, face, :4]
+    return c[0] + x * (c[1] + x * (c[2] + x * c[3]))
+
+
+@pytest.mark.parametrize("shape, mid_high", [("barrel", True), ("s", False)])
+def test_tooth_entries_have_the_iso_profile_shapes(shape, mid_high):
+    """``[[errors.tooth]]`` entries read from parameters, evaluated over the active profile (x = −1 its start, +1
+    the tip) along the line of action: a slope deviation f_Hα = 4 µm is the difference tip − start (more material at
+    the tip); a form deviation f_fα = 3 µm is the range of what is left after the profile's straight line
+    (least squares) is removed, and has no straight-line part of its own, with material mid-profile for a barrel and
+    towards the tip for an s-form; entries on
+    other teeth or faces leave this one perfect."""
+    x = np.linspace(-1.0, 1.0, 2001)
+    params = with_overrides(reference_dpgt(3), {"errors.tooth": [
+        {"gear": "b2", "tooth": 5, "flank": "ccw", "slope": "4 um"},
+        {"gear": "b2", "tooth": 7, "flank": "cw", "form": "3 um", "form_shape": shape}]})
+    si = params.si()
+    slope = _profile(si, "b2", 5, 0, x)
+    assert slope[-1] - slope[0] == pytest.approx(4e-6, rel=1e-12)
+    np.testing.assert_allclose(np.diff(slope), np.diff(slope)[0], rtol=1e-9)      # a straight line
+    form = _profile(si, "b2", 7, 1, x)
+    line = np.polyfit(x, form, 1)
+    assert abs(line[0]) < 5e-3 * 3e-6                     # a form deviation has no slope of its own
+    curved = form - np.polyval(line, x)
+    assert np.ptp(curved) == pytest.approx(3e-6, rel=5e-3)       # a discrete fit: within 0.15 % of the L2 one
+    if mid_high:
+        assert curved[1000] == curved.max() and curved[0] == curved[-1] == pytest.approx(curved.min())
+    else:
+        assert form[-1] > form[0] and form[-1] == pytest.approx(form.max())
+    assert np.all(_profile(si, "b2", 5, 1, x) == 0.0) and np.all(_profile(si, "b2", 6, 0, x) == 0.0)
+
+
+def test_tip_relief_starts_its_length_from_the_tip():
+    """``gears.sun.tip_relief = 10 µm`` over ``tip_relief_length`` L_a = 40 % of the sun–inner path of contact,
+    linear: the sun's relief in that mesh is C_a at the sun's tip (ξ = 1), C_a/2 at L_a/2 from the tip along the
+    roll length, nothing L_a or farther from the tip; parabolic: C_a/4 at L_a/2."""
+    from components.geometry import layout
+    from mbd.elements.tooth_pairs import _relief
+    mg = layout(reference_dpgt(3)).meshes["sun_inner"]
+    path = mg.contact_ratio * mg.base_pitch
+    L_a = 0.4 * path
+    for shape, half in (("linear", 0.5), ("parabolic", 0.25)):
+        params = with_overrides(reference_dpgt(3), {"gears.sun.tip_relief": "10 um",
+                                                    "gears.sun.tip_relief_length": f"{L_a} m",
+                                                    "gears.sun.tip_relief_shape": shape})
+        pp = mesh_pairs(params.si(), mg, ["sun"], ["a1"])
+        xi = 1.0 - np.array([0.0, 0.5 * L_a, L_a, 1.2 * L_a, 0.9 * path]) / path
+        R, _ = _relief(xi, np.repeat(pp.relief1, xi.size, axis=0))
+        np.testing.assert_allclose(R, [10e-6, half * 10e-6, 0.0, 0.0, 0.0], atol=1e-15)
+        assert np.all(pp.relief2[:, 0] == 0.0)                       # the planet has none
