@@ -170,7 +170,7 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     flanks = loaded_flanks(np.sign(T_s) if T_s != 0 else np.sign(speed["sun"]))
     tooth_pairs = teeth.has_teeth(si)       # real teeth: the tooth-pair law (perfect ones: its exact reduction)
     common = dict(time_varying=opt.mesh_stiffness == "time_varying", smoothing=ms.smoothing_width,
-                  ratio=ms.stiffness_ratio)
+                  ratio=ms.stiffness_ratio, damping_ramp=ms.damping_ramp)
     M = lay.meshes
     for key, g1, g2, th1, th2 in (("sun_inner", ["sun"] * N, a_names, np.zeros(N), ph.gamma_inner),
                                   ("inner_outer", a_names, b_names, ph.gamma_inner, ph.gamma_outer),

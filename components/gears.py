@@ -21,11 +21,12 @@ __all__ = ["add_mesh_family"]
 
 
 def add_mesh_family(scene: Scene, family: str, mg, *, gear1: list[str], gear2: list[str], theta1_0, theta2_0,
-                    flank: int, time_varying: bool, smoothing: float, ratio: float, errors: dict,
-                    pairs: ToothPairs | None = None) -> slice:
+                    flank: int, time_varying: bool, smoothing: float, ratio: float, damping_ramp: float,
+                    errors: dict, pairs: ToothPairs | None = None) -> slice:
     """Add the N meshes of one type (``mg`` a :class:`components.geometry.MeshGeometry`).
     ``theta*_0`` are the gears' body angles at assembly (tooth 0 at the body angle); u0 makes both
-    flanks' compression zero there. ``errors``: per-instance runout offsets
+    flanks' compression zero there. ``damping_ramp``: the compression over which a flank's damping grows
+    (``mesh.damping_ramp``). ``errors``: per-instance runout offsets
     (:func:`components.faults.mesh_error_args`; {} for a perfect machine); ``pairs``: the tooth-pair law's
     data (:func:`components.teeth.mesh_pairs`) of a machine whose teeth are not perfect, else None (the
     rectangular law, which the pair law then equals). A constant stiffness with pairs splits a constant
@@ -54,5 +55,6 @@ def add_mesh_family(scene: Scene, family: str, mg, *, gear1: list[str], gear2: l
     fam = scene.family(family, GearMesh, ("gear1", "gear2"), internal=mg.internal, stiffness=shape, pairs=pairs)
     n = phi.size
     return fam.add(n, gear1=gear1, gear2=gear2, rb1=rb1, rb2=rb2, alpha=mg.pressure_angle, a0=mg.centre_distance,
-                   teeth1=mg.z1, k_mean=mg.k_mean, c_mesh=mg.damping, u0=u0, p0=p0, backlash=mg.backlash, phi_ref=phi,
+                   teeth1=mg.z1, k_mean=mg.k_mean, c_mesh=mg.damping, damping_ramp=damping_ramp, u0=u0, p0=p0,
+                   backlash=mg.backlash, phi_ref=phi,
                    **errors)

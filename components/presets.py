@@ -281,6 +281,9 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
             smoothing_width=assumed(0.05, "the source gives none: 5 % of a mesh cycle per step, "
                                           "smooth enough for Newton, sharp enough to keep the wave"),
             damping_ratio=assumed(0.07),
+            damping_ramp=assumed("1 um", "a contact's damping grows with its compressed zone (Hunt & Crossley); "
+                                         "under a third of the loaded flank's compression at rated load (3.1-15 um "
+                                         "at conditions 1-3), so loaded flanks keep their whole damping"),
         ),
         operating=operating_point(condition, direction),
         rig=RigParams(

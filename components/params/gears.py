@@ -135,6 +135,8 @@ class MeshParams(Params["MeshSI"]):
     smoothing_width: Quantity = param("dimensionless", "step width of the stiffness wave, fraction of a mesh cycle",
                                       lo=0.0, hi=0.5, lo_open=True, bound_text="in (0, 0.5]")
     damping_ratio: Quantity = nonneg("dimensionless", "mesh damping ratio zeta_m")
+    damping_ramp: Quantity = nonneg("length", "compression over which a flank's (a tooth pair's) damping grows from 0 "
+                                              "at first touch to zeta_m's (0: all of it at first touch)")
     backlash_sun_inner: Quantity | None = _backlash("sun-inner planet meshes")
     backlash_inner_outer: Quantity | None = _backlash("inner-outer planet meshes")
     backlash_outer_ring: Quantity | None = _backlash("outer planet-ring meshes")
@@ -147,6 +149,7 @@ class MeshSI(SI):
     stiffness_ratio: float
     smoothing_width: float
     damping_ratio: float
+    damping_ramp: float
     backlash_sun_inner: float | None
     backlash_inner_outer: float | None
     backlash_outer_ring: float | None

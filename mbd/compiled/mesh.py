@@ -4,12 +4,12 @@ The force law is the reference kernel's, operation for operation (so values agre
 of arctan2/cos/sin), with its Jacobians derived by hand. One family may mix external and internal
 meshes (σ per instance, as after System fusion).
 
-P, shape (n, 14 [+ 4] [+ 4] [+ 13]), one row per mesh (constants ``P_*`` below):
+P, shape (n, 15 [+ 4] [+ 4] [+ 13]), one row per mesh (constants ``P_*`` below):
 
     0 σ (+1 external, −1 internal)   1 r_b1     2 r_b2      3 a0     4 sin α    5 κ0 = σ r_b1 + r_b2
     6 p_b base pitch                 7 z1       8 k_mean    9 c_m   10 u0      11 p0
-    12 b backlash                   13 φ_ref
-    RectangularStiffness only: 14 h = (ε_α − 1)/2   15 s smoothing   16 k_single/k_mean   17 ratio
+    12 b backlash                   13 φ_ref   14 δ_c damping ramp
+    RectangularStiffness only: 15 h = (ε_α − 1)/2   16 s smoothing   17 k_single/k_mean   18 ratio
     then, only in a family with eccentricity, from column G[1]: o1x, o1y, o2x, o2y [m]
     then, only in a family with the tooth-pair law, from column G[2]: its block (:mod:`.tooth_pairs`)
 
@@ -48,7 +48,7 @@ __all__ = ["pack_gear_mesh", "evaluate_gear_mesh"]
 _TWO_PI = 2.0 * np.pi
 
 (P_SIGMA, P_RB1, P_RB2, P_A0, P_SIN_ALPHA, P_KAPPA0, P_PITCH, P_TEETH1, P_K_MEAN, P_C_MESH, P_U0, P_P0,
- P_BACKLASH, P_PHI_REF, P_RECT_H, P_RECT_S, P_RECT_SINGLE, P_RECT_RATIO) = range(18)
+ P_BACKLASH, P_PHI_REF, P_RAMP, P_RECT_H, P_RECT_S, P_RECT_SINGLE, P_RECT_RATIO) = range(19)
 G_SHAPE, G_OFFSET, G_PAIRS, G_TABLE, G_FOURIER = 0, 1, 2, 3, 4
 SHAPE_CONSTANT, SHAPE_RECTANGULAR, SHAPE_FOURIER = 0, 1, 2
 
@@ -56,7 +56,7 @@ SHAPE_CONSTANT, SHAPE_RECTANGULAR, SHAPE_FOURIER = 0, 1, 2
 def pack_gear_mesh(elem: GearMesh):
     """(P, G) of a GearMesh family (layouts in the module docstring)."""
     cols = [elem.sigma, elem.rb1, elem.rb2, elem.a0, elem.sin_alpha, elem.kappa0, elem.pitch, elem.teeth1,
-            elem.k_mean, elem.c_mesh, elem.u0, elem.p0, elem.backlash, elem.phi_ref]
+            elem.k_mean, elem.c_mesh, elem.u0, elem.p0, elem.backlash, elem.phi_ref, elem.damping_ramp]
     shape, fourier = elem.stiffness, []
     if type(shape) is ConstantStiffness:
         kind = SHAPE_CONSTANT
@@ -227,21 +227,25 @@ def _from_geometric(Fg, Jqg, Jvg, r, vl, F, Jq, Jv, jac):
 @njit(cache=True)
 def _lumped_flanks(shape, P, i, G, p_geo, z1, k_mean, c, phx, phy, d_plus, d_minus, r_plus, r_minus, ds, dr, dsd,
                    drd, dkp, gp, gm, jac):
-    """(F_+, F_−) of the lumped law k(p) δ_f + c_m δ̇_f (gated, no pull) and, with ``jac``, their gradients
-    into gp, gm from those of s, the radial term and their rates."""
+    """(F_+, F_−) of the lumped law k(p) δ_f + c_m S(δ_f/δ_c) δ̇_f (gated, no pull) and, with ``jac``, their
+    gradients into gp, gm from those of s, the radial term and their rates."""
     fac, dfac = _factor(shape, p_geo + P[i, P_P0], P, i, G)
     kp = k_mean * fac
-    g_plus = kp * d_plus + c * r_plus
-    g_minus = kp * d_minus + c * r_minus
+    S_plus, dS_plus = tooth_pairs.damping_share(d_plus, P[i, P_RAMP])
+    S_minus, dS_minus = tooth_pairs.damping_share(d_minus, P[i, P_RAMP])
+    g_plus = kp * d_plus + c * S_plus * r_plus
+    g_minus = kp * d_minus + c * S_minus * r_minus
     on_plus = d_plus > 0.0 and g_plus > 0.0          # flank in contact and not pulling
     on_minus = d_minus > 0.0 and g_minus > 0.0
     if jac:
         dpdth = z1 * (1.0 / _TWO_PI)
         dk = k_mean * dfac
         dkp[0], dkp[1], dkp[2] = -dk * dpdth * phx, -dk * dpdth * phy, dk * dpdth
+        kp_plus, kp_minus = kp + c * r_plus * dS_plus, kp + c * r_minus * dS_minus     # ∂F/∂δ
         for j in range(8):
-            gp[j] = (dkp[j] * d_plus + kp * (ds[j] - dr[j]) + c * (dsd[j] - drd[j])) if on_plus else 0.0
-            gm[j] = (dkp[j] * d_minus + kp * (-ds[j] - dr[j]) + c * (-dsd[j] - drd[j])) if on_minus else 0.0
+            gp[j] = (dkp[j] * d_plus + kp_plus * (ds[j] - dr[j]) + c * S_plus * (dsd[j] - drd[j])) if on_plus else 0.0
+            gm[j] = (dkp[j] * d_minus + kp_minus * (-ds[j] - dr[j]) + c * S_minus * (-dsd[j] - drd[j])) \
+                if on_minus else 0.0
     return (g_plus if on_plus else 0.0), (g_minus if on_minus else 0.0)
 
 
@@ -297,12 +301,13 @@ def _meshes(ql, vl, P, G, F, Jq, Jv, jac):
                 dv_p[j], dv_m[j] = dsd[j] - drd[j], -dsd[j] - drd[j]
             h, sw, single, ratio = P[i, P_RECT_H], P[i, P_RECT_S], P[i, P_RECT_SINGLE], P[i, P_RECT_RATIO]
             z2 = np.rint(rb2 / rb1 * z1)
-            F_plus = tooth_pairs.flank_force(1.0, P, i, pcol, G, tstart, sig, z1, z2, k_mean, c, h, sw, single,
+            ramp = P[i, P_RAMP]
+            F_plus = tooth_pairs.flank_force(1.0, P, i, pcol, G, tstart, sig, z1, z2, k_mean, c, ramp, h, sw, single,
                                              ratio, th1, th2, phi_e, w1, d_plus, r_plus, ex, ey, tx, ty, inv_a,
                                              t_dd, e_dd, dd_p, dv_p, gp, jac)
-            F_minus = tooth_pairs.flank_force(-1.0, P, i, pcol, G, tstart, sig, z1, z2, k_mean, c, h, sw, single,
-                                              ratio, th1, th2, phi_e, w1, d_minus, r_minus, ex, ey, tx, ty, inv_a,
-                                              t_dd, e_dd, dd_m, dv_m, gm, jac)
+            F_minus = tooth_pairs.flank_force(-1.0, P, i, pcol, G, tstart, sig, z1, z2, k_mean, c, ramp, h, sw,
+                                              single, ratio, th1, th2, phi_e, w1, d_minus, r_minus, ex, ey, tx, ty,
+                                              inv_a, t_dd, e_dd, dd_m, dv_m, gm, jac)
         else:
             F_plus, F_minus = _lumped_flanks(shape, P, i, G, z1 * (th1 - phi_e) * (1.0 / _TWO_PI), z1, k_mean, c,
                                              phx, phy, d_plus, d_minus, r_plus, r_minus, ds, dr, dsd, drd, dkp,

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["flank_force", "NCOLS"]
+__all__ = ["flank_force", "damping_share", "NCOLS"]
 
 _TWO_PI = 2.0 * np.pi
 (Q_ENTRY, Q_PHASE2, Q_RELIEF1, Q_RELIEF2, Q_START1, Q_START2, Q_BOUND) = (0, 2, 4, 7, 10, 11, 12)
@@ -33,6 +33,19 @@ def _box(u, centre, half, s):
     dx = -sg / s
     w = x * x * x * (10.0 + x * (-15.0 + 6.0 * x))
     return w, 30.0 * x * x * (1.0 - x) * (1.0 - x) * dx, 60.0 * x * (1.0 - x) * (1.0 - 2.0 * x) * dx * dx
+
+
+@njit(cache=True)
+def damping_share(comp, ramp):
+    """(S, dS/dcomp): the damping share of :func:`mbd.elements.tooth_pairs.damping_share` ((1, 0) for ramp 0)."""
+    if ramp <= 0.0:
+        return 1.0, 0.0
+    x = comp * (1.0 / ramp)              # the reference's order of operations
+    if x >= 1.0:
+        return 1.0, 0.0
+    if x <= 0.0:
+        return 0.0, 0.0
+    return x * x * x * (10.0 + x * (-15.0 + 6.0 * x)), 30.0 * x * x * (1.0 - x) * (1.0 - x) / ramp
 
 
 @njit(cache=True)
@@ -55,7 +68,7 @@ def _cubic(G, base, x):
 
 
 @njit(cache=True)
-def flank_force(f, P, i, col, G, tstart, sig, z1, z2, k_mean, c_m, h, s, single, ratio, th1, th2, phi_e,
+def flank_force(f, P, i, col, G, tstart, sig, z1, z2, k_mean, c_m, ramp, h, s, single, ratio, th1, th2, phi_e,
                 w1, delta, rate, ex, ey, tx, ty, inv_a, t_dd, e_dd, ddelta, drate, grad, jac):
     """F_f of flank f of mesh i by the pair law; with ``jac`` its gradient into ``grad`` (8,), from the
     flank's ∇δ_f (``ddelta``) and ∇δ̇_f (``drate``)."""
@@ -117,19 +130,21 @@ def flank_force(f, P, i, col, G, tstart, sig, z1, z2, k_mean, c_m, h, s, single,
         comp = delta - gg[j]
         if comp <= 0.0 or k == 0.0:
             continue
+        S, dS = damping_share(comp, ramp)
         cj = c_m * k / K0
         rj = rate - dg[j] * udot
-        Fj = k * comp + cj * rj
+        Fj = k * comp + cj * S * rj
         if Fj <= 0.0:
             continue
         F += Fj
         if not jac:
             continue
         dcj = c_m * (dk[j] * K0 - k * dK0) / (K0 * K0)
-        a_u = dk[j] * comp - k * dg[j] + dcj * rj - cj * d2g[j] * udot     # ∂F_j/∂u
-        a_ud = -cj * dg[j]                                                 # ∂F_j/∂u̇
+        kc = k + cj * rj * dS                                              # ∂F_j/∂comp
+        a_u = dk[j] * comp - kc * dg[j] + dcj * S * rj - cj * S * d2g[j] * udot     # ∂F_j/∂u (comp = δ − g(u))
+        a_ud = -cj * S * dg[j]                                                      # ∂F_j/∂u̇
         for v in range(8):
-            grad[v] += k * ddelta[v] + cj * drate[v]
+            grad[v] += kc * ddelta[v] + cj * S * drate[v]
         grad[0] += a_u * gu0 + a_ud * gv0
         grad[1] += a_u * gu1 + a_ud * gv1
         grad[2] += a_u * gu2

@@ -24,8 +24,11 @@ At a = a0, κ = cos α and −∂δ_f/∂d is the spec's line of action n_f on t
 (gear 2 external, the planet internal). δ is invariant under a rigid motion of both gears, so the
 forces sum to zero and the moments balance about any point, exactly, in any state.
 
-Flank force F_f = max(k(p) δ_f + c_m δ̇_f, 0) while δ_f > 0, else 0, with δ̇_f = ∇δ_f · q̇ (the same in
-R and in I, because δ is frame-invariant). The mesh position p = z1 (θ1 − φ_e)/2π + p0 (mod 1) is
+Flank force F_f = max(k(p) δ_f + c_m S(δ_f/δ_c) δ̇_f, 0) while δ_f > 0, else 0, with δ̇_f = ∇δ_f · q̇ (the
+same in R and in I, because δ is frame-invariant). The damping grows with the compression over the first δ_c
+(``damping_ramp``; S the quintic smoothstep, 0 at first touch, 1 from δ_c on), as the dissipation of a
+contact grows with its compressed zone (the idea of Hunt & Crossley's law): a damping that switched on whole at
+contact would make the force jump by c_m δ̇_f at every re-engagement. δ_c = 0 is that jump (Kelvin–Voigt). The mesh position p = z1 (θ1 − φ_e)/2π + p0 (mod 1) is
 gear 1's angle relative to the line of centres, measured from the direction e that points from gear 1's
 centre to its contact zone in both kinds (external: towards gear 2; internal: from the ring centre out
 through the planet to where it touches the ring). It is computed from the states, never from time.
@@ -57,7 +60,7 @@ import numpy as np
 from .. import ad
 from ..element import Element, body_dofs, marker, marker_velocity
 from ..errors import ModelError
-from .tooth_pairs import ToothPairs, flank_force, smooth_box
+from .tooth_pairs import ToothPairs, damping_share, flank_force, smooth_box
 
 __all__ = ["StiffnessShape", "ConstantStiffness", "RectangularStiffness", "FourierStiffness", "STIFFNESS_SHAPES",
            "GearMesh", "mesh_offset", "mesh_u0", "contact_ratio_to_fraction"]
@@ -237,7 +240,8 @@ class GearMesh(Element):
     r_b1 ± r_b2 = a0 cos α, checked); ``teeth1`` tooth count of gear 1 (r_b2/r_b1 must be a tooth-count
     ratio); ``k_mean`` mean mesh stiffness [N/m]; ``c_mesh`` mesh damping [N·s/m]; ``u0`` [m] from
     :func:`mesh_u0`; ``p0`` mesh phase [cycles]; ``backlash`` b ≥ 0 [m] (b = 0: both flanks touch at
-    the nominal state with zero force); ``stiffness`` a :class:`StiffnessShape` shared by the family;
+    the nominal state with zero force); ``damping_ramp`` δ_c ≥ 0 [m], the compression over which the damping
+    grows to c_m (0: all of it at first touch); ``stiffness`` a :class:`StiffnessShape` shared by the family;
     ``phi_ref`` [rad] the nominal angle of e: φ_e is taken in (phi_ref − π, phi_ref + π], so a u0
     computed with an unwrapped nominal angle matches exactly (any 2π offset costs whole base pitches,
     which the pitch wrap removes anyway).
@@ -257,7 +261,7 @@ class GearMesh(Element):
     compiled_twin = "mesh.gear_mesh"
 
     def __init__(self, name, gear1, gear2, *, internal: bool, rb1, rb2, alpha, a0, teeth1, k_mean,
-                 c_mesh=0.0, u0=0.0, p0=0.0, backlash=0.0, stiffness: StiffnessShape | None = None,
+                 c_mesh=0.0, damping_ramp=0.0, u0=0.0, p0=0.0, backlash=0.0, stiffness: StiffnessShape | None = None,
                  phi_ref=0.0, offset1=None, offset2=None, pairs: ToothPairs | None = None):
         self.name = name
         self.dofs = body_dofs(gear1, gear2)
@@ -269,6 +273,7 @@ class GearMesh(Element):
         self.teeth1 = self._per_instance("teeth1", teeth1, positive=True)
         self.k_mean = self._per_instance("k_mean", k_mean, positive=True)
         self.c_mesh = self._per_instance("c_mesh", c_mesh, nonneg=True)
+        self.damping_ramp = self._per_instance("damping_ramp", damping_ramp, nonneg=True)
         self.u0 = self._per_instance("u0", u0)
         self.p0 = self._per_instance("p0", p0)
         self.backlash = self._per_instance("backlash", backlash, nonneg=True)
@@ -315,7 +320,8 @@ class GearMesh(Element):
                              f"parameter 'stiffness' must be rectangular, got {type(self.stiffness).__name__}")
         self.pairs = pairs.checked(self.name, self.n, self.teeth1, self.teeth2)
 
-    _FUSED = ("dofs", "rb1", "rb2", "alpha", "a0", "teeth1", "teeth2", "k_mean", "c_mesh", "u0", "p0", "backlash",
+    _FUSED = ("dofs", "rb1", "rb2", "alpha", "a0", "teeth1", "teeth2", "k_mean", "c_mesh", "damping_ramp", "u0", "p0",
+              "backlash",
               "phi_ref", "pitch", "kappa0", "sigma", "sin_alpha", "offset1", "offset2")
 
     def fuse_key(self):
@@ -372,15 +378,15 @@ class GearMesh(Element):
         r_minus = -1.0 * s_dot - radial_dot
         p = self.teeth1 * (th1 - phi_e) * (1.0 / _TWO_PI) + self.p0
         if self.pairs is not None:     # tooth by tooth (tooth_pairs), each flank over its own pairs
-            pair_args = (self.pairs, sig, self.teeth1, self.teeth2, self.k_mean, self.c_mesh, self._shape_args,
-                         th1, th2, phi_e, t_dd * inv_a, w1)
+            pair_args = (self.pairs, sig, self.teeth1, self.teeth2, self.k_mean, self.c_mesh, self.damping_ramp,
+                         self._shape_args, th1, th2, phi_e, t_dd * inv_a, w1)
             F_plus, kp = flank_force(pair_args[0], 1, *pair_args[1:], d_plus, r_plus)
             F_minus, _ = flank_force(pair_args[0], -1, *pair_args[1:], d_minus, r_minus)
         else:
             kp = self.k_mean * self._factor(p)
-            c = self.c_mesh
-            F_plus = ad.where(d_plus > 0.0, ad.pos(kp * d_plus + c * r_plus), 0.0)
-            F_minus = ad.where(d_minus > 0.0, ad.pos(kp * d_minus + c * r_minus), 0.0)
+            c, ramp = self.c_mesh, self.damping_ramp
+            F_plus = ad.where(d_plus > 0.0, ad.pos(kp * d_plus + c * damping_share(d_plus, ramp) * r_plus), 0.0)
+            F_minus = ad.where(d_minus > 0.0, ad.pos(kp * d_minus + c * damping_share(d_minus, ramp) * r_minus), 0.0)
         # Q = −Σ F_f ∇δ_f; on the body at the head of d: (F+ − F−) κ t + σ (F+ + F−) sin α e
         F_net = F_plus - F_minus
         F_sum = F_plus + F_minus

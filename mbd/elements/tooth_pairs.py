@@ -4,7 +4,10 @@ A flank f = ±1 of a spur mesh is the sum of the tooth pairs that can touch on i
 ratio (1 < ε < 2) at most two pairs are engaged: the newest, which entered on flank f at its roll
 coordinate u = 0, and the older one at u + 1; a pair leaves at u = ε. Pair j carries
 
-    F_j = k_j(u_j)·(δ_f − g_j(u_j)) + c_j(u_j)·(δ̇_f − ġ_j),   while δ_f − g_j > 0 and F_j > 0, else 0
+    F_j = k_j(u_j)·(δ_f − g_j(u_j)) + c_j(u_j)·S((δ_f − g_j)/δ_c)·(δ̇_f − ġ_j),   while δ_f − g_j > 0 and F_j > 0
+
+(else 0; S the damping share of :func:`damping_share`, growing over the pair's first δ_c
+of compression)
 
 with δ_f the flank compression of :mod:`mbd.elements.gear_mesh` (the same for every pair of perfect
 involutes) and g_j the pair's *gap*: how much farther the flank must be compressed before that pair
@@ -49,7 +52,7 @@ import numpy as np
 from .. import ad
 from ..errors import ModelError
 
-__all__ = ["ToothPairs", "TABLE_STRIDE", "FACES", "tooth_table", "flank_force", "smooth_box"]
+__all__ = ["ToothPairs", "TABLE_STRIDE", "FACES", "tooth_table", "flank_force", "smooth_box", "damping_share"]
 
 _TWO_PI = 2.0 * np.pi
 TABLE_STRIDE = 5       # per tooth and face: c0, c1, c2, c3 [m], stiffness factor
@@ -170,11 +173,23 @@ def _lookup(table, start, tooth, face):
     return table[base[..., None] + np.arange(TABLE_STRIDE)]
 
 
-def flank_force(pp: ToothPairs, f: int, sig, z1, z2, k_mean, c_mesh, shape_args, th1, th2, phi_e, phi_dot, w1,
-                delta, delta_rate):
+def damping_share(delta, ramp):
+    """S(δ/δ_c): the share of the mesh damping at compression δ, the quintic smoothstep over [0, δ_c]: a
+    contact's dissipation grows with its compressed zone (as in Hunt & Crossley's law) instead of switching on
+    whole at first touch (δ_c = 0: S = 1, the Kelvin–Voigt jump). Dual-capable in δ; ``ramp`` per instance."""
+    width = np.where(ramp > 0.0, ramp, 1.0)
+    x = delta * (1.0 / width)
+    x = ad.where(x > 1.0, 1.0, ad.where(x < 0.0, 0.0, x))
+    return ad.where(ramp > 0.0, x * x * x * (10.0 + x * (-15.0 + 6.0 * x)), 1.0)
+
+
+def flank_force(pp: ToothPairs, f: int, sig, z1, z2, k_mean, c_mesh, damping_ramp, shape_args, th1, th2, phi_e,
+                phi_dot, w1, delta, delta_rate):
     """(F_f, K_f) of flank f of n meshes by the pair law (module docstring); Dual-capable in the angles,
     rates and δ_f, δ̇_f. ``shape_args`` = (h, s, k_single/k_mean, ratio) of the rectangular stiffness
-    (ε = 2h + 1); ``phi_dot`` the line of centres' angular speed. K_f: the engaged pairs' stiffness."""
+    (ε = 2h + 1); ``phi_dot`` the line of centres' angular speed; ``damping_ramp`` δ_c, over which a pair's
+    damping grows with its compression (:func:`damping_share`). K_f: the engaged pairs'
+    stiffness."""
     h, s, single, ratio = shape_args
     eps = 2.0 * h + 1.0
     fi = 0 if f > 0 else 1
@@ -212,7 +227,7 @@ def flank_force(pp: ToothPairs, f: int, sig, z1, z2, k_mean, c_mesh, shape_args,
         K0 = K0 + k0
     for k, gap, dgap in pairs:
         comp = delta - gap
-        force = k * comp + (c_mesh * k / K0) * (delta_rate - dgap * udot)
+        force = k * comp + (c_mesh * k / K0) * damping_share(comp, damping_ramp) * (delta_rate - dgap * udot)
         F = F + ad.where(comp > 0.0, ad.pos(force), 0.0)
         K = K + ad.value(k)
     return F, K

@@ -47,6 +47,7 @@ def mesh_cases(draw):
     shape = MESH_SHAPES[draw(st.sampled_from(sorted(MESH_SHAPES)))]
     backlash = draw(st.sampled_from([0.0, 1e-5, 4e-5]))
     zeta = draw(st.sampled_from([0.0, 0.07, 0.5]))
+    ramp = draw(st.sampled_from([0.0, 3e-6, 3e-5]))
     sep = draw(st.sampled_from([0.0, 3.0, 30.0]))   # m/s of random relative translation: clips the damper
     rng = np.random.default_rng(seed)
 
@@ -55,7 +56,8 @@ def mesh_cases(draw):
         internal, z1, z2 = PAIRS[pair]
         c = float(mesh_damping(zeta, K_MEAN, 1e-3, 2e-3, rb(z1), rb(z2)))
         v = v + sep * rng.normal(0.0, 1.0, v.size) * np.tile([1.0, 1.0, 0.0], v.size // 3)
-        return make_mesh(pair, p1, p2, backlash=backlash, shape=shape, c_mesh=c, p0=rng.uniform(), name=name), q, v
+        return make_mesh(pair, p1, p2, backlash=backlash, shape=shape, c_mesh=c, damping_ramp=ramp, p0=rng.uniform(),
+                         name=name), q, v
 
     if kind == "fused":
         ea, qa, va = part("sun_planet", "ext")
@@ -135,7 +137,7 @@ def test_rectangular_shape_parameters_are_per_instance_in_a_fused_family():
         vs.append(v)
     fused = GearMesh.fuse(parts)
     P, G = mesh.pack_gear_mesh(fused)
-    assert P.shape == (6, 18) and G[0] == mesh.SHAPE_RECTANGULAR
+    assert P.shape == (6, 19) and G[0] == mesh.SHAPE_RECTANGULAR
     np.testing.assert_array_equal(P[:, mesh.P_RECT_RATIO], [1.2] * 3 + [2.2] * 3)
     np.testing.assert_array_equal(P[:, mesh.P_SIGMA], [1.0] * 3 + [-1.0] * 3)
     with libm_arctan2():

@@ -24,15 +24,15 @@ from tests.support.strategies import assert_jacobians_match, assert_third_law
 @settings(suppress_health_check=[HealthCheck.filter_too_much])
 @given(seed=st.integers(0, 2**32 - 1), pair=st.sampled_from(sorted(PAIRS)),
        shape=st.sampled_from(sorted(SHAPES)), backlash=st.sampled_from([0.0, 1e-5, 4e-5]),
-       zeta=st.sampled_from([0.0, 0.07, 0.5]))
-def test_jacobian_matches_finite_differences(seed, pair, shape, backlash, zeta):
+       zeta=st.sampled_from([0.0, 0.07, 0.5]), ramp=st.sampled_from([0.0, 3e-6, 3e-5]))
+def test_jacobian_matches_finite_differences(seed, pair, shape, backlash, zeta, ramp):
     rng = np.random.default_rng(seed)
     n = 4
     p1, p2, q, v = perturbed_state(pair, rng, n)
     internal, z1, z2 = PAIRS[pair]
     J1, J2 = 1e-3, 2e-3
     c = float(mesh_damping(zeta, K_MEAN, J1, J2, rb(z1), rb(z2)))
-    elem = make_mesh(pair, p1, p2, backlash=backlash, shape=shape, c_mesh=c, p0=rng.uniform())
+    elem = make_mesh(pair, p1, p2, backlash=backlash, shape=shape, c_mesh=c, damping_ramp=ramp, p0=rng.uniform())
     assume(far_from_kinks(elem, q, v))
     jac_check(elem, q, v)
     # and the suite's shared check on the full coordinate vector (steps small enough for the kinks)
@@ -568,3 +568,53 @@ def test_parameter_validation_names_the_parameter():
     assert all(issubclass(cls, StiffnessShape) for cls in STIFFNESS_SHAPES.values())
     with pytest.raises(ParameterError, match="J2"):
         mesh_damping(0.07, K_MEAN, 1e-3, 0.0, 0.03, 0.03)
+
+
+@pytest.mark.parametrize("pair", sorted(PAIRS))
+def test_the_damping_grows_from_zero_at_first_touch(pair):
+    """A flank closing at δ̇ = 0.05 m/s: with the damping ramp δ_c the force is continuous at contact — at
+    δ = 1e-12 m it is k·δ plus S(1e-7)·c·δ̇, nothing of the c·δ̇ = 100 N a Kelvin–Voigt contact (δ_c = 0) jumps
+    to — half-way up the ramp the damping share is S(½) = ½, and from δ_c on the law is the undamped-start one,
+    k δ + c δ̇, to round-off."""
+    rng = np.random.default_rng(3)
+    p1, p2 = nominal(pair, 1, rng)
+    internal, z1, z2 = PAIRS[pair]
+    ramp, c = 2e-6, 2e3
+    e = (p1[:, :2] - p2[:, :2]) if internal else (p2[:, :2] - p1[:, :2])
+    forces = {}
+    for width in (0.0, ramp):
+        elem = make_mesh(pair, p1, p2, shape="constant", c_mesh=c, damping_ramp=width)
+        for delta in (1e-12, 0.5 * ramp, 1.5 * ramp):
+            q1, v1 = p1.copy(), np.zeros_like(p1)
+            sgn = -1.0 if internal else 1.0          # turning gear 1 forward compresses the drive flank
+            q1[:, 2] += sgn * delta / rb(z1)
+            v1[:, 2] = sgn * 0.05 / rb(z1)
+            _, out, _, _ = evaluate(elem, 0.0, FS0, full(q1, p2), full(v1, np.zeros_like(p2)), None, False)
+            assert out["deflection"][0] == pytest.approx(delta, rel=1e-6, abs=1e-15)
+            assert out["deflection_rate"][0] == pytest.approx(0.05, rel=1e-9)
+            forces[width, delta] = out["force_drive"][0]
+    assert forces[0.0, 1e-12] == pytest.approx(c * 0.05 + K_MEAN * 1e-12, rel=1e-6)     # the jump
+    assert forces[ramp, 1e-12] < 2 * K_MEAN * 1e-12                                  # none with the ramp
+    half = 0.5 * ramp * K_MEAN
+    assert forces[ramp, 0.5 * ramp] == pytest.approx(half + 0.5 * c * 0.05, rel=1e-6)
+    assert forces[ramp, 1.5 * ramp] == pytest.approx(forces[0.0, 1.5 * ramp], rel=1e-12)
+
+
+@pytest.mark.parametrize("pair", sorted(PAIRS))
+def test_jacobian_inside_the_damping_ramp(pair):
+    """Both flanks' dampers inside the ramp (drive flank at a third, closing at 0.2 m/s; small angles, so that a
+    coordinate step of 1e-10 m resolves the ramp's curvature): the Jacobians against central differences."""
+    rng = np.random.default_rng(5)
+    internal, z1, z2 = PAIRS[pair]
+    p1, p2 = nominal(pair, 2, rng, angle_span=0.5)
+    ramp = 3e-6
+    elem = make_mesh(pair, p1, p2, shape="rectangular", c_mesh=3e3, damping_ramp=ramp, p0=0.3)
+    sgn = -1.0 if internal else 1.0
+    q1, v1 = p1.copy(), np.zeros_like(p1)
+    q1[:, 2] += sgn * ramp / 3.0 / rb(z1)
+    v1[:, 2] = sgn * 0.2 / rb(z1)
+    v1[:, :2] = rng.normal(0.0, 0.01, (2, 2))
+    q, v = full(q1, p2), full(v1, np.zeros_like(p2))
+    out = evaluate(elem, 0.0, FS0, q, v, None, False)[1]
+    assert np.all((out["deflection"] > 0) & (out["deflection"] < ramp))
+    jac_check(elem, q, v, hq=1e-10)

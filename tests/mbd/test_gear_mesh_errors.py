@@ -110,7 +110,7 @@ def test_zero_offsets_are_bit_for_bit(pair):
     quiet = make_mesh(pair, p1, p2, shape=RECT, c_mesh=2e3, p0=0.4, offset1=np.zeros((n, 2)), offset2=(0.0, 0.0))
     assert not quiet.has_offset
     (P, G), (Pq, Gq) = mesh.pack_gear_mesh(plain), mesh.pack_gear_mesh(quiet)
-    assert P.shape == (n, 18) and list(G) == [mesh.SHAPE_RECTANGULAR, -1, -1, 4]  # no error columns or tables
+    assert P.shape == (n, 19) and list(G) == [mesh.SHAPE_RECTANGULAR, -1, -1, 4]  # no error columns or tables
     np.testing.assert_array_equal(Pq, P)
     np.testing.assert_array_equal(Gq, G)
     (ref, out), (got, out_q) = _all_outputs(plain, q, v), _all_outputs(quiet, q, v)
@@ -130,7 +130,7 @@ def test_fusing_plain_and_error_families_keeps_each_instance_exact():
     shifted = GearMesh.fuse([err])            # the same family with its bodies after the plain one's
     shifted.dofs = err.dofs + qa.size
     fused = GearMesh.fuse([plain, shifted])
-    assert fused.has_offset and mesh.pack_gear_mesh(fused)[0].shape == (8, 18 + 4)
+    assert fused.has_offset and mesh.pack_gear_mesh(fused)[0].shape == (8, 19 + 4)
     q, v = np.concatenate([qa, qb]), np.concatenate([va, vb])
     (got, _), (ref_a, _), (ref_b, _) = _all_outputs(fused, q, v), _all_outputs(plain, qa, va), _all_outputs(err, qb, vb)
     for g, a, b in zip(got, ref_a, ref_b):

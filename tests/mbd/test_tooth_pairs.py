@@ -44,9 +44,9 @@ def pairs_of(pair, n, *, entry=0.0, entry_coast=None, phase2=0.0, phase2_coast=N
                       table=np.concatenate([t1, t2]), start1=np.zeros(n), start2=np.full(n, float(t1.size)))
 
 
-def random_case(pair, seed, n=12, near_pi=False, offsets=False):
+def random_case(pair, seed, n=12, near_pi=False, offsets=False, ramp=0.0):
     """(family, q, v): random deviations on both gears, a missing and a cracked tooth, relief on both, and
-    (``offsets``) eccentric gears, in perturbed states around nominal poses."""
+    (``offsets``) eccentric gears, in perturbed states around nominal poses; ``ramp`` the damping ramp δ_c."""
     internal, z1, z2 = PAIRS[pair]
     rng = np.random.default_rng(seed)
     psi = np.pi + rng.uniform(-3e-4, 3e-4, n) if near_pi else None
@@ -58,7 +58,8 @@ def random_case(pair, seed, n=12, near_pi=False, offsets=False):
                   excess=(rng.normal(0, DEV, (z1, 2, 4)), rng.normal(0, DEV, (z2, 2, 4))), factor=(f1, f2),
                   relief1=(8e-6, 0.7, 2.0), relief2=(6e-6, 0.75, 1.0))
     kw = dict(offset1=rng.normal(0, 2e-5, (n, 2)), offset2=rng.normal(0, 2e-5, (n, 2))) if offsets else {}
-    return make_mesh(pair, p1, p2, shape=RECT, c_mesh=2e3, p0=rng.uniform(), backlash=1e-5, pairs=pp, **kw), q, v
+    return make_mesh(pair, p1, p2, shape=RECT, c_mesh=2e3, damping_ramp=ramp, p0=rng.uniform(), backlash=1e-5,
+                     pairs=pp, **kw), q, v
 
 
 def smooth_instances(elem, q, v, rtol=1e-6):
@@ -74,13 +75,13 @@ def smooth_instances(elem, q, v, rtol=1e-6):
 # ----------------------------------------------------------------------------------------------------
 # (a) reference vs compiled, finite differences
 # ----------------------------------------------------------------------------------------------------
-@pytest.mark.parametrize("near_pi", [False, True])
+@pytest.mark.parametrize("near_pi, ramp", [(False, 0.0), (True, 0.0), (False, 2e-5)])
 @pytest.mark.parametrize("offsets", [False, True])
 @pytest.mark.parametrize("pair", sorted(PAIRS))
-def test_pair_law_matches_compiled_and_finite_differences(pair, offsets, near_pi):
+def test_pair_law_matches_compiled_and_finite_differences(pair, offsets, near_pi, ramp):
     checked = loaded = 0
     for seed in range(3):
-        elem, q, v = random_case(pair, seed, near_pi=near_pi, offsets=offsets)
+        elem, q, v = random_case(pair, seed, near_pi=near_pi, offsets=offsets, ramp=ramp)
         with libm_arctan2():
             assert_matches_reference(elem, 0.0, FS0, q, v)
         F, out, Jq, Jv = evaluate(elem, 0.0, FS0, q, v, None, True)

@@ -62,12 +62,14 @@ def nominal(pair, n, rng, angle_span=50.0, spread=0.2, psi=None):
     return p1, p2
 
 
-def make_mesh(pair, p1, p2, *, backlash=0.0, shape="constant", c_mesh=0.0, p0=0.0, name="mesh", **errors):
+def make_mesh(pair, p1, p2, *, backlash=0.0, shape="constant", c_mesh=0.0, damping_ramp=0.0, p0=0.0, name="mesh",
+              **errors):
     """A family of n meshes with u0 from the nominal poses p1, p2; ``errors``: GearMesh's error arguments."""
     internal, z1, z2 = PAIRS[pair]
     n = p1.shape[0]
     return GearMesh(name, np.arange(n), n + np.arange(n), internal=internal, rb1=rb(z1), rb2=rb(z2),
                     alpha=ALPHA, a0=a0_of(internal, z1, z2), teeth1=z1, k_mean=K_MEAN, c_mesh=c_mesh,
+                    damping_ramp=damping_ramp,
                     u0=mesh_u0(internal, rb(z1), rb(z2), p1, p2), p0=p0, backlash=backlash,
                     stiffness=SHAPES[shape] if isinstance(shape, str) else shape, **errors)
 
@@ -117,9 +119,11 @@ def perturbed_state(pair, rng, n, du=2e-5, psi=None):
     return p1, p2, q1.ravel(), v.ravel()
 
 
-def jac_check(elem, q, v):
+def jac_check(elem, q, v, hq=1e-8):
+    """The element's Jacobians against central differences (``hq`` the coordinate step: smaller than a tenth of
+    a thousandth of any smooth ramp the law has, so that the differences' truncation stays below 1e-6)."""
     F, out, Jq, Jv = evaluate(elem, 0.0, FS0, q, v, None, True)
-    Jq_fd, Jv_fd = fd_jacobians(elem, q, v)
+    Jq_fd, Jv_fd = fd_jacobians(elem, q, v, hq=hq)
     for Ja, Jf in ((Jq, Jq_fd), (Jv, Jv_fd)):
         scale = max(np.abs(Ja).max(), np.abs(Jf).max(), 1.0)
         np.testing.assert_allclose(Ja, Jf, rtol=1e-6, atol=1e-6 * scale)
@@ -127,12 +131,15 @@ def jac_check(elem, q, v):
 
 
 def far_from_kinks(elem, q, v, margin_d=1e-7, margin_f=200.0):
-    """No flank within finite-difference reach of its contact switch or of its clip max(kδ + cδ̇, 0)."""
+    """No flank within finite-difference reach of its contact switch or of its clip max(kδ + c S(δ) δ̇, 0), nor
+    damped inside the damping ramp, whose curvature the default steps do not resolve (a test of its own)."""
+    from mbd.elements.tooth_pairs import damping_share
     out = evaluate(elem, 0.0, FS0, q, v, None, False)[1]
     ok = True
     for d, r in ((out["deflection"], out["deflection_rate"]), (out["deflection_coast"], out["deflection_rate_coast"])):
-        arg = out["stiffness"] * d + elem.c_mesh * r
+        arg = out["stiffness"] * d + elem.c_mesh * damping_share(d, elem.damping_ramp) * r
         ok &= np.all(np.abs(d) > margin_d) and np.all((d <= 0) | (np.abs(arg) > margin_f))
+        ok &= not np.any((d > 0) & (d < elem.damping_ramp) & (elem.c_mesh * np.abs(r) > margin_f))
     return bool(ok)
 
 
