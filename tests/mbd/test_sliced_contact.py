@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from hypothesis import given, strategies as st
 
+from mbd.element import marker
 from mbd.elements.contact import RaceContact, TanhTraction
 from mbd.elements.sliced import SlicedContact, iso_16281_stiffness, slice_stations
 from mbd.errors import ModelError
 
-from tests.support.contact import (DR, FS, K_HZ, LR, M_ROLLER, N, R_IN, R_OUT, SETTINGS, race_scene, race_states,
-                                   rot)
+from tests.support.contact import DR, FS, K_HZ, LR, M_ROLLER, N, R_IN, R_OUT, SETTINGS, race_scene, race_states
 
 P = 10.0 / 9.0
 
@@ -51,12 +51,12 @@ def test_a_straight_aligned_roller_is_the_planar_contact(kind, n_s, data):
     ql = qf[planar.dofs]
     _, out = planar.kernel(0.0, FS, list(ql.T), list(np.zeros_like(ql).T), None)
     p = ql[:, 0:2]
-    c = ql[:, 3:5] + (rot(ql[0, 5]) @ mk)[None, :]
+    (cx, cy), _ = marker(list(ql[:, 3:].T), planar.race_marker)      # the race centre exactly as the element has it
+    c = np.stack([cx, cy], axis=1)
     res = _law(kind, n_s, n=N).evaluate(p, np.zeros((N, 2)), c, np.zeros((N, 2)))
-    # round-off: the race centre 0.08 m from the origin is known to ~1e-17 m, against deflections of µm
-    np.testing.assert_allclose(res.load.sum(axis=1), out["load"], rtol=1e-11, atol=0.0)
-    np.testing.assert_allclose(res.force[:, 0], out["fx"], rtol=1e-11, atol=1e-9)
-    np.testing.assert_allclose(res.force[:, 1], out["fy"], rtol=1e-11, atol=1e-9)
+    np.testing.assert_allclose(res.load.sum(axis=1), out["load"], rtol=1e-13, atol=0.0)
+    np.testing.assert_allclose(res.force[:, 0], out["fx"], rtol=1e-13, atol=1e-12)
+    np.testing.assert_allclose(res.force[:, 1], out["fy"], rtol=1e-13, atol=1e-12)
     np.testing.assert_allclose(res.delta, np.repeat(np.asarray(deltas)[:, None], n_s, 1), rtol=0, atol=1e-15)
     np.testing.assert_allclose(res.race_force, -res.force, rtol=0, atol=0)
     # no tilt, no profile: every slice the same, no moment on either body's slope
