@@ -60,7 +60,7 @@ def _crowned(b, x):
         return np.zeros_like(x)
     Rc = (c * c + h * h) / (2.0 * h)
     s = np.clip(np.abs(x) - 0.5 * lf, 0.0, c)
-    return Rc - np.sqrt(Rc * Rc - s * s)
+    return s * s / (Rc + np.sqrt(Rc * Rc - s * s))          # R_c − sqrt(R_c² − s²) without the cancellation
 
 
 def _table(b, x):

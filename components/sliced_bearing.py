@@ -164,6 +164,10 @@ class SlicedBearing:
                 break
             reg = 1e-12 * np.abs(Jyy).max(axis=(1, 2), keepdims=True) + 1e-300
             dy = -np.linalg.solve(Jyy - reg * np.eye(2), g[:, :, None])[:, :, 0]
+            # a step at the round-off of the roller's radius: the residual is as small as the positions allow
+            active &= np.maximum(np.abs(dy[:, 0]), np.abs(dy[:, 1]) * lscale) > 64.0 * np.finfo(float).eps * r
+            if not active.any():
+                break
             dy[~active] = 0.0
             alpha = np.ones(len(e))
             for _h in range(30):
@@ -177,6 +181,27 @@ class SlicedBearing:
         else:
             raise RuntimeError(f"sliced bearing: a roller found no equilibrium (residual {norm.max():.3g} N)")
         return r, tau, ri, ro, g, Jyy, Jyu
+
+    def _directions(self, cage_angle):
+        psi = cage_angle + 2.0 * math.pi * np.arange(self.Z) / self.Z
+        return psi, np.tile(np.stack([np.cos(psi), np.sin(psi)], axis=1), (self.rows, 1))
+
+    def _state(self, u, psi, r, tau, ri, ro) -> SlicedBearingState:
+        shape = (self.rows, self.Z, self.n_s)
+        q_pin, q_bore = ri.load.reshape(shape), ro.load.reshape(shape)
+        return SlicedBearingState(u=np.asarray(u, float), psi=psi, radius=r.reshape(self.rows, self.Z),
+                                  tilt=tau.reshape(self.rows, self.Z), q_pin=q_pin, q_bore=q_bore,
+                                  p_pin=self._p_scale[0] * np.sqrt(q_pin), p_bore=self._p_scale[1] * np.sqrt(q_bore),
+                                  moment=ro.race_moment.sum(axis=0), z=self.z)
+
+    def rollers_at(self, u, slope, cage_angle: float = 0.0) -> SlicedBearingState:
+        """The rollers in equilibrium at a given bore displacement ``u`` (2,) [m] and pin slope ``slope`` (2,) [rad]
+        against the bore (the bore's force balance not imposed)."""
+        psi, e = self._directions(cage_angle)
+        u, s_pin = np.asarray(u, float), np.asarray(slope, float)
+        R_m = 0.5 * (self.b.inner_raceway_radius + self.b.outer_raceway_radius)
+        r, tau, ri, ro, *_ = self._solve_rollers(e, u, s_pin, R_m + 0.5 * (e @ u), 0.5 * (e @ s_pin))
+        return self._state(u, psi, r, tau, ri, ro)
 
     # ------------------------------------------------------------------ the bearing
     def solve(self, load, misalignment: float = 0.0, direction: str = "radial", cage_angle: float = 0.0,
@@ -198,10 +223,9 @@ class SlicedBearing:
         else:
             beta = float(direction)
         s_pin = misalignment * np.array([math.cos(beta), math.sin(beta)])
-        psi = cage_angle + 2.0 * math.pi * np.arange(self.Z) / self.Z
-        e = np.tile(np.stack([np.cos(psi), np.sin(psi)], axis=1), (self.rows, 1))
+        psi, e = self._directions(cage_angle)
         R_i, R_o = b.inner_raceway_radius, b.outer_raceway_radius
-        state = {"r": np.full(len(e), 0.5 * (R_i + R_o)), "tau": e @ s_pin * 0.5}
+        state = {}
 
         def bore(uv):
             r0 = 0.5 * (R_i + R_o) + 0.5 * (e @ uv)
@@ -226,13 +250,7 @@ class SlicedBearing:
         if not (np.hypot(*G) <= 1e-8 * Fn):
             raise RuntimeError(f"sliced bearing: no equilibrium under {Fn:g} N (residual {np.hypot(*G):.3g} N; "
                                f"{sol.message})")
-        ri, ro = state["ri"], state["ro"]
-        shape = (self.rows, self.Z, self.n_s)
-        q_pin, q_bore = ri.load.reshape(shape), ro.load.reshape(shape)
-        return SlicedBearingState(u=sol.x, psi=psi, radius=state["r"].reshape(self.rows, self.Z),
-                                  tilt=state["tau"].reshape(self.rows, self.Z), q_pin=q_pin, q_bore=q_bore,
-                                  p_pin=self._p_scale[0] * np.sqrt(q_pin), p_bore=self._p_scale[1] * np.sqrt(q_bore),
-                                  moment=ro.race_moment.sum(axis=0), z=self.z)
+        return self._state(sol.x, psi, state["r"], state["tau"], state["ri"], state["ro"])
 
     def states(self, load, misalignment=0.0, direction="radial", positions: int = 8) -> list[SlicedBearingState]:
         """The bearing at ``positions`` cage angles evenly over one roller pitch (each started from the last)."""
