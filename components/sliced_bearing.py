@@ -43,7 +43,8 @@ from mbd.elements.sliced import SlicedContact, iso_16281_stiffness, slice_statio
 from . import life
 from .profiles import reduced_modulus, roller_drop
 
-__all__ = ["ARCMIN", "MISALIGNMENT_DIRECTIONS", "SlicedBearing", "SlicedBearingState", "sliced_bearing_life"]
+__all__ = ["ARCMIN", "MISALIGNMENT_DIRECTIONS", "SlicedBearing", "SlicedBearingState", "sliced_bearing_life",
+           "misalignment_sweep"]
 
 ARCMIN = math.pi / (180.0 * 60.0)
 MISALIGNMENT_DIRECTIONS = ("radial", "tangential")
@@ -272,3 +273,22 @@ def sliced_bearing_life(states: list[SlicedBearingState], b) -> float | None:
     pe = life.equivalent_load(np.mean(q_pin ** life.STATIONARY_EXPONENT, axis=(0, 2)), life.STATIONARY_EXPONENT)
     be = life.equivalent_load(np.mean(q_bore ** life.ROTATING_EXPONENT, axis=(0, 2)), life.ROTATING_EXPONENT)
     return life.sliced_life(pe, be, b)
+
+
+def misalignment_sweep(b, load, gammas, direction: str, positions: int = 8) -> list[dict]:
+    """The bearing ``b`` under ``load`` (2,) [N] at each pin slope γ of ``gammas`` [rad] (``direction`` "radial" or
+    "tangential" to the load): per γ the sliced life ``life_Mrev`` [10^6 revolutions], ``life_relative`` to the first
+    γ of the list (give 0 first: relative to the aligned bearing), and over the ``positions`` cage positions the
+    largest ``edge_ratio`` of the most loaded roller, the largest slice pressure ``p_max_Pa`` and the smallest
+    ``loaded_length``."""
+    sb = SlicedBearing(b)
+    rows = []
+    for g in gammas:
+        st = sb.states(load, g, direction, positions=positions)
+        rows.append({"gamma_rad": float(g), "direction": direction, "life_Mrev": sliced_bearing_life(st, b),
+                     "edge_ratio": max(s.edge_ratio() for s in st), "p_max_Pa": max(s.max_pressure for s in st),
+                     "loaded_length": min(s.loaded_length() for s in st)})
+    ref = rows[0]["life_Mrev"]
+    for r in rows:
+        r["life_relative"] = r["life_Mrev"] / ref if ref and r["life_Mrev"] else None
+    return rows
