@@ -285,3 +285,22 @@ def test_profiles_against_their_hand_values():
                                                                   {"x": "4.5 mm", "drop": "7 um"}]})
     np.testing.assert_allclose(roller_drop(tb, np.array([-4.5e-3, -2.0e-3, 1.5e-3, 3.75e-3])),
                                [7e-6, 2e-6 / 3, 0.5e-6, 4e-6], rtol=1e-12)
+
+
+def test_a_double_row_bearing_under_twice_the_load_is_two_single_rows_and_its_rows_combine():
+    """Aligned: two rows under 2F carry per roller what one row carries under F, and the life is the single row's
+    times 2^(−8/9) (Σ_rows L^(−9/8)); under a radial slope the rows sit at ±l/2 on the pin and carry different
+    loads — the row where the pin's axis ζ s is displaced towards the load zone (ζ < 0 for a slope along F: the
+    zone lies opposite F) more — and the life falls."""
+    one, two = _bearing(), _bearing(rows=2)
+    s1 = SlicedBearing(one).states(LOAD, 0.0, positions=2)
+    s2 = SlicedBearing(two).states(2 * LOAD, 0.0, positions=2)
+    for a, b2 in zip(s1, s2):
+        for r in range(2):
+            np.testing.assert_allclose(b2.q_pin[r], a.q_pin[0], rtol=0, atol=1e-9 * a.q_pin.max())
+    L1, L2 = sliced_bearing_life(s1, one), sliced_bearing_life(s2, two)
+    assert L2 == pytest.approx(L1 * 2 ** (-8 / 9), rel=1e-9)
+    tilted = SlicedBearing(two).states(2 * LOAD, 4 * ARCMIN, "radial", positions=2)
+    rows = tilted[0].q_pin.sum(axis=(1, 2))
+    assert rows[0] - rows[1] > 0.05 * rows.sum()
+    assert sliced_bearing_life(tilted, two) < L2
