@@ -98,7 +98,8 @@ class SlicedContact:
     diameter [m]; ``K`` one physical contact's constant of the planar law [N/m^p]; ``exponent`` p ≥ 1;
     ``z`` (n_s,) slice stations on the roller [m] (:func:`slice_stations`); ``drop`` (n_s,) or (n, n_s) profile
     drop of roller plus raceway at each slice [m]; ``row_offset`` ζ_row [m] the roller centre's axial station
-    on the race body (per contact or one). Per-contact values broadcast from scalars."""
+    on the race body (per contact or one). Per-contact values broadcast from scalars, and a law of scalars serves
+    any number of contacts (the inputs' leading dimension)."""
 
     def __init__(self, *, kind, R_race, D, K, exponent, z, drop, row_offset):
         kinds = np.atleast_1d(np.asarray(kind))
@@ -125,15 +126,20 @@ class SlicedContact:
         """Slice compressions, loads and the generalised forces (and their Jacobian) of all contacts at roller
         centres ``p`` (n, 2), roller slopes ``sigma_r`` (n, 2), raceway centres ``c`` (n, 2) and raceway slopes
         ``sigma_c`` (n, 2) [m, rad]."""
-        p, sigma_r, c, sigma_c = (np.broadcast_to(np.asarray(a, float), (self.n, 2)) for a in (p, sigma_r, c, sigma_c))
-        z, zeta, kap = self.z[None, :, None], self.zeta[:, :, None], self.kappa[:, None]
+        args = [np.asarray(a, float) for a in (p, sigma_r, c, sigma_c)]
+        n = np.broadcast_shapes((self.n,), *[a.shape[:-1] or (1,) for a in args])[0]
+        p, sigma_r, c, sigma_c = (np.broadcast_to(a, (n, 2)) for a in args)
+        per = lambda a: np.broadcast_to(a, (n,) + a.shape[1:])                         # noqa: E731
+        kappa, D, R, K, zeta_all, drop = (per(a) for a in (self.kappa, self.D, self.R_race, self.K, self.zeta,
+                                                            self.drop))
+        z, zeta, kap = self.z[None, :, None], zeta_all[:, :, None], kappa[:, None]
         w = (p - c)[:, None, :] + z * sigma_r[:, None, :] - zeta * sigma_c[:, None, :]      # (n, n_s, 2)
         d = np.sqrt(np.einsum("nki,nki->nk", w, w))
         nrm = w / d[:, :, None]
-        delta = 0.5 * self.D[:, None] - kap * (d - self.R_race[:, None]) - self.drop
+        delta = 0.5 * D[:, None] - kap * (d - R[:, None]) - drop
         touch = delta > 0.0
         ds = np.where(touch, delta, 1.0)
-        k_s = (self.K / self.n_s)[:, None]
+        k_s = (K / self.n_s)[:, None]
         q = np.where(touch, k_s * ds ** self.exponent, 0.0)
         F = (kap * q)[:, :, None] * nrm                                                       # on the roller
         force = F.sum(axis=1)
@@ -146,6 +152,6 @@ class SlicedContact:
             A = -dq[:, :, None, None] * nn + (kap * q / d)[:, :, None, None] * (np.eye(2) - nn)   # ∂F_k/∂w_k
             beta = np.stack([np.ones_like(zeta[:, :, 0]), np.broadcast_to(self.z, zeta.shape[:2]),
                              -np.ones_like(zeta[:, :, 0]), -zeta[:, :, 0]], axis=2)           # (n, n_s, 4)
-            J = np.einsum("nka,nkb,nkij->naibj", beta, beta, A).reshape(self.n, 8, 8)
+            J = np.einsum("nka,nkb,nkij->naibj", beta, beta, A).reshape(n, 8, 8)
         return SlicedResult(delta=delta, load=q, normal=nrm, force=force, roller_moment=mom_r, race_force=-force,
                             race_moment=-mom_c, jacobian=J)

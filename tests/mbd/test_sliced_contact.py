@@ -183,3 +183,14 @@ def test_mirror_and_row_offset():
     np.testing.assert_allclose(s.load, a.load, rtol=1e-12, atol=1e-12 * a.load.max())
     np.testing.assert_allclose(s.race_moment, a.race_moment - shift * a.force, rtol=1e-10,
                                atol=1e-12 * a.load.max() * LR)
+
+
+def test_a_law_of_scalars_serves_any_number_of_contacts():
+    rng = np.random.default_rng(11)
+    state = _state("outer", rng, 9)
+    one = _law("outer", 11)                       # n = 1 from its parameters
+    many = _law("outer", 11, n=9)
+    a, b = one.evaluate(*state, jacobian=True), many.evaluate(*state, jacobian=True)
+    np.testing.assert_array_equal(a.load, b.load)
+    np.testing.assert_array_equal(a.jacobian, b.jacobian)
+    assert a.load.shape == (9, 11)
