@@ -198,11 +198,26 @@ class SlicedBearing:
     def rollers_at(self, u, slope, cage_angle: float = 0.0) -> SlicedBearingState:
         """The rollers in equilibrium at a given bore displacement ``u`` (2,) [m] and pin slope ``slope`` (2,) [rad]
         against the bore (the bore's force balance not imposed)."""
+        _, _, rollers = self.bore_balance(u, np.zeros(2), slope, cage_angle)
+        return self._state(u, self._directions(cage_angle)[0], *rollers)
+
+    def bore_balance(self, u, load, slope, cage_angle: float = 0.0):
+        """(G, ∂G/∂u, rollers): the bore's force balance G = F + Σ (contact forces on the bore) [N] at the bore
+        displacement ``u`` with every roller in equilibrium, its exact derivative through the rollers (the Schur
+        complement ∂G/∂u − ∂G/∂y (∂g/∂y)⁺ ∂g/∂u), and the rollers' (r, τ, pin and bore contacts)."""
         psi, e = self._directions(cage_angle)
         u, s_pin = np.asarray(u, float), np.asarray(slope, float)
         R_m = 0.5 * (self.b.inner_raceway_radius + self.b.outer_raceway_radius)
-        r, tau, ri, ro, *_ = self._solve_rollers(e, u, s_pin, R_m + 0.5 * (e @ u), 0.5 * (e @ s_pin))
-        return self._state(u, psi, r, tau, ri, ro)
+        r, tau, ri, ro, g, Jyy, Jyu = self._solve_rollers(e, u, s_pin, R_m + 0.5 * (e @ u), 0.5 * (e @ s_pin))
+        G = np.asarray(load, float) + ro.race_force.sum(axis=0)
+        Jo = ro.jacobian
+        JGu = Jo[:, 4:6, 4:6].sum(axis=0)
+        JGy = np.stack([np.einsum("nij,nj->ni", Jo[:, 4:6, 0:2], e),
+                        np.einsum("nij,nj->ni", Jo[:, 4:6, 2:4], e)], axis=2)           # (n, 2, 2)
+        # a roller touching at one slice only pivots there (J_yy of rank 1): the pseudo-inverse leaves its neutral
+        # direction out; an unloaded roller (J_yy = 0) adds nothing
+        corr = np.einsum("nij,njk,nkl->il", JGy, np.linalg.pinv(Jyy, rcond=1e-12), Jyu)
+        return G, JGu - corr, (r, tau, ri, ro)
 
     # ------------------------------------------------------------------ the bearing
     def solve(self, load, misalignment: float = 0.0, direction: str = "radial", cage_angle: float = 0.0,
@@ -224,23 +239,12 @@ class SlicedBearing:
         else:
             beta = float(direction)
         s_pin = misalignment * np.array([math.cos(beta), math.sin(beta)])
-        psi, e = self._directions(cage_angle)
-        R_i, R_o = b.inner_raceway_radius, b.outer_raceway_radius
+        psi = self._directions(cage_angle)[0]
         state = {}
 
         def bore(uv):
-            r0 = 0.5 * (R_i + R_o) + 0.5 * (e @ uv)
-            r, tau, ri, ro, g, Jyy, Jyu = self._solve_rollers(e, uv, s_pin, r0, e @ s_pin * 0.5)
-            state.update(r=r, tau=tau, ri=ri, ro=ro)
-            G = F + ro.race_force.sum(axis=0)
-            Jo = ro.jacobian
-            JGu = Jo[:, 4:6, 4:6].sum(axis=0)
-            JGy = np.stack([np.einsum("nij,nj->ni", Jo[:, 4:6, 0:2], e),
-                            np.einsum("nij,nj->ni", Jo[:, 4:6, 2:4], e)], axis=2)       # (n, 2, 2)
-            # a roller touching at one slice only pivots there (J_yy of rank 1): the pseudo-inverse leaves its
-            # neutral direction out; an unloaded roller (J_yy = 0) adds nothing
-            corr = np.einsum("nij,njk,nkl->il", JGy, np.linalg.pinv(Jyy, rcond=1e-12), Jyu)
-            return G, JGu - corr
+            G, J, state["rollers"] = self.bore_balance(uv, F, s_pin, cage_angle)
+            return G, J
 
         if u0 is None:
             q_max = 5.0 * Fn / (self.Z * b.rows)
@@ -251,7 +255,7 @@ class SlicedBearing:
         if not (np.hypot(*G) <= 1e-8 * Fn):
             raise RuntimeError(f"sliced bearing: no equilibrium under {Fn:g} N (residual {np.hypot(*G):.3g} N; "
                                f"{sol.message})")
-        return self._state(sol.x, psi, state["r"], state["tau"], state["ri"], state["ro"])
+        return self._state(sol.x, psi, *state["rollers"])
 
     def states(self, load, misalignment=0.0, direction="radial", positions: int = 8) -> list[SlicedBearingState]:
         """The bearing at ``positions`` cage angles evenly over one roller pitch (each started from the last)."""

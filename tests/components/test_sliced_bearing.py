@@ -304,3 +304,17 @@ def test_a_double_row_bearing_under_twice_the_load_is_two_single_rows_and_its_ro
     rows = tilted[0].q_pin.sum(axis=(1, 2))
     assert rows[0] - rows[1] > 0.05 * rows.sum()
     assert sliced_bearing_life(tilted, two) < L2
+
+
+def test_the_bore_balance_jacobian_through_the_rollers_against_differences():
+    """∂G/∂u of the bore's balance with every roller re-solved (the Schur complement the solver uses) against central
+    differences of G, under a slope and a profile (rollers tilted, some edge-loaded)."""
+    sb = SlicedBearing(_bearing(**{"profile.shape": "logarithmic"}))
+    slope = 8 * ARCMIN * np.array([0.6, 0.8])
+    u = np.array([2.9e-5, 0.8e-5])
+    G, J, _ = sb.bore_balance(u, LOAD, slope, 0.13)
+    h = 2.0 ** -34
+    fd = np.column_stack([(sb.bore_balance(u + h * ei, LOAD, slope, 0.13)[0]
+                           - sb.bore_balance(u - h * ei, LOAD, slope, 0.13)[0]) / (2 * h) for ei in np.eye(2)])
+    assert np.abs(J).max() > 1e8
+    np.testing.assert_allclose(J, fd, rtol=0, atol=1e-6 * np.abs(J).max())
