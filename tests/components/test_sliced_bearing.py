@@ -13,7 +13,7 @@ import pytest
 from scipy.optimize import brentq, fsolve
 
 from components import life
-from components.params import with_overrides
+from components.params import overrides_from_toml, with_overrides
 from components.presets import reference_bearing
 from components.profiles import reduced_modulus, roller_drop
 from components.sliced_bearing import ARCMIN, SlicedBearing, sliced_bearing_life
@@ -318,3 +318,27 @@ def test_the_bore_balance_jacobian_through_the_rollers_against_differences():
                            - sb.bore_balance(u - h * ei, LOAD, slope, 0.13)[0]) / (2 * h) for ei in np.eye(2)])
     assert np.abs(J).max() > 1e8
     np.testing.assert_allclose(J, fd, rtol=0, atol=1e-6 * np.abs(J).max())
+
+
+def test_a_profile_is_read_from_toml_like_every_parameter():
+    text = """
+[bearing.profile]
+shape = "table"
+
+[[bearing.profile.points]]
+x = "0 mm"
+drop = "0 um"
+
+[[bearing.profile.points]]
+x = "4.5 mm"
+drop = "9 um"
+
+[bearing.slicing]
+slices = 41
+stiffness = "iso_16281"
+"""
+    b = with_overrides(reference_bearing(), {k.removeprefix("bearing."): v
+                                             for k, v in overrides_from_toml(text).items()}).si()
+    assert b.slicing.slices == 41 and b.slicing.stiffness == "iso_16281"
+    np.testing.assert_allclose(roller_drop(b, np.array([-2.25e-3, 4.5e-3])), [4.5e-6, 9e-6], rtol=1e-12)
+    assert SlicedBearing(b).n_s == 41
