@@ -48,6 +48,12 @@ planet relative to its pin and in hours at that relative speed:
   this life is ISO 281's (C_r/(λν F_r))^4 where ISO 281 says (C_r/F_r)^(10/3): the two agree only at
   F_r = λν^6 C_r; at planet-bearing loads (F_r ≈ C_r/3) the roller sum gives about 4× ISO 281's life.
   The exponent 4 is the line-contact theory's; ISO 281's 10/3 is its compromise for real rollers.
+
+* **ISO/TS 16281 with slices** (ISO/TS 16281:2008 §5.3 with its laminae; the sliced contact of docs/model.md §8.8):
+  the roller cut into n_s slices, per raceway and slice k an equivalent slice load q_e,k over the rollers and the
+  window (exponents 4.5 and 4 as above) and the slice rating q_c = Q_c n_s^(−7/9); the bearing's
+  L = [Σ_rows Σ_k ((q_e,k,pin/q_c,pin)^(9/2) + (q_e,k,bore/q_c,bore)^(9/2))]^(−8/9) (:func:`sliced_life`).
+  Equal slices q_e,k = Q_e/n_s give exactly the roller sum above: n_s (n_s^(−2/9))^(9/2) = 1.
 """
 from __future__ import annotations
 
@@ -58,7 +64,8 @@ from scipy.integrate import quad
 
 __all__ = ["LIFE_EXPONENT", "LINE_EXPONENT", "WEIBULL_SLOPE", "ROTATING_EXPONENT", "STATIONARY_EXPONENT",
            "relative_life", "iso281_rating", "iso281_life", "raceway_ratings", "equivalent_load",
-           "lundberg_palmgren_life", "lundberg_palmgren_rating", "load_zone_integrals", "hours"]
+           "lundberg_palmgren_life", "lundberg_palmgren_rating", "load_zone_integrals", "hours",
+           "sliced_raceway_ratings", "sliced_life"]
 
 LIFE_EXPONENT = 10.0 / 3.0     # ISO 281, roller bearings: L10 ∝ P^(−10/3)
 LINE_EXPONENT = 4.0            # Lundberg–Palmgren line contact: raceway life (Q_c/Q_e)^4
@@ -128,6 +135,29 @@ def lundberg_palmgren_life(q_pin: float, q_bore: float, b) -> float | None:
     e = WEIBULL_SLOPE
     damage = b.rows * ((q_pin / qc_pin) ** (LINE_EXPONENT * e) + (q_bore / qc_bore) ** (LINE_EXPONENT * e))
     return float(damage ** (-1.0 / e)) if damage > 0 else None
+
+
+def sliced_raceway_ratings(b, n_slices: int) -> tuple[float, float]:
+    """(q_c,pin, q_c,bore) [N] of one slice of n_s: the raceway ratings times n_s^(−7/9) (ISO/TS 16281:2008:
+    the rating scales with the length as l^(7/9))."""
+    return tuple(q * float(n_slices) ** (-7.0 / 9.0) for q in raceway_ratings(b))
+
+
+def sliced_life(q_pin, q_bore, b) -> float | None:
+    """ISO/TS 16281 life with slices [10^6 revolutions] from the slices' equivalent loads ``q_pin``, ``q_bore`` [N]
+    (per physical roller; each taken with its raceway's exponent by the caller): arrays (rows, n_s), or (n_s,) for
+    ``b.rows`` identical rows. L = [Σ_rows Σ_k ((q_pin,k/q_c,pin)^(4e) + (q_bore,k/q_c,bore)^(4e))]^(−1/e),
+    q_c = :func:`sliced_raceway_ratings`, e = 9/8. None when no slice is loaded."""
+    q_pin, q_bore = np.asarray(q_pin, float), np.asarray(q_bore, float)
+    if q_pin.shape != q_bore.shape or q_pin.ndim not in (1, 2):
+        raise ValueError(f"slice loads: expected equal shapes (n_s,) or (rows, n_s), got {q_pin.shape}, {q_bore.shape}")
+    if not (np.all(q_pin >= 0.0) and np.all(q_bore >= 0.0)):
+        raise ValueError("slice equivalent loads must be >= 0 N")
+    qc_pin, qc_bore = sliced_raceway_ratings(b, q_pin.shape[-1])
+    p = LINE_EXPONENT * WEIBULL_SLOPE
+    damage = float(np.sum((q_pin / qc_pin) ** p) + np.sum((q_bore / qc_bore) ** p))
+    damage *= b.rows if q_pin.ndim == 1 else 1.0
+    return damage ** (-1.0 / WEIBULL_SLOPE) if damage > 0 else None
 
 
 def load_zone_integrals(n: float) -> tuple[float, float, float]:

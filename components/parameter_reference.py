@@ -237,6 +237,18 @@ standard; **[assumed]** an engineering estimate, its basis after the meaning. Wh
 model: [`model.md`](model.md)."""
 
 
+def _entry_lists(prefix: str, cls: type) -> list[tuple[str, type]]:
+    """(dotted key, entry class) of every list of tables in the nested class ``cls`` and the classes nested in it."""
+    out = []
+    for g in dataclasses.fields(cls):
+        spec = g.metadata.get("spec")
+        if spec is not None and spec.kind == "entries":
+            out.append((f"{prefix}.{g.name}", spec.cls))
+        elif spec is not None and spec.kind == "nested":
+            out += _entry_lists(f"{prefix}.{g.name}", spec.cls)
+    return out
+
+
 def reference_markdown() -> str:
     """The whole reference (``docs/parameters.md``) of the reference machine at its defaults."""
     with warnings.catch_warnings():
@@ -257,14 +269,11 @@ def reference_markdown() -> str:
         lines += ["", f"## `{f.name}`", "", what, ""]
         lines += _table(mine)
         if spec.kind == "nested":
-            for g in dataclasses.fields(spec.cls):
-                if "spec" in g.metadata and g.metadata["spec"].kind == "entries":
-                    cls = g.metadata["spec"].cls
-                    key = f"{f.name}.{g.name}"
-                    lines += ["", f"### `[[{key}]]`", "", _first_paragraph(cls.__doc__)
-                              + f" One table per entry in a TOML file (`[[{key}]]`); errors name the entry as "
-                                f"`{key}[0]`.", ""]
-                    lines += _table(entry_rows(key, cls), source=False)
+            for key, cls in _entry_lists(f.name, spec.cls):
+                lines += ["", f"### `[[{key}]]`", "", _first_paragraph(cls.__doc__)
+                          + f" One table per entry in a TOML file (`[[{key}]]`); errors name the entry as "
+                            f"`{key}[0]`.", ""]
+                lines += _table(entry_rows(key, cls), source=False)
     lines += ["", "## Derived values", "",
               "What `DPGTParams.si()` resolves from the parameters above (the reference machine), [derived]; the model "
               "behind them: docs/model.md §1.", "", *derived,

@@ -15,8 +15,8 @@ import numpy as np
 
 from .params import (BearingParams, BearingRigParams, CageParams, CarrierRippleParams, DPGTParams, ErrorsParams,
                      FlankClassParams, GearParams, GearSetParams, HousingParams, LifeParams, LubricantParams, MeshParams,
-                     OperatingPoint, PinholeErrorParams, RigParams, RunoutParams, SensorParams,
-                     SlideRollTractionParams, SupportParams, assumed, derived,
+                     OperatingPoint, PinholeErrorParams, ProfileParams, RigParams, RunoutParams, SensorParams,
+                     SlicingParams, SlideRollTractionParams, SupportParams, assumed, derived,
                      overrides_from_toml, paper, with_overrides)
 from .tolerances import radial_runout
 from .units import Q_, ParameterError
@@ -148,6 +148,17 @@ def reference_bearing() -> BearingParams:
             material_factor=derived(1.1, "ISO 281:2007 Table 1: b_m = 1.1 for cylindrical roller bearings"),
             reduction_factor=derived(0.83, "ISO 281:2007 f_c = 207.9 λν ... with λν = 0.83 (ISO/TR 1281-1; "
                                            "ISO/TS 16281:2008 undoes it for its raceway ratings)")),
+        profile=ProfileParams(
+            shape=assumed("straight", "the source gives no profile; the planar model's rollers are straight"),
+            flat_length=assumed("5 mm", "a crowned roller's straight middle, ~55 % of l"),
+            crown_drop=assumed("10 um", "a crowned roller's end drop, ~0.13 % of D"),
+            design_load=assumed("4 kN", "about the most loaded roller at condition 3 (4.08 F_r/Z at F_r ~ 12 kN)"),
+            points=assumed((), "no user table")),
+        slicing=SlicingParams(
+            slices=assumed(31, "odd, > 30 (ISO/TS 16281 uses 30): the sliced life within 1 % of n_s = 121 "
+                               "(docs/model.md §8.8)"),
+            stiffness=assumed("palmgren", "the planar law's constant: a straight, aligned roller is the planar "
+                                          "contact")),
     )
 
 

@@ -52,6 +52,7 @@ values fit together (rollers fit, gears assemble, tip circles clear) is checked 
 """
 from ._machinery import SI, Derived, Params, Source, Sourced, assumed, derived, paper
 from .bearing import (BearingParams, BearingSI, CageParams, CageSI, LifeParams, LifeSI, LubricantParams, LubricantSI,
+                      ProfileParams, ProfilePointParams, ProfilePointSI, ProfileSI, SlicingParams, SlicingSI,
                       SlideRollTractionParams, SlideRollTractionSI)
 from .dotted import describe, flatten, overrides_from_toml, parameter_names, parameter_rows, to_toml, with_overrides
 from .errors import (ErrorsParams, ErrorsSI, FlankClassParams, FlankClassSI, PinholeErrorParams, PinholeErrorSI,

@@ -8,9 +8,10 @@ from typing import ClassVar
 
 from .. import geometry as geo
 from ..units import ParameterError, Quantity
-from ._machinery import SI, Params, computed, nested, nonneg, param, positive, rule, si_of
+from ._machinery import SI, Params, computed, entries, nested, nonneg, param, positive, rule, si_of
 
 __all__ = ["CageParams", "CageSI", "SlideRollTractionParams", "SlideRollTractionSI", "LifeParams", "LifeSI",
+           "ProfilePointParams", "ProfilePointSI", "ProfileParams", "ProfileSI", "SlicingParams", "SlicingSI",
            "BearingParams", "BearingSI", "LubricantParams", "LubricantSI"]
 
 
@@ -110,6 +111,62 @@ class LifeSI(SI):
 
 
 @dataclass(frozen=True, kw_only=True)
+class ProfilePointParams(Params["ProfilePointSI"]):
+    """One point of a user's roller profile: the drop of the roller's radius at an axial position."""
+    _prefix: ClassVar[str] = "bearing.profile.points"
+    x: Quantity = param("length", "axial position from the roller centre (all >= 0: a symmetric profile)")
+    drop: Quantity = nonneg("length", "drop of the roller radius there")
+
+
+@si_of(ProfilePointParams)
+class ProfilePointSI(SI):
+    x: float
+    drop: float
+
+
+@dataclass(frozen=True, kw_only=True)
+class ProfileParams(Params["ProfileSI"]):
+    """The rollers' axial profile: the drop P(x) of the roller radius along its length, races straight
+    (:mod:`components.profiles`, docs/model.md §8.8). Read only by the sliced contact; the planar model's rollers
+    are straight."""
+    _prefix: ClassVar[str] = "bearing.profile"
+    shape: str = param("choice", "straight; crowned (flat length, circular ends); logarithmic (Lundberg/Johns-Gohar "
+                                 "at the design load); iso_16281 (ISO/TS 16281 default); table (the points)",
+                       choices=("straight", "crowned", "logarithmic", "iso_16281", "table"))
+    flat_length: Quantity = nonneg("length", "crowned: the straight middle length l_f (<= l)")
+    crown_drop: Quantity = nonneg("length", "crowned: the drop h at the roller's ends")
+    design_load: Quantity = positive("force", "logarithmic: the roller load Q_d whose pressure the profile makes "
+                                              "uniform")
+    points: tuple[ProfilePointParams, ...] = entries(ProfilePointParams, "table: the (x, drop) points, linearly interpolated")
+
+
+@si_of(ProfileParams)
+class ProfileSI(SI):
+    shape: str
+    flat_length: float
+    crown_drop: float
+    design_load: float
+    points: tuple[ProfilePointSI, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class SlicingParams(Params["SlicingSI"]):
+    """The sliced (quasi-3D) roller contact (:mod:`mbd.elements.sliced`, docs/model.md §8.8): slice count and
+    the slice law's constant. Used by the quasi-static sliced bearing (:mod:`components.sliced_bearing`)."""
+    _prefix: ClassVar[str] = "bearing.slicing"
+    slices: int = param("count", "slices n_s per roller", lo=1, bound_text=">= 1")
+    stiffness: str = param("choice", "slice law constant: palmgren (the planar law's K, K/n_s per slice) or "
+                                     "iso_16281 (c_L = 35948 L^(8/9) for the two contacts in series)",
+                           choices=("palmgren", "iso_16281"))
+
+
+@si_of(SlicingParams)
+class SlicingSI(SI):
+    slices: int
+    stiffness: str
+
+
+@dataclass(frozen=True, kw_only=True)
 class BearingParams(Params["BearingSI"]):
     """Cylindrical roller planet bearing (same for inner and outer planets), with its cage.
 
@@ -147,6 +204,8 @@ class BearingParams(Params["BearingSI"]):
                                     hi_open=True, bound_text="in [0, 0.5)")
     cage: CageParams = nested(CageParams, "cage")
     life: LifeParams = nested(LifeParams, "fatigue life rating factors")
+    profile: ProfileParams = nested(ProfileParams, "roller profile (sliced contact)")
+    slicing: SlicingParams = nested(SlicingParams, "sliced contact: slices and slice law")
 
     def _si_values(self, v):
         dm, dr, ln = v["pitch_diameter"], v["roller_diameter"], v["roller_length"]
@@ -186,6 +245,8 @@ class BearingSI(SI):
     poisson_ratio: float
     cage: CageSI
     life: LifeSI
+    profile: ProfileSI
+    slicing: SlicingSI
     inner_raceway_radius: float = computed("R_i = (d_m - D)/2, the pin [m]")
     outer_raceway_radius: float = computed("R_o = (d_m + D + P_d)/2, the planet bore [m]")
 

@@ -308,11 +308,13 @@ def test_si_view_is_plain_floats_and_read_only():
     # a choice among names (a law, a relief shape) stays a name
     choices = {f.name for c in _params_classes() for f in dataclasses.fields(c)
                if "spec" in f.metadata and f.metadata["spec"].kind == "choice"}
+    lists = {f.name for c in _params_classes() for f in dataclasses.fields(c)     # a nested list of tables
+             if "spec" in f.metadata and f.metadata["spec"].kind == "entries"}
     for sect in ("bearing", "gears", "mesh", "support", "lubricant"):
         for k, v in s[sect].to_dict().items():
             if isinstance(v, dict):
                 assert all(isinstance(x, (int, float, bool)) or x is None or (isinstance(x, str) and y in choices)
-                           for y, x in v.items()), (sect, k)
+                           or (isinstance(x, tuple) and y in lists) for y, x in v.items()), (sect, k)
             elif k in choices:
                 assert isinstance(v, str), (sect, k)
             else:
