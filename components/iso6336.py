@@ -32,11 +32,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from .tolerances import flank_tolerances
+
 __all__ = ["Q_PRIME_COEFFICIENTS", "MEASURED_FACTOR", "SOLID_BLANK_FACTOR", "REFERENCE_LINE_LOAD", "SINGLE_DOUBLE_RATIO",
            "CASE_HARDENED_RUNNING_IN", "RUNNING_IN_LIMIT",
            "theoretical_single_stiffness", "basic_rack_factor", "load_correction", "single_stiffness",
            "mesh_stiffness_per_width", "MeshStiffness", "mesh_stiffness", "pair_reduced_mass", "planetary_reduced_mass",
-           "resonance_ratio", "running_in", "DynamicFactor", "dynamic_factor_method_b"]
+           "resonance_ratio", "running_in", "DynamicFactor", "dynamic_factor_method_b", "machine_dynamic_factors"]
 
 # Table of the coefficients of q' (ISO 6336-1:2019 clause 9.3.2, method B), mm·µm/N
 Q_PRIME_COEFFICIENTS = (0.04723, 0.15551, 0.25791, -0.00635, -0.11654, -0.00193, -0.24188, 0.00529, 0.00182)
@@ -206,3 +208,40 @@ def dynamic_factor_method_b(N: float, line_load: float, c_single: float, f_pb_ef
     else:
         kv, where = above, "supercritical"
     return DynamicFactor(K_v=kv, N=N, range=where, N_S=N_S, B_p=B_p, B_f=B_f, B_k=B_k)
+
+
+# the standard's rule for each mesh type of the double planetary train (planetary_reduced_mass)
+_MESH_KIND = {"sun_inner": "sun_planet", "inner_outer": "planet_planet", "outer_ring": "planet_ring"}
+
+
+def machine_dynamic_factors(si, grade: int | None) -> dict[str, DynamicFactor | None]:
+    """Method B's K_v of each mesh type of a DPGT (``si``: ``DPGTParams.si()``) with every gear of ISO 1328-1:2013
+    flank tolerance class ``grade`` (None: perfect teeth, f_pb = f_fα = 0), None where the train transmits no load.
+
+    Per mesh: c' and c_γα the model's (k_single and k_mean per face width: ISO's unless overridden), w the nominal
+    line load (K_A = 1), N from the mesh frequency relative to the carrier z_r f_c and the reduced mass of
+    :func:`planetary_reduced_mass` with the gears' inertias, f_pb = f_pT cos α and f_fα = f_fαT the larger of the
+    two gears' tolerances, less the case-hardened running-in allowance (:func:`running_in`), C_a the larger tip
+    relief of the two gears, ε_γ = ε_α (spur)."""
+    lay, gs = si.layout, si.gears
+    out = {}
+    for key, m in lay.meshes.items():
+        if m.line_load <= 0.0:
+            out[key] = None
+            continue
+        g1, g2 = gs[m.gear1], gs[m.gear2]
+        b = m.face_width
+        J_sun = gs.sun.inertia
+        m_red = planetary_reduced_mass(_MESH_KIND[key], gs.planets, J_sun, g1.inertia if key != "sun_inner" else
+                                       g2.inertia, gs.sun.base_radius, (g1 if key != "sun_inner" else g2).base_radius,
+                                       b, g2.inertia, g2.base_radius)
+        N = resonance_ratio(si.operating.mesh_frequency, m.k_mean / b, m_red)
+        f_pb = f_fa = 0.0
+        if grade is not None:
+            tol = [flank_tolerances(g.module, 2.0 * g.pitch_radius, grade) for g in (g1, g2)]
+            f_pb = max(t.single_pitch for t in tol) * math.cos(g1.pressure_angle)
+            f_fa = max(t.profile_form for t in tol)
+        out[key] = dynamic_factor_method_b(N, m.line_load, m.k_single / b, f_pb - running_in(f_pb),
+                                           f_fa - running_in(f_fa), max(g1.tip_relief, g2.tip_relief),
+                                           m.contact_ratio)
+    return out

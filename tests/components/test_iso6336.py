@@ -135,3 +135,37 @@ def test_planetary_reduced_mass():
     c, m, z1, n1 = 16.0, 0.05, 24, 3000.0                      # N/(mm·µm), kg/mm, teeth, r/min
     n_e1 = 30000 / (math.pi * z1) * math.sqrt(c / m)
     assert iso.resonance_ratio(z1 * n1 / 60, c * UNIT, m * 1e3) == pytest.approx(n1 / n_e1, rel=1e-12)
+
+
+def test_machine_method_b_by_hand():
+    """The reference machine at condition 3 with class-6 teeth, by hand: the outer–ring mesh (planet against a ring
+    of infinite mass: m_red = J_b/(r_bb² b)) lies in the main resonance, K_v = 1 + 0.32 B_p + 0.34 B_f + 0.90 (no
+    tip relief: B_k = 1) with f_pb = f_pT cos 20° and f_fα = f_fαT of the ring (the larger, d = 246 mm; ISO
+    1328-1:2013 class 6: (0.001 d + 0.4 m + 5)√2 and (0.55 m + 5)√2 µm), less 7.5 % running-in; the sun–inner mesh of
+    perfect teeth is subcritical, K_v = 1 + 0.23 N."""
+    import warnings
+
+    from components.presets import reference_dpgt
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        si = reference_dpgt(3).si()
+    ring = si.layout.meshes["outer_ring"]
+    b, J_b, r_bb = ring.face_width, si.gears.outer_planet.inertia, si.gears.outer_planet.base_radius
+    N = 82 * 70.0 / (math.sqrt(ring.k_mean / b / (J_b / (r_bb ** 2 * b))) / (2 * math.pi))
+    w = ring.line_load
+    c1 = ring.k_single / b
+    f_pb = 0.925 * (0.246 + 1.2 + 5) * math.sqrt(2) * 1e-6 * math.cos(math.radians(20))
+    f_fa = 0.925 * (0.55 * 3 + 5) * math.sqrt(2) * 1e-6
+    got = iso.machine_dynamic_factors(si, 6)
+    assert got["outer_ring"].N == pytest.approx(N, rel=1e-9)
+    assert got["outer_ring"].range == "main resonance"
+    assert got["outer_ring"].K_v == pytest.approx(1 + 0.32 * c1 * f_pb / w + 0.34 * c1 * f_fa / w + 0.90, rel=1e-9)
+    si_s = si.layout.meshes["sun_inner"]
+    J_s, J_a = si.gears.sun.inertia, si.gears.inner_planet.inertia
+    m_s, m_a = J_s / (si.gears.sun.base_radius ** 2 * b), J_a / (si.gears.inner_planet.base_radius ** 2 * b)
+    N_s = 82 * 70.0 / (math.sqrt(si_s.k_mean / b / (m_a * m_s / (m_s + 3 * m_a))) / (2 * math.pi))
+    perfect = iso.machine_dynamic_factors(si, None)["sun_inner"]
+    assert perfect.range == "subcritical" and perfect.K_v == pytest.approx(1 + 0.23 * N_s, rel=1e-9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert iso.machine_dynamic_factors(reference_dpgt(4).si(), 6)["outer_ring"] is None   # no load
