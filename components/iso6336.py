@@ -231,10 +231,9 @@ def machine_dynamic_factors(si, grade: int | None) -> dict[str, DynamicFactor | 
             continue
         g1, g2 = gs[m.gear1], gs[m.gear2]
         b = m.face_width
-        J_sun = gs.sun.inertia
-        m_red = planetary_reduced_mass(_MESH_KIND[key], gs.planets, J_sun, g1.inertia if key != "sun_inner" else
-                                       g2.inertia, gs.sun.base_radius, (g1 if key != "sun_inner" else g2).base_radius,
-                                       b, g2.inertia, g2.base_radius)
+        planet = g2 if key == "sun_inner" else g1         # the planet of the mesh (inner–outer: the inner one)
+        m_red = planetary_reduced_mass(_MESH_KIND[key], gs.planets, gs.sun.inertia, planet.inertia,
+                                       gs.sun.base_radius, planet.base_radius, b, g2.inertia, g2.base_radius)
         N = resonance_ratio(si.operating.mesh_frequency, m.k_mean / b, m_red)
         f_pb = f_fa = 0.0
         if grade is not None:
