@@ -48,6 +48,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import iso6336 as iso
 from .units import ParameterError
 
 
@@ -57,7 +58,7 @@ __all__ = [
     "Kinematics", "Finding", "DesignWarning",
     "centre_distances", "pair_angle", "planet_angles", "speed_ratio", "planet_speed_ratios", "iso_minimum_backlash",
     "mesh_frequency", "SIDEBAND_ORIGINS", "sideband_origin", "contact_path", "contact_ratio", "assembly_number", "mesh_phases",
-    "mesh_stiffness_levels", "mesh_damping", "mesh_equivalent_mass", "palmgren_stiffness", "kinematics", "layout", "loaded_flanks",
+    "mesh_stiffness_levels", "nominal_tangential_force", "mesh_damping", "mesh_equivalent_mass", "palmgren_stiffness", "kinematics", "layout", "loaded_flanks",
     "design_findings", "check_design", "centre_distance_limit",
 ]
 
@@ -135,6 +136,8 @@ def mesh_stiffness_levels(k_mean: float, ratio: float, eps: float) -> tuple[floa
     """(k_single, k_double) of a rectangular wave with mean ``k_mean``, k_double/k_single = ``ratio``
     and double-tooth contact over the fraction ε−1 of a cycle (clipped to [0, 1])."""
     frac = min(max(eps - 1.0, 0.0), 1.0)
+    if frac == 1.0:                 # double contact throughout (ε ≥ 2): the mean is the double level
+        return k_mean / ratio, k_mean
     k_single = k_mean / (1.0 + (ratio - 1.0) * frac)
     return k_single, ratio * k_single
 
@@ -320,7 +323,8 @@ class MeshGeometry:
 
     ``line_angle`` and ``p0`` are (N,) arrays, one entry per planet pair. ``k_mean`` is the mean mesh
     stiffness (given, or c_γα × common face width); k_single/k_double the levels of the rectangular
-    wave; ``damping`` = 2ζ_m·sqrt(k_mean·m_eq).
+    wave; ``damping`` = 2ζ_m·sqrt(k_mean·m_eq). ``stiffness`` holds ISO 6336-1's c'_th, c' and c_γα of this mesh
+    at ``line_load`` (:func:`components.iso6336.mesh_stiffness`), whether or not the parameters override c_γα.
     """
 
     name: str
@@ -344,6 +348,8 @@ class MeshGeometry:
     m_eq: float
     damping: float
     backlash: float                # normal backlash j_bn along the line of action
+    line_load: float               # nominal F_t/b of the operating point [N/m] (K_A = 1)
+    stiffness: iso.MeshStiffness   # ISO 6336-1 c'_th, c', c_γα at line_load
     line_angle: np.ndarray = field(repr=False)   # φ_e at assembly, per pair
     p0: np.ndarray = field(repr=False)           # phase in p = z_1(θ_1 − φ_e)/2π + p0, per pair
     p_assembly: np.ndarray = field(repr=False)   # p at assembly (θ = 0), per pair
@@ -414,6 +420,16 @@ def _gear_geometries(gs) -> dict:
             for name, g in ((n, gs[n]) for n in ("sun", "inner_planet", "outer_planet", "ring"))}
 
 
+def nominal_tangential_force(operating_si, sun: GearGeometry, ring: GearGeometry, planets: int) -> float:
+    """F_t = |T_s|/(N r_s) [N]: the nominal tangential force at the reference circle of every mesh of the train (one
+    module: the same F_t on the sun's, the planets' and the ring's meshes), T_s = P/|ω_s| of the operating point
+    (``operating_si``: its carrier_speed [rad/s] and output_power [W]); 0 without power or without sun speed."""
+    w_s = abs(speed_ratio(sun.teeth, ring.teeth) * operating_si.carrier_speed)
+    if not (operating_si.output_power > 0 and w_s > 0):
+        return 0.0
+    return operating_si.output_power / w_s / (planets * sun.pitch_radius)
+
+
 def layout(params, gears_si=None, mesh_si=None) -> Layout:
     """The nominal layout of ``params`` (a DPGTParams; or pass the SI views of its gears and mesh).
 
@@ -432,12 +448,17 @@ def layout(params, gears_si=None, mesh_si=None) -> Layout:
     phi_ab = np.arctan2(cb[:, 1] - ca[:, 1], cb[:, 0] - ca[:, 0])
     ph = mesh_phases(sun.teeth, ga.teeth, gb.teeth, ring.teeth, psi_a, psi_b, phi_ab)
 
+    f_t = nominal_tangential_force(params.operating.si(), sun, ring, n) if params is not None else 0.0
+
     def mesh(name, n1, n2, a, internal, line, p0, p_asm):
         g1, g2 = G[n1], G[n2]
         gp1, gp2, alpha_w = contact_path(g1, g2, a, internal)
         eps = (gp1 + gp2) / g1.base_pitch
         b = min(gs[n1].face_width, gs[n2].face_width)
-        k_mean = ms.mean_stiffness if ms.mean_stiffness is not None else ms.c_gamma_alpha * b
+        iso_k = iso.mesh_stiffness(g1.teeth, g2.teeth, internal, g1.dedendum_coefficient, g2.dedendum_coefficient,
+                                   g1.pressure_angle, eps, f_t / b)
+        c_ga = ms.c_gamma_alpha if ms.c_gamma_alpha is not None else iso_k.mean
+        k_mean = ms.mean_stiffness if ms.mean_stiffness is not None else c_ga * b
         k1, k2 = mesh_stiffness_levels(k_mean, ms.stiffness_ratio, eps)
         args = (gs[n1].inertia, gs[n2].inertia, g1.base_radius, g2.base_radius)
         c, m_eq = float(mesh_damping(ms.damping_ratio, k_mean, *args)), float(mesh_equivalent_mass(*args))
@@ -447,7 +468,7 @@ def layout(params, gears_si=None, mesh_si=None) -> Layout:
                             base_radius1=g1.base_radius, base_radius2=g2.base_radius, centre_distance=a,
                             pressure_angle=alpha_w, base_pitch=g1.base_pitch, path1=gp1, path2=gp2,
                             contact_ratio=eps, face_width=b, k_mean=k_mean, k_single=k1, k_double=k2,
-                            m_eq=m_eq, damping=c, backlash=b_n, line_angle=np.asarray(line, dtype=float), p0=p0,
+                            m_eq=m_eq, damping=c, backlash=b_n, line_load=f_t / b, stiffness=iso_k, line_angle=np.asarray(line, dtype=float), p0=p0,
                             p_assembly=p_asm)
 
     meshes = {

@@ -201,9 +201,19 @@ def _derived(params) -> list[str]:
     for key, m in lay.meshes.items():
         p = f"si.layout.meshes[\"{key}\"]"
         rows += [(f"{p}.contact_ratio", m.contact_ratio, "1", f"{key}: transverse contact ratio ε_α"),
+                 (f"{p}.line_load", m.line_load * 1e-3, "N/mm", f"{key}: nominal line load F_t/b of the operating "
+                                                                "point (K_A = 1)"),
+                 (f"{p}.stiffness.theoretical", m.stiffness.theoretical * 1e-9, "N/(mm·µm)",
+                  f"{key}: ISO 6336-1 theoretical single stiffness c'_th = 1/q'"),
+                 (f"{p}.stiffness.single", m.stiffness.single * 1e-9, "N/(mm·µm)",
+                  f"{key}: ISO 6336-1 single stiffness c' = c'_th C_M C_R C_B × load correction "
+                  f"({m.stiffness.load_factor:.4g})"),
+                 (f"{p}.stiffness.mean", m.stiffness.mean * 1e-9, "N/(mm·µm)",
+                  f"{key}: ISO 6336-1 mesh stiffness c_γα = c'(0.75 ε_α + 0.25)"),
                  (f"{p}.k_mean", m.k_mean, "N/m", f"{key}: mean mesh stiffness c_γα × common face width"),
-                 (f"{p}.k_single", m.k_single, "N/m", f"{key}: single-contact stiffness of the rectangular wave"),
-                 (f"{p}.k_double", m.k_double, "N/m", f"{key}: double-contact stiffness"),
+                 (f"{p}.k_single", m.k_single, "N/m", f"{key}: single-contact stiffness of the rectangular wave, "
+                                                                   "c' × common face width"),
+                 (f"{p}.k_double", m.k_double, "N/m", f"{key}: double-contact stiffness, 1.75 k_single"),
                  (f"{p}.damping", m.damping, "N·s/m", f"{key}: mesh damping 2 ζ_m √(k_mean m_eq)"),
                  (f"{p}.backlash", m.backlash * 1e3, "mm", f"{key}: normal backlash j_bn")]
     lines = ["| where (`DPGTParams.si()`) | value | unit | what |", "|---|---|---|---|"]

@@ -287,8 +287,6 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
             ring_tangential_stiffness=assumed("1e9 N/m", "ring fixed: k_theta = 1e9 N/m x r_r^2"),
         ),
         mesh=MeshParams(
-            c_gamma_alpha=assumed("20 N/(mm*um)", "ISO 6336 typical c_gamma_alpha"),
-            stiffness_ratio=assumed(1.5, "k_double / k_single"),
             smoothing_width=assumed(0.05, "the source gives none: 5 % of a mesh cycle per step, "
                                           "smooth enough for Newton, sharp enough to keep the wave"),
             damping_ratio=assumed(0.07),

@@ -30,7 +30,7 @@ __all__ = ["steady_motion", "held_dofs", "snapshot_times", "solve_snapshots", "s
 
 # summary keys a static solution cannot give (they need the motion's transients)
 DYNAMIC_ONLY = ("cage_", "pocket_", "guide_", "heat_land", "whole_revolutions", "carrier_speed_error",
-                "te_peak_to_peak", "dynamic_factor", "roller_cage_")
+                "te_peak_to_peak", "dynamic_factor", "drive_flank_peak", "roller_cage_")
 
 
 def _rollers(scene):

@@ -11,8 +11,9 @@ the teeth's. All runs use the tooth-pair mesh law where teeth are real (the perf
 reduction), the same window and the same runner as the paper study (resumable, on Dask).
 
 Writes ``runs.csv`` (a row per run and bearing type: mean and largest bearing load, largest roller load, cage
-guide and pocket-impact maxima, both lives, and per mesh type the dynamic factor K_v and the loaded
-transmission error's peak-to-peak), ``by_grade.csv`` (per condition, direction, class and bearing type the
+guide and pocket-impact maxima, both lives, and per mesh type the simulated dynamic factor K_v (the mesh cycles'
+peaks, and the 99th percentile, over the mean drive-flank force), ISO 6336-1 method B's K_v for the class and the
+loaded transmission error's peak-to-peak), ``by_grade.csv`` (per condition, direction, class and bearing type the
 mean over the seeds with their smallest and largest value, and the forward/reverse change of the mean load and
 the life), ``findings.md`` (the answer in words) and ``quality.png``.
 """
@@ -27,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.iso6336 import machine_dynamic_factors
 from components.results.io import atomic_write_text
 
 from .core import args
@@ -34,7 +36,7 @@ from .core.command import command
 from .core.lock import holds_out_folder
 from .core.runner import RunConfig
 from .core.study import Study, StudyRun
-from .core.sweep import OPERATING_AXES, Case, user_overrides
+from .core.sweep import OPERATING_AXES, Case, build_params, user_overrides
 
 __all__ = ["main", "run", "make_cases", "rows_of", "by_grade", "findings", "QUANTITIES", "MESHES"]
 
@@ -51,8 +53,11 @@ QUANTITIES = {
     "life_iso281_h": ("life_iso281_h", "ISO 281 life (pair 1)", "h"),
     "life_iso16281_h": ("life_iso16281_h", "roller-load life (pair 1)", "h"),
 }
+# per mesh type: the simulated K_v (mean over mesh cycles of each cycle's peak drive-flank force over the mean), its
+# 99th-percentile form, ISO 6336-1 method B's K_v for the class (components.iso6336) and the loaded TE peak-to-peak
+MESH_COLUMNS = ("dynamic_factor", "dynamic_factor_p99", "kv_iso_b", "te_p2p_um")
 COLUMNS = (["condition", "direction", "grade", "seed", "bearing", *QUANTITIES]
-           + [f"{k}_{m}" for m in MESHES for k in ("dynamic_factor", "te_p2p_um")])
+           + [f"{k}_{m}" for m in MESHES for k in MESH_COLUMNS])
 
 
 EXAMPLES = ["{prog} --conditions 3 --grades 6 --seeds 1 --out results/gear_quality",
@@ -118,11 +123,15 @@ def rows_of(cases: list[Case], results: dict) -> list[dict]:
         if s is None or s.failed:
             continue
         g, seed = _grade_seed(case)
+        iso_b = machine_dynamic_factors(build_params(case).si(), g)
         mesh = {}
         for m in MESHES:
             d = s["meshes"][m]
             # K_v needs a load to scale: none where the train transmits no torque (summary.json says null there)
-            mesh[f"dynamic_factor_{m}"] = d.get("dynamic_factor") if s.get("power_W", 1.0) else None
+            loaded = bool(s.get("power_W", 1.0))
+            mesh[f"dynamic_factor_{m}"] = d.get("dynamic_factor") if loaded else None
+            mesh[f"dynamic_factor_p99_{m}"] = d.get("dynamic_factor_p99") if loaded else None
+            mesh[f"kv_iso_b_{m}"] = iso_b[m].K_v if iso_b.get(m) is not None else None
             mesh[f"te_p2p_um_{m}"] = 1e6 * d["te_peak_to_peak_m"]
         for kind in ("inner", "outer"):
             b = s[kind]
@@ -180,14 +189,18 @@ def findings(groups: list[dict]) -> str:
                     q = at.get((c, d, g, b))
                     if q is None:
                         continue
-                    kv = max(q[f"dynamic_factor_{m}"] or 0.0 for m in MESHES)
+                    kv = "/".join(f"{q[f'dynamic_factor_{m}']:.2f}" if q[f"dynamic_factor_{m}"] is not None else "–"
+                                  for m in MESHES)
+                    kb = "/".join(f"{q[f'kv_iso_b_{m}']:.2f}" if q[f"kv_iso_b_{m}"] is not None else "–"
+                                  for m in MESHES)
                     parts.append(
                         f"class {g}: mean load {pct(q['bearing_load_mean_N'], p['bearing_load_mean_N']):+.1f} %, "
                         f"largest {pct(q['bearing_load_max_N'], p['bearing_load_max_N']):+.0f} % "
                         f"[{pct(q['bearing_load_max_N_min'], p['bearing_load_max_N']):+.0f}, "
                         f"{pct(q['bearing_load_max_N_max'], p['bearing_load_max_N']):+.0f}], roller "
                         f"{pct(q['roller_max_N'], p['roller_max_N']):+.0f} %, life "
-                        f"{pct(q['life_iso16281_h'], p['life_iso16281_h']):+.1f} %, K_v {kv:.2f}")
+                        f"{pct(q['life_iso16281_h'], p['life_iso16281_h']):+.1f} %, K_v {kv} (ISO 6336-1 "
+                        f"method B {kb}; sun-inner/inner-outer/outer-ring)")
                 lines.append(f"  {d:>7} {b} bearings ({p['bearing_load_mean_N'] / 1e3:.1f} kN mean, "
                              f"{p['bearing_load_max_N'] / 1e3:.1f} kN largest with perfect teeth): " + "; ".join(parts))
         for b in ("inner", "outer"):

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from .. import geometry as geo
+from .. import iso6336 as iso
 from ..units import Quantity
 from ._machinery import SI, Params, Source, computed, nested, nonneg, param, positive, rule, si_of
 
@@ -120,18 +121,28 @@ class GearSetSI(SI):
 
 @dataclass(frozen=True, kw_only=True)
 class MeshParams(Params["MeshSI"]):
-    """Mesh stiffness and damping, common to the three meshes.
+    """Mesh stiffness and damping of the three meshes.
 
-    k_mean of a mesh = ``mean_stiffness`` if given, else c_γα × the mesh's common face width; the
-    time-varying stiffness is a smoothed rectangular wave with k_double/k_single = ``stiffness_ratio``;
-    ``smoothing_width`` is the width of its steps as a fraction of one mesh cycle. Resolved per mesh in
-    ``DPGTParams.si().layout.meshes``.
+    k_mean of a mesh = ``mean_stiffness`` if given, else c_γα × the mesh's common face width, c_γα given (then
+    common to the three meshes) or ISO 6336-1's for each mesh; the time-varying stiffness is a smoothed rectangular
+    wave with k_double/k_single = ``stiffness_ratio``; ``smoothing_width`` is the width of its steps as a fraction
+    of one mesh cycle. Resolved per mesh in ``DPGTParams.si().layout.meshes``.
     """
 
     _prefix: ClassVar[str] = "mesh"
-    c_gamma_alpha: Quantity = positive("stiffness_per_width", "ISO 6336 mean mesh stiffness per face width")
+    c_gamma_alpha: Quantity | None = rule(
+        "stiffness_per_width", "derived",
+        "ISO 6336-1:2019 clause 9 (method B), per mesh: c_gamma_alpha = c' (0.75 eps_alpha + 0.25), c' = c'_th C_M "
+        "C_R C_B (w / 100 N/mm)^0.25 for a line load w = F_t/b < 100 N/mm (F_t of the operating point, K_A = 1; "
+        "no correction without load), c'_th = 1/q', q' = 0.04723 + 0.15551/z_1 + 0.25791/z_2 mm um/N (no profile "
+        "shift; the ring: z_2 = infinity), C_M = 0.8, C_R = 1 (solid blanks), C_B = 1 + 0.5 (1.2 - h_f/m) at 20 deg",
+        "mean mesh stiffness per face width c_gamma_alpha (given: the same for the three meshes)")
     mean_stiffness: Quantity | None = rule("stiffness", "derived", "c_gamma_alpha x common face width of each mesh")
-    stiffness_ratio: Quantity = param("dimensionless", "k_double / k_single", lo=1.0, bound_text=">= 1")
+    stiffness_ratio: Quantity | None = param(
+        "dimensionless", "k_double / k_single of the stiffness wave", default=None, lo=1.0, bound_text=">= 1",
+        optional=True, rule=Source("derived", "ISO 6336-1:2019 clause 9: 1.75, since c_gamma_alpha = c' (0.75 "
+                                              "eps_alpha + 0.25) = c' [1 + 0.75 (eps_alpha - 1)] is the mean of c' in "
+                                              "single and 1.75 c' in double contact"))
     smoothing_width: Quantity = param("dimensionless", "step width of the stiffness wave, fraction of a mesh cycle",
                                       lo=0.0, hi=0.5, lo_open=True, bound_text="in (0, 0.5]")
     damping_ratio: Quantity = nonneg("dimensionless", "mesh damping ratio zeta_m")
@@ -141,12 +152,18 @@ class MeshParams(Params["MeshSI"]):
     backlash_inner_outer: Quantity | None = _backlash("inner-outer planet meshes")
     backlash_outer_ring: Quantity | None = _backlash("outer planet-ring meshes")
 
+    def _si_values(self, v):
+        if v["stiffness_ratio"] is not None:
+            return {}
+        return dict(stiffness_ratio=iso.SINGLE_DOUBLE_RATIO)
+
 
 @si_of(MeshParams)
 class MeshSI(SI):
-    c_gamma_alpha: float
+    c_gamma_alpha: float | None = computed("given c_gamma_alpha [N/m^2], or None: ISO 6336-1's per mesh "
+                                           "(layout.meshes[...].stiffness)")
     mean_stiffness: float | None
-    stiffness_ratio: float
+    stiffness_ratio: float = computed("k_double / k_single (given, or the rule's 1.75)")
     smoothing_width: float
     damping_ratio: float
     damping_ramp: float

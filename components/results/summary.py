@@ -103,8 +103,19 @@ SUMMARY_WORDS = {
     **{f"{f}_force_mean_per_pair_N": (f"{f} flank force mean, per pair", "N") for f in ("drive", "coast")},
     "te_peak_to_peak_m": ("loaded transmission error peak-to-peak, largest pair", "m"),
     "te_peak_to_peak_per_pair_m": ("loaded transmission error peak-to-peak, per pair", "m"),
-    "dynamic_factor": ("dynamic factor K_v, largest pair", "1"),
-    "dynamic_factor_per_pair": ("dynamic factor K_v, per pair", "1"),
+    "drive_flank_peak_over_mean": ("largest drive-flank force over its mean in the window, largest pair", "1"),
+    "drive_flank_peak_over_mean_per_pair": ("largest drive-flank force over its mean in the window, per pair", "1"),
+    "dynamic_factor": ("dynamic factor K_v: mean over mesh cycles of each cycle's peak drive-flank force over the "
+                       "mean force (whole carrier revolutions), largest pair", "1"),
+    "dynamic_factor_per_pair": ("dynamic factor K_v from the mesh cycles' peaks, per pair", "1"),
+    "dynamic_factor_p99": ("99th percentile of the drive-flank force over its mean (whole carrier revolutions), "
+                           "largest pair", "1"),
+    "dynamic_factor_p99_per_pair": ("99th percentile of the drive-flank force over its mean, per pair", "1"),
+    "dynamic_factor_window_s": ("window of the dynamic factors: whole carrier revolutions from the window's start",
+                                "s"),
+    "dynamic_factor_carrier_revolutions": ("whole carrier revolutions in the dynamic factors' window (0: whole "
+                                           "mesh cycles only)", "1"),
+    "dynamic_factor_mesh_cycles": ("whole mesh cycles in the dynamic factors' window", "1"),
 }
 
 # numeric summary keys without a unit (counts, ratios, factors, signs): the only ones without a UNIT_SUFFIXES suffix

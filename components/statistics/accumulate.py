@@ -29,7 +29,13 @@ except ImportError:      # pragma: no cover - numba is a dependency; this keeps 
     def jit(fn):
         return fn
 
-__all__ = ["Accumulators", "accumulate_steps", "compile_accumulators", "IMPACT_ROWS"]
+__all__ = ["Accumulators", "accumulate_steps", "compile_accumulators", "IMPACT_ROWS", "FlankPeaks", "accumulate_flank",
+           "FLANK_RANGE", "FLANK_BINS", "DYNAMIC_PERCENTILE"]
+
+# the drive-flank force's distribution: x/F_nom in FLANK_BINS equal bins over [0, FLANK_RANGE), one more above
+FLANK_RANGE = 8.0
+FLANK_BINS = 8000
+DYNAMIC_PERCENTILE = 99.0
 
 # rows of the impact accumulator (one column per pocket contact)
 IMPACT_ROWS = ("count", "touches", "speed_sum", "speed_max", "peak_sum", "peak_max", "peak_now", "active")
@@ -164,6 +170,139 @@ def accumulate_steps(t, V, own, acc, T, angle, is_open, t_close, target, has_tar
             _impacts(i, t_b, t0, t_a, h, wb, V, Z, pocket_cols, pocket_bearing, v_floor, imp)
 
 
+@jit
+def _spread(hist, j, lo, hi, dt, scale):
+    """Add the time ``dt`` a linear piece spends going between the values ``lo`` ≤ ``hi`` to column ``j`` of
+    ``hist`` (bins of x/scale), in proportion to each bin's share of [lo, hi]: a linear piece spends equal times in
+    equal value intervals."""
+    nb = hist.shape[1] - 1
+    width = FLANK_RANGE / nb
+    a, b = max(lo / scale, 0.0), max(hi / scale, 0.0)
+    ka, kb = min(int(a / width), nb), min(int(b / width), nb)
+    if kb == ka or b <= a:
+        hist[j, ka] += dt
+        return
+    span = b - a
+    for k in range(ka, kb + 1):
+        left = k * width if k > ka else a
+        right = (k + 1) * width if k < kb else b
+        if k == nb:
+            right = b
+        if right > left:
+            hist[j, k] += dt * (right - left) / span
+
+
+@jit
+def accumulate_flank(t, V, t0, t_end, period, scale, hist, sums, cyc):
+    """The drive-flank force's distribution and its mesh-cycle peaks over [t0, t_end] from the steps between the
+    rows of ``t`` (K+1,) / ``V`` (K+1, n) (one column per mesh instance), linear within a step: ``hist`` (n,
+    FLANK_BINS + 1) the time spent in each bin of x/``scale`` (the last: above FLANK_RANGE), ``sums`` (2, n) Σx dt
+    and the time covered, ``cyc`` (4, n) the sum of the finished cycles' peaks, their count, the current cycle's
+    peak and its index (cycle k = [t0 + k·period, t0 + (k+1)·period]; a step is cut at the cycle edges, the force
+    there interpolated). All updated in place."""
+    K = t.size - 1
+    n = V.shape[1]
+    for i in range(K):
+        t_a, t_b = t[i], t[i + 1]
+        if t_b <= t0 or t_a >= t_end:
+            continue
+        h = t_b - t_a
+        s_a = max(t_a, t0)
+        stop = min(t_b, t_end)
+        while s_a < stop:
+            k = int(math.floor((s_a - t0) / period + 1e-9))
+            s_b = min(stop, t0 + (k + 1) * period)
+            if s_b <= s_a:
+                s_b = stop
+            wa, wb = (s_a - t_a) / h, (s_b - t_a) / h
+            dt = s_b - s_a
+            for j in range(n):
+                x0, x1 = V[i, j], V[i + 1, j]
+                va, vb = x0 + wa * (x1 - x0), x0 + wb * (x1 - x0)
+                sums[0, j] += 0.5 * (va + vb) * dt
+                sums[1, j] += dt
+                _spread(hist, j, min(va, vb), max(va, vb), dt, scale)
+                if cyc[3, j] != k:
+                    if cyc[3, j] >= 0.0:
+                        cyc[0, j] += cyc[2, j]
+                        cyc[1, j] += 1.0
+                    cyc[3, j] = k
+                    cyc[2, j] = -np.inf
+                cyc[2, j] = _max(cyc[2, j], _max(va, vb))
+            s_a = s_b
+
+
+class FlankPeaks:
+    """The drive flank's force over whole carrier revolutions (:func:`accumulate_flank`): its time-weighted
+    distribution, mean and mesh-cycle peaks per mesh instance, for the dynamic factors of
+    :func:`.summaries.mesh_summary`.
+
+    ``keys``, ``sizes``: the drive-force quantities, in order, and their instances (one column each); ``t0``,
+    ``t_end``: the window [s]; ``period``: one mesh cycle [s]; ``scale``: the nominal drive-flank force [N] the bins
+    are counted in; ``revolutions``: the whole carrier revolutions the window spans (0: whole mesh cycles only)."""
+
+    def __init__(self, keys, sizes, t0: float, t_end: float, period: float, scale: float, revolutions: int):
+        self.revolutions = int(revolutions)
+        self.keys, self.sizes = tuple(keys), tuple(int(n) for n in sizes)
+        self.t0, self.t_end, self.period, self.scale = float(t0), float(t_end), float(period), float(scale)
+        n = sum(self.sizes)
+        self.hist = np.zeros((n, FLANK_BINS + 1))
+        self.sums = np.zeros((2, n))
+        self.cyc = np.zeros((4, n))
+        self.cyc[3] = -1.0
+        self.cyc[2] = -np.inf
+
+    def add_steps(self, t, rows) -> None:
+        """K steps: their K+1 ends ``t`` and the quantities at them (``rows``, the drive forces among them)."""
+        V = np.concatenate([np.asarray(rows[k], float).reshape(t.size, -1) for k in self.keys], axis=1)
+        accumulate_flank(np.asarray(t, float), V, self.t0, self.t_end, self.period, self.scale, self.hist, self.sums,
+                         self.cyc)
+
+    def complete(self) -> bool:
+        """Has the window been covered to its end?"""
+        return bool(self.sums[1].size) and float(self.sums[1].min()) >= (self.t_end - self.t0) * (1.0 - 1e-9)
+
+    def _split(self, x) -> dict:
+        edges = np.cumsum((0,) + self.sizes)
+        return {k: x[..., a:b] for k, a, b in zip(self.keys, edges[:-1], edges[1:])}
+
+    def results(self) -> dict:
+        """{key: {"mean", "percentile", "cycle_peak_mean", "cycles"}} per instance (arrays): the time mean, the
+        DYNAMIC_PERCENTILE-th percentile of the time distribution (linear within a bin; inf when it lies above
+        FLANK_RANGE × scale) and the mean of the whole cycles' peaks; NaN without a whole window."""
+        T = self.sums[1]
+        mean = np.where(T > 0, self.sums[0] / np.where(T > 0, T, 1.0), np.nan)
+        cum = np.cumsum(self.hist, axis=1)
+        goal = DYNAMIC_PERCENTILE / 100.0 * T
+        width = FLANK_RANGE / FLANK_BINS
+        pct = np.full(T.size, np.nan)
+        for j in range(T.size):
+            if T[j] <= 0:
+                continue
+            k = int(np.searchsorted(cum[j], goal[j], side="left"))
+            if k >= FLANK_BINS:
+                pct[j] = np.inf
+                continue
+            below = cum[j, k - 1] if k > 0 else 0.0
+            frac = (goal[j] - below) / self.hist[j, k] if self.hist[j, k] > 0 else 0.0
+            pct[j] = (k + frac) * width * self.scale
+        peaks, count = self.cyc[0].copy(), self.cyc[1].copy()
+        if self.complete():                      # the last cycle ended with the window: it is whole
+            last = self.cyc[3] >= 0
+            peaks += np.where(last, self.cyc[2], 0.0)
+            count += last
+        cyc = np.where(count > 0, peaks / np.where(count > 0, count, 1.0), np.nan)
+        parts = {name: self._split(x) for name, x in (("mean", mean), ("percentile", pct), ("cycle_peak_mean", cyc),
+                                                         ("cycles", count))}
+        return {k: {name: parts[name][k] for name in parts} for k in self.keys}
+
+    def state_dict(self) -> dict:
+        return {"hist": self.hist, "sums": self.sums, "cyc": self.cyc}
+
+    def load_state_dict(self, d: dict) -> None:
+        self.hist[:], self.sums[:], self.cyc[:] = d["hist"], d["sums"], d["cyc"]
+
+
 class Accumulators:
     """The running sums of every quantity over its window: per instance Σx dt, Σx² dt, max and min (one flat
     (4, n) array; :meth:`stats` reads it back), the time each bearing's window and the global (mesh) one have
@@ -295,7 +434,7 @@ class Accumulators:
 
 def accumulators_cached() -> bool:
     """Does numba's disk cache hold the accumulators of this code (plain Python without numba: nothing to compile)?"""
-    return _compiled is None or _compiled.kernels_cached(accumulate_steps)
+    return _compiled is None or (_compiled.kernels_cached(accumulate_steps) and _compiled.kernels_cached(accumulate_flank))
 
 
 def compile_accumulators() -> None:
@@ -304,8 +443,11 @@ def compile_accumulators() -> None:
     if _compiled is None:      # pragma: no cover - plain Python
         return
     i0, f0 = np.zeros(0, np.int64), np.zeros(0)
-    toy = lambda: accumulate_steps(np.array([0.0, 1.0]), np.zeros((2, 1)), np.array([-1]), np.zeros((4, 1)),
-                                   np.zeros(2), np.zeros(1), np.ones(1, bool), np.zeros(1), np.ones(1), False, 0.0,
-                                   1.0, i0, i0, i0, np.zeros((2, 0)), f0, np.zeros((8, 0)))
+    def toy():
+        accumulate_steps(np.array([0.0, 1.0]), np.zeros((2, 1)), np.array([-1]), np.zeros((4, 1)), np.zeros(2),
+                         np.zeros(1), np.ones(1, bool), np.zeros(1), np.ones(1), False, 0.0, 1.0, i0, i0, i0,
+                         np.zeros((2, 0)), f0, np.zeros((8, 0)))
+        accumulate_flank(np.array([0.0, 1.0]), np.ones((2, 1)), 0.0, 1.0, 0.5, 1.0, np.zeros((1, FLANK_BINS + 1)),
+                         np.zeros((2, 1)), np.array([[0.0], [0.0], [-np.inf], [-1.0]]))
     _compiled.compile_announced(toy, cold=not accumulators_cached(), what="the statistics' accumulator kernels",
                                 done="accumulator kernels", about="a few seconds")

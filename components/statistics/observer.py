@@ -13,7 +13,7 @@ from mbd.simulate import ENGINES
 from ..bearing import bearing_kinematics
 from ..families import FAMILY
 from . import quantities as Q
-from .accumulate import Accumulators, compile_accumulators
+from .accumulate import Accumulators, FlankPeaks, compile_accumulators
 from .summaries import run_summary
 
 __all__ = ["WindowStatistics", "default_window", "cage_period"]
@@ -96,8 +96,31 @@ class WindowStatistics(mbd.Observer):
         pockets = p.pocket_bearing if p.pocket_bearing is not None else np.zeros(0, np.int64)
         floor = self.model.element(FAMILY["pocket"]).v_min * (1.0 + 1e-9) if pockets.size else np.zeros(0)
         self.sums = Accumulators(p.planet.size, self.t0, self.t1, self.target, pockets, floor)
+        self.flank = self._flank_peaks()
         self._prev = None            # the quantities at the last step's end: the next step's start
         self.ref_roller = None       # (inner, outer) race_inner instance of the reference rollers
+
+    def _flank_peaks(self) -> FlankPeaks | None:
+        """The drive flanks' dynamic-factor statistics (:class:`.accumulate.FlankPeaks`) over whole carrier revolutions
+        from t0 (as many as fit in [t0, t1]; fewer than one: whole mesh cycles), counted in mesh cycles of
+        z_s |ω_s − ω_c|/2π, binned in the nominal drive-flank force |T_s|/(N r_b,sun) (every mesh of the train carries
+        it quasi-statically); None without a sun mesh, without torque or without motion."""
+        fam = self.plan.meshes.get("sun_inner")
+        w_s, w_c = float(self.scene.speeds.sun), self.omega_c
+        if fam is None or self.scene.sun_torque == 0.0 or w_c == 0.0 or w_s == w_c:
+            return None
+        sun = self.model.element(fam)
+        f_m = float(sun.teeth1[0]) * abs(w_s - w_c) / (2.0 * math.pi)
+        T_m, T_c = 1.0 / f_m, 2.0 * math.pi / abs(w_c)
+        span = self.t1 - self.t0
+        revs = math.floor(span / T_c + 1e-9)
+        t_end = self.t0 + (revs * T_c if revs >= 1 else math.floor(span / T_m + 1e-9) * T_m)
+        if t_end <= self.t0:
+            return None
+        scale = abs(self.scene.sun_torque) / (len(self.scene.pairs) * float(sun.rb1[0]))
+        keys = [f"{k}_drive_force" for k in self.plan.meshes]
+        sizes = [self.model.element(f).n for f in self.plan.meshes.values()]
+        return FlankPeaks(keys, sizes, self.t0, t_end, T_m, scale, revs)
 
     # states -> quantities ------------------------------------------------------------------------
     def snapshot(self, s) -> dict[str, np.ndarray]:
@@ -144,6 +167,8 @@ class WindowStatistics(mbd.Observer):
             self.ref_roller = Q.reference_rollers(self.plan, _at(rows, i), _at(rows, i + 1), wa)
         self._layout(rows)
         self.sums.add_steps(t, rows, Z)
+        if self.flank is not None:
+            self.flank.add_steps(t, rows)
         self._prev = {k: x[-1].copy() for k, x in rows.items()}
 
     def add_samples(self, rows) -> None:
@@ -168,12 +193,15 @@ class WindowStatistics(mbd.Observer):
     # checkpoints ---------------------------------------------------------------------------------
     def state_dict(self) -> dict:
         d = self.sums.state_dict()
+        d.update({f"flank__{k}": v for k, v in (self.flank.state_dict() if self.flank is not None else {}).items()})
         d.update({f"prev__{k}": v for k, v in (self._prev or {}).items()})
         d["ref"] = np.array(self.ref_roller if self.ref_roller is not None else (-1, -1))
         return d
 
     def load_state_dict(self, d: dict) -> None:
         self.sums.load_state_dict(d)
+        if self.flank is not None and "flank__hist" in d:
+            self.flank.load_state_dict({k[7:]: v for k, v in d.items() if k.startswith("flank__")})
         self._prev = {k[6:]: v.copy() for k, v in d.items() if k.startswith("prev__")} or None
         if self.sums.flat is not None and self._prev is not None:
             self._layout({k: x[None] for k, x in self._prev.items()})
@@ -199,7 +227,8 @@ class WindowStatistics(mbd.Observer):
         if self.duration <= 0.0:
             raise mbd.ModelError(f"no accepted step fell into the statistics window [{self.t0}, {self.t1}] s")
         self.sums.close_impacts()
-        return run_summary(self.sums, self.plan, self.ref_roller, self._w_rel, self.scene.sun_torque != 0.0)
+        return run_summary(self.sums, self.plan, self.ref_roller, self._w_rel, self.scene.sun_torque != 0.0,
+                           self.flank)
 
 
 def _at(rows, i: int) -> dict:

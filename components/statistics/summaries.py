@@ -22,19 +22,19 @@ __all__ = ["run_summary", "bearing_summary", "load_summary", "roller_summary", "
            "heat_summary", "film_summary", "cage_summary", "mesh_summary"]
 
 
-def run_summary(sums, p, ref_roller, w_rel: dict, loaded: bool) -> dict:
+def run_summary(sums, p, ref_roller, w_rel: dict, loaded: bool, flank=None) -> dict:
     """The statistics users read (see README: summary.json): the windows, the drive's speed error, per bearing kind
     :func:`bearing_summary`, per mesh type :func:`mesh_summary`. ``sums``: the :class:`~.accumulate.Accumulators`
     (impacts closed); ``p``: the :class:`~.quantities.Plan`; ``ref_roller``: the (inner, outer) reference rollers;
     ``w_rel``: {kind: the planet's speed relative to its pin [rad/s]} (a life's revolutions); ``loaded``: does the
-    train transmit torque?"""
+    train transmit torque? ``flank``: the drive flanks' :class:`~.accumulate.FlankPeaks` (None: no dynamic factor)."""
     out: dict = {"window_s": [sums.t0, sums.t1], "window_duration_s": sums.duration}
     if "carrier_speed_error" in sums.acc:
         # the time mean: a settled drive oscillates about its reference (mesh dynamics), an unsettled one is off
         out["carrier_speed_error_mean_pct"] = float(100.0 * sums.stats("carrier_speed_error")["mean"][0])
     for kind in ("inner", "outer"):
         out[kind] = bearing_summary(sums, p, kind, ref_roller, w_rel[kind])
-    out["meshes"] = mesh_summary(sums, p, loaded)
+    out["meshes"] = mesh_summary(sums, p, loaded, flank)
     return out
 
 
@@ -208,28 +208,51 @@ def cage_summary(d, sums, p, ref, sel) -> None:
         d["all_cages"]["cage_guide_rms_N"] = d["all_rollers"]["cage_guide_rms_N"]
 
 
-def mesh_summary(sums, p, loaded: bool) -> dict:
+def mesh_summary(sums, p, loaded: bool, flank=None) -> dict:
     """Per mesh type, over all planet pairs: mean (average of the pairs) and max of each flank; the loaded
-    transmission error's peak-to-peak (the drive flank's compression, max − min over the window) and the
-    dynamic factor K_v = max / mean of the drive flank's force (ISO 6336-1's notion, from the run; None when
-    the train transmits no torque, ``loaded`` false), the largest of the pairs and per pair."""
+    transmission error's peak-to-peak (the drive flank's compression, max − min over the window); the drive flank's
+    largest force over its mean in the window (``drive_flank_peak_over_mean``: it grows with the window, a record,
+    not a factor); and the dynamic factor K_v as ISO 6336-1 means it — the dynamic over the nominal tooth load — from
+    ``flank`` (:class:`~.accumulate.FlankPeaks`, whole carrier revolutions): ``dynamic_factor`` the mean over the
+    mesh cycles of each cycle's peak drive-flank force, over the mean force, and ``dynamic_factor_p99`` the 99th
+    percentile of the drive-flank force in time over its mean. Each the largest of the pairs and per pair; None
+    when the train transmits no torque (``loaded`` false: no nominal load to scale)."""
     out = {}
+    res = flank.results() if flank is not None and loaded else None
     for key in p.meshes:
         d = {"drive_flank": int(p.flanks.get(key, 1))}
-        for flank in ("drive", "coast"):
-            f, x = sums.stats(f"{key}_{flank}_force"), sums.stats(f"{key}_{flank}_deflection")
-            d[f"{flank}_force_mean_N"] = float(f["mean"].mean())
-            d[f"{flank}_force_max_N"] = float(f["max"].max())
-            d[f"{flank}_deflection_mean_m"] = float(x["mean"].mean())
-            d[f"{flank}_deflection_max_m"] = float(x["max"].max())
-            d[f"{flank}_force_mean_per_pair_N"] = [float(y) for y in f["mean"]]
+        for flank_name in ("drive", "coast"):
+            f, x = sums.stats(f"{key}_{flank_name}_force"), sums.stats(f"{key}_{flank_name}_deflection")
+            d[f"{flank_name}_force_mean_N"] = float(f["mean"].mean())
+            d[f"{flank_name}_force_max_N"] = float(f["max"].max())
+            d[f"{flank_name}_deflection_mean_m"] = float(x["mean"].mean())
+            d[f"{flank_name}_deflection_max_m"] = float(x["max"].max())
+            d[f"{flank_name}_force_mean_per_pair_N"] = [float(y) for y in f["mean"]]
         f, x = sums.stats(f"{key}_drive_force"), sums.stats(f"{key}_drive_deflection")
         te = x["max"] - x["min"]
-        # K_v has no meaning where the train transmits no torque (condition 4): no nominal load to scale
-        kv = f["max"] / np.where(loaded & (f["mean"] > 0), f["mean"], np.nan)
         d["te_peak_to_peak_m"] = float(te.max())
         d["te_peak_to_peak_per_pair_m"] = [float(y) for y in te]
-        d["dynamic_factor"] = float(np.nanmax(kv)) if np.any(np.isfinite(kv)) else None
-        d["dynamic_factor_per_pair"] = [float(y) if np.isfinite(y) else None for y in kv]
+        peak = f["max"] / np.where(loaded & (f["mean"] > 0), f["mean"], np.nan)
+        _largest_and_pairs(d, "drive_flank_peak_over_mean", peak)
+        r = res.get(f"{key}_drive_force") if res is not None else None
+        mean = np.where(r["mean"] > 0, r["mean"], np.nan) if r is not None else None
+        _largest_and_pairs(d, "dynamic_factor", r["cycle_peak_mean"] / mean if r is not None else None)
+        _largest_and_pairs(d, "dynamic_factor_p99", r["percentile"] / mean if r is not None else None)
+        if r is not None:
+            d["dynamic_factor_window_s"] = [flank.t0, flank.t_end]
+            d["dynamic_factor_carrier_revolutions"] = flank.revolutions
+            d["dynamic_factor_mesh_cycles"] = int(np.min(r["cycles"]))
         out[key] = d
     return out
+
+
+def _largest_and_pairs(d: dict, name: str, x) -> None:
+    """d[name] the largest finite entry of ``x`` (per pair) or None, d[name + "_per_pair"] each (None where not
+    finite; an infinite percentile, beyond the bins, is None too)."""
+    if x is None:
+        d[name], d[f"{name}_per_pair"] = None, None
+        return
+    x = np.asarray(x, float)
+    ok = np.isfinite(x)
+    d[name] = float(np.max(x[ok])) if ok.any() else None
+    d[f"{name}_per_pair"] = [float(y) if np.isfinite(y) else None for y in x]

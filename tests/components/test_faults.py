@@ -20,6 +20,9 @@ from components.units import ParameterError
 from tests.support import DATA, dpgt_runs
 
 REF = DATA / "perfect_machine_a223f98.npz"
+# the machine of commit a223f98 had the typical mesh stiffness c_γα = 20 N/(mm·µm) with k_double/k_single = 1.5 of
+# every mesh (before ISO 6336-1's per-mesh values became the default): its states are those of that machine
+A223F98_MESH = {"mesh.c_gamma_alpha": "20 N/(mm*um)", "mesh.stiffness_ratio": 1.5}
 PINHOLE_B1 = {"errors.pinhole": [{"planet": "b1", "radial": "0 um", "tangential": "30 um"}]}
 
 
@@ -40,7 +43,7 @@ def test_perfect_machine_reproduces_the_machine_before_errors_existed(condition,
     other iterates, which the contacts amplify far above round-off (measured after 0.5 ms: 7.7e-5 to
     2.5e-4 of max|q|, 1.2e-3 to 3.1e-3 of max|v|): that would test the convergence rule, not the machine."""
     ref = np.load(REF)
-    sc = _build(reference_dpgt(condition, direction))
+    sc = _build(with_overrides(reference_dpgt(condition, direction), A223F98_MESH))
     key = f"{condition}{direction}"
     assert np.array_equal(sc.q0, ref[f"q0_{key}"]) and np.array_equal(sc.v0, ref[f"v0_{key}"])
     stepper = dataclasses.replace(mbd.PRODUCTION.stepper(), per_component=False)
@@ -58,7 +61,7 @@ def test_perfect_machine_has_the_forces_it_had_before_errors_existed(condition, 
     round-off is allowed, on any CPU (bit-identical here)."""
     ref = np.load(REF)
     key = f"{condition}{direction}"
-    sc = _build(reference_dpgt(condition, direction))
+    sc = _build(with_overrides(reference_dpgt(condition, direction), A223F98_MESH))
     z = {k[len(f"z_{key}_"):]: ref[k] for k in ref.files if k.startswith(f"z_{key}_")}
     ev = mbd.System(sc.model).evaluate(float(ref[f"t_{key}"]), ref[f"q_{key}"], ref[f"v_{key}"], z, jac=True)
     Jq = ev.Jq.toarray() if hasattr(ev.Jq, "toarray") else ev.Jq
@@ -217,9 +220,9 @@ def test_sun_runout_modulates_its_meshes_once_per_sun_revolution():
     assert a1 > 100 * a0 and a1 > 0.05 * F1.mean()
 
 
-@pytest.mark.parametrize("gear, tooth, factor, period_of", [("b1", 0, 0.0, "outer_planet_rel"),
-                                                             ("ring", 5, 0.5, "f_c")])
-def test_tooth_fault_weakens_its_mesh_once_per_revolution_of_its_gear(gear, tooth, factor, period_of):
+@pytest.mark.parametrize("gear, tooth, factor, period_of, mesh", [("b1", 0, 0.0, "outer_planet_rel", {}),
+                                                                   ("ring", 5, 0.5, "f_c", A223F98_MESH)])
+def test_tooth_fault_weakens_its_mesh_once_per_revolution_of_its_gear(gear, tooth, factor, period_of, mesh):
     """A missing tooth on outer planet b1 / a cracked ring tooth: the b1–ring mesh stiffness drops to the
     fault's share exactly once per revolution of the faulty gear relative to the carrier (b1: 4.18 ms; the
     ring, fixed, meets b1 once per carrier revolution: 14.3 ms) and nowhere else. The tooth index is the
@@ -227,17 +230,26 @@ def test_tooth_fault_weakens_its_mesh_once_per_revolution_of_its_gear(gear, toot
     loaded flank it touches a quarter pitch from there, inside the path of contact), and the weak stretch
     is ε_α pitches of the tooth's travel. The mesh force's deviation from the perfect machine's repeats once
     per revolution of the faulty gear (correlation with itself one revolution later ≥ 0.9, seen 0.975–0.997;
-    half a revolution later ≤ 0.5, seen ≈ −0.2)."""
+    half a revolution later ≤ 0.5, seen ≈ −0.2).
+
+    The cracked ring tooth runs on the machine with c_γα = 20 N/(mm·µm) and k_double/k_single = 1.5 on every mesh
+    (``mesh``): with ISO 6336-1's stiffness (the default) the deviation from the perfect machine carries, besides the
+    fault's once-per-revolution pulse (325 N RMS in the weak stretches), a part that does not repeat: one
+    revolution's deviation differs from the next by ≈ 50 N RMS throughout (with the typical stiffness by 15 N, 1–3 N
+    in most milliseconds; the ring mesh runs near its resonance, method B's N = 0.92), which brings the
+    one-revolution correlation over 30 ms to 0.80 (half a revolution: 0.10; from 15 ms on over 38 ms: 0.94). The fault
+    law this test holds — which tooth, how often, how long — does not depend on the stiffness."""
     from scenarios.fault_study import characteristic_frequencies
 
-    p = reference_dpgt(3)
+    p = with_overrides(reference_dpgt(3), mesh) if mesh else reference_dpgt(3)
     period = 1.0 / characteristic_frequencies(p.si())[period_of]
     t, F, k, th1, th2, phi = _mesh_history({"errors.tooth_fault": [{"gear": gear, "tooth": tooth,
-                                                                     "stiffness_factor": factor}]}, "outer_ring")
+                                                                     "stiffness_factor": factor}], **mesh},
+                                           "outer_ring")
     low = k < 1.0 - 1e-9
     # the weak pair's share: down to the factor in single contact, (1 + c)/2 in double contact
     assert k.min() == pytest.approx(factor, abs=1e-12) and k.max() == pytest.approx(1.0, abs=1e-12)
-    t0, F0, *_ = _perfect_mesh_history("outer_ring")
+    t0, F0, *_ = _mesh_history(mesh, "outer_ring") if mesh else _perfect_mesh_history("outer_ring")
     assert _repeats(t, F, t0, F0, period) >= 0.9 and _repeats(t, F, t0, F0, 0.5 * period) <= 0.5
     starts = t[1:][np.diff(low.astype(int)) == 1]
     assert starts.size >= 2

@@ -274,18 +274,37 @@ def test_loaded_flanks_follow_the_torque_path(sun_torque_sign):
 
 
 def test_mesh_stiffness_and_damping(lay, ref):
+    """ISO 6336-1's stiffness by hand at condition 3: w = F_t/b = (200 kW/|ω_s|)/(3 r_s)/32 mm with
+    ω_s = (1 − 82/31) ω_c, c' = c'_th · 0.8 · C_B (w/100 N/mm)^0.25, C_B = 1 + 0.5(1.2 − 1.25) = 0.975; the wave's
+    single level is c' b and its double level 1.75 c' b."""
     gs = ref.si().gears
-    for m in lay.meshes.values():
+    w_s = (82 / 31 - 1) * 4200 * RPM
+    w = 200e3 / w_s / (3 * 46.5e-3) / 32e-3                                  # N/m
+    assert w == pytest.approx(61.9e3, rel=1e-3)
+    q = {"sun_inner": 0.04723 + 0.15551 / 31 + 0.25791 / 24, "inner_outer": 0.04723 + (0.15551 + 0.25791) / 24,
+         "outer_ring": 0.04723 + 0.15551 / 24}                                # mm·µm/N; the ring's z_2 = ∞
+    for key, m in lay.meshes.items():
         assert m.face_width == pytest.approx(32e-3)
-        assert m.k_mean == pytest.approx(6.4e8)                               # 20 N/(mm·µm) × 32 mm
-        assert m.k_double / m.k_single == pytest.approx(1.5)
+        assert m.line_load == pytest.approx(w, rel=1e-12)
+        c1 = 1e9 / q[key] * 0.8 * 0.975 * (w / 1e5) ** 0.25                   # N/m²
+        assert m.k_single == pytest.approx(c1 * 32e-3, rel=1e-12), key
+        assert m.k_double == pytest.approx(1.75 * c1 * 32e-3, rel=1e-12), key
+        assert m.k_mean == pytest.approx(c1 * (0.75 * m.contact_ratio + 0.25) * 32e-3, rel=1e-12), key
         frac2 = m.contact_ratio - 1
         assert m.k_single * (1 - frac2) + m.k_double * frac2 == pytest.approx(m.k_mean)
         j1, j2 = gs[m.gear1].inertia, gs[m.gear2].inertia
         m_eq = j1 * j2 / (j1 * m.base_radius2 ** 2 + j2 * m.base_radius1 ** 2)
-        assert m.damping == pytest.approx(2 * 0.07 * math.sqrt(6.4e8 * m_eq))
+        assert m.damping == pytest.approx(2 * 0.07 * math.sqrt(m.k_mean * m_eq))
     k = with_overrides(ref, {"mesh.mean_stiffness": "5e8 N/m"}).si().layout.meshes["outer_ring"]
     assert k.k_mean == 5e8
+    # a given c_γα is common to the three meshes; a given ratio replaces 1.75
+    given = with_overrides(ref, {"mesh.c_gamma_alpha": "20 N/(mm*um)", "mesh.stiffness_ratio": 1.5}).si().layout
+    for m in given.meshes.values():
+        assert m.k_mean == pytest.approx(6.4e8) and m.k_double / m.k_single == pytest.approx(1.5)
+    # without load (condition 4) the standard's load correction is not applied: c' at 100 N/mm
+    idle = reference_dpgt(4).si().layout.meshes["sun_inner"]
+    assert idle.line_load == 0.0
+    assert idle.k_single == pytest.approx(1e9 / q["sun_inner"] * 0.8 * 0.975 * 32e-3, rel=1e-12)
 
 
 def test_palmgren_stiffness():

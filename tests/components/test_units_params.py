@@ -210,7 +210,7 @@ def test_preset_source_tags():
         "bearing.pitch_diameter": "paper", "bearing.rollers": "paper", "bearing.clearance": "assumed",
         "bearing.roller_mass": "derived", "bearing.contact_stiffness": "derived",
         "bearing.cage.pocket_stiffness": "assumed", "mesh.mean_stiffness": "derived",
-        "mesh.c_gamma_alpha": "assumed", "operating.carrier_speed": "paper", "operating.output_power": "paper",
+        "mesh.c_gamma_alpha": "derived", "mesh.stiffness_ratio": "derived", "operating.carrier_speed": "paper", "operating.output_power": "paper",
         "lubricant.density": "assumed", "support.ring_tangential_stiffness": "assumed", "gravity": "assumed",
     }
     for path, tag in tags.items():

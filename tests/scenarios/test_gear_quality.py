@@ -12,7 +12,7 @@ def _row(c, d, g, seed, b, load, life, kv=1.2):
     r = {k: 1.0 for k in gear_quality.QUANTITIES}
     r.update(condition=c, direction=d, grade=g, seed=seed, bearing=b, bearing_load_mean_N=load, life_iso16281_h=life,
              bearing_load_max_N=2 * load, roller_max_N=0.4 * load)
-    r.update({f"{k}_{m}": kv for m in gear_quality.MESHES for k in ("dynamic_factor", "te_p2p_um")})
+    r.update({f"{k}_{m}": kv for m in gear_quality.MESHES for k in gear_quality.MESH_COLUMNS})
     return r
 
 
@@ -31,6 +31,7 @@ def test_by_grade_takes_mean_range_and_reverse_change_over_the_seeds():
     assert g[("forward", None)]["bearing_load_mean_N_reverse_change_pct"] == pytest.approx(40.0)
     text = gear_quality.findings(gear_quality.by_grade(rows))
     assert "class 6: mean load +10.0 %" in text and "perfect +40.0 %, class 6 +36.4 %" in text
+    assert "K_v 1.20/1.20/1.20 (ISO 6336-1 method B 1.20/1.20/1.20" in text
 
 
 @pytest.mark.slow
@@ -45,6 +46,8 @@ def test_gear_quality_study_runs_end_to_end(tmp_path):
     # real teeth excite the mesh: its transmission error and dynamic load exceed perfect teeth's
     for m in gear_quality.MESHES:
         assert float(by["6"][f"te_p2p_um_{m}"]) > float(by[""][f"te_p2p_um_{m}"])
+        # method B's K_v of class 6 exceeds perfect teeth's (B_p, B_f > 0), both from the standard
+        assert float(by["6"][f"kv_iso_b_{m}"]) > float(by[""][f"kv_iso_b_{m}"]) > 1.0
     for f in ("by_grade.csv", "findings.md", "quality.png", "study.json"):
         assert (out / f).exists(), f
     assert "condition 3:" in (out / "findings.md").read_text()
