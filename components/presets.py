@@ -291,8 +291,9 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
                                           "smooth enough for Newton, sharp enough to keep the wave"),
             damping_ratio=assumed(0.07),
             damping_ramp=assumed("1 um", "a contact's damping grows with its compressed zone (Hunt & Crossley); "
-                                         "under a third of the loaded flank's compression at rated load (3.1-15 um "
-                                         "at conditions 1-3), so loaded flanks keep their whole damping"),
+                                         "about a third of the least compressed loaded flank at rated load (2.9 um, "
+                                         "the ring mesh at condition 3; up to 18 um at condition 1), so loaded "
+                                         "flanks keep their whole damping"),
         ),
         operating=operating_point(condition, direction),
         rig=RigParams(
