@@ -798,7 +798,7 @@ def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
 
     values: (quantity key, condition, bearing, direction) -> value in SI units (None or absent: no such run).
     quantities: (key, words, SI unit). Bars start at zero; forces are shown in kN from 1 kN on."""
-    conds = sorted({k[1] for k in values})
+    conds = sorted({k[1] for k in values}, key=lambda c: (isinstance(c, str), c))   # conditions 1-4, then points
     if not conds:
         raise ValueError("values is empty")
     present = [d for d in ("forward", "reverse")
@@ -833,7 +833,8 @@ def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
                 ax.set_xlim(-0.6, len(bearings) - 0.4)
                 ax.grid(axis="x", visible=False)
                 ax.set_ylabel(_axis_label(_wrap(words, 24), shown))
-                ax.set_title(f"condition {c}" if len(conds) > 1 else words, fontsize=9)
+                where = f"condition {c}" if isinstance(c, (int, np.integer)) else f"point {c}"
+                ax.set_title(where if len(conds) > 1 else words, fontsize=9)
         _direction_legend(fig, present, hatch=True)
         if title:
             fig.suptitle(title)
