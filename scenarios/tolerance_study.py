@@ -165,6 +165,9 @@ def parse_args(argv):
                    help="dynamic runs: seconds analysed (default: the paper study's, whole cage revolutions)")
     args.add_shared(p, out="results/tolerances", conditions="3")
     a = p.parse_args(argv)
+    if a.operating:      # its torques are fractions of a condition's rated torque, its tables keyed by condition
+        p.error("argument --operating: the tolerance study runs the source's conditions (--conditions 1,2,3) and "
+                "fractions of their torque (--torques); user operating points are not taken here yet")
     if "4" in a.conditions.split(","):
         p.error("argument --conditions: condition 4 transmits no torque (0 kW): there is no load to share; "
                 "take 1, 2 and/or 3")

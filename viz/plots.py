@@ -26,7 +26,8 @@ from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator
 __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution", "against_viscosity",
            "mode_shapes", "fault_spectra", "fault_loads", "FAULT_QUANTITIES", "gear_quality", "forward_reverse_headline",
            "time_history_group", "cage_orbit_picture", "display_unit", "format_pct", "HEADLINE_QUANTITIES", "FWD", "REV",
-           "STYLE", "tolerance_distributions", "tolerance_against_torque", "tolerance_life_cdf"]
+           "STYLE", "tolerance_distributions", "tolerance_against_torque", "tolerance_life_cdf", "damage_shares",
+           "binned_series"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
 STYLE = {
@@ -531,7 +532,7 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
     the ring mesh's dynamic factor K_v and loaded transmission error p2p (the mesh the rig's sensor hears; the
     printed findings name the largest K_v of any mesh). ``groups``: rows of :func:`scenarios.gear_quality.by_grade`."""
     grades = [None] + sorted({g["grade"] for g in groups if g["grade"] is not None})
-    conds = sorted({g["condition"] for g in groups})
+    conds = sorted({g["condition"] for g in groups}, key=lambda c: (isinstance(c, str), c))   # conditions, then points
     at = {(g["condition"], g["direction"], g["grade"], g["bearing"]): g for g in groups}
     colors = ["#222222", "#2b8a3e", "#1f5fa8", "#c2255c", "#e07b00", "#7a1f7a"]
     width = 0.8 / len(grades)
@@ -578,7 +579,8 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
             ax.set_ylabel(_axis_label(words + ", ring mesh", unit))
             ax.set_title("ring mesh (outer planets–ring)")       # not a bearing column: say so
         for ax in axes[-1]:
-            ax.set_xticks(range(len(conds)), [f"condition {c}" for c in conds])
+            ax.set_xticks(range(len(conds)), [f"condition {c}" if isinstance(c, (int, np.integer)) else f"point {c}"
+                                              for c in conds])
             ax.set_xlim(-0.55, len(conds) - 0.45)
         axes[0, 0].legend(loc="best", title="filled: forward, open: reverse", title_fontsize=7)
         for ax in axes.ravel():
@@ -955,4 +957,62 @@ def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = Non
         fig.legend(handles=handles, loc="outside lower center", ncols=3, frameon=False, fontsize=7.5)
         if title:
             fig.suptitle(title)
+        return _save(fig, path)
+
+
+def damage_shares(bins: Sequence[str], time_shares: Sequence[float], shares: Mapping[str, Sequence[float]], path, *,
+                  title: str | None = None) -> Path:
+    """A duty cycle's damage per bin: for each bin its share of the cycle's time (grey) beside each bearing type's
+    and life's share of the damage (bars from zero, in %); a bin that does more damage than its time share is
+    where the life goes."""
+    n, k = len(bins), len(shares)
+    x = np.arange(n)
+    w = 0.8 / (k + 1)
+    colors = ["#1f5fa8", "#e07b00", "#6aa2d8", "#f2b066", "#4d9a4d", "#a64d79"]
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(max(6.0, 0.9 * n * (k + 1) / 2 + 2.5), 4.2), layout="constrained")
+        ax = fig.subplots()
+        ax.bar(x - 0.4 + w / 2, 100 * np.asarray(time_shares, float), w, color="#bbbbbb", label="time share")
+        for i, (name, vals) in enumerate(shares.items()):
+            y = np.array([np.nan if v is None else 100 * float(v) for v in vals])
+            ax.bar(x - 0.4 + w * (i + 1.5), y, w, color=colors[i % len(colors)], label=name,
+                   hatch="//" if "16281" in name else None, edgecolor="white", linewidth=0)
+        ax.set_xticks(x, [textwrap.fill(b, 18) for b in bins], fontsize=7.5, rotation=0 if n <= 6 else 30,
+                      ha="center" if n <= 6 else "right")
+        ax.set_ylim(0.0, None)
+        ax.set_ylabel(_axis_label("share of the cycle", "%"))
+        ax.grid(axis="x", visible=False)
+        ax.legend(loc="upper left", fontsize=7)
+        if title:
+            fig.suptitle(textwrap.fill(title, 110), fontsize=9.5)
+        return _save(fig, path)
+
+
+def binned_series(series: Mapping[str, Sequence[float]], names: Sequence[str], path, *,
+                  title: str | None = None) -> Path:
+    """A time series and its bins: speed and torque against time, each sample coloured by its bin (grey: at
+    standstill, in no bin); time in the unit that suits the span."""
+    t = np.asarray(series["t"], float)
+    b = np.asarray(series["bin"], int)
+    scale, unit = (1 / 3600, "h") if t[-1] - t[0] > 7200 else ((1 / 60, "min") if t[-1] - t[0] > 120 else (1, "s"))
+    cmap = mpl.colormaps["tab20"]
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(8.0, 5.0), layout="constrained")
+        axes = fig.subplots(2, 1, sharex=True)
+        for ax, key, words, u in ((axes[0], "speed_rpm", "carrier speed", "rpm"),
+                                  (axes[1], "torque_N_m", "output torque", "N m")):
+            y = np.asarray(series[key], float)
+            ax.step(t * scale, y, where="post", color="#888888", linewidth=0.6)
+            for j in range(len(names)):
+                sel = np.flatnonzero(b == j)
+                if sel.size:
+                    # sample k holds over [t_k, t_k+1): a horizontal segment per sample in its bin's colour
+                    segs = [[(t[i] * scale, y[i]), (t[i + 1] * scale, y[i])] for i in sel]
+                    ax.add_collection(LineCollection(segs, colors=[cmap(j % 20)], linewidths=2.2,
+                                                     label=names[j] if key == "speed_rpm" else None))
+            ax.set_ylabel(_axis_label(words, u))
+        axes[1].set_xlabel(_axis_label("time", unit))
+        fig.legend(loc="outside right upper", fontsize=6.5, title="bin")
+        if title:
+            fig.suptitle(textwrap.fill(title, 100), fontsize=9.5)
         return _save(fig, path)

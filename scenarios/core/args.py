@@ -17,6 +17,8 @@ from components.names import argparse_hint, did_you_mean
 from components.scene import SceneOptions
 from components.units import ParameterError, quantity, to_si
 
+from .points import parse_point
+
 __all__ = ["Parser", "parser", "add_shared", "SHARED", "positive", "nonnegative", "count", "alpha", "conditions",
            "one_condition", "operating_point", "directions", "existing_file", "quantity_of", "key_value", "scheduler", "out_folder",
            "choice_list", "int_list", "float_list", "parse_sets", "switch_value", "scene_options", "invoked_as"]
@@ -256,7 +258,6 @@ class _Given(argparse.Action):
 
 def operating_point(text):
     """One ``--operating`` point (scenarios.core.points.parse_point), checked where it is read; the text is passed on."""
-    from .points import parse_point
     try:
         parse_point(text)
     except ParameterError as exc:
@@ -318,9 +319,10 @@ def add_shared(p, *names: str, out: str | None = None, conditions: str | None = 
             if one_condition_only:
                 flags = (*flags, "--condition")
                 writes = "out" in (names or SWEEP)          # a command without --out: no advice about it
-                kw.update(type=one_condition if writes else _one_condition(), metavar="C",
+                kw.update(type=one_condition if writes else _one_condition(), metavar="C", action=_Given,
                           help=f"operating condition 1-4, one (docs/parameters.md; default {conditions}; --condition: "
                                f"the former spelling, still accepted)")
+                p.set_defaults(conditions_given=False)
             else:
                 kw["help"] = kw["help"].format(conditions=conditions)
                 kw["action"] = _Given            # a study tells a default from a choice (points: README)

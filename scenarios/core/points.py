@@ -32,11 +32,12 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from components.geometry import speed_ratio
+from components.params import overrides_from_toml
 from components.presets import CONDITIONS
 from components.units import ParameterError, quantity, to_si
 
 __all__ = ["Point", "parse_point", "preset", "points_from_toml", "file_overrides", "study_points", "point_overrides",
-           "check_oil_temperature", "machine_identity", "points_of", "machine_overrides", "point_label", "point_tag", "point_order", "OIL_RANGE_C",
+           "check_oil_temperature", "checked_point", "machine_identity", "points_of", "machine_overrides", "point_words", "file_without", "point_label", "point_tag", "point_order", "OIL_RANGE_C",
            "OIL_MIN_VISCOSITY"]
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]*$")
@@ -125,7 +126,7 @@ def parse_point(text: str, default_name: str = "p1", where: str = "--operating")
             _once(fields, "load", item, where, text)
         else:
             _once(fields, "oil_temperature", item, where, text)
-    return _checked(Point(**fields), where)
+    return checked_point(Point(**fields), where)
 
 
 def _once(fields: dict, key: str, value, where: str, text: str) -> None:
@@ -134,7 +135,7 @@ def _once(fields: dict, key: str, value, where: str, text: str) -> None:
     fields[key] = value
 
 
-def _checked(p: Point, where: str) -> Point:
+def checked_point(p: Point, where: str) -> Point:
     """A point whose name is a folder-safe word, with a speed and a load (a preset's numbers are its own)."""
     if not _NAME.match(p.name) or p.name.isdigit():
         raise ParameterError.at(where, f"a point's name is a word of letters, digits, '_', '-' or '.' starting with a "
@@ -178,7 +179,7 @@ def points_from_toml(path) -> list[Point]:
         if ("power" in t) == ("torque" in t):
             raise ParameterError.at(where, "give one of power and torque")
         shaft = "carrier" if "carrier_speed" in t else "sun"
-        out.append(_checked(Point(name=str(t.get("name", f"p{i + 1}")), speed=str(t[f"{shaft}_speed"]), shaft=shaft,
+        out.append(checked_point(Point(name=str(t.get("name", f"p{i + 1}")), speed=str(t[f"{shaft}_speed"]), shaft=shaft,
                                   load=str(t.get("power", t.get("torque"))), direction=t.get("direction"),
                                   oil_temperature=t.get("oil_temperature")), where))
     return out
@@ -193,7 +194,6 @@ def _toml(path) -> dict:
 
 def file_overrides(path) -> dict:
     """The parameter overrides of a ``--params`` file without its ``[[operating_point]]`` tables."""
-    from components.params import overrides_from_toml
     data = _toml(path)
     if "operating_point" not in data:
         return overrides_from_toml(Path(path).read_text(encoding="utf-8"))
@@ -253,14 +253,14 @@ def _machine_point(file_ops: dict, set_ops: dict, params_file: str | None) -> Po
         miss = "operating.carrier_speed" if "operating.carrier_speed" not in ops else "operating.output_power"
         raise ParameterError.at(miss, f"the machine's operating point needs both operating.carrier_speed and "
                                       f"operating.output_power (reference: {ref_speed:~P}, {ref_power:~P})")
-    return _checked(Point(name=name, speed=str(ops["operating.carrier_speed"]), load=str(ops["operating.output_power"]),
+    return checked_point(Point(name=name, speed=str(ops["operating.carrier_speed"]), load=str(ops["operating.output_power"]),
                           direction=ops.get("operating.direction")), "operating")
 
 
 def check_oil_temperature(text: str, lubricant_si, where: str) -> None:
     """Refuse an oil temperature outside :data:`OIL_RANGE_C` or where the lubricant's Walther line gives less than
     :data:`OIL_MIN_VISCOSITY` (one line naming ``where``)."""
-    from components.lubrication import walther_viscosity
+    from components.lubrication import walther_viscosity  # deferred: it imports the engine (numba), which parsing does not need
     T = to_si(quantity(where, text, "temperature"))
     lo, hi = OIL_RANGE_C
     if not lo + 273.15 <= T <= hi + 273.15:
@@ -348,3 +348,19 @@ def machine_overrides(sets: dict, points: list[Point]) -> dict:
         raise ParameterError.at("lubricant.temperature", f"--set sets it, but the point {own[0]} sets its own oil "
                                                          f"temperature: give it in one place")
     return {k: v for k, v in sets.items() if not k.startswith("operating.")}
+
+
+def point_words(condition) -> str:
+    """How a table or a figure names a point: ``condition 3`` for a preset, ``point cruise`` for a user point."""
+    return f"condition {condition}" if isinstance(condition, int) else f"point {condition}"
+
+
+def file_without(params_file: str | None, owned: dict[str, str]) -> tuple[dict, list[str]]:
+    """A study that sweeps some parameters (``owned``: key → its option) takes a ``--params`` file that also sets
+    them: the file's other overrides (not its operating point, which :func:`points_of` reads) and the keys the
+    sweep's values replace (the caller says so in one line)."""
+    if not params_file:
+        return {}, []
+    fo = file_overrides(params_file)
+    replaced = sorted(k for k in fo if k in owned)
+    return {k: v for k, v in fo.items() if k not in owned and not k.startswith("operating.")}, replaced

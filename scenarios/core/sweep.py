@@ -31,6 +31,7 @@ from components.results import Summary
 from components.results.io import atomic_write_text
 from components.units import ParameterError
 
+from .points import Point, file_overrides, point_overrides
 from .integrity import OtherResults, claim_folder, differences, read_summary
 from .runner import finished_run, parameters_fingerprint, run_case, run_description, run_fingerprint
 
@@ -160,7 +161,6 @@ def build_params(case: Case):
     """The case's parameters: a preset's reference machine at its condition and direction, the ``--params`` file,
     the overrides; a user point's machine (the file and overrides at the reference condition 3) put at the point
     (:func:`scenarios.core.points.point_overrides`)."""
-    from .points import Point, file_overrides, point_overrides
     if case.point is None:
         base = reference_dpgt(case.condition, case.direction)
         if case.params_file:
