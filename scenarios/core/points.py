@@ -94,7 +94,7 @@ def parse_point(text: str, default_name: str = "p1", where: str = "--operating")
     ParameterError naming ``where`` and the item otherwise."""
     raw = str(text).strip()
     name = default_name
-    m = re.match(r"^\s*([A-Za-z_][A-Za-z0-9_.\-]*)\s*:(.*)$", raw)
+    m = re.match(r"^\s*([^:,]*?)\s*:(.*)$", raw)          # a name (checked below) before the first colon
     if m:
         name, raw = m.group(1), m.group(2)
     items = [x.strip() for x in raw.split(",") if x.strip()]
@@ -188,7 +188,9 @@ def points_from_toml(path) -> list[Point]:
 def _toml(path) -> dict:
     try:
         return tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError as exc:
+        raise ParameterError.at(f"--params {path}", str(exc)) from None
+    except tomllib.TOMLDecodeError as exc:
         raise ParameterError.at(f"--params {path}", f"invalid TOML: {exc}") from None
 
 
@@ -216,23 +218,29 @@ _OPERATING = ("operating.carrier_speed", "operating.output_power", "operating.di
 def study_points(conditions: str | None, operating: list[str] | None, params_file: str | None, sets: dict,
                  default: str) -> list[Point]:
     """The points a study runs (module docstring): ``--conditions`` (None: not given), ``--operating`` texts, the
-    ``--params`` file's ``[[operating_point]]`` tables or its ``[operating]`` table; the study's ``default``
-    conditions when none of them names a point. A point named twice, or an ``operating.*`` override that would
-    change a point, is refused in one line."""
-    file_ops = {k: v for k, v in (file_overrides(params_file) if params_file else {}).items() if k in _OPERATING}
+    ``--params`` file's ``[[operating_point]]`` tables or its ``[operating]`` table (the machine's own point, when it
+    gives the speed and the power and nothing else names a point); the study's ``default`` conditions when none of
+    them names a point. Refused in one line: a ``--set operating.*`` (a point sets it: it would relabel the run), a
+    file's ``[operating]`` beside other points or without its speed and power, a point named twice."""
+    for key in sorted(k for k in sets if k.startswith("operating.")):
+        raise ParameterError(f"{key} is set by this study's {_OPTION.get(key, '--conditions or --operating')}, not "
+                             f"by --set (a point gives the speed, the load and the direction: --operating "
+                             f"\"NAME: SPEED, LOAD[, reverse]\")", parameter=key)
+    file_ops = {k: v for k, v in (file_overrides(params_file) if params_file else {}).items()
+                if k.startswith("operating.")}
     pts = [preset(int(c)) for c in str(conditions).split(",") if c.strip()] if conditions else []
     pts += [parse_point(t, f"p{i + 1}") for i, t in enumerate(operating or [])]
     if params_file:
         pts += points_from_toml(params_file)
-    set_ops = sorted(k for k in sets if k.startswith("operating."))
-    if pts and (file_ops or set_ops):
-        key = set_ops[0] if set_ops else sorted(file_ops)[0]
-        src = "--set" if set_ops else f"--params {params_file}"
-        raise ParameterError.at(key, f"{src} sets it, but the points ({', '.join(p.name for p in pts)}) set the "
-                                     f"operating point: give the speed and load in the point "
-                                     f"(--operating \"NAME: SPEED, LOAD\" or [[operating_point]]), not both")
-    if not pts and (file_ops or set_ops):
-        pts = [_machine_point(file_ops, {k: sets[k] for k in set_ops}, params_file)]
+    if file_ops:
+        complete = {"operating.carrier_speed", "operating.output_power"} <= set(file_ops)
+        if pts or not complete:
+            key = sorted(file_ops)[0]
+            why = (f"beside the points {', '.join(p.name for p in pts)}" if pts else
+                   "(a file's [operating] table with carrier_speed and output_power is the machine's own point)")
+            raise ParameterError(f"{key} is set by this study's {_OPTION.get(key, '--conditions or --operating')}, "
+                                 f"not by --params {params_file} {why}", parameter=key)
+        pts = [_machine_point(file_ops, params_file)]
     if not pts:
         pts = [preset(int(c)) for c in default.split(",")]
     names = [p.name for p in pts]
@@ -242,19 +250,22 @@ def study_points(conditions: str | None, operating: list[str] | None, params_fil
     return pts
 
 
-def _machine_point(file_ops: dict, set_ops: dict, params_file: str | None) -> Point:
-    """The point a machine file's ``[operating]`` table (or ``--set operating.*``) gives, named after the file."""
-    ops = {**file_ops, **set_ops}
-    ref_speed, ref_power = CONDITIONS[3]
-    name = re.sub(r"[^A-Za-z0-9_.\-]", "_", Path(params_file).stem) if params_file else "operating"
-    if not _NAME.match(name):
+_OPTION = {"operating.carrier_speed": "--conditions or --operating", "operating.output_power":
+           "--conditions or --operating", "operating.direction": "--directions"}
+
+
+def _machine_point(ops: dict, params_file: str) -> Point:
+    """The point a machine file's ``[operating]`` table gives, named after the file."""
+    name = re.sub(r"[^A-Za-z0-9_.\-]", "_", Path(params_file).stem)
+    if not _NAME.match(name) or name.isdigit():
         name = f"m_{name}"
-    if "operating.carrier_speed" not in ops or "operating.output_power" not in ops:
-        miss = "operating.carrier_speed" if "operating.carrier_speed" not in ops else "operating.output_power"
-        raise ParameterError.at(miss, f"the machine's operating point needs both operating.carrier_speed and "
-                                      f"operating.output_power (reference: {ref_speed:~P}, {ref_power:~P})")
-    return checked_point(Point(name=name, speed=str(ops["operating.carrier_speed"]), load=str(ops["operating.output_power"]),
-                          direction=ops.get("operating.direction")), "operating")
+    unknown = sorted(set(ops) - set(_OPERATING))
+    if unknown:
+        raise ParameterError.at(unknown[0], f"--params {params_file}: the operating point takes carrier_speed, "
+                                            f"output_power and direction")
+    return checked_point(Point(name=name, speed=str(ops["operating.carrier_speed"]),
+                               load=str(ops["operating.output_power"]), direction=ops.get("operating.direction")),
+                         f"--params {params_file} [operating]")
 
 
 def check_oil_temperature(text: str, lubricant_si, where: str) -> None:
