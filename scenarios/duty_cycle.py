@@ -560,6 +560,12 @@ def headline(rec: dict) -> str:
         cells = [f"{_g(weakest[k][0])} ({weakest[k][1]})" if k in weakest else "–" for k, _ in LIVES]
         lines.append(f"| {kind} | {cells[0]} | {cells[1]} | {d['equivalent_load_N'] / 1e3:.4g} | "
                      f"{rec['bins'][top]['name']} ({100 * shares[top]:.1f} %) |")
+    for b in rec["bins"]:
+        inc = b["dynamic_increment_equivalent_load"]
+        if inc:
+            lines.append(f"dynamic bin {b['name']}: its dynamic run's equivalent load is "
+                         f"{100 * inc['inner']:+.2f} % (inner) and {100 * inc['outer']:+.2f} % (outer) of the static "
+                         f"solution's; its lives are the dynamic run's")
     if rec["static_lives_note"]:
         lines.append(f"note: {rec['static_lives_note']} ({len(rec['lives_ignore_dynamic_load'])} of "
                      f"{len(rec['bins'])} bins)")

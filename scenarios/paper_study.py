@@ -32,7 +32,7 @@ from components.results.io import atomic_write_text, write_summary
 from .core.integrity import read_summary
 from .core.runner import RunConfig
 from .core.study import Study, StudyRun
-from .core.points import machine_overrides, point_label, point_order, point_tag, points_of
+from .core.points import machine_identity, machine_overrides, point_label, point_order, point_tag, points_of
 from .core.sweep import Case, user_overrides
 from .core import args
 from .core.command import command
@@ -179,7 +179,7 @@ def _fmt(x, nd=4):
     return "–" if x is None else f"{x:.{nd}g}"
 
 
-def write_tables(rows: list[dict], out: Path) -> tuple[Path, Path, str]:
+def write_tables(rows: list[dict], out: Path, machine: dict | None = None) -> tuple[Path, Path, str]:
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=list(rows[0]) if rows else ["condition"])
     w.writeheader()
@@ -193,6 +193,8 @@ def write_tables(rows: list[dict], out: Path) -> tuple[Path, Path, str]:
                 md.append(f"| {r['bearing']} | {r['description']} [{r['unit']}] | {_fmt(r['forward'])} | "
                           f"{_fmt(r['reverse'])} | {_fmt(r['difference_pct'], 3)} |")
     text = "\n".join(md).strip() + "\n"
+    if machine is not None:        # the machine the tables are of: its file, a short fingerprint, the overrides
+        text = f"Machine: {machine['label']}\n\n" + text
     atomic_write_text(out / "comparison.md", text)
     return out / "comparison.csv", out / "comparison.md", text
 
@@ -428,7 +430,12 @@ class PaperStudy(Study):
         rows = comparison_rows(results)
         if static:         # a quantity only a dynamic run gives is not in the tables at all (not a row of dashes)
             rows = [r for r in rows if r["forward"] is not None or r["reverse"] is not None]
-        csv_p, md_p, text = write_tables(rows, self.out)
+        sets = args.parse_sets(self.a.set)
+        over = {k: v for k, v in sets.items() if not k.startswith("operating.")}
+        if self.a.planets is not None:
+            over["gears.planets"] = self.a.planets
+        machine = machine_identity(self.a.params, over)
+        csv_p, md_p, text = write_tables(rows, self.out, machine)
         print("\n" + headline_table(rows))   # the headline first, then the whole comparison
         print("\n" + text)
         if static:

@@ -970,13 +970,14 @@ def damage_shares(bins: Sequence[str], time_shares: Sequence[float], shares: Map
     w = 0.8 / (k + 1)
     colors = ["#1f5fa8", "#e07b00", "#6aa2d8", "#f2b066", "#4d9a4d", "#a64d79"]
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(max(6.0, 0.9 * n * (k + 1) / 2 + 2.5), 4.2), layout="constrained")
+        fig = Figure(figsize=(min(12.0, max(6.0, 1.2 * n + 2.0)), 4.4), layout="constrained")
         ax = fig.subplots()
         ax.bar(x - 0.4 + w / 2, 100 * np.asarray(time_shares, float), w, color="#bbbbbb", label="time share")
         for i, (name, vals) in enumerate(shares.items()):
             y = np.array([np.nan if v is None else 100 * float(v) for v in vals])
-            ax.bar(x - 0.4 + w * (i + 1.5), y, w, color=colors[i % len(colors)], label=name,
-                   hatch="//" if "16281" in name else None, edgecolor="white", linewidth=0)
+            bars = ax.bar(x - 0.4 + w * (i + 1.5), y, w, color=colors[i % len(colors)], label=name,
+                          hatch="//" if "16281" in name else None, edgecolor="white", linewidth=0)
+            ax.bar_label(bars, labels=["" if not v >= 1.0 else f"{v:.0f}" for v in y], fontsize=6, padding=1)
         ax.set_xticks(x, [textwrap.fill(b, 18) for b in bins], fontsize=7.5, rotation=0 if n <= 6 else 30,
                       ha="center" if n <= 6 else "right")
         ax.set_ylim(0.0, None)
