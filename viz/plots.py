@@ -996,9 +996,9 @@ def binned_series(series: Mapping[str, Sequence[float]], names: Sequence[str], p
     t = np.asarray(series["t"], float)
     b = np.asarray(series["bin"], int)
     scale, unit = (1 / 3600, "h") if t[-1] - t[0] > 7200 else ((1 / 60, "min") if t[-1] - t[0] > 120 else (1, "s"))
-    cmap = mpl.colormaps["tab20"]
+    cmap = mpl.colormaps["tab10" if len(names) <= 10 else "tab20"]
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(8.0, 5.0), layout="constrained")
+        fig = Figure(figsize=(8.0, 5.6 + 0.2 * ((len(names) + 2) // 3)), layout="constrained")
         axes = fig.subplots(2, 1, sharex=True)
         for ax, key, words, u in ((axes[0], "speed_rpm", "carrier speed", "rpm"),
                                   (axes[1], "torque_N_m", "output torque", "N m")):
@@ -1009,11 +1009,12 @@ def binned_series(series: Mapping[str, Sequence[float]], names: Sequence[str], p
                 if sel.size:
                     # sample k holds over [t_k, t_k+1): a horizontal segment per sample in its bin's colour
                     segs = [[(t[i] * scale, y[i]), (t[i + 1] * scale, y[i])] for i in sel]
-                    ax.add_collection(LineCollection(segs, colors=[cmap(j % 20)], linewidths=2.2,
+                    ax.add_collection(LineCollection(segs, colors=[cmap(j % cmap.N)], linewidths=2.2,
                                                      label=names[j] if key == "speed_rpm" else None))
             ax.set_ylabel(_axis_label(words, u))
         axes[1].set_xlabel(_axis_label("time", unit))
-        fig.legend(loc="outside right upper", fontsize=6.5, title="bin")
+        fig.legend(loc="outside lower center", ncols=min(3, max(1, len(names))), fontsize=7, title="bin",
+                   title_fontsize=7.5)
         if title:
             fig.suptitle(textwrap.fill(title, 100), fontsize=9.5)
         return _save(fig, path)
