@@ -40,7 +40,7 @@ from components.units import ParameterError, quantity, to_si
 from .core import args
 from .core.command import command
 from .core.lock import holds_out_folder
-from .core.points import Point, checked_point, machine_identity
+from .core.points import Point, checked_point, machine_identity, points_from_toml
 from .core.runner import RunConfig
 from .core.study import Study, StudyRun
 from .core.sweep import Case, build_params, user_overrides
@@ -440,8 +440,13 @@ class DutyCycle(Study):
         super().__init__(a)
         sets = args.parse_sets(a.set)
         self.overrides = user_overrides(sets, a.params, {"operating": "the cycle's bins (--cycle)"})
+        if a.params and points_from_toml(a.params):
+            raise ParameterError.at(f"--params {a.params}", "its [[operating_point]] tables are not used here: the "
+                                                            "cycle's bins (--cycle) are the operating points")
         self.machine = machine_identity(a.params, self.overrides)
         self.cycle = read_cycle(a.cycle, a.speed_bin, a.torque_bin)
+        for n in self.cycle.notes:             # said before anything runs (and kept in duty_cycle.json)
+            print(n, flush=True)
         names = [b.point.name for b in self.cycle.bins]
         asked = [x.strip() for x in a.dynamic.split(",") if x.strip()]
         if asked == ["all"]:
@@ -483,8 +488,6 @@ class DutyCycle(Study):
         return {"machine": self.machine, "cycle": self.cycle.source}
 
     def report(self, run: StudyRun) -> dict:
-        for n in self.cycle.notes:
-            print(n)
         res = run.results
         bins = self.cycle.bins
         chosen, increments, sources = [], {}, []

@@ -322,7 +322,8 @@ def headline_values(results: dict) -> dict[tuple, float | None]:
     return vals
 
 
-def plots(results: dict, out: Path) -> list[Path]:
+def plots(results: dict, out: Path, machine: str = "") -> list[Path]:
+    """Every figure of a dynamic study; ``machine``: the machine's label, in the headline figure's title."""
     # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
     from viz import plots as vp
     from viz.results import study_cage_pictures
@@ -344,7 +345,7 @@ def plots(results: dict, out: Path) -> list[Path]:
         one = f", {_title(conds[0]).lower()}" if len(conds) == 1 else ""
         paths.append(vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
                                                  title=f"Planet bearings (pair 1): mean load and L10 life, forward vs "
-                                                       f"reverse{one}"))
+                                                       f"reverse{one}" + (f"\n{machine}" if machine else "")))
     table, bar_units, ylabels = {}, {}, {}
     for q, unit in QUANTITIES:
         if q not in BAR_QUANTITIES:
@@ -367,7 +368,7 @@ def plots(results: dict, out: Path) -> list[Path]:
     return paths
 
 
-def static_plots(results: dict, out: Path) -> list[Path]:
+def static_plots(results: dict, out: Path, machine: str = "") -> list[Path]:
     """Static mode's figure: the headline (mean load and lives, forward vs reverse); the others need time series."""
     from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
@@ -378,7 +379,7 @@ def static_plots(results: dict, out: Path) -> list[Path]:
     one = f", {_title(conds[0]).lower()}" if len(conds) == 1 else ""
     return [vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
                                         title=f"Planet bearings (pair 1), quasi-static: mean load and L10 life, "
-                                              f"forward vs reverse{one}")]
+                                              f"forward vs reverse{one}" + (f"\n{machine}" if machine else ""))]
 
 
 def animate(results: dict, out: Path) -> list[Path]:
@@ -443,8 +444,8 @@ class PaperStudy(Study):
             print(f"static mode ({self.a.snapshots} snapshots): left out, as only a dynamic run gives them: "
                   f"{', '.join(left)}; no time histories, cage orbits, bars of RMS values or animation")
         run.step("tables", lambda: [csv_p, md_p])
-        figs = run.step("figures", plots, results, self.out) if not static else \
-            run.step("figures", static_plots, results, self.out)
+        figs = run.step("figures", plots, results, self.out, machine["label"]) if not static else \
+            run.step("figures", static_plots, results, self.out, machine["label"])
         anims = run.step("animation", animate, results, self.out) if self.a.animate and not static else []
         return {"rows": rows, "figures": figs, "animations": anims}
 

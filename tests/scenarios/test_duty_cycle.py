@@ -199,3 +199,11 @@ def test_the_example_cycles_read(tmp_path):
     assert sum(b.share for b in rev.bins if b.point.direction == "reverse") == pytest.approx(0.1, rel=1e-12)
     series = duty_cycle.read_cycle(root / "series.csv", "500 rpm", "200 N*m")
     assert series.binning is not None and any(b.point.direction == "reverse" for b in series.bins)
+
+
+def test_a_machine_file_with_its_own_points_is_refused_beside_a_cycle(tmp_path, capsys):
+    """The cycle's bins are the operating points: a --params file's points would be ignored silently."""
+    m = _cycle(tmp_path, "m.toml", '[[operating_point]]\nname = "x"\ncarrier_speed = "1000 rpm"\npower = "1 kW"\n')
+    c = _cycle(tmp_path, "c.toml", ONE_BIN)
+    assert duty_cycle.main(["--cycle", str(c), "--params", str(m), "--out", str(tmp_path / "o")]) == 2
+    assert "[[operating_point]] tables are not used here" in capsys.readouterr().err
