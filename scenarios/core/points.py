@@ -287,8 +287,7 @@ def point_overrides(point: Point, params) -> dict:
     """The parameter overrides that put the machine ``params`` at ``point`` (a user point; a preset's are its
     ``reference_dpgt(condition, direction)``): the carrier speed (a sun speed through the machine's ratio
     ω_s = (1 − z_r/z_s)... as :func:`components.geometry.speed_ratio` gives), the output power (a torque times its
-    shaft's speed; lossless), the direction and the oil temperature. Braking (a negative load) is refused: the
-    model drives the sun and loads the carrier (operating.output_power >= 0)."""
+    shaft's speed; lossless; negative: braking), the direction and the oil temperature."""
     where = f"point {point.name}"
     g = params.gears.si()
     w = to_si(quantity(f"{where} speed", point.speed, "angular_velocity"))
@@ -297,10 +296,6 @@ def point_overrides(point: Point, params) -> dict:
     w_shaft = w
     kind, value = _quantity_kind(point.load)
     power = value if kind == "power" else value * w_shaft
-    if power < 0:
-        raise ParameterError.at(where, f"braking ({point.load}: power flowing from the carrier back to the sun) is "
-                                       f"not modelled: the rig drives the sun and loads the carrier "
-                                       f"(operating.output_power >= 0)")
     out = {"operating.carrier_speed": point.speed if point.shaft == "carrier" else f"{w_c!r} rad/s",
            "operating.output_power": point.load if kind == "power" else f"{power!r} W"}
     if point.direction is not None:

@@ -167,7 +167,6 @@ def test_binning_a_synthetic_series_gives_its_known_times_and_revolutions():
      "[[bin]] #1: carrier speed 5000 rpm is above the machine's rated 4200 rpm"),
     ('[[bin]]\nname = "hot"\ncarrier_speed = "1000 rpm"\npower = "50 kW"\nhours = 1\noil_temperature = "200 degC"\n',
      "[[bin]] #1: oil temperature 200 degC is outside the lubricant's range"),
-    ('[[bin]]\nname = "brake"\ncarrier_speed = "1000 rpm"\npower = "-50 kW"\nhours = 1\n', "[[bin]] #1: braking"),
 ])
 def test_a_bad_cycle_is_refused_in_one_line_naming_the_row(text, message, tmp_path, capsys):
     p = _cycle(tmp_path, "bad.toml", text)
