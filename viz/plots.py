@@ -48,6 +48,15 @@ REV = {"color": "#e07b00", "linestyle": "--", "label": "reverse"}
 _MARK_COLOR = "#7a1f7a"
 
 
+def _point_key(c):
+    """Operating conditions 1-4 first, then a user's points by name."""
+    return (isinstance(c, str), c)
+
+
+def _point_words(c) -> str:
+    return f"condition {c}" if isinstance(c, (int, np.integer)) else f"point {c}"
+
+
 def _axis_label(name: str, unit: str | None) -> str:
     return f"{name} [{unit if unit else '–'}]"
 
@@ -622,7 +631,7 @@ def tolerance_distributions(dist: Mapping[tuple, Mapping[tuple, Sequence[float]]
     """The distribution of the mesh K_γ over the machines (empirical CDF, a step per machine): a panel per
     (condition, torque fraction), a colour per class, solid forward and dashed reverse; the rating tables' value
     and the P90 level dotted. ``dist``: {(condition, torque fraction): {(class, direction): K_γ values}}."""
-    conds = sorted({k[0] for k in dist})
+    conds = sorted({k[0] for k in dist}, key=_point_key)
     torques = sorted({k[1] for k in dist})
     classes = sorted({c for v in dist.values() for c, _ in v})
     directions = [d for d in ("forward", "reverse") if any(dd == d for v in dist.values() for _, dd in v)]
@@ -640,7 +649,7 @@ def tolerance_distributions(dist: Mapping[tuple, Mapping[tuple, Sequence[float]]
                 ax.axvline(table, color=_MARK_COLOR, ls=":", lw=0.9)
                 ax.axhline(0.9, color="#888888", ls=":", lw=0.8)
                 ax.set_ylim(0.0, 1.02)
-                ax.set_title(f"condition {c}, {f:g} × rated torque")
+                ax.set_title(f"{_point_words(c)}, {f:g} × rated torque")
                 ax.set_xlabel(_axis_label("mesh load sharing K_γ", None))
                 if k == 0:
                     ax.set_ylabel(_axis_label("share of machines at or below", None))
@@ -657,7 +666,7 @@ def tolerance_against_torque(bands: Mapping[tuple, Mapping[int, Sequence[tuple]]
     """The mesh K_γ against the output torque: the machines' median (line and markers) and the band up to their
     P90 (shaded, its edge thin), a panel per (condition, direction), a colour per class. ``bands``:
     {(condition, direction): {class: [(output torque N·m, P50, P90), ...]}}."""
-    conds = sorted({k[0] for k in bands})
+    conds = sorted({k[0] for k in bands}, key=_point_key)
     directions = [d for d in ("forward", "reverse") if any(k[1] == d for k in bands)]
     classes = sorted({c for v in bands.values() for c in v})
     with mpl.rc_context(STYLE):
@@ -677,7 +686,7 @@ def tolerance_against_torque(bands: Mapping[tuple, Mapping[int, Sequence[tuple]]
                     ax.plot(t, p50, color=color, lw=1.4, marker="o", ms=4)
                 ax.axhline(table, color=_MARK_COLOR, ls=":", lw=0.9)
                 ax.set_xlim(0.0, 1.06 * ax.get_xlim()[1])        # from zero torque, the last marker inside
-                ax.set_title(f"condition {c}, {d}")
+                ax.set_title(f"{_point_words(c)}, {d}")
                 ax.set_xlabel(_axis_label("output torque", "N·m"))
                 if k == 0:
                     ax.set_ylabel(_axis_label("mesh load sharing K_γ", None))
@@ -698,7 +707,7 @@ def tolerance_life_cdf(cdfs: Mapping[tuple, Mapping[tuple, tuple]], path, *, tit
     machine's (a dotted vertical line per direction, black forward, grey reverse): a row per (condition, bearing
     type), a column per life standard, a colour per class. ``cdfs``: {(condition, bearing type, standard):
     {(class, direction): (lives in h, the perfect machine's life in h)}}."""
-    rows = sorted({(k[0], k[1]) for k in cdfs})
+    rows = sorted({(k[0], k[1]) for k in cdfs}, key=lambda r: (_point_key(r[0]), r[1]))
     stds = sorted({k[2] for k in cdfs}, key=lambda s: "16281" in s)
     classes = sorted({c for v in cdfs.values() for c, _ in v})
     directions = [d for d in ("forward", "reverse") if any(dd == d for v in cdfs.values() for _, dd in v)]
@@ -723,7 +732,7 @@ def tolerance_life_cdf(cdfs: Mapping[tuple, Mapping[tuple, tuple]], path, *, tit
                 _plain_log(ax.xaxis, decades=1.0)
                 ax.axhline(0.1, color="#888888", ls=":", lw=0.6)
                 ax.set_ylim(0.0, 1.02)
-                ax.set_title(f"condition {c}, {kind} planet bearings, {std}")
+                ax.set_title(f"{_point_words(c)}, {kind} planet bearings, {std}")
                 ax.set_xlabel(_axis_label("L10 life of the weakest bearing", "h"))
                 if k == 0:
                     ax.set_ylabel(_axis_label("share of machines at or below", None))

@@ -146,3 +146,19 @@ def test_braking_loads_the_flanks_reverse_driving_loads(tmp_path):
         assert mb["drive_flank"] == md["drive_flank"]
         assert mb["drive_force_mean_N"] == pytest.approx(md["drive_force_mean_N"], rel=0.01)
         assert mb["coast_force_mean_N"] == 0.0
+
+
+def test_the_tolerance_study_scales_a_points_torque(tmp_path):
+    """Its torques are fractions of the point's own load: at 0.5 and 1 × "120 kW" the machines run 60 and 120 kW at
+    the point's speed; a point that transmits nothing is refused."""
+    from scenarios import tolerance_study
+    a = tolerance_study.parse_args(["--samples", "2", "--classes", "5", "--torques", "0.5,1", "--operating",
+                                    "cruise: 1500 rpm, 120 kW", "--directions", "forward", "--out", str(tmp_path)])
+    tasks = tolerance_study.ToleranceStudy(a).tasks
+    powers = {(t.torque, t.sample): build_params(t.case).si().operating for t in tasks}
+    assert {k[0]: v.output_power for k, v in powers.items()} == {0.5: pytest.approx(60e3), 1.0: pytest.approx(120e3)}
+    assert all(v.carrier_speed == pytest.approx(1500 * math.pi / 30) for v in powers.values())
+    assert {t.path.split("/")[-2] for t in tasks if t.sample is not None} == {"cruise_forward_t0.5", "cruise_forward_t1"}
+    a = tolerance_study.parse_args(["--operating", "idle: 1500 rpm, 0 kW", "--out", str(tmp_path)])
+    with pytest.raises(ParameterError, match="point idle: transmits no torque"):
+        tolerance_study.ToleranceStudy(a)
