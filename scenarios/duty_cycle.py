@@ -484,8 +484,11 @@ class DutyCycle(Study):
                 out.append(self._case(b, dynamic=True))
         return out
 
+    def machine_identity(self) -> dict:
+        return self.machine
+
     def study_record(self) -> dict:
-        return {"machine": self.machine, "cycle": self.cycle.source}
+        return {"cycle": self.cycle.source}
 
     def report(self, run: StudyRun) -> dict:
         res = run.results

@@ -421,6 +421,12 @@ class PaperStudy(Study):
     def cases(self) -> list[Case]:
         return make_cases(self.a, self.out)
 
+    def machine_identity(self) -> dict:
+        over = {k: v for k, v in args.parse_sets(self.a.set).items() if not k.startswith("operating.")}
+        if self.a.planets is not None:
+            over["gears.planets"] = self.a.planets
+        return machine_identity(self.a.params, over)
+
     def report(self, run: StudyRun) -> dict:
         results = run.results
         relative_life(results)
@@ -431,11 +437,7 @@ class PaperStudy(Study):
         rows = comparison_rows(results)
         if static:         # a quantity only a dynamic run gives is not in the tables at all (not a row of dashes)
             rows = [r for r in rows if r["forward"] is not None or r["reverse"] is not None]
-        sets = args.parse_sets(self.a.set)
-        over = {k: v for k, v in sets.items() if not k.startswith("operating.")}
-        if self.a.planets is not None:
-            over["gears.planets"] = self.a.planets
-        machine = machine_identity(self.a.params, over)
+        machine = self.machine_identity()
         csv_p, md_p, text = write_tables(rows, self.out, machine)
         print("\n" + headline_table(rows))   # the headline first, then the whole comparison
         print("\n" + text)
