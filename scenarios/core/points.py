@@ -37,7 +37,8 @@ from components.presets import CONDITIONS
 from components.units import ParameterError, quantity, to_si
 
 __all__ = ["Point", "parse_point", "preset", "points_from_toml", "file_overrides", "study_points", "point_overrides",
-           "check_oil_temperature", "checked_point", "machine_identity", "points_of", "machine_overrides", "point_words", "file_without", "point_label", "point_tag", "point_order", "OIL_RANGE_C",
+           "check_oil_temperature", "checked_point", "machine_identity", "points_of", "machine_overrides",
+           "point_words", "file_without", "point_label", "point_tag", "point_order", "OIL_RANGE_C",
            "OIL_MIN_VISCOSITY"]
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]*$")
@@ -179,9 +180,9 @@ def points_from_toml(path) -> list[Point]:
         if ("power" in t) == ("torque" in t):
             raise ParameterError.at(where, "give one of power and torque")
         shaft = "carrier" if "carrier_speed" in t else "sun"
-        out.append(checked_point(Point(name=str(t.get("name", f"p{i + 1}")), speed=str(t[f"{shaft}_speed"]), shaft=shaft,
-                                  load=str(t.get("power", t.get("torque"))), direction=t.get("direction"),
-                                  oil_temperature=t.get("oil_temperature")), where))
+        out.append(checked_point(Point(name=str(t.get("name", f"p{i + 1}")), speed=str(t[f"{shaft}_speed"]),
+                                       shaft=shaft, load=str(t.get("power", t.get("torque"))),
+                                       direction=t.get("direction"), oil_temperature=t.get("oil_temperature")), where))
     return out
 
 
@@ -285,17 +286,16 @@ def check_oil_temperature(text: str, lubricant_si, where: str) -> None:
 
 def point_overrides(point: Point, params) -> dict:
     """The parameter overrides that put the machine ``params`` at ``point`` (a user point; a preset's are its
-    ``reference_dpgt(condition, direction)``): the carrier speed (a sun speed through the machine's ratio
-    ω_s = (1 − z_r/z_s)... as :func:`components.geometry.speed_ratio` gives), the output power (a torque times its
-    shaft's speed; lossless; negative: braking), the direction and the oil temperature."""
+    ``reference_dpgt(condition, direction)``): the carrier speed (a sun speed through the machine's own ratio
+    |ω_s/ω_c| = |1 − z_r/z_s|, :func:`components.geometry.speed_ratio`), the output power (a torque times the speed
+    of its shaft, the one whose speed the point gives; lossless; negative: braking), the direction and the oil
+    temperature."""
     where = f"point {point.name}"
     g = params.gears.si()
-    w = to_si(quantity(f"{where} speed", point.speed, "angular_velocity"))
-    ratio = abs(speed_ratio(g.sun.teeth, g.ring.teeth))
-    w_c = w if point.shaft == "carrier" else w / ratio
-    w_shaft = w
+    w = to_si(quantity(f"{where} speed", point.speed, "angular_velocity"))      # the given shaft's speed
+    w_c = w if point.shaft == "carrier" else w / abs(speed_ratio(g.sun.teeth, g.ring.teeth))
     kind, value = _quantity_kind(point.load)
-    power = value if kind == "power" else value * w_shaft
+    power = value if kind == "power" else value * w
     out = {"operating.carrier_speed": point.speed if point.shaft == "carrier" else f"{w_c!r} rad/s",
            "operating.output_power": point.load if kind == "power" else f"{power!r} W"}
     if point.direction is not None:
