@@ -517,18 +517,20 @@ class Kinematics:
 
 
 def kinematics(z_s: int, z_a: int, z_b: int, z_r: int, carrier_speed: float, output_power: float) -> Kinematics:
-    """Nominal speeds and torques for signed carrier speed [rad/s] and output power [W] ≥ 0."""
+    """Nominal speeds and torques for signed carrier speed [rad/s] and output power [W]: P > 0 driving (the power
+    flows from the sun to the carrier), P < 0 braking (from the carrier to the sun). Lossless: T_s = P/ω_s,
+    T_c = −P/ω_c, so T_s ω_s + T_c ω_c = 0."""
     w_c = carrier_speed
     w_s = speed_ratio(z_s, z_r) * w_c
     ra, rb = planet_speed_ratios(z_a, z_b, z_r)
-    if output_power > 0 and w_c == 0:
+    if output_power != 0 and w_c == 0:
         raise ParameterError.at("operating.output_power",
                                 f"{output_power:g} W cannot be transmitted at carrier speed 0")
-    if output_power > 0 and w_s == 0:
+    if output_power != 0 and w_s == 0:
         raise ParameterError.at("gears.ring.teeth", "z_r = z_s: with the ring fixed the sun does not turn, "
                                                     "so no power can be driven in")
-    t_s = math.copysign(output_power / abs(w_s), w_s) if output_power > 0 else 0.0
-    t_c = -output_power / w_c if output_power > 0 else 0.0
+    t_s = output_power / w_s if output_power != 0 else 0.0      # P/ω_s: along ω_s when driving, against it braking
+    t_c = -output_power / w_c if output_power != 0 else 0.0
     if not (math.isfinite(t_s) and math.isfinite(t_c)):
         raise ParameterError.at("operating.carrier_speed", f"{abs(w_c):.3g} rad/s is too slow to transmit "
                                                            f"{output_power:g} W: the torques P/omega overflow")

@@ -65,7 +65,8 @@ from scipy.integrate import quad
 __all__ = ["LIFE_EXPONENT", "LINE_EXPONENT", "WEIBULL_SLOPE", "ROTATING_EXPONENT", "STATIONARY_EXPONENT",
            "relative_life", "iso281_rating", "iso281_life", "raceway_ratings", "equivalent_load",
            "lundberg_palmgren_life", "lundberg_palmgren_rating", "load_zone_integrals", "hours",
-           "sliced_raceway_ratings", "sliced_life"]
+           "sliced_raceway_ratings", "sliced_life", "revolution_shares", "miner_life", "damage_shares",
+           "spectrum_equivalent_load"]
 
 LIFE_EXPONENT = 10.0 / 3.0     # ISO 281, roller bearings: L10 ∝ P^(−10/3)
 LINE_EXPONENT = 4.0            # Lundberg–Palmgren line contact: raceway life (Q_c/Q_e)^4
@@ -189,3 +190,52 @@ def hours(million_revolutions: float | None, relative_speed: float) -> float | N
     if million_revolutions is None or w == 0.0:
         return None
     return float(million_revolutions * 1e6 * 2.0 * math.pi / w / 3600.0)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# a load spectrum: lives of its bins combined (Palmgren–Miner)
+# ---------------------------------------------------------------------------------------------------------------
+def revolution_shares(revolutions) -> np.ndarray:
+    """u_i = N_i / Σ N_j: each bin's share of the revolutions of a duty cycle (N_i ≥ 0, not all 0)."""
+    n = np.asarray(revolutions, float)
+    if n.ndim != 1 or n.size == 0 or not np.all(np.isfinite(n)) or np.any(n < 0) or not n.sum() > 0:
+        raise ValueError(f"revolutions must be >= 0 and not all 0, got {n.tolist()!r}")
+    return n / n.sum()
+
+
+def miner_life(lives, shares) -> float | None:
+    """The life under a spectrum by the Palmgren–Miner rule, L = 1 / Σ_i (u_i / L_i).
+
+    Bin i runs N_i revolutions per duty cycle at conditions under which the bearing's life is L_i revolutions; it
+    uses up the fraction N_i/L_i of the life (Miner's linear damage sum). One cycle of N = Σ N_i revolutions uses
+    D = Σ N_i/L_i, so the bearing lasts 1/D cycles, L = N/D = 1/Σ (u_i/L_i) revolutions with u_i = N_i/N — the
+    form of ISO 281:2007's variable-conditions note and of ISO/TS 16281:2008 (Palmgren 1924; Miner 1945; Harris &
+    Kotzalas, *Rolling Bearing Analysis* 5th ed. vol. 2 §8.8). ``lives`` and ``shares`` in the same unit of
+    revolutions and summing to one; the same sum with time shares τ_i and lives in hours, each at its bin's own
+    speed, gives the life in hours (N_i/L_i = t_i/L_h,i). A bin with no life (None: no load) does no damage;
+    None when no bin does."""
+    u = np.asarray(shares, float)
+    d = [ui / float(L) for ui, L in zip(u, lives) if L is not None and ui > 0]
+    if len(u) != len(lives):
+        raise ValueError(f"{len(lives)} lives for {len(u)} shares")
+    if any(L is not None and not float(L) > 0 for L in lives):
+        raise ValueError(f"lives must be > 0, got {list(lives)!r}")
+    total = math.fsum(d)
+    return 1.0 / total if total > 0 else None
+
+
+def damage_shares(lives, shares) -> list[float | None]:
+    """Each bin's share of the damage, (u_i/L_i) / Σ_j (u_j/L_j) (they sum to one); None for a bin without a life,
+    all None when no bin does damage."""
+    d = [ui / float(L) if L is not None and ui > 0 else (0.0 if L is not None else None)
+         for ui, L in zip(np.asarray(shares, float), lives)]
+    total = math.fsum(x for x in d if x is not None)
+    return [None if x is None or total == 0 else x / total for x in d]
+
+
+def spectrum_equivalent_load(loads, shares, exponent: float = LIFE_EXPONENT) -> float:
+    """The constant load of the same life as the spectrum, P = (Σ_i u_i P_i^p)^(1/p) with u_i the revolution shares
+    and p the life exponent (ISO 281: 10/3): with L_i = (C/P_i)^p, 1/L = Σ u_i/L_i = Σ u_i P_i^p / C^p
+    (:func:`miner_life`)."""
+    P, u = np.asarray(loads, float), np.asarray(shares, float)
+    return float(math.fsum(u * P ** exponent) ** (1.0 / exponent))

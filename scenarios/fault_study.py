@@ -40,6 +40,7 @@ from .core.lock import holds_out_folder
 from .core.runner import RunConfig
 from .core.analysis import amplitude_spectrum, line_table, sensor_signal, sideband_resolution
 from .core.study import Study, StudyRun
+from .core.points import file_without, machine_overrides, point_label, points_of
 from .core.sweep import Case, build_params, user_overrides
 
 __all__ = ["FAULTS", "main", "run", "characteristic_frequencies", "COLUMNS"]
@@ -127,13 +128,23 @@ def make_cases(a, out: Path) -> list[Case]:
             raise SystemExit(f"error: --machine {name}={path}: the name {name!r} is {what}'s; choose another")
         user_overrides({}, str(path), operating)
         machines[name] = ({}, str(path))
+    # the operating point: one (--conditions, --operating, the --params file's point); --set may not move it
+    sets = args.parse_sets(a.set)
+    points = points_of(a, sets)
+    if len(points) != 1:
+        raise SystemExit(f"error: this command runs one operating point at a time, got {len(points)} "
+                         f"({', '.join(p.name for p in points)}); run it once per point (each with its own --out)")
+    point = points[0]
     # --params holds what every machine shares (not its errors): read into the overrides, so that a machine's own
     # file can sit beside it
-    user = user_overrides(args.parse_sets(a.set), a.params, {**operating, "errors": "--faults or --machine NAME=FILE.toml"},
-                          merge_file=True)
+    errors = {"errors": "--faults or --machine NAME=FILE.toml"}
+    user_overrides(sets, a.params, errors)           # neither --set nor --params may set the errors
+    shared, _ = file_without(a.params, {})
+    user = {**shared, **machine_overrides(sets, points)}
     # a run's folder is named as its progress and time lines name it (Case.label: c{condition}_{direction}_{machine})
-    return [Case(int(a.conditions), d, str(out / f"c{int(a.conditions)}_{d}_{name}"), {**user, **ov}, path, tag=name)
-            for name, (ov, path) in machines.items() for d in a.directions.split(",")]
+    return [Case.at(point, d, str(out / f"{point_label(point, d)}_{name}"), {**user, **ov}, path, tag=name)
+            for name, (ov, path) in machines.items() for d in ([point.direction] if point.direction
+                                                               else a.directions.split(","))]
 
 
 def characteristic_frequencies(si) -> dict[str, float]:

@@ -36,7 +36,8 @@ from .core.command import command
 from .core.lock import holds_out_folder
 from .core.runner import RunConfig
 from .core.study import Study, StudyRun
-from .core.sweep import OPERATING_AXES, Case, build_params, user_overrides
+from .core.points import machine_overrides, point_label, point_order, point_words, points_of
+from .core.sweep import Case, build_params, user_overrides
 
 __all__ = ["main", "run", "make_cases", "rows_of", "by_grade", "findings", "QUANTITIES", "MESHES"]
 
@@ -96,17 +97,20 @@ def _tag(grade, seed) -> str:
 
 def make_cases(a, out: Path) -> list[Case]:
     """Perfect teeth, and every class × seed, at every condition and direction."""
-    user = user_overrides(args.parse_sets(a.set), a.params, {**OPERATING_AXES, "errors.flank_class": "--grades and --seeds"})
+    sets = args.parse_sets(a.set)
+    points = points_of(a, sets)
+    user = machine_overrides(user_overrides(sets, a.params, {"errors.flank_class": "--grades and --seeds"}), points)
     machines = [(None, None)] + [(g, s) for g in a.grades for s in a.seeds]
     cases = []
-    for c in (int(x) for x in a.conditions.split(",")):
-        for d in a.directions.split(","):
+    for p in points:
+        for d in ([p.direction] if p.direction else a.directions.split(",")):
             for g, s in machines:
                 ov = dict(user)
                 if g is not None:
                     ov["errors.flank_class"] = [{"gear": "all", "grade": g, "seed": s,
                                                  "systematic_share": a.systematic_share}]
-                cases.append(Case(c, d, str(out / f"c{c}_{d}_{_tag(g, s)}"), ov, a.params, tag=_tag(g, s)))
+                cases.append(Case.at(p, d, str(out / f"{point_label(p, d)}_{_tag(g, s)}"), ov, a.params,
+                                     tag=_tag(g, s)))
     return cases
 
 
@@ -150,7 +154,8 @@ def by_grade(rows: list[dict]) -> list[dict]:
         groups.setdefault((r["condition"], r["direction"], r["grade"], r["bearing"]), []).append(r)
     cols = [c for c in COLUMNS if c not in ("condition", "direction", "grade", "seed", "bearing")]
     out = []
-    for (c, d, g, b), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1], kv[0][2] or 0, kv[0][3])):
+    for (c, d, g, b), rs in sorted(groups.items(), key=lambda kv: (point_order(kv[0][0]), kv[0][1], kv[0][2] or 0,
+                                                                   kv[0][3])):
         row = {"condition": c, "direction": d, "grade": g, "bearing": b, "seeds": len(rs)}
         for col in cols:
             v = np.array([np.nan if r[col] is None else float(r[col]) for r in rs])
@@ -177,8 +182,8 @@ def findings(groups: list[dict]) -> str:
     lines = ["What real teeth do (ISO 1328-1:2013 flank tolerance class, every gear its own teeth; mean of the "
              "seeds, their range in brackets; against perfect teeth at the same operating point).", ""]
     pct = lambda x, y: 100.0 * (x / y - 1.0)
-    for c in sorted({g["condition"] for g in groups}):
-        lines.append(f"condition {c}:")
+    for c in sorted({g["condition"] for g in groups}, key=point_order):
+        lines.append(f"{point_words(c)}:")
         for d in ("forward", "reverse"):
             for b in ("inner", "outer"):
                 p = at.get((c, d, None, b))

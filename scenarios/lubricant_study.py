@@ -41,7 +41,8 @@ from components.results.io import atomic_write_text
 
 from .core.runner import RunConfig
 from .core.study import Study, StudyRun
-from .core.sweep import OPERATING_AXES, Case, build_params, user_overrides
+from .core.points import file_without, machine_overrides, point_label, point_order, point_words, points_of
+from .core.sweep import Case, build_params, user_overrides
 from .core import args
 from .core.command import command
 from .core.lock import holds_out_folder
@@ -112,18 +113,28 @@ def lubricants(a) -> dict[str, dict]:
 
 
 def make_cases(a, out: Path) -> list[Case]:
-    conds = [int(c) for c in str(a.conditions).split(",") if c.strip()]
+    """Every point (:mod:`scenarios.core.points`) × direction × oil. A ``--params`` file that also sets an oil is
+    taken: the sweep's oils replace it (said in one line); a ``--set`` of an oil is refused (it would relabel runs)."""
     dirs = [d.strip() for d in str(a.directions).split(",") if d.strip()]
-    if not conds or not dirs or any(c not in (1, 2, 3, 4) for c in conds) \
-            or any(d not in ("forward", "reverse") for d in dirs):
-        raise ParameterError.at("--conditions/--directions", f"expected conditions 1-4 and forward/reverse, got "
-                                                              f"{a.conditions!r}, {a.directions!r}")
+    if not dirs or any(d not in ("forward", "reverse") for d in dirs):
+        raise ParameterError.at("--directions", f"expected forward and/or reverse, got {a.directions!r}")
     oils = "--grades or --viscosities"
-    owned = {**OPERATING_AXES, "lubricant.viscosity_40": oils, "lubricant.viscosity_100": oils,
-             "lubricant.oil_viscosity": oils}
-    user = {"bearing.traction_law": "ehl", **user_overrides(args.parse_sets(a.set), a.params, owned)}
-    return [Case(c, d, str(out / f"c{c}_{d}_{lab}"), {**user, **ov}, a.params, tag=lab)
-            for lab, ov in lubricants(a).items() for c in conds for d in dirs]
+    owned = {"lubricant.viscosity_40": oils, "lubricant.viscosity_100": oils, "lubricant.oil_viscosity": oils}
+    sets = args.parse_sets(a.set)
+    points = points_of(a, sets)
+    machine, replaced = file_without(a.params, owned)
+    if replaced:
+        print(f"note: {a.params} sets {', '.join(replaced)}; this study's oils ({oils}) replace it")
+    params_file = None if replaced else a.params       # the file's other overrides travel in the cases then
+    user = {"bearing.traction_law": "ehl", **(machine if replaced else {}),
+            **machine_overrides(user_overrides(sets, None, owned), points)}
+    cases = []
+    for lab, ov in lubricants(a).items():
+        for p in points:
+            for d in ([p.direction] if p.direction else dirs):
+                cases.append(Case.at(p, d, str(out / f"{point_label(p, d)}_{lab}"), {**user, **ov}, params_file,
+                                     tag=lab))
+    return cases
 
 
 def rows_of(cases: list[Case], results: dict) -> list[dict]:
@@ -154,8 +165,8 @@ def answer(rows: list[dict]) -> str:
              f"Λ < 1 boundary-dominated. Skid: cage slip > {SKID_PCT:g} %. Per oil: Λ_min inner/outer, cage slip "
              "inner/outer.", ""]
     need = {}
-    for (c, d) in sorted({(r["condition"], r["direction"]) for r in rows}):
-        lines.append(f"condition {c}, {d}:")
+    for (c, d) in sorted({(r["condition"], r["direction"]) for r in rows}, key=lambda x: (point_order(x[0]), x[1])):
+        lines.append(f"{point_words(c)}, {d}:")
         for lab in sorted({r["lubricant"] for r in rows}, key=lambda x: _eta(rows, x)):
             rr = {r["bearing"]: r for r in rows if (r["condition"], r["direction"], r["lubricant"]) == (c, d, lab)}
             if set(rr) != {"inner", "outer"}:
@@ -169,12 +180,12 @@ def answer(rows: list[dict]) -> str:
         need[(c, d)] = {level: _needed_viscosity(here, level) for level in LAMBDA_LEVELS}
         lines.append(f"  least viscosity: Λ ≥ {lo:g} from {1e3 * need[(c, d)][lo]:.3g} mPa·s; full film (Λ ≥ {hi:g}) "
                      f"from {1e3 * need[(c, d)][hi]:.3g} mPa·s")
-    for c in sorted({k[0] for k in need}):
+    for c in sorted({k[0] for k in need}, key=point_order):
         f, r = need.get((c, "forward")), need.get((c, "reverse"))
         if f is not None and r is not None:
             parts = [f"Λ ≥ {x:g} {100 * (r[x] / f[x] - 1):+.1f} % ({1e3 * f[x]:.3g} vs {1e3 * r[x]:.3g} mPa·s)"
                      for x in LAMBDA_LEVELS]
-            lines.append(f"condition {c}: reverse needs against forward: {'; '.join(parts)}.")
+            lines.append(f"{point_words(c)}: reverse needs against forward: {'; '.join(parts)}.")
     return "\n".join(lines)
 
 
@@ -221,15 +232,15 @@ def plot(rows: list[dict], out: Path) -> list[Path]:
     direction (the conditions' own markers when there are several)."""
     from viz.plots import against_viscosity  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
-    conds = sorted({r["condition"] for r in rows})
+    conds = sorted({r["condition"] for r in rows}, key=point_order)
     series = {}
     for key in ("lambda_min", "h_min_m", "cage_slip_pct", "heat_traction_W"):
         for r in sorted(rows, key=lambda r: r["viscosity_Pa_s"]):
-            k = (key, r["bearing"], r["direction"]) + ((f"condition {r['condition']}",) if len(conds) > 1 else ())
+            k = (key, r["bearing"], r["direction"]) + ((point_words(r["condition"]),) if len(conds) > 1 else ())
             x, y = series.setdefault(k, ([], []))
             x.append(r["viscosity_Pa_s"])
             y.append(r[key])
-    at = f", condition {conds[0]}" if len(conds) == 1 else ""
+    at = f", {point_words(conds[0])}" if len(conds) == 1 else ""
     return [against_viscosity(series, [("lambda_min", "film parameter Λ_min = h_min/σ", "1", True),
                                        ("h_min_m", "thinnest film h_min", "m", True),
                                        ("cage_slip_pct", "cage slip", "%", False),
@@ -254,7 +265,7 @@ def read_rows(path) -> list[dict]:
     if not rows or set(COLUMNS) - set(rows[0]):
         raise ParameterError.at("--replot", f"{path} is not a lubricant study's summary.csv (columns "
                                             f"{', '.join(sorted(set(COLUMNS) - set(rows[0] if rows else {})))} missing)")
-    return [{c: int(r[c]) if c == "condition" else r[c] if c in _TEXT_COLUMNS else
+    return [{c: (int(r[c]) if r[c].isdigit() else r[c]) if c == "condition" else r[c] if c in _TEXT_COLUMNS else
              (float(r[c]) if r[c] != "" else None) for c in COLUMNS} for r in rows]
 
 

@@ -32,7 +32,8 @@ from components.results.io import atomic_write_text, write_summary
 from .core.integrity import read_summary
 from .core.runner import RunConfig
 from .core.study import Study, StudyRun
-from .core.sweep import OPERATING_AXES, Case, user_overrides
+from .core.points import machine_identity, machine_overrides, point_label, point_order, point_tag, points_of
+from .core.sweep import Case, user_overrides
 from .core import args
 from .core.command import command
 from .core.lock import holds_out_folder
@@ -104,18 +105,45 @@ def build_config(a) -> RunConfig:
 
 
 def make_cases(a, out: Path) -> list[Case]:
-    conds = [int(c) for c in str(a.conditions).split(",") if c.strip()]
+    """Every point (``--conditions``, ``--operating``, the file's points: :mod:`scenarios.core.points`) in every
+    direction of ``--directions`` (a point that fixes its direction runs in that one only)."""
     dirs = [d.strip() for d in str(a.directions).split(",") if d.strip()]
     for d in dirs:
         if d not in ("forward", "reverse"):
             raise SystemExit(f"error: --directions takes forward and/or reverse, got {d!r}")
-    overrides = user_overrides(args.parse_sets(a.set), a.params, OPERATING_AXES)
+    sets = args.parse_sets(a.set)
+    points = points_of(a, sets)
+    overrides = machine_overrides(user_overrides(sets, None, {}), points)
     if a.planets is not None:
         overrides["gears.planets"] = a.planets
-    for c in conds:
-        if c not in (1, 2, 3, 4):
-            raise SystemExit(f"error: --conditions takes 1, 2, 3 and/or 4 (docs/parameters.md), got {c}")
-    return [Case(c, d, str(out / f"c{c}_{d}"), overrides, a.params) for c in conds for d in dirs]
+    cases = {}
+    for p in points:
+        for d in ([p.direction] if p.direction else dirs):
+            cases.setdefault(point_label(p, d), Case.at(p, d, str(out / point_label(p, d)), overrides, a.params))
+    return list(cases.values())
+
+
+def _at(results: dict, c, direction: str) -> Summary:
+    """The run of point ``c`` (a condition's number or a point's name) in ``direction`` (an empty summary if none)."""
+    for s in results.values():
+        if s.get("condition") == c and s.get("direction") == direction:
+            return s
+    return Summary()
+
+
+def _label_of(results: dict, c, direction: str) -> str | None:
+    for k, s in results.items():
+        if s.get("condition") == c and s.get("direction") == direction:
+            return k
+    return None
+
+
+def _conds(results: dict) -> list:
+    return sorted({s["condition"] for s in results.values() if not s.failed}, key=point_order)
+
+
+def _title(c) -> str:
+    return f"Condition {c}" if isinstance(c, int) else f"Point {c}"
 
 
 def relative_life(results: dict) -> None:
@@ -123,7 +151,7 @@ def relative_life(results: dict) -> None:
     for label, s in results.items():
         if s.failed:
             continue
-        fwd = results.get(f"c{s['condition']}_forward")
+        fwd = _at(results, s["condition"], "forward") or None
         for kind in ("inner", "outer"):
             if fwd is None or fwd.failed:
                 s[kind]["life_L10_relative"] = None
@@ -134,9 +162,9 @@ def relative_life(results: dict) -> None:
 
 def comparison_rows(results: dict) -> list[dict]:
     rows = []
-    conds = sorted({s["condition"] for s in results.values() if not s.failed})
+    conds = _conds(results)
     for c in conds:
-        f, r = results.get(f"c{c}_forward", Summary()), results.get(f"c{c}_reverse", Summary())
+        f, r = _at(results, c, "forward"), _at(results, c, "reverse")
         for kind in ("inner", "outer"):
             for q, unit in QUANTITIES:
                 fv = f.get(kind, {}).get(q) if not f.failed else None
@@ -151,20 +179,22 @@ def _fmt(x, nd=4):
     return "–" if x is None else f"{x:.{nd}g}"
 
 
-def write_tables(rows: list[dict], out: Path) -> tuple[Path, Path, str]:
+def write_tables(rows: list[dict], out: Path, machine: dict | None = None) -> tuple[Path, Path, str]:
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=list(rows[0]) if rows else ["condition"])
     w.writeheader()
     w.writerows(rows)
     atomic_write_text(out / "comparison.csv", buf.getvalue())
     md = []
-    for c in sorted({r["condition"] for r in rows}):
-        md.append(f"\n### Condition {c}\n\n| bearing | quantity | forward | reverse | difference % |\n|---|---|---|---|---|")
+    for c in sorted({r["condition"] for r in rows}, key=point_order):
+        md.append(f"\n### {_title(c)}\n\n| bearing | quantity | forward | reverse | difference % |\n|---|---|---|---|---|")
         for r in rows:
             if r["condition"] == c:
                 md.append(f"| {r['bearing']} | {r['description']} [{r['unit']}] | {_fmt(r['forward'])} | "
                           f"{_fmt(r['reverse'])} | {_fmt(r['difference_pct'], 3)} |")
     text = "\n".join(md).strip() + "\n"
+    if machine is not None:        # the machine the tables are of: its file, a short fingerprint, the overrides
+        text = f"Machine: {machine['label']}\n\n" + text
     atomic_write_text(out / "comparison.md", text)
     return out / "comparison.csv", out / "comparison.md", text
 
@@ -181,7 +211,7 @@ def headline_table(rows: list[dict]) -> str:
     head = "".join(f" | {w} fwd / rev [{u}] (change)" for _, w, _, u in HEADLINE)
     lines = [f"headline (pair 1's planet bearings, forward vs reverse):\n| condition | bearing{head} |",
              "|---|---" + "|---" * len(HEADLINE) + "|"]
-    for c, b in sorted({(r["condition"], r["bearing"]) for r in rows}):
+    for c, b in sorted({(r["condition"], r["bearing"]) for r in rows}, key=lambda x: (point_order(x[0]), x[1])):
         cells = []
         for q, _, k, _ in HEADLINE:
             r = at.get((c, b, q))
@@ -194,13 +224,14 @@ def headline_table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def _runs_of(results: dict, out: Path, c: int) -> dict[str, Path]:
-    """direction -> results.nc of condition ``c``'s runs that finished (a missing run is left out, not faked)."""
+def _runs_of(results: dict, out: Path, c) -> dict[str, Path]:
+    """direction -> results.nc of point ``c``'s runs that finished (a missing run is left out, not faked)."""
     runs = {}
     for d in ("forward", "reverse"):
-        p = out / f"c{c}_{d}" / "results.nc"
-        s = results.get(f"c{c}_{d}")
-        if p.exists() and s is not None and not s.failed:
+        label = _label_of(results, c, d)
+        p = out / str(label) / "results.nc"
+        s = results.get(label)
+        if label is not None and p.exists() and s is not None and not s.failed:
             runs[d] = p
     return runs
 
@@ -291,29 +322,30 @@ def headline_values(results: dict) -> dict[tuple, float | None]:
     return vals
 
 
-def plots(results: dict, out: Path) -> list[Path]:
+def plots(results: dict, out: Path, machine: str = "") -> list[Path]:
+    """Every figure of a dynamic study; ``machine``: the machine's label, in the headline figure's title."""
     # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
     from viz import plots as vp
     from viz.results import study_cage_pictures
 
     paths = []
-    conds = sorted({s["condition"] for s in results.values() if not s.failed})
+    conds = _conds(results)
     for c in conds:
         runs = _runs_of(results, out, c)
         if not runs:
             continue
         for g, (rows, cols) in history_groups(runs).items():
             titles = {"inner": "inner planet bearing", "outer": "outer planet bearing", **MESH_COLUMNS}
-            paths.append(vp.time_history_group(rows, out / f"c{c}_{g}.png", columns=cols, column_titles=titles,
-                                               title=f"Condition {c}: {HISTORY_GROUPS[g]}"))
-        paths += study_cage_pictures(runs, out, prefix=f"c{c}_",
-                                     title=f"Condition {c}: cage orbits in the guide clearance")
+            paths.append(vp.time_history_group(rows, out / f"{point_tag(c)}_{g}.png", columns=cols,
+                                               column_titles=titles, title=f"{_title(c)}: {HISTORY_GROUPS[g]}"))
+        paths += study_cage_pictures(runs, out, prefix=f"{point_tag(c)}_",
+                                     title=f"{_title(c)}: cage orbits in the guide clearance")
     vals = headline_values(results)
     if vals:
-        one = f", condition {conds[0]}" if len(conds) == 1 else ""
+        one = f", {_title(conds[0]).lower()}" if len(conds) == 1 else ""
         paths.append(vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
                                                  title=f"Planet bearings (pair 1): mean load and L10 life, forward vs "
-                                                       f"reverse{one}"))
+                                                       f"reverse{one}" + (f"\n{machine}" if machine else "")))
     table, bar_units, ylabels = {}, {}, {}
     for q, unit in QUANTITIES:
         if q not in BAR_QUANTITIES:
@@ -324,30 +356,30 @@ def plots(results: dict, out: Path) -> list[Path]:
             bar_units[key] = unit
             ylabels[key] = SUMMARY_WORDS[q][0]
             for c in conds:
-                f, r = results.get(f"c{c}_forward", Summary()), results.get(f"c{c}_reverse", Summary())
+                f, r = _at(results, c, "forward"), _at(results, c, "reverse")
                 fv = f.get(kind, {}).get(q) if not f.failed else None
                 rv = r.get(kind, {}).get(q) if not r.failed else None
                 table[key][c] = (fv, rv)
     if conds and table:
-        paths.append(vp.bar_chart([f"condition {c}" for c in conds], {k: {f"condition {c}": v for c, v in by.items()}
+        paths.append(vp.bar_chart([_title(c).lower() for c in conds], {k: {_title(c).lower(): v for c, v in by.items()}
                                                                        for k, by in table.items()},
                                   bar_units, out / "bars.png", ylabels=ylabels, ncols=2,
                                   title="RMS across conditions: forward vs reverse"))
     return paths
 
 
-def static_plots(results: dict, out: Path) -> list[Path]:
+def static_plots(results: dict, out: Path, machine: str = "") -> list[Path]:
     """Static mode's figure: the headline (mean load and lives, forward vs reverse); the others need time series."""
     from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     vals = headline_values(results)
     if not vals:
         return []
-    conds = sorted({s["condition"] for s in results.values() if not s.failed})
-    one = f", condition {conds[0]}" if len(conds) == 1 else ""
+    conds = _conds(results)
+    one = f", {_title(conds[0]).lower()}" if len(conds) == 1 else ""
     return [vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
                                         title=f"Planet bearings (pair 1), quasi-static: mean load and L10 life, "
-                                              f"forward vs reverse{one}")]
+                                              f"forward vs reverse{one}" + (f"\n{machine}" if machine else ""))]
 
 
 def animate(results: dict, out: Path) -> list[Path]:
@@ -363,13 +395,15 @@ def animate(results: dict, out: Path) -> list[Path]:
     if not ok:
         print(f"animation skipped: {msg}")
         return paths
-    for c in sorted({s["condition"] for s in results.values() if not s.failed}):
-        f, r = out / f"c{c}_forward" / "results.nc", out / f"c{c}_reverse" / "results.nc"
+    for c in _conds(results):
+        f = out / str(_label_of(results, c, "forward")) / "results.nc"
+        r = out / str(_label_of(results, c, "reverse")) / "results.nc"
         if f.exists() and r.exists():
-            paths.append(Path(study_cage_animation(f, r, out / f"c{c}_cage_orbits.gif", max_frames=150)))
+            paths.append(Path(study_cage_animation(f, r, out / f"{point_tag(c)}_cage_orbits.gif", max_frames=150)))
         else:      # the animation sets forward beside reverse
-            print(f"animation of condition {c} skipped: it shows forward beside reverse, and "
-                  f"{'c%d_reverse' % c if f.exists() else 'c%d_forward' % c} was not run (--directions forward,reverse)")
+            missing = "reverse" if f.exists() else "forward"
+            print(f"animation of {_title(c).lower()} skipped: it shows forward beside reverse, and "
+                  f"{point_tag(c)}_{missing} was not run (--directions forward,reverse)")
     return paths
 
 
@@ -387,6 +421,12 @@ class PaperStudy(Study):
     def cases(self) -> list[Case]:
         return make_cases(self.a, self.out)
 
+    def machine_identity(self) -> dict:
+        over = {k: v for k, v in args.parse_sets(self.a.set).items() if not k.startswith("operating.")}
+        if self.a.planets is not None:
+            over["gears.planets"] = self.a.planets
+        return machine_identity(self.a.params, over)
+
     def report(self, run: StudyRun) -> dict:
         results = run.results
         relative_life(results)
@@ -397,7 +437,8 @@ class PaperStudy(Study):
         rows = comparison_rows(results)
         if static:         # a quantity only a dynamic run gives is not in the tables at all (not a row of dashes)
             rows = [r for r in rows if r["forward"] is not None or r["reverse"] is not None]
-        csv_p, md_p, text = write_tables(rows, self.out)
+        machine = self.machine_identity()
+        csv_p, md_p, text = write_tables(rows, self.out, machine)
         print("\n" + headline_table(rows))   # the headline first, then the whole comparison
         print("\n" + text)
         if static:
@@ -405,8 +446,8 @@ class PaperStudy(Study):
             print(f"static mode ({self.a.snapshots} snapshots): left out, as only a dynamic run gives them: "
                   f"{', '.join(left)}; no time histories, cage orbits, bars of RMS values or animation")
         run.step("tables", lambda: [csv_p, md_p])
-        figs = run.step("figures", plots, results, self.out) if not static else \
-            run.step("figures", static_plots, results, self.out)
+        figs = run.step("figures", plots, results, self.out, machine["label"]) if not static else \
+            run.step("figures", static_plots, results, self.out, machine["label"])
         anims = run.step("animation", animate, results, self.out) if self.a.animate and not static else []
         return {"rows": rows, "figures": figs, "animations": anims}
 

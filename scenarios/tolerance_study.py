@@ -36,7 +36,7 @@ import os
 import sys
 import time
 import warnings
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -58,7 +58,8 @@ from .core.integrity import OtherResults, read_summary
 from .core.lock import holds_out_folder
 from .core.runner import RunConfig, code_digest
 from .core.study import Study, StudyRun
-from .core.sweep import OPERATING_AXES, Case, build_params, dask_client, user_overrides, validate_cases
+from .core.points import Point, machine_overrides, point_label, point_order, point_words, points_of
+from .core.sweep import Case, build_params, dask_client, user_overrides, validate_cases
 
 __all__ = ["main", "run", "parse_args", "QUANTITIES", "MESHES", "quantities_of", "percentile_ci", "statistics",
            "agreement_rows", "sample_rows", "sample_columns", "answer", "StaticTask", "static_tasks", "solve_static_task"]
@@ -199,7 +200,8 @@ class StaticTask:
         text, snapshots — cheap to compare for thousands of files (the parameters are built from it alone)."""
         text = Path(self.case.params_file).read_text(encoding="utf-8") if self.case.params_file else ""
         what = {"condition": self.case.condition, "direction": self.case.direction, "overrides": self.case.overrides,
-                "params_file": text, "snapshots": self.snapshots, "record": RECORD_VERSION}
+                "params_file": text, "snapshots": self.snapshots, "record": RECORD_VERSION,
+                **({"point": self.case.point} if self.case.point is not None else {})}
         asked = hashlib.sha256(json.dumps(what, sort_keys=True, default=repr).encode()).hexdigest()[:16]
         full = hashlib.sha256(f"{asked}:{code_digest()}".encode()).hexdigest()[:16]
         return asked, full
@@ -221,23 +223,35 @@ def machines(a, si) -> dict[int, tuple[dict, dict]]:
     return {c: [draw_errors(si, a.spec[c], u[i], teeth_seed(a.seed, i)) for i in range(a.samples)] for c in a.classes}
 
 
-def static_tasks(a, out: Path, user: dict) -> list[StaticTask]:
-    """The perfect machine and every sample at every class, condition, direction and torque."""
+def _scaled(p: Point, d: str, f: float, power: float, user: dict, params_file):
+    """The case maker of point ``p`` in direction ``d`` at ``f`` × its power ``power`` [W]: a condition's case with
+    the power overridden (as it always was), a user point's with its load replaced."""
+    if p.is_preset:
+        op = {**user, "operating.output_power": f"{f * power:.17g} W"}
+        return lambda folder, ov=None: Case(p.condition, d, folder, {**op, **(ov or {})}, params_file)
+    q = replace(p, load=f"{f * power:.17g} W")
+    return lambda folder, ov=None: Case.at(q, d, folder, {**user, **(ov or {})}, params_file)
+
+
+def static_tasks(a, out: Path, user: dict, points: list[Point]) -> list[StaticTask]:
+    """The perfect machine and every sample at every class, operating point, direction and torque."""
     tasks = []
-    for cond in (int(x) for x in a.conditions.split(",")):
-        for d in a.directions.split(","):
-            nominal = build_params(Case(cond, d, "", dict(user), a.params))
+    for p in points:
+        for d in ([p.direction] if p.direction else a.directions.split(",")):
+            nominal = build_params(Case.at(p, d, "", dict(user), a.params))
             power = nominal.si().operating.output_power
+            if power == 0:
+                raise ParameterError.at(f"point {p.name}", "transmits no torque (0 W): there is no load to share")
             drawn = machines(a, nominal.si())
             for f in a.torques:
-                point = f"c{cond}_{d}_{_torque_tag(f)}"
-                op = {**user, "operating.output_power": f"{f * power:.17g} W"}
-                tasks.append(StaticTask(Case(cond, d, str(out / "static"), op, a.params),
+                case = _scaled(p, d, f, power, user, a.params)
+                point = f"{point_label(p, d)}_{_torque_tag(f)}"
+                tasks.append(StaticTask(case(str(out / "static")),
                                         str(out / "static" / f"perfect_{point}.json"), a.snapshots, None, f, None, {}))
                 for c in a.classes:
                     folder = out / "static" / f"class{c}" / point
                     for i, (ov, dr) in enumerate(drawn[c]):
-                        tasks.append(StaticTask(Case(cond, d, str(folder), {**op, **ov}, a.params),
+                        tasks.append(StaticTask(case(str(folder), ov),
                                                 str(folder / f"sample_{i:04d}.json"), a.snapshots, c, f, i, dr))
     return tasks
 
@@ -403,7 +417,7 @@ def percentile_ci(x, q: float | None, replicate) -> dict:
 
 def _order(key: tuple) -> tuple:
     c, cond, d, f, i = key
-    return (-1 if c is None else c, cond, d, f, -1 if i is None else i)
+    return (-1 if c is None else c, point_order(cond), d, f, -1 if i is None else i)
 
 
 def _groups(records: dict) -> dict:
@@ -556,8 +570,8 @@ def answer(stats: list[dict], agree: list[dict], a_record: dict) -> str:
          "the planets' centrifugal load). Values: the statistic with its 95 % interval (over the independent "
          "replicates) in brackets.", ""]
     top = max(g["torque_fraction"] for g in stats)
-    for cond in sorted({g["condition"] for g in stats}):
-        L.append(f"## Condition {cond}")
+    for cond in sorted({g["condition"] for g in stats}, key=point_order):
+        L.append(f"## {point_words(cond).capitalize()}")
         for c in sorted({g["class"] for g in stats}):
             rated = {g["direction"]: g for g in stats if g["condition"] == cond and g["class"] == c
                      and g["torque_fraction"] == top}
@@ -619,7 +633,7 @@ def answer(stats: list[dict], agree: list[dict], a_record: dict) -> str:
             L.append("")
     if agree:
         L += ["## Static against dynamic", ""]
-        for cond in sorted({r["condition"] for r in agree}):
+        for cond in sorted({r["condition"] for r in agree}, key=point_order):
             for d in sorted({r["direction"] for r in agree if r["condition"] == cond}):
                 rs = [r for r in agree if r["condition"] == cond and r["direction"] == d and r["sample"] != "perfect"]
                 p = [r for r in agree if r["condition"] == cond and r["direction"] == d and r["sample"] == "perfect"]
@@ -627,13 +641,13 @@ def answer(stats: list[dict], agree: list[dict], a_record: dict) -> str:
                     continue
                 inc = np.array([r[f"{HEADLINE}_increment"] for r in rs])
                 loads = np.array([r[f"bearing_load_mean_{k}_N_increment_pct"] for r in rs for k in KINDS])
-                words = (f"- condition {cond}, {d}: over {len(rs)} machine{'s' if len(rs) > 1 else ''} the dynamic mesh "
+                words = (f"- {point_words(cond)}, {d}: over {len(rs)} machine{'s' if len(rs) > 1 else ''} the dynamic mesh "
                          f"K_γ minus the static one is {inc.mean():+.4f} on average (from {inc.min():+.4f} to "
                          f"{inc.max():+.4f}, RMS {np.sqrt(np.mean(inc ** 2)):.4f}) — the dynamic increment and the static "
                          f"estimate's error together (its snapshots see each mesh's teeth at a few instants of a carrier "
                          f"revolution, a dynamic run at every one); "
                          f"the most loaded bearings' mean loads differ by {np.abs(loads).max():.2f} % at most"
-                         if rs else f"- condition {cond}, {d}:")
+                         if rs else f"- {point_words(cond)}, {d}:")
                 if p:
                     words += (f"; the perfect machine: static {p[0][f'{HEADLINE}_static']:.4f}, dynamic "
                               f"{p[0][f'{HEADLINE}_dynamic']:.4f}")
@@ -698,10 +712,12 @@ class ToleranceStudy(Study):
 
     def __init__(self, a):
         super().__init__(a)
-        self.user = user_overrides(args.parse_sets(a.set), a.params,
-                                   {**OPERATING_AXES, "errors": "the tolerance options (--classes, --pinhole-tolerance, "
-                                                                "--clearance-tolerance, --roller-lot)"})
-        self.tasks = static_tasks(a, self.out, self.user)
+        sets = args.parse_sets(a.set)
+        self.points = points_of(a, sets)
+        self.user = machine_overrides(user_overrides(sets, a.params, {
+            "errors": "the tolerance options (--classes, --pinhole-tolerance, --clearance-tolerance, --roller-lot)"}),
+            self.points)
+        self.tasks = static_tasks(a, self.out, self.user, self.points)
         self.records: dict = {}
         self.cost: dict = {}
 
@@ -719,9 +735,8 @@ class ToleranceStudy(Study):
         for t in self._dynamic_tasks():
             who = "perfect" if t.sample is None else f"class{t.flank_class}_s{t.sample:04d}"
             tag = f"{_torque_tag(t.torque)}_{who}"
-            label = f"c{t.case.condition}_{t.case.direction}_{tag}"
-            out.append(Case(t.case.condition, t.case.direction, str(self.out / label), t.case.overrides,
-                            t.case.params_file, tag=tag))
+            label = replace(t.case, tag=tag).label          # c3_forward_TAG, or the point's name and TAG
+            out.append(replace(t.case, out_dir=str(self.out / label), tag=tag))
         return out
 
     def study_record(self) -> dict:

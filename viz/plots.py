@@ -26,7 +26,8 @@ from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator
 __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution", "against_viscosity",
            "mode_shapes", "fault_spectra", "fault_loads", "FAULT_QUANTITIES", "gear_quality", "forward_reverse_headline",
            "time_history_group", "cage_orbit_picture", "display_unit", "format_pct", "HEADLINE_QUANTITIES", "FWD", "REV",
-           "STYLE", "tolerance_distributions", "tolerance_against_torque", "tolerance_life_cdf"]
+           "STYLE", "tolerance_distributions", "tolerance_against_torque", "tolerance_life_cdf", "damage_shares",
+           "binned_series"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
 STYLE = {
@@ -45,6 +46,15 @@ STYLE = {
 FWD = {"color": "#1f5fa8", "linestyle": "-", "label": "forward"}
 REV = {"color": "#e07b00", "linestyle": "--", "label": "reverse"}
 _MARK_COLOR = "#7a1f7a"
+
+
+def _point_key(c):
+    """Operating conditions 1-4 first, then a user's points by name."""
+    return (isinstance(c, str), c)
+
+
+def _point_words(c) -> str:
+    return f"condition {c}" if isinstance(c, (int, np.integer)) else f"point {c}"
 
 
 def _axis_label(name: str, unit: str | None) -> str:
@@ -531,7 +541,7 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
     the ring mesh's dynamic factor K_v and loaded transmission error p2p (the mesh the rig's sensor hears; the
     printed findings name the largest K_v of any mesh). ``groups``: rows of :func:`scenarios.gear_quality.by_grade`."""
     grades = [None] + sorted({g["grade"] for g in groups if g["grade"] is not None})
-    conds = sorted({g["condition"] for g in groups})
+    conds = sorted({g["condition"] for g in groups}, key=lambda c: (isinstance(c, str), c))   # conditions, then points
     at = {(g["condition"], g["direction"], g["grade"], g["bearing"]): g for g in groups}
     colors = ["#222222", "#2b8a3e", "#1f5fa8", "#c2255c", "#e07b00", "#7a1f7a"]
     width = 0.8 / len(grades)
@@ -578,7 +588,8 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
             ax.set_ylabel(_axis_label(words + ", ring mesh", unit))
             ax.set_title("ring mesh (outer planets–ring)")       # not a bearing column: say so
         for ax in axes[-1]:
-            ax.set_xticks(range(len(conds)), [f"condition {c}" for c in conds])
+            ax.set_xticks(range(len(conds)), [f"condition {c}" if isinstance(c, (int, np.integer)) else f"point {c}"
+                                              for c in conds])
             ax.set_xlim(-0.55, len(conds) - 0.45)
         axes[0, 0].legend(loc="best", title="filled: forward, open: reverse", title_fontsize=7)
         for ax in axes.ravel():
@@ -620,7 +631,7 @@ def tolerance_distributions(dist: Mapping[tuple, Mapping[tuple, Sequence[float]]
     """The distribution of the mesh K_γ over the machines (empirical CDF, a step per machine): a panel per
     (condition, torque fraction), a colour per class, solid forward and dashed reverse; the rating tables' value
     and the P90 level dotted. ``dist``: {(condition, torque fraction): {(class, direction): K_γ values}}."""
-    conds = sorted({k[0] for k in dist})
+    conds = sorted({k[0] for k in dist}, key=_point_key)
     torques = sorted({k[1] for k in dist})
     classes = sorted({c for v in dist.values() for c, _ in v})
     directions = [d for d in ("forward", "reverse") if any(dd == d for v in dist.values() for _, dd in v)]
@@ -638,7 +649,7 @@ def tolerance_distributions(dist: Mapping[tuple, Mapping[tuple, Sequence[float]]
                 ax.axvline(table, color=_MARK_COLOR, ls=":", lw=0.9)
                 ax.axhline(0.9, color="#888888", ls=":", lw=0.8)
                 ax.set_ylim(0.0, 1.02)
-                ax.set_title(f"condition {c}, {f:g} × rated torque")
+                ax.set_title(f"{_point_words(c)}, {f:g} × rated torque")
                 ax.set_xlabel(_axis_label("mesh load sharing K_γ", None))
                 if k == 0:
                     ax.set_ylabel(_axis_label("share of machines at or below", None))
@@ -655,7 +666,7 @@ def tolerance_against_torque(bands: Mapping[tuple, Mapping[int, Sequence[tuple]]
     """The mesh K_γ against the output torque: the machines' median (line and markers) and the band up to their
     P90 (shaded, its edge thin), a panel per (condition, direction), a colour per class. ``bands``:
     {(condition, direction): {class: [(output torque N·m, P50, P90), ...]}}."""
-    conds = sorted({k[0] for k in bands})
+    conds = sorted({k[0] for k in bands}, key=_point_key)
     directions = [d for d in ("forward", "reverse") if any(k[1] == d for k in bands)]
     classes = sorted({c for v in bands.values() for c in v})
     with mpl.rc_context(STYLE):
@@ -675,7 +686,7 @@ def tolerance_against_torque(bands: Mapping[tuple, Mapping[int, Sequence[tuple]]
                     ax.plot(t, p50, color=color, lw=1.4, marker="o", ms=4)
                 ax.axhline(table, color=_MARK_COLOR, ls=":", lw=0.9)
                 ax.set_xlim(0.0, 1.06 * ax.get_xlim()[1])        # from zero torque, the last marker inside
-                ax.set_title(f"condition {c}, {d}")
+                ax.set_title(f"{_point_words(c)}, {d}")
                 ax.set_xlabel(_axis_label("output torque", "N·m"))
                 if k == 0:
                     ax.set_ylabel(_axis_label("mesh load sharing K_γ", None))
@@ -696,7 +707,7 @@ def tolerance_life_cdf(cdfs: Mapping[tuple, Mapping[tuple, tuple]], path, *, tit
     machine's (a dotted vertical line per direction, black forward, grey reverse): a row per (condition, bearing
     type), a column per life standard, a colour per class. ``cdfs``: {(condition, bearing type, standard):
     {(class, direction): (lives in h, the perfect machine's life in h)}}."""
-    rows = sorted({(k[0], k[1]) for k in cdfs})
+    rows = sorted({(k[0], k[1]) for k in cdfs}, key=lambda r: (_point_key(r[0]), r[1]))
     stds = sorted({k[2] for k in cdfs}, key=lambda s: "16281" in s)
     classes = sorted({c for v in cdfs.values() for c, _ in v})
     directions = [d for d in ("forward", "reverse") if any(dd == d for v in cdfs.values() for _, dd in v)]
@@ -721,7 +732,7 @@ def tolerance_life_cdf(cdfs: Mapping[tuple, Mapping[tuple, tuple]], path, *, tit
                 _plain_log(ax.xaxis, decades=1.0)
                 ax.axhline(0.1, color="#888888", ls=":", lw=0.6)
                 ax.set_ylim(0.0, 1.02)
-                ax.set_title(f"condition {c}, {kind} planet bearings, {std}")
+                ax.set_title(f"{_point_words(c)}, {kind} planet bearings, {std}")
                 ax.set_xlabel(_axis_label("L10 life of the weakest bearing", "h"))
                 if k == 0:
                     ax.set_ylabel(_axis_label("share of machines at or below", None))
@@ -798,7 +809,7 @@ def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
 
     values: (quantity key, condition, bearing, direction) -> value in SI units (None or absent: no such run).
     quantities: (key, words, SI unit). Bars start at zero; forces are shown in kN from 1 kN on."""
-    conds = sorted({k[1] for k in values})
+    conds = sorted({k[1] for k in values}, key=lambda c: (isinstance(c, str), c))   # conditions 1-4, then points
     if not conds:
         raise ValueError("values is empty")
     present = [d for d in ("forward", "reverse")
@@ -833,7 +844,8 @@ def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
                 ax.set_xlim(-0.6, len(bearings) - 0.4)
                 ax.grid(axis="x", visible=False)
                 ax.set_ylabel(_axis_label(_wrap(words, 24), shown))
-                ax.set_title(f"condition {c}" if len(conds) > 1 else words, fontsize=9)
+                where = f"condition {c}" if isinstance(c, (int, np.integer)) else f"point {c}"
+                ax.set_title(where if len(conds) > 1 else words, fontsize=9)
         _direction_legend(fig, present, hatch=True)
         if title:
             fig.suptitle(title)
@@ -954,4 +966,64 @@ def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = Non
         fig.legend(handles=handles, loc="outside lower center", ncols=3, frameon=False, fontsize=7.5)
         if title:
             fig.suptitle(title)
+        return _save(fig, path)
+
+
+def damage_shares(bins: Sequence[str], time_shares: Sequence[float], shares: Mapping[str, Sequence[float]], path, *,
+                  title: str | None = None) -> Path:
+    """A duty cycle's damage per bin: for each bin its share of the cycle's time (grey) beside each bearing type's
+    and life's share of the damage (bars from zero, in %); a bin that does more damage than its time share is
+    where the life goes."""
+    n, k = len(bins), len(shares)
+    x = np.arange(n)
+    w = 0.8 / (k + 1)
+    colors = ["#1f5fa8", "#e07b00", "#6aa2d8", "#f2b066", "#4d9a4d", "#a64d79"]
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(min(12.0, max(6.0, 1.2 * n + 2.0)), 4.4), layout="constrained")
+        ax = fig.subplots()
+        ax.bar(x - 0.4 + w / 2, 100 * np.asarray(time_shares, float), w, color="#bbbbbb", label="time share")
+        for i, (name, vals) in enumerate(shares.items()):
+            y = np.array([np.nan if v is None else 100 * float(v) for v in vals])
+            bars = ax.bar(x - 0.4 + w * (i + 1.5), y, w, color=colors[i % len(colors)], label=name,
+                          hatch="//" if "16281" in name else None, edgecolor="white", linewidth=0)
+            ax.bar_label(bars, labels=["" if not v >= 1.0 else f"{v:.0f}" for v in y], fontsize=6, padding=1)
+        ax.set_xticks(x, [textwrap.fill(b, 18) for b in bins], fontsize=7.5, rotation=0 if n <= 6 else 30,
+                      ha="center" if n <= 6 else "right")
+        ax.set_ylim(0.0, None)
+        ax.set_ylabel(_axis_label("share of the cycle", "%"))
+        ax.grid(axis="x", visible=False)
+        ax.legend(loc="upper left", fontsize=7)
+        if title:
+            fig.suptitle(textwrap.fill(title, 110), fontsize=9.5)
+        return _save(fig, path)
+
+
+def binned_series(series: Mapping[str, Sequence[float]], names: Sequence[str], path, *,
+                  title: str | None = None) -> Path:
+    """A time series and its bins: speed and torque against time, each sample coloured by its bin (grey: at
+    standstill, in no bin); time in the unit that suits the span."""
+    t = np.asarray(series["t"], float)
+    b = np.asarray(series["bin"], int)
+    scale, unit = (1 / 3600, "h") if t[-1] - t[0] > 7200 else ((1 / 60, "min") if t[-1] - t[0] > 120 else (1, "s"))
+    cmap = mpl.colormaps["tab10" if len(names) <= 10 else "tab20"]
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(8.0, 5.6 + 0.2 * ((len(names) + 2) // 3)), layout="constrained")
+        axes = fig.subplots(2, 1, sharex=True)
+        for ax, key, words, u in ((axes[0], "speed_rpm", "carrier speed", "rpm"),
+                                  (axes[1], "torque_N_m", "output torque", "N m")):
+            y = np.asarray(series[key], float)
+            ax.step(t * scale, y, where="post", color="#888888", linewidth=0.6)
+            for j in range(len(names)):
+                sel = np.flatnonzero(b == j)
+                if sel.size:
+                    # sample k holds over [t_k, t_k+1): a horizontal segment per sample in its bin's colour
+                    segs = [[(t[i] * scale, y[i]), (t[i + 1] * scale, y[i])] for i in sel]
+                    ax.add_collection(LineCollection(segs, colors=[cmap(j % cmap.N)], linewidths=2.2,
+                                                     label=names[j] if key == "speed_rpm" else None))
+            ax.set_ylabel(_axis_label(words, u))
+        axes[1].set_xlabel(_axis_label("time", unit))
+        fig.legend(loc="outside lower center", ncols=min(3, max(1, len(names))), fontsize=7, title="bin",
+                   title_fontsize=7.5)
+        if title:
+            fig.suptitle(textwrap.fill(title, 100), fontsize=9.5)
         return _save(fig, path)

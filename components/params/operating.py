@@ -16,7 +16,8 @@ __all__ = ["OperatingPoint", "OperatingSI", "CarrierRippleParams", "CarrierRippl
 @dataclass(frozen=True, kw_only=True)
 class OperatingPoint(Params["OperatingSI"]):
     """Ring fixed, sun driven, carrier loaded. ``carrier_speed`` is a magnitude; ``direction`` gives
-    its sense (forward = counter-clockwise seen from the input side = positive).
+    its sense (forward = counter-clockwise seen from the input side = positive); ``output_power`` < 0 brakes (the
+    carrier drives the sun: the torques turn over, the speeds stay).
 
     si(): carrier_speed signed [rad/s], output_power [W], direction (str) and sign (±1);
     ``DPGTParams.si().operating`` adds the nominal speeds and torques (:class:`geometry.Kinematics`).
@@ -25,7 +26,8 @@ class OperatingPoint(Params["OperatingSI"]):
     _prefix: ClassVar[str] = "operating"
     carrier_speed: Quantity = param("angular_velocity", "carrier speed magnitude n_c", lo=0.0,
                                     bound_text=">= 0 (give the sense with direction)")
-    output_power: Quantity = nonneg("power", "output power P")
+    output_power: Quantity = param("power", "output power P (> 0 driving: the sun drives the carrier; < 0 braking: "
+                                            "the carrier drives the sun)")
     direction: str = param("choice", "sense of rotation", choices=("forward", "reverse"), default="forward")
 
     def _si_values(self, v):

@@ -17,8 +17,10 @@ from components.names import argparse_hint, did_you_mean
 from components.scene import SceneOptions
 from components.units import ParameterError, quantity, to_si
 
+from .points import parse_point
+
 __all__ = ["Parser", "parser", "add_shared", "SHARED", "positive", "nonnegative", "count", "alpha", "conditions",
-           "one_condition", "directions", "existing_file", "quantity_of", "key_value", "scheduler", "out_folder",
+           "one_condition", "operating_point", "directions", "existing_file", "quantity_of", "key_value", "scheduler", "out_folder",
            "choice_list", "int_list", "float_list", "parse_sets", "switch_value", "scene_options", "invoked_as"]
 
 CONDITIONS = (1, 2, 3, 4)
@@ -245,6 +247,24 @@ def out_folder(text):
     return str(p)
 
 
+class _Given(argparse.Action):
+    """Stores the value and that it was given (``DEST_given``): the default conditions stand only when no point is
+    named otherwise (``--operating``, a file's points)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+        setattr(namespace, f"{self.dest}_given", True)
+
+
+def operating_point(text):
+    """One ``--operating`` point (scenarios.core.points.parse_point), checked where it is read; the text is passed on."""
+    try:
+        parse_point(text)
+    except ParameterError as exc:
+        raise argparse.ArgumentTypeError(exc.problem or str(exc)) from None
+    return text
+
+
 # ---------------------------------------------------------------------------------------------------------------
 # the shared command grammar: one definition of every option the commands share (issue 24 §3)
 # ---------------------------------------------------------------------------------------------------------------
@@ -252,6 +272,11 @@ SHARED = {
     "conditions": (("--conditions",), dict(type=conditions, metavar="C[,C...]",
                                             help="comma list of operating conditions 1-4 (docs/parameters.md; default "
                                                  "{conditions})")),
+    "operating": (("--operating",), dict(action="append", default=[], type=operating_point, metavar='"[NAME:] SPEED, LOAD"',
+                                         help='your own operating point, e.g. --operating "cruise: 1500 rpm, 120 kW" '
+                                              '(repeatable; items: a speed, "sun" for the sun\'s, a power or a torque, '
+                                              'forward/reverse, "oil 80 degC"; or [[operating_point]] tables in '
+                                              '--params; README: Operating points)')),
     "params": (("--params",), dict(default=None, type=existing_file, metavar="FILE.toml",
                                    help="TOML file of parameter overrides, dotted keys as `dpgt params` lists them")),
     "set": (("--set",), dict(action="append", default=[], metavar="KEY=VALUE", type=key_value,
@@ -274,7 +299,7 @@ SHARED = {
                                               "(default: a local cluster)")),
 }
 SHARED_TITLE = "shared options (the same name, default and meaning in every dpgt command)"
-SWEEP = ("conditions", "params", "set", "out", "overwrite", "force", "no-progress", "workers", "scheduler")
+SWEEP = ("conditions", "operating", "params", "set", "out", "overwrite", "force", "no-progress", "workers", "scheduler")
 
 
 def add_shared(p, *names: str, out: str | None = None, conditions: str | None = None,
@@ -294,11 +319,14 @@ def add_shared(p, *names: str, out: str | None = None, conditions: str | None = 
             if one_condition_only:
                 flags = (*flags, "--condition")
                 writes = "out" in (names or SWEEP)          # a command without --out: no advice about it
-                kw.update(type=one_condition if writes else _one_condition(), metavar="C",
+                kw.update(type=one_condition if writes else _one_condition(), metavar="C", action=_Given,
                           help=f"operating condition 1-4, one (docs/parameters.md; default {conditions}; --condition: "
                                f"the former spelling, still accepted)")
+                p.set_defaults(conditions_given=False)
             else:
                 kw["help"] = kw["help"].format(conditions=conditions)
+                kw["action"] = _Given            # a study tells a default from a choice (points: README)
+                p.set_defaults(conditions_given=False)
         g.add_argument(*flags, **kw)
 
 

@@ -33,7 +33,9 @@ from typing import Callable, ClassVar
 from components.results import Summary
 from components.results.io import atomic_write_text
 
+from .args import parse_sets
 from .integrity import read_summary
+from .points import machine_identity
 from .memory import process_peak_mb
 from .plausibility import check_runs
 from .runner import RunConfig, run_report
@@ -133,6 +135,12 @@ class Study(abc.ABC):
         """What study.json holds besides the cases and the failed runs."""
         return {}
 
+    def machine_identity(self) -> dict:
+        """The machine the study runs (said first, kept in study.json): its ``--params`` file's name, a short
+        fingerprint and the ``--set`` overrides (not the operating point's), :func:`scenarios.core.points.machine_identity`."""
+        sets = {k: v for k, v in parse_sets(getattr(self.a, "set", None) or []).items() if not k.startswith("operating.")}
+        return machine_identity(getattr(self.a, "params", None), sets)
+
     def prepare(self, cfg: RunConfig, cases: list[Case]) -> None:
         """A study's own work after every check and before its sweep (the tolerance study's static solutions)."""
 
@@ -147,6 +155,8 @@ class Study(abc.ABC):
         cfg = self.config()
         cases = self.cases()
         validate_cases(cases, lambda c: self.check(c, cfg))      # every parameter checked before any run starts
+        machine = self.machine_identity()
+        print(f"machine: {machine['label']}", flush=True)
         self.out.mkdir(parents=True, exist_ok=True)
         for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], self.out, a.force):
             print(f"warning (--force): {w}")
@@ -170,7 +180,8 @@ class Study(abc.ABC):
                 "peak_rss_MB": process_peak_mb(), "runs": {k: o.span for k, o in outcomes.items()}}, indent=1))
         if self.record:
             atomic_write_text(self.out / "study.json", json.dumps(
-                {"cases": [dataclasses.asdict(c) for c in cases], **self.study_record(), "failed": run.failed},
+                {"machine": machine, "cases": [dataclasses.asdict(c) for c in cases], **self.study_record(),
+                 "failed": run.failed},
                 indent=2, default=str))
         r = {"results": run.results, "outcomes": outcomes, "failed": run.failed, "files": run.files, **extra}
         self.epilogue(run)

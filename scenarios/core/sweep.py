@@ -26,11 +26,12 @@ from tqdm.auto import tqdm
 from components import faults
 from components.geometry import check_design
 from components.params import overrides_from_toml, with_overrides
-from components.presets import load_toml, reference_dpgt
+from components.presets import reference_dpgt
 from components.results import Summary
 from components.results.io import atomic_write_text
 from components.units import ParameterError
 
+from .points import Point, file_overrides, point_overrides
 from .integrity import OtherResults, claim_folder, differences, read_summary
 from .runner import finished_run, parameters_fingerprint, run_case, run_description, run_fingerprint
 
@@ -40,17 +41,33 @@ __all__ = ["Case", "Status", "Outcome", "sweep", "run_sweep", "execute_case", "c
 
 @dataclass(frozen=True)
 class Case:
-    condition: int
+    condition: int | str                            # a preset 1-4, or a user point's name (then ``point`` is set)
     direction: str
     out_dir: str
     overrides: dict = field(default_factory=dict)   # dotted parameter path -> value string
     params_file: str | None = None
     window: float | None = None                     # per-case recorded window [s] (None: the config's)
     tag: str = ""                                   # tells apart cases of one operating point (e.g. the oil)
+    point: dict | None = None                       # a user operating point (scenarios.core.points.Point as a dict)
+    mode: str | None = None                         # per-case "static"/"dynamic" (None: the config's)
 
     @property
     def label(self) -> str:
-        return f"c{self.condition}_{self.direction}" + (f"_{self.tag}" if self.tag else "")
+        if self.point is not None:
+            base = self.point["name"] if self.point.get("direction") else f"{self.point['name']}_{self.direction}"
+        else:
+            base = f"c{self.condition}_{self.direction}"
+        return base + (f"_{self.tag}" if self.tag else "")
+
+    @classmethod
+    def at(cls, point, direction: str, out_dir: str, overrides: dict | None = None, params_file: str | None = None,
+           **kw) -> "Case":
+        """The case of the operating point ``point`` (:class:`scenarios.core.points.Point`) in ``direction`` (a point
+        that fixes its direction keeps it): a preset's case is the condition's, exactly as before."""
+        if point.is_preset:
+            return cls(point.condition, direction, out_dir, dict(overrides or {}), params_file, **kw)
+        return cls(point.name, point.direction or direction, out_dir, dict(overrides or {}), params_file,
+                   point=point.as_dict(), **kw)
 
 
 class Status(str, Enum):
@@ -141,13 +158,26 @@ def validate_cases(cases: list[Case], check=None) -> None:
 
 
 def build_params(case: Case):
-    base = reference_dpgt(case.condition, case.direction)
+    """The case's parameters: a preset's reference machine at its condition and direction, the ``--params`` file,
+    the overrides; a user point's machine (the file and overrides at the reference condition 3) put at the point
+    (:func:`scenarios.core.points.point_overrides`)."""
+    if case.point is None:
+        base = reference_dpgt(case.condition, case.direction)
+        if case.params_file:
+            base = with_overrides(base, file_overrides(case.params_file))
+        return with_overrides(base, case.overrides)
+    base = reference_dpgt(3, case.direction)
     if case.params_file:
-        base = load_toml(case.params_file, base=base)
-    return with_overrides(base, case.overrides)
+        base = with_overrides(base, file_overrides(case.params_file))
+    machine = with_overrides(base, case.overrides)
+    ops = point_overrides(Point(**case.point), machine)
+    ops.setdefault("operating.direction", case.direction)
+    return with_overrides(machine, ops)
 
 
 def _case_cfg(case: Case, cfg):
+    if case.mode is not None and case.mode != cfg.mode:
+        cfg = replace(cfg, mode=case.mode)
     return cfg if case.window is None else replace(cfg, window=case.window)
 
 
@@ -198,8 +228,10 @@ def _execute(case: Case, cfg, overwrite: bool) -> Outcome:
         done = _finished(case, params, cfg)
         if done is not None:
             return Outcome(case, Status.REUSED, summary=done)
-        s = run_case(params, cfg, out, label={"condition": case.condition, "direction": case.direction},
-                     overwrite=overwrite)
+        label = {"condition": case.condition, "direction": case.direction}
+        if case.point is not None:       # a user point: its name stands where a condition's number does
+            label["operating_point"] = dict(case.point)
+        s = run_case(params, cfg, out, label=label, overwrite=overwrite)
         err = out / "error.json"
         if err.exists():
             err.unlink()

@@ -126,6 +126,24 @@ def test_planet_speeds_roll_without_slip_at_every_pitch_point(direction):
     assert k.outer_planet_speed == pytest.approx(k.carrier_speed * (1 - 82 / 24))
 
 
+@pytest.mark.parametrize("direction", ["forward", "reverse"])
+@pytest.mark.parametrize("power_kw", [150.0, -150.0])
+def test_torques_carry_the_power_and_braking_turns_them_over(direction, power_kw):
+    """Lossless: the sun's torque times its speed is the output power P (> 0: driven in; < 0 braking: taken out),
+    the carrier's the opposite; braking turns both torques over and keeps the speeds, so its loaded flanks are the
+    other direction's (geometry.loaded_flanks follows the sun torque's sign)."""
+    k = with_overrides(reference_dpgt(2, direction), {"operating.output_power": f"{power_kw} kW"}).si().operating
+    assert k.sun_torque * k.sun_speed == pytest.approx(power_kw * 1e3, rel=1e-14)
+    assert k.carrier_torque * k.carrier_speed == pytest.approx(-power_kw * 1e3, rel=1e-14)
+    assert k.ring_torque == pytest.approx(-(k.sun_torque + k.carrier_torque), rel=1e-14)
+    driving = with_overrides(reference_dpgt(2, direction), {"operating.output_power": "150 kW"}).si().operating
+    assert k.sun_speed == driving.sun_speed and abs(k.sun_torque) == pytest.approx(abs(driving.sun_torque), rel=1e-15)
+    other = "reverse" if direction == "forward" else "forward"
+    flip = geo.loaded_flanks(np.sign(k.sun_torque))
+    same = geo.loaded_flanks(np.sign(reference_dpgt(2, direction if power_kw > 0 else other).si().operating.sun_torque))
+    assert flip == same
+
+
 # ------------------------------------------------------------------ assembly and phasing
 def test_assembly_condition():
     assert geo.assembly_number(31, 82, 3) == 17

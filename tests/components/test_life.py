@@ -125,3 +125,44 @@ def test_hours_and_bad_input():
         reference_bearing().replace(life={"material_factor": 1.1, "reduction_factor": 1.5})
     src = reference_bearing().life.source("material_factor")
     assert src.tag == "derived" and "ISO 281" in src.note
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# a load spectrum: Palmgren–Miner
+# ---------------------------------------------------------------------------------------------------------------
+def test_miner_life_of_a_two_bin_spectrum_by_hand():
+    """A quarter of the revolutions at a life of 100, three quarters at 400: 1/(0.25/100 + 0.75/400) = 1600/7; the
+    first bin does 4/7 of the damage. An exponent or a share swapped would move both."""
+    assert life.miner_life([100.0, 400.0], [0.25, 0.75]) == pytest.approx(1600.0 / 7.0, rel=1e-15)
+    assert life.damage_shares([100.0, 400.0], [0.25, 0.75]) == pytest.approx([4.0 / 7.0, 3.0 / 7.0], rel=1e-15)
+    assert life.miner_life([123.0], [1.0]) == pytest.approx(123.0, rel=1e-15)   # one bin: its own life
+    assert life.miner_life([50.0, 50.0, 50.0], [0.2, 0.3, 0.5]) == pytest.approx(50.0, rel=1e-15)
+    assert life.miner_life([None, 80.0], [0.5, 0.5]) == pytest.approx(160.0)   # an unloaded bin does no damage
+    assert life.miner_life([None], [1.0]) is None
+    with pytest.raises(ValueError):
+        life.miner_life([0.0, 10.0], [0.5, 0.5])
+
+
+@pytest.mark.parametrize("loads, shares", [([8e3, 12e3, 5e3], [0.2, 0.5, 0.3]), ([1e4, 3e4], [0.9, 0.1])])
+def test_the_spectrum_equivalent_load_has_the_miner_life(loads, shares):
+    """With L_i = (C/P_i)^(10/3) (ISO 281), the equivalent load P = (Σ u_i P_i^(10/3))^(3/10) gives the Miner life
+    (C/P)^(10/3): two routes, one law."""
+    C = 3.0e4
+    lives = [(C / P) ** (10.0 / 3.0) for P in loads]
+    P = life.spectrum_equivalent_load(loads, shares)
+    assert (C / P) ** (10.0 / 3.0) == pytest.approx(life.miner_life(lives, shares), rel=1e-12)
+    assert min(loads) < P < max(loads)
+
+
+def test_revolution_shares_and_the_hours_identity():
+    """u_i = N_i/ΣN; the Miner life in revolutions over the mean speed equals 1/Σ(τ_i/L_h,i) with each bin's life in
+    hours at its own speed (N_i/L_i = t_i/L_h,i)."""
+    t = np.array([3.0, 1.0, 6.0])                 # h per cycle
+    n = np.array([1000.0, 4200.0, 2000.0])        # rev/min
+    L_h = np.array([5000.0, 60.0, 800.0])         # each at its bin's speed
+    u = life.revolution_shares(t * n)
+    L_rev = L_h * 60.0 * n                        # revolutions
+    L_cycle_h = life.miner_life(L_rev, u) / ((t * n).sum() * 60.0 / t.sum())
+    assert L_cycle_h == pytest.approx(1.0 / np.sum((t / t.sum()) / L_h), rel=1e-13)
+    with pytest.raises(ValueError):
+        life.revolution_shares([0.0, 0.0])

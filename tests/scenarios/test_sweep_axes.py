@@ -1,6 +1,9 @@
 """A study's sweep owns its axes (issue 24): an override of one by --set or a --params file would silently
 relabel runs (a folder c3_forward holding a reverse run), so every study refuses it in one line naming the key,
-where it came from and the option to use; a --params file that is not UTF-8 TOML is a usage error naming it."""
+where it came from and the option to use; a --params file that is not UTF-8 TOML is a usage error naming it.
+Two exceptions, by design: a machine file's whole [operating] table (speed and power) is that machine's own
+operating point (scenarios.core.points), and a file that sets the oil is taken by the lubricant study, whose
+sweep's oils replace it (said in one line)."""
 from __future__ import annotations
 
 import pytest
@@ -26,7 +29,6 @@ def files(tmp_path):
     (paper_study, ["--set", "operating.direction=reverse"], "operating.direction is set by this study's --directions, not by --set"),
     (paper_study, ["--set", "operating.carrier_speed=100 rpm"], "operating.carrier_speed is set by this study's --conditions"),
     (paper_study, ["--params", "{bad}"], "--params {bad}: 'utf-8' codec"),
-    (lubricant_study, ["--params", "{oil}"], "lubricant.viscosity_40 is set by this study's --grades or --viscosities"),
     (lubricant_study, ["--set", "lubricant.oil_viscosity=0.02 Pa*s"], "lubricant.oil_viscosity is set by this study's"),
     (lubricant_study, ["--viscosities", "30"], "--viscosities: give the unit"),
     (fault_study, ["--set", "errors.tooth_fault=[]"], "errors.tooth_fault is set by this study's --faults or --machine"),
