@@ -196,7 +196,8 @@ STUDIES = {"paper_study": "results/study", "demo": "results/demo", "lubricant_st
            "tolerance_study": "results/tolerances"}
 OTHERS = {"spectrum": "results/spectrum", "bearing_rig": "results/bearing_rig", "modal": "results/modal",
           "work_precision": "results/numerics", "stability": "results/numerics", "benchmark": "results/numerics",
-          "bench_engine": None, "params": None, "animate": None, "duty_cycle": "results/duty_cycle"}
+          "bench_engine": None, "params": None, "animate": None, "duty_cycle": "results/duty_cycle",
+          "bearing_misalignment": "results/bearing_misalignment"}
 SHARED_OPTIONS = ("--params", "--set", "--out", "--overwrite", "--force", "--no-progress", "--workers",
                   "--scheduler", "--conditions")
 
