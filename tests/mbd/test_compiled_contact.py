@@ -229,6 +229,22 @@ def test_race_with_rolling_resistance_matches_reference(kind, law, data, fs, exp
     assert_matches_reference(elem, fs, qf, vf)
 
 
+@SETTINGS
+@given(data=st.data(), fs=frame_states(), m_in=MULTS, m_out=MULTS)
+def test_fused_race_family_with_rolling_resistance(data, fs, m_in, m_out):
+    """Inner and outer raceways with rolling resistance fused into one family: per-instance κ and R_red."""
+    qi, vi, mki, Ri = race_scene("inner", *data.draw(race_states("inner")))
+    qo, vo, mko, Ro = race_scene("outer", *data.draw(race_states("outer")))
+    qf, vf = _joined((qi, vi), (qo, vo))
+    mk = dict(D=DR, K=K_HZ, exponent=10.0 / 9.0, zeta=0.05, m_roller=M_ROLLER, traction=FILM, rolling=ROLL)
+    inner = RaceContact("inner", np.arange(1, N + 1), 0, kind="inner", race_marker=mki, R_race=Ri, multiplicity=m_in,
+                        **mk)
+    outer = RaceContact("outer", np.arange(N + 2, 2 * N + 2), N + 1, kind="outer", race_marker=mko, R_race=Ro,
+                        multiplicity=m_out, **mk)
+    assert inner.fuse_key() == outer.fuse_key()
+    assert_matches_reference(RaceContact.fuse([inner, outer]), fs, qf, vf)
+
+
 def test_default_packs_are_unchanged_by_the_opt_in_laws():
     """Without rolling resistance or viscous churning the packs are the plain laws' (G of 11, P of 4 columns):
     the kernels take the plain branches."""
