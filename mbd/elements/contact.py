@@ -331,8 +331,9 @@ class HoupertRolling(RollingResistance):
     isothermal Newtonian solutions (Biboulet & Houpert 2010, Proc. IMechE J 224: 765–775, line contacts; Houpert
     2002, Tribol. Trans. 45: 345–353):
         F_R = (29.2/α_p) R L (U G)^0.648 W^0.246,   U = η₀ũ/(E'R), G = α_p E', W = w'/(E'R), w' = Q/L,
-    the pressure gradient of the inlet shearing the film against the entraining direction on both surfaces
-    (the piezoviscous-elastic regime it was fitted in). ũ = √(u² + u_reg²) regularises the entraining speed;
+    the pressure gradient of the inlet shearing the film against the entraining direction on both surfaces.
+    Range: fitted in the piezoviscous-elastic regime (the loaded contacts of rolling bearings); at light loads,
+    where the contact becomes rigid-piezoviscous or rigid-isoviscous, it is extrapolated. ũ = √(u² + u_reg²) regularises the entraining speed;
     the force carries the sign of u: F = F_R(ũ)·u/ũ (odd and smooth in u, zero at rest). Zero load: zero force.
     eta0 [Pa·s], alpha_p [1/Pa], E_red E' [Pa], length L [m], u_reg [m/s]. Isothermal: the inlet's shear
     heating, which thins the film (§9.2), lowers this force too; the law does not include it (an upper bound)."""
@@ -348,11 +349,6 @@ class HoupertRolling(RollingResistance):
         for k in ("eta0", "alpha_p", "E_red", "length", "u_reg"):
             if not (np.isfinite(getattr(self, k)) and getattr(self, k) > 0):
                 raise ModelError(f"HoupertRolling: {k} must be > 0, got {getattr(self, k)!r}")
-
-    def prefactor(self) -> float:
-        """C with F_R = C R^(1 − 0.648 − 0.246) Q^0.246 ũ^0.648 (the law's constants gathered) [SI]."""
-        L, a = self.length, self.alpha_p
-        return (self.COEF / a) * L * (self.eta0 * a) ** self.U_EXP * (self.E_red * L) ** (-self.W_EXP)
 
     def force(self, Q, u, R):
         ut = ad.sqrt(u * u + self.u_reg ** 2)
