@@ -2,7 +2,8 @@
 spins down under the viscous churning moment alone as its closed form ω₀e^(−t/τ), τ = J/(π η_e D² l); in a
 two-body model, a roller pressed with a known load onto a turning ring and braked by a known moment settles at the
 slip the traction curve gives for that moment (tanh law: v_s = v₀ artanh(M/(r μ_max Q))), and, with the rolling
-resistance on, at the slip of that moment plus the rolling resistance's own.
+resistance on, at the slip of that moment plus the rolling resistance's own; a loaded, turning rig with both laws
+runs alike on the compiled and numpy engines.
 """
 from __future__ import annotations
 
@@ -118,3 +119,22 @@ def test_rolling_resistance_adds_its_moment_to_the_brake():
     plain = _integrate(*_held_roller(Q, w, moment)[:3], 0.01).state
     p_lever = R_RING - (plain.q[3] - plain.q[0])
     assert abs(vs) > abs(plain.v[5] * p_lever - plain.v[2] * R_RING)   # more slip than the brake alone gives
+
+
+def test_the_engines_run_the_skid_physics_alike():
+    """A loaded, turning rig with both opt-in laws, 1000 fixed steps: the compiled and numpy engines reach the same
+    state to round-off. (With adaptive steps an accept/reject decision at the edge of the error bound can go either
+    way on an ulp, after which the runs differ by the controller's tolerance, not by round-off: fixed steps compare
+    the laws, not the controller's coin flips.)"""
+    b = reference_bearing().replace(drag_law="viscous", rolling_resistance="houpert").si()
+    lub = reference_dpgt().lubricant.replace(temperature="40 degC").si()
+    built = build_bearing_rig(b, radial_load=2000.0, outer_speed=300.0, lubricant=lub,
+                              options=SceneOptions(cage="free", drag=True))
+    kw = dict(stepper=SETTINGS.stepper(), controller=mbd.FixedStep(2e-6), progress=False)
+    c = mbd.simulate(built.model, built.q0, built.v0, 0.002, engine="compiled", **kw)
+    r = mbd.simulate(built.model, built.q0, built.v0, 0.002, engine="numpy", **kw)
+    assert c.engine == "compiled" and r.engine == "numpy"
+    assert c.counters == r.counters
+    tol = SETTINGS.stepper().tol.scale(built.model, None, None)
+    assert np.all(np.abs(c.state.q - r.state.q) <= 1e-6 * tol)          # seen: 1e-13 of it
+    np.testing.assert_allclose(c.state.v, r.state.v, rtol=0, atol=1e-12 * np.abs(r.state.v).max())
