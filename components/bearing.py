@@ -72,7 +72,7 @@ def traction(b: BearingSI, lubricant: LubricantSI | None = None) -> Traction:
 
 def rolling_resistance(b: BearingSI, lubricant: LubricantSI | None = None) -> RollingResistance | None:
     """The rolling-resistance law named by ``bearing.rolling_resistance`` (None for "none"), with the oil's
-    viscosity and pressure-viscosity coefficient and the rollers' reduced modulus and length."""
+    viscosity and the rollers' reduced modulus and length."""
     if b.rolling_resistance == "none":
         return None
     if lubricant is None:
@@ -80,8 +80,8 @@ def rolling_resistance(b: BearingSI, lubricant: LubricantSI | None = None) -> Ro
                                                               "viscosity); this scene has none")
     assert set(ROLLING_LAWS) == {"houpert"}
     E_red = reduced_modulus(b.elastic_modulus, b.poisson_ratio, b.elastic_modulus, b.poisson_ratio)
-    return HoupertRolling(eta0=lubricant.oil_viscosity, alpha_p=lubricant.pressure_viscosity, E_red=E_red,
-                          length=b.roller_length, u_reg=lubricant.film_speed_reg)
+    return HoupertRolling(eta0=lubricant.oil_viscosity, E_red=E_red, length=b.roller_length,
+                          u_reg=lubricant.film_speed_reg)
 
 
 def mixture(lubricant: LubricantSI) -> tuple[float, float]:

@@ -141,8 +141,9 @@ class BearingParams(Params["BearingSI"]):
                                     "roller spin, with the oil-air mixture's viscosity)",
                           choices=("inertial", "viscous"))
     rolling_resistance: str = param("choice", "hydrodynamic rolling resistance of the loaded roller-raceway "
-                                              "contacts: none, or houpert (Poiseuille rolling force of the EHL "
-                                              "line contact)", choices=("none", "houpert"))
+                                              "contacts: none, or houpert (Biboulet-Houpert's fully flooded "
+                                              "rolling force of the line contact, IVR to EHL)",
+                                    choices=("none", "houpert"))
     traction_mu_max: Quantity = nonneg("dimensionless", "traction curve maximum mu_max (mu = mu_max tanh(v/v0))")
     traction_v0: Quantity = positive("velocity", "traction curve slip velocity scale v0")
     slide_roll_traction: SlideRollTractionParams = nested(SlideRollTractionParams, "slide-to-roll traction curve")

@@ -11,7 +11,7 @@ Layouts (P: one row per instance, columns in this order; G: family-wide values):
                   law 0 (TanhTraction): mu_max, v0;  law 1 (SlideRollTraction): A, B, C, D, u_reg, s_eps;
                   law 2 (EHLTraction): eta0, alpha_p, E_red, length, tau_L0, gamma_L, G_e, u_reg,
                   beta·eta0/k_oil (L = that × u², the thermal loading number); a family with rolling resistance
-                  (HoupertRolling) packs 6 more: 1, eta0, alpha_p, E_red, length, u_reg (G of 17: the kernel
+                  (HoupertRolling) packs 5 more: 1, eta0, E_red, length, u_reg (G of 16: the kernel
                   decides from G's size, a family without it pays nothing)
 ``PocketContact`` P (n, 10): pocket_angle ψ, pitch_radius, clearance, K_p, λ (impact law damping), v_min, mu,
                   v_mu, D, multiplicity;  G (0,)
@@ -98,7 +98,7 @@ def pack_race(elem):
         if type(roll) is not HoupertRolling:
             raise NotImplementedError(f"{elem.name}: RaceContact with rolling law {type(roll).__name__} has no "
                                       "compiled kernel (compiled: HoupertRolling)")
-        G = np.concatenate([G, [1.0, roll.eta0, roll.alpha_p, roll.E_red, roll.length, roll.u_reg]])
+        G = np.concatenate([G, [1.0, roll.eta0, roll.E_red, roll.length, roll.u_reg]])
     return P, G
 
 
@@ -265,19 +265,23 @@ def _ehl_traction(G, v_s, u, Q, Rr):
 
 
 _RG = 11                                        # G index of the rolling-resistance block (pack_race)
-_RC, _RU, _RW = HoupertRolling.COEF, HoupertRolling.U_EXP, HoupertRolling.W_EXP
+_R_IVR, _R_EHL, _R_BLEND, _R_HERTZ = HoupertRolling.IVR, HoupertRolling.EHL, HoupertRolling.BLEND, HoupertRolling.HERTZ
 
 
 @njit(cache=True)
 def _rolling(G, Q, u, Rr):
-    """HoupertRolling.force (the reference's operations) and its partials ∂F/∂Q = 0.246 F/Q and
-    ∂F/∂u = (F_R/ũ)(0.648 u²/ũ² + u_reg²/ũ²), F = F_R(ũ) u/ũ."""
-    eta0, alpha, E, L, u_reg = G[_RG + 1], G[_RG + 2], G[_RG + 3], G[_RG + 4], G[_RG + 5]
+    """HoupertRolling.force (the reference's operations) and its partials. F_R = c√(UW)(1 + s)^(−1/10), s ∝ W⁵/U^(5/2):
+    ∂ln F_R/∂ln W = ½/(1 + s), ∂ln F_R/∂ln U = ½ + ¼ s/(1 + s); F = F_R(ũ) u/ũ."""
+    eta0, E, L, u_reg = G[_RG + 1], G[_RG + 2], G[_RG + 3], G[_RG + 4]
     ut = np.sqrt(u * u + u_reg ** 2)
-    U, Gm, W = eta0 * ut / (E * Rr), alpha * E, Q * (1.0 / (E * Rr * L))
-    FR = (_RC / alpha) * Rr * L * (U * Gm) ** _RU * W ** _RW
+    ER = E * Rr
+    U, W = (2.0 * eta0) * ut / ER, Q * (1.0 / (ER * L))
+    M = W / np.sqrt(U)
+    s = (_R_IVR / _R_EHL) ** _R_BLEND * M ** (0.5 * _R_BLEND)
+    FR = (ER * L) * ((_R_IVR * _R_HERTZ) * np.sqrt(U * W) * (1.0 + s) ** (-1.0 / _R_BLEND))
     F = FR * u / ut
-    return F, _RW * F / Q, (FR / ut) * (_RU * u * u + u_reg * u_reg) / (ut * ut)
+    n_u = 0.5 + 0.25 * s / (1.0 + s)
+    return F, 0.5 * F / (Q * (1.0 + s)), (FR / ut) * (n_u * u * u + u_reg * u_reg) / (ut * ut)
 
 
 @njit(cache=True)

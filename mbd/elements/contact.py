@@ -327,34 +327,47 @@ class RollingResistance:
 
 @dataclass(frozen=True)
 class HoupertRolling(RollingResistance):
-    """Hydrodynamic (Poiseuille) rolling force of an EHL line contact in pure rolling, Houpert's fit of numerical
-    isothermal Newtonian solutions (Biboulet & Houpert 2010, Proc. IMechE J 224: 765–775, line contacts; Houpert
-    2002, Tribol. Trans. 45: 345–353):
-        F_R = (29.2/α_p) R L (U G)^0.648 W^0.246,   U = η₀ũ/(E'R), G = α_p E', W = w'/(E'R), w' = Q/L,
-    the pressure gradient of the inlet shearing the film against the entraining direction on both surfaces.
-    Range: fitted in the piezoviscous-elastic regime (the loaded contacts of rolling bearings); at light loads,
-    where the contact becomes rigid-piezoviscous or rigid-isoviscous, it is extrapolated. ũ = √(u² + u_reg²) regularises the entraining speed;
-    the force carries the sign of u: F = F_R(ũ)·u/ũ (odd and smooth in u, zero at rest). Zero load: zero force.
-    eta0 [Pa·s], alpha_p [1/Pa], E_red E' [Pa], length L [m], u_reg [m/s]. Isothermal: the inlet's shear
-    heating, which thins the film (§9.2), lowers this force too; the law does not include it (an upper bound)."""
+    """Hydrodynamic (Poiseuille) rolling force of a fully flooded line contact in pure rolling, Houpert's correlation
+    (Biboulet & Houpert 2010, "Hydrodynamic force and moment in pure rolling lubricated contacts. Part 1: line
+    contacts", Proc. IMechE J 224: 765–775): with their groups (eq. 14) U = 2η₀ũ/(E'R) (ũ the mean surface speed),
+    W = w'/(E'R), w' = Q/L, and Moes' M = W/√U, the fully flooded moment per unit length in Hertzian units is
+    (eq. 42)
+        T* = M^(−3/2) · 1.4√M / (1 + ((1.4/1.45)√M)^10)^(1/10),
+    between the isoviscous-rigid asymptote T* = 1.4/M (eq. 40: T̃ = 1.42 (UW)^(1/2)) and the elastohydrodynamic one
+    T* = 1.45 M^(−3/2) (eq. 41: T̃ = 1.47 U^(3/4), independent of load and of α_p). T̃ = t/(E'R²) = T* p_h b²/(E'R²)
+    = T*·8W^(3/2)/(π√(2π)), and the force per unit length is T̃·E'R (eq. 31: the moment is the rolling force times R,
+    the pressure adding none), so F_R = E'RL·1.4k√(UW)·(1 + (1.4/1.45)^10 M⁵)^(−1/10), k = 8/(π√(2π)).
+    Range: their EHL solutions cover Moes L = 4–16, M = 0.2–200 (steel, G = 4520: U = 6.1e-13–1.6e-10,
+    W = 1.6e-7–2.5e-3), the IVR asymptote below; fully flooded (their starvation factor, eq. 44, is not applied),
+    isothermal, Newtonian. ũ = √(u² + u_reg²) regularises the entraining speed; the force carries the sign of u:
+    F = F_R(ũ)·u/ũ (odd and smooth in u, zero at rest). Zero load: zero force (as √Q).
+    eta0 [Pa·s], E_red E' [Pa], length L [m], u_reg [m/s]."""
     eta0: float
-    alpha_p: float
     E_red: float
     length: float
     u_reg: float
 
-    COEF, U_EXP, W_EXP = 29.2, 0.648, 0.246
+    # eq. 42's constants: the IVR coefficient 1.4, the EHL one 1.45, the blend's exponent 10; Hertz's units to
+    # classical ones, T̃/(T* W^(3/2)) = 8/(π √(2π))
+    IVR, EHL, BLEND = 1.4, 1.45, 10.0
+    HERTZ = 8.0 / (np.pi * np.sqrt(2.0 * np.pi))
 
     def __post_init__(self):
-        for k in ("eta0", "alpha_p", "E_red", "length", "u_reg"):
+        for k in ("eta0", "E_red", "length", "u_reg"):
             if not (np.isfinite(getattr(self, k)) and getattr(self, k) > 0):
                 raise ModelError(f"HoupertRolling: {k} must be > 0, got {getattr(self, k)!r}")
 
+    def moment(self, U, W):
+        """T̃ = t/(E'R²), the fully flooded moment per unit length (eq. 42 in the classical units), of arrays U, W."""
+        M = W / ad.sqrt(U)
+        s = (self.IVR / self.EHL) ** self.BLEND * ad.power(M, 0.5 * self.BLEND)
+        return (self.IVR * self.HERTZ) * ad.sqrt(U * W) * ad.power(1.0 + s, -1.0 / self.BLEND)
+
     def force(self, Q, u, R):
         ut = ad.sqrt(u * u + self.u_reg ** 2)
-        U, G, W = self.eta0 * ut / (self.E_red * R), self.alpha_p * self.E_red, Q * (1.0 / (self.E_red * R * self.length))
-        FR = (self.COEF / self.alpha_p) * R * self.length * ad.power(U * G, self.U_EXP) * ad.power(W, self.W_EXP)
-        return FR * u / ut
+        ER = self.E_red * R
+        U, W = (2.0 * self.eta0) * ut / ER, Q * (1.0 / (ER * self.length))
+        return (ER * self.length) * self.moment(U, W) * u / ut
 
 
 # the rolling-resistance laws by name (a parameter chooses one; None: no rolling resistance)

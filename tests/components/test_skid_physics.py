@@ -59,7 +59,7 @@ J_R = M_R * D ** 2 / 8
 R_RING = 23.76e-3                      # the outer raceway's radius
 K, P = 1.22e9, 10.0 / 9.0
 TANH = TanhTraction(mu_max=0.08, v0=0.3)
-ROLL = HoupertRolling(eta0=0.025, alpha_p=2.2e-8, E_red=2.31e11, length=L, u_reg=0.1)
+ROLL = HoupertRolling(eta0=0.025, E_red=2.31e11, length=L, u_reg=0.1)
 
 
 def _held_roller(Q, omega_ring, moment, rolling=None):
@@ -112,7 +112,7 @@ def test_rolling_resistance_adds_its_moment_to_the_brake():
     u_e = 0.5 * (v[5] * lever + v[2] * R_RING)         # contact point at rest: the surfaces' mean speed
     R_red = 1.0 / (2.0 / D - 1.0 / R_RING)
     F_R = ROLL.force(np.array([Q]), np.array([u_e]), R_red)[0]
-    assert F_R > 0.1                                   # a real share of the brake: (R − ρ)F_R ≈ 0.4 M
+    assert F_R > 0.3                                   # a real share of the brake: (R − ρ)F_R ≈ 1.2 M (M ≈ 0.7: IVR–EHL)
     # the roller's moment balance about its centre: traction, rolling resistance and brake
     expected = -brentq(lambda x: TANH.mu_max * np.tanh(x / TANH.v0) * Q * lever - moment - lever * F_R, 0.0, 1.0)
     assert vs == pytest.approx(expected, rel=1e-5)

@@ -213,7 +213,7 @@ def test_viscous_drag_matches_reference(state, fs, mult, eta):
     assert_matches_reference(elem, fs, qf, vf)
 
 
-ROLL = HoupertRolling(eta0=0.025, alpha_p=2.2e-8, E_red=2.31e11, length=9e-3, u_reg=0.1)
+ROLL = HoupertRolling(eta0=0.025, E_red=2.31e11, length=9e-3, u_reg=0.1)
 
 
 @pytest.mark.parametrize("kind", ["inner", "outer"])
@@ -253,7 +253,7 @@ def test_default_packs_are_unchanged_by_the_opt_in_laws():
     assert pack_race(plain)[1].size == 11
     rolled = RaceContact("race", [1], 0, kind="inner", race_marker=mk, R_race=R, D=DR, K=K_HZ, exponent=10 / 9,
                          zeta=0.05, m_roller=M_ROLLER, traction=TANH, rolling=ROLL)
-    assert pack_race(rolled)[1].size == 17
+    assert pack_race(rolled)[1].size == 16
     assert plain.fuse_key() != rolled.fuse_key()
     _, _, drag, _ = drag_scene((0, 0, 0), (0, 0, 0), 0.0, [0.0], [0.0], [1.0], [0.0], [0.0])
     assert kind_of(LubricantDrag).pack(drag)[0].shape[1] == 4
