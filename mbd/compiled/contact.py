@@ -449,8 +449,10 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
             fRx, fRy = g * tx, g * ty
             MRr = (rho - R) * FR
             MRb = -(rcx * fRy - rcy * fRx) - R * FR
-        _write(F, Jq, Jv, i, -1, mult, Fx + fRx, Fy + fRy, rrx * Fy - rry * Fx + MRr, -Fx + -fRx, -Fy + -fRy,
-               rbx * (-Fy) - rby * (-Fx) + MRb)
+            _write(F, Jq, Jv, i, -1, mult, Fx + fRx, Fy + fRy, rrx * Fy - rry * Fx + MRr, -Fx + -fRx, -Fy + -fRy,
+                   rbx * (-Fy) - rby * (-Fx) + MRb)
+        else:
+            _write(F, Jq, Jv, i, -1, mult, Fx, Fy, rrx * Fy - rry * Fx, -Fx, -Fy, rbx * (-Fy) - rby * (-Fx))
         if out:
             _race_out(O, i, Q, delta, Ft, v_s, u, Fx, Fy)
         if not jac:
