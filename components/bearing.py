@@ -11,11 +11,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from mbd.elements import BodySpring
-from mbd.elements.contact import (IMPACT_LAWS, TRACTION_LAWS, DryLand, EHLTraction, GuideContact, HydrodynamicLand,
-                                  LubricantDrag, PocketContact, RaceContact, SlideRollTraction, TanhTraction, Traction)
+from mbd.elements.contact import (IMPACT_LAWS, ROLLING_LAWS, TRACTION_LAWS, DryLand, EHLTraction, GuideContact,
+                                  HoupertRolling, HydrodynamicLand, LubricantDrag, PocketContact, RaceContact,
+                                  RollingResistance, SlideRollTraction, TanhTraction, Traction)
 
 from .families import FAMILY
-from .lubrication import reduced_modulus
+from .lubrication import oil_density, reduced_modulus
 from .params import BearingSI, LubricantSI
 from .scene import Scene
 from .units import ParameterError
@@ -67,6 +68,29 @@ def traction(b: BearingSI, lubricant: LubricantSI | None = None) -> Traction:
     """The roller–raceway traction law named by ``bearing.traction_law``, with its SI parameters (the
     lubricant's too, for the EHL law)."""
     return _TRACTION_FROM[b.traction_law](b, lubricant)
+
+
+def rolling_resistance(b: BearingSI, lubricant: LubricantSI | None = None) -> RollingResistance | None:
+    """The rolling-resistance law named by ``bearing.rolling_resistance`` (None for "none"), with the oil's
+    viscosity and the rollers' reduced modulus and length."""
+    if b.rolling_resistance == "none":
+        return None
+    if lubricant is None:
+        raise ParameterError.at("bearing.rolling_resistance", f"{b.rolling_resistance!r} needs a lubricant (its "
+                                                              "viscosity); this scene has none")
+    assert set(ROLLING_LAWS) == {"houpert"}
+    E_red = reduced_modulus(b.elastic_modulus, b.poisson_ratio, b.elastic_modulus, b.poisson_ratio)
+    return HoupertRolling(eta0=lubricant.oil_viscosity, E_red=E_red, length=b.roller_length,
+                          u_reg=lubricant.film_speed_reg)
+
+
+def mixture(lubricant: LubricantSI) -> tuple[float, float]:
+    """(density, dynamic viscosity) of the oil–air mixture of the viscous drag law: the oil's at the operating
+    temperature times its volume fraction ``lubricant.oil_fraction`` (air's own density and viscosity, ≈ 1/700 and
+    ≈ 1/1000 of the oil's, left out)."""
+    X = lubricant.oil_fraction
+    rho = oil_density(lubricant.oil_density, lubricant.thermal_expansion, lubricant.temperature)
+    return X * rho, X * lubricant.oil_viscosity
 
 
 def bearing_kinematics(b: BearingSI, omega_inner: float, omega_outer: float) -> tuple[float, float]:
@@ -127,6 +151,9 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
     common = dict(D=damage.get("D", D), K=b.contact_stiffness, zeta=b.contact_damping_ratio, m_roller=b.roller_mass,
                   multiplicity=b.rows)
     law = dict(traction=traction(b, lubricant), exponent=b.contact_exponent)     # family-wide laws
+    rolling = rolling_resistance(b, lubricant)
+    if rolling is not None:
+        law["rolling"] = rolling
     inner = scene.family(FAMILY["race_inner"], RaceContact, ("roller", "race_body"), kind="inner", **law)
     s_in = inner.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker, R_race=b.inner_raceway_radius,
                      **common, **damage.get("inner", {}))
@@ -140,9 +167,14 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
             raise ParameterError.at("lubricant", "the scene has lubricant drag on (option drag) but no lubricant "
                                                  "was given")
         drag = scene.family(FAMILY["drag"], LubricantDrag, ("roller", "race_body"))
+        if b.drag_law == "viscous":         # the mixture's density and viscosity at the oil's temperature
+            rho_e, eta_e = mixture(lubricant)
+            visc = dict(rho=rho_e, eta=eta_e)
+        else:
+            visc = dict(rho=lubricant.density)
         drag_slice = drag.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker,
-                              C_d=lubricant.drag_coefficient, rho=lubricant.density, D=D, l=b.roller_length, d_m=d_m,
-                              multiplicity=b.rows)
+                              C_d=lubricant.drag_coefficient, D=D, l=b.roller_length, d_m=d_m,
+                              multiplicity=b.rows, **visc)
         handles = replace(handles, drag=drag_slice)
     if opt.cage != "none":
         handles = replace(handles, **_add_cage(scene, tag, b, names, psi, pin_xy, pin_vel, wm, outer_body,

@@ -132,6 +132,9 @@ def reference_bearing() -> BearingParams:
         contact_exponent=derived(10.0 / 9.0, "Palmgren line contact Q = K delta^(10/9) (docs/model.md §8.1)"),
         contact_damping_ratio=assumed(0.05, "of critical, gated to compression"),
         traction_law=assumed("tanh", "a smooth, bounded Coulomb-like law (docs/model.md §8.2); slide_roll: an EHL-type curve of the slide-to-roll ratio"),
+        drag_law=assumed("inertial", "quadratic drag of the oil-air mixture on the roller orbit (docs/model.md "
+                                     "§8.7); viscous: with the oil's viscosity, and a moment on the roller spin"),
+        rolling_resistance=assumed("none", "houpert: the contacts' Poiseuille rolling force (docs/model.md §9.5)"),
         traction_mu_max=assumed(0.08, "mu = 0.08 tanh(v_s / 0.3 m/s)"),
         traction_v0=assumed("0.3 m/s"),
         slide_roll_traction=SlideRollTractionParams(

@@ -193,6 +193,14 @@ class BearingParams(Params["BearingSI"]):
     contact_damping_ratio: Quantity = nonneg("dimensionless", "roller-raceway contact damping ratio")
     traction_law: str = param("choice", "roller-raceway traction law (ehl: from the lubricant's film)",
                               choices=("tanh", "slide_roll", "ehl"))
+    drag_law: str = param("choice", "lubricant drag on the rollers: inertial (quadratic drag on the orbit, C_d "
+                                    "constant) or viscous (C_d(Re) of a cylinder and a viscous moment on the "
+                                    "roller spin, with the oil-air mixture's viscosity)",
+                          choices=("inertial", "viscous"))
+    rolling_resistance: str = param("choice", "hydrodynamic rolling resistance of the loaded roller-raceway "
+                                              "contacts: none, or houpert (Biboulet-Houpert's fully flooded "
+                                              "rolling force of the line contact, IVR to EHL)",
+                                    choices=("none", "houpert"))
     traction_mu_max: Quantity = nonneg("dimensionless", "traction curve maximum mu_max (mu = mu_max tanh(v/v0))")
     traction_v0: Quantity = positive("velocity", "traction curve slip velocity scale v0")
     slide_roll_traction: SlideRollTractionParams = nested(SlideRollTractionParams, "slide-to-roll traction curve")
@@ -236,6 +244,8 @@ class BearingSI(SI):
     contact_exponent: float
     contact_damping_ratio: float
     traction_law: str
+    drag_law: str
+    rolling_resistance: str
     traction_mu_max: float
     traction_v0: float
     slide_roll_traction: SlideRollTractionSI
@@ -293,6 +303,10 @@ class LubricantParams(Params["LubricantSI"]):
     temperature_viscosity: Quantity | None = rule("per_temperature", "derived",
                                                   "beta = -(1/eta) d(eta)/dT of Walther's line and the density "
                                                   "at the temperature")
+    oil_fraction: Quantity | None = rule("dimensionless", "derived", "the mixture density over the oil's density "
+                                                                    "at the temperature",
+                                         "volume fraction X of oil in the bearing's free space (the viscous drag "
+                                         "law's mixture: density X rho_oil, viscosity X eta_oil)")
 
     def _si_values(self, v):
         # deferred: components.lubrication imports the engine (mbd.elements, numba), which parameters do not need
@@ -306,7 +320,13 @@ class LubricantParams(Params["LubricantSI"]):
                                                              "with lubricant.thermal_expansion")
         eta = v["oil_viscosity"]
         beta = v["temperature_viscosity"]
+        X = v["oil_fraction"]
+        if X is None:
+            X = v["density"] / oil_density(v["oil_density"], v["thermal_expansion"], v["temperature"])
+        if not 0.0 < X <= 1.0:
+            raise ParameterError.at("lubricant.oil_fraction", f"must lie in (0, 1] (a volume fraction), got {X!r}")
         return dict(
+            oil_fraction=X,
             oil_viscosity=eta if eta is not None else dynamic_viscosity(*line, v["oil_density"],
                                                                         v["thermal_expansion"], v["temperature"]),
             temperature_viscosity=beta if beta is not None else temperature_viscosity(*line, v["thermal_expansion"],
@@ -332,3 +352,5 @@ class LubricantSI(SI):
     oil_viscosity: float = computed("dynamic viscosity at the operating temperature [Pa s] (given, or Walther)")
     temperature_viscosity: float = computed("temperature-viscosity coefficient beta at the operating "
                                             "temperature [1/K] (given, or Walther)")
+    oil_fraction: float = computed("volume fraction of oil in the bearing's free space (given, or the mixture "
+                                   "density over the oil's at the temperature)")

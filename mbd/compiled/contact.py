@@ -10,12 +10,16 @@ Layouts (P: one row per instance, columns in this order; G: family-wide values):
                   G (11,): exponent p, traction law id, then the law's coefficients (zero-padded):
                   law 0 (TanhTraction): mu_max, v0;  law 1 (SlideRollTraction): A, B, C, D, u_reg, s_eps;
                   law 2 (EHLTraction): eta0, alpha_p, E_red, length, tau_L0, gamma_L, G_e, u_reg,
-                  beta·eta0/k_oil (L = that × u², the thermal loading number)
+                  beta·eta0/k_oil (L = that × u², the thermal loading number); a family with rolling resistance
+                  (HoupertRolling) packs 5 more: 1, eta0, E_red, length, u_reg (G of 16: the kernel
+                  decides from G's size, a family without it pays nothing)
 ``PocketContact`` P (n, 10): pocket_angle ψ, pitch_radius, clearance, K_p, λ (impact law damping), v_min, mu,
                   v_mu, D, multiplicity;  G (0,)
 ``GuideContact``  P (n, 7): clearance, K_g, λ, v_min, mu, v_mu, land_radius;  G (4,): land law (0 dry,
                   1 hydrodynamic), then for the film: eta, width, min_film
-``LubricantDrag`` P (n, 4): race_marker x, y [m], coef = C_d ρ D l d_m²/8, multiplicity;  G (0,)
+``LubricantDrag`` P (n, 4): race_marker x, y [m], coef = C_d ρ D l d_m²/8, multiplicity; with viscous churning
+                  2 more: coef_visc (of Ω|Ω|^(1/3)), coef_spin = π η_e D² l (the kernel decides from P's width);
+                  G (0,)
 
 The impact families' internal state z (n, 4) is the reference's: [v₀, x, ẋ, valid].
 
@@ -42,8 +46,8 @@ import numpy as np
 from numba import njit
 
 from ..elements import ehl
-from ..elements.contact import (DryLand, EHLTraction, GuideContact, HydrodynamicLand, LubricantDrag, PocketContact,
-                                RaceContact, SlideRollTraction, TanhTraction)
+from ..elements.contact import (DryLand, EHLTraction, GuideContact, HoupertRolling, HydrodynamicLand, LubricantDrag,
+                                PocketContact, RaceContact, SlideRollTraction, TanhTraction)
 
 __all__ = ["pack_race", "evaluate_race", "outputs_race", "pack_pocket", "evaluate_pocket", "outputs_pocket",
            "update_pocket", "pack_guide", "evaluate_guide", "outputs_guide", "update_guide", "pack_drag",
@@ -89,6 +93,12 @@ def pack_race(elem):
     P = _rows(*cols)
     G = np.zeros(11)
     G[:2 + len(coef)] = [elem.exponent, float(law), *coef]
+    roll = elem.rolling
+    if roll is not None:
+        if type(roll) is not HoupertRolling:
+            raise NotImplementedError(f"{elem.name}: RaceContact with rolling law {type(roll).__name__} has no "
+                                      "compiled kernel (compiled: HoupertRolling)")
+        G = np.concatenate([G, [1.0, roll.eta0, roll.E_red, roll.length, roll.u_reg]])
     return P, G
 
 
@@ -116,7 +126,10 @@ def pack_guide(elem):
 def pack_drag(elem):
     _require(elem, LubricantDrag)
     mk = elem.race_marker
-    return _rows(mk[:, 0], mk[:, 1], elem.coef, elem.multiplicity), np.zeros(0)
+    cols = [mk[:, 0], mk[:, 1], elem.coef, elem.multiplicity]
+    if elem.viscous:
+        cols += [elem.coef_visc, elem.coef_spin]
+    return _rows(*cols), np.zeros(0)
 
 
 # ----------------------------------------------------------------------------------- scalar helpers
@@ -251,6 +264,26 @@ def _ehl_traction(G, v_s, u, Q, Rr):
     return mu, t_s / pbar, t_u / pbar, t_Q / pbar - mu * 0.5 / Q
 
 
+_RG = 11                                        # G index of the rolling-resistance block (pack_race)
+_R_IVR, _R_EHL, _R_BLEND, _R_HERTZ = HoupertRolling.IVR, HoupertRolling.EHL, HoupertRolling.BLEND, HoupertRolling.HERTZ
+
+
+@njit(cache=True)
+def _rolling(G, Q, u, Rr):
+    """HoupertRolling.force (the reference's operations) and its partials. F_R = c√(UW)(1 + s)^(−1/10), s ∝ W⁵/U^(5/2):
+    ∂ln F_R/∂ln W = ½/(1 + s), ∂ln F_R/∂ln U = ½ + ¼ s/(1 + s); F = F_R(ũ) u/ũ."""
+    eta0, E, L, u_reg = G[_RG + 1], G[_RG + 2], G[_RG + 3], G[_RG + 4]
+    ut = np.sqrt(u * u + u_reg ** 2)
+    ER = E * Rr
+    U, W = (2.0 * eta0) * ut / ER, Q * (1.0 / (ER * L))
+    M = W / np.sqrt(U)
+    s = (_R_IVR / _R_EHL) ** _R_BLEND * M ** (0.5 * _R_BLEND)
+    FR = (ER * L) * ((_R_IVR * _R_HERTZ) * np.sqrt(U * W) * (1.0 + s) ** (-1.0 / _R_BLEND))
+    F = FR * u / ut
+    n_u = 0.5 + 0.25 * s / (1.0 + s)
+    return F, 0.5 * F / (Q * (1.0 + s)), (FR / ut) * (n_u * u * u + u_reg * u_reg) / (ut * ut)
+
+
 @njit(cache=True)
 def _approach(v_min, xd, v_stored):
     """(v₀, dv₀/dẋ): the stored approach speed if > 0, else max(ẋ, v_min) of the iterate."""
@@ -360,6 +393,8 @@ def outputs_race(t, phi, omega, domega, ql, vl, z, P, G, O):
 def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
     """The race law: forces into F (and Jacobians); with O of 7 rows, the outputs too (else O is (0, 0))."""
     p, law = G[0], int(G[1])
+    roll = G.size > _RG                         # rolling resistance (decided at pack time)
+    need_u = law != TANH or roll                # the Jacobian needs the rolling speed's differential
     pe = 0.5 * (p - 1.0)                        # exponent of the damping's δ factor
     spall = P.shape[1] > RACE_COLS              # decided at pack time (see the module docstring)
     out = O.shape[0] > 0
@@ -406,7 +441,18 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
         Ft = -mu * Q
         Fx = kap * Q * ex + Ft * tx
         Fy = kap * Q * ey + Ft * ty
-        _write(F, Jq, Jv, i, -1, mult, Fx, Fy, rrx * Fy - rry * Fx, -Fx, -Fy, rbx * (-Fy) - rby * (-Fx))
+        FR, FR_Q, FR_u, a1, g, fRx, fRy, MRr, MRb = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        if roll:          # Poiseuille shear at P on both bodies, the pressure's share through each centre
+            FR, FR_Q, FR_u = _rolling(G, Q, u, 1.0 / (2.0 / D + kap / R))
+            a1 = 2.0 * R / rho
+            g = FR * (a1 - 1.0)
+            fRx, fRy = g * tx, g * ty
+            MRr = (rho - R) * FR
+            MRb = -(rcx * fRy - rcy * fRx) - R * FR
+            _write(F, Jq, Jv, i, -1, mult, Fx + fRx, Fy + fRy, rrx * Fy - rry * Fx + MRr, -Fx + -fRx, -Fy + -fRy,
+                   rbx * (-Fy) - rby * (-Fx) + MRb)
+        else:
+            _write(F, Jq, Jv, i, -1, mult, Fx, Fy, rrx * Fy - rry * Fx, -Fx, -Fy, rbx * (-Fy) - rby * (-Fx))
         if out:
             _race_out(O, i, Q, delta, Ft, v_s, u, Fx, Fy)
         if not jac:
@@ -443,15 +489,25 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
             dur = dVrx * tx + Vrx * dtx + dVry * ty + Vry * dty
             dub = dVbx * tx + Vbx * dtx + dVby * ty + Vby * dty
             dmu = mu_s * (dur - dub) + mu_Q * dQ
-            if law != TANH:
+            du = 0.0
+            if need_u:
                 dwt = dwx * tx + wx * dtx + dwy * ty + wy * dty
                 dvP = dVcx * tx + Vcx * dtx + dVcy * ty + Vcy * dty + R * (dwt - wt * drho / rho) / rho
-                dmu += mu_u * (0.5 * (dur + dub) - dvP)
+                du = 0.5 * (dur + dub) - dvP
+                if law != TANH:
+                    dmu += mu_u * du
             dFt = -(dmu * Q + mu * dQ)
             dFx = kap * (dQ * ex + Q * dex) + dFt * tx + Ft * dtx
             dFy = kap * (dQ * ey + Q * dey) + dFt * ty + Ft * dty
             dMr = _d_cross(rrx, rry, drrx, drry, Fx, Fy, dFx, dFy)
             dMb = -_d_cross(rbx, rby, drbx, drby, Fx, Fy, dFx, dFy)
+            if roll:
+                dFR = FR_Q * dQ + FR_u * du
+                dg = dFR * (a1 - 1.0) - FR * 2.0 * R * drho / (rho * rho)
+                dfRx, dfRy = dg * tx + g * dtx, dg * ty + g * dty
+                dFx, dFy = dFx + dfRx, dFy + dfRy
+                dMr += drho * FR + (rho - R) * dFR
+                dMb += -_d_cross(rcx, rcy, drcx, drcy, fRx, fRy, dfRx, dfRy) - R * dFR
             _write(F, Jq, Jv, i, j, mult, dFx, dFy, dMr, -dFx, -dFy, dMb)
             if j < 2:
                 _write(F, Jq, Jv, i, j + 3, mult, -dFx, -dFy, -dMr, dFx, dFy, -dMb)
@@ -470,13 +526,23 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
             dur = dVrx * tx + dVry * ty
             dub = dVbx * tx + dVby * ty
             dmu = mu_s * (dur - dub) + mu_Q * dQ
-            if law != TANH:
+            du = 0.0
+            if need_u:
                 dvP = dVcx * tx + dVcy * ty + R * (dwx * tx + dwy * ty) / rho
-                dmu += mu_u * (0.5 * (dur + dub) - dvP)
+                du = 0.5 * (dur + dub) - dvP
+                if law != TANH:
+                    dmu += mu_u * du
             dFt = -(dmu * Q + mu * dQ)
             dFx = kap * (dQ * ex) + dFt * tx
             dFy = kap * (dQ * ey) + dFt * ty
-            _write(F, Jq, Jv, i, j, mult, dFx, dFy, rrx * dFy - rry * dFx, -dFx, -dFy, -(rbx * dFy - rby * dFx))
+            dMr, dMb = rrx * dFy - rry * dFx, -(rbx * dFy - rby * dFx)
+            if roll:         # velocities leave ρ, t and the markers: only F_R moves
+                dFR = FR_Q * dQ + FR_u * du
+                dfRx, dfRy = dFR * (a1 - 1.0) * tx, dFR * (a1 - 1.0) * ty
+                dFx, dFy = dFx + dfRx, dFy + dfRy
+                dMr += (rho - R) * dFR
+                dMb += -(rcx * dfRy - rcy * dfRx) - R * dFR
+            _write(F, Jq, Jv, i, j, mult, dFx, dFy, dMr, -dFx, -dFy, dMb)
 
 
 # ----------------------------------------------------------------------------------- pocket contact
@@ -758,6 +824,7 @@ def update_guide(z, t0, t1, ql0, vl0, ql1, vl1, P, G):
 # ----------------------------------------------------------------------------------- lubricant drag
 @njit(cache=True)
 def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    visc = P.shape[1] > 4                       # viscous churning (decided at pack time)
     for i in range(ql.shape[0]):
         mx, my, coef, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3]
         xr, yr = ql[i, 0], ql[i, 1]
@@ -774,14 +841,23 @@ def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         num = dx * wy - dy * wx
         om = num / rho2 - vb2                   # orbital speed relative to the race body
         Fd = coef * om * abs(om)
+        cs, Ms, Fd_om = 0.0, 0.0, 2.0 * coef * abs(om)    # d(Ω|Ω|)/dΩ = 2|Ω|
+        if visc:         # C_D(Re) of the orbit: sign(Ω)|Ω|^(4/3); the spin's viscous moment
+            cv, cs = P[i, 4], P[i, 5]
+            a43 = abs(om) ** (4.0 / 3.0)
+            Fd = Fd + cv * _sign(om) * a43
+            Fd_om += cv * (4.0 / 3.0) * abs(om) ** (1.0 / 3.0)
+            Ms = -cs * (vl[i, 2] - vb2)
         Fx, Fy = Fd * dy / rho, -Fd * dx / rho   # −Fd·t at the roller centre
         px, py = rcx + dx, rcy + dy              # roller centre from the race body's centre
-        _write(F, Jq, Jv, i, -1, mult, Fx, Fy, 0.0, -Fx, -Fy, px * (-Fy) - py * (-Fx))
+        if visc:
+            _write(F, Jq, Jv, i, -1, mult, Fx, Fy, Ms, -Fx, -Fy, px * (-Fy) - py * (-Fx) - Ms)
+        else:
+            _write(F, Jq, Jv, i, -1, mult, Fx, Fy, 0.0, -Fx, -Fy, px * (-Fy) - py * (-Fx))
         if not jac:
             continue
-        Fd_om = 2.0 * coef * abs(om)             # d(Ω|Ω|)/dΩ = 2|Ω|
         for j in range(12):
-            dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, _, dvb0, dvb1, dvb2 = _unit(j)
+            dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, dvr2, dvb0, dvb1, dvb2 = _unit(j)
             drcx, drcy = -dthb * rcy, dthb * rcx
             ddx, ddy = dxr - dxb - drcx, dyr - dyb - drcy
             drho2 = 2.0 * (dx * ddx + dy * ddy)
@@ -792,6 +868,10 @@ def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
             dFd = Fd_om * ((dnum - num * drho2 / rho2) / rho2 - dvb2)
             dFx = (dFd * dy + Fd * ddy - Fx * drho) / rho
             dFy = (-dFd * dx - Fd * ddx - Fy * drho) / rho
-            _write(F, Jq, Jv, i, j, mult, dFx, dFy, 0.0, -dFx, -dFy,
-                   -_d_cross(px, py, drcx + ddx, drcy + ddy, Fx, Fy, dFx, dFy))
+            dMb = -_d_cross(px, py, drcx + ddx, drcy + ddy, Fx, Fy, dFx, dFy)
+            if visc:
+                dMs = -cs * (dvr2 - dvb2)
+                _write(F, Jq, Jv, i, j, mult, dFx, dFy, dMs, -dFx, -dFy, dMb - dMs)
+            else:
+                _write(F, Jq, Jv, i, j, mult, dFx, dFy, 0.0, -dFx, -dFy, dMb)
 

@@ -32,7 +32,7 @@ from ..errors import ModelError
 __all__ = ["Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS", "ImpactLaw", "ExactRestitution",
            "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS", "RaceContact", "PocketContact",
            "GuideContact", "LubricantDrag", "restitution_lambda", "LandLaw", "DryLand", "HydrodynamicLand",
-           "LAND_LAWS", "spall_profile"]
+           "LAND_LAWS", "spall_profile", "RollingResistance", "HoupertRolling", "ROLLING_LAWS"]
 
 _ETA2 = 1e-24  # (1e-12 m)²: below round-off of any physical distance squared, keeps norms nonzero
 
@@ -316,6 +316,65 @@ TRACTION_LAWS = MappingProxyType({"tanh": TanhTraction, "slide_roll": SlideRollT
 
 
 # --------------------------------------------------------------------------------------------
+class RollingResistance:
+    """Base of the hydrodynamic rolling-resistance laws of a lubricated roller–raceway contact (docs/model.md §9.5):
+    ``force(Q, u, R)`` the Poiseuille rolling force F_R [N] (signed as the entraining speed u) of a contact carrying
+    Q [N] with reduced radius R [m]. A small frozen dataclass registered in :data:`ROLLING_LAWS` by name."""
+
+    def force(self, Q, u, R):  # pragma: no cover - abstract
+        raise TypeError(f"{type(self).__name__} must define force(Q, u, R)")
+
+
+@dataclass(frozen=True)
+class HoupertRolling(RollingResistance):
+    """Hydrodynamic (Poiseuille) rolling force of a fully flooded line contact in pure rolling, Houpert's correlation
+    (Biboulet & Houpert 2010, "Hydrodynamic force and moment in pure rolling lubricated contacts. Part 1: line
+    contacts", Proc. IMechE J 224: 765–775): with their groups (eq. 14) U = 2η₀ũ/(E'R) (ũ the mean surface speed),
+    W = w'/(E'R), w' = Q/L, and Moes' M = W/√U, the fully flooded moment per unit length in Hertzian units is
+    (eq. 42)
+        T* = M^(−3/2) · 1.4√M / (1 + ((1.4/1.45)√M)^10)^(1/10),
+    between the isoviscous-rigid asymptote T* = 1.4/M (eq. 40: T̃ = 1.42 (UW)^(1/2)) and the elastohydrodynamic one
+    T* = 1.45 M^(−3/2) (eq. 41: T̃ = 1.47 U^(3/4), independent of load and of α_p). T̃ = t/(E'R²) = T* p_h b²/(E'R²)
+    = T*·8W^(3/2)/(π√(2π)), and the force per unit length is T̃·E'R (eq. 31: the moment is the rolling force times R,
+    the pressure adding none), so F_R = E'RL·1.4k√(UW)·(1 + (1.4/1.45)^10 M⁵)^(−1/10), k = 8/(π√(2π)).
+    Range: their EHL solutions cover Moes L = 4–16, M = 0.2–200 (steel, G = 4520: U = 6.1e-13–1.6e-10,
+    W = 1.6e-7–2.5e-3), the IVR asymptote below; fully flooded (their starvation factor, eq. 44, is not applied),
+    isothermal, Newtonian. ũ = √(u² + u_reg²) regularises the entraining speed; the force carries the sign of u:
+    F = F_R(ũ)·u/ũ (odd and smooth in u, zero at rest). Zero load: zero force (as √Q).
+    eta0 [Pa·s], E_red E' [Pa], length L [m], u_reg [m/s]."""
+    eta0: float
+    E_red: float
+    length: float
+    u_reg: float
+
+    # eq. 42's constants: the IVR coefficient 1.4, the EHL one 1.45, the blend's exponent 10; Hertz's units to
+    # classical ones, T̃/(T* W^(3/2)) = 8/(π √(2π))
+    IVR, EHL, BLEND = 1.4, 1.45, 10.0
+    HERTZ = 8.0 / (np.pi * np.sqrt(2.0 * np.pi))
+
+    def __post_init__(self):
+        for k in ("eta0", "E_red", "length", "u_reg"):
+            if not (np.isfinite(getattr(self, k)) and getattr(self, k) > 0):
+                raise ModelError(f"HoupertRolling: {k} must be > 0, got {getattr(self, k)!r}")
+
+    def moment(self, U, W):
+        """T̃ = t/(E'R²), the fully flooded moment per unit length (eq. 42 in the classical units), of arrays U, W."""
+        M = W / ad.sqrt(U)
+        s = (self.IVR / self.EHL) ** self.BLEND * ad.power(M, 0.5 * self.BLEND)
+        return (self.IVR * self.HERTZ) * ad.sqrt(U * W) * ad.power(1.0 + s, -1.0 / self.BLEND)
+
+    def force(self, Q, u, R):
+        ut = ad.sqrt(u * u + self.u_reg ** 2)
+        ER = self.E_red * R
+        U, W = (2.0 * self.eta0) * ut / ER, Q * (1.0 / (ER * self.length))
+        return (ER * self.length) * self.moment(U, W) * u / ut
+
+
+# the rolling-resistance laws by name (a parameter chooses one; None: no rolling resistance)
+ROLLING_LAWS = MappingProxyType({"houpert": HoupertRolling})
+
+
+# --------------------------------------------------------------------------------------------
 def spall_profile(s, hi, edge):
     """(B(s), B'(s)) of a raceway defect: 1 for |s| ≤ hi − edge, 0 for |s| ≥ hi, and the C² quintic
     smoothstep B = x³(10 − 15x + 6x²), x = (hi − |s|)/edge, in between; B' = −sign(s)·30x²(1 − x)²/edge.
@@ -360,6 +419,15 @@ class RaceContact(Element):
     The contact point and the traction geometry are unchanged. A family without a spall evaluates
     exactly as before (no extra work).
 
+    Hydrodynamic rolling resistance (docs/model.md §9.5; ``rolling`` a :class:`RollingResistance`, or None = none,
+    the default, evaluated exactly as without it): where the contact carries Q > 0, the film's Poiseuille shear
+    F = rolling.force(Q, u_e, R_red) acts at P along −t on *both* surfaces (against the entraining direction), and
+    the pressure's tangential resultant, equal to the two shears together (the film's force balance), acts along
+    +t through each body's centre of curvature, shared as a_roller = 2R/ρ, a_race = 2(ρ − R)/ρ (the curvatures'
+    shares of 1/R_red for the parabolic gap; a pressure normal to a circular surface has no moment about its
+    centre). Forces and moments balance exactly; the roller keeps the moment (ρ − R)F against its rolling, and the
+    power is −2F·u_e ≤ 0 (u_e relative to the moving contact point).
+
     Outputs, all per physical contact: "load" Q ≥ 0 [N]; "deflection" δ_eff [m] (negative: a gap); "traction"
     tangential force on the roller along t [N] (opposes v_s); "slip_velocity" v_s [m/s]; "rolling_speed"
     the entraining speed u_e = (u_roller + u_race)/2 relative to the contact point [m/s] (what builds an
@@ -373,7 +441,7 @@ class RaceContact(Element):
 
     def __init__(self, name, roller, race_body, *, kind, race_marker, R_race, D, K, exponent, zeta, m_roller,
                  traction: Traction, multiplicity=1, spall_angle=None, spall_width=None, spall_depth=None,
-                 spall_edge=None):
+                 spall_edge=None, rolling: "RollingResistance | None" = None):
         self.name = name
         self.dofs = body_dofs(roller, race_body)
         if kind not in ("inner", "outer"):
@@ -393,6 +461,10 @@ class RaceContact(Element):
         self.zeta = self._per_instance("zeta", zeta, nonneg=True)
         self.m_roller = self._per_instance("m_roller", m_roller, positive=True)
         self.traction = traction
+        if rolling is not None and not isinstance(rolling, RollingResistance):
+            raise ModelError(f"{name}: parameter 'rolling' must be a RollingResistance (one of "
+                             f"{sorted(ROLLING_LAWS)}) or None, got {rolling!r}")
+        self.rolling = rolling
         self._c0 = 2.0 * self.zeta * np.sqrt(self.m_roller * self.exponent * self.K)
         self.kappa = np.full(self.n, self.kappa)   # per instance: inner and outer families can be fused
         self.R_red = 1.0 / (2.0 / self.D + self.kappa / self.R_race)   # reduced radius: convex inner, concave outer
@@ -426,14 +498,14 @@ class RaceContact(Element):
         self._spall_hi = 0.5 * self.spall_width + 0.5 * self.spall_edge
 
     def fuse_key(self):
-        return ("RaceContact", self.exponent, self.traction, self.has_spall)
+        return ("RaceContact", self.exponent, self.traction, self.has_spall, self.rolling)
 
     @classmethod
     def fuse(cls, parts):
         """One family holding the instances of several (inner and outer raceways alike; with a spall or
         without, as the fuse key keeps them apart)."""
         f = super().fuse(parts)
-        f.kind, f.exponent, f.traction = None, parts[0].exponent, parts[0].traction
+        f.kind, f.exponent, f.traction, f.rolling = None, parts[0].exponent, parts[0].traction, parts[0].rolling
         f._multi = bool(np.any(f.multiplicity != 1.0))
         f.has_spall = parts[0].has_spall
         for a in cls._SPALL + ("_spall_hi",) if f.has_spall else ():
@@ -447,6 +519,16 @@ class RaceContact(Element):
         s_dot = R * ((dx * wy - dy * wx) / (dx * dx + dy * dy + _ETA2) - w_race)
         B, B_s = spall_profile(s, self._spall_hi, self.spall_edge)
         return delta - h * B, delta_dot - h * B_s * s_dot
+
+    def _rolling_forces(self, Q, u_e, rho, tx, ty, rc, R):
+        """Generalized forces of the rolling resistance (class docstring): on the roller F(2R/ρ − 1) along t and
+        the moment (ρ − R)F; on the race body the opposite force and the moment −rc × f − R F."""
+        loaded = ad.value(Q) > 0.0
+        F = ad.where(loaded, self.rolling.force(ad.where(loaded, Q, 1.0), u_e, self.R_red), 0.0)
+        g = F * (2.0 * R / rho - 1.0)
+        fx, fy = g * tx, g * ty
+        Mb = -1.0 * (rc[0] * fy - rc[1] * fx) - R * F
+        return [fx, fy, (rho - R) * F, -1.0 * fx, -1.0 * fy, Mb]
 
     def kernel(self, t, fs, q, v, z):
         qr, qb, vr, vb = q[:3], q[3:], v[:3], v[3:]
@@ -489,6 +571,8 @@ class RaceContact(Element):
         Fx = kap * Q * ex + Ft * tx
         Fy = kap * Q * ey + Ft * ty
         forces = point_force(r_roll, (Fx, Fy)) + point_force(r_race, (-1.0 * Fx, -1.0 * Fy))
+        if self.rolling is not None:
+            forces = [a + b for a, b in zip(forces, self._rolling_forces(Q, u_e, rho, tx, ty, rc, R))]
         forces = _scaled(forces, self.multiplicity, self._multi)
         return forces, {"load": Q, "deflection": delta, "traction": Ft, "slip_velocity": v_s, "angle": angle,
                         "rolling_speed": u_e, "fx": Fx, "fy": Fy}   # fx, fy: force on one physical roller, in R
@@ -739,13 +823,23 @@ class LubricantDrag(Element):
     ``multiplicity`` (default 1): identical parallel rollers per instance; C_d, D, l are one roller's and
     the generalized forces are multiplied by it.
 
+    Viscous churning (docs/model.md §8.7; ``eta`` the mixture's dynamic viscosity η_e [Pa·s] per instance, or None =
+    none, the default, evaluated exactly as without it). The orbit drag takes the drag coefficient of a circular
+    cylinder in cross flow with its Reynolds number Re = ρ|v|D/η_e, v = (d_m/2)Ω_m (White, Fluid Mechanics:
+    C_D ≈ 1 + 10 Re^(−2/3) for 1 ≤ Re ≤ 2·10⁵), C_D = C_d + 10 Re^(−2/3):
+        F_d = (1/8) C_d ρ D l d_m² Ω_m|Ω_m| + 5 l D^(1/3) ρ^(1/3) η_e^(2/3) (d_m/2)^(4/3) Ω_m|Ω_m|^(1/3);
+    and the roller's spin ω_R relative to the race body meets the moment of a cylinder turning in unbounded viscous
+    fluid, the exact Couette solution u_θ = ω a²/r (Landau & Lifshitz, Fluid Mechanics, §18, problem 2, with the
+    outer cylinder's radius → ∞: wall shear 2η_e ω, moment 4π η_e ω a² l, a = D/2):
+        M_s = −π η_e D² l (ω_R − ω_race)   on the roller, the opposite on the race body.
+
     Output: "force" signed F_d [N] on one physical roller (the drag on it is −force·t).
     """
     batched = True
     n_local = 6
     compiled_twin = "contact.drag"
 
-    def __init__(self, name, roller, race_body, *, race_marker, C_d, rho, D, l, d_m, multiplicity=1):
+    def __init__(self, name, roller, race_body, *, race_marker, C_d, rho, D, l, d_m, multiplicity=1, eta=None):
         self.name = name
         self.dofs = body_dofs(roller, race_body)
         self.race_marker = self._per_instance_xy("race_marker", race_marker)
@@ -757,6 +851,11 @@ class LubricantDrag(Element):
         self.coef = 0.125 * C_d * rho * D * l * d_m * d_m
         self.multiplicity = _multiplicity(self, multiplicity)
         self._multi = bool(np.any(self.multiplicity != 1.0))
+        self.viscous = eta is not None
+        if self.viscous:
+            eta = self._per_instance("eta", eta, positive=True)
+            self.coef_visc = 5.0 * l * np.cbrt(D * rho) * eta ** (2.0 / 3.0) * (0.5 * d_m) ** (4.0 / 3.0)
+            self.coef_spin = np.pi * eta * D * D * l
 
     def kernel(self, t, fs, q, v, z):
         qr, qb, vr, vb = q[:3], q[3:], v[:3], v[3:]
@@ -768,7 +867,13 @@ class LubricantDrag(Element):
         wx, wy = vr[0] - Vc[0], vr[1] - Vc[1]
         om = (dx * wy - dy * wx) / rho2 - vb[2]
         Fd = self.coef * om * ad.abs_(om)
+        if self.viscous:             # Ω|Ω|^(1/3) as sign(Ω)|Ω|^(4/3): its derivative (4/3)|Ω|^(1/3) is finite at 0
+            Fd = Fd + self.coef_visc * ad.sign(om) * ad.power(ad.abs_(om), 4.0 / 3.0)
         Fx, Fy = Fd * dy / rho, -1.0 * Fd * dx / rho   # −Fd·t, t = (−dy, dx)/ρ
         zero = 0.0 * qr[0]
         forces = [Fx, Fy, zero] + point_force((rc[0] + dx, rc[1] + dy), (-1.0 * Fx, -1.0 * Fy))
+        if self.viscous:
+            Ms = -1.0 * self.coef_spin * (vr[2] - vb[2])
+            forces[2] = forces[2] + Ms
+            forces[5] = forces[5] - Ms
         return _scaled(forces, self.multiplicity, self._multi), {"force": Fd}

@@ -16,7 +16,7 @@ from mbd.compiled.contact import TRACTION_IDS, pack_race
 from mbd.compiled.registry import kind_of
 from mbd.element import evaluate
 from mbd.model import FrameState
-from mbd.elements.contact import (IMPACT_LAWS, GuideContact, HydrodynamicLand, LubricantDrag,
+from mbd.elements.contact import (IMPACT_LAWS, GuideContact, HoupertRolling, HydrodynamicLand, LubricantDrag,
                                   PocketContact, RaceContact, SlideRollTraction, TanhTraction, Traction)
 
 from tests.support.contact import (C_G, DM, DR, EHL, FILM, K_G, K_HZ, M_ROLLER, N, TANH, assert_matches_reference,
@@ -203,6 +203,60 @@ def test_update_matches_update_internal(kind, data, z):
 def test_drag_matches_reference(state, fs, mult):
     qf, vf, elem, _ = drag_scene(*state, multiplicity=mult)
     assert_matches_reference(elem, fs, qf, vf)
+
+
+@SETTINGS
+@given(state=drag_states(), fs=frame_states(), mult=MULTS, eta=st.sampled_from([1e-4, 1.3e-3, 0.5]))
+def test_viscous_drag_matches_reference(state, fs, mult, eta):
+    """The viscous churning law (C_d(Re) on the orbit, the spin's viscous moment)."""
+    qf, vf, elem, _ = drag_scene(*state, multiplicity=mult, eta=eta)
+    assert_matches_reference(elem, fs, qf, vf)
+
+
+ROLL = HoupertRolling(eta0=0.025, E_red=2.31e11, length=9e-3, u_reg=0.1)
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+@pytest.mark.parametrize("law", ["tanh", "ehl", "film"])
+@SETTINGS
+@given(data=st.data(), fs=frame_states(), **RACE_LAW)
+def test_race_with_rolling_resistance_matches_reference(kind, law, data, fs, exponent, zeta, multiplicity):
+    qf, vf, mk, R = race_scene(kind, *data.draw(race_states(kind)))
+    rollers, race_body = np.arange(1, N + 1), 0
+    elem = RaceContact("race", rollers, race_body, kind=kind, race_marker=mk, R_race=R, D=DR, K=K_HZ,
+                       exponent=exponent, zeta=zeta, m_roller=M_ROLLER, traction=TRACTIONS[law],
+                       multiplicity=multiplicity, rolling=ROLL)
+    assert_matches_reference(elem, fs, qf, vf)
+
+
+@SETTINGS
+@given(data=st.data(), fs=frame_states(), m_in=MULTS, m_out=MULTS)
+def test_fused_race_family_with_rolling_resistance(data, fs, m_in, m_out):
+    """Inner and outer raceways with rolling resistance fused into one family: per-instance κ and R_red."""
+    qi, vi, mki, Ri = race_scene("inner", *data.draw(race_states("inner")))
+    qo, vo, mko, Ro = race_scene("outer", *data.draw(race_states("outer")))
+    qf, vf = _joined((qi, vi), (qo, vo))
+    mk = dict(D=DR, K=K_HZ, exponent=10.0 / 9.0, zeta=0.05, m_roller=M_ROLLER, traction=FILM, rolling=ROLL)
+    inner = RaceContact("inner", np.arange(1, N + 1), 0, kind="inner", race_marker=mki, R_race=Ri, multiplicity=m_in,
+                        **mk)
+    outer = RaceContact("outer", np.arange(N + 2, 2 * N + 2), N + 1, kind="outer", race_marker=mko, R_race=Ro,
+                        multiplicity=m_out, **mk)
+    assert inner.fuse_key() == outer.fuse_key()
+    assert_matches_reference(RaceContact.fuse([inner, outer]), fs, qf, vf)
+
+
+def test_default_packs_are_unchanged_by_the_opt_in_laws():
+    """Without rolling resistance or viscous churning the packs are the plain laws' (G of 11, P of 4 columns):
+    the kernels take the plain branches."""
+    qf, vf, mk, R = race_scene("inner", (0, 0, 0), (0, 0, 0), 0.0, [0.3], [1e-5], [0.0], [2.0], [0.0])
+    plain = race("inner", mk, R, TANH, bodies=([1], 0))
+    assert pack_race(plain)[1].size == 11
+    rolled = RaceContact("race", [1], 0, kind="inner", race_marker=mk, R_race=R, D=DR, K=K_HZ, exponent=10 / 9,
+                         zeta=0.05, m_roller=M_ROLLER, traction=TANH, rolling=ROLL)
+    assert pack_race(rolled)[1].size == 16
+    assert plain.fuse_key() != rolled.fuse_key()
+    _, _, drag, _ = drag_scene((0, 0, 0), (0, 0, 0), 0.0, [0.0], [0.0], [1.0], [0.0], [0.0])
+    assert kind_of(LubricantDrag).pack(drag)[0].shape[1] == 4
 
 
 def test_drag_zero_relative_orbit_has_zero_jacobian():

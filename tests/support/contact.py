@@ -323,7 +323,7 @@ C_D, RHO_OIL = 1.0, 45.0
 DRAG_COEF = C_D * RHO_OIL * DR * LR * DM ** 2 / 8
 
 
-def drag_scene(pose, vel, psi, angles, radial, orbit, v_rad, spins, multiplicity=1):
+def drag_scene(pose, vel, psi, angles, radial, orbit, v_rad, spins, multiplicity=1, eta=None):
     n = len(angles)
     mk = np.array([RCA * np.cos(psi), RCA * np.sin(psi)])
     qf, vf = np.zeros(3 * (n + 1)), np.zeros(3 * (n + 1))
@@ -337,7 +337,7 @@ def drag_scene(pose, vel, psi, angles, radial, orbit, v_rad, spins, multiplicity
         qf[3 * (j + 1):3 * (j + 2)] = (p[0], p[1], 0.0)
         vf[3 * (j + 1):3 * (j + 2)] = (pdot[0], pdot[1], spins[j])
     elem = LubricantDrag("drag", np.arange(1, n + 1), 0, race_marker=mk, C_d=C_D, rho=RHO_OIL, D=DR, l=LR, d_m=DM,
-                         multiplicity=multiplicity)
+                         multiplicity=multiplicity, eta=eta)
     omega_m = np.asarray(orbit) - vel[2]
     return qf, vf, elem, omega_m
 
