@@ -25,10 +25,14 @@ from mbd.static import SteadyMotion, _evaluator, carry, solve_static
 
 from .outputs import WindowStatistics, cage_period
 
-__all__ = ["steady_motion", "held_dofs", "snapshot_times", "solve_snapshots", "static_statistics", "static_summary",
+__all__ = ["STATIC_LIVES_NOTE", "steady_motion", "held_dofs", "snapshot_times", "solve_snapshots", "static_statistics", "static_summary",
            "rate_groups", "DYNAMIC_ONLY", "DEFAULT_SNAPSHOTS", "MOVES", "RATE_STEP"]
 
 # summary keys a static solution cannot give (they need the motion's transients)
+# what a static solution's lives are: every output that shows them says it (summary.json, the studies' tables)
+STATIC_LIVES_NOTE = ("lives from the quasi-static solution's mean loads: they leave out the dynamic load (the meshes' "
+                     "dynamic factor, impacts, cage motion), so they are longer than a dynamic run's of the same mean "
+                     "load where the load fluctuates")
 DYNAMIC_ONLY = ("cage_", "pocket_", "guide_", "heat_land", "whole_revolutions", "carrier_speed_error",
                 "te_peak_to_peak", "dynamic_factor", "drive_flank_peak", "roller_cage_")
 
@@ -183,6 +187,7 @@ def static_summary(scene, n_snapshots: int = DEFAULT_SNAPSHOTS, engine: str = "a
     omitted: set[str] = set()
     summary = _drop(stats.summary(), omitted)
     summary["mode"] = "static"
+    summary["lives_ignore_dynamic_load"] = True          # STATIC_LIVES_NOTE
     summary["snapshots"] = len(sols)
     summary["omitted"] = sorted(omitted)
     summary["static_solver"] = {"steps": int(sum(s.steps for s in sols)),

@@ -34,7 +34,7 @@ from components.names import did_you_mean
 from components.presets import CONDITIONS
 from components.results import Summary
 from components.results.io import atomic_write_text, write_summary
-from components.static import DEFAULT_SNAPSHOTS
+from components.static import DEFAULT_SNAPSHOTS, STATIC_LIVES_NOTE
 from components.units import ParameterError, quantity, to_si
 
 from .core import args
@@ -56,8 +56,7 @@ WRITES = ("per bin BIN/summary.json (BIN_dynamic/ for a --dynamic bin); duty_cyc
           "cycles), duty_cycle.md (the tables), duty_cycle.json (everything, with the machine and the binning), "
           "damage_share.png; for a time series binning.png")
 
-STATIC_NOTE = ("static bins: their lives leave out the dynamic load (the meshes' dynamic factor, impacts, cage "
-               "motion): the quasi-static solution's mean loads only; a --dynamic bin's lives are its dynamic run's")
+STATIC_NOTE = f"static bins: {STATIC_LIVES_NOTE}; a --dynamic bin's lives are its dynamic run's"
 # the carrier speed above which a bin is refused unless --rated-speed says otherwise: the source's fastest condition
 RATED_DEFAULT = max(s for s, _ in CONDITIONS.values())
 SHARE_TOL = 1e-9      # |Σ shares − 1| above which the shares are normalised with a warning

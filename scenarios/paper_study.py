@@ -23,7 +23,7 @@ import numpy as np
 
 import mbd
 from components.families import MESH_FAMILY
-from components.static import DEFAULT_SNAPSHOTS
+from components.static import DEFAULT_SNAPSHOTS, STATIC_LIVES_NOTE
 from components.outputs import FAMILY, radial_tangential
 from components.outputs import relative_life as iso_relative_life
 from components.results import SUMMARY_WORDS, Summary, json_attr, open_run
@@ -445,6 +445,8 @@ class PaperStudy(Study):
             left = sorted({q for q, _ in QUANTITIES} - {r["quantity"] for r in rows})
             print(f"static mode ({self.a.snapshots} snapshots): left out, as only a dynamic run gives them: "
                   f"{', '.join(left)}; no time histories, cage orbits, bars of RMS values or animation")
+            print(f"note: {STATIC_LIVES_NOTE}")
+            atomic_write_text(md_p, text + f"\nNote: {STATIC_LIVES_NOTE}.\n")
         run.step("tables", lambda: [csv_p, md_p])
         figs = run.step("figures", plots, results, self.out, machine["label"]) if not static else \
             run.step("figures", static_plots, results, self.out, machine["label"])

@@ -45,7 +45,7 @@ from tqdm.auto import tqdm
 
 import mbd
 from components.dpgt import build_dpgt
-from components.static import DEFAULT_SNAPSHOTS, static_summary
+from components.static import DEFAULT_SNAPSHOTS, STATIC_LIVES_NOTE, static_summary
 from components.tolerance_sampling import (DISTRIBUTIONS, TOLERANCE_DEFAULTS, ToleranceSpec, coordinates, draw_errors,
                                            replicate_of, sobol_points, teeth_seed)
 from components.units import ParameterError, quantity, to_si
@@ -568,7 +568,7 @@ def answer(stats: list[dict], agree: list[dict], a_record: dict) -> str:
          "planet pair's mean drive-flank force over the mean of the pairs (ISO 6336's mesh load factor); of a "
          "bearing row: the most loaded planet bearing's mean load over the row's mean (the bearing load includes "
          "the planets' centrifugal load). Values: the statistic with its 95 % interval (over the independent "
-         "replicates) in brackets.", ""]
+         "replicates) in brackets. The lives' percentiles are static: " + STATIC_LIVES_NOTE + ".", ""]
     top = max(g["torque_fraction"] for g in stats)
     for cond in sorted({g["condition"] for g in stats}, key=point_order):
         L.append(f"## {point_words(cond).capitalize()}")

@@ -232,9 +232,10 @@ def test_bad_input_is_refused_in_one_line():
 
 
 def test_the_paper_study_in_static_mode(tmp_path):
-    """--mode static: each run's summary.json says so and lists what it leaves out, there is no results.nc, the
-    comparison has the static quantities only, and the reverse inner planet bearing carries more than forward
-    (the load path's sign, as the dynamic study finds it)."""
+    """--mode static: each run's summary.json says so, that its lives leave out the dynamic load, and lists what it
+    leaves out, there is no results.nc, the comparison has the static quantities only and says what its lives
+    ignore, and the reverse inner planet bearing carries more than forward (the load path's sign, as the dynamic
+    study finds it)."""
     import csv
     import json
 
@@ -243,6 +244,8 @@ def test_the_paper_study_in_static_mode(tmp_path):
                              "--no-progress"]) == 0
     s = json.loads((tmp_path / "c3_reverse" / "summary.json").read_text())
     assert s["mode"] == "static" and s["snapshots"] == 4 and "cage_slip_pct" in s["omitted"]
+    assert s["lives_ignore_dynamic_load"] is True
+    assert "leave out the dynamic load" in (tmp_path / "comparison.md").read_text()
     assert not (tmp_path / "c3_reverse" / "results.nc").exists()
     rows = list(csv.DictReader((tmp_path / "comparison.csv").open()))
     quantities = {r["quantity"] for r in rows}
