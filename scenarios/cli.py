@@ -22,6 +22,7 @@ SCENARIOS = {
     "fault_study": "what errors and faults do to the planet bearings and the rig's sensor",
     "gear_quality": "the forward/reverse study with real teeth: ISO 1328-1 tooth classes and seeds against perfect teeth",
     "tolerance_study": "load sharing K_γ, bearing loads and lives of machines drawn from their tolerances (static + dynamic)",
+    "sensitivity": "which assumed parameters move each headline output: Morris screening, then Sobol indices (static)",
     "spectrum": "fixed-frame carrier-housing acceleration spectrum (the source's test rig)",
     "bearing_rig": "one planet bearing on a rig: roller load distribution, load zone, Q_max",
     "modal": "natural frequencies and mode shapes (single planetary set, DPGT with linear bearings)",
