@@ -372,13 +372,15 @@ def sobol_indices(fs: list[Factor], Y: np.ndarray, seed: int) -> dict:
     return out
 
 
-def screen(morris_by_point: dict, keys: list[str], n: int) -> list[str]:
-    """The ``n`` factors of the largest screened effects: each factor's share of an output is its μ* over that output's
-    largest μ* (at one operating point); its score the largest share over every output and operating point, ties
-    broken by the mean share; the highest scores, with score > 0."""
+def screen(morris_by_point: dict, keys: list[str], n: int, outputs: list[str] | None = None) -> list[str]:
+    """The ``n`` factors of the largest screened effects on ``outputs`` (default: every output): each factor's share
+    of an output is its μ* over that output's largest μ* (at one operating point); its score the largest share over
+    those outputs and every operating point, ties broken by the mean share; the highest scores, with score > 0."""
     shares: dict[str, list[float]] = {k: [] for k in keys}
     for by_output in morris_by_point.values():
-        for res in by_output.values():
+        for out, res in by_output.items():
+            if outputs is not None and out not in outputs:
+                continue
             top = max((v["mu_star"] for v in res.values()), default=0.0)
             if top > 0.0:
                 for key, v in res.items():
@@ -490,6 +492,10 @@ def parse_args(argv):
     p.add_argument("--sobol", type=args.count(0), default=4, metavar="K",
                    help="Sobol indices for the K screened parameters of the largest effects (0: Morris only; "
                         "default 4)")
+    p.add_argument("--sobol-outputs", type=args.choice_list(tuple(OUTPUTS), "outputs"), default=None,
+                   metavar="OUT[,OUT...]",
+                   help="screen for the Sobol indices by these outputs only (e.g. k_gamma_mesh: the load sharing's "
+                        "own strongest parameters; default: every output)")
     p.add_argument("--sobol-samples", type=args.count(2), default=32, metavar="N",
                    help="Sobol base samples N, a power of 2 (N (K + 2) evaluations per operating point; default 32)")
     p.add_argument("--snapshots", type=args.count(1), default=8, metavar="N",
@@ -508,6 +514,7 @@ def parse_args(argv):
     if a.sobol_samples & (a.sobol_samples - 1):
         p.error(f"argument --sobol-samples: must be a power of 2 (Sobol sequence), got {a.sobol_samples}")
     a.parameters = None if a.parameters is None else [x.strip() for x in a.parameters.split(",") if x.strip()]
+    a.sobol_outputs = None if a.sobol_outputs is None else a.sobol_outputs.split(",")
     return a
 
 
@@ -591,7 +598,8 @@ class SensitivityStudy(Study):
             self.results[p] = {"condition": p[0], "direction": p[1], "nominal": (nom[0] or {}).get("outputs"),
                                "morris": {o: morris_indices(fs, X, Y[o], a.levels, a.seed) for o in outputs},
                                "morris_failed": int(sum(map(_failed, mor)))}
-        chosen = screen({p: r["morris"] for p, r in self.results.items()}, [f.key for f in fs], a.sobol)
+        chosen = screen({p: r["morris"] for p, r in self.results.items()}, [f.key for f in fs], a.sobol,
+                        a.sobol_outputs)
         self.sobol_factors = [f for f in fs if f.key in chosen]
         self.sobol_factors.sort(key=lambda f: chosen.index(f.key))
         if not self.sobol_factors:
@@ -611,7 +619,8 @@ class SensitivityStudy(Study):
     def _settings(self) -> dict:
         a = self.a
         return {"conditions": a.conditions, "directions": a.directions, "trajectories": a.trajectories,
-                "levels": a.levels, "sobol": a.sobol, "sobol_samples": a.sobol_samples, "snapshots": a.snapshots,
+                "levels": a.levels, "sobol": a.sobol, "sobol_samples": a.sobol_samples,
+                "sobol_outputs": a.sobol_outputs, "snapshots": a.snapshots,
                 "seed": a.seed, "base_overrides": self.base, "params_file": a.params,
                 "evaluator": _evaluator_name(self.evaluator),
                 "factors": [asdict(f) for f in self.factors]}

@@ -976,8 +976,14 @@ def morris_heatmap(rel: Mapping[str, Mapping[str, Mapping[str, float]]], paramet
     rows = sorted(parameters, key=lambda k: -worst[k])
     norm = LogNorm(1e-2, 1e2, clip=True)
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(2.2 + 0.42 * len(outputs) * len(labels), 1.8 + 0.26 * len(rows)), layout="constrained")
-        axes = fig.subplots(1, len(labels), squeeze=False, sharey=True)[0]
+        cols = min(2, len(labels))
+        nrows = (len(labels) + cols - 1) // cols
+        fig = Figure(figsize=(2.6 + 0.42 * len(outputs) * cols, 0.9 + (1.9 + 0.24 * len(rows)) * nrows),
+                     layout="constrained")
+        grid = fig.subplots(nrows, cols, squeeze=False, sharey=True)
+        axes = list(grid.flat)
+        for ax in axes[len(labels):]:
+            ax.set_visible(False)
         img = None
         for ax, label in zip(axes, labels):
             m = np.array([[100.0 * rel[label].get(o, {}).get(k, np.nan) for o in outputs] for k in rows], float)
@@ -991,7 +997,7 @@ def morris_heatmap(rel: Mapping[str, Mapping[str, Mapping[str, float]]], paramet
             ax.set_yticks(range(len(rows)), rows, fontsize=7)
             ax.grid(False)
             ax.set_title(label.replace("_", " "))
-        fig.colorbar(img, ax=list(axes), label=_axis_label("μ* / nominal", "%"), shrink=0.6)
+        fig.colorbar(img, ax=axes[:len(labels)], label=_axis_label("μ* / nominal", "%"), shrink=0.6)
         if title:
             fig.suptitle(_wrap(title, max(40, int(11 * fig.get_figwidth()))))
         return _save(fig, path)

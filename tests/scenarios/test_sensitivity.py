@@ -54,6 +54,7 @@ def test_a_linear_toy_model_gives_the_closed_form_morris_and_sobol_indices(tmp_p
     r = _study(tmp_path, "--parameters", ",".join(TOY), "--trajectories", "4", "--sobol", "4",
                "--sobol-samples", "128", "--seed", "3")
     p = r["points"]["c3_forward"]
+    assert {f.name for f in r["files"]} == {"ranking.csv", "ranking.md", "sensitivity.json", "morris.png", "sobol.png"}
     for key, c in CONTRIBUTION.items():
         m = p["morris"]["y"][key]
         assert m["mu_star"] == pytest.approx(abs(c), rel=1e-6)       # |a_i| × range, every elementary effect
@@ -121,9 +122,22 @@ def test_factors_convert_declared_ranges_to_si_in_their_own_units():
     (["--sobol-samples", "24"], "--sobol-samples: must be a power of 2"),
     (["--levels", "3"], "--levels: Morris needs an even number of levels"),
     (["--conditions", "4"], "condition 4 transmits no torque"),
+    (["--sobol-outputs", "k_gama_mesh"], "(did you mean 'k_gamma_mesh'?)"),
 ])
 def test_bad_input_is_refused_in_one_line(argv, words, tmp_path, capsys):
     assert cli.main(["sensitivity", *argv, "--out", str(tmp_path / "out")]) == USAGE
     err = capsys.readouterr().err
     assert err.startswith("error: ") and words in err and err.count("\n") == 1, err
     assert not list((tmp_path / "out").glob("**/*.json"))           # nothing was evaluated
+
+
+def test_the_screening_picks_each_outputs_strongest_and_can_be_asked_for_one_output():
+    """Shares of each output's largest μ*: a factor strongest for any output scores 1; ties go to the larger mean share;
+    a factor that moves nothing is never picked; ``outputs`` restricts the screening to those outputs."""
+    m = lambda **kw: {k: {"mu_star": v} for k, v in kw.items()}
+    morris = {("c3", "forward"): {"k": m(a=4.0, b=2.0, c=0.0, d=1.0), "life": m(a=0.0, b=1.0, c=0.0, d=3.0)},
+              ("c2", "forward"): {"k": m(a=1.0, b=2.5, c=0.0, d=0.1), "life": m(a=0.0, b=0.0, c=0.0, d=5.0)}}
+    keys = ["a", "b", "c", "d"]
+    assert sensitivity.screen(morris, keys, 2) == ["d", "b"]        # d: 1 twice; a and b: 1 once, b's mean larger
+    assert sensitivity.screen(morris, keys, 4) == ["d", "b", "a"]   # c moves nothing
+    assert sensitivity.screen(morris, keys, 2, ["k"]) == ["b", "a"]
