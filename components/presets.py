@@ -16,7 +16,7 @@ import numpy as np
 from .params import (BearingParams, BearingRigParams, CageParams, CarrierRippleParams, DPGTParams, ErrorsParams,
                      FlankClassParams, GearParams, GearSetParams, HousingParams, LifeParams, LubricantParams, MeshParams,
                      OperatingPoint, PinholeErrorParams, ProfileParams, RigParams, RunoutParams, SensorParams,
-                     SlicingParams, SlideRollTractionParams, SupportParams, assumed, derived,
+                     SlicingParams, SlideRollTractionParams, Span, SupportParams, assumed, derived,
                      overrides_from_toml, paper, with_overrides)
 from .tolerances import radial_runout
 from .units import Q_, ParameterError
@@ -83,7 +83,7 @@ _TYPICAL_100 = {"VG10": 2.5, "VG15": 3.5, "VG22": 4.5, "VG46": 6.5, "VG100": 11.
 OIL_GRADES = {
     "VG32": {"viscosity_40": assumed("32 mm^2/s", "ISO 3448 grade VG 32"),
              "viscosity_100": assumed("5.4 mm^2/s", "mineral oil, VI ~ 100")},
-    "VG68": {"viscosity_40": assumed("68 mm^2/s", "ISO 3448 grade VG 68; the source names no oil"),
+    "VG68": {"viscosity_40": assumed("68 mm^2/s", "ISO 3448 grade VG 68; the source names no oil", span=Span("61.2 mm^2/s", "74.8 mm^2/s", "ISO 3448: a grade's 40 degC viscosity within +-10 %")),
              "viscosity_100": assumed("8.7 mm^2/s", "mineral oil, VI ~ 100")},
     "VG150": {"viscosity_40": assumed("150 mm^2/s", "ISO 3448 grade VG 150"),
               "viscosity_100": assumed("14.7 mm^2/s", "mineral oil, VI ~ 100")},
@@ -104,14 +104,14 @@ def oil_grade(name: str) -> dict:
 def reference_bearing() -> BearingParams:
     """The planet bearing (same for inner and outer planets) and its cage."""
     cage = CageParams(
-        mass=assumed("0.04 kg", "machined brass cage with side rings"),
-        pocket_clearance=assumed("0.10 mm", "circumferential, per side"),
-        guide_clearance=assumed("0.15 mm", "radial, outer-raceway guided"),
-        pocket_stiffness=assumed("2e7 N/m"),
-        guide_stiffness=assumed("2e7 N/m"),
+        mass=assumed("0.04 kg", "machined brass cage with side rings", span=Span("0.03 kg", "0.06 kg", "machined brass cages of this size, lighter or heavier side rings")),
+        pocket_clearance=assumed("0.10 mm", "circumferential, per side", span=Span("0.05 mm", "0.2 mm", "pocket play of machined cages")),
+        guide_clearance=assumed("0.15 mm", "radial, outer-raceway guided", span=Span("0.08 mm", "0.3 mm", "land play of ring-guided cages, ~0.2-0.7 % of the land diameter")),
+        pocket_stiffness=assumed("2e7 N/m", span=Span("5e6 N/m", "1e8 N/m", "a brass cage bar against a roller: its bending to the line contact", log=True)),
+        guide_stiffness=assumed("2e7 N/m", span=Span("5e6 N/m", "1e8 N/m", "a brass land on the bore: the cage ring's bending to the contact", log=True)),
         restitution=assumed(0.8, "Hunt-Crossley, pocket and guide impacts"),
-        pocket_friction=assumed(0.1, "not stated by the source"),
-        guide_friction=assumed(0.1, "not stated by the source"),
+        pocket_friction=assumed(0.1, "not stated by the source", span=Span(0.05, 0.15, "lubricated steel on brass")),
+        guide_friction=assumed(0.1, "not stated by the source", span=Span(0.05, 0.15, "lubricated steel on brass")),
         friction_speed=assumed("0.01 m/s", "tanh-regularised Coulomb friction: full mu above ~2 cm/s of sliding"),
         impact_speed_floor=assumed("0.01 m/s", "bounds the Hunt-Crossley damping of slow, quasi-static pocket "
                                                "and land contacts; a roller at 1 cm/s carries ~1e-7 J"),
@@ -127,16 +127,16 @@ def reference_bearing() -> BearingParams:
         roller_length=paper("9 mm"),
         rollers=paper(12),
         rows=paper(1, "one row in the source's table"),
-        clearance=assumed("20 um", "diametral"),
+        clearance=assumed("20 um", "diametral", span=Span("5 um", "40 um", "mounted clearance: ISO 5753-1 groups 2 to N at this bore, less fit and warm pin")),
         roller_density=assumed("7850 kg/m^3", "bearing steel"),
         contact_exponent=derived(10.0 / 9.0, "Palmgren line contact Q = K delta^(10/9) (docs/model.md §8.1)"),
-        contact_damping_ratio=assumed(0.05, "of critical, gated to compression"),
+        contact_damping_ratio=assumed(0.05, "of critical, gated to compression", span=Span(0.02, 0.15, "EHL and Hertzian contact damping, a few to 15 % of critical")),
         traction_law=assumed("tanh", "a smooth, bounded Coulomb-like law (docs/model.md §8.2); slide_roll: an EHL-type curve of the slide-to-roll ratio"),
         drag_law=assumed("inertial", "quadratic drag of the oil-air mixture on the roller orbit (docs/model.md "
                                      "§8.7); viscous: with the oil's viscosity, and a moment on the roller spin"),
         rolling_resistance=assumed("none", "houpert: the contacts' Poiseuille rolling force (docs/model.md §9.5)"),
-        traction_mu_max=assumed(0.08, "mu = 0.08 tanh(v_s / 0.3 m/s)"),
-        traction_v0=assumed("0.3 m/s"),
+        traction_mu_max=assumed(0.08, "mu = 0.08 tanh(v_s / 0.3 m/s)", span=Span(0.04, 0.1, "traction plateaus of mineral oils in EHL contacts")),
+        traction_v0=assumed("0.3 m/s", span=Span("0.1 m/s", "1 m/s", "slip speed at which the traction saturates: a few tenths of a m/s", log=True)),
         slide_roll_traction=SlideRollTractionParams(
             A=assumed(-0.04, "A + D = 0: no traction in pure rolling"), B=assumed(5.0),
             C=assumed(40.0, "peak mu ~ 0.073 at s ~ 0.033"), D=assumed(0.04, "mu at large slip"),
@@ -260,21 +260,21 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
         gears=reference_gears(),
         bearing=reference_bearing(),
         lubricant=LubricantParams(
-            drag_coefficient=assumed(1.0),
-            density=assumed("45 kg/m^3", "oil-air mixture: 5 % oil of 870 kg/m^3"),
+            drag_coefficient=assumed(1.0, span=Span(0.5, 2.0, "a cylinder's drag coefficient over Re 1e2-1e5, rollers shielding one another")),
+            density=assumed("45 kg/m^3", "oil-air mixture: 5 % oil of 870 kg/m^3", span=Span("15 kg/m^3", "90 kg/m^3", "2-10 % oil by volume")),
             oil_density=assumed("870 kg/m^3", "mineral oil at 15 degC"),
             thermal_expansion=assumed("7.2e-4 1/K", "lubricating oils, API MPMS 11.1 (ASTM D1250-04): "
                                                     "alpha_60 = K1/rho_60 per degF, K1 = 0.34878 kg/m^3: "
                                                     "1.8 x 0.34878/870 per K"),
             viscosity_40=OIL_GRADES["VG68"]["viscosity_40"],
             viscosity_100=OIL_GRADES["VG68"]["viscosity_100"],
-            temperature=assumed("60 degC", "oil in the bearings of a running gearbox; not stated by the source"),
+            temperature=assumed("60 degC", "oil in the bearings of a running gearbox; not stated by the source", span=Span("40 degC", "90 degC", "a cool rig to a hot industrial gearbox's oil")),
             pressure_viscosity=assumed("2.2e-8 1/Pa", "mineral oil (Hamrock, Fundamentals of Fluid Film "
-                                                      "Lubrication: 1.5-2.5e-8 1/Pa)"),
+                                                      "Lubrication: 1.5-2.5e-8 1/Pa)", span=Span("1.5e-8 1/Pa", "2.5e-8 1/Pa", "Hamrock's range for mineral oils")),
             thermal_conductivity=assumed("0.13 W/(m*K)", "mineral oils: 0.12-0.15 W/(m K) in handbooks, "
                                                          "slowly falling with temperature; not measured for "
                                                          "this oil"),
-            roughness=assumed("0.15 um", "composite Rq of a ground raceway (~0.1 um) and a roller (~0.1 um)"),
+            roughness=assumed("0.15 um", "composite Rq of a ground raceway (~0.1 um) and a roller (~0.1 um)", span=Span("0.1 um", "0.3 um", "superfinished to plain ground surfaces")),
             limiting_shear_stress=assumed("2 MPa", "Bair and Winer (1979): small at zero pressure"),
             limiting_shear_slope=assumed(0.07, "Bair and Winer (1979), mineral oils: tau_L/p ~ 0.05-0.1; with "
                                                "it the EHL traction plateau is near the tanh law's 0.08"),
@@ -283,20 +283,21 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
                                                 "contacts"),
         ),
         support=SupportParams(
-            sun_stiffness=assumed("1e8 N/m"),
-            ring_stiffness=assumed("1e8 N/m"),
-            carrier_stiffness=assumed("1e8 N/m"),
-            damping_ratio=assumed(0.02),
-            ring_tangential_stiffness=assumed("1e9 N/m", "ring fixed: k_theta = 1e9 N/m x r_r^2"),
+            sun_stiffness=assumed("1e8 N/m", span=Span("1e6 N/m", "1e10 N/m", "a floating sun (held by its coupling only) to a rigid seat", log=True)),
+            ring_stiffness=assumed("1e8 N/m", span=Span("1e7 N/m", "1e10 N/m", "a ring on a loose spline fit to one shrunk into a stiff housing", log=True)),
+            carrier_stiffness=assumed("1e8 N/m", span=Span("3e7 N/m", "3e9 N/m", "rolling bearings of this size (1e8-1e9 N/m) in a compliant or stiff housing", log=True)),
+            damping_ratio=assumed(0.02, span=Span(0.01, 0.05, "bolted joints and bearings: 1-5 % of critical")),
+            ring_tangential_stiffness=assumed("1e9 N/m", "ring fixed: k_theta = 1e9 N/m x r_r^2", span=Span("1e8 N/m", "1e10 N/m", "a torque arm or splines to a bolted flange", log=True)),
         ),
         mesh=MeshParams(
             smoothing_width=assumed(0.05, "the source gives none: 5 % of a mesh cycle per step, "
-                                          "smooth enough for Newton, sharp enough to keep the wave"),
-            damping_ratio=assumed(0.07),
+                                          "smooth enough for Newton, sharp enough to keep the wave", span=Span(0.02, 0.09, "from under half the step to the widest the outer-ring mesh's contact ratio 1.91 allows")),
+            damping_ratio=assumed(0.07, span=Span(0.03, 0.17, "mesh damping ratios the gear dynamics literature reports")),
             damping_ramp=assumed("1 um", "a contact's damping grows with its compressed zone (Hunt & Crossley); "
                                          "about a third of the least compressed loaded flank at rated load (2.9 um, "
                                          "the ring mesh at condition 3; up to 18 um at condition 1), so loaded "
-                                         "flanks keep their whole damping"),
+                                         "flanks keep their whole damping",
+                                 span=Span("0 um", "2 um", "no ramp (the Kelvin-Voigt jump) to two thirds of the least compressed loaded flank")),
         ),
         operating=operating_point(condition, direction),
         rig=RigParams(

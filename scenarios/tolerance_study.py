@@ -29,10 +29,8 @@ import contextlib
 import csv
 import hashlib
 import io
-import itertools
 import json
 import math
-import os
 import sys
 import time
 import warnings
@@ -41,7 +39,6 @@ from pathlib import Path
 
 import numpy as np
 from scipy.stats import t as student_t
-from tqdm.auto import tqdm
 
 import mbd
 from components.dpgt import build_dpgt
@@ -59,7 +56,8 @@ from .core.lock import holds_out_folder
 from .core.runner import RunConfig, code_digest
 from .core.study import Study, StudyRun
 from .core.points import Point, machine_overrides, point_label, point_order, point_words, points_of
-from .core.sweep import Case, build_params, dask_client, user_overrides, validate_cases
+from .core.sweep import Case, build_params, user_overrides, validate_cases
+from .core.tasks import solve_tasks
 
 __all__ = ["main", "run", "parse_args", "QUANTITIES", "MESHES", "quantities_of", "percentile_ci", "statistics",
            "agreement_rows", "sample_rows", "sample_columns", "answer", "StaticTask", "static_tasks", "solve_static_task"]
@@ -343,50 +341,11 @@ def _earlier(tasks: list[StaticTask], overwrite: bool) -> tuple[dict, list[Stati
 
 
 def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None, progress: bool) -> dict:
-    """{key: record} of ``todo`` solved in this process (one worker) or on Dask; a line every 10 s (or a bar on a
-    terminal) says how far it is."""
-    out: dict = {}
-    if not todo:
-        return out
-    bars = progress and sys.stderr.isatty()
-    bar = tqdm(total=len(todo), desc="static solutions", disable=not bars)
-    t0 = last = time.perf_counter()
-
-    def took(rec):
-        nonlocal last
-        out[(rec["class"], rec["condition"], rec["direction"], rec["torque_fraction"], rec["sample"])] = rec
-        bar.update(1)
-        now = time.perf_counter()
-        if progress and not bars and (now - last > 10.0 or len(out) == len(todo)):
-            last = now
-            failed = sum(r.failed for r in out.values())
-            print(f"static: {len(out)}/{len(todo)} solved ({failed} failed), {now - t0:.0f} s", file=sys.stderr,
-                  flush=True)
-
-    n = workers or min(len(todo), os.cpu_count() or 1)
-    if scheduler is None and n <= 1:
-        for t in todo:
-            took(solve_static_task(t))
-    else:
-        from dask.distributed import as_completed  # deferred: Dask (≈ 0.2–0.4 s) only when solving on it
-
-        with dask_client(n, scheduler) as client:
-            # a few tasks per worker in flight, the next submitted as one finishes: thousands of machines at once
-            # made a graph of 50 MB (Dask warned) and held every task's parameters on the scheduler
-            queue = iter(todo)
-            running = as_completed()
-            try:
-                for t in itertools.islice(queue, 4 * n):
-                    running.add(client.submit(solve_static_task, t, pure=False))
-                for fut in running:
-                    took(fut.result())
-                    for t in itertools.islice(queue, 1):
-                        running.add(client.submit(solve_static_task, t, pure=False))
-            except BaseException:        # Ctrl-C: take the solutions off the scheduler (finished files stay)
-                client.cancel(list(running.futures), force=True)
-                raise
-    bar.close()
-    return out
+    """{key: record} of ``todo`` solved in this process (one worker) or on Dask (:func:`scenarios.core.tasks.solve_tasks`:
+    a few tasks per worker in flight; a line every 10 s, or a bar on a terminal, says how far it is)."""
+    recs = solve_tasks(solve_static_task, todo, workers=workers, scheduler=scheduler, progress=progress,
+                       what="static solutions", failed=lambda r: r.failed)
+    return {(r["class"], r["condition"], r["direction"], r["torque_fraction"], r["sample"]): r for r in recs}
 
 
 # ---------------------------------------------------------------------------------------------------------------

@@ -193,7 +193,7 @@ def test_did_you_mean_is_one_helper_with_sane_matches():
 # the shared command grammar (issue 24 §3): one definition of every shared option, the same in every command
 STUDIES = {"paper_study": "results/study", "demo": "results/demo", "lubricant_study": "results/lubricant",
            "fault_study": "results/faults", "gear_quality": "results/gear_quality",
-           "tolerance_study": "results/tolerances"}
+           "tolerance_study": "results/tolerances", "sensitivity": "results/sensitivity"}
 OTHERS = {"spectrum": "results/spectrum", "bearing_rig": "results/bearing_rig", "modal": "results/modal",
           "work_precision": "results/numerics", "stability": "results/numerics", "benchmark": "results/numerics",
           "bench_engine": None, "params": None, "animate": None, "duty_cycle": "results/duty_cycle",

@@ -27,7 +27,7 @@ __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_di
            "mode_shapes", "fault_spectra", "fault_loads", "FAULT_QUANTITIES", "gear_quality", "forward_reverse_headline",
            "time_history_group", "cage_orbit_picture", "display_unit", "format_pct", "HEADLINE_QUANTITIES", "FWD", "REV",
            "STYLE", "tolerance_distributions", "tolerance_against_torque", "tolerance_life_cdf", "damage_shares",
-           "binned_series"]
+           "binned_series", "morris_heatmap", "sobol_heatmap"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
 STYLE = {
@@ -1026,4 +1026,83 @@ def binned_series(series: Mapping[str, Sequence[float]], names: Sequence[str], p
                    title_fontsize=7.5)
         if title:
             fig.suptitle(textwrap.fill(title, 100), fontsize=9.5)
+
+
+# ----------------------------------------------------------------------------------------------
+# sensitivity (scenarios.sensitivity)
+
+def morris_heatmap(rel: Mapping[str, Mapping[str, Mapping[str, float]]], parameters: Sequence[str], path, *,
+                   title: str | None = None) -> Path:
+    """Morris screening as a heat map per operating point: a row per parameter, a column per output, the colour the
+    parameter's μ* as a share of the output's nominal value in % (log colour scale from 0.01 % to 100 %; below it
+    white), the value written in each cell ≥ 0.1 %. ``rel``: {point label: {output: {parameter: μ*/|nominal|}}};
+    ``parameters``: the rows, top to bottom (sorted here by their largest share over all cells)."""
+    from matplotlib.colors import LogNorm  # deferred: only this figure uses it
+
+    labels = list(rel)
+    outputs = list(dict.fromkeys(o for v in rel.values() for o in v))
+    worst = {k: max((rel[p][o].get(k, 0.0) or 0.0 for p in labels for o in rel[p]
+                     if np.isfinite(rel[p][o].get(k, np.nan))), default=0.0) for k in parameters}
+    rows = sorted(parameters, key=lambda k: -worst[k])
+    norm = LogNorm(1e-2, 1e2, clip=True)
+    with mpl.rc_context(STYLE):
+        cols = min(2, len(labels))
+        nrows = (len(labels) + cols - 1) // cols
+        fig = Figure(figsize=(2.6 + 0.42 * len(outputs) * cols, 0.9 + (1.9 + 0.24 * len(rows)) * nrows),
+                     layout="constrained")
+        grid = fig.subplots(nrows, cols, squeeze=False, sharey=True)
+        axes = list(grid.flat)
+        for ax in axes[len(labels):]:
+            ax.set_visible(False)
+        img = None
+        for ax, label in zip(axes, labels):
+            m = np.array([[100.0 * rel[label].get(o, {}).get(k, np.nan) for o in outputs] for k in rows], float)
+            shown = np.where(m >= 1e-2, m, np.nan)
+            img = ax.imshow(shown, norm=norm, cmap="viridis", aspect="auto")
+            for (i, j), v in np.ndenumerate(m):
+                if np.isfinite(v) and v >= 0.1:
+                    ax.text(j, i, f"{v:.2g}", ha="center", va="center", fontsize=6,
+                            color="white" if v < 3.0 else "black")
+            ax.set_xticks(range(len(outputs)), outputs, rotation=90, fontsize=7)
+            ax.set_yticks(range(len(rows)), rows, fontsize=7)
+            ax.grid(False)
+            ax.set_title(label.replace("_", " "))
+        fig.colorbar(img, ax=axes[:len(labels)], label=_axis_label("μ* / nominal", "%"), shrink=0.6)
+        if title:
+            fig.suptitle(_wrap(title, max(40, int(11 * fig.get_figwidth()))))
+        return _save(fig, path)
+
+
+def sobol_heatmap(sobol: Mapping[str, Mapping[str, Mapping[str, Mapping]]], parameters: Sequence[str], path, *,
+                  title: str | None = None) -> Path:
+    """Sobol indices as a heat map per operating point: a row per parameter, a column per output, the colour the
+    first-order index S1 (0–1), each cell written "S1 / ST" (ST the total index; their intervals are in the tables).
+    ``sobol``: {point label: {output: {parameter: {"S1", "ST", ...}}}}."""
+    labels = [p for p in sobol if sobol[p]]
+    outputs = list(dict.fromkeys(o for p in labels for o, v in sobol[p].items() if v))
+    norm = Normalize(0.0, 1.0)
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(3.2 + 0.55 * len(outputs), 0.6 + (1.7 + 0.42 * len(parameters)) * len(labels)),
+                     layout="constrained")
+        axes = fig.subplots(len(labels), 1, squeeze=False, sharex=True)
+        img = None
+        for n, ax in enumerate(axes.flat):
+            if n >= len(labels):
+                ax.set_visible(False)
+                continue
+            label = labels[n]
+            s1 = np.array([[sobol[label].get(o, {}).get(k, {}).get("S1", np.nan) for o in outputs] for k in parameters])
+            st = np.array([[sobol[label].get(o, {}).get(k, {}).get("ST", np.nan) for o in outputs] for k in parameters])
+            img = ax.imshow(np.clip(s1, 0.0, 1.0), norm=norm, cmap="viridis", aspect="auto")
+            for (i, j), v in np.ndenumerate(s1):
+                if np.isfinite(v):
+                    ax.text(j, i, f"{v:.2f}\n{st[i, j]:.2f}", ha="center", va="center", fontsize=5.5,
+                            color="white" if v < 0.6 else "black")
+            ax.set_xticks(range(len(outputs)), outputs, rotation=90, fontsize=7)
+            ax.set_yticks(range(len(parameters)), parameters, fontsize=7)
+            ax.grid(False)
+            ax.set_title(label.replace("_", " "))
+        fig.colorbar(img, ax=list(axes.flat), label="S1 [–]", shrink=0.6)
+        if title:
+            fig.suptitle(_wrap(title, max(40, int(11 * fig.get_figwidth()))))
         return _save(fig, path)

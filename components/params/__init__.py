@@ -11,7 +11,7 @@ Where things are
 * ``errors``    — manufacturing errors and faults, :class:`ErrorsParams` and one class per kind of entry
 * ``machine``   — the whole machine :class:`DPGTParams` (and :class:`SupportParams`)
 * ``dotted``    — :func:`with_overrides`, :func:`flatten`, :func:`parameter_names`, :func:`parameter_rows`,
-  :func:`describe`, :func:`to_toml`, :func:`overrides_from_toml`
+  :func:`describe`, :func:`to_toml`, :func:`overrides_from_toml`, :func:`spans` (the ranges of assumed values)
 * ``_machinery`` — how a parameter class works (field specifications, conversion, provenance, the ``Params``
   and ``SI`` bases, :func:`~components.params._machinery.si_of`); code that uses parameters need not touch it.
 
@@ -50,11 +50,12 @@ Single values are checked here (positive masses, clearances ≥ 0, N ≥ 1, Z �
 values fit together (rollers fit, gears assemble, tip circles clear) is checked by
 :func:`components.geometry.check_design`, which a builder should call before building.
 """
-from ._machinery import SI, Derived, Params, Source, Sourced, assumed, derived, paper
+from ._machinery import SI, Derived, Params, Source, Sourced, Span, assumed, derived, paper
 from .bearing import (BearingParams, BearingSI, CageParams, CageSI, LifeParams, LifeSI, LubricantParams, LubricantSI,
                       ProfileParams, ProfilePointParams, ProfilePointSI, ProfileSI, SlicingParams, SlicingSI,
                       SlideRollTractionParams, SlideRollTractionSI)
-from .dotted import describe, flatten, overrides_from_toml, parameter_names, parameter_rows, to_toml, with_overrides
+from .dotted import (describe, flatten, overrides_from_toml, parameter_names, parameter_rows, spans, to_toml,
+                     with_overrides)
 from .errors import (ErrorsParams, ErrorsSI, FlankClassParams, FlankClassSI, PinholeErrorParams, PinholeErrorSI,
                      RollerDiameterErrorParams, RollerDiameterErrorSI, RunoutParams, RunoutSI, SpallParams, SpallSI,
                      ToothDeviationParams, ToothDeviationSI, ToothFaultParams, ToothFaultSI)
@@ -65,7 +66,7 @@ from .operating import (BearingRigParams, BearingRigSI, CarrierRippleParams, Car
 from .sensor import HousingParams, HousingSI, SensorParams, SensorSI
 
 __all__ = [
-    "Source", "Sourced", "paper", "derived", "assumed", "SI", "Derived", "Params",
+    "Source", "Sourced", "Span", "paper", "derived", "assumed", "SI", "Derived", "Params",
     "GearParams", "GearSetParams", "CageParams", "SlideRollTractionParams", "LifeParams", "BearingParams", "LubricantParams",
     "SupportParams", "MeshParams", "OperatingPoint", "HousingParams", "SensorParams", "CarrierRippleParams", "RigParams",
     "DPGTParams", "BearingRigParams",
@@ -76,4 +77,5 @@ __all__ = [
     "BearingRigSI", "ErrorsSI", "PinholeErrorSI", "RunoutSI", "RollerDiameterErrorSI", "SpallSI", "ToothFaultSI",
     "ToothDeviationSI", "FlankClassSI",
     "with_overrides", "parameter_names", "flatten", "describe", "parameter_rows", "to_toml", "overrides_from_toml",
+    "spans",
 ]

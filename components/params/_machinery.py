@@ -15,6 +15,7 @@ needs only the field helpers, :class:`Params`, :func:`si_of` and :func:`computed
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import numbers
 import re
@@ -28,7 +29,7 @@ import numpy as np
 from ..names import did_you_mean
 from ..units import ParameterError, Quantity, quantity, to_si
 
-__all__ = ["Source", "Sourced", "paper", "derived", "assumed", "Spec", "param", "positive", "nonneg", "rule", "nested",
+__all__ = ["Source", "Sourced", "Span", "paper", "derived", "assumed", "Spec", "param", "positive", "nonneg", "rule", "nested",
            "entries", "named", "param_fields", "convert", "Params", "SI", "Derived", "computed", "si_of", "si_extends",
            "fields_of"]
 
@@ -37,16 +38,31 @@ __all__ = ["Source", "Sourced", "paper", "derived", "assumed", "Spec", "param", 
 # provenance
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
+class Span:
+    """The range an [assumed] value may plausibly take, with its basis: what a sensitivity study
+    (``scenarios.sensitivity``) varies it over. ``low`` < ``high`` in the parameter's kind (strings such as
+    ``"1e6 N/m"`` are converted and checked against the field's bounds when the parameter is built, and the
+    assumed value must lie inside); ``log``: spread evenly in the logarithm (a range over decades, e.g. a
+    support from floating to rigid), else evenly in the value."""
+
+    low: Any
+    high: Any
+    basis: str
+    log: bool = False
+
+
+@dataclass(frozen=True)
 class Source:
     """Where a value comes from: tag ``paper`` | ``derived`` | ``assumed`` | ``user`` | ``default``.
 
     ``value`` is the value the tag was given to (filled in automatically); a parameter whose current
-    value differs from it is reported as ``user``.
+    value differs from it is reported as ``user``. ``span``: the range of an assumed value (:class:`Span`), or None.
     """
 
     tag: str
     note: str = ""
     value: Any = field(default=None, compare=False, repr=False)
+    span: Span | None = field(default=None, compare=False, repr=False)
 
     def __str__(self) -> str:
         return f"[{self.tag}]" + (f" {self.note}" if self.note else "")
@@ -70,9 +86,10 @@ def derived(value, note: str = "") -> Sourced:
     return Sourced(value, Source("derived", note))
 
 
-def assumed(value, note: str = "") -> Sourced:
-    """An engineering estimate; say its basis in ``note``."""
-    return Sourced(value, Source("assumed", note))
+def assumed(value, note: str = "", span: Span | None = None) -> Sourced:
+    """An engineering estimate; say its basis in ``note`` and, where a study should vary it, its plausible range in
+    ``span`` (:class:`Span`: low, high, basis, log)."""
+    return Sourced(value, Source("assumed", note, span=span))
 
 
 _USER = Source("user")
@@ -248,6 +265,40 @@ def _convert_entries(spec: Spec, name: str, value) -> tuple:
             hint = did_you_mean(unknown[0], [f.name for f in fs]) if unknown else ""
             raise ParameterError.at(path, f"needs {missing} (unknown keys: {unknown}{hint})") from None
     return tuple(out)
+
+
+def _checked_span(spec: Spec, name: str, span: Span | None, value) -> Span | None:
+    """``span`` with its ends converted like a value of the field (``name``: its dotted path), checked: both inside
+    the field's bounds, low < high (a log span: low > 0), the value between them."""
+    if span is None:
+        return None
+    if not isinstance(span, Span):
+        raise ParameterError.at(name, f"a range must be a Span(low, high, basis), got {span!r}")
+    try:
+        converted, lo, hi = _converted_span(spec, name, span)
+    except TypeError:                   # unhashable ends (e.g. numpy values): convert them each time
+        converted, lo, hi = _converted_span.__wrapped__(spec, name, span)
+    x = to_si(value) if value is not None else None
+    if x is not None and not lo <= x <= hi:
+        raise ParameterError.at(name, f"the value {value} lies outside its range [{span.low}, {span.high}]")
+    return converted
+
+
+@functools.lru_cache(maxsize=1024)
+def _converted_span(spec: Spec, name: str, span: Span) -> tuple[Span, float, float]:
+    """(the span with its ends converted, low and high in SI), checked; cached: the reference machine's ranges are
+    declared anew each time it is built, and pint's parsing would cost a build ~30 %."""
+    if spec.kind in ("count", "sign", "flag", "choice", "name", "tooth", "nested", "entries"):
+        raise ParameterError.at(name, f"a range needs a quantity; this parameter is a {spec.kind}")
+    low, high = convert(spec, f"{name} (range low)", span.low), convert(spec, f"{name} (range high)", span.high)
+    lo, hi = to_si(low), to_si(high)
+    if not lo < hi:
+        raise ParameterError.at(name, f"empty range: low {span.low!r} must be below high {span.high!r}")
+    if span.log and not lo > 0.0:
+        raise ParameterError.at(name, f"a log range needs low > 0, got {span.low!r}")
+    if not span.basis.strip():
+        raise ParameterError.at(name, "a range needs its basis (why these ends)")
+    return Span(low, high, span.basis, bool(span.log)), lo, hi
 
 
 def param_fields(cls) -> tuple:
@@ -475,7 +526,8 @@ class Params(Generic[_S]):
             object.__setattr__(self, f.name, value)
             src = tags.get(f.name)
             if src is not None and src.value is None:  # remember what the tag was given to
-                tags[f.name] = dataclasses.replace(src, value=value)
+                span = _checked_span(f.metadata["spec"], self._path(f.name), src.span, value)
+                tags[f.name] = dataclasses.replace(src, value=value, span=span)
         object.__setattr__(self, "sources", MappingProxyType(tags))
 
     @classmethod

@@ -9,10 +9,10 @@ from typing import Any, Mapping, TypeVar
 
 from ..names import did_you_mean
 from ..units import KINDS, ParameterError, Quantity, format_quantity
-from ._machinery import Params, convert, param_fields
+from ._machinery import Params, Span, convert, param_fields
 
 __all__ = ["with_overrides", "parameter_names", "flatten", "describe", "parameter_rows", "to_toml",
-           "overrides_from_toml"]
+           "overrides_from_toml", "spans"]
 
 _P = TypeVar("_P", bound=Params)
 
@@ -27,6 +27,21 @@ def flatten(params: Params, prefix: str = "") -> dict[str, Any]:
             out.update(flatten(v, path + "."))
         else:
             out[path] = v
+    return out
+
+
+def spans(params: Params) -> dict[str, Span]:
+    """{dotted path: :class:`Span`} of every parameter that holds the assumed value its range was declared with
+    (``assumed(value, note, span=Span(...))``; a value overridden since is the user's: it has no range)."""
+    out: dict[str, Span] = {}
+    for path in flatten(params):
+        *owner_path, name = path.split(".")
+        owner = params
+        for p in owner_path:
+            owner = getattr(owner, p)
+        span = owner.source(name).span
+        if span is not None:
+            out[path] = span
     return out
 
 
