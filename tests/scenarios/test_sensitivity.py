@@ -14,16 +14,16 @@ from scenarios import cli, sensitivity
 from scenarios.core.command import USAGE
 
 # the toy's factors, named out of their declaration order, with ranges written out here from presets' declarations
-# in SI (m, K, N/m², log10 of N/m): the study must apply each range to its own parameter in its unit
+# in SI (m, K, m²/s, log10 of N/m): the study must apply each range to its own parameter in its unit
 TOY = {                                  # key: (SI low, SI high, log)
     "lubricant.temperature": (313.15, 363.15, False),          # 40–90 degC
     "bearing.clearance": (5e-6, 40e-6, False),                  # 5–40 um
     "support.sun_stiffness": (1e6, 1e10, True),                 # 1e6–1e10 N/m, over its decades
-    "mesh.c_gamma_alpha": (14e9, 24e9, False),                  # 14–24 N/(mm um)
+    "lubricant.viscosity_40": (61.2e-6, 74.8e-6, False),        # 61.2–74.8 mm²/s
 }
 # each factor's contribution over its whole range (design-space span × coefficient): distinct, one negative
 CONTRIBUTION = {"lubricant.temperature": -1.0, "bearing.clearance": 3.0, "support.sun_stiffness": 1.5,
-                "mesh.c_gamma_alpha": 2.0}
+                "lubricant.viscosity_40": 2.0}
 
 
 def _span(key):
@@ -39,7 +39,8 @@ def toy(params: DPGTParams, snapshots: int) -> dict:
     parameters; a second output z = 7 y + 1 (μ* scales by 7, indices do not)."""
     si = params.si()
     x = {"lubricant.temperature": si.lubricant.temperature, "bearing.clearance": si.bearing.clearance,
-         "support.sun_stiffness": math.log10(si.support.sun_stiffness), "mesh.c_gamma_alpha": si.mesh.c_gamma_alpha}
+         "support.sun_stiffness": math.log10(si.support.sun_stiffness),
+         "lubricant.viscosity_40": si.lubricant.viscosity_40}
     y = sum(COEF[k] * x[k] for k in TOY)
     return {"y": y, "z": 7.0 * y + 1.0}
 
