@@ -32,8 +32,7 @@ import numpy as np
 from components import life
 from components.names import did_you_mean
 from components.presets import CONDITIONS
-from components.results import Summary
-from components.results.io import atomic_write_text, write_summary
+from components.results.io import atomic_write_text
 from components.static import DEFAULT_SNAPSHOTS, STATIC_LIVES_NOTE
 from components.units import ParameterError, quantity, to_si
 
@@ -509,9 +508,6 @@ class DutyCycle(Study):
         if missing:
             print(f"no lives over the cycle: the bins {', '.join(missing)} have no results")
             return {"lives": None}
-        for label, s in res.items():          # every run's summary names the machine it ran
-            if "stale_after_failure" not in s and s.get("machine") != self.machine:
-                write_summary(run.outcomes[label].case.out_dir, Summary({**s, "machine": self.machine}))
         shares = [b.share for b in bins]
         hours = [b.hours for b in bins]
         lives = spectrum_lives(chosen, shares, hours)

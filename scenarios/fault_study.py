@@ -226,8 +226,9 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
     return rows, spectra
 
 
-def write_tables(rows: list[dict], out: Path) -> list[Path]:
-    """summary.csv, summary.md and findings.md."""
+def write_tables(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
+    """summary.csv, summary.md and findings.md (the markdown files headed by ``machine``, the machine's name)."""
+    head = [f"Machine: {machine}", ""] if machine else []
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=COLUMNS)
     w.writeheader()
@@ -236,20 +237,23 @@ def write_tables(rows: list[dict], out: Path) -> list[Path]:
     fmt = lambda v: f"{v:.4g}" if isinstance(v, float) else ("" if v is None else str(v))
     md = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     md += ["| " + " | ".join(fmt(r[c]) for c in COLUMNS) + " |" for r in rows]
-    atomic_write_text(out / "summary.md", "\n".join(md) + "\n")
-    atomic_write_text(out / "findings.md", findings(rows) + "\n")
+    atomic_write_text(out / "summary.md", "\n".join(head + md) + "\n")
+    atomic_write_text(out / "findings.md", "\n".join(head + [findings(rows)]) + "\n")
     return [out / "summary.csv", out / "summary.md", out / "findings.md"]
 
 
-def plots(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
-    """loads.png and (with a perfect machine to compare against) spectra.png."""
+def plots(rows: list[dict], spectra: dict, out: Path, machine: str = "") -> list[Path]:
+    """loads.png and (with a perfect machine to compare against) spectra.png; ``machine`` names the machine in the
+    titles."""
+    on = f" — {machine}" if machine else ""
     from viz.plots import fault_loads, fault_spectra  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
-    files = [fault_loads(rows, out / "loads.png", title="What each fault does to the planet bearings (pair 1)")]
+    files = [fault_loads(rows, out / "loads.png", title=f"What each fault does to the planet bearings (pair 1){on}")]
     panels = _spectrum_panels(spectra)
     if panels:
         files.append(fault_spectra(panels, out / "spectra.png",
-                                   title="The housing sensor around the mesh frequency: each fault against the perfect machine"))
+                                   title=f"The housing sensor around the mesh frequency: each fault against the perfect "
+                                         f"machine{on}"))
     return files
 
 
@@ -340,8 +344,8 @@ class FaultStudy(Study):
                       + (f"sensor f_m / floor {row['sensor_f_m']:.3g}" if row["sensor_f_m"] is not None
                          else "sensor lines not meaningful (too short a window)"))
         if rows:
-            run.step("tables", write_tables, rows, self.out)
-            run.step("figures", plots, rows, spectra, self.out)
+            run.step("tables", write_tables, rows, self.out, self.machine_identity()["label"])
+            run.step("figures", plots, rows, spectra, self.out, self.machine_identity()["label"])
         return {"rows": rows}
 
 

@@ -227,21 +227,22 @@ def _write_csv(path: Path, rows: list[dict], columns=None) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-def write_tables(rows: list[dict], out: Path) -> list[Path]:
-    """runs.csv, by_grade.csv and findings.md."""
+def write_tables(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
+    """runs.csv, by_grade.csv and findings.md (headed by ``machine``, the machine's name)."""
     groups = by_grade(rows)
     _write_csv(out / "runs.csv", rows, COLUMNS)
     _write_csv(out / "by_grade.csv", groups)
-    atomic_write_text(out / "findings.md", findings(groups) + "\n")
+    atomic_write_text(out / "findings.md", (f"Machine: {machine}\n\n" if machine else "") + findings(groups) + "\n")
     return [out / "runs.csv", out / "by_grade.csv", out / "findings.md"]
 
 
-def plot(rows: list[dict], out: Path) -> list[Path]:
+def plot(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
     """quality.png."""
     from viz.plots import gear_quality  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     return [gear_quality(by_grade(rows), out / "quality.png",
-                         title="Gear tooth quality (ISO 1328 flank class) against perfect teeth: planet bearings and the ring mesh")]
+                         title="Gear tooth quality (ISO 1328 flank class) against perfect teeth: planet bearings and the ring mesh"
+                               + (f" — {machine}" if machine else ""))]
 
 
 def write_outputs(rows: list[dict], out: Path) -> list[Path]:
@@ -264,8 +265,8 @@ class GearQualityStudy(Study):
         rows = rows_of(run.cases, run.results)
         if rows:
             print(findings(by_grade(rows)))      # the headline first
-            run.step("tables", write_tables, rows, self.out)
-            run.step("figures", plot, rows, self.out)
+            run.step("tables", write_tables, rows, self.out, self.machine_identity()["label"])
+            run.step("figures", plot, rows, self.out, self.machine_identity()["label"])
         return {"rows": rows}
 
 

@@ -212,8 +212,9 @@ def _eta(rows, lab) -> float:
     return next(r["viscosity_Pa_s"] for r in rows if r["lubricant"] == lab)
 
 
-def write_tables(rows: list[dict], out: Path) -> list[Path]:
-    """summary.csv, summary.md and answer.md."""
+def write_tables(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
+    """summary.csv, summary.md and answer.md (the markdown files headed by ``machine``, the machine's name)."""
+    head = [f"Machine: {machine}", ""] if machine else []
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=COLUMNS)
     w.writeheader()
@@ -222,12 +223,12 @@ def write_tables(rows: list[dict], out: Path) -> list[Path]:
     md = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     md += ["| " + " | ".join(f"{r[c]:.4g}" if isinstance(r[c], float) else str(r[c]) for c in COLUMNS) + " |"
            for r in rows]
-    atomic_write_text(out / "summary.md", "\n".join(md) + "\n")
-    atomic_write_text(out / "answer.md", answer(rows) + "\n")
+    atomic_write_text(out / "summary.md", "\n".join(head + md) + "\n")
+    atomic_write_text(out / "answer.md", "\n".join(head + [answer(rows)]) + "\n")
     return [out / "summary.csv", out / "summary.md", out / "answer.md"]
 
 
-def plot(rows: list[dict], out: Path) -> list[Path]:
+def plot(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
     """film_and_slip.png: Λ, film, cage slip and traction heat against the viscosity, a line per condition and
     direction (the conditions' own markers when there are several)."""
     from viz.plots import against_viscosity  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
@@ -246,7 +247,8 @@ def plot(rows: list[dict], out: Path) -> list[Path]:
                                        ("cage_slip_pct", "cage slip", "%", False),
                                        ("heat_traction_W", "traction heat", "W", False)],
                               out / "film_and_slip.png",
-                              title=f"Film and cage against the oil's viscosity (at the operating temperature){at}",
+                              title=f"Film and cage against the oil's viscosity (at the operating temperature){at}"
+                                    + (f" — {machine}" if machine else ""),
                               # the grades by name; a viscosity given as such is its own tick label
                               names={r["lubricant"]: r["viscosity_Pa_s"] for r in rows if r["lubricant"] in OIL_GRADES}
                               or None,
@@ -301,8 +303,8 @@ class LubricantStudy(Study):
         text = answer(rows) if rows else ""
         print(text)                          # the headline first
         if rows:
-            run.step("tables", write_tables, rows, self.out)
-            run.step("figures", plot, rows, self.out)
+            run.step("tables", write_tables, rows, self.out, self.machine_identity()["label"])
+            run.step("figures", plot, rows, self.out, self.machine_identity()["label"])
         return {"rows": rows, "answer": text}
 
 

@@ -627,10 +627,12 @@ def answer(stats: list[dict], agree: list[dict], a_record: dict) -> str:
 # ---------------------------------------------------------------------------------------------------------------
 # figures
 # ---------------------------------------------------------------------------------------------------------------
-def plots(records: dict, stats: list[dict], out: Path) -> list[Path]:
+def plots(records: dict, stats: list[dict], out: Path, machine: str = "") -> list[Path]:
+    """The study's three figures; ``machine`` names the machine in their titles."""
     # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
     from viz.plots import tolerance_against_torque, tolerance_distributions, tolerance_life_cdf
 
+    on = f" — {machine}" if machine else ""
     groups = _groups(records)
     dist = {(cond, f): {} for (_, cond, _, f) in groups}
     for (c, cond, d, f), e in groups.items():
@@ -638,14 +640,14 @@ def plots(records: dict, stats: list[dict], out: Path) -> list[Path]:
     failed = sum(1 for e in groups.values() for r in e["samples"] if "quantities" not in r)
     files = [tolerance_distributions(dist, out / "k_gamma_distribution.png",
                                      title="Mesh load sharing K_γ of machines drawn from their tolerances"
-                                           + (f" ({failed} without a static solution left out)" if failed else ""))]
+                                           + (f" ({failed} without a static solution left out)" if failed else "") + on)]
     bands = {}
     for g in stats:
         k = g["quantities"][HEADLINE]
         bands.setdefault((g["condition"], g["direction"]), {}).setdefault(g["class"], []).append(
             (g["output_torque_N_m"], k["p50"]["value"], k["p90"]["value"]))
     files.append(tolerance_against_torque(bands, out / "k_gamma_torque.png",
-                                          title="Mesh K_γ against the output torque: median and P90 of the machines"))
+                                          title="Mesh K_γ against the output torque: median and P90 of the machines" + on))
     top = max(f for (_, _, _, f) in groups)
     cdfs = {}
     for (c, cond, d, f), e in groups.items():
@@ -658,7 +660,7 @@ def plots(records: dict, stats: list[dict], out: Path) -> list[Path]:
             cdfs.setdefault((cond, kind, std), {})[(c, d)] = (_column(e["samples"], life), nominal)
     files.append(tolerance_life_cdf(cdfs, out / "life_cdf.png",
                                     title=f"Weakest planet bearing's L10 life at {top:g} × rated torque against the "
-                                          f"perfect machine's (dotted)"))
+                                          f"perfect machine's (dotted){on}"))
     return files
 
 
@@ -764,12 +766,12 @@ class ToleranceStudy(Study):
             files.append(self.out / "statistics.json")
             if agree:
                 files.append(_write_csv(self.out / "agreement.csv", agree))
-            atomic_write_text(self.out / "answer.md", text + "\n")
+            atomic_write_text(self.out / "answer.md", f"Machine: {self.machine_identity()['label']}\n\n" + text + "\n")
             return files + [self.out / "answer.md"]
 
         run.step("tables", tables)
         if any("quantities" in r for r in self.records.values()):
-            run.step("figures", plots, self.records, stats, self.out)
+            run.step("figures", plots, self.records, stats, self.out, self.machine_identity()["label"])
         return {"statistics": stats, "agreement": agree, "static": self.records}
 
     @staticmethod

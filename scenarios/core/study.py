@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Callable, ClassVar
 
 from components.results import Summary
-from components.results.io import atomic_write_text
+from components.results.io import atomic_write_text, write_summary
 
 from .args import parse_sets
 from .integrity import read_summary
@@ -166,6 +166,10 @@ class Study(abc.ABC):
         t_sweep, sweep_timing = time.perf_counter(), {}
         outcomes = sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
                          overwrite=a.overwrite, announce=True, timing=sweep_timing)
+        for o in outcomes.values():       # every run's summary.json names the machine it ran
+            if o.ok and o.summary.get("machine") != machine:
+                o.summary["machine"] = machine
+                write_summary(o.case.out_dir, o.summary)
         run = StudyRun(self.out, cases, outcomes)
         print(runs_line(outcomes), flush=True)
         t_report = time.perf_counter()

@@ -245,6 +245,7 @@ def test_the_paper_study_in_static_mode(tmp_path):
     s = json.loads((tmp_path / "c3_reverse" / "summary.json").read_text())
     assert s["mode"] == "static" and s["snapshots"] == 4 and "cage_slip_pct" in s["omitted"]
     assert s["lives_ignore_dynamic_load"] is True
+    assert s["machine"]["label"].startswith("reference machine [")                 # the machine it ran
     assert "leave out the dynamic load" in (tmp_path / "comparison.md").read_text()
     assert not (tmp_path / "c3_reverse" / "results.nc").exists()
     rows = list(csv.DictReader((tmp_path / "comparison.csv").open()))

@@ -51,6 +51,7 @@ def test_fault_study_runs_end_to_end(tmp_path):
     for f in ("summary.md", "findings.md", "loads.png", "spectra.png", "study.json"):
         assert (out / f).exists(), f
     text = (out / "findings.md").read_text()
+    assert text.startswith("Machine: reference machine [")                 # the tables name the machine
     assert "forward:" in text and "cracked_tooth: life ×" in text and "bent: life ×" in text
     # a second call finds every run finished (resumes, nothing recomputed) and refuses other parameters
     assert fault_study.main(args) == 0

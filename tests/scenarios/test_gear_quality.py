@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import json
 
 import pytest
 
@@ -51,6 +52,9 @@ def test_gear_quality_study_runs_end_to_end(tmp_path):
     for f in ("by_grade.csv", "findings.md", "quality.png", "study.json"):
         assert (out / f).exists(), f
     assert "condition 3:" in (out / "findings.md").read_text()
+    assert (out / "findings.md").read_text().startswith("Machine: reference machine [")      # names the machine
+    s = json.loads(next(out.glob("c3_*_class6_*")).joinpath("summary.json").read_text())
+    assert s["machine"]["label"] == (out / "findings.md").read_text().split("\n")[0][len("Machine: "):]
     assert gear_quality.main(args) == 0                     # finished: resumes, nothing recomputed
     assert gear_quality.main([*args[:-2], "--systematic-share", "0.2", "--out", str(out)]) == 2   # other parameters
 

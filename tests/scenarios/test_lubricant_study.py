@@ -44,6 +44,7 @@ def test_the_study_writes_its_table_answer_and_plot(study, capsys):
             for r in sel:
                 assert r["regime"] == lubricant_study.regime(float(r["lambda_min"]))
     text = (study / "answer.md").read_text()
+    assert text.startswith("Machine: reference machine [")                 # the answer names the machine
     assert "condition 3, forward" in text and "condition 3, reverse" in text and "Λ" in text
     assert "Λ ≥ 1.5 from" in text and "full film (Λ ≥ 3) from" in text and "reverse needs against forward" in text
     assert (study / "film_and_slip.png").stat().st_size > 10_000

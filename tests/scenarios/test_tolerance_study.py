@@ -295,6 +295,7 @@ def test_a_small_study_writes_its_files_reuses_its_solutions_and_refuses_others(
     assert g["perfect_machine"]["k_gamma_mesh"] == pytest.approx(float(rows[0]["k_gamma_mesh"]))
     assert stats["method"]["defaults"]["pinhole"]["source"] == "[assumed]"
     assert "lives' percentiles are static" in (out / "answer.md").read_text()        # what the lives leave out
+    assert (out / "answer.md").read_text().startswith("Machine: reference machine [")
     for f in ("answer.md", "k_gamma_distribution.png", "k_gamma_torque.png", "life_cdf.png", "study.json"):
         assert (out / f).stat().st_size > 0, f
     assert _study(out) == 0
