@@ -40,7 +40,7 @@ from .core.lock import holds_out_folder
 from .core.runner import RunConfig
 from .core.analysis import amplitude_spectrum, line_table, sensor_signal, sideband_resolution
 from .core.study import Study, StudyRun
-from .core.points import file_without, machine_overrides, point_label, points_of
+from .core.points import file_without, machine_overrides, point_label, point_order, point_words, points_of
 from .core.sweep import Case, build_params, user_overrides
 
 __all__ = ["FAULTS", "main", "run", "characteristic_frequencies", "COLUMNS"]
@@ -66,7 +66,7 @@ FAULTS = {
     "missing_tooth": ({"errors.tooth_fault": [{"gear": "b1", "tooth": 0, "stiffness_factor": 0.0}]},
                       "the same tooth missing"),
 }
-COLUMNS = ["fault", "direction", "bearing", "load_sharing_factor", "bearing_load_mean_N", "bearing_load_max_N",
+COLUMNS = ["fault", "condition", "direction", "bearing", "load_sharing_factor", "bearing_load_mean_N", "bearing_load_max_N",
            "roller_max_N", "life_iso281_h", "life_iso16281_h", "life_relative", "cage_slip_pct",
            "pocket_impacts_per_rev", "cage_acc_rel_rms_m_s2",
            "sensor_f_m", "sensor_f_m-1f_c", "sensor_f_m+1f_c", "sensor_f_m-3f_c", "sensor_f_m+3f_c",
@@ -93,8 +93,8 @@ def parse_args(argv):
     p.add_argument("--window", type=args.positive("s"), default=0.1,
                    help="seconds analysed (default 0.1: 10 Hz resolution, the f_c sidebands at 2000 r/min)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz] (> 2 f_m)")
-    # one condition per study: its folders are named by machine and direction
-    args.add_shared(p, out="results/faults", conditions="2", one_condition_only=True)
+    # its folders are named by operating point, direction and machine
+    args.add_shared(p, out="results/faults", conditions="2")
     return p.parse_args(argv)
 
 
@@ -128,13 +128,9 @@ def make_cases(a, out: Path) -> list[Case]:
             raise SystemExit(f"error: --machine {name}={path}: the name {name!r} is {what}'s; choose another")
         user_overrides({}, str(path), operating)
         machines[name] = ({}, str(path))
-    # the operating point: one (--conditions, --operating, the --params file's point); --set may not move it
+    # the operating points (--conditions, --operating, the --params file's points); --set may not move them
     sets = args.parse_sets(a.set)
     points = points_of(a, sets)
-    if len(points) != 1:
-        raise SystemExit(f"error: this command runs one operating point at a time, got {len(points)} "
-                         f"({', '.join(p.name for p in points)}); run it once per point (each with its own --out)")
-    point = points[0]
     # --params holds what every machine shares (not its errors): read into the overrides, so that a machine's own
     # file can sit beside it
     errors = {"errors": "--faults or --machine NAME=FILE.toml"}
@@ -143,8 +139,8 @@ def make_cases(a, out: Path) -> list[Case]:
     user = {**shared, **machine_overrides(sets, points)}
     # a run's folder is named as its progress and time lines name it (Case.label: c{condition}_{direction}_{machine})
     return [Case.at(point, d, str(out / f"{point_label(point, d)}_{name}"), {**user, **ov}, path, tag=name)
-            for name, (ov, path) in machines.items() for d in ([point.direction] if point.direction
-                                                               else a.directions.split(","))]
+            for point in points for name, (ov, path) in machines.items()
+            for d in ([point.direction] if point.direction else a.directions.split(","))]
 
 
 def characteristic_frequencies(si) -> dict[str, float]:
@@ -189,7 +185,7 @@ def sensor_spectrum(run_dir: Path, f_c: float):
 
 def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
     rows, spectra = [], {}
-    perfect = {c.direction: results.get(c.label, {}) for c in cases if c.tag == "perfect"}
+    perfect = {(c.condition, c.direction): results.get(c.label, {}) for c in cases if c.tag == "perfect"}
     for case in cases:
         s = results.get(case.label)
         if s is None or s.failed:
@@ -198,7 +194,7 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
         fr = characteristic_frequencies(si)
         f, amp, coarse = sensor_spectrum(Path(case.out_dir), fr["f_c"])
         own = _own_frequency(case, si, fr)
-        spectra[(case.tag, case.direction)] = (f, amp, fr, own)
+        spectra[(case.tag, case.condition, case.direction)] = (f, amp, fr, own)
         fm, fc = fr["f_m"], fr["f_c"]
         marks = {f"sensor_f_m{k:+d}f_c" if k else "sensor_f_m": fm + k * fc for k in (-3, -1, 0, 1, 3)}
         if own is not None:
@@ -207,9 +203,9 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
         # lines that cannot mean anything are left out, not interpreted (the note says why)
         sensor = {r["line"]: None if coarse else r["over_median"] for r in line_table(f, amp, marks, band)}
         for kind in ("inner", "outer"):
-            d, p0 = s[kind], perfect.get(case.direction, {}).get(kind)
+            d, p0 = s[kind], perfect.get((case.condition, case.direction), {}).get(kind)
             life = d["life_iso16281_h"] / p0["life_iso16281_h"] if p0 else None
-            row = {"fault": case.tag, "direction": case.direction, "bearing": kind,
+            row = {"fault": case.tag, "condition": case.condition, "direction": case.direction, "bearing": kind,
                    "load_sharing_factor": d.get("load_sharing_factor"),
                    "bearing_load_mean_N": d["bearing_load_mean_all_N"], "bearing_load_max_N": d["bearing_load_max_N"],
                    "roller_max_N": max(d["roller_inner_race_max_N"], d["roller_outer_race_max_N"]),
@@ -265,6 +261,11 @@ def write_outputs(rows: list[dict], spectra: dict, out: Path) -> list[Path]:
 SENSOR_LINES = ("sensor_f_m", "sensor_f_m-1f_c", "sensor_f_m+1f_c", "sensor_f_m-3f_c", "sensor_f_m+3f_c", "sensor_own")
 
 
+def _where(row: dict) -> str:
+    """A row's operating point and direction, as the headline names them."""
+    return f"{point_words(row['condition'])}, {row['direction']}"
+
+
 def findings(rows: list[dict]) -> str:
     """The table in words: per direction the faults ranked by the shortest planet-bearing life they leave
     (pair 1, ISO/TS 16281-style, the shorter of the inner and outer bearing's: the one that governs), against
@@ -272,14 +273,15 @@ def findings(rows: list[dict]) -> str:
     whether the housing sensor hears the fault: a marked line at least 3× its perfect level and 2× the floor."""
     lines = ["What each fault does (life: the shorter of pair 1's two planet-bearing lives, ISO/TS 16281-style, "
              "against the perfect machine's; sensor: the marked line that rose most over the floor).", ""]
-    for d in sorted({r["direction"] for r in rows}):
+    groups = sorted({(r["condition"], r["direction"]) for r in rows}, key=lambda cd: (point_order(cd[0]), cd[1]))
+    for c, d in groups:
         by = {}
         for r in rows:
-            if r["direction"] == d:
+            if (r["condition"], r["direction"]) == (c, d):
                 by.setdefault(r["fault"], {})[r["bearing"]] = r
         if "perfect" not in by:
             continue
-        lines.append(f"{d}:")
+        lines.append(f"{point_words(c)}, {d}:" if len(groups) > 1 and len({g[0] for g in groups}) > 1 else f"{d}:")
         shortest = lambda f: min(by[f].values(), key=lambda r: r["life_iso16281_h"])
         p = shortest("perfect")
         ranked = sorted((f for f in by if f != "perfect"), key=lambda f: shortest(f)["life_iso16281_h"])
@@ -302,10 +304,12 @@ def findings(rows: list[dict]) -> str:
 
 
 def _spectrum_panels(spectra: dict) -> list[tuple]:
-    """Each damaged machine's sensor spectrum against the perfect one's (same direction), around f_m."""
+    """Each damaged machine's sensor spectrum against the perfect one's (same operating point and direction), around
+    f_m."""
     panels = []
-    for (tag, direction), (f, amp, fr, own) in spectra.items():
-        ref = spectra.get(("perfect", direction))
+    several = len({c for _, c, _ in spectra}) > 1
+    for (tag, cond, direction), (f, amp, fr, own) in spectra.items():
+        ref = spectra.get(("perfect", cond, direction))
         if ref is None or tag == "perfect":
             continue
         fm, fc = fr["f_m"], fr["f_c"]
@@ -313,7 +317,8 @@ def _spectrum_panels(spectra: dict) -> list[tuple]:
         if own is not None and abs(own - fc) > 1e-9 * fc:
             marks.update({"f_m−f_x": fm - own, "f_m+f_x": fm + own})
         half = max(6.5 * fc, 1.3 * (own or 0.0))
-        panels.append((f"{tag}, {direction}", f, amp, ref[1], marks, (fm - half, fm + half)))
+        where = f"{point_words(cond)}, {direction}" if several else direction
+        panels.append((f"{tag}, {where}", f, amp, ref[1], marks, (fm - half, fm + half)))
     return panels
 
 
@@ -339,7 +344,7 @@ class FaultStudy(Study):
         rows, spectra = rows_of(run.cases, run.results)
         for row in rows:                     # the headline first
             if row["bearing"] == "outer":
-                print(f"{row['fault']:>14} {row['direction']:>8}, outer planet bearings: K_γ {row['load_sharing_factor']:.3f}, "
+                print(f"{row['fault']:>14} {_where(row)}, outer planet bearings: K_γ {row['load_sharing_factor']:.3f}, "
                       f"max bearing load {row['bearing_load_max_N']:.0f} N, life {row['life_relative'] or float('nan'):.2f}, "
                       + (f"sensor f_m / floor {row['sensor_f_m']:.3g}" if row["sensor_f_m"] is not None
                          else "sensor lines not meaningful (too short a window)"))

@@ -66,3 +66,22 @@ def test_a_sample_rate_that_cannot_resolve_the_sidebands_is_refused_in_either_di
         assert fault_study.main(["--faults", "", "--directions", d, "--sample-rate", "5500", "--no-progress",
                                  "--out", str(tmp_path / d)]) == 2
         assert "--sample-rate: 5500 Hz cannot resolve" in capsys.readouterr().err
+
+
+def test_several_operating_points_each_compare_with_their_own_perfect_machine(tmp_path):
+    """--conditions 2,3 (or several --operating points): every machine at every point, each folder its own; the
+    findings rank each point's faults against that point's perfect machine (a fault's life relative to the perfect
+    machine of the other point would be meaningless)."""
+    a = fault_study.parse_args(["--conditions", "2,3", "--faults", "pinhole", "--directions", "forward",
+                                "--out", str(tmp_path)])
+    cases = fault_study.make_cases(a, tmp_path)
+    assert sorted((c.condition, c.tag) for c in cases) == [(2, "perfect"), (2, "pinhole"), (3, "perfect"), (3, "pinhole")]
+    assert len({c.out_dir for c in cases}) == 4
+    row = lambda fault, cond, life: {"fault": fault, "condition": cond, "direction": "forward", "bearing": "outer",
+                                     "life_iso16281_h": life, "load_sharing_factor": 1.0, "bearing_load_max_N": 1e4,
+                                     **{k: None for k in fault_study.SENSOR_LINES}}
+    text = fault_study.findings([row("perfect", 2, 100.0), row("pinhole", 2, 90.0),
+                                 row("perfect", 3, 50.0), row("pinhole", 3, 49.0)])
+    assert "condition 2, forward:" in text and "condition 3, forward:" in text
+    c2, c3 = text.split("condition 3, forward:")
+    assert "0.90" in c2 and "0.98" in c3, text
