@@ -56,8 +56,8 @@ def test_a_spectrum_needs_three_carrier_revolutions():
 
 def test_fault_findings_give_no_sensor_verdict_on_too_short_a_window():
     row = lambda fault, life, line, notes="": {
-        "fault": fault, "direction": "forward", "bearing": "outer", "life_iso16281_h": life, "load_sharing_factor": 1.0,
-        "bearing_load_max_N": 1.0, "sensor_f_m": line, "sensor_f_m-1f_c": line, "sensor_f_m+1f_c": line,
+        "fault": fault, "condition": 2, "direction": "forward", "bearing": "outer", "life_iso16281_h": life,
+        "load_sharing_factor": 1.0, "bearing_load_max_N": 1.0, "sensor_f_m": line, "sensor_f_m-1f_c": line, "sensor_f_m+1f_c": line,
         "sensor_f_m-3f_c": line, "sensor_f_m+3f_c": line, "sensor_own": None, "own_frequency": None, "notes": notes}
     text = findings([row("perfect", 100.0, None, "too few"), row("pinhole", 50.0, None, "the spectrum covers 0.33")])
     assert "mean nothing here" in text and "hears it" not in text and "[not meaningful: the spectrum covers 0.33]" in text
