@@ -1,4 +1,4 @@
-"""Command-line arguments checked where they are read, before any simulation starts (issue 17).
+"""Command-line arguments checked where they are read, before any simulation starts.
 
 :class:`Parser` is argparse with one-line errors (``error: argument --window: must be > 0 s, got '-1'``,
 exit 2 through :func:`scenarios.core.command.command`). The ``type=`` callables below check one argument each
@@ -266,7 +266,7 @@ def operating_point(text):
 
 
 # ---------------------------------------------------------------------------------------------------------------
-# the shared command grammar: one definition of every option the commands share (issue 24 §3)
+# the shared command grammar: one definition of every option the commands share
 # ---------------------------------------------------------------------------------------------------------------
 SHARED = {
     "conditions": (("--conditions",), dict(type=conditions, metavar="C[,C...]",

@@ -1,4 +1,4 @@
-"""One skeleton for every sweep study (issue 24 §3): cases → validate → check runs and folders → sweep → rows →
+"""One skeleton for every sweep study: cases → validate → check runs and folders → sweep → rows →
 write → epilogue.
 
 A study is a subclass of :class:`Study` that says what is particular to it — its run settings (:meth:`config`),

@@ -1,5 +1,5 @@
 """Fatigue life laws (components.life): ISO 281's rating and life, and the ISO/TS 16281-style life summed
-from roller loads, against their closed forms for a pure radial load (issue 16, Life)."""
+from roller loads, against their closed forms for a pure radial load."""
 from __future__ import annotations
 
 import dataclasses
