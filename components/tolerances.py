@@ -23,7 +23,7 @@ capability C_p = 1: 99.7 % of the teeth within the class):
   form deviation is a barrel of signed range (``ToothDeviationParams``).
 
 A class is an inspected lot: a gear is shipped only if its measured deviations are within the class, so
-:func:`draw_teeth` draws whole gears from the process until one passes (:func:`inspect`; rejection, not
+:func:`draw_teeth` draws whole gears from the process until one passes (:func:`passes_inspection`; rejection, not
 truncation of single teeth: the gear is what is accepted or scrapped, and rejection keeps the process's
 tooth-to-tooth correlations inside the shipped gears). Inspection covers every tooth and both flank faces:
 the single pitch deviations |f_pt| ≤ f_pT (differences of neighbouring positions about their mean), the
@@ -49,7 +49,7 @@ import numpy as np
 
 from .units import ParameterError
 
-__all__ = ["FlankTolerances", "flank_tolerances", "radial_runout", "draw_teeth", "inspect", "pass_rate",
+__all__ = ["FlankTolerances", "flank_tolerances", "radial_runout", "draw_teeth", "passes_inspection", "pass_rate",
            "MAX_DRAWS"]
 
 # a class the process cannot make: no gear of this many draws passes inspection (a pass rate below 1 / MAX_DRAWS)
@@ -101,7 +101,7 @@ def _process(rng, z: int, tol: FlankTolerances, systematic: float) -> dict:
     return {"pitch": pitch, "slope": slope, "form": form}
 
 
-def inspect(teeth: dict, tol: FlankTolerances) -> bool:
+def passes_inspection(teeth: dict, tol: FlankTolerances) -> bool:
     """Does a gear (:func:`draw_teeth`'s dict) pass its class: every tooth and flank face within f_pT, F_pT, f_HαT,
     f_fαT? Pitch: positions about their mean per face, single pitch = neighbours' difference around the gear."""
     p = teeth["pitch"] - teeth["pitch"].mean(axis=0)
@@ -118,7 +118,7 @@ def draw_teeth(name: str, teeth: int, tol: FlankTolerances, seed: int, systemati
     rng = np.random.default_rng([int(seed), zlib.crc32(name.encode())])
     for n in range(1, MAX_DRAWS + 1):
         d = _process(rng, int(teeth), tol, systematic)
-        if inspect(d, tol):
+        if passes_inspection(d, tol):
             return {**d, "draws": n}
     raise ParameterError.at("errors.flank_class", f"no gear {name!r} ({int(teeth)} teeth) of {MAX_DRAWS} drawn at the "
                                                   f"class's tolerances at 3σ passes inspection: the process cannot "
@@ -126,6 +126,6 @@ def draw_teeth(name: str, teeth: int, tol: FlankTolerances, seed: int, systemati
 
 
 def pass_rate(teeth: int, tol: FlankTolerances, systematic: float, gears: int, seed: int) -> float:
-    """The share of ``gears`` gears from the process that pass inspection (:func:`inspect`)."""
+    """The share of ``gears`` gears from the process that pass inspection (:func:`passes_inspection`)."""
     rng = np.random.default_rng(int(seed))
-    return sum(inspect(_process(rng, int(teeth), tol, systematic), tol) for _ in range(int(gears))) / int(gears)
+    return sum(passes_inspection(_process(rng, int(teeth), tol, systematic), tol) for _ in range(int(gears))) / int(gears)
