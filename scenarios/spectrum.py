@@ -41,13 +41,13 @@ import numpy as np
 import mbd
 from components.geometry import sideband_origin
 from components.params import flatten, overrides_from_toml, with_overrides
-from components.presets import reference_dpgt, typical_errors
+from components.presets import SENSOR_PRESETS, reference_dpgt, typical_errors
 from components.results import open_dataset
 from components.sensor import PATHS as SENSOR_PATHS
 from components.results.io import atomic_write_text
 from components.units import ParameterError
 
-from .core.analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution
+from .core.analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution, tooth_cycle
 from .core.analysis import whole_revolutions as _whole_revolutions
 from .core.plausibility import check_runs
 from .core.runner import RunConfig, finished_run, run_case, run_report
@@ -98,7 +98,13 @@ def parse_args(argv):
                         "or --set errors.* replace them; the operating point is this command's options")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.06,
                    help="seconds discarded (default 0.06: a lightly damped ~2.6 kHz mode rings for ~50 ms after the start)")
-    p.add_argument("--window", type=args.positive("s"), default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")
+    p.add_argument("--window", type=args.positive("s"), default=None,
+                   help="seconds analysed (default: one tooth cycle, the carrier revolutions after which the planets' "
+                        "teeth meet the ring's as at the start — 12 for z_r = 82, z_p = 24: 0.36 s at 2000 r/min)")
+    p.add_argument("--sensor-at", default="housing_top", choices=list(SENSOR_PRESETS),
+                   help="where the accelerometer is read (components.presets.SENSOR_PRESETS): housing_top (the machine's "
+                        "rig.sensor, default) or carrier_bearing (the source's place, on the carrier bearing's boss near "
+                        "the axis); read from the same run"),
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz]")
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="scene switch")
     p.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="initial step [s]")
@@ -144,20 +150,40 @@ def machine(a):
     return params
 
 
-def run_config(a) -> RunConfig:
-    """The run settings from the command line (window, recording, integration, scene switches)."""
-    return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, options=args.scene_options(a.option),
+def cycle_of(params) -> int:
+    """The machine's tooth cycle in carrier revolutions (:func:`scenarios.core.analysis.tooth_cycle`)."""
+    g = params.si().gears
+    return tooth_cycle(g.ring.teeth, (g.inner_planet.teeth, g.outer_planet.teeth))
+
+
+def default_window(params, sample_rate: float) -> float:
+    """One tooth cycle of ``params`` at its carrier speed [s], two samples to spare (the spectrum is cut to it)."""
+    return round(cycle_of(params) / params.si().operating.carrier_frequency + 2.0 / sample_rate, 6)   # to the µs
+
+
+def run_config(a, params=None) -> RunConfig:
+    """The run settings from the command line (window — one tooth cycle of ``params`` unless given —, recording,
+    integration, scene switches)."""
+    window = a.window if a.window is not None else default_window(params if params is not None else machine(a),
+                                                                  a.sample_rate)
+    return RunConfig(settle=a.settle, window=window, sample_rate=a.sample_rate, options=args.scene_options(a.option),
                      integration=dataclasses.replace(mbd.PRODUCTION, h=a.h), progress=not a.no_progress)
 
 
 def run(a) -> dict:
-    return measure(machine(a), a.sensor, run_config(a), Path(a.out), force=a.force, overwrite=a.overwrite)
+    params = machine(a)
+    return measure(params, a.sensor, run_config(a, params), Path(a.out), force=a.force, overwrite=a.overwrite,
+                   place=a.sensor_at)
 
 
-def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = False, overwrite: bool = False) -> dict:
+def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = False, overwrite: bool = False,
+            place: str = "housing_top") -> dict:
     """Run ``params`` (:class:`components.params.DPGTParams`) on the rig, read ``sensor`` (a key of
-    :data:`SENSORS`), and write its spectrum, line table and peaks into ``out`` (module docstring). ``force``: run
-    despite the plausibility checks; ``overwrite``: replace a finished run of other parameters in ``out``."""
+    :data:`SENSORS`) at ``place`` (a key of :data:`components.presets.SENSOR_PRESETS`), and write its spectrum, line
+    table and peaks into ``out`` (module docstring). ``force``: run despite the plausibility checks; ``overwrite``:
+    replace a finished run of other parameters in ``out``."""
+    if place not in SENSOR_PRESETS:
+        raise SystemExit(f"error: --sensor-at {place!r}: expected one of {list(SENSOR_PRESETS)}")
     if sensor not in SENSORS:
         raise SystemExit(f"error: --sensor {sensor!r}: expected one of {list(SENSORS)}")
     out.mkdir(parents=True, exist_ok=True)
@@ -172,7 +198,8 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
             warnings.simplefilter("ignore")
             s = run_case(params, cfg, out / "run", label={"scenario": "spectrum", "sensor": sensor},
                          overwrite=overwrite)
-    t, signals = _whole_revolutions(*_signals(out / "run" / "results.nc", sensor), s["f_c_hz"])
+    at = SENSOR_PRESETS[place](params)              # the sensor is read afterwards: every place from one run
+    t, signals = _whole_revolutions(*_signals(out / "run" / "results.nc", sensor, at.si()), s["f_c_hz"], cycle_of(params))
     spectra = {k: amplitude_spectrum(t, x) for k, x in signals.items()}
     f, amp, df = spectra["amplitude"]
     f_c, f_m = s["f_c_hz"], s["f_m_hz"]
@@ -190,10 +217,11 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     _write_csv(out / "peaks.csv", peaks)
     summary = {"f_m_hz": f_m, "f_c_hz": f_c, "resolution_hz": df, "window_s": s["window_s"],
                "carrier_rpm": s["carrier_rpm"], "sun_rpm": s["sun_rpm"], "power_W": s["power_W"],
-               "sensor": sensor, "quantity": SENSORS[sensor],
+               "sensor": sensor, "sensor_at": place, "quantity": SENSORS[sensor],
+               "revolutions": float(round((t[-1] - t[0] + (t[1] - t[0])) * f_c, 6)), "tooth_cycle": cycle_of(params),
                # the machine's errors and the rig as their parameters read, each value with its unit (as text)
                "errors": {k: [_as_text(e) for e in getattr(params.errors, k)] for k in params.si().errors.to_dict()},
-               "sensor_parameters": _as_text(params.rig.sensor),
+               "sensor_parameters": _as_text(at),
                "carrier_ripple": _as_text(params.rig.carrier_ripple),
                "lines": lines, "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"],
                "error_estimate": s["error_estimate"], "warnings": s["warnings"] + ([coarse] if coarse else [])}
@@ -208,7 +236,7 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
 
 
 # summary.json's numeric keys without a unit suffix (components.results.UNIT_SUFFIXES): ratios and counts
-DIMENSIONLESS_KEYS = frozenset({"over_median", "k", "distance_bins", *(f"{p}_over_floor" for p in PATHS)})
+DIMENSIONLESS_KEYS = frozenset({"over_median", "k", "distance_bins", "revolutions", "tooth_cycle", *(f"{p}_over_floor" for p in PATHS)})
 
 
 def _renamed(row: dict, names: dict) -> dict:
@@ -227,10 +255,11 @@ def _as_text(params) -> dict:
     return out
 
 
-def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
+def _signals(path: Path, sensor: str, at=None) -> tuple[np.ndarray, dict]:
     """Sample times and the signals of a run: "amplitude" (the sensor read), every path of the housing sensor
-    and their sum, and the axis sensor's x and y."""
-    t, signals = sensor_paths(path)
+    (``at``: its :class:`components.params.SensorSI`, the run's own unless given) and their sum, and the axis
+    sensor's x and y."""
+    t, signals = sensor_paths(path, at)
     with open_dataset(path) as ds:
         acc = ds["fixed.acceleration"].values[:, list(ds["fixed.body"].values).index("carrier")]
     signals.update({"axis_x": acc[:, 0], "axis_y": acc[:, 1]})
