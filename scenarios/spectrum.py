@@ -226,7 +226,7 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
                "lines": lines, "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"],
                "error_estimate": s["error_estimate"], "warnings": s["warnings"] + ([coarse] if coarse else [])}
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
-    fig = _plot(f, spectra, f_m, f_c, s, sensor, out)
+    fig = _plot(f, spectra, f_m, f_c, s, sensor, out, place)
     _report(lines, peaks, f_m, f_c, df, t, sensor)
     if coarse:
         print(f"warning: {coarse}")
@@ -296,14 +296,15 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-def _plot(f, spectra, f_m, f_c, s, sensor, out):
+def _plot(f, spectra, f_m, f_c, s, sensor, out, place="housing_top"):
     from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     shown = {"housing": ["housing", *SENSOR_PATHS], "axis": ["axis_x", "axis_y"]}.get(sensor, [sensor, "housing"])
     names = {"housing": "housing sensor", "mesh": "mesh path", "torque": "torque path", "bearing": "bearing path",
              "axis_x": "x", "axis_y": "y"}
     marks = {"f_m": f_m, **{f"f_m{'+' if k > 0 else '−'}{abs(k)}f_c": f_m + k * f_c for k in (-3, -1, 1, 3)}}
-    where = "carrier acceleration (fixed frame)" if sensor == "axis" else "housing accelerometer"
+    where = "carrier acceleration (fixed frame)" if sensor == "axis" else (
+        "accelerometer on the carrier bearing's boss" if place == "carrier_bearing" else "housing accelerometer")
     zero = [k for k in shown if not np.any(spectra[k][1])]      # a log axis cannot draw them: said in the title
     title = f"{where.capitalize()}, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min" + (
         f"\n({', '.join(names[k] for k in zero)} zero for this sensor, not drawn)" if zero else "")

@@ -221,10 +221,9 @@ def test_spectrum_housing_sensor_on_a_perfect_machine(tmp_path, capsys):
     the lines phasing cancels, f_m, f_m + f_c and f_m ± 3f_c among them, stay below 1 % of the strongest
     (seen: ≤ 5e-4 %): the window alone does not bring f_m or f_m + f_c (McFadden & Smith 1985: "complete
     suppression of the component at the tooth meshing frequency"); errors (docs/model.md §11) must."""
-    argv = ["--out", str(tmp_path), "--settle", "0.06", "--window", "0.09", "--option", "bearings=linear",
-            "--no-progress", "--perfect"]
-    s = spectrum.run(spectrum.parse_args(argv))
-    assert s["sensor"] == "housing" and s["resolution_hz"] == pytest.approx(s["f_c_hz"] / 3, rel=1e-3)
+    argv = ["--out", str(tmp_path), "--settle", "0.06", "--option", "bearings=linear", "--no-progress", "--perfect"]
+    s = spectrum.run(spectrum.parse_args(argv))           # one tooth cycle: 12 carrier revolutions
+    assert s["sensor"] == "housing" and s["resolution_hz"] == pytest.approx(s["f_c_hz"] / 12, rel=1e-3)
     # another sensor of the same machine reads the same run: reused, said so, not simulated again
     nc = tmp_path / "run" / "results.nc"
     made, capsys_before = nc.stat().st_mtime_ns, capsys.readouterr()
@@ -413,7 +412,7 @@ def test_spectrum_rig_machine_errors_bring_the_cancelled_lines(tmp_path):
     f_m, f_m ± f_c, f_m ± 3f_c all standing out — is not reproduced: the teeth raise the band's floor with the
     lines, and on the sum (carried by the mesh path) f_m, f_m + f_c and f_m ± 3f_c stay at the floor
     (0.9–1.25×; docs/gear_quality.md has the full model, other classes, paths and speeds)."""
-    common = ["--settle", "0.06", "--window", "0.09", "--option", "bearings=linear", "--no-progress"]
+    common = ["--settle", "0.06", "--option", "bearings=linear", "--no-progress"]     # one tooth cycle
     perfect = spectrum.run(spectrum.parse_args(["--out", str(tmp_path / "perfect"), "--perfect", *common]))
     rig = spectrum.run(spectrum.parse_args(["--out", str(tmp_path / "rig"), *common]))
     assert any(rig["errors"].values()) and not any(perfect["errors"].values())
