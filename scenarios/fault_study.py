@@ -13,7 +13,8 @@ pocket impacts and cage acceleration, the bearing lives of pair 1 (whose planet 
 faults: ISO 281's and the roller-load ISO/TS 16281-style life in hours, and the latter relative to the perfect
 machine), and the housing sensor's lines f_m, f_m ± f_c, f_m ± 3 f_c and f_m ± the fault's own frequency
 (roller-pass frequencies over pin and bore, the rotation of the faulty gear, the cage's revolution), each as
-its amplitude over the band's median (the spectrum's floor).
+its amplitude over the band's floor (the median of its bins between the carrier orders and the marked lines:
+scenarios.core.analysis.band_floor).
 
 Writes ``summary.csv`` / ``summary.md``, ``findings.md`` (the table in words), ``spectra.png`` (each fault's sensor spectrum against the perfect
 machine's, its characteristic frequencies marked), ``loads.png`` and ``study.json``.

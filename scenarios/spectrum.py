@@ -14,14 +14,18 @@ the carrier's acceleration in the fixed frame, x component.
 Writes the one-sided amplitude spectrum (Hann window) to DIR/spectrum.csv (frequency_hz, amplitude = the
 chosen sensor, then every path, their sum and the axis sensor's x and y), DIR/spectrum.png with f_m = z_r f_c
 and f_m ± f_c, f_m ± 3 f_c marked, DIR/lines.csv (f_m + k f_c, |k| ≤ 6: the sensor's amplitude, over the
-band's median, what lets a sensor see the line — planet phasing, the transfer path, or errors,
+band's floor (the median of its bins between the carrier orders' main lobes,
+:func:`scenarios.core.analysis.band_floor`), what lets a sensor see the line — planet phasing, the transfer path, or errors,
 :func:`components.geometry.sideband_origin` — and every path's amplitude and amplitude over its own band
-median, with the path that carries the most of it), the strongest peaks near f_m in DIR/peaks.csv, and
+floor, with the path that carries the most of it), the strongest peaks near f_m in DIR/peaks.csv, and
 DIR/summary.json (its keys with a unit end in it, as a run's summary: ``amplitude_m_s2``, ``f_m_hz``; the machine's
-errors and the rig's parameters as text with their units). The spectrum covers the first whole number
-of carrier revolutions of the window (the lines then fall on bins); its resolution is f_c/revolutions: resolve
-f_c sidebands with a window of several carrier periods (default 0.1 s: 3 revolutions at 2000 r/min, 11.1 Hz
-against f_c = 33.3 Hz).
+errors and the rig's parameters as text with their units). The spectrum covers the first whole tooth cycles of the
+window (:func:`scenarios.core.analysis.tooth_cycle`: 12 carrier revolutions for z_r = 82, z_p = 24, after which the
+planets' teeth meet the ring's as at the start; whole carrier revolutions when the window is shorter): every carrier
+order and every line of the planets' tooth errors then falls on a bin. Its resolution is f_c/revolutions; the floor
+needs at least 4 revolutions (default window: one tooth cycle, 0.36 s at 2000 r/min, 2.8 Hz against f_c = 33.3 Hz).
+``--sensor-at carrier_bearing`` reads the same run with the accelerometer at the source's place
+(:data:`components.presets.SENSOR_PRESETS`).
 
 The machine is one argument of :func:`measure` (a :class:`components.params.DPGTParams`, built by
 :func:`machine`), the sensor one option.
@@ -267,9 +271,9 @@ def _signals(path: Path, sensor: str, at=None) -> tuple[np.ndarray, dict]:
 
 
 def _lines(f, spectra, f_m, f_c, z_r: int, planets: int, sensor: str) -> list[dict]:
-    """f_m + k f_c, |k| <= SIDEBANDS: the sensor's amplitude, over the band's median, what lets a sensor see it,
+    """f_m + k f_c, |k| <= SIDEBANDS: the sensor's amplitude, over the band's floor, what lets a sensor see it,
     whether a perfect machine shows it to this sensor (:data:`SEEN`), and per path of the housing sensor (and
-    their sum) its amplitude and amplitude over its own band median; ``carried_by``: the path with the largest
+    their sum) its amplitude and amplitude over its own band floor; ``carried_by``: the path with the largest
     amplitude at the line. ``spectra``: name -> (f, amplitude, df) with "amplitude" the sensor read."""
     ks = range(-SIDEBANDS, SIDEBANDS + 1)
     marks = {f"f_m{k:+d}f_c" if k else "f_m": f_m + k * f_c for k in ks}
@@ -317,8 +321,8 @@ def _report(lines, peaks, f_m, f_c, df, t, sensor) -> None:
     print(f"f_c = {f_c:.2f} Hz, f_m = {f_m:.1f} Hz, resolution {df:.2f} Hz over {t[-1] - t[0]:.4g} s")
     print("lines f_m + k f_c (origin: phasing = a perfect machine shows it at the axis; transfer path = "
           "phasing allows it through a position-dependent path; errors = cancelled in a perfect machine); "
-          "each path's amplitude over its own band median, and the path that carries the line:")
-    print("  (amp in m/s²; 'x median' and the path columns: amplitude over that signal's own band median; "
+          "each path's amplitude over its own band floor, and the path that carries the line:")
+    print("  (amp in m/s²; 'x median' and the path columns: amplitude over that signal's own band floor; "
           "'perfect': a perfect machine shows the line; –: the path is zero for this sensor)")
     print(f"  {'line':>9} {'freq':>9}    {'amp':>9}  {'x median':>8}   {'origin':<13} {'perfect':8} "
           + " ".join(f"{p:>8}" for p in PATHS) + "  carried by")

@@ -377,12 +377,11 @@ def test_a_perfect_machine_keeps_the_cancelled_lines_on_every_path(perfect_linea
     f_m − f_c. At the rig's sensor (radial, on the vertical through the rocking centre) the torque path's
     lever is 0, and so is the path.
 
-    The full model (gravity, roller bearings) takes 45–90 s (`python -m scenarios.spectrum --perfect`), too long
-    for the suite; measured there: the sum's cancelled lines at 1.0–1.9× the band's median (f_m 1.3×, f_m + f_c
-    1.9×, f_m ± 3f_c 1.0× / 1.3×), the mesh path's at 1.0–1.7× its own; but the bearing path's f_m + f_c at 8.1×
-    its own (far lower) floor and, read tangentially, the torque path's f_m at 16×: the roller bearings leave the
-    planets' load shares 2.5e-4 apart (K_γ = 1.00025), which a net force shows at f_m + f_c and a net torque at
-    f_m — at 0.09 and 0.66 m/s², under the sum's floor."""
+    The full model (gravity, roller bearings; `python -m scenarios.spectrum --perfect`, one tooth cycle, ≈ 200 s,
+    tests/scenarios/test_spectrum_full_model.py): the sum's cancelled lines at 0.1–7.6× the floor between the
+    carrier orders (f_m 2.6×, f_m + f_c 7.6×, f_m ± 3f_c 2.7×; ≤ 1.9 % of f_m − f_c in m/s²), the bearing path's
+    f_m + f_c at 12.5× its own floor: the roller bearings leave the planets' load shares slightly apart, which a net
+    force shows at f_m + f_c."""
     path, fc, fm = perfect_linear_run
     s = dataclasses.replace(reference_dpgt(2).si().rig.sensor, **where)
     t, paths = _whole_revolutions(*sensor_paths(path, s), fc)

@@ -1,6 +1,6 @@
 """Statistics that cannot mean anything are said, never reported silently or interpreted (issue 24 §1): a window
 shorter than one cage revolution relative to the carrier, a carrier drive not settled, a load ramp inside the
-window, a spectrum over fewer than three carrier revolutions."""
+window, a spectrum over fewer than four carrier revolutions."""
 from __future__ import annotations
 
 import warnings

@@ -217,7 +217,7 @@ def test_spectrum_peaks_sit_on_mesh_sidebands(tmp_path):
 def test_spectrum_housing_sensor_on_a_perfect_machine(tmp_path, capsys):
     """The windowed housing sensor (docs/model.md §12) on a perfect machine: a passing-planet window carries every
     carrier order, so besides f_m − f_c the other lines planet phasing allows for z_r = 82, N = 3 appear —
-    f_m + 2f_c, f_m − 4f_c, f_m + 5f_c stand out of the band's median by ≥ 5× (seen: 8e4–2e5×) — while
+    f_m + 2f_c, f_m − 4f_c, f_m + 5f_c stand out of the band's floor by ≥ 5× — while
     the lines phasing cancels, f_m, f_m + f_c and f_m ± 3f_c among them, stay below 1 % of the strongest
     (seen: ≤ 5e-4 %): the window alone does not bring f_m or f_m + f_c (McFadden & Smith 1985: "complete
     suppression of the component at the tooth meshing frequency"); errors (docs/model.md §11) must."""
