@@ -165,6 +165,27 @@ def test_torque_and_bearing_paths_against_the_modes_closed_forms():
         assert math.remainder(ph - np.angle(z), 2 * math.pi) == pytest.approx(0.0, abs=1e-4), name
 
 
+def test_the_sensor_at_the_sources_place_is_derived_from_its_position():
+    """The carrier bearing's boss (components.presets.carrier_bearing_accelerometer): the window spans the circle, so
+    a planet 120° away weighs cos²(60°) = 1/4 and one opposite 0; m_eq is the ring's mass plus the housing's and
+    follows them; the torque path's lever is 0 (radial at the top), the housing is the machine's."""
+    from components.presets import SENSOR_PRESETS, carrier_bearing_accelerometer
+
+    base = reference_dpgt(2)
+    p = carrier_bearing_accelerometer(base)
+    assert p.source("window_width").tag == "derived" and p.source("equivalent_mass").tag == "derived"
+    assert p.source("radius").tag == "assumed" and "carrier axis" in p.source("radius").note
+    s = p.si()
+    assert s.window_width == pytest.approx(2 * math.pi) and s.radius < base.si().gears.ring.pitch_radius
+    w = hann_window(np.array([0.0, 2 * math.pi / 3, -2 * math.pi / 3, math.pi]), s.window_width)
+    assert w == pytest.approx([1.0, 0.25, 0.25, 0.0], abs=1e-12)
+    assert s.equivalent_mass == pytest.approx(6.07 + 50.0)
+    heavier = with_overrides(base, {"gears.ring.mass": "7 kg", "rig.sensor.housing.mass": "60 kg"})
+    assert carrier_bearing_accelerometer(heavier).si().equivalent_mass == pytest.approx(67.0)
+    assert rocking_lever(s) == 0.0 and s.housing == base.si().rig.sensor.housing
+    assert SENSOR_PRESETS["housing_top"](base) == base.rig.sensor and SENSOR_PRESETS["carrier_bearing"](base) == p
+
+
 def test_sensor_parameters_are_checked_and_sourced():
     p = rig_accelerometer()
     for name in ("angle", "radius", "window_width", "equivalent_mass", "direction"):
