@@ -230,14 +230,15 @@ def rig_housing() -> HousingParams:
 
 
 def rig_accelerometer() -> SensorParams:
-    """The housing accelerometer of docs/model.md §12. The source gives only "on the carrier bearing housing near
-    the carrier axis"; where on the housing, how wide a planet is heard and through what mass, and the
-    housing's modes (:func:`rig_housing`) are assumed."""
+    """The housing accelerometer of docs/model.md §12, at the top of the housing over the ring: it hears the planet
+    passing beneath it. The source gives only "on the carrier bearing housing near the carrier axis"
+    (:func:`carrier_bearing_accelerometer` puts it there); where on the housing, how wide a planet is heard and
+    through what mass, and the housing's modes (:func:`rig_housing`) are assumed."""
     return SensorParams(
         angle=assumed("90 deg", "top of the housing (+Y of the fixed frame), where a rig's accelerometer is "
                                 "usually mounted; the source does not say"),
-        radius=assumed("0.1 m", "on the carrier bearing housing near the carrier axis (the source): the boss "
-                                "around the carrier's bearing"),
+        radius=assumed("0.1 m", "on the housing's top, over the ring; it enters only the rocking lever, 0 for a "
+                                "radial sensor at the top (the source's place: carrier_bearing_accelerometer)"),
         window_width=assumed("120 deg", "Hann window (McFadden & Smith 1985; Inalpolat & Kahraman 2009) as wide "
                                         "as the spacing of N = 3 planets: the sensor hears one planet at a time"),
         equivalent_mass=assumed("6.07 kg", "the ring gear's mass (Table 1): the mass a ring-mesh force "
