@@ -23,7 +23,8 @@ from .units import Q_, ParameterError
 from .names import did_you_mean
 
 __all__ = ["CONDITIONS", "DIRECTIONS", "OIL_GRADES", "oil_grade", "operating_point", "reference_gears", "reference_bearing",
-           "reference_dpgt", "reference_bearing_rig", "rig_accelerometer", "rig_housing", "ideal_carrier_drive", "load_toml",
+           "reference_dpgt", "reference_bearing_rig", "rig_accelerometer", "carrier_bearing_accelerometer", "SENSOR_PRESETS",
+           "rig_housing", "ideal_carrier_drive", "load_toml",
            "perfect_machine", "typical_errors"]
 
 # the study's four operating conditions: carrier speed n_c and output power P (ring fixed)
@@ -229,14 +230,15 @@ def rig_housing() -> HousingParams:
 
 
 def rig_accelerometer() -> SensorParams:
-    """The housing accelerometer of docs/model.md §12. The source gives only "on the carrier bearing housing near
-    the carrier axis"; where on the housing, how wide a planet is heard and through what mass, and the
-    housing's modes (:func:`rig_housing`) are assumed."""
+    """The housing accelerometer of docs/model.md §12, at the top of the housing over the ring: it hears the planet
+    passing beneath it. The source gives only "on the carrier bearing housing near the carrier axis"
+    (:func:`carrier_bearing_accelerometer` puts it there); where on the housing, how wide a planet is heard and
+    through what mass, and the housing's modes (:func:`rig_housing`) are assumed."""
     return SensorParams(
         angle=assumed("90 deg", "top of the housing (+Y of the fixed frame), where a rig's accelerometer is "
                                 "usually mounted; the source does not say"),
-        radius=assumed("0.1 m", "on the carrier bearing housing near the carrier axis (the source): the boss "
-                                "around the carrier's bearing"),
+        radius=assumed("0.1 m", "on the housing's top, over the ring; it enters only the rocking lever, 0 for a "
+                                "radial sensor at the top (the source's place: carrier_bearing_accelerometer)"),
         window_width=assumed("120 deg", "Hann window (McFadden & Smith 1985; Inalpolat & Kahraman 2009) as wide "
                                         "as the spacing of N = 3 planets: the sensor hears one planet at a time"),
         equivalent_mass=assumed("6.07 kg", "the ring gear's mass (Table 1): the mass a ring-mesh force "
@@ -244,6 +246,44 @@ def rig_accelerometer() -> SensorParams:
         direction=assumed("radial", "an accelerometer screwed onto the housing's outer surface"),
         housing=rig_housing(),
     )
+
+
+def carrier_bearing_accelerometer(params: DPGTParams) -> SensorParams:
+    """The source's accelerometer where the source put it: "on the carrier bearing housing near the carrier axis"
+    — on the boss of the carrier's bearing in the end cover, at radius r_s from the axis, read radially at the top
+    (the side is not stated). Its paths' strengths follow from that place (:mod:`components.sensor`):
+
+    * mesh path, window: the ring meshes lie at r_r from the axis, so a sensor at r_s < r_r is at a distance
+      between r_r − r_s and r_r + r_s from every planet's mesh — none is out of reach: the window spans the
+      whole circle (the widest Hann window, cos²(Δψ/2); an inverse-distance weight would hear a planet 120°
+      away at (r_r − r_s)/|r_r e^{i 120°} − r_s| = 0.47 of the nearest, this window at 0.25);
+    * mesh path, mass: a ring-mesh force reaches the boss only through the ring's seat and the housing, which
+      it moves together: m_eq = the ring's mass + the housing's;
+    * torque and bearing paths: the housing's modes (``params.rig.sensor.housing``), read at r_s; radial at the
+      top the rocking moves the sensor across its axis (no torque path, :func:`components.sensor.rocking_lever`).
+
+    The housing and every other path law are those of ``params``' own sensor (:func:`rig_accelerometer`)."""
+    base = params.rig.sensor
+    m_eq = params.gears.ring.mass + base.housing.mass
+    return SensorParams(
+        angle=assumed("90 deg", "top of the housing (+Y of the fixed frame); the source does not say"),
+        radius=assumed("0.05 m", "the carrier bearing's boss in the end cover, near the carrier axis (the source): "
+                                 "a bearing of ~80 mm outside diameter in a 10 mm wall; the source gives no size"),
+        window_width=derived("360 deg", "a sensor at r_s = 0.05 m < r_r = 0.123 m (the ring's pitch radius) is "
+                                        "within r_r +- r_s of every planet's ring mesh: the window spans the circle"),
+        equivalent_mass=derived(m_eq.to("kg"), f"the ring's mass ({params.gears.ring.mass:~P}) + the housing's "
+                                              f"({base.housing.mass:~P}): a ring-mesh force reaches the carrier "
+                                              "bearing's boss only through the ring's seat and the housing"),
+        direction=assumed("radial", "an accelerometer screwed onto the boss's outer surface"),
+        housing=base.housing,
+    )
+
+
+# the rig's accelerometer at each place: name -> the sensor's parameters for a machine
+SENSOR_PRESETS = MappingProxyType({
+    "housing_top": lambda params: params.rig.sensor,
+    "carrier_bearing": carrier_bearing_accelerometer,
+})
 
 
 def ideal_carrier_drive() -> CarrierRippleParams:

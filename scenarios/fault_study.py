@@ -13,7 +13,8 @@ pocket impacts and cage acceleration, the bearing lives of pair 1 (whose planet 
 faults: ISO 281's and the roller-load ISO/TS 16281-style life in hours, and the latter relative to the perfect
 machine), and the housing sensor's lines f_m, f_m ± f_c, f_m ± 3 f_c and f_m ± the fault's own frequency
 (roller-pass frequencies over pin and bore, the rotation of the faulty gear, the cage's revolution), each as
-its amplitude over the band's median (the spectrum's floor).
+its amplitude over the band's floor (the median of its bins between the carrier orders and the marked lines:
+scenarios.core.analysis.band_floor).
 
 Writes ``summary.csv`` / ``summary.md``, ``findings.md`` (the table in words), ``spectra.png`` (each fault's sensor spectrum against the perfect
 machine's, its characteristic frequencies marked), ``loads.png`` and ``study.json``.
@@ -38,7 +39,7 @@ from .core import args
 from .core.command import command
 from .core.lock import holds_out_folder
 from .core.runner import RunConfig
-from .core.analysis import amplitude_spectrum, line_table, sensor_signal, sideband_resolution
+from .core.analysis import amplitude_spectrum, carrier_orders, line_table, sensor_signal, sideband_resolution, tooth_cycle
 from .core.study import Study, StudyRun
 from .core.points import file_without, machine_overrides, point_label, point_order, point_words, points_of
 from .core.sweep import Case, build_params, user_overrides
@@ -90,8 +91,10 @@ def parse_args(argv):
     p.add_argument("--machine", action="append", default=[], metavar="NAME=FILE.toml", type=_machine,
                    help="a damaged machine described in a TOML file (repeatable)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded after the start (default 0.03)")
-    p.add_argument("--window", type=args.positive("s"), default=0.1,
-                   help="seconds analysed (default 0.1: 10 Hz resolution, the f_c sidebands at 2000 r/min)")
+    p.add_argument("--window", type=args.positive("s"), default=0.1801,
+                   help="seconds analysed (default 0.1801: 6 carrier revolutions at 2000 r/min, a sample to spare; 5.6 Hz "
+                        "resolution, three bins of floor between two carrier orders; 0.3601 for one tooth cycle, 12 "
+                        "revolutions, as the spectrum command)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz] (> 2 f_m)")
     # its folders are named by operating point, direction and machine
     args.add_shared(p, out="results/faults", conditions="2")
@@ -175,10 +178,11 @@ def _own_frequency(case: Case, si, fr: dict) -> float | None:
     return fr["f_c"] if e.pinhole else None
 
 
-def sensor_spectrum(run_dir: Path, f_c: float):
-    """(f, amplitude, why) of the recorded housing sensor of a run (scenarios.spectrum's definition); ``why`` says
-    why its lines mean nothing (too few carrier revolutions), None when they do."""
-    t, x = sensor_signal(run_dir / "results.nc", f_c)
+def sensor_spectrum(run_dir: Path, f_c: float, cycle: int = 1):
+    """(f, amplitude, why) of the recorded housing sensor of a run (scenarios.spectrum's definition: whole tooth
+    cycles of ``cycle`` carrier revolutions where the record holds one); ``why`` says why its lines mean nothing (too
+    few carrier revolutions), None when they do."""
+    t, x = sensor_signal(run_dir / "results.nc", f_c, cycle=cycle)
     f, amp, _ = amplitude_spectrum(t, x)
     return f, amp, sideband_resolution(t, f_c)
 
@@ -192,7 +196,9 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
             continue
         si = build_params(case).si()
         fr = characteristic_frequencies(si)
-        f, amp, coarse = sensor_spectrum(Path(case.out_dir), fr["f_c"])
+        g = si.gears
+        f, amp, coarse = sensor_spectrum(Path(case.out_dir), fr["f_c"],
+                                         tooth_cycle(g.ring.teeth, (g.inner_planet.teeth, g.outer_planet.teeth)))
         own = _own_frequency(case, si, fr)
         spectra[(case.tag, case.condition, case.direction)] = (f, amp, fr, own)
         fm, fc = fr["f_m"], fr["f_c"]
@@ -200,8 +206,10 @@ def rows_of(cases: list[Case], results: dict) -> tuple[list[dict], dict]:
         if own is not None:
             marks.update({"own-": fm - own, "own+": fm + own})
         band = (fm - 6.5 * max(fc, own or 0.0), fm + 6.5 * max(fc, own or 0.0))
-        # lines that cannot mean anything are left out, not interpreted (the note says why)
-        sensor = {r["line"]: None if coarse else r["over_median"] for r in line_table(f, amp, marks, band)}
+        # the floor: between the carrier orders and the marked lines; lines that cannot mean anything are left
+        # out, not interpreted (the note says why)
+        between = carrier_orders(fm, fc, band) + list(marks.values())
+        sensor = {r["line"]: None if coarse else r["over_median"] for r in line_table(f, amp, marks, band, between)}
         for kind in ("inner", "outer"):
             d, p0 = s[kind], perfect.get((case.condition, case.direction), {}).get(kind)
             life = d["life_iso16281_h"] / p0["life_iso16281_h"] if p0 else None

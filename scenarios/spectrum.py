@@ -14,14 +14,18 @@ the carrier's acceleration in the fixed frame, x component.
 Writes the one-sided amplitude spectrum (Hann window) to DIR/spectrum.csv (frequency_hz, amplitude = the
 chosen sensor, then every path, their sum and the axis sensor's x and y), DIR/spectrum.png with f_m = z_r f_c
 and f_m ± f_c, f_m ± 3 f_c marked, DIR/lines.csv (f_m + k f_c, |k| ≤ 6: the sensor's amplitude, over the
-band's median, what lets a sensor see the line — planet phasing, the transfer path, or errors,
+band's floor (the median of its bins between the carrier orders' main lobes,
+:func:`scenarios.core.analysis.band_floor`), what lets a sensor see the line — planet phasing, the transfer path, or errors,
 :func:`components.geometry.sideband_origin` — and every path's amplitude and amplitude over its own band
-median, with the path that carries the most of it), the strongest peaks near f_m in DIR/peaks.csv, and
+floor, with the path that carries the most of it), the strongest peaks near f_m in DIR/peaks.csv, and
 DIR/summary.json (its keys with a unit end in it, as a run's summary: ``amplitude_m_s2``, ``f_m_hz``; the machine's
-errors and the rig's parameters as text with their units). The spectrum covers the first whole number
-of carrier revolutions of the window (the lines then fall on bins); its resolution is f_c/revolutions: resolve
-f_c sidebands with a window of several carrier periods (default 0.1 s: 3 revolutions at 2000 r/min, 11.1 Hz
-against f_c = 33.3 Hz).
+errors and the rig's parameters as text with their units). The spectrum covers the first whole tooth cycles of the
+window (:func:`scenarios.core.analysis.tooth_cycle`: 12 carrier revolutions for z_r = 82, z_p = 24, after which the
+planets' teeth meet the ring's as at the start; whole carrier revolutions when the window is shorter): every carrier
+order and every line of the planets' tooth errors then falls on a bin. Its resolution is f_c/revolutions; the floor
+needs at least 4 revolutions (default window: one tooth cycle, 0.36 s at 2000 r/min, 2.8 Hz against f_c = 33.3 Hz).
+``--sensor-at carrier_bearing`` reads the same run with the accelerometer at the source's place
+(:data:`components.presets.SENSOR_PRESETS`).
 
 The machine is one argument of :func:`measure` (a :class:`components.params.DPGTParams`, built by
 :func:`machine`), the sensor one option.
@@ -41,13 +45,13 @@ import numpy as np
 import mbd
 from components.geometry import sideband_origin
 from components.params import flatten, overrides_from_toml, with_overrides
-from components.presets import reference_dpgt, typical_errors
+from components.presets import SENSOR_PRESETS, reference_dpgt, typical_errors
 from components.results import open_dataset
 from components.sensor import PATHS as SENSOR_PATHS
 from components.results.io import atomic_write_text
 from components.units import ParameterError
 
-from .core.analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution
+from .core.analysis import amplitude_spectrum, line_table, peak_table, sensor_paths, sideband_resolution, tooth_cycle
 from .core.analysis import whole_revolutions as _whole_revolutions
 from .core.plausibility import check_runs
 from .core.runner import RunConfig, finished_run, run_case, run_report
@@ -98,7 +102,13 @@ def parse_args(argv):
                         "or --set errors.* replace them; the operating point is this command's options")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.06,
                    help="seconds discarded (default 0.06: a lightly damped ~2.6 kHz mode rings for ~50 ms after the start)")
-    p.add_argument("--window", type=args.positive("s"), default=0.1, help="seconds analysed (default 0.1 → 10 Hz resolution)")
+    p.add_argument("--window", type=args.positive("s"), default=None,
+                   help="seconds analysed (default: one tooth cycle, the carrier revolutions after which the planets' "
+                        "teeth meet the ring's as at the start — 12 for z_r = 82, z_p = 24: 0.36 s at 2000 r/min)")
+    p.add_argument("--sensor-at", default="housing_top", choices=list(SENSOR_PRESETS),
+                   help="where the accelerometer is read (components.presets.SENSOR_PRESETS): housing_top (the machine's "
+                        "rig.sensor, default) or carrier_bearing (the source's place, on the carrier bearing's boss near "
+                        "the axis); read from the same run"),
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz]")
     p.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", type=args.key_value, help="scene switch")
     p.add_argument("--h", type=args.positive("s", upper=1e-3), default=5e-6, help="initial step [s]")
@@ -144,20 +154,40 @@ def machine(a):
     return params
 
 
-def run_config(a) -> RunConfig:
-    """The run settings from the command line (window, recording, integration, scene switches)."""
-    return RunConfig(settle=a.settle, window=a.window, sample_rate=a.sample_rate, options=args.scene_options(a.option),
+def cycle_of(params) -> int:
+    """The machine's tooth cycle in carrier revolutions (:func:`scenarios.core.analysis.tooth_cycle`)."""
+    g = params.si().gears
+    return tooth_cycle(g.ring.teeth, (g.inner_planet.teeth, g.outer_planet.teeth))
+
+
+def default_window(params, sample_rate: float) -> float:
+    """One tooth cycle of ``params`` at its carrier speed [s], two samples to spare (the spectrum is cut to it)."""
+    return round(cycle_of(params) / params.si().operating.carrier_frequency + 2.0 / sample_rate, 6)   # to the µs
+
+
+def run_config(a, params=None) -> RunConfig:
+    """The run settings from the command line (window — one tooth cycle of ``params`` unless given —, recording,
+    integration, scene switches)."""
+    window = a.window if a.window is not None else default_window(params if params is not None else machine(a),
+                                                                  a.sample_rate)
+    return RunConfig(settle=a.settle, window=window, sample_rate=a.sample_rate, options=args.scene_options(a.option),
                      integration=dataclasses.replace(mbd.PRODUCTION, h=a.h), progress=not a.no_progress)
 
 
 def run(a) -> dict:
-    return measure(machine(a), a.sensor, run_config(a), Path(a.out), force=a.force, overwrite=a.overwrite)
+    params = machine(a)
+    return measure(params, a.sensor, run_config(a, params), Path(a.out), force=a.force, overwrite=a.overwrite,
+                   place=a.sensor_at)
 
 
-def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = False, overwrite: bool = False) -> dict:
+def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = False, overwrite: bool = False,
+            place: str = "housing_top") -> dict:
     """Run ``params`` (:class:`components.params.DPGTParams`) on the rig, read ``sensor`` (a key of
-    :data:`SENSORS`), and write its spectrum, line table and peaks into ``out`` (module docstring). ``force``: run
-    despite the plausibility checks; ``overwrite``: replace a finished run of other parameters in ``out``."""
+    :data:`SENSORS`) at ``place`` (a key of :data:`components.presets.SENSOR_PRESETS`), and write its spectrum, line
+    table and peaks into ``out`` (module docstring). ``force``: run despite the plausibility checks; ``overwrite``:
+    replace a finished run of other parameters in ``out``."""
+    if place not in SENSOR_PRESETS:
+        raise SystemExit(f"error: --sensor-at {place!r}: expected one of {list(SENSOR_PRESETS)}")
     if sensor not in SENSORS:
         raise SystemExit(f"error: --sensor {sensor!r}: expected one of {list(SENSORS)}")
     out.mkdir(parents=True, exist_ok=True)
@@ -172,7 +202,8 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
             warnings.simplefilter("ignore")
             s = run_case(params, cfg, out / "run", label={"scenario": "spectrum", "sensor": sensor},
                          overwrite=overwrite)
-    t, signals = _whole_revolutions(*_signals(out / "run" / "results.nc", sensor), s["f_c_hz"])
+    at = SENSOR_PRESETS[place](params)              # the sensor is read afterwards: every place from one run
+    t, signals = _whole_revolutions(*_signals(out / "run" / "results.nc", sensor, at.si()), s["f_c_hz"], cycle_of(params))
     spectra = {k: amplitude_spectrum(t, x) for k, x in signals.items()}
     f, amp, df = spectra["amplitude"]
     f_c, f_m = s["f_c_hz"], s["f_m_hz"]
@@ -190,15 +221,16 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     _write_csv(out / "peaks.csv", peaks)
     summary = {"f_m_hz": f_m, "f_c_hz": f_c, "resolution_hz": df, "window_s": s["window_s"],
                "carrier_rpm": s["carrier_rpm"], "sun_rpm": s["sun_rpm"], "power_W": s["power_W"],
-               "sensor": sensor, "quantity": SENSORS[sensor],
+               "sensor": sensor, "sensor_at": place, "quantity": SENSORS[sensor],
+               "revolutions": float(round((t[-1] - t[0] + (t[1] - t[0])) * f_c, 6)), "tooth_cycle": cycle_of(params),
                # the machine's errors and the rig as their parameters read, each value with its unit (as text)
                "errors": {k: [_as_text(e) for e in getattr(params.errors, k)] for k in params.si().errors.to_dict()},
-               "sensor_parameters": _as_text(params.rig.sensor),
+               "sensor_parameters": _as_text(at),
                "carrier_ripple": _as_text(params.rig.carrier_ripple),
                "lines": lines, "peaks": peaks, "wall_s": s["wall_s"], "steps": s["steps"],
                "error_estimate": s["error_estimate"], "warnings": s["warnings"] + ([coarse] if coarse else [])}
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
-    fig = _plot(f, spectra, f_m, f_c, s, sensor, out)
+    fig = _plot(f, spectra, f_m, f_c, s, sensor, out, place)
     _report(lines, peaks, f_m, f_c, df, t, sensor)
     if coarse:
         print(f"warning: {coarse}")
@@ -208,7 +240,7 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
 
 
 # summary.json's numeric keys without a unit suffix (components.results.UNIT_SUFFIXES): ratios and counts
-DIMENSIONLESS_KEYS = frozenset({"over_median", "k", "distance_bins", *(f"{p}_over_floor" for p in PATHS)})
+DIMENSIONLESS_KEYS = frozenset({"over_median", "k", "distance_bins", "revolutions", "tooth_cycle", *(f"{p}_over_floor" for p in PATHS)})
 
 
 def _renamed(row: dict, names: dict) -> dict:
@@ -227,10 +259,11 @@ def _as_text(params) -> dict:
     return out
 
 
-def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
+def _signals(path: Path, sensor: str, at=None) -> tuple[np.ndarray, dict]:
     """Sample times and the signals of a run: "amplitude" (the sensor read), every path of the housing sensor
-    and their sum, and the axis sensor's x and y."""
-    t, signals = sensor_paths(path)
+    (``at``: its :class:`components.params.SensorSI`, the run's own unless given) and their sum, and the axis
+    sensor's x and y."""
+    t, signals = sensor_paths(path, at)
     with open_dataset(path) as ds:
         acc = ds["fixed.acceleration"].values[:, list(ds["fixed.body"].values).index("carrier")]
     signals.update({"axis_x": acc[:, 0], "axis_y": acc[:, 1]})
@@ -238,9 +271,9 @@ def _signals(path: Path, sensor: str) -> tuple[np.ndarray, dict]:
 
 
 def _lines(f, spectra, f_m, f_c, z_r: int, planets: int, sensor: str) -> list[dict]:
-    """f_m + k f_c, |k| <= SIDEBANDS: the sensor's amplitude, over the band's median, what lets a sensor see it,
+    """f_m + k f_c, |k| <= SIDEBANDS: the sensor's amplitude, over the band's floor, what lets a sensor see it,
     whether a perfect machine shows it to this sensor (:data:`SEEN`), and per path of the housing sensor (and
-    their sum) its amplitude and amplitude over its own band median; ``carried_by``: the path with the largest
+    their sum) its amplitude and amplitude over its own band floor; ``carried_by``: the path with the largest
     amplitude at the line. ``spectra``: name -> (f, amplitude, df) with "amplitude" the sensor read."""
     ks = range(-SIDEBANDS, SIDEBANDS + 1)
     marks = {f"f_m{k:+d}f_c" if k else "f_m": f_m + k * f_c for k in ks}
@@ -267,14 +300,15 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-def _plot(f, spectra, f_m, f_c, s, sensor, out):
+def _plot(f, spectra, f_m, f_c, s, sensor, out, place="housing_top"):
     from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     shown = {"housing": ["housing", *SENSOR_PATHS], "axis": ["axis_x", "axis_y"]}.get(sensor, [sensor, "housing"])
     names = {"housing": "housing sensor", "mesh": "mesh path", "torque": "torque path", "bearing": "bearing path",
              "axis_x": "x", "axis_y": "y"}
     marks = {"f_m": f_m, **{f"f_m{'+' if k > 0 else '−'}{abs(k)}f_c": f_m + k * f_c for k in (-3, -1, 1, 3)}}
-    where = "carrier acceleration (fixed frame)" if sensor == "axis" else "housing accelerometer"
+    where = "carrier acceleration (fixed frame)" if sensor == "axis" else (
+        "accelerometer on the carrier bearing's boss" if place == "carrier_bearing" else "housing accelerometer")
     zero = [k for k in shown if not np.any(spectra[k][1])]      # a log axis cannot draw them: said in the title
     title = f"{where.capitalize()}, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min" + (
         f"\n({', '.join(names[k] for k in zero)} zero for this sensor, not drawn)" if zero else "")
@@ -287,8 +321,8 @@ def _report(lines, peaks, f_m, f_c, df, t, sensor) -> None:
     print(f"f_c = {f_c:.2f} Hz, f_m = {f_m:.1f} Hz, resolution {df:.2f} Hz over {t[-1] - t[0]:.4g} s")
     print("lines f_m + k f_c (origin: phasing = a perfect machine shows it at the axis; transfer path = "
           "phasing allows it through a position-dependent path; errors = cancelled in a perfect machine); "
-          "each path's amplitude over its own band median, and the path that carries the line:")
-    print("  (amp in m/s²; 'x median' and the path columns: amplitude over that signal's own band median; "
+          "each path's amplitude over its own band floor, and the path that carries the line:")
+    print("  (amp in m/s²; 'x median' and the path columns: amplitude over that signal's own band floor; "
           "'perfect': a perfect machine shows the line; –: the path is zero for this sensor)")
     print(f"  {'line':>9} {'freq':>9}    {'amp':>9}  {'x median':>8}   {'origin':<13} {'perfect':8} "
           + " ".join(f"{p:>8}" for p in PATHS) + "  carried by")

@@ -153,6 +153,20 @@ def test_the_spectrum_summary_follows_the_unit_suffix_rule(spectrum_summary):
                                                                                 "sensor_parameters.angle"]
 
 
+def test_the_spectrum_reads_the_sensor_at_the_sources_place_from_the_same_run(spectrum_summary, capsys):
+    """--sensor-at carrier_bearing reads the same run (reused, not simulated again) with the sensor on the carrier
+    bearing's boss: its parameters in summary.json are the preset's (m_eq = ring 6.07 kg + housing 50 kg)."""
+    from scenarios import spectrum
+
+    _, out = spectrum_summary
+    capsys.readouterr()
+    s = spectrum.run(spectrum.parse_args(["--out", str(out), "--settle", "0.002", "--window", "0.012", "--option",
+                                          "bearings=linear", "--no-progress", "--sensor-at", "carrier_bearing"]))
+    assert "run: reused (same parameters, settings and code" in capsys.readouterr().out
+    assert s["sensor_at"] == "carrier_bearing" and s["sensor_parameters"]["equivalent_mass"] == "56.07 kg"
+    assert s["sensor_parameters"]["window_width"] == "360 deg" and s["sensor_parameters"]["radius"] == "0.05 m"
+
+
 def test_every_key_of_a_real_run_is_documented(summary):
     documented = set(SUMMARY_WORDS) | readme_summary_names()
     missing = sorted({key for path, key, _, _ in leaves(summary)

@@ -1,6 +1,6 @@
 """Statistics that cannot mean anything are said, never reported silently or interpreted (issue 24 §1): a window
 shorter than one cage revolution relative to the carrier, a carrier drive not settled, a load ramp inside the
-window, a spectrum over fewer than three carrier revolutions."""
+window, a spectrum over fewer than four carrier revolutions."""
 from __future__ import annotations
 
 import warnings
@@ -44,7 +44,9 @@ def test_a_too_short_run_says_what_its_statistics_cannot_mean(tmp_path):
     assert "ramp" in text and "ends inside the window" in text
 
 
-def test_a_spectrum_needs_three_carrier_revolutions():
+def test_a_spectrum_needs_four_carrier_revolutions():
+    """Over N carrier revolutions each carrier order's Hann main lobe fills 3 of the N bins between two orders: from
+    4 on the floor has bins of its own (scenarios.core.analysis.band_floor)."""
     fc, dt = 33.3, 5e-5
     for revs, ok in ((2.9, False), (MIN_REVOLUTIONS, True), (4.0, True), (1.0, False)):
         t = np.arange(int(round(revs / fc / dt))) * dt
