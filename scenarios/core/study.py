@@ -10,7 +10,8 @@ words in every study:
 2. the recordings checked against the limit and the disk (``--force``), the folders against results of other
    parameters (``--overwrite``); then the study's own work before its sweep, if any (:meth:`Study.prepare`);
 3. the sweep (:func:`scenarios.core.sweep.sweep`): each case an :class:`~scenarios.core.sweep.Outcome`, finished, reused
-   or failed;
+   or failed; then, if the study chooses more cases from those results (:meth:`Study.second_phase`), their checks
+   and a second sweep;
 4. the study's report: its headline table first, then one line per post-processing step (:meth:`StudyRun.step`:
    tables, figures, animation);
 5. the epilogue: each run's wall time and error estimate (a reused run marked "reused", with the wall time of
@@ -144,6 +145,11 @@ class Study(abc.ABC):
     def prepare(self, cfg: RunConfig, cases: list[Case]) -> None:
         """A study's own work after every check and before its sweep (the tolerance study's static solutions)."""
 
+    def second_phase(self, run: StudyRun) -> list[Case]:
+        """Cases chosen from the first sweep's results, run in a second sweep with the same checks before it starts
+        (the duty cycle's dynamic runs of the bins that carry the damage); none by default."""
+        return []
+
     # -- the skeleton -----------------------------------------------------------------------------------------
     def run(self) -> dict:
         """Cases → validate → check runs and folders → sweep → report → epilogue; returns {"results",
@@ -166,11 +172,20 @@ class Study(abc.ABC):
         t_sweep, sweep_timing = time.perf_counter(), {}
         outcomes = sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
                          overwrite=a.overwrite, announce=True, timing=sweep_timing)
-        for o in outcomes.values():       # every run's summary.json names the machine it ran
-            if o.ok and o.summary.get("machine") != machine:
-                o.summary["machine"] = machine
-                write_summary(o.case.out_dir, o.summary)
+        self._stamp(outcomes, machine)
         run = StudyRun(self.out, cases, outcomes)
+        more = self.second_phase(run)
+        if more:                          # the same checks, then a second sweep; its outcomes join the first's
+            validate_cases(more, lambda c: self.check(c, cfg))
+            for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in more], self.out, a.force):
+                print(f"warning (--force): {w}")
+            check_folders(more, cfg, a.overwrite)
+            second = sweep(more, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
+                           overwrite=a.overwrite, announce=True, timing=sweep_timing.setdefault("second_phase", {}))
+            self._stamp(second, machine)
+            outcomes = {**outcomes, **second}
+            cases = [*cases, *more]
+            run = StudyRun(self.out, cases, outcomes)
         print(runs_line(outcomes), flush=True)
         t_report = time.perf_counter()
         if self.keep_earlier:
@@ -190,6 +205,14 @@ class Study(abc.ABC):
         r = {"results": run.results, "outcomes": outcomes, "failed": run.failed, "files": run.files, **extra}
         self.epilogue(run)
         return r
+
+    @staticmethod
+    def _stamp(outcomes: dict[str, Outcome], machine: dict) -> None:
+        """Every run's summary.json names the machine it ran."""
+        for o in outcomes.values():
+            if o.ok and o.summary.get("machine") != machine:
+                o.summary["machine"] = machine
+                write_summary(o.case.out_dir, o.summary)
 
     @staticmethod
     def _earlier(run: StudyRun) -> dict[str, dict]:
