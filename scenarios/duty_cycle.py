@@ -25,6 +25,7 @@ of the damage bounds what they leave out.
 """
 from __future__ import annotations
 
+import argparse
 import csv
 import io
 import json
@@ -450,7 +451,6 @@ def dominant_bins(table: dict[str, list[float]], share: float) -> list[int]:
 
 
 def _share(text: str) -> float:
-    import argparse
     try:
         x = float(text.strip().rstrip("%")) / (100.0 if text.strip().endswith("%") else 1.0)
     except ValueError:

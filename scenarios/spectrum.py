@@ -90,8 +90,9 @@ def parse_args(argv):
                    help="housing: the rig's accelerometer (rig.sensor.*, default), the sum of its paths mesh, torque "
                         "and bearing (each alone by name); axis: ideal, at the carrier axis")
     p.add_argument("--perfect", action="store_true",
-                   help="a perfect machine: no manufacturing errors (default: the errors of --gear-grade)")
-    p.add_argument("--gear-grade", type=args.count(1, 11), default=None,
+                   help="a perfect machine: no manufacturing errors (default: the errors of --gear-class)")
+    args.renamed(p, "--grades", "--classes", "--gear-grade", new=args.GEAR_CLASS)
+    p.add_argument(args.GEAR_CLASS, type=args.count(1, 11), default=None, metavar="CLASS",
                    help="ISO 1328-1 flank tolerance class of the gears behind the default manufacturing errors "
                         "(default 6: every gear's teeth drawn for that class, runouts F_r/2 of that grade, all "
                         "carrier pinholes within ±10 µm; components.presets.typical_errors); errors given by --params "
@@ -109,7 +110,7 @@ def parse_args(argv):
 def machine(a):
     """The machine on the rig: the reference DPGT (or ``--params FILE.toml`` on it) at the operating point
     asked for, with ``--set`` overrides (a usage error names the parameter) and its manufacturing errors: those
-    given (``--set errors.X`` / the TOML file), else the typical errors of ``--gear-grade``, none with
+    given (``--set errors.X`` / the TOML file), else the typical errors of ``--gear-class``, none with
     ``--perfect``. The operating point belongs to this command's options: a file or ``--set`` that sets it is
     refused, as is ``--perfect`` with errors given."""
     try:
@@ -129,11 +130,11 @@ def machine(a):
         params = with_overrides(reference_dpgt(2, a.direction), overrides)
         if a.perfect and not params.errors.perfect:
             raise SystemExit("error: --perfect contradicts the manufacturing errors given (--params / --set errors.*)")
-        if a.gear_grade is not None and (a.perfect or not params.errors.perfect):
-            raise SystemExit(f"error: --gear-grade {a.gear_grade} contradicts "
+        if a.gear_class is not None and (a.perfect or not params.errors.perfect):
+            raise SystemExit(f"error: --gear-class {a.gear_class} contradicts "
                              f"{'--perfect' if a.perfect else 'the manufacturing errors given (--params / --set errors.*)'}")
         if not a.perfect and params.errors.perfect:      # the rig's machine, unless errors were given
-            params = params.replace(errors=typical_errors(params, 6 if a.gear_grade is None else a.gear_grade))
+            params = params.replace(errors=typical_errors(params, 6 if a.gear_class is None else a.gear_class))
         si = params.si()
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None

@@ -82,7 +82,7 @@ BAD_ARGUMENTS = [
     ("paper_study", ["--scheduler", "my laptop"], "--scheduler: expected a Dask scheduler address"),
     ("paper_study", ["--method", "rk4"], "--method: invalid choice"),
     ("paper_study", ["--frobnicate"], "unrecognized arguments: --frobnicate"),
-    ("lubricant_study", ["--grades", "VG999"], "--grades: takes ISO VG grades"),
+    ("lubricant_study", ["--oil", "VG999"], "--oil: takes ISO VG grades"),
     ("lubricant_study", ["--directions", ""], "--directions: expected a comma list"),
     ("spectrum", ["--power", "200 kg"], "--power: expected a power"),
     ("spectrum", ["--carrier-rpm", "-5"], "--carrier-rpm: must be > 0 r/min"),
@@ -408,7 +408,117 @@ def test_params_files_reach_every_case_of_the_studies_that_gained_them(tmp_path)
     assert set(by) == {"perfect", "runout", "bent"}
     assert all(si.bearing.clearance == pytest.approx(30e-6) for si in by.values())
     assert by["bent"].errors.pinhole and by["runout"].errors.runout and not by["perfect"].errors.pinhole
-    a = gear_quality.parse_args(["--params", str(common), "--conditions", "3", "--grades", "6", "--seeds", "1",
+    a = gear_quality.parse_args(["--params", str(common), "--conditions", "3", "--gear-class", "6", "--seeds", "1",
                                  "--out", str(tmp_path / "g")])
     assert all(build_params(c).si().bearing.clearance == pytest.approx(30e-6)
                for c in gear_quality.make_cases(a, tmp_path / "g"))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# one vocabulary: the same option name for the same thing in every command
+# ---------------------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("name,old,new,value", [
+    ("gear_quality", "--grades", "--gear-class", "6"), ("tolerance_study", "--classes", "--gear-class", "5"),
+    ("spectrum", "--gear-grade", "--gear-class", "8"), ("lubricant_study", "--grades", "--oil", "VG68"),
+    ("gear_quality", "--classes", "--gear-class", "6"), ("tolerance_study", "--gear-grade", "--gear-class", "5"),
+])
+def test_a_retired_option_name_is_refused_in_one_line_naming_the_new_one(name, old, new, value, capsys):
+    import importlib
+    mod = importlib.import_module(f"scenarios.{name}")
+    assert mod.main([old, value, "--out", "unused"]) == USAGE
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {old} ") and f"use {new}" in err and err.count("\n") == 1
+
+
+def test_the_tooth_class_and_the_oil_have_one_name_each():
+    """--gear-class is the ISO 1328 class wherever a command takes one, --oil the ISO VG grade; no command keeps the
+    old spellings in its --help."""
+    from scenarios import gear_quality, lubricant_study, spectrum, tolerance_study
+    assert gear_quality.parse_args(["--gear-class", "5,8"]).gear_class == [5, 8]
+    assert tolerance_study.parse_args(["--gear-class", "6"]).gear_class == [6]
+    assert spectrum.parse_args(["--gear-class", "8"]).gear_class == 8
+    assert lubricant_study.parse_args(["--oil", "VG46,VG220"]).oil == "VG46,VG220"
+
+
+@pytest.mark.parametrize("name", ["gear_quality", "tolerance_study", "spectrum", "lubricant_study"])
+def test_help_names_no_retired_option(name, capsys):
+    import importlib
+    mod = importlib.import_module(f"scenarios.{name}")
+    with pytest.raises(SystemExit):
+        mod.parse_args(["--help"])
+    text = capsys.readouterr().out
+    assert not any(o in text for o in ("--grades", "--classes", "--gear-grade"))
+
+
+def test_a_command_whose_default_conditions_differ_says_why():
+    """The default --conditions is 3; a command with another default refuses to be built without the reason, and
+    every --help states its default's reason."""
+    import argparse
+
+    from scenarios.core import args
+    p = argparse.ArgumentParser(prog="x")
+    with pytest.raises(ValueError, match="say why"):
+        args.add_shared(p, "conditions", conditions="1,2")
+    from scenarios import bearing_misalignment, fault_study, gear_quality, paper_study, sensitivity
+    for mod in (paper_study, fault_study, gear_quality, sensitivity, bearing_misalignment):
+        text = _help_text(mod)
+        block = text[text.index("--conditions C"):].split("\n  --")[0]
+        assert ":" in block.split("default", 1)[1], f"{mod.__name__}: {block}"
+
+
+def _help_text(mod):
+    import contextlib
+    import io
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf), pytest.raises(SystemExit):
+        mod.parse_args(["--help"]) if hasattr(mod, "parse_args") else mod.main(["--help"])
+    return " ".join(buf.getvalue().split("\n")).replace("  ", " ")
+
+
+@pytest.mark.parametrize("text,unit,value", [
+    ("0.01", "s", 0.01), ("10 ms", "s", 0.01), ("2 ms", "s", 0.002), ("1.5 s", "s", 1.5), ("250 us", "s", 2.5e-4),
+    ("20 kHz", "Hz", 2e4), ("25000", "Hz", 25000.0), ("2000 rpm", "r/min", 2000.0), ("2000", "r/min", 2000.0),
+])
+def test_every_time_option_takes_a_quantity_or_plain_seconds(text, unit, value):
+    """The shared number grammar: a plain number in the option's unit, or a quantity with its own unit, converted
+    (1 ms = 1e-3 s, 1 kHz = 1e3 Hz)."""
+    from scenarios.core import args
+    assert args.positive(unit)(text) == pytest.approx(value, rel=1e-12)
+
+
+def test_time_options_of_the_commands_read_quantities():
+    from scenarios import duty_cycle, fault_study, gear_quality, lubricant_study, paper_study, spectrum, \
+        tolerance_study
+    for mod in (paper_study, fault_study, gear_quality, lubricant_study, tolerance_study, spectrum):
+        a = mod.parse_args(["--settle", "10 ms", "--window", "2 ms"])
+        assert (a.settle, a.window) == (pytest.approx(0.01), pytest.approx(0.002)), mod.__name__
+    a = duty_cycle.parse_args(["--cycle", "examples/duty_cycles/forward.toml", "--settle", "5 ms"])
+    assert a.settle == pytest.approx(0.005)
+
+
+@pytest.mark.parametrize("text,words", [("10 kg", "a time with its unit"), ("-1 ms", "must be > 0 s"),
+                                        ("soon", "a time with its unit")])
+def test_a_bad_time_is_refused_in_one_line(text, words, tmp_path, capsys):
+    assert paper_study.main(["--window", text, "--out", str(tmp_path)]) == USAGE
+    err = capsys.readouterr().err
+    assert "--window" in err and words in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("name,argv", [("bearing_rig", ["--radial-load", "{}"]), ("modal", ["--set", "planets={}"])])
+def test_bearing_rig_and_modal_take_overwrite_and_no_progress(name, argv, tmp_path, capsys):
+    """A second run with other inputs into the same folder is refused naming what differs; --overwrite replaces it;
+    --no-progress is accepted."""
+    import importlib
+    import json
+    mod = importlib.import_module(f"scenarios.{name}")
+    first, second = ("10 kN", "12 kN") if name == "bearing_rig" else ("3", "4")
+    fill = lambda v: [x.format(v) for x in argv]                                     # noqa: E731
+    assert mod.main([*fill(first), "--out", str(tmp_path), "--no-progress"]) == 0
+    assert mod.main([*fill(first), "--out", str(tmp_path)]) == 0                     # the same inputs: runs again
+    capsys.readouterr()
+    assert mod.main([*fill(second), "--out", str(tmp_path)]) == USAGE
+    err = capsys.readouterr().err
+    assert "other parameters or settings" in err and "--overwrite" in err and second in err
+    assert mod.main([*fill(second), "--out", str(tmp_path), "--overwrite"]) == 0
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert second in json.dumps(s["run_description"])

@@ -23,7 +23,7 @@ def test_every_grade_is_its_own_viscosity_at_40_degC_and_thicker_grades_are_thic
 
 
 def test_the_study_takes_any_grade_and_keeps_its_default_span(tmp_path):
-    a = lubricant_study.parse_args(["--grades", "VG46,VG220", "--conditions", "3", "--out", str(tmp_path)])
+    a = lubricant_study.parse_args(["--oil", "VG46,VG220", "--conditions", "3", "--out", str(tmp_path)])
     assert sorted(lubricant_study.lubricants(a)) == ["VG220", "VG46"]
     a = lubricant_study.parse_args(["--conditions", "3", "--out", str(tmp_path)])
     assert list(lubricant_study.lubricants(a)) == ["VG32", "VG68", "VG150"]

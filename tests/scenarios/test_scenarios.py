@@ -427,7 +427,7 @@ def test_spectrum_rig_machine_errors_bring_the_cancelled_lines(tmp_path):
 
 
 def test_spectrum_params_file_is_a_users_machine_and_its_conflicts_are_refused(tmp_path):
-    """``--params FILE.toml`` puts a user's machine on the rig (its errors replace the --gear-grade ones); the
+    """``--params FILE.toml`` puts a user's machine on the rig (its errors replace the --gear-class ones); the
     operating point belongs to the command's options, and --perfect with errors given is a contradiction."""
     machine = tmp_path / "m.toml"
     machine.write_text('[[errors.tooth]]\ngear = "b1"\ntooth = 3\nflank = "both"\npitch = "5 um"\n')
