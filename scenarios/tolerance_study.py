@@ -353,6 +353,27 @@ def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None
 # ---------------------------------------------------------------------------------------------------------------
 # statistics
 # ---------------------------------------------------------------------------------------------------------------
+def fewest_samples(q: float) -> int:
+    """The fewest values of which Hazen's q-th percentile (q in %) is not simply the smallest or the largest: its
+    plotting positions (i − ½)/m hold q/100 strictly between two of them only when ½/m < min(q, 100 − q)/100,
+    m > 50/min(q, 100 − q) (P90 and P10: 6, P99: 51)."""
+    return math.floor(50.0 / min(q, 100.0 - q) + 1e-9) + 1
+
+
+def too_few_samples(samples: int, replicates: int) -> list[str]:
+    """The percentiles the study reports (P50, P90, P99 of K_γ and loads, P10 of the lives) that ``samples`` machines
+    in ``replicates`` replicates cannot give: each replicate's percentile would be its largest (or smallest) value."""
+    m = samples // replicates
+    out = []
+    for name, q in (*PERCENTILES.items(), ("p10", 10.0)):
+        need = fewest_samples(q)
+        if m < need:
+            out.append(f"{name.upper()} from {m} machine{'s' if m != 1 else ''} per replicate (--samples {samples} / "
+                       f"--replicates {replicates}) is each replicate's {'largest' if q > 50 else 'smallest'} value, "
+                       f"not a percentile: it needs {need} per replicate, --samples {need * replicates} or more")
+    return out
+
+
 def percentile_ci(x, q: float | None, replicate) -> dict:
     """{"value", "ci95"}: the mean (``q`` None) or the q-th percentile of ``x`` by randomised QMC: the statistic of each
     independent replicate (``replicate`` the replicate of each value,
@@ -681,6 +702,9 @@ class ToleranceStudy(Study):
             "errors": "the tolerance options (--gear-class, --pinhole-tolerance, --clearance-tolerance, --roller-lot)"}),
             self.points)
         self.tasks = static_tasks(a, self.out, self.user, self.points)
+        self.too_few = too_few_samples(a.samples, a.replicates)
+        for w in self.too_few:                   # said before anything runs, and again above the answer
+            print(f"warning before the run: {w}", flush=True)
         self.records: dict = {}
         self.cost: dict = {}
 
@@ -754,6 +778,10 @@ class ToleranceStudy(Study):
         agree = agreement_rows(self.records, dynamic)
         record = {"samples": a.samples, "tolerances": self._tolerance_words(), "static_cost": self.cost}
         text = answer(stats, agree, record)
+        if self.too_few:                          # a percentile that is an extreme value is not a finding
+            text = "\n".join(["**Not findings** — these percentiles are extreme values of too few samples (the "
+                               "others stand):",
+                               *(f"- {w}" for w in self.too_few), "", text])
         print(text)                               # the headline first
         rows = sample_rows(self.records)
 

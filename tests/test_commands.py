@@ -1,6 +1,7 @@
 """How commands end (scenarios.core.command): one line and an exit code, a traceback only with --debug."""
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import mbd
@@ -522,3 +523,57 @@ def test_bearing_rig_and_modal_take_overwrite_and_no_progress(name, argv, tmp_pa
     assert mod.main([*fill(second), "--out", str(tmp_path), "--overwrite"]) == 0
     s = json.loads((tmp_path / "summary.json").read_text())
     assert second in json.dumps(s["run_description"])
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# said before the run
+# ---------------------------------------------------------------------------------------------------------------
+def test_a_window_shorter_than_a_cage_revolution_is_said_before_the_run_as_the_run_then_measures(tmp_path, capsys):
+    """Before the run: the window is shorter than a cage revolution relative to the carrier, with the window that
+    covers one; after it, the run's own count of the cage's revolutions agrees (its measured period within 1 %), and
+    a settle shorter than the torque ramp is said too, with the estimated run time — all before the sweep starts."""
+    import re
+    assert paper_study.main(["--conditions", "3", "--directions", "forward", "--settle", "2 ms", "--window", "2 ms",
+                             "--workers", "1", "--no-progress", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    start = out.index("runs: 1 to run")
+    before, after = out[:start], out[start:]
+    assert "warning before the run (c3_forward): the window 0.002 s is shorter than a revolution of the cage" in before
+    assert "ends before the sun torque's ramp" in before and "estimated run time: ≈" in before
+    predicted = float(re.search(r'--window "([\d.]+) ms" or more covers one', before).group(1)) * 1e-3
+    measured = float(re.search(r"inner planet bearings: the window covers [\d.]+ cage revolutions.*?a window of at "
+                               r"least ([\d.e-]+) s covers one", after).group(1))
+    assert predicted == pytest.approx(measured, rel=0.01)
+
+
+def test_a_resumed_study_says_how_many_runs_finished_earlier(tmp_path, capsys):
+    tiny = ["--conditions", "4", "--settle", "0.0005", "--window", "0.0005", "--no-progress", "--workers", "1",
+            "--out", str(tmp_path)]
+    assert paper_study.main([*tiny, "--directions", "forward"]) == 0
+    capsys.readouterr()
+    assert paper_study.main([*tiny, "--directions", "forward,reverse"]) == 0
+    assert "resuming: 1 of 2 runs finished earlier" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("q", [10.0, 50.0, 90.0, 99.0])
+def test_the_fewest_samples_for_a_percentile_are_where_it_stops_being_the_extreme_value(q):
+    """numpy's Hazen percentile of m distinct values is the largest (or smallest) value for m below the count the
+    tolerance study asks for, and strictly inside the values from that count on."""
+    from scenarios.tolerance_study import fewest_samples
+    rng = np.random.default_rng(3)
+    need = fewest_samples(q)
+    for m in range(1, need + 3):
+        x = rng.permutation(np.arange(m, dtype=float))
+        v = np.percentile(x, q, method="hazen")
+        extreme = v == (x.max() if q > 50 else x.min())
+        assert extreme == (m < need), (q, m, v)
+
+
+def test_too_few_samples_for_a_percentile_are_said_before_the_run_and_above_the_answer(capsys):
+    from scenarios.tolerance_study import too_few_samples
+    few = too_few_samples(4, 1)                       # a P90 from 4 machines
+    assert any(w.startswith("P90 from 4 machines") and "--samples 6 or more" in w for w in few)
+    assert any(w.startswith("P99") and "--samples 51 or more" in w for w in few)
+    assert [w.split()[0] for w in too_few_samples(64, 8)] == ["P99"]   # 8 per replicate: P90 and P10 stand
+    assert [w.split()[0] for w in too_few_samples(400, 8)] == ["P99"]   # 50 per replicate: P99 is the largest
+    assert too_few_samples(408, 8) == []

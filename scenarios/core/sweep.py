@@ -302,6 +302,8 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
     if announce:
         print(f"runs: {len(todo)} to run, {len(cases) - len(todo)} reused (finished earlier with the same parameters, "
               f"settings and code)", flush=True)
+        if todo and len(todo) < len(cases):
+            print(f"resuming: {len(cases) - len(todo)} of {len(cases)} runs finished earlier", flush=True)
     results = {c.label: execute_case(c, cfg) for c in cases if c not in todo}   # finished: just load
     timing["reuse_check_s"] = time.perf_counter() - t0
     if not todo:
