@@ -26,7 +26,7 @@ from components.families import MESH_FAMILY
 from components.static import DEFAULT_SNAPSHOTS, STATIC_LIVES_NOTE
 from components.outputs import FAMILY, radial_tangential
 from components.outputs import relative_life as iso_relative_life
-from components.results import SUMMARY_WORDS, Summary, json_attr, open_run
+from components.results import SUMMARY_WORDS, Summary, json_attr, open_run, percent_change
 from components.results.io import atomic_write_text, write_summary
 
 from .core.integrity import read_summary
@@ -169,9 +169,10 @@ def comparison_rows(results: dict) -> list[dict]:
             for q, unit in QUANTITIES:
                 fv = f.get(kind, {}).get(q) if not f.failed else None
                 rv = r.get(kind, {}).get(q) if not r.failed else None
-                diff = (rv - fv) / fv * 100.0 if (fv not in (None, 0) and rv is not None) else None
                 rows.append({"condition": c, "bearing": kind, "quantity": q, "description": SUMMARY_WORDS[q][0],
-                             "unit": unit, "forward": fv, "reverse": rv, "difference_pct": diff})
+                             "unit": unit, "forward": fv, "reverse": rv,
+                             "difference": rv - fv if fv is not None and rv is not None else None,
+                             "difference_pct": percent_change(fv, rv)})
     return rows
 
 
@@ -187,11 +188,14 @@ def write_tables(rows: list[dict], out: Path, machine: dict | None = None) -> tu
     atomic_write_text(out / "comparison.csv", buf.getvalue())
     md = []
     for c in sorted({r["condition"] for r in rows}, key=point_order):
-        md.append(f"\n### {_title(c)}\n\n| bearing | quantity | forward | reverse | difference % |\n|---|---|---|---|---|")
+        md.append(f"\n### {_title(c)}\n\n| bearing | quantity | forward | reverse | reverse − forward | difference % "
+                  f"|\n|---|---|---|---|---|---|")
         for r in rows:
             if r["condition"] == c:
+                pct = _fmt(r["difference_pct"], 3) if r["difference_pct"] is not None or r["difference"] is None \
+                    else "– (sign changes)" if (r["forward"] or 0) * (r["reverse"] or 0) < 0 else "–"
                 md.append(f"| {r['bearing']} | {r['description']} [{r['unit']}] | {_fmt(r['forward'])} | "
-                          f"{_fmt(r['reverse'])} | {_fmt(r['difference_pct'], 3)} |")
+                          f"{_fmt(r['reverse'])} | {_fmt(r['difference'])} | {pct} |")
     text = "\n".join(md).strip() + "\n"
     if machine is not None:        # the machine the tables are of: its file, a short fingerprint, the overrides
         text = f"Machine: {machine['label']}\n\n" + text
@@ -334,10 +338,16 @@ def plots(results: dict, out: Path, machine: str = "") -> list[Path]:
         runs = _runs_of(results, out, c)
         if not runs:
             continue
+        f_m = [results[_label_of(results, c, d)].get("f_m_hz") for d in runs]
+        mesh_period = 1.0 / f_m[0] if f_m and f_m[0] else None
         for g, (rows, cols) in history_groups(runs).items():
             titles = {"inner": "inner planet bearing", "outer": "outer planet bearing", **MESH_COLUMNS}
+            # forward and reverse in rows of their own; the mesh histories, sampled a few times per mesh cycle, as
+            # their envelope over a mesh period
             paths.append(vp.time_history_group(rows, out / f"{point_tag(c)}_{g}.png", columns=cols,
-                                               column_titles=titles, title=f"{_title(c)}: {HISTORY_GROUPS[g]}"))
+                                               column_titles=titles, title=f"{_title(c)}: {HISTORY_GROUPS[g]}",
+                                               separate_runs=True, envelope=mesh_period if g == "mesh" else None,
+                                               envelope_words="mesh cycle"))
         paths += study_cage_pictures(runs, out, prefix=f"{point_tag(c)}_",
                                      title=f"{_title(c)}: cage orbits in the guide clearance")
     vals = headline_values(results)
@@ -364,7 +374,8 @@ def plots(results: dict, out: Path, machine: str = "") -> list[Path]:
         paths.append(vp.bar_chart([_title(c).lower() for c in conds], {k: {_title(c).lower(): v for c, v in by.items()}
                                                                        for k, by in table.items()},
                                   bar_units, out / "bars.png", ylabels=ylabels, ncols=2,
-                                  title="RMS across conditions: forward vs reverse"))
+                                  title=("RMS per condition: forward vs reverse" if len(conds) > 1 else
+                                         f"RMS at {_title(conds[0]).lower()}: forward vs reverse")))
     return paths
 
 

@@ -280,7 +280,8 @@ def _plot(f, spectra, f_m, f_c, s, sensor, out):
     title = f"{where.capitalize()}, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min" + (
         f"\n({', '.join(names[k] for k in zero)} zero for this sensor, not drawn)" if zero else "")
     return vp.spectrum(f, {names[k]: spectra[k][1] for k in shown if k not in zero}, marks, out / "spectrum.png",
-                       fmax=min(f[-1], 2.5 * f_m), quantity=where, unit="m/s²", logy=True, title=title)
+                       fmax=min(f[-1], 2.5 * f_m), quantity=where, unit="m/s²", logy=True, title=title,
+                       zoom=(f_m - 5 * f_c, f_m + 5 * f_c))
 
 
 def _report(lines, peaks, f_m, f_c, df, t, sensor) -> None:
