@@ -191,7 +191,7 @@ def test_did_you_mean_is_one_helper_with_sane_matches():
     assert argparse_hint(p, "unrecognized arguments: --zzz") == "unrecognized arguments: --zzz"
 
 
-# the shared command grammar (issue 24 §3): one definition of every shared option, the same in every command
+# the shared command grammar: one definition of every shared option, the same in every command
 STUDIES = {"paper_study": "results/study", "demo": "results/demo", "lubricant_study": "results/lubricant",
            "fault_study": "results/faults", "gear_quality": "results/gear_quality",
            "tolerance_study": "results/tolerances", "sensitivity": "results/sensitivity"}

@@ -103,7 +103,7 @@ def time_histories(t, series: Mapping[str, tuple], units: Mapping[str, str], pat
             ax.legend(loc="upper right")
         axes[-1].set_xlabel(_axis_label("time", tunit))
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -160,7 +160,7 @@ def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]
             ax.set_visible(False)
         _direction_legend(fig, [d for d in ("forward", "reverse") if d in present], hatch=True)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -363,7 +363,7 @@ def mode_shapes(freqs_hz, shapes, labels: Sequence[str], path, *, max_modes: int
         if freqs.size > n:       # say what is left out
             fig.text(0.5, 0.0, f"the first {n} of {freqs.size} modes shown", ha="center", va="bottom", fontsize=8)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -437,7 +437,7 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
         if handles:
             fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 6), frameon=False)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -492,7 +492,7 @@ def fault_spectra(panels: Sequence[tuple], path, *, quantity: str = "sensor acce
                             Line2D([], [], color=FWD["color"], lw=1.0, label="damaged machine (panel title)")],
                    loc="outside lower center", ncols=2, frameon=False)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -544,7 +544,7 @@ def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = 
             ax.set_xticks(x, faults, rotation=30, ha="right")
         _direction_legend(fig, present, hatch=True)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -612,8 +612,14 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
             if ax.get_yscale() == "linear":      # from zero, with room above the highest marker
                 _from_zero(ax)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
+
+
+def _suptitle(fig: Figure, title: str) -> None:
+    """The figure's title, each of its lines wrapped to the figure's width (a long machine label stays readable)."""
+    width = max(30, int(fig.get_figwidth() * 11.5))
+    fig.suptitle("\n".join(_wrap(line, width) for line in str(title).split("\n")))
 
 
 def _from_zero(ax) -> None:
@@ -871,7 +877,7 @@ def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
                 ax.set_title(where if len(conds) > 1 else words, fontsize=9)
         _direction_legend(fig, present, hatch=True)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -960,7 +966,7 @@ def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], t
                                f"the lines their mean over it (peaks from every step: summary.json)",
                      ha="center", va="bottom", fontsize=7, gid="envelope_note", wrap=True)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -1041,7 +1047,7 @@ def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = Non
                                                                    f"deflection (up to {beyond:.3g} µm)"))
         fig.legend(handles=handles, loc="outside lower center", ncols=3, frameon=False, fontsize=7.5)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 

@@ -1,4 +1,4 @@
-"""The results of a run, in one module (issue 27 §2).
+"""The results of a run, in one module.
 
 * :mod:`.summary` — :class:`Summary`: summary.json typed (per-bearing-kind and per-mesh sections, the failed-run
   form, the words and units of its keys, :data:`SUMMARY_WORDS`).

@@ -72,7 +72,6 @@ def run_advice(scene, cfg, window: float) -> list[str]:
     wrong, said before it runs (module docstring); nothing for a static solution."""
     # deferred: the runner (≈ 1 s) stays out of dpgt's start-up (command.py imports Implausible)
     from components.outputs import cage_period
-
     from .runner import RunConfig
 
     if cfg.mode == "static":

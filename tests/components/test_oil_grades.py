@@ -1,4 +1,4 @@
-"""Every ISO VG grade from VG 10 to VG 1500 is a lubricant the study takes (issue 24 §4): its Walther line passes
+"""Every ISO VG grade from VG 10 to VG 1500 is a lubricant the study takes: its Walther line passes
 through the grade at 40 °C (ISO 3448's definition) and its typical 100 °C value, and thicker grades are thicker at
 the bearings' 60 °C."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""A study's sweep owns its axes (issue 24): an override of one by --set or a --params file would silently
+"""A study's sweep owns its axes: an override of one by --set or a --params file would silently
 relabel runs (a folder c3_forward holding a reverse run), so every study refuses it in one line naming the key,
 where it came from and the option to use; a --params file that is not UTF-8 TOML is a usage error naming it.
 Two exceptions, by design: a machine file's whole [operating] table (speed and power) is that machine's own
