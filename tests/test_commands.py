@@ -577,3 +577,14 @@ def test_too_few_samples_for_a_percentile_are_said_before_the_run_and_above_the_
     assert [w.split()[0] for w in too_few_samples(64, 8)] == ["P99"]   # 8 per replicate: P90 and P10 stand
     assert [w.split()[0] for w in too_few_samples(400, 8)] == ["P99"]   # 50 per replicate: P99 is the largest
     assert too_few_samples(408, 8) == []
+
+
+def test_params_refuses_a_machine_that_cannot_be_built_as_a_run_would(capsys):
+    """A 40 mm roller on a 39 mm pitch circle leaves no pin: `dpgt params` refuses it in the words of the design
+    check a run makes, not a table of a machine that cannot exist."""
+    from scenarios import params
+    assert params.main(["--set", "bearing.roller_diameter=40 mm"]) == USAGE
+    err = capsys.readouterr().err
+    assert err.startswith("error: bearing.roller_diameter") and "leaves no pin" in err and err.count("\n") == 1
+    assert params.main(["--set", "bearing.roller_diameter=7 mm", "--grep", "roller_diameter"]) == 0
+    assert "7 mm" in capsys.readouterr().out

@@ -246,6 +246,9 @@ def _execute(case: Case, cfg, overwrite: bool) -> Outcome:
         return Outcome(case, Status.FAILED, error=info.error, traceback=info.get("traceback", ""))
 
 
+SETTLED_ESTIMATE = 0.1      # share of a run's simulated time after which its time left is shown
+
+
 class _RunBars:
     """One bar per running case, fed from the progress.json each worker writes (simulated time)."""
 
@@ -267,7 +270,11 @@ class _RunBars:
             b.n = min(1.0, d["t"] / d["t_end"]) if d["t_end"] else 0.0
             rate = d["steps"] / max(d["wall_s"], 1e-9)
             left = (d["t_end"] - d["t"]) / max(d["t"], 1e-12) * d["wall_s"]
-            b.set_postfix_str(f"t={d['t']:.4f}/{d['t_end']:.4f} s, {rate:.0f} steps/s, ~{left:.0f} s left")
+            # the kinematic start is slow and the compile counts in the first seconds: an estimate from them
+            # would be many times too long, so it is shown once the run is past its start
+            settled = d["t"] >= SETTLED_ESTIMATE * d["t_end"] and d["wall_s"] > 2.0
+            b.set_postfix_str(f"t={d['t']:.4f}/{d['t_end']:.4f} s, {rate:.0f} steps/s, "
+                              + (f"~{left:.0f} s left" if settled else "estimating the time left"))
 
     def finish(self, c):
         if c.label in self.bars:
