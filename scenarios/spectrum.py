@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
-from components.geometry import sideband_origin
+from components.geometry import check_design, sideband_origin
 from components.params import flatten, overrides_from_toml, with_overrides
 from components.presets import reference_dpgt, typical_errors
 from components.results import open_dataset
@@ -51,6 +51,7 @@ from .core.analysis import amplitude_spectrum, line_table, peak_table, sensor_pa
 from .core.analysis import whole_revolutions as _whole_revolutions
 from .core.plausibility import check_runs
 from .core.runner import RunConfig, finished_run, run_case, run_report
+from .core.sweep import say_design_warnings
 from .core import args
 from .core.command import command
 
@@ -162,6 +163,10 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     if sensor not in SENSORS:
         raise SystemExit(f"error: --sensor {sensor!r}: expected one of {list(SENSORS)}")
     out.mkdir(parents=True, exist_ok=True)
+    with warnings.catch_warnings(record=True) as caught:  # the design warnings every command says
+        warnings.simplefilter("always")
+        check_design(params)
+    say_design_warnings(caught)
     cfg = dataclasses.replace(cfg, sensor=True)          # every path is written, whichever sensor is read
     for w in check_runs([("spectrum", params, cfg)], out, force):
         print(f"warning (--force): {w}")

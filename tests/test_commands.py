@@ -588,3 +588,39 @@ def test_params_refuses_a_machine_that_cannot_be_built_as_a_run_would(capsys):
     assert err.startswith("error: bearing.roller_diameter") and "leaves no pin" in err and err.count("\n") == 1
     assert params.main(["--set", "bearing.roller_diameter=7 mm", "--grep", "roller_diameter"]) == 0
     assert "7 mm" in capsys.readouterr().out
+
+
+def test_spectrum_says_the_design_warnings_the_other_commands_say(tmp_path, monkeypatch, capsys):
+    """The reference machine's two tip-circle overlaps, said before anything runs (the run stopped right after)."""
+    from scenarios import spectrum
+
+    def stop(*a, **k):
+        raise SystemExit("error: stopped after the checks")
+    monkeypatch.setattr(spectrum, "check_runs", stop)
+    assert spectrum.main(["--out", str(tmp_path)]) == USAGE
+    out = capsys.readouterr().out
+    assert out.count("design warning: gears.") == 2 and "tip circles" in out
+
+
+@pytest.mark.parametrize("key,words", [("gears.inner_planet.addendum_coefficient", "the inner planets and the ring"),
+                                       ("gears.ring.addendum_coefficient", "the inner planets and the ring"),
+                                       ("gears.sun.addendum_coefficient", "the sun and outer planet"),
+                                       ("gears.outer_planet.addendum_coefficient", "the sun and outer planet")])
+def test_a_design_warning_names_the_parameter_value_that_removes_it(key, words):
+    """The tip-circle overlap's warning names each gear's addendum coefficient that removes it: at that value the
+    warning is gone, a hundredth above it is still there (the tip radius moves by h_a m)."""
+    import re
+    import warnings
+
+    from components.geometry import design_findings
+    from components.params import with_overrides
+    from components.presets import reference_dpgt
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        found = [str(f) for f in design_findings(reference_dpgt(3)) if words in str(f)]
+        assert len(found) == 1
+        limit = float(re.search(re.escape(key) + r" <= ([\d.]+)", found[0]).group(1))
+        at = [str(f) for f in design_findings(with_overrides(reference_dpgt(3), {key: limit})) if words in str(f)]
+        above = [str(f) for f in design_findings(with_overrides(reference_dpgt(3), {key: limit + 0.01}))
+                 if words in str(f)]
+    assert at == [] and len(above) == 1

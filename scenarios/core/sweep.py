@@ -36,7 +36,7 @@ from .integrity import OtherResults, claim_folder, differences, read_summary
 from .runner import finished_run, parameters_fingerprint, run_case, run_description, run_fingerprint
 
 __all__ = ["Case", "Status", "Outcome", "sweep", "run_sweep", "execute_case", "check_folders", "user_overrides",
-           "validate_cases", "dask_client", "OPERATING_AXES"]
+           "validate_cases", "dask_client", "OPERATING_AXES", "say_design_warnings"]
 
 
 @dataclass(frozen=True)
@@ -153,6 +153,11 @@ def validate_cases(cases: list[Case], check=None) -> None:
                     check(c)
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
+    say_design_warnings(caught)
+
+
+def say_design_warnings(caught) -> None:
+    """Each distinct design warning among the caught warnings once, as every command says them."""
     for msg in sorted({str(w.message) for w in caught if issubclass(w.category, UserWarning)}):
         print(f"design {msg}" if msg.startswith("warning: ") else f"design warning: {msg}")
 
