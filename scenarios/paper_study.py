@@ -30,7 +30,7 @@ from components.results import SUMMARY_WORDS, Summary, json_attr, open_run, perc
 from components.results.io import atomic_write_text, write_summary
 
 from .core.integrity import read_summary
-from .core.runner import RunConfig
+from .core.runner import SETTLED_SPEED_ERROR_PCT, RunConfig
 from .core.study import Study, StudyRun
 from .core.points import machine_identity, machine_overrides, point_label, point_order, point_tag, points_of
 from .core.sweep import Case, user_overrides
@@ -205,6 +205,23 @@ def write_tables(rows: list[dict], out: Path, machine: dict | None = None) -> tu
 
 HEADLINE = (("bearing_load_mean_N", "mean load", 1e-3, "kN"), ("life_iso281_h", "L10 ISO 281", 1.0, "h"),
             ("life_iso16281_h", "L10 roller loads", 1.0, "h"))
+
+
+def meaningless(results: dict) -> str:
+    """Why the runs' statistics do not mean anything, in one line ('' when they do): a bearing whose cage turned less
+    than once relative to the carrier in the window, or a carrier drive off its speed by more than
+    :data:`scenarios.core.runner.SETTLED_SPEED_ERROR_PCT` on average (each run's warnings say it in full)."""
+    why = []
+    for label, s in sorted(results.items()):
+        if not s.has_bearings:
+            continue
+        short = [k for k in ("inner", "outer") if (s[k].get("cage_revolutions") or 1.0) < 1.0]
+        if short:
+            why.append(f"{label}: the window covers less than one cage revolution ({', '.join(short)})")
+        err = s.get("carrier_speed_error_mean_pct")
+        if err is not None and abs(err) > SETTLED_SPEED_ERROR_PCT:
+            why.append(f"{label}: the carrier drive had not settled ({err:+.2g} %)")
+    return "; ".join(why)
 
 
 def headline_table(rows: list[dict]) -> str:
@@ -450,7 +467,11 @@ class PaperStudy(Study):
             rows = [r for r in rows if r["forward"] is not None or r["reverse"] is not None]
         machine = self.machine_identity()
         csv_p, md_p, text = write_tables(rows, self.out, machine)
-        print("\n" + headline_table(rows))   # the headline first, then the whole comparison
+        doubts = meaningless(results)
+        if doubts:          # a headline of runs whose statistics mean nothing is not a finding: said above it
+            text = f"**Not a finding**: {doubts}.\n\n" + text
+            atomic_write_text(md_p, text)
+        print(("\nnot a finding: " + doubts + "\n" if doubts else "\n") + headline_table(rows))   # the headline first
         print("\n" + text)
         if static:
             left = sorted({q for q, _ in QUANTITIES} - {r["quantity"] for r in rows})

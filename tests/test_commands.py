@@ -544,6 +544,10 @@ def test_a_window_shorter_than_a_cage_revolution_is_said_before_the_run_as_the_r
     measured = float(re.search(r"inner planet bearings: the window covers [\d.]+ cage revolutions.*?a window of at "
                                r"least ([\d.e-]+) s covers one", after).group(1))
     assert predicted == pytest.approx(measured, rel=0.01)
+    # the headline of such a run is not printed as a finding: the reason stands above it, and above comparison.md
+    flag = after.index("not a finding: c3_forward: the window covers less than one cage revolution (inner, outer)")
+    assert flag < after.index("headline (pair 1's planet bearings")
+    assert (tmp_path / "comparison.md").read_text().startswith("**Not a finding**: c3_forward: the window covers")
 
 
 def test_a_resumed_study_says_how_many_runs_finished_earlier(tmp_path, capsys):
