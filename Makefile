@@ -10,9 +10,11 @@ DEMO_OUT ?= results/demo
 .PHONY: demo test install warm bench clean
 
 $(STAMP): pyproject.toml
+	@echo "install: a virtual environment in $(VENV) with this project (editable) and its dependencies from pyproject.toml (numpy, scipy, numba, pint, xarray, dask, matplotlib, pyvista, pytest ...); a few minutes the first time"
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e ".[test]"
+	@$(PY) -m pip list --format=freeze 2>/dev/null | wc -l | xargs -I{} echo "install: done, {} packages in $(VENV)"
 	touch $(STAMP)
 
 install: $(STAMP)

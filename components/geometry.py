@@ -561,9 +561,18 @@ class Finding:
 _TAG = {"inner_planet": "a", "outer_planet": "b"}     # planets are named a1..aN, b1..bN (components.dpgt)
 
 
-def _overlap_findings(out, name_i, name_j, ci, cj, ri, rj, parameter, same=False, pitch=None, tags=("", "")):
+def _addendum_fix(overlap: float, *gears: tuple[str, "GearGeometry"]) -> str:
+    """The parameters that would remove a tip-circle overlap: each gear's addendum coefficient shortened by the
+    overlap over its module (its tip radius moves by h_a m)."""
+    return " (e.g. " + " or ".join(f"gears.{n}.addendum_coefficient <= {g.addendum_coefficient - overlap / g.module:.3g}"
+                                   for n, g in gears) + ")"
+
+
+def _overlap_findings(out, name_i, name_j, ci, cj, ri, rj, parameter, same=False, pitch=None, tags=("", ""),
+                      fix: str = ""):
     """Warn about the worst tip-circle overlap between two families of gear centres (non-meshing). ``tags``: the
-    planets' name letters ("a" inner, "b" outer): a planet is named as everywhere else, a1..aN (pair n from 1)."""
+    planets' name letters ("a" inner, "b" outer): a planet is named as everywhere else, a1..aN (pair n from 1).
+    ``fix``: a callable of the overlap [m] naming the parameters that would remove it."""
     ci, cj = np.atleast_2d(ci), np.atleast_2d(cj)
     d = np.linalg.norm(ci[:, None, :] - cj[None, :, :], axis=-1)
     if same:
@@ -581,7 +590,7 @@ def _overlap_findings(out, name_i, name_j, ci, cj, ri, rj, parameter, same=False
             # the model has no contact between these bodies, so it still runs; the machine could not exist
             what += "; even their pitch circles overlap: the gears would collide"
         else:
-            what += "; a real design needs profile shift, shorter addenda or an axial offset"
+            what += "; a real design needs profile shift, shorter addenda or an axial offset" + (fix(ov[k]) if fix else "")
         out.append(Finding("warning", parameter, what, collides))
 
 
@@ -663,7 +672,8 @@ def _interference_findings(lay, G, out) -> None:
     ra = {n: G[n].tip_radius for n in _GEARS}
     zero = np.zeros((1, 2))
     _overlap_findings(out, "the sun", "outer planet", zero, lay.centres_b, ra["sun"], ra["outer_planet"], "gears.sun",
-                      pitch=(G["sun"].pitch_radius, G["outer_planet"].pitch_radius), tags=("", "b"))
+                      pitch=(G["sun"].pitch_radius, G["outer_planet"].pitch_radius), tags=("", "b"),
+                      fix=lambda ov: _addendum_fix(ov, ("sun", G["sun"]), ("outer_planet", G["outer_planet"])))
     # inner planet inside the ring: its outermost point must stay inside the ring's tip (inner) circle
     reach = lay.r_ca + ra["inner_planet"]
     if reach > ra["ring"] + 1e-12:
@@ -674,7 +684,8 @@ def _interference_findings(lay, G, out) -> None:
         if collides:
             what += "; even their pitch circles overlap: the gears would collide"
         else:
-            what += "; a real design needs profile shift, shorter addenda or an axial offset"
+            what += ("; a real design needs profile shift, shorter addenda or an axial offset"
+                     + _addendum_fix(reach - ra["ring"], ("inner_planet", G["inner_planet"]), ("ring", G["ring"])))
         out.append(Finding("warning", "gears.ring", what, collides))
     ca, cb = lay.centres_a, lay.centres_b
     if lay.planets > 1:

@@ -1,4 +1,4 @@
-"""Did you mean …? — the one suggestion for a near-miss name, used by every command (issue 24 §5).
+"""Did you mean …? — the one suggestion for a near-miss name, used by every command.
 
 A misspelt parameter key (``--set bearing.clearence=…``, a ``--params`` file's key, an error entry's field), scene
 option (``--option frme=fixed``), option name (``--condtions``), choice (``--method hht-adaptiv``, a fault, an oil

@@ -288,7 +288,7 @@ def reference_markdown() -> str:
               "What `DPGTParams.si()` resolves from the parameters above (the reference machine), [derived]; the model "
               "behind them: docs/model.md §1.", "", *derived,
               "", "## Oil grades", "",
-              "The ISO VG grades the lubricant study takes (`--grades`; `components.presets.oil_grade`): each sets "
+              "The ISO VG grades the lubricant study takes (`--oil`; `components.presets.oil_grade`): each sets "
               "`lubricant.viscosity_40` and `lubricant.viscosity_100`.", "", *_oil_grades()]
     rig = reference_bearing_rig()
     lines += ["", "## Bearing rig", "",

@@ -102,7 +102,7 @@ class NewtonPolicy:
     rate_refresh: float = 0.3    # contraction rate above which the Jacobian is refreshed
     max_refresh: int = 2         # Jacobian refreshes per step before a rate >= 1 counts as divergence
     reuse: bool = True           # False: fresh Jacobian + LU at the start of every step
-    per_component: bool = True   # False: the test on the max norm alone (the engine before issue 23)
+    per_component: bool = True   # False: the test on the max norm alone (the former test, kept to compare)
 
     def __post_init__(self):
         if self.max_iter < 1 or not (0 < self.newton_tol < 1):

@@ -64,7 +64,9 @@ def parse_args(argv):
                    help="cage positions over one roller pitch for the life (default 8)")
     p.add_argument("--load", default=None, type=args.quantity_of("force", positive_only=True),
                    help='one bearing load for every case instead of the static solutions (e.g. "12 kN")')
-    args.add_shared(p, "conditions", "params", "set", "out", out="results/bearing_misalignment", conditions="1,3")
+    args.add_shared(p, "conditions", "params", "set", "out", out="results/bearing_misalignment", conditions="1,3",
+                    conditions_why="1 and 3: the slowest and the fastest loaded condition (1000 and 4200 rpm at "
+                                   "200 kW), the two ends of the planets' centrifugal load")
     return p.parse_args(argv)
 
 

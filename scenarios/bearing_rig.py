@@ -30,6 +30,7 @@ from components.units import ParameterError, quantity, to_si
 
 from .core import args
 from .core.command import command
+from .core.integrity import claim_for_inputs, command_inputs
 from .core.runner import accuracy_line, engine_record, time_record
 
 ATOL = mbd.PRODUCTION.atol_pos     # the rig runs the production stepper (components.rig.rig_static_solution)
@@ -53,7 +54,7 @@ def parse_args(argv):
     p.add_argument("--cage", default="held", choices=["held", "free", "none"], help="cage held (default), free or absent")
     p.add_argument("--no-drag", action="store_true", help="switch lubricant drag off")
     # the bearing's parameters (bearing.*) from a file or --set; the options above win over them
-    args.add_shared(p, "params", "set", "out", out="results/bearing_rig")
+    args.add_shared(p, "params", "set", "out", "overwrite", "no-progress", out="results/bearing_rig")
     return p.parse_args(argv)
 
 
@@ -78,6 +79,7 @@ def run(a) -> dict:
             raise ParameterError.at("radial_load", f"must be > 0 N, got {a.radial_load!r}")
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
+    identity = claim_for_inputs(out, command_inputs(a), a.overwrite)     # other inputs' results: --overwrite
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         built = build_bearing_rig(params.bearing, lubricant=None if a.no_drag else params.lubricant, radial_load=F,
@@ -105,6 +107,7 @@ def run(a) -> dict:
                             "ring_deflection_m": theory.deflection, "load_zone_deg": float(np.degrees(theory.zone_angle)),
                             "roller_angle_deg": np.degrees(theory.angles).tolist(), "roller_load_N": theory.loads.tolist(),
                             "note": "rigid rings, discrete rollers, no centrifugal force or traction"},
+        **identity,
     }
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
     from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn

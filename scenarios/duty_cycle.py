@@ -9,15 +9,23 @@ The cycle (:func:`read_cycle`) is a table of bins — a speed (the carrier's or 
 (a CSV with a ``time`` column) that the command bins itself (:func:`bin_series`). Every bin is an operating point
 (:mod:`scenarios.core.points`) solved quasi-statically (:mod:`components.static`: the mean loads and the lives in
 seconds), the bins named in ``--dynamic`` also by time integration; on Dask, resumable like every sweep.
+``--dynamic auto`` makes it a study of two phases: every bin statically, then dynamically the fewest bins that carry
+``--dynamic-share`` of every planet bearing's damage by those static lives (:func:`dominant_bins`), named with the
+shares they carry before their runs start.
 
 The lives per bearing type and planet (:mod:`components.life`): each bin's ISO 281 and ISO/TS 16281-style L10, its
 damage share and the combined life by Palmgren–Miner over the revolutions (:func:`components.life.miner_life`),
 ISO 281's equivalent load of the spectrum; the meshes' drive-flank forces per bin with their mesh cycles.
-A static bin's lives leave out the dynamic load (the mesh's dynamic factor, impacts): said in every output, and a
-``--dynamic`` bin's lives are its dynamic run's, with the dynamic increment of its equivalent load.
+A static bin's lives leave out the dynamic load (the mesh's dynamic factor, impacts): said in every output with the
+share of each bearing's damage those bins do, and a ``--dynamic`` bin's lives are its dynamic run's, with the dynamic
+increment of its equivalent load. No increment is carried from a dynamic bin to a static one: it depends on the bin's
+own speed (the mesh frequency against the train's natural frequencies) and load (a lightly loaded bearing's
+fluctuating load is a large part of its equivalent load), so a borrowed one would be a guess; the static bins' share
+of the damage bounds what they leave out.
 """
 from __future__ import annotations
 
+import argparse
 import csv
 import io
 import json
@@ -48,6 +56,7 @@ NAME = "duty_cycle"
 OUT = "results/duty_cycle"
 EXAMPLES = ["{prog} --cycle examples/duty_cycles/forward.toml --out results/duty_cycle",
             "{prog} --cycle examples/duty_cycles/reverse_10pct.toml --dynamic rev_rated --workers 2",
+            "{prog} --cycle examples/duty_cycles/forward.toml --dynamic auto --dynamic-share 0.9",
             '{prog} --cycle examples/duty_cycles/series.csv --speed-bin "500 rpm" --torque-bin "200 N*m"']
 WRITES = ("per bin BIN/summary.json (BIN_dynamic/ for a --dynamic bin); duty_cycle.csv (per bin, bearing type and "
           "planet: time and revolution shares, both lives, damage shares), lives.csv (the combined lives per bearing "
@@ -55,7 +64,9 @@ WRITES = ("per bin BIN/summary.json (BIN_dynamic/ for a --dynamic bin); duty_cyc
           "cycles), duty_cycle.md (the tables), duty_cycle.json (everything, with the machine and the binning), "
           "damage_share.png; for a time series binning.png")
 
-STATIC_NOTE = f"static bins: {STATIC_LIVES_NOTE}; a --dynamic bin's lives are its dynamic run's"
+STATIC_NOTE = (f"static bins: {STATIC_LIVES_NOTE}; a --dynamic bin's lives are its dynamic run's; no dynamic "
+               f"increment is carried over from a dynamic bin to a static one (it depends on the bin's own speed and "
+               f"load)")
 # the carrier speed above which a bin is refused unless --rated-speed says otherwise: the source's fastest condition
 RATED_DEFAULT = max(s for s, _ in CONDITIONS.values())
 SHARE_TOL = 1e-9      # |Σ shares − 1| above which the shares are normalised with a warning
@@ -393,6 +404,63 @@ def mesh_spectrum(summaries: list[dict], names: list[str], hours: list[float | N
 
 
 # ---------------------------------------------------------------------------------------------------------------
+# the bins that carry the damage
+# ---------------------------------------------------------------------------------------------------------------
+DEFAULT_DYNAMIC_SHARE = 0.9
+SHARE_SLACK = 1e-12       # round-off allowed in a bearing's carried share (shares that sum to one sum to 1 ± 1e-16 n)
+
+
+def damage_table(lives: dict) -> dict[str, list[float]]:
+    """{bearing: damage shares per bin} from :func:`spectrum_lives`: every planet bearing of each type, by each of
+    its lives (ISO 281 and ISO/TS 16281-style) — e.g. ``"inner a1 ISO 281"``; a bin without a life does none."""
+    table = {}
+    for kind in KINDS:
+        for planet, p in lives[kind]["planets"].items():
+            for key, words in LIVES:
+                if key in p:
+                    table[f"{kind} {planet} {words}"] = [x or 0.0 for x in p[key]["damage_shares"]]
+    return table
+
+
+def dominant_bins(table: dict[str, list[float]], share: float) -> list[int]:
+    """The fewest bins that together carry at least ``share`` of every bearing's damage (``table``: {bearing: damage
+    shares per bin, each row summing to one}); among equally few, those carrying the most damage summed over the
+    bearings. Indices in cycle order.
+
+    A covering problem solved exactly as a 0–1 integer programme (scipy.optimize.milp, HiGHS): minimise
+    Σ x_i − ε Σ_b Σ_i d_bi x_i subject to Σ_i d_bi x_i ≥ share for every bearing b, x_i ∈ {0, 1}, with
+    ε = 1/(2B) for B bearings so that the tie-break (≤ B ε = 1/2) never trades a bin. For one bearing this is the
+    bins in falling order of damage until the share is reached; for several, the union of those per-bearing sets
+    can hold more bins than needed (a bin that matters to two bearings serves both)."""
+    from scipy.optimize import Bounds, LinearConstraint, milp    # deferred: only when bins are chosen
+
+    if not 0.0 < share <= 1.0:
+        raise ValueError(f"share must be in (0, 1], got {share!r}")
+    d = np.array([table[k] for k in sorted(table)], float)
+    if d.ndim != 2 or d.size == 0 or not np.all(np.isfinite(d)) or np.any(d < 0):
+        raise ValueError("damage shares must be finite and >= 0, a row per bearing")
+    n_b, n = d.shape
+    cost = np.ones(n) - 0.5 / n_b * d.sum(axis=0)
+    res = milp(cost, integrality=np.ones(n), bounds=Bounds(0, 1),
+               constraints=LinearConstraint(d, lb=share - SHARE_SLACK, ub=np.inf), options={"mip_rel_gap": 0.0})
+    if res.x is None:
+        raise ValueError(f"no set of bins carries {share:g} of every bearing's damage ({res.message})")
+    chosen = [i for i in range(n) if res.x[i] > 0.5]
+    assert np.all(d[:, chosen].sum(axis=1) >= share - SHARE_SLACK), "milp returned an infeasible set"
+    return chosen
+
+
+def _share(text: str) -> float:
+    try:
+        x = float(text.strip().rstrip("%")) / (100.0 if text.strip().endswith("%") else 1.0)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a share in (0, 1] or a percentage, got {text!r}") from None
+    if not 0.0 < x <= 1.0:
+        raise argparse.ArgumentTypeError(f"must be in (0, 1] (or 0-100 %), got {text!r}")
+    return x
+
+
+# ---------------------------------------------------------------------------------------------------------------
 # the study
 # ---------------------------------------------------------------------------------------------------------------
 def build_parser():
@@ -400,9 +468,14 @@ def build_parser():
     p.add_argument("--cycle", required=True, type=args.existing_file, metavar="FILE",
                    help="the duty cycle: a bin table (TOML [[bin]] tables or CSV) or a CSV time series (a 'time' "
                         "column), README: Duty cycles")
-    p.add_argument("--dynamic", default="", metavar="BIN[,BIN...]",
+    p.add_argument("--dynamic", default="", metavar="BIN[,BIN...]|all|auto",
                    help="bins also run dynamically (time integration): their lives include the dynamic load; "
-                        "'all' for every bin (default: none, every bin quasi-static)")
+                        "'all' for every bin; 'auto': every bin statically first, then dynamically the fewest bins "
+                        "that carry --dynamic-share of every bearing's damage (named before they run) (default: none, "
+                        "every bin quasi-static)")
+    p.add_argument("--dynamic-share", type=_share, default=None, metavar="SHARE",
+                   help=f"with --dynamic auto: the share of each bearing's damage (by its static lives) the dynamic "
+                        f"bins carry, e.g. 0.9 or 90%% (default {DEFAULT_DYNAMIC_SHARE:g})")
     p.add_argument("--snapshots", type=args.count(1), default=DEFAULT_SNAPSHOTS,
                    help=f"static solutions per bin over a carrier revolution and the mesh cycle (default "
                         f"{DEFAULT_SNAPSHOTS})")
@@ -447,6 +520,14 @@ class DutyCycle(Study):
             print(n, flush=True)
         names = [b.point.name for b in self.cycle.bins]
         asked = [x.strip() for x in a.dynamic.split(",") if x.strip()]
+        self.auto = asked == ["auto"]
+        if a.dynamic_share is not None and not self.auto:
+            raise ParameterError.at("--dynamic-share", "is the share the bins of --dynamic auto carry; give it with "
+                                                       "--dynamic auto")
+        self.share = a.dynamic_share if a.dynamic_share is not None else DEFAULT_DYNAMIC_SHARE
+        self.selection: dict | None = None
+        if self.auto:
+            asked = []
         if asked == ["all"]:
             asked = names
         unknown = [x for x in asked if x not in names]
@@ -485,8 +566,37 @@ class DutyCycle(Study):
     def machine_identity(self) -> dict:
         return self.machine
 
+    def second_phase(self, run: StudyRun) -> list[Case]:
+        """``--dynamic auto``: the bins that carry ``--dynamic-share`` of every bearing's damage by the static lives
+        (:func:`dominant_bins`), named with the shares they carry before their dynamic runs start."""
+        if not self.auto:
+            return []
+        res = run.results
+        bins = self.cycle.bins
+        static = [res.get(b.point.name) for b in bins]
+        missing = [b.point.name for b, st in zip(bins, static) if st is None or not st.has_bearings]
+        if missing:
+            print(f"--dynamic auto: no bins chosen, the static runs of {', '.join(missing)} have no results")
+            return []
+        table = damage_table(spectrum_lives(static, [b.share for b in bins], [b.hours for b in bins]))
+        chosen = dominant_bins(table, self.share)
+        carried = {k: math.fsum(v[i] for i in chosen) for k, v in table.items()}
+        least = min(carried, key=carried.get)
+        per_kind = {kind: min(v for k, v in carried.items() if k.startswith(kind + " ")) for kind in KINDS}
+        names = [bins[i].point.name for i in chosen]
+        self.dynamic = set(names)
+        self.selection = {"share": self.share, "bins": names, "carried": carried, "least_covered": least,
+                          "rule": "the fewest bins that carry at least the share of every planet bearing's damage "
+                                  "(each type and planet, ISO 281 and ISO/TS 16281-style, by the static lives); "
+                                  "among equally few, those carrying the most damage"}
+        print(f"dynamic bins (--dynamic auto, share {self.share:g} of every bearing's damage by the static lives): "
+              f"{', '.join(names)} ({len(names)} of {len(bins)}); they carry at least "
+              + ", ".join(f"{100 * per_kind[k]:.1f} % ({k})" for k in KINDS)
+              + f" of each bearing's damage, least {100 * carried[least]:.1f} % ({least})", flush=True)
+        return [self._case(bins[i], dynamic=True) for i in chosen]
+
     def study_record(self) -> dict:
-        return {"cycle": self.cycle.source}
+        return {"cycle": self.cycle.source, "dynamic_selection": self.selection}
 
     def report(self, run: StudyRun) -> dict:
         res = run.results
@@ -527,11 +637,15 @@ class DutyCycle(Study):
                          "revolution_share": {k: lives[k]["revolution_shares"][i] for k in KINDS},
                          "life_source": sources[i], "dynamic_load_included": sources[i] == "dynamic",
                          "dynamic_increment_equivalent_load": increments.get(b.point.name)})
+        static_idx = [i for i, src in enumerate(sources) if src == "static"]
+        ignoring = {k: math.fsum(v[i] for i in static_idx) for k, v in damage_table(lives).items()}
         total_h = math.fsum(b.hours for b in self.cycle.bins) if self.cycle.bins[0].hours is not None else None
         return {"machine": self.machine, "cycle": {"file": Path(self.cycle.source).name, "hours": total_h,
                                                    "binning": self.cycle.binning, "notes": self.cycle.notes},
                 "static_lives_note": STATIC_NOTE if "static" in sources else None,
                 "lives_ignore_dynamic_load": [n for n, src in zip(names, sources) if src == "static"],
+                "damage_share_ignoring_dynamic_load": ignoring,
+                "dynamic_selection": self.selection,
                 "method": ("Palmgren-Miner over the revolutions of the planet relative to its pin: L = 1/sum(u_i/L_i), "
                            "u_i = N_i/sum N (components.life.miner_life); in hours at the cycle's mean relative speed, "
                            "equal to 1/sum(tau_i/L_h,i) with time shares tau_i; equivalent load (sum u_i P_i^(10/3))^(3/10)"),
@@ -567,9 +681,17 @@ def headline(rec: dict) -> str:
             lines.append(f"dynamic bin {b['name']}: its dynamic run's equivalent load is "
                          f"{100 * inc['inner']:+.2f} % (inner) and {100 * inc['outer']:+.2f} % (outer) of the static "
                          f"solution's; its lives are the dynamic run's")
+    sel = rec.get("dynamic_selection")
+    if sel:
+        lines.append(f"dynamic bins chosen by --dynamic auto: {', '.join(sel['bins'])}, at least "
+                     f"{100 * sel['carried'][sel['least_covered']]:.1f} % of every bearing's damage by the static "
+                     f"lives (asked {100 * sel['share']:.4g} %)")
     if rec["static_lives_note"]:
+        ign = rec.get("damage_share_ignoring_dynamic_load") or {}
+        worst = max(ign, key=ign.get) if ign else None
+        share = f"; they do up to {100 * ign[worst]:.1f} % of a bearing's damage ({worst})" if worst else ""
         lines.append(f"note: {rec['static_lives_note']} ({len(rec['lives_ignore_dynamic_load'])} of "
-                     f"{len(rec['bins'])} bins)")
+                     f"{len(rec['bins'])} bins: {', '.join(rec['lives_ignore_dynamic_load'])}{share})")
     return "\n".join(lines)
 
 

@@ -97,7 +97,9 @@ def parse_args(argv):
                         "revolutions, as the spectrum command)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=20000.0, help="recording rate [Hz] (> 2 f_m)")
     # its folders are named by operating point, direction and machine
-    args.add_shared(p, out="results/faults", conditions="2")
+    args.add_shared(p, out="results/faults", conditions="2",
+                    conditions_why="condition 2, 2000 rpm: the speed of the source's test rig, whose sensor spectra the "
+                                   "faults' lines are read against")
     return p.parse_args(argv)
 
 

@@ -1,6 +1,6 @@
 """What real gears do to the planet bearings: the forward/reverse study with ISO 1328-1 tooth classes.
 
-    python -m scenarios.gear_quality [--conditions 1,2,3,4] [--directions forward,reverse] [--grades 5,6,8]
+    python -m scenarios.gear_quality [--conditions 1,2,3,4] [--directions forward,reverse] [--gear-class 5,6,8]
         [--seeds 1,2,3] [--systematic-share 0.5] [--settle S] [--window S] [--set KEY=VALUE ...]
         [--workers N | --scheduler ADDR] [--force] [--overwrite] [--out DIR]
 
@@ -61,9 +61,9 @@ COLUMNS = (["condition", "direction", "grade", "seed", "bearing", *QUANTITIES]
            + [f"{k}_{m}" for m in MESHES for k in MESH_COLUMNS])
 
 
-EXAMPLES = ["{prog} --conditions 3 --grades 6 --seeds 1 --out results/gear_quality",
-            "{prog} --conditions 1,2,3,4 --grades 5,6,8 --seeds 1,2,3 --workers 2",
-            "{prog} --params my_machine.toml --grades 8 --systematic-share 0.2"]
+EXAMPLES = ["{prog} --conditions 3 --gear-class 6 --seeds 1 --out results/gear_quality",
+            "{prog} --conditions 1,2,3,4 --gear-class 5,6,8 --seeds 1,2,3 --workers 2",
+            "{prog} --params my_machine.toml --gear-class 8 --systematic-share 0.2"]
 WRITES = ("c{condition}_{direction}_{perfect|class{G}_seed{S}}/{results.nc, summary.json} per run; runs.csv (a "
           "row per run and bearing type), by_grade.csv (per class the mean over the seeds and their range, the "
           "forward/reverse change), findings.md (the answer in words, also printed), quality.png, study.json")
@@ -72,15 +72,19 @@ WRITES = ("c{condition}_{direction}_{perfect|class{G}_seed{S}}/{results.nc, summ
 def parse_args(argv):
     p = args.parser("gear_quality", __doc__, examples=EXAMPLES, writes=WRITES, out="results/gear_quality")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
-    p.add_argument("--grades", default="5,6,8", type=args.int_list(1, 11, "flank tolerance classes"),
-                   help="ISO 1328-1:2013 flank tolerance classes 1..11 (default 5,6,8)")
+    p.add_argument(args.GEAR_CLASS, default="5,6,8", type=args.int_list(1, 11, "flank tolerance classes"),
+                   metavar="CLASS[,CLASS...]", help="ISO 1328-1:2013 flank tolerance classes 1..11 (default 5,6,8)")
+    args.renamed(p, "--grades", "--classes", "--gear-grade", new=args.GEAR_CLASS)
     p.add_argument("--seeds", default="1,2,3", type=args.int_list(0, None, "seeds"), help="seeds of the draws (default 1,2,3)")
     p.add_argument("--systematic-share", type=_share, default=0.5,
                    help="share of the profile deviations' variance common to a gear flank's teeth (default 0.5)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded (default 0.03)")
     p.add_argument("--window", type=args.positive("s"), default=None,
                    help="seconds analysed (default: the paper study's, whole cage revolutions)")
-    args.add_shared(p, out="results/gear_quality", conditions="1,2,3,4")
+    args.add_shared(p, out="results/gear_quality", conditions="1,2,3,4",
+                    conditions_why="all four: what a tooth class does depends on the mesh frequency against the "
+                                   "train's natural frequencies and on the load, so every speed and load of the "
+                                   "source is asked")
     return p.parse_args(argv)
 
 
@@ -99,8 +103,8 @@ def make_cases(a, out: Path) -> list[Case]:
     """Perfect teeth, and every class × seed, at every condition and direction."""
     sets = args.parse_sets(a.set)
     points = points_of(a, sets)
-    user = machine_overrides(user_overrides(sets, a.params, {"errors.flank_class": "--grades and --seeds"}), points)
-    machines = [(None, None)] + [(g, s) for g in a.grades for s in a.seeds]
+    user = machine_overrides(user_overrides(sets, a.params, {"errors.flank_class": "--gear-class and --seeds"}), points)
+    machines = [(None, None)] + [(g, s) for g in a.gear_class for s in a.seeds]
     cases = []
     for p in points:
         for d in ([p.direction] if p.direction else a.directions.split(",")):

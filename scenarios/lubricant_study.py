@@ -1,7 +1,7 @@
 """Which oil for which direction? The source study's open question, answered with the dynamic model.
 
     python -m scenarios.lubricant_study [--conditions 3] [--directions forward,reverse]
-        [--grades VG32,VG68,VG150 | --viscosities "10,30,100 mPa*s"] [--settle S] [--window S]
+        [--oil VG32,VG68,VG150 | --viscosities "10,30,100 mPa*s"] [--settle S] [--window S]
         [--set KEY=VALUE ...] [--params FILE] [--workers N | --scheduler ADDR] [--out DIR]
 
 Every condition × direction × lubricant runs through the one runner (resumable, on Dask like the paper
@@ -61,7 +61,7 @@ _FROM_SUMMARY = {"h_min_m": "film_min_m", "h_mean_m": "film_mean_m", "h_min_isot
 
 
 EXAMPLES = ["{prog} --conditions 3 --out results/lubricant", "{prog} --replot --out results/lubricant",
-            "{prog} --conditions 1,2,3,4 --grades VG32,VG68,VG150,VG220 --workers 2",
+            "{prog} --conditions 1,2,3,4 --oil VG32,VG68,VG150,VG220 --workers 2",
             '{prog} --viscosities "10,30,100 mPa*s" --directions reverse']
 WRITES = ("c{condition}_{direction}_{oil}/{results.nc, summary.json} per run; summary.csv and summary.md (a row "
           "per run and bearing type: film with and without its thermal reduction, Λ and its regime, traction, "
@@ -73,7 +73,8 @@ def parse_args(argv):
     p = args.parser("lubricant_study", __doc__, examples=EXAMPLES, writes=WRITES, out="results/lubricant")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--grades", default=None, type=args.choice_list(tuple(OIL_GRADES), "ISO VG grades"),
+    args.renamed(p, "--grades", "--oils", new=args.OIL)
+    g.add_argument(args.OIL, default=None, type=args.choice_list(tuple(OIL_GRADES), "ISO VG grades"), metavar="VG[,VG...]",
                    help=f"comma list of ISO VG grades ({', '.join(OIL_GRADES)}; default {','.join(DEFAULT_GRADES)})")
     g.add_argument("--viscosities", default=None,
                    help='dynamic viscosities at the operating temperature, e.g. "10,30,100 mPa*s"')
@@ -108,7 +109,7 @@ def lubricants(a) -> dict[str, dict]:
                 raise ParameterError.at("--viscosities", f"expected positive viscosities, got {q!r}")
             out[q.replace(" ", "").replace("*", "")] = {"lubricant.oil_viscosity": q}   # a file-name-safe label
         return out
-    grades = [s.strip() for s in (a.grades or ",".join(DEFAULT_GRADES)).split(",") if s.strip()]
+    grades = [s.strip() for s in (a.oil or ",".join(DEFAULT_GRADES)).split(",") if s.strip()]
     return {g: {k: v.value for k, v in oil_grade(g).items()} for g in grades}
 
 
@@ -118,7 +119,7 @@ def make_cases(a, out: Path) -> list[Case]:
     dirs = [d.strip() for d in str(a.directions).split(",") if d.strip()]
     if not dirs or any(d not in ("forward", "reverse") for d in dirs):
         raise ParameterError.at("--directions", f"expected forward and/or reverse, got {a.directions!r}")
-    oils = "--grades or --viscosities"
+    oils = "--oil or --viscosities"
     owned = {"lubricant.viscosity_40": oils, "lubricant.viscosity_100": oils, "lubricant.oil_viscosity": oils}
     sets = args.parse_sets(a.set)
     points = points_of(a, sets)

@@ -35,6 +35,7 @@ from components.units import ParameterError
 
 from .core import args
 from .core.command import command
+from .core.integrity import claim_for_inputs, command_inputs
 
 
 EXAMPLES = ["{prog} --params my_planetary.toml --out results/modal", "{prog} --set planets=4",
@@ -51,7 +52,8 @@ def parse_args(argv):
     p.add_argument("--dpgt", action="store_true", help="analyse the DPGT with linear bearings instead")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="DPGT: seconds to reach the loaded steady state")
     # --params and --set describe a single planetary set here (or, with --dpgt, --set the DPGT's keys)
-    args.add_shared(p, "conditions", "out", out="results/modal", conditions="3", one_condition_only=True)
+    args.add_shared(p, "conditions", "out", "overwrite", "no-progress", out="results/modal", conditions="3",
+                    one_condition_only=True)
     return p.parse_args(argv)
 
 
@@ -96,13 +98,14 @@ def dpgt(a):
 def run(a) -> dict:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    identity = claim_for_inputs(out, command_inputs(a), a.overwrite)     # other inputs' results: --overwrite
     built, f, X, kind, groups = dpgt(a) if a.dpgt else planetary(a)
     mult = _multiplicity(groups, f.size)
     m = built.model
     labels = [f"{m.body_names[i // 3]}.{'xyθ'[i % 3]}" for i in m.free]
     summary = {"model": "dpgt_linear_bearings" if a.dpgt else "single_planetary",
                "frequencies_hz": [float(x) for x in f], "mode_class": kind, "multiplicity": mult.tolist(),
-               "dof": int(m.ndof)}
+               "dof": int(m.ndof), **identity}
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2))
     buf = io.StringIO()
     w = csv.writer(buf)

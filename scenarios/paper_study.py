@@ -26,11 +26,11 @@ from components.families import MESH_FAMILY
 from components.static import DEFAULT_SNAPSHOTS, STATIC_LIVES_NOTE
 from components.outputs import FAMILY, radial_tangential
 from components.outputs import relative_life as iso_relative_life
-from components.results import SUMMARY_WORDS, Summary, json_attr, open_run
+from components.results import SUMMARY_WORDS, Summary, json_attr, open_run, percent_change
 from components.results.io import atomic_write_text, write_summary
 
 from .core.integrity import read_summary
-from .core.runner import RunConfig
+from .core.runner import SETTLED_SPEED_ERROR_PCT, RunConfig
 from .core.study import Study, StudyRun
 from .core.points import machine_identity, machine_overrides, point_label, point_order, point_tag, points_of
 from .core.sweep import Case, user_overrides
@@ -169,9 +169,10 @@ def comparison_rows(results: dict) -> list[dict]:
             for q, unit in QUANTITIES:
                 fv = f.get(kind, {}).get(q) if not f.failed else None
                 rv = r.get(kind, {}).get(q) if not r.failed else None
-                diff = (rv - fv) / fv * 100.0 if (fv not in (None, 0) and rv is not None) else None
                 rows.append({"condition": c, "bearing": kind, "quantity": q, "description": SUMMARY_WORDS[q][0],
-                             "unit": unit, "forward": fv, "reverse": rv, "difference_pct": diff})
+                             "unit": unit, "forward": fv, "reverse": rv,
+                             "difference": rv - fv if fv is not None and rv is not None else None,
+                             "difference_pct": percent_change(fv, rv)})
     return rows
 
 
@@ -187,11 +188,14 @@ def write_tables(rows: list[dict], out: Path, machine: dict | None = None) -> tu
     atomic_write_text(out / "comparison.csv", buf.getvalue())
     md = []
     for c in sorted({r["condition"] for r in rows}, key=point_order):
-        md.append(f"\n### {_title(c)}\n\n| bearing | quantity | forward | reverse | difference % |\n|---|---|---|---|---|")
+        md.append(f"\n### {_title(c)}\n\n| bearing | quantity | forward | reverse | reverse − forward | difference % "
+                  f"|\n|---|---|---|---|---|---|")
         for r in rows:
             if r["condition"] == c:
+                pct = _fmt(r["difference_pct"], 3) if r["difference_pct"] is not None or r["difference"] is None \
+                    else "– (sign changes)" if (r["forward"] or 0) * (r["reverse"] or 0) < 0 else "–"
                 md.append(f"| {r['bearing']} | {r['description']} [{r['unit']}] | {_fmt(r['forward'])} | "
-                          f"{_fmt(r['reverse'])} | {_fmt(r['difference_pct'], 3)} |")
+                          f"{_fmt(r['reverse'])} | {_fmt(r['difference'])} | {pct} |")
     text = "\n".join(md).strip() + "\n"
     if machine is not None:        # the machine the tables are of: its file, a short fingerprint, the overrides
         text = f"Machine: {machine['label']}\n\n" + text
@@ -201,6 +205,23 @@ def write_tables(rows: list[dict], out: Path, machine: dict | None = None) -> tu
 
 HEADLINE = (("bearing_load_mean_N", "mean load", 1e-3, "kN"), ("life_iso281_h", "L10 ISO 281", 1.0, "h"),
             ("life_iso16281_h", "L10 roller loads", 1.0, "h"))
+
+
+def meaningless(results: dict) -> str:
+    """Why the runs' statistics do not mean anything, in one line ('' when they do): a bearing whose cage turned less
+    than once relative to the carrier in the window, or a carrier drive off its speed by more than
+    :data:`scenarios.core.runner.SETTLED_SPEED_ERROR_PCT` on average (each run's warnings say it in full)."""
+    why = []
+    for label, s in sorted(results.items()):
+        if not s.has_bearings:
+            continue
+        short = [k for k in ("inner", "outer") if (s[k].get("cage_revolutions") or 1.0) < 1.0]
+        if short:
+            why.append(f"{label}: the window covers less than one cage revolution ({', '.join(short)})")
+        err = s.get("carrier_speed_error_mean_pct")
+        if err is not None and abs(err) > SETTLED_SPEED_ERROR_PCT:
+            why.append(f"{label}: the carrier drive had not settled ({err:+.2g} %)")
+    return "; ".join(why)
 
 
 def headline_table(rows: list[dict]) -> str:
@@ -334,10 +355,16 @@ def plots(results: dict, out: Path, machine: str = "") -> list[Path]:
         runs = _runs_of(results, out, c)
         if not runs:
             continue
+        f_m = [results[_label_of(results, c, d)].get("f_m_hz") for d in runs]
+        mesh_period = 1.0 / f_m[0] if f_m and f_m[0] else None
         for g, (rows, cols) in history_groups(runs).items():
             titles = {"inner": "inner planet bearing", "outer": "outer planet bearing", **MESH_COLUMNS}
+            # forward and reverse in rows of their own; the mesh histories, sampled a few times per mesh cycle, as
+            # their envelope over a mesh period
             paths.append(vp.time_history_group(rows, out / f"{point_tag(c)}_{g}.png", columns=cols,
-                                               column_titles=titles, title=f"{_title(c)}: {HISTORY_GROUPS[g]}"))
+                                               column_titles=titles, title=f"{_title(c)}: {HISTORY_GROUPS[g]}",
+                                               separate_runs=True, envelope=mesh_period if g == "mesh" else None,
+                                               envelope_words="mesh cycle"))
         paths += study_cage_pictures(runs, out, prefix=f"{point_tag(c)}_",
                                      title=f"{_title(c)}: cage orbits in the guide clearance")
     vals = headline_values(results)
@@ -364,7 +391,8 @@ def plots(results: dict, out: Path, machine: str = "") -> list[Path]:
         paths.append(vp.bar_chart([_title(c).lower() for c in conds], {k: {_title(c).lower(): v for c, v in by.items()}
                                                                        for k, by in table.items()},
                                   bar_units, out / "bars.png", ylabels=ylabels, ncols=2,
-                                  title="RMS across conditions: forward vs reverse"))
+                                  title=("RMS per condition: forward vs reverse" if len(conds) > 1 else
+                                         f"RMS at {_title(conds[0]).lower()}: forward vs reverse")))
     return paths
 
 
@@ -439,7 +467,11 @@ class PaperStudy(Study):
             rows = [r for r in rows if r["forward"] is not None or r["reverse"] is not None]
         machine = self.machine_identity()
         csv_p, md_p, text = write_tables(rows, self.out, machine)
-        print("\n" + headline_table(rows))   # the headline first, then the whole comparison
+        doubts = meaningless(results)
+        if doubts:          # a headline of runs whose statistics mean nothing is not a finding: said above it
+            text = f"**Not a finding**: {doubts}.\n\n" + text
+            atomic_write_text(md_p, text)
+        print(("\nnot a finding: " + doubts + "\n" if doubts else "\n") + headline_table(rows))   # the headline first
         print("\n" + text)
         if static:
             left = sorted({q for q, _ in QUANTITIES} - {r["quantity"] for r in rows})

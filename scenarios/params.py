@@ -18,6 +18,7 @@ import warnings
 from pathlib import Path
 
 from components.parameter_reference import reference_markdown
+from components.geometry import check_design
 from components.params import overrides_from_toml, parameter_rows, with_overrides
 from components.presets import reference_dpgt
 from components.results.io import atomic_write_text
@@ -60,6 +61,7 @@ def rows(a) -> list[dict[str, str]]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         params = with_overrides(reference_dpgt(int(a.conditions), a.direction), {**from_file, **args.parse_sets(a.set)})
+        check_design(params)          # a machine that cannot be built is refused as a run would refuse it
     out = parameter_rows(params)
     if a.grep:
         word = a.grep.lower()

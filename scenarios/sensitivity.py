@@ -504,7 +504,9 @@ def parse_args(argv):
                    help=f"tangential pinhole error of planet {PINHOLE_PLANET} (default 10 um: the tolerance study's "
                         f"±10 µm at 3σ at its limit; 0 um: the perfect machine, K_γ = 1)")
     p.add_argument("--seed", type=args.count(0), default=1, help="seed of the designs and bootstraps (default 1)")
-    args.add_shared(p, out="results/sensitivity", conditions="2,3")
+    args.add_shared(p, out="results/sensitivity", conditions="2,3",
+                    conditions_why="2 and 3: a middle and the fastest loaded speed (2000 and 4200 rpm at 200 kW), "
+                                   "to show whether the ranking of the parameters moves with speed")
     a = p.parse_args(argv)
     if "4" in a.conditions.split(","):
         p.error("argument --conditions: condition 4 transmits no torque (0 kW): there is no load to share; "

@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
-from components.geometry import sideband_origin
+from components.geometry import check_design, sideband_origin
 from components.params import flatten, overrides_from_toml, with_overrides
 from components.presets import SENSOR_PRESETS, reference_dpgt, typical_errors
 from components.results import open_dataset
@@ -55,6 +55,7 @@ from .core.analysis import amplitude_spectrum, line_table, peak_table, sensor_pa
 from .core.analysis import whole_revolutions as _whole_revolutions
 from .core.plausibility import check_runs
 from .core.runner import RunConfig, finished_run, run_case, run_report
+from .core.sweep import say_design_warnings
 from .core import args
 from .core.command import command
 
@@ -94,8 +95,9 @@ def parse_args(argv):
                    help="housing: the rig's accelerometer (rig.sensor.*, default), the sum of its paths mesh, torque "
                         "and bearing (each alone by name); axis: ideal, at the carrier axis")
     p.add_argument("--perfect", action="store_true",
-                   help="a perfect machine: no manufacturing errors (default: the errors of --gear-grade)")
-    p.add_argument("--gear-grade", type=args.count(1, 11), default=None,
+                   help="a perfect machine: no manufacturing errors (default: the errors of --gear-class)")
+    args.renamed(p, "--grades", "--classes", "--gear-grade", new=args.GEAR_CLASS)
+    p.add_argument(args.GEAR_CLASS, type=args.count(1, 11), default=None, metavar="CLASS",
                    help="ISO 1328-1 flank tolerance class of the gears behind the default manufacturing errors "
                         "(default 6: every gear's teeth drawn for that class, runouts F_r/2 of that grade, all "
                         "carrier pinholes within ±10 µm; components.presets.typical_errors); errors given by --params "
@@ -119,7 +121,7 @@ def parse_args(argv):
 def machine(a):
     """The machine on the rig: the reference DPGT (or ``--params FILE.toml`` on it) at the operating point
     asked for, with ``--set`` overrides (a usage error names the parameter) and its manufacturing errors: those
-    given (``--set errors.X`` / the TOML file), else the typical errors of ``--gear-grade``, none with
+    given (``--set errors.X`` / the TOML file), else the typical errors of ``--gear-class``, none with
     ``--perfect``. The operating point belongs to this command's options: a file or ``--set`` that sets it is
     refused, as is ``--perfect`` with errors given."""
     try:
@@ -139,11 +141,11 @@ def machine(a):
         params = with_overrides(reference_dpgt(2, a.direction), overrides)
         if a.perfect and not params.errors.perfect:
             raise SystemExit("error: --perfect contradicts the manufacturing errors given (--params / --set errors.*)")
-        if a.gear_grade is not None and (a.perfect or not params.errors.perfect):
-            raise SystemExit(f"error: --gear-grade {a.gear_grade} contradicts "
+        if a.gear_class is not None and (a.perfect or not params.errors.perfect):
+            raise SystemExit(f"error: --gear-class {a.gear_class} contradicts "
                              f"{'--perfect' if a.perfect else 'the manufacturing errors given (--params / --set errors.*)'}")
         if not a.perfect and params.errors.perfect:      # the rig's machine, unless errors were given
-            params = params.replace(errors=typical_errors(params, 6 if a.gear_grade is None else a.gear_grade))
+            params = params.replace(errors=typical_errors(params, 6 if a.gear_class is None else a.gear_class))
         si = params.si()
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
@@ -191,6 +193,10 @@ def measure(params, sensor: str, cfg: RunConfig, out: Path, *, force: bool = Fal
     if sensor not in SENSORS:
         raise SystemExit(f"error: --sensor {sensor!r}: expected one of {list(SENSORS)}")
     out.mkdir(parents=True, exist_ok=True)
+    with warnings.catch_warnings(record=True) as caught:  # the design warnings every command says
+        warnings.simplefilter("always")
+        check_design(params)
+    say_design_warnings(caught)
     cfg = dataclasses.replace(cfg, sensor=True)          # every path is written, whichever sensor is read
     for w in check_runs([("spectrum", params, cfg)], out, force):
         print(f"warning (--force): {w}")
@@ -313,7 +319,8 @@ def _plot(f, spectra, f_m, f_c, s, sensor, out, place="housing_top"):
     title = f"{where.capitalize()}, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min" + (
         f"\n({', '.join(names[k] for k in zero)} zero for this sensor, not drawn)" if zero else "")
     return vp.spectrum(f, {names[k]: spectra[k][1] for k in shown if k not in zero}, marks, out / "spectrum.png",
-                       fmax=min(f[-1], 2.5 * f_m), quantity=where, unit="m/s²", logy=True, title=title)
+                       fmax=min(f[-1], 2.5 * f_m), quantity=where, unit="m/s²", logy=True, title=title,
+                       zoom=(f_m - 5 * f_c, f_m + 5 * f_c))
 
 
 def _report(lines, peaks, f_m, f_c, df, t, sensor) -> None:

@@ -2,7 +2,7 @@
 and lives over machines drawn from stated tolerances (docs/tolerances.md).
 
     python -m scenarios.tolerance_study [--samples 64] [--torques 0.25,0.5,1] [--conditions 3]
-        [--directions forward,reverse] [--classes 5,7] [--pinhole-tolerance "10 um"] [--clearance-tolerance "5 um"]
+        [--directions forward,reverse] [--gear-class 5,7] [--pinhole-tolerance "10 um"] [--clearance-tolerance "5 um"]
         [--roller-lot "2 um"] [--dynamic 16] [--snapshots 16] [--seed 1] [--settle S] [--window S]
         [--params FILE.toml] [--set KEY=VALUE ...] [--workers N | --scheduler ADDR] [--force] [--overwrite] [--out DIR]
 
@@ -82,9 +82,9 @@ PERCENTILES = {"p50": 50.0, "p90": 90.0, "p99": 99.0}
 RECORD_VERSION = 1       # what a static result file holds (_kept); another version is solved again
 TABLE_K_GAMMA = 1.0      # the rating tables' K_γ for up to three planets (docs/tolerances.md: what was found, cited)
 
-EXAMPLES = ["{prog} --samples 64 --conditions 3 --classes 5,7 --dynamic 2 --out results/tolerances",
+EXAMPLES = ["{prog} --samples 64 --conditions 3 --gear-class 5,7 --dynamic 2 --out results/tolerances",
             "{prog} --samples 1024 --conditions 2,3 --torques 0.25,0.5,1 --workers 2",
-            '{prog} --classes 6 --pinhole-tolerance "20 um" --clearance-tolerance "5 um" --dynamic 0']
+            '{prog} --gear-class 6 --pinhole-tolerance "20 um" --clearance-tolerance "5 um" --dynamic 0']
 WRITES = ("static/class{C}/c{condition}_{direction}_t{torque}/sample_NNNN.json and static/perfect_c{condition}_"
           "{direction}_t{torque}.json (one static solution each); "
           "c{condition}_{direction}_t{torque}_{classC_sNNNN|perfect}/{results.nc, summary.json} per dynamic run; "
@@ -140,7 +140,9 @@ def parse_args(argv):
     p.add_argument("--torques", type=_fractions, default=[1.0], metavar="F[,F...]",
                    help="fractions > 0 of each condition's rated output torque (default 1)")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
-    p.add_argument("--classes", type=args.int_list(1, 11, "ISO 1328 classes"), default=d["classes"][0],
+    args.renamed(p, "--grades", "--classes", "--gear-grade", new=args.GEAR_CLASS)
+    p.add_argument(args.GEAR_CLASS, type=args.int_list(1, 11, "ISO 1328 classes"), default=d["classes"][0],
+                   metavar="CLASS[,CLASS...]",
                    help=f"ISO 1328-1:2013 flank tolerance classes 1..11, each with its runout tolerance 0.9 F_pT "
                         f"(default {d['classes'][0]})")
     p.add_argument("--pinhole-tolerance", type=_tolerance, default=d["pinhole"][0], metavar="LENGTH",
@@ -172,7 +174,7 @@ def parse_args(argv):
                 "take 1, 2 and/or 3")
     a.torques = sorted(a.torques)
     a.spec = {c: ToleranceSpec(c, a.pinhole_tolerance, a.clearance_tolerance, a.roller_lot,
-                               float(d["systematic_share"][0])) for c in a.classes}
+                               float(d["systematic_share"][0])) for c in a.gear_class}
     return a
 
 
@@ -218,7 +220,7 @@ def machines(a, si) -> dict[int, tuple[dict, dict]]:
     """{class: [(overrides, drawn) per sample]}: every sample's errors (the same Sobol points for every class)."""
     N, Z = si.layout.planets, si.bearing.rollers
     u = sobol_points(a.samples, len(coordinates(N, Z)), a.seed, a.replicates)
-    return {c: [draw_errors(si, a.spec[c], u[i], teeth_seed(a.seed, i)) for i in range(a.samples)] for c in a.classes}
+    return {c: [draw_errors(si, a.spec[c], u[i], teeth_seed(a.seed, i)) for i in range(a.samples)] for c in a.gear_class}
 
 
 def _scaled(p: Point, d: str, f: float, power: float, user: dict, params_file):
@@ -246,7 +248,7 @@ def static_tasks(a, out: Path, user: dict, points: list[Point]) -> list[StaticTa
                 point = f"{point_label(p, d)}_{_torque_tag(f)}"
                 tasks.append(StaticTask(case(str(out / "static")),
                                         str(out / "static" / f"perfect_{point}.json"), a.snapshots, None, f, None, {}))
-                for c in a.classes:
+                for c in a.gear_class:
                     folder = out / "static" / f"class{c}" / point
                     for i, (ov, dr) in enumerate(drawn[c]):
                         tasks.append(StaticTask(case(str(folder), ov),
@@ -351,6 +353,27 @@ def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None
 # ---------------------------------------------------------------------------------------------------------------
 # statistics
 # ---------------------------------------------------------------------------------------------------------------
+def fewest_samples(q: float) -> int:
+    """The fewest values of which Hazen's q-th percentile (q in %) is not simply the smallest or the largest: its
+    plotting positions (i − ½)/m hold q/100 strictly between two of them only when ½/m < min(q, 100 − q)/100,
+    m > 50/min(q, 100 − q) (P90 and P10: 6, P99: 51)."""
+    return math.floor(50.0 / min(q, 100.0 - q) + 1e-9) + 1
+
+
+def too_few_samples(samples: int, replicates: int) -> list[str]:
+    """The percentiles the study reports (P50, P90, P99 of K_γ and loads, P10 of the lives) that ``samples`` machines
+    in ``replicates`` replicates cannot give: each replicate's percentile would be its largest (or smallest) value."""
+    m = samples // replicates
+    out = []
+    for name, q in (*PERCENTILES.items(), ("p10", 10.0)):
+        need = fewest_samples(q)
+        if m < need:
+            out.append(f"{name.upper()} from {m} machine{'s' if m != 1 else ''} per replicate (--samples {samples} / "
+                       f"--replicates {replicates}) is each replicate's {'largest' if q > 50 else 'smallest'} value, "
+                       f"not a percentile: it needs {need} per replicate, --samples {need * replicates} or more")
+    return out
+
+
 def percentile_ci(x, q: float | None, replicate) -> dict:
     """{"value", "ci95"}: the mean (``q`` None) or the q-th percentile of ``x`` by randomised QMC: the statistic of each
     independent replicate (``replicate`` the replicate of each value,
@@ -676,9 +699,12 @@ class ToleranceStudy(Study):
         sets = args.parse_sets(a.set)
         self.points = points_of(a, sets)
         self.user = machine_overrides(user_overrides(sets, a.params, {
-            "errors": "the tolerance options (--classes, --pinhole-tolerance, --clearance-tolerance, --roller-lot)"}),
+            "errors": "the tolerance options (--gear-class, --pinhole-tolerance, --clearance-tolerance, --roller-lot)"}),
             self.points)
         self.tasks = static_tasks(a, self.out, self.user, self.points)
+        self.too_few = too_few_samples(a.samples, a.replicates)
+        for w in self.too_few:                   # said before anything runs, and again above the answer
+            print(f"warning before the run: {w}", flush=True)
         self.records: dict = {}
         self.cost: dict = {}
 
@@ -704,7 +730,7 @@ class ToleranceStudy(Study):
         a = self.a
         return {"samples": a.samples, "seed": a.seed, "replicates": a.replicates, "snapshots": a.snapshots,
                 "torques": a.torques,
-                "classes": a.classes, "tolerances": self._tolerance_words(),
+                "classes": a.gear_class, "tolerances": self._tolerance_words(),
                 "distributions": DISTRIBUTIONS, "sampler": "randomised QMC: --replicates independently scrambled scipy.stats.qmc.Sobol "
                                                        "sequences of --seed, machine i in replicate i mod R; inverse CDFs",
                 "defaults": {k: {"value": v[0], "source": v[1], "basis": v[2]} for k, v in TOLERANCE_DEFAULTS.items()},
@@ -712,7 +738,7 @@ class ToleranceStudy(Study):
 
     def _tolerance_words(self) -> str:
         a = self.a
-        return (f"ISO 1328 classes {', '.join(map(str, a.classes))} (teeth and runout), pinholes ± "
+        return (f"ISO 1328 classes {', '.join(map(str, a.gear_class))} (teeth and runout), pinholes ± "
                 f"{a.pinhole_tolerance * 1e6:g} µm at 3σ, bearing clearance nominal ± {a.clearance_tolerance * 1e6:g} µm "
                 f"(uniform), roller lot {a.roller_lot * 1e6:g} µm (uniform)")
 
@@ -752,6 +778,10 @@ class ToleranceStudy(Study):
         agree = agreement_rows(self.records, dynamic)
         record = {"samples": a.samples, "tolerances": self._tolerance_words(), "static_cost": self.cost}
         text = answer(stats, agree, record)
+        if self.too_few:                          # a percentile that is an extreme value is not a finding
+            text = "\n".join(["**Not findings** — these percentiles are extreme values of too few samples (the "
+                               "others stand):",
+                               *(f"- {w}" for w in self.too_few), "", text])
         print(text)                               # the headline first
         rows = sample_rows(self.records)
 

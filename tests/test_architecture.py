@@ -80,7 +80,7 @@ def test_the_engine_knows_nothing_of_the_domain():
             assert not [d for d in deps if not d.startswith("mbd")], (mod, deps)
 
 
-# what viz reads results through (issue 27 §2): the results module's namespace, summary and reader
+# what viz reads results through: the results module's namespace, summary and reader
 RESULTS = "components.results"
 RESULTS_ENGINE_FREE = {RESULTS, f"{RESULTS}.summary", f"{RESULTS}.reader"}
 
@@ -163,7 +163,7 @@ def test_parameter_choices_name_the_registered_laws():
 
 def test_the_parameter_package_is_entered_through_components_params():
     """Parameters are used through ``components.params`` (its __init__ re-exports every public name); its modules,
-    the machinery above all, are the package's own business (issue 27 §4)."""
+    the machinery above all, are the package's own business."""
     graph = import_graph()
     assert {"components.params._machinery", "components.params.machine"} <= set(graph)
     inner = {(mod, d) for mod, deps in graph.items() if not mod.startswith("components.params")
@@ -173,7 +173,7 @@ def test_the_parameter_package_is_entered_through_components_params():
 
 def test_every_si_class_is_written_out_next_to_its_parameter_class():
     """No SI class is made at run time (a type checker would not see it): each is a class statement in its
-    parameter class's module, declaring every field (issue 27 §4; tests/components/test_params_typing.py runs mypy)."""
+    parameter class's module, declaring every field (tests/components/test_params_typing.py runs mypy)."""
     import components.params as P
 
     def subclasses(cls):
@@ -274,7 +274,7 @@ def test_scene_touches_no_private_attribute_of_the_model_builder():
     assert {"_pose", "_mass", "_inertia"} <= builder        # what Scene used to write and read
 
 
-# scenarios/ in three kinds (issue 27 §5): the studies a user runs at the top of the package, beside the two entrances
+# scenarios/ in three kinds: the studies a user runs at the top of the package, beside the two entrances
 # (the console command, the Python entry point) and the shims that keep the numerics scripts' documented
 # `python -m scenarios.NAME`; the numerics and benchmark scripts in scenarios.numerics; the machinery they share in
 # scenarios.core. The kinds are read from the layout, so a new module is walled in by where it is put.
@@ -294,7 +294,7 @@ def scenario_kinds(graph: dict[str, set[str]]) -> dict[str, str]:
     return kinds
 
 
-# the modules every scenario builds on; a scenario borrows nothing from another scenario (issue 24 §3)
+# the modules every scenario builds on; a scenario borrows nothing from another scenario
 def scenario_infrastructure(graph: dict[str, set[str]]) -> set[str]:
     return {"scenarios", "scenarios.numerics", "scenarios.numerics.common",
             *(m for m, k in scenario_kinds(graph).items() if k == "core")}
@@ -379,7 +379,7 @@ def test_every_numerics_script_has_its_command_and_every_shim_is_one_import():
             f"from .numerics.{name} import main", "if __name__ == '__main__':\n    raise SystemExit(main())"], name
 
 
-# a function-local import says why it is not at the top of its module (issue 27): it breaks an import cycle
+# a function-local import says why it is not at the top of its module: it breaks an import cycle
 # ("# cycle: ..."), or it defers a heavy or optional import that a start-up path does not need ("# deferred: ...":
 # numba's kernels, VTK, Dask, matplotlib, xarray/HDF5, the runner in dpgt's start-up). The reason is on the import's
 # line, or on a comment line right above the block of imports it belongs to.
@@ -627,7 +627,7 @@ def test_every_family_of_the_shipped_scenes_has_a_compiled_twin():
 
 
 def test_the_results_module_imports_no_engine_internals_and_viz_reads_through_it():
-    """components.results (issue 27 §2): its namespace, the summary and the reader import nothing of the project
+    """components.results: its namespace, the summary and the reader import nothing of the project
     (viz reads through them without the engine); its writer and schema take the engine only through ``mbd``'s
     public API (never ``mbd.<module>``); viz enters the project through components.results alone (and the
     did-you-mean, components.names)."""

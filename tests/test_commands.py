@@ -1,6 +1,7 @@
 """How commands end (scenarios.core.command): one line and an exit code, a traceback only with --debug."""
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import mbd
@@ -82,7 +83,7 @@ BAD_ARGUMENTS = [
     ("paper_study", ["--scheduler", "my laptop"], "--scheduler: expected a Dask scheduler address"),
     ("paper_study", ["--method", "rk4"], "--method: invalid choice"),
     ("paper_study", ["--frobnicate"], "unrecognized arguments: --frobnicate"),
-    ("lubricant_study", ["--grades", "VG999"], "--grades: takes ISO VG grades"),
+    ("lubricant_study", ["--oil", "VG999"], "--oil: takes ISO VG grades"),
     ("lubricant_study", ["--directions", ""], "--directions: expected a comma list"),
     ("spectrum", ["--power", "200 kg"], "--power: expected a power"),
     ("spectrum", ["--carrier-rpm", "-5"], "--carrier-rpm: must be > 0 r/min"),
@@ -190,7 +191,7 @@ def test_did_you_mean_is_one_helper_with_sane_matches():
     assert argparse_hint(p, "unrecognized arguments: --zzz") == "unrecognized arguments: --zzz"
 
 
-# the shared command grammar (issue 24 §3): one definition of every shared option, the same in every command
+# the shared command grammar: one definition of every shared option, the same in every command
 STUDIES = {"paper_study": "results/study", "demo": "results/demo", "lubricant_study": "results/lubricant",
            "fault_study": "results/faults", "gear_quality": "results/gear_quality",
            "tolerance_study": "results/tolerances", "sensitivity": "results/sensitivity"}
@@ -408,7 +409,222 @@ def test_params_files_reach_every_case_of_the_studies_that_gained_them(tmp_path)
     assert set(by) == {"perfect", "runout", "bent"}
     assert all(si.bearing.clearance == pytest.approx(30e-6) for si in by.values())
     assert by["bent"].errors.pinhole and by["runout"].errors.runout and not by["perfect"].errors.pinhole
-    a = gear_quality.parse_args(["--params", str(common), "--conditions", "3", "--grades", "6", "--seeds", "1",
+    a = gear_quality.parse_args(["--params", str(common), "--conditions", "3", "--gear-class", "6", "--seeds", "1",
                                  "--out", str(tmp_path / "g")])
     assert all(build_params(c).si().bearing.clearance == pytest.approx(30e-6)
                for c in gear_quality.make_cases(a, tmp_path / "g"))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# one vocabulary: the same option name for the same thing in every command
+# ---------------------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("name,old,new,value", [
+    ("gear_quality", "--grades", "--gear-class", "6"), ("tolerance_study", "--classes", "--gear-class", "5"),
+    ("spectrum", "--gear-grade", "--gear-class", "8"), ("lubricant_study", "--grades", "--oil", "VG68"),
+    ("gear_quality", "--classes", "--gear-class", "6"), ("tolerance_study", "--gear-grade", "--gear-class", "5"),
+])
+def test_a_retired_option_name_is_refused_in_one_line_naming_the_new_one(name, old, new, value, capsys):
+    import importlib
+    mod = importlib.import_module(f"scenarios.{name}")
+    assert mod.main([old, value, "--out", "unused"]) == USAGE
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {old} ") and f"use {new}" in err and err.count("\n") == 1
+
+
+def test_the_tooth_class_and_the_oil_have_one_name_each():
+    """--gear-class is the ISO 1328 class wherever a command takes one, --oil the ISO VG grade; no command keeps the
+    old spellings in its --help."""
+    from scenarios import gear_quality, lubricant_study, spectrum, tolerance_study
+    assert gear_quality.parse_args(["--gear-class", "5,8"]).gear_class == [5, 8]
+    assert tolerance_study.parse_args(["--gear-class", "6"]).gear_class == [6]
+    assert spectrum.parse_args(["--gear-class", "8"]).gear_class == 8
+    assert lubricant_study.parse_args(["--oil", "VG46,VG220"]).oil == "VG46,VG220"
+
+
+@pytest.mark.parametrize("name", ["gear_quality", "tolerance_study", "spectrum", "lubricant_study"])
+def test_help_names_no_retired_option(name, capsys):
+    import importlib
+    mod = importlib.import_module(f"scenarios.{name}")
+    with pytest.raises(SystemExit):
+        mod.parse_args(["--help"])
+    text = capsys.readouterr().out
+    assert not any(o in text for o in ("--grades", "--classes", "--gear-grade"))
+
+
+def test_a_command_whose_default_conditions_differ_says_why():
+    """The default --conditions is 3; a command with another default refuses to be built without the reason, and
+    every --help states its default's reason."""
+    import argparse
+
+    from scenarios.core import args
+    p = argparse.ArgumentParser(prog="x")
+    with pytest.raises(ValueError, match="say why"):
+        args.add_shared(p, "conditions", conditions="1,2")
+    from scenarios import bearing_misalignment, fault_study, gear_quality, paper_study, sensitivity
+    for mod in (paper_study, fault_study, gear_quality, sensitivity, bearing_misalignment):
+        text = _help_text(mod)
+        block = text[text.index("--conditions C"):].split("\n  --")[0]
+        assert ":" in block.split("default", 1)[1], f"{mod.__name__}: {block}"
+
+
+def _help_text(mod):
+    import contextlib
+    import io
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf), pytest.raises(SystemExit):
+        mod.parse_args(["--help"]) if hasattr(mod, "parse_args") else mod.main(["--help"])
+    return " ".join(buf.getvalue().split("\n")).replace("  ", " ")
+
+
+@pytest.mark.parametrize("text,unit,value", [
+    ("0.01", "s", 0.01), ("10 ms", "s", 0.01), ("2 ms", "s", 0.002), ("1.5 s", "s", 1.5), ("250 us", "s", 2.5e-4),
+    ("20 kHz", "Hz", 2e4), ("25000", "Hz", 25000.0), ("2000 rpm", "r/min", 2000.0), ("2000", "r/min", 2000.0),
+])
+def test_every_time_option_takes_a_quantity_or_plain_seconds(text, unit, value):
+    """The shared number grammar: a plain number in the option's unit, or a quantity with its own unit, converted
+    (1 ms = 1e-3 s, 1 kHz = 1e3 Hz)."""
+    from scenarios.core import args
+    assert args.positive(unit)(text) == pytest.approx(value, rel=1e-12)
+
+
+def test_time_options_of_the_commands_read_quantities():
+    from scenarios import duty_cycle, fault_study, gear_quality, lubricant_study, paper_study, spectrum, \
+        tolerance_study
+    for mod in (paper_study, fault_study, gear_quality, lubricant_study, tolerance_study, spectrum):
+        a = mod.parse_args(["--settle", "10 ms", "--window", "2 ms"])
+        assert (a.settle, a.window) == (pytest.approx(0.01), pytest.approx(0.002)), mod.__name__
+    a = duty_cycle.parse_args(["--cycle", "examples/duty_cycles/forward.toml", "--settle", "5 ms"])
+    assert a.settle == pytest.approx(0.005)
+
+
+@pytest.mark.parametrize("text,words", [("10 kg", "a time with its unit"), ("-1 ms", "must be > 0 s"),
+                                        ("soon", "a time with its unit")])
+def test_a_bad_time_is_refused_in_one_line(text, words, tmp_path, capsys):
+    assert paper_study.main(["--window", text, "--out", str(tmp_path)]) == USAGE
+    err = capsys.readouterr().err
+    assert "--window" in err and words in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("name,argv", [("bearing_rig", ["--radial-load", "{}"]), ("modal", ["--set", "planets={}"])])
+def test_bearing_rig_and_modal_take_overwrite_and_no_progress(name, argv, tmp_path, capsys):
+    """A second run with other inputs into the same folder is refused naming what differs; --overwrite replaces it;
+    --no-progress is accepted."""
+    import importlib
+    import json
+    mod = importlib.import_module(f"scenarios.{name}")
+    first, second = ("10 kN", "12 kN") if name == "bearing_rig" else ("3", "4")
+    fill = lambda v: [x.format(v) for x in argv]                                     # noqa: E731
+    assert mod.main([*fill(first), "--out", str(tmp_path), "--no-progress"]) == 0
+    assert mod.main([*fill(first), "--out", str(tmp_path)]) == 0                     # the same inputs: runs again
+    capsys.readouterr()
+    assert mod.main([*fill(second), "--out", str(tmp_path)]) == USAGE
+    err = capsys.readouterr().err
+    assert "other parameters or settings" in err and "--overwrite" in err and second in err
+    assert mod.main([*fill(second), "--out", str(tmp_path), "--overwrite"]) == 0
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert second in json.dumps(s["run_description"])
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# said before the run
+# ---------------------------------------------------------------------------------------------------------------
+def test_a_window_shorter_than_a_cage_revolution_is_said_before_the_run_as_the_run_then_measures(tmp_path, capsys):
+    """Before the run: the window is shorter than a cage revolution relative to the carrier, with the window that
+    covers one; after it, the run's own count of the cage's revolutions agrees (its measured period within 1 %), and
+    a settle shorter than the torque ramp is said too, with the estimated run time — all before the sweep starts."""
+    import re
+    assert paper_study.main(["--conditions", "3", "--directions", "forward", "--settle", "2 ms", "--window", "2 ms",
+                             "--workers", "1", "--no-progress", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    start = out.index("runs: 1 to run")
+    before, after = out[:start], out[start:]
+    assert "warning before the run (c3_forward): the window 0.002 s is shorter than a revolution of the cage" in before
+    assert "ends before the sun torque's ramp" in before and "estimated run time: ≈" in before
+    predicted = float(re.search(r'--window "([\d.]+) ms" or more covers one', before).group(1)) * 1e-3
+    measured = float(re.search(r"inner planet bearings: the window covers [\d.]+ cage revolutions.*?a window of at "
+                               r"least ([\d.e-]+) s covers one", after).group(1))
+    assert predicted == pytest.approx(measured, rel=0.01)
+    # the headline of such a run is not printed as a finding: the reason stands above it, and above comparison.md
+    flag = after.index("not a finding: c3_forward: the window covers less than one cage revolution (inner, outer)")
+    assert flag < after.index("headline (pair 1's planet bearings")
+    assert (tmp_path / "comparison.md").read_text().startswith("**Not a finding**: c3_forward: the window covers")
+
+
+def test_a_resumed_study_says_how_many_runs_finished_earlier(tmp_path, capsys):
+    tiny = ["--conditions", "4", "--settle", "0.0005", "--window", "0.0005", "--no-progress", "--workers", "1",
+            "--out", str(tmp_path)]
+    assert paper_study.main([*tiny, "--directions", "forward"]) == 0
+    capsys.readouterr()
+    assert paper_study.main([*tiny, "--directions", "forward,reverse"]) == 0
+    assert "resuming: 1 of 2 runs finished earlier" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("q", [10.0, 50.0, 90.0, 99.0])
+def test_the_fewest_samples_for_a_percentile_are_where_it_stops_being_the_extreme_value(q):
+    """numpy's Hazen percentile of m distinct values is the largest (or smallest) value for m below the count the
+    tolerance study asks for, and strictly inside the values from that count on."""
+    from scenarios.tolerance_study import fewest_samples
+    rng = np.random.default_rng(3)
+    need = fewest_samples(q)
+    for m in range(1, need + 3):
+        x = rng.permutation(np.arange(m, dtype=float))
+        v = np.percentile(x, q, method="hazen")
+        extreme = v == (x.max() if q > 50 else x.min())
+        assert extreme == (m < need), (q, m, v)
+
+
+def test_too_few_samples_for_a_percentile_are_said_before_the_run_and_above_the_answer(capsys):
+    from scenarios.tolerance_study import too_few_samples
+    few = too_few_samples(4, 1)                       # a P90 from 4 machines
+    assert any(w.startswith("P90 from 4 machines") and "--samples 6 or more" in w for w in few)
+    assert any(w.startswith("P99") and "--samples 51 or more" in w for w in few)
+    assert [w.split()[0] for w in too_few_samples(64, 8)] == ["P99"]   # 8 per replicate: P90 and P10 stand
+    assert [w.split()[0] for w in too_few_samples(400, 8)] == ["P99"]   # 50 per replicate: P99 is the largest
+    assert too_few_samples(408, 8) == []
+
+
+def test_params_refuses_a_machine_that_cannot_be_built_as_a_run_would(capsys):
+    """A 40 mm roller on a 39 mm pitch circle leaves no pin: `dpgt params` refuses it in the words of the design
+    check a run makes, not a table of a machine that cannot exist."""
+    from scenarios import params
+    assert params.main(["--set", "bearing.roller_diameter=40 mm"]) == USAGE
+    err = capsys.readouterr().err
+    assert err.startswith("error: bearing.roller_diameter") and "leaves no pin" in err and err.count("\n") == 1
+    assert params.main(["--set", "bearing.roller_diameter=7 mm", "--grep", "roller_diameter"]) == 0
+    assert "7 mm" in capsys.readouterr().out
+
+
+def test_spectrum_says_the_design_warnings_the_other_commands_say(tmp_path, monkeypatch, capsys):
+    """The reference machine's two tip-circle overlaps, said before anything runs (the run stopped right after)."""
+    from scenarios import spectrum
+
+    def stop(*a, **k):
+        raise SystemExit("error: stopped after the checks")
+    monkeypatch.setattr(spectrum, "check_runs", stop)
+    assert spectrum.main(["--out", str(tmp_path)]) == USAGE
+    out = capsys.readouterr().out
+    assert out.count("design warning: gears.") == 2 and "tip circles" in out
+
+
+@pytest.mark.parametrize("key,words", [("gears.inner_planet.addendum_coefficient", "the inner planets and the ring"),
+                                       ("gears.ring.addendum_coefficient", "the inner planets and the ring"),
+                                       ("gears.sun.addendum_coefficient", "the sun and outer planet"),
+                                       ("gears.outer_planet.addendum_coefficient", "the sun and outer planet")])
+def test_a_design_warning_names_the_parameter_value_that_removes_it(key, words):
+    """The tip-circle overlap's warning names each gear's addendum coefficient that removes it: at that value the
+    warning is gone, a hundredth above it is still there (the tip radius moves by h_a m)."""
+    import re
+    import warnings
+
+    from components.geometry import design_findings
+    from components.params import with_overrides
+    from components.presets import reference_dpgt
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        found = [str(f) for f in design_findings(reference_dpgt(3)) if words in str(f)]
+        assert len(found) == 1
+        limit = float(re.search(re.escape(key) + r" <= ([\d.]+)", found[0]).group(1))
+        at = [str(f) for f in design_findings(with_overrides(reference_dpgt(3), {key: limit})) if words in str(f)]
+        above = [str(f) for f in design_findings(with_overrides(reference_dpgt(3), {key: limit + 0.01}))
+                 if words in str(f)]
+    assert at == [] and len(above) == 1

@@ -1,4 +1,4 @@
-"""summary.json's names (issue 24 §4): every numeric key with a unit ends in its unit's suffix, every other numeric
+"""summary.json's names: every numeric key with a unit ends in its unit's suffix, every other numeric
 key is on the explicit list of dimensionless ones, and every key is documented — in
 components.outputs.SUMMARY_WORDS or in the README's summary.json section — checked on a real run's file.
 And one indexing convention: planets and pairs counted from 1 as they are named (a1/b1 = pair 1) in messages,

@@ -26,7 +26,7 @@ from .render_check import require_offscreen
 
 pv.OFF_SCREEN = True  # before any plotter exists: never try to open a window
 
-__all__ = ["cage_orbit_animation", "train_animation", "frame_indices", "force_colour_scale"]
+__all__ = ["cage_orbit_animation", "excursion_factor", "train_animation", "frame_indices", "force_colour_scale"]
 
 _BG = "white"
 _INK = "black"
@@ -514,10 +514,30 @@ def _orbit_scales(orb, clr, rol, magnify):
     return E, ring_r, r_roll, max_off, mag
 
 
+EXCURSION_SPAN = 0.5     # the magnified excursion reaches about this fraction of the guide clearance
+
+
+def excursion_factor(orbits: Mapping[str, np.ndarray], clearance: Mapping[str, float]) -> float:
+    """One magnification of the cage centre's excursion about its mean for every panel (so that they compare): the
+    largest excursion reaches :data:`EXCURSION_SPAN` of its clearance in the panel where that needs the least
+    magnification, rounded down to 1, 2 or 5 × 10^k; 1 when the cages already move that far."""
+    ratios = []
+    for lab, e in orbits.items():
+        dev = float(np.nanmax(np.hypot(*(e - np.nanmean(e, axis=0)).T)))
+        if dev > 0:
+            ratios.append(EXCURSION_SPAN * float(clearance[lab]) / dev)
+    k = min(ratios) if ratios else 1.0
+    if k <= 2.0:
+        return 1.0
+    decade = 10.0 ** np.floor(np.log10(k))
+    return float(max(m for m in (1.0, 2.0, 5.0) if m * decade <= k) * decade)
+
+
 def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
                          magnify: float | None = None, rollers: Mapping[str, np.ndarray] | None = None,
                          fps: float = 20, size: Sequence[int] = (800, 400), title: str | None = None,
-                         max_frames: int | None = None, legend: bool = True, progress: bool = True) -> Path:
+                         max_frames: int | None = None, legend: bool = True, progress: bool = True,
+                         excursion: float | None = None) -> Path:
     """Cage-centre orbits inside the guiding clearance, one panel per label, side by side.
 
     t: (n_t,) s.  orbits: label -> (n_t, 2) cage-centre offset from the bore centre, m.
@@ -530,10 +550,15 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
     chosen so the largest offset is about half a roller-circle radius; the factor is written in the legend).
     legend: a strip under the panels saying what each mark is (the clearance circle, the cage centre and its
     trail, the rollers), with the guide clearance and the rollers' magnification. progress: frames rendered, on
-    stderr (:class:`_Progress`).
+    stderr (:class:`_Progress`). excursion: the cage centre drawn at its mean position plus ``excursion`` times its
+    excursion from it (None: :func:`excursion_factor`, so that a cage pressed into its land at speed, moving a
+    few µm, is seen moving; 1 when it already moves over a good part of the clearance); the factor is in the legend.
     """
     path = _output_path(path, fps)
     t, labels, orb, clr, rol = _orbit_inputs(t, orbits, clearance_m, rollers)
+    k_exc = excursion_factor(orb, clr) if excursion is None else float(excursion)
+    if k_exc != 1.0:
+        orb = {lab: np.nanmean(e, axis=0) + k_exc * (e - np.nanmean(e, axis=0)) for lab, e in orb.items()}
     n_t = t.size
     require_offscreen()
     W, H = _even_size(size, path)
@@ -580,8 +605,9 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
 
         if legend:
             Cs = sorted({round(c * 1e6, 1) for c in clr.values()})
+            centre = "cage centre" if k_exc == 1.0 else f"cage centre: mean + excursion ×{k_exc:.3g}"
             entries = [("line", "#888888", "guide clearance C_g = " + " / ".join(f"{c:g}" for c in Cs) + " µm"),
-                       ("dot", "#d50000", "cage centre"), ("line", _PANEL_COLORS[0], "its trail (panel colour)")]
+                       ("dot", "#d50000", centre), ("line", _PANEL_COLORS[0], "its trail (panel colour)")]
             if rol:
                 entries += [("ring", "#bbbbbb", "roller, centred in its pocket"),
                             ("ring", _PANEL_COLORS[0], f"roller, offset ×{mag:.3g}")]

@@ -23,6 +23,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator
 
+from components.results import percent_change
+
 __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution", "against_viscosity",
            "mode_shapes", "fault_spectra", "fault_loads", "FAULT_QUANTITIES", "gear_quality", "forward_reverse_headline",
            "time_history_group", "cage_orbit_picture", "display_unit", "format_pct", "HEADLINE_QUANTITIES", "FWD", "REV",
@@ -101,7 +103,7 @@ def time_histories(t, series: Mapping[str, tuple], units: Mapping[str, str], pat
             ax.legend(loc="upper right")
         axes[-1].set_xlabel(_axis_label("time", tunit))
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -158,7 +160,7 @@ def bar_chart(conditions: Sequence[str], table: Mapping[str, Mapping[str, tuple]
             ax.set_visible(False)
         _direction_legend(fig, [d for d in ("forward", "reverse") if d in present], hatch=True)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -167,37 +169,49 @@ _MORE_COLORS = ("tab:green", "tab:purple", "tab:brown", "tab:gray", "tab:olive")
 
 def spectrum(freq_hz, amplitude, marks: Mapping[str, float], path, fmax: float | None = None, *,
              quantity: str = "amplitude", unit: str = "a.u.", logy: bool = False,
-             title: str | None = None) -> Path:
+             title: str | None = None, zoom: tuple[float, float] | None = None) -> Path:
     """Amplitude spectrum with characteristic frequencies marked (e.g. f_m, f_m ± k f_c).
 
     amplitude: (n,) array, or label -> (n,) array for overlays (forward/reverse).  marks: label ->
     frequency in Hz; marks above fmax are left out; labels are staggered so neighbours stay legible.
+    zoom: (f_lo, f_hi) [Hz], a band of close marks (the side bands around f_m): a second panel shows it, its marks
+    labelled there; the full panel shades the band and labels only the marks outside it.
     """
     f = np.asarray(freq_hz, float)
     curves = dict(amplitude) if isinstance(amplitude, Mapping) else {None: amplitude}
     fmax = float(np.nanmax(f)) if fmax is None else float(fmax)
-    keep = f <= fmax
     styles = [FWD, REV]
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(7.5, 3.6), layout="constrained")
-        ax = fig.add_subplot()
-        for i, (label, a) in enumerate(curves.items()):
-            st = dict(styles[i % 2]) if label is not None else dict(FWD)
-            st["linestyle"] = "-"
-            st["label"] = label
-            if i >= 2:           # beyond forward/reverse: colours of their own (the cycle would repeat theirs)
-                st["color"] = _MORE_COLORS[(i - 2) % len(_MORE_COLORS)]
-            ax.plot(f[keep], np.asarray(a, float)[keep], **st)
-        if logy:
-            ax.set_yscale("log")
-        ax.set_xlim(max(0.0, float(np.nanmin(f))), fmax)
-        ax.set_xlabel(_axis_label("frequency", "Hz"))
-        ax.set_ylabel(_axis_label(quantity, unit))
-        if any(k is not None for k in curves):
-            ax.legend(loc="best", fontsize=8, framealpha=0.9)
+        fig = Figure(figsize=(7.5, 3.6 if zoom is None else 6.4), layout="constrained")
+        axes = [fig.add_subplot()] if zoom is None else list(fig.subplots(2, 1, height_ratios=[1.0, 1.0]))
+        spans = [(max(0.0, float(np.nanmin(f))), fmax)] + ([tuple(map(float, zoom))] if zoom is not None else [])
+        for j, (ax, (lo, hi)) in enumerate(zip(axes, spans)):
+            keep = (f >= lo) & (f <= hi)
+            for i, (label, a) in enumerate(curves.items()):
+                st = dict(styles[i % 2]) if label is not None else dict(FWD)
+                st["linestyle"] = "-"
+                st["label"] = label
+                if i >= 2:       # beyond forward/reverse: colours of their own (the cycle would repeat theirs)
+                    st["color"] = _MORE_COLORS[(i - 2) % len(_MORE_COLORS)]
+                ax.plot(f[keep], np.asarray(a, float)[keep], **st)
+            if logy:
+                ax.set_yscale("log")
+            ax.set_xlim(lo, hi)
+            ax.set_xlabel(_axis_label("frequency", "Hz"))
+            ax.set_ylabel(_axis_label(quantity, unit))
+            if j == 0 and any(k is not None for k in curves):
+                ax.legend(loc="best", fontsize=8, framealpha=0.9)
         if title:
-            ax.set_title(title)
-        _mark_frequencies(fig, ax, marks, fmax)
+            axes[0].set_title(title)
+        if zoom is None:
+            _mark_frequencies(fig, axes[0], marks, fmax)
+        else:
+            lo, hi = spans[1]
+            axes[0].axvspan(lo, hi, color="0.85", alpha=0.6, lw=0, gid="zoom_band")
+            outside = {k: v for k, v in marks.items() if not lo <= float(v) <= hi}
+            _mark_frequencies(fig, axes[0], outside, fmax)
+            _mark_frequencies(fig, axes[1], {k: v for k, v in marks.items() if lo <= float(v) <= hi}, hi)
+            axes[1].set_title(f"zoom: {lo:.0f}–{hi:.0f} Hz (shaded above)", fontsize=9)
         return _save(fig, path)
 
 
@@ -349,7 +363,7 @@ def mode_shapes(freqs_hz, shapes, labels: Sequence[str], path, *, max_modes: int
         if freqs.size > n:       # say what is left out
             fig.text(0.5, 0.0, f"the first {n} of {freqs.size} modes shown", ha="center", va="bottom", fontsize=8)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -402,6 +416,8 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
                 _plain_log(ax.xaxis)
                 if log:
                     ax.set_yscale("log")
+                else:                 # from zero: auto-scaling would stretch a 0.1 % difference over the panel
+                    _from_zero(ax)
                 _levels(ax, {v * scale: words for v, words in (levels or {}).get(key, {}).items()})
                 if log:
                     _plain_log(ax.yaxis)
@@ -421,7 +437,7 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
         if handles:
             fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 6), frameon=False)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -476,7 +492,7 @@ def fault_spectra(panels: Sequence[tuple], path, *, quantity: str = "sensor acce
                             Line2D([], [], color=FWD["color"], lw=1.0, label="damaged machine (panel title)")],
                    loc="outside lower center", ncols=2, frameon=False)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -528,7 +544,7 @@ def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = 
             ax.set_xticks(x, faults, rotation=30, ha="right")
         _direction_legend(fig, present, hatch=True)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
@@ -594,11 +610,25 @@ def gear_quality(groups: Sequence[Mapping], path, *, quantities: Sequence[tuple]
         axes[0, 0].legend(loc="best", title="filled: forward, open: reverse", title_fontsize=7)
         for ax in axes.ravel():
             if ax.get_yscale() == "linear":      # from zero, with room above the highest marker
-                lo, hi = ax.get_ylim()
-                ax.set_ylim(min(lo, 0.0), hi + 0.06 * (hi - min(lo, 0.0)))
+                _from_zero(ax)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
+
+
+def _suptitle(fig: Figure, title: str) -> None:
+    """The figure's title, each of its lines wrapped to the figure's width (a long machine label stays readable)."""
+    width = max(30, int(fig.get_figwidth() * 11.5))
+    fig.suptitle("\n".join(_wrap(line, width) for line in str(title).split("\n")))
+
+
+def _from_zero(ax) -> None:
+    """A linear y axis that holds zero, with room beyond the farthest value: differences read against the values
+    themselves (an auto-scaled axis stretches a 0.1 % difference over the panel's height)."""
+    lo, hi = ax.get_ylim()
+    lo, hi = min(lo, 0.0), max(hi, 0.0)
+    span = hi - lo
+    ax.set_ylim(lo - (0.06 * span if lo < 0 else 0.0), hi + (0.06 * span if hi > 0 else 0.0))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -772,10 +802,9 @@ def _wrap(text: str, width: int) -> str:
 
 
 def _pct(fwd, rev) -> float | None:
-    """The change of reverse against forward in % (None when either is missing or forward is 0)."""
-    if fwd is None or rev is None or not np.isfinite(fwd) or not np.isfinite(rev) or fwd == 0:
-        return None
-    return (rev - fwd) / fwd * 100.0
+    """The change of reverse against forward in % (None when either is missing, forward is 0 or the sign changes:
+    :func:`components.results.percent_change`)."""
+    return percent_change(fwd, rev)
 
 
 def format_pct(p: float) -> str:
@@ -848,17 +877,23 @@ def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
                 ax.set_title(where if len(conds) > 1 else words, fontsize=9)
         _direction_legend(fig, present, hatch=True)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 
 def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], title: str | None = None,
-                       column_titles: Mapping[str, str] | None = None) -> Path:
+                       column_titles: Mapping[str, str] | None = None, separate_runs: bool = False,
+                       envelope: float | None = None, envelope_words: str = "period") -> Path:
     """A readable group of time histories: one row per quantity, one column per part (e.g. the inner and the
     outer planet bearing), every panel on one time axis in ms, rows sharing their y scale, one legend.
 
     rows: (words, SI unit, {column: {run: (t [s], y [SI])}}); a run named "forward"/"reverse" gets the
-    study's styles, any other name the next colour. Forces are shown in kN from 1 kN on."""
+    study's styles, any other name the next colour. Forces are shown in kN from 1 kN on.
+    ``separate_runs``: each quantity gets a row per run (forward above reverse), the rows of a quantity on one y
+    scale, so that two runs never lie over each other. ``envelope``: a period [s] (the mesh period) that the
+    samples resolve poorly: a series with fewer than :data:`ENVELOPE_MIN_SAMPLES` samples per period is drawn as the
+    band between the running minimum and maximum of its samples over one period with their running mean over it
+    (scipy.ndimage's filters), and the figure says so (``envelope_words`` names the period)."""
     if not rows:
         raise ValueError("rows is empty")
     columns = list(columns)
@@ -869,11 +904,21 @@ def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], t
     styles: dict[str, dict] = {"forward": FWD, "reverse": REV}
     extra = iter(["#2e7d32", "#8e24aa", "#c62828", "#00838f", "#555555"])
     handles: dict[str, object] = {}
+    shown_rows = []                 # (words, unit, by_col, run label or None, quantity index)
+    for q, (words, unit, by_col) in enumerate(rows):
+        names = sorted({r for runs in by_col.values() for r in runs}, key=lambda k: {"forward": 0, "reverse": 1}.get(k, 2))
+        if separate_runs and len(names) > 1:
+            shown_rows += [(words, unit, {c: {n: runs[n]} for c, runs in by_col.items() if n in runs}, n, q)
+                           for n in names]
+        else:
+            shown_rows.append((words, unit, by_col, None, q))
+    enveloped = []
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(3.3 * len(columns) + 0.9, 1.75 * len(rows) + 0.9), layout="constrained")
-        axes = fig.subplots(len(rows), len(columns), squeeze=False, sharex=True, sharey="row")
-        for r, (words, unit, by_col) in enumerate(rows):
-            ys = [np.asarray(y, float) for runs in by_col.values() for _, y in runs.values()]
+        fig = Figure(figsize=(3.3 * len(columns) + 0.9, 1.75 * len(shown_rows) + 0.9 + (0.3 if envelope else 0)),
+                     layout="constrained")
+        axes = fig.subplots(len(shown_rows), len(columns), squeeze=False, sharex=True, sharey="row")
+        for r, (words, unit, by_col, run_name, q) in enumerate(shown_rows):
+            ys = [np.asarray(y, float) for runs in rows[q][2].values() for _, y in runs.values()]
             scale, shown = display_unit(unit, np.concatenate(ys) if ys else [])
             for c, col in enumerate(columns):
                 ax = axes[r, c]
@@ -882,23 +927,50 @@ def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], t
                         styles[run] = {"color": next(extra, "#555555"), "linestyle": "-", "label": run}
                     st = {**styles[run], "label": run}
                     t = np.asarray(t, float)
-                    # many samples: thinner lines, so that two overlaid runs stay apart
-                    lw = 1.2 if t.size < 200 else 0.9 if t.size < 1000 else 0.6
-                    (ln,) = ax.plot(t * tscale, np.asarray(y, float) * scale, lw=lw, **st)
+                    y = np.asarray(y, float) * scale
+                    per = envelope / float(np.median(np.diff(t))) if envelope and t.size > 2 else None
+                    if per is not None and per < ENVELOPE_MIN_SAMPLES:
+                        from scipy.ndimage import maximum_filter1d, minimum_filter1d, uniform_filter1d  # deferred: scipy only for an envelope
+                        k = max(2, int(round(per)))
+                        ax.fill_between(t * tscale, minimum_filter1d(y, k), maximum_filter1d(y, k),
+                                        color=st["color"], alpha=0.25, lw=0)
+                        (ln,) = ax.plot(t * tscale, uniform_filter1d(y, k), lw=1.0, **st)
+                        enveloped.append(per)
+                    else:
+                        # many samples: thinner lines, so that two overlaid runs stay apart
+                        lw = 1.2 if t.size < 200 else 0.9 if t.size < 1000 else 0.6
+                        (ln,) = ax.plot(t * tscale, y, lw=lw, **st)
                     handles.setdefault(run, ln)
                 if r == 0:
                     ax.set_title((column_titles or {}).get(col, col))
                 if c == 0:
-                    ax.set_ylabel(_axis_label(_wrap(words, 22), shown))
-                if r == len(rows) - 1:
+                    label = _wrap(words, 22) + (f"\n{run_name}" if run_name else "")
+                    ax.set_ylabel(_axis_label(label, shown))
+                if r == len(shown_rows) - 1:
                     ax.set_xlabel(_axis_label("time", tunit))
+        for q in range(len(rows)):      # the rows of one quantity on one y scale
+            group = [axes[r, c] for r, row in enumerate(shown_rows) if row[4] == q for c in range(len(columns))
+                     if axes[r, c].has_data()]
+            if len(group) > 1:
+                lo = min(ax.get_ylim()[0] for ax in group)
+                hi = max(ax.get_ylim()[1] for ax in group)
+                for ax in group:
+                    ax.set_ylim(lo, hi)
         if handles:
             order = sorted(handles, key=lambda k: {"forward": 0, "reverse": 1}.get(k, 2))
             fig.legend([handles[k] for k in order], order, loc="outside lower center", ncols=len(order),
                        frameon=False)
+        if enveloped:
+            fig.text(0.5, 0.0, f"{min(enveloped):.1f} samples per {envelope_words}: too few to draw its waveform "
+                               f"(they alias it); the bands are the range of the samples over each {envelope_words}, "
+                               f"the lines their mean over it (peaks from every step: summary.json)",
+                     ha="center", va="bottom", fontsize=7, gid="envelope_note", wrap=True)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
+
+
+ENVELOPE_MIN_SAMPLES = 8     # samples per period below which a history is drawn as its envelope (time_history_group)
 
 
 def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = None) -> Path:
@@ -909,7 +981,8 @@ def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = Non
 
     panels: (label, t [s] (n,), offset of the cage centre from the bore centre [m] (n, 2), guide clearance
     C_g [m]) — the offset as :func:`viz.results.cage_orbits` gives it (carrier axes). A cage pressed into its
-    land sits beyond the circle by the land contact's deflection."""
+    land sits beyond the circle by the land contact's deflection: that band, from the circle to the farthest the
+    trail reaches, is shaded and named in the legend with its depth."""
 
     if not panels:
         raise ValueError("panels is empty")
@@ -927,12 +1000,18 @@ def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = Non
         fig.get_layout_engine().set(hspace=0.06)          # the zoom row's titles clear the x labels above
         axes = fig.subplots(2, len(panels), squeeze=False)
         lc = None
+        beyond = 0.0
         for k, ((label, t, _, clearance), e) in enumerate(zip(panels, es)):
             t = np.asarray(t, float) * tscale
             C = float(clearance) * um
             seg = np.stack([e[:-1], e[1:]], axis=1)
             mid = np.nanmean(e, axis=0)
+            r_out = float(np.nanmax(np.hypot(*e.T)))
             for row, ax in enumerate(axes[:, k]):
+                if r_out > C:             # beyond the circle: the cage presses into its land, an elastic contact
+                    ring = np.concatenate([C * np.exp(1j * circle), r_out * np.exp(-1j * circle)])
+                    ax.fill(ring.real, ring.imag, color="#f2c14e", alpha=0.35, lw=0, gid="land_deflection")
+                    beyond = max(beyond, r_out - C)
                 ax.plot(C * np.cos(circle), C * np.sin(circle), color="0.45", lw=1.4, ls="--")
                 ax.plot([0], [0], marker="+", color="0.35", ms=9, mew=1.2, ls="none")
                 lc = LineCollection(seg, cmap=cmap, norm=norm, linewidths=1.3 if row == 0 else 1.6)
@@ -963,9 +1042,12 @@ def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = Non
                    Line2D([], [], marker="s", color="#d50000", ls="none", label="end"),
                    Line2D([], [], marker="+", color="0.35", mew=1.2, ls="none", label="bore centre"),
                    Line2D([], [], color="k", lw=0.7, label="zoomed area")]
+        if beyond > 0:
+            handles.append(Patch(color="#f2c14e", alpha=0.35, label=f"beyond the circle: the land contact's "
+                                                                   f"deflection (up to {beyond:.3g} µm)"))
         fig.legend(handles=handles, loc="outside lower center", ncols=3, frameon=False, fontsize=7.5)
         if title:
-            fig.suptitle(title)
+            _suptitle(fig, title)
         return _save(fig, path)
 
 

@@ -1,4 +1,4 @@
-"""The results of a run, in one module (issue 27 §2).
+"""The results of a run, in one module.
 
 * :mod:`.summary` — :class:`Summary`: summary.json typed (per-bearing-kind and per-mesh sections, the failed-run
   form, the words and units of its keys, :data:`SUMMARY_WORDS`).
@@ -15,8 +15,9 @@ engine, enters here.
 from .reader import (RESULTS_NAME, SUMMARY_NAME, DamagedResults, ResultsError, RunFiles, count_samples, json_attr,
                      load_summary, open_dataset, open_run, results_path)
 from .summary import (BEARING_KINDS, DIMENSIONLESS_KEYS, SUMMARY_WORDS, UNIT_SUFFIXES, Quantity, Section, Summary,
-                      describe_key, unit_of_key)
+                      describe_key, percent_change, unit_of_key)
 
 __all__ = ["RESULTS_NAME", "SUMMARY_NAME", "DamagedResults", "ResultsError", "RunFiles", "count_samples", "json_attr",
            "load_summary", "open_dataset", "open_run", "results_path", "BEARING_KINDS", "DIMENSIONLESS_KEYS",
-           "SUMMARY_WORDS", "UNIT_SUFFIXES", "Quantity", "Section", "Summary", "describe_key", "unit_of_key"]
+           "SUMMARY_WORDS", "UNIT_SUFFIXES", "Quantity", "Section", "Summary", "describe_key", "percent_change",
+           "unit_of_key"]

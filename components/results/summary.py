@@ -10,6 +10,8 @@ the statistics, :mod:`components.outputs` re-exports the table. Imports nothing 
 """
 from __future__ import annotations
 
+import numpy as np
+
 from collections.abc import Iterator, Mapping, MutableMapping
 from typing import Any, NamedTuple
 
@@ -248,3 +250,15 @@ class Summary(dict):
         if self.failed:
             raise KeyError(f"the summary has no {name!r} section: the run {self.get('case', '')} failed: {self.error}")
         raise KeyError(f"the summary has no {name!r} section")
+
+
+def percent_change(before, after) -> float | None:
+    """(after − before)/before in %, where a percentage means something: both values finite, of the same sign and
+    ``before`` not zero; else None (a change of sign, e.g. a cage slip from +0.2 % to −0.3 %, is −250 % of nothing
+    in particular: show the two values and their difference in the quantity's unit instead)."""
+    if before is None or after is None:
+        return None
+    before, after = float(before), float(after)
+    if not (np.isfinite(before) and np.isfinite(after)) or before == 0.0 or before * after < 0.0:
+        return None
+    return (after - before) / before * 100.0

@@ -21,7 +21,8 @@ from .points import parse_point
 
 __all__ = ["Parser", "parser", "add_shared", "SHARED", "positive", "nonnegative", "count", "alpha", "conditions",
            "one_condition", "operating_point", "directions", "existing_file", "quantity_of", "key_value", "scheduler", "out_folder",
-           "choice_list", "int_list", "float_list", "parse_sets", "switch_value", "scene_options", "invoked_as"]
+           "choice_list", "int_list", "float_list", "parse_sets", "switch_value", "scene_options", "invoked_as", "renamed",
+           "GEAR_CLASS", "OIL", "QUANTITY_UNITS"]
 
 CONDITIONS = (1, 2, 3, 4)
 DIRECTIONS = ("forward", "reverse")
@@ -69,20 +70,37 @@ def _named(fn, name):
     return fn
 
 
-def _float(text: str, what: str) -> float:
+# the units in which a plain number may also be given as a quantity ("10 ms", "20 kHz", "2000 rpm"): its dimension and
+# pint's name of the unit
+QUANTITY_UNITS = {"s": ("time", "s"), "Hz": ("frequency", "Hz"), "r/min": ("angular_velocity", "rpm")}
+
+
+def _float(text: str, what: str, unit: str = "") -> float:
+    """A finite number: plain (in ``unit``), or, for a unit of :data:`QUANTITY_UNITS`, a quantity with its own unit
+    converted to ``unit`` ("10 ms" for seconds)."""
     try:
         x = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from None
+        if unit not in QUANTITY_UNITS:
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from None
+        dimension, name = QUANTITY_UNITS[unit]
+        try:
+            x = float(quantity("value", text, dimension).to(name).magnitude)
+        except ParameterError:
+            raise argparse.ArgumentTypeError(f"expected {what} or a {dimension.replace('_', ' ')} with its unit "
+                                             f"(e.g. '{_EXAMPLE[unit]}'), got {text!r}") from None
     if not math.isfinite(x):
         raise argparse.ArgumentTypeError(f"expected a finite number ({what}), got {text!r}")
     return x
 
 
+_EXAMPLE = {"s": "10 ms", "Hz": "20 kHz", "r/min": "2000 rpm"}
+
+
 def positive(unit: str, upper: float | None = None):
     """A number > 0 [unit] (and <= upper when given)."""
     def conv(text):
-        x = _float(text, f"a number > 0 {unit}")
+        x = _float(text, f"a number > 0 {unit}", unit)
         if not x > 0 or (upper is not None and x > upper):
             bound = f"> 0 and <= {upper:g} {unit}" if upper is not None else f"> 0 {unit}"
             raise argparse.ArgumentTypeError(f"must be {bound}, got {text!r}")
@@ -92,7 +110,7 @@ def positive(unit: str, upper: float | None = None):
 
 def nonnegative(unit: str):
     def conv(text):
-        x = _float(text, f"a number >= 0 {unit}")
+        x = _float(text, f"a number >= 0 {unit}", unit)
         if x < 0:
             raise argparse.ArgumentTypeError(f"must be >= 0 {unit}, got {text!r}")
         return x
@@ -256,6 +274,27 @@ class _Given(argparse.Action):
         setattr(namespace, f"{self.dest}_given", True)
 
 
+class _Renamed(argparse.Action):
+    """An option's retired name: refused in one line naming the option that does its work."""
+
+    def __init__(self, option_strings, dest, new: str = "", **kw):
+        super().__init__(option_strings, dest=dest, nargs="?", default=None, help=argparse.SUPPRESS)
+        self.new = new
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        raise SystemExit(f"error: {option_string} is not an option of any dpgt command; use {self.new}")
+
+
+def renamed(p, *old: str, new: str) -> None:
+    """Refuse the retired option names ``old`` of the parser ``p`` in one line naming ``new`` (hidden from --help)."""
+    p.add_argument(*old, action=_Renamed, new=new, dest="retired_" + old[0].lstrip("-").replace("-", "_"))
+
+
+# the one name of each option that several commands take (refused spellings: renamed)
+GEAR_CLASS = "--gear-class"      # ISO 1328-1 flank tolerance class of the gears
+OIL = "--oil"                    # ISO VG grade of the oil
+
+
 def operating_point(text):
     """One ``--operating`` point (scenarios.core.points.parse_point), checked where it is read; the text is passed on."""
     try:
@@ -302,11 +341,21 @@ SHARED_TITLE = "shared options (the same name, default and meaning in every dpgt
 SWEEP = ("conditions", "operating", "params", "set", "out", "overwrite", "force", "no-progress", "workers", "scheduler")
 
 
+# the default --conditions of the commands (the source's fastest loaded condition); a command whose default differs
+# says why in its --help (add_shared's conditions_why)
+DEFAULT_CONDITIONS = "3"
+DEFAULT_CONDITIONS_WHY = "condition 3, 4200 rpm and 200 kW: the source's fastest loaded condition"
+
+
 def add_shared(p, *names: str, out: str | None = None, conditions: str | None = None,
-               one_condition_only: bool = False) -> None:
+               one_condition_only: bool = False, conditions_why: str | None = None) -> None:
     """Add the shared options ``names`` (keys of :data:`SHARED`; default: all of them) to the parser ``p``, with
-    one help text each. ``out``: the command's default output folder; ``conditions``: its default conditions;
+    one help text each. ``out``: the command's default output folder; ``conditions``: its default conditions
+    (other than :data:`DEFAULT_CONDITIONS` only with ``conditions_why``, said in the help);
     ``one_condition_only``: the command runs one condition (``--condition`` then stays as the former spelling)."""
+    if "conditions" in (names or SWEEP) and conditions != DEFAULT_CONDITIONS and not conditions_why:
+        raise ValueError(f"{p.prog}: default --conditions {conditions} differs from {DEFAULT_CONDITIONS}: say why "
+                         f"(conditions_why)")
     g = p.add_argument_group(SHARED_TITLE)
     for name in names or SWEEP:
         flags, kw = SHARED[name]
@@ -320,11 +369,12 @@ def add_shared(p, *names: str, out: str | None = None, conditions: str | None = 
                 flags = (*flags, "--condition")
                 writes = "out" in (names or SWEEP)          # a command without --out: no advice about it
                 kw.update(type=one_condition if writes else _one_condition(), metavar="C", action=_Given,
-                          help=f"operating condition 1-4, one (docs/parameters.md; default {conditions}; --condition: "
-                               f"the former spelling, still accepted)")
+                          help=f"operating condition 1-4, one (docs/parameters.md; default {conditions}, "
+                               f"{DEFAULT_CONDITIONS_WHY}; --condition: the former spelling, still accepted)")
                 p.set_defaults(conditions_given=False)
             else:
-                kw["help"] = kw["help"].format(conditions=conditions)
+                kw["help"] = kw["help"].format(conditions=conditions) + (
+                    f"; {conditions_why}" if conditions_why else f"; {DEFAULT_CONDITIONS_WHY}")
                 kw["action"] = _Given            # a study tells a default from a choice (points: README)
                 p.set_defaults(conditions_given=False)
         g.add_argument(*flags, **kw)

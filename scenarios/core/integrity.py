@@ -9,6 +9,8 @@
 """
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 import sys
 import time
@@ -134,3 +136,25 @@ def differences(old: dict | None, new: dict | None, most: int = 4) -> str:
         return ""
     shown = ", ".join(f"{k}: {old.get(k, '(none)')} → {new.get(k, '(none)')}" for k in keys[:most])
     return f" ({shown}{f' and {len(keys) - most} more' if len(keys) > most else ''})"
+
+
+def claim_for_inputs(folder, inputs: dict, overwrite: bool) -> dict:
+    """For a command whose run is one short computation (the bearing rig, the modal analysis): ``folder`` may take it
+    when it holds nothing, or a summary of the same ``inputs`` (the command's options and the text of its files);
+    a summary of other inputs is refused (:class:`OtherResults`, naming what differs) unless ``overwrite``. Returns
+    the keys its summary.json keeps so that the next run can tell (``parameters_fingerprint``, ``run_description``)."""
+    described = {k: str(v) for k, v in sorted(inputs.items())}
+    fp = hashlib.sha256(json.dumps(described, sort_keys=True).encode()).hexdigest()[:16]
+    claim_folder(folder, fp, None, overwrite, description=described)
+    return {"parameters_fingerprint": fp, "run_description": described}
+
+
+def command_inputs(a, files: tuple[str, ...] = ("params",)) -> dict:
+    """A command's parsed options as its inputs, without those that do not change its results (--out, --overwrite,
+    --no-progress); the option ``files`` by their text, so that an edited file is other inputs."""
+    skip = {"out", "overwrite", "no_progress"}
+    d = {k: v for k, v in vars(a).items() if k not in skip}
+    for k in files:
+        if d.get(k):
+            d[k] = f"{d[k]}: {Path(d[k]).read_text(encoding='utf-8', errors='replace')}"
+    return d

@@ -10,7 +10,8 @@ words in every study:
 2. the recordings checked against the limit and the disk (``--force``), the folders against results of other
    parameters (``--overwrite``); then the study's own work before its sweep, if any (:meth:`Study.prepare`);
 3. the sweep (:func:`scenarios.core.sweep.sweep`): each case an :class:`~scenarios.core.sweep.Outcome`, finished, reused
-   or failed;
+   or failed; then, if the study chooses more cases from those results (:meth:`Study.second_phase`), their checks
+   and a second sweep;
 4. the study's report: its headline table first, then one line per post-processing step (:meth:`StudyRun.step`:
    tables, figures, animation);
 5. the epilogue: each run's wall time and error estimate (a reused run marked "reused", with the wall time of
@@ -37,9 +38,9 @@ from .args import parse_sets
 from .integrity import read_summary
 from .points import machine_identity
 from .memory import process_peak_mb
-from .plausibility import check_runs
+from .plausibility import check_runs, estimated_wall_s
 from .runner import RunConfig, run_report
-from .sweep import Case, Outcome, Status, _case_cfg, build_params, check_folders, sweep, validate_cases
+from .sweep import Case, Outcome, Status, _case_cfg, _is_finished, build_params, check_folders, sweep, validate_cases
 
 __all__ = ["Study", "StudyRun", "run_lines", "runs_line", "TIMING_ENV"]
 
@@ -144,6 +145,11 @@ class Study(abc.ABC):
     def prepare(self, cfg: RunConfig, cases: list[Case]) -> None:
         """A study's own work after every check and before its sweep (the tolerance study's static solutions)."""
 
+    def second_phase(self, run: StudyRun) -> list[Case]:
+        """Cases chosen from the first sweep's results, run in a second sweep with the same checks before it starts
+        (the duty cycle's dynamic runs of the bins that carry the damage); none by default."""
+        return []
+
     # -- the skeleton -----------------------------------------------------------------------------------------
     def run(self) -> dict:
         """Cases → validate → check runs and folders → sweep → report → epilogue; returns {"results",
@@ -158,19 +164,33 @@ class Study(abc.ABC):
         machine = self.machine_identity()
         print(f"machine: {machine['label']}", flush=True)
         self.out.mkdir(parents=True, exist_ok=True)
-        for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], self.out, a.force):
+        advice: list = []
+        for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in cases], self.out, a.force, advice):
             print(f"warning (--force): {w}")
         check_folders(cases, cfg, a.overwrite)                  # never replace results of other parameters silently
+        self.say_before(cases, cfg, advice)
         t_prepare = time.perf_counter()
         self.prepare(cfg, cases)
         t_sweep, sweep_timing = time.perf_counter(), {}
         outcomes = sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
                          overwrite=a.overwrite, announce=True, timing=sweep_timing)
-        for o in outcomes.values():       # every run's summary.json names the machine it ran
-            if o.ok and o.summary.get("machine") != machine:
-                o.summary["machine"] = machine
-                write_summary(o.case.out_dir, o.summary)
+        self._stamp(outcomes, machine)
         run = StudyRun(self.out, cases, outcomes)
+        more = self.second_phase(run)
+        if more:                          # the same checks, then a second sweep; its outcomes join the first's
+            validate_cases(more, lambda c: self.check(c, cfg))
+            advice = []
+            for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in more], self.out, a.force,
+                                advice):
+                print(f"warning (--force): {w}")
+            check_folders(more, cfg, a.overwrite)
+            self.say_before(more, cfg, advice)
+            second = sweep(more, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
+                           overwrite=a.overwrite, announce=True, timing=sweep_timing.setdefault("second_phase", {}))
+            self._stamp(second, machine)
+            outcomes = {**outcomes, **second}
+            cases = [*cases, *more]
+            run = StudyRun(self.out, cases, outcomes)
         print(runs_line(outcomes), flush=True)
         t_report = time.perf_counter()
         if self.keep_earlier:
@@ -190,6 +210,35 @@ class Study(abc.ABC):
         r = {"results": run.results, "outcomes": outcomes, "failed": run.failed, "files": run.files, **extra}
         self.epilogue(run)
         return r
+
+    def say_before(self, cases: list[Case], cfg: RunConfig, advice: list) -> None:
+        """Before the sweep: what the runs would get wrong (:func:`scenarios.core.plausibility.run_advice`), each
+        distinct warning once with the runs it concerns, and the estimated wall time of the runs still to run."""
+        said: dict[str, list[str]] = {}
+        for item in advice:
+            if item[0] != "time":
+                said.setdefault(item[1], []).append(item[0])
+        for msg, labels in said.items():
+            who = ", ".join(labels[:3]) + (f" and {len(labels) - 3} more" if len(labels) > 3 else "")
+            print(f"warning before the run ({who}): {msg}", flush=True)
+        todo = {c.label for c in cases if not _is_finished(c, cfg)}
+        runs = [(label, t) for kind, label, t in (x for x in advice if x[0] == "time") if label in todo]
+        if not runs:
+            return
+        workers = getattr(self.a, "workers", None) or min(len(runs), os.cpu_count() or 1)
+        n_dyn = sum(t is not None for _, t in runs)
+        est = estimated_wall_s(runs, workers)
+        print(f"estimated run time: ≈ {_duration(est)} for {len(runs)} run{'s' if len(runs) > 1 else ''} to run "
+              f"({n_dyn} dynamic, {len(runs) - n_dyn} static) on {workers} worker{'s' if workers > 1 else ''} "
+              f"(measured rates of a shared 2-core machine; yours differ)", flush=True)
+
+    @staticmethod
+    def _stamp(outcomes: dict[str, Outcome], machine: dict) -> None:
+        """Every run's summary.json names the machine it ran."""
+        for o in outcomes.values():
+            if o.ok and o.summary.get("machine") != machine:
+                o.summary["machine"] = machine
+                write_summary(o.case.out_dir, o.summary)
 
     @staticmethod
     def _earlier(run: StudyRun) -> dict[str, dict]:
@@ -218,3 +267,12 @@ class Study(abc.ABC):
     @staticmethod
     def exit_code(r: dict) -> int:
         return 1 if r["failed"] else 0
+
+
+def _duration(seconds: float) -> str:
+    """A wall time in words: "40 s", "12 min", "3.5 h"."""
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"

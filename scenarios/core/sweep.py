@@ -36,7 +36,7 @@ from .integrity import OtherResults, claim_folder, differences, read_summary
 from .runner import finished_run, parameters_fingerprint, run_case, run_description, run_fingerprint
 
 __all__ = ["Case", "Status", "Outcome", "sweep", "run_sweep", "execute_case", "check_folders", "user_overrides",
-           "validate_cases", "dask_client", "OPERATING_AXES"]
+           "validate_cases", "dask_client", "OPERATING_AXES", "say_design_warnings"]
 
 
 @dataclass(frozen=True)
@@ -153,6 +153,11 @@ def validate_cases(cases: list[Case], check=None) -> None:
                     check(c)
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
+    say_design_warnings(caught)
+
+
+def say_design_warnings(caught) -> None:
+    """Each distinct design warning among the caught warnings once, as every command says them."""
     for msg in sorted({str(w.message) for w in caught if issubclass(w.category, UserWarning)}):
         print(f"design {msg}" if msg.startswith("warning: ") else f"design warning: {msg}")
 
@@ -246,6 +251,9 @@ def _execute(case: Case, cfg, overwrite: bool) -> Outcome:
         return Outcome(case, Status.FAILED, error=info.error, traceback=info.get("traceback", ""))
 
 
+SETTLED_ESTIMATE = 0.1      # share of a run's simulated time after which its time left is shown
+
+
 class _RunBars:
     """One bar per running case, fed from the progress.json each worker writes (simulated time)."""
 
@@ -267,7 +275,11 @@ class _RunBars:
             b.n = min(1.0, d["t"] / d["t_end"]) if d["t_end"] else 0.0
             rate = d["steps"] / max(d["wall_s"], 1e-9)
             left = (d["t_end"] - d["t"]) / max(d["t"], 1e-12) * d["wall_s"]
-            b.set_postfix_str(f"t={d['t']:.4f}/{d['t_end']:.4f} s, {rate:.0f} steps/s, ~{left:.0f} s left")
+            # the kinematic start is slow and the compile counts in the first seconds: an estimate from them
+            # would be many times too long, so it is shown once the run is past its start
+            settled = d["t"] >= SETTLED_ESTIMATE * d["t_end"] and d["wall_s"] > 2.0
+            b.set_postfix_str(f"t={d['t']:.4f}/{d['t_end']:.4f} s, {rate:.0f} steps/s, "
+                              + (f"~{left:.0f} s left" if settled else "estimating the time left"))
 
     def finish(self, c):
         if c.label in self.bars:
@@ -302,6 +314,8 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
     if announce:
         print(f"runs: {len(todo)} to run, {len(cases) - len(todo)} reused (finished earlier with the same parameters, "
               f"settings and code)", flush=True)
+        if todo and len(todo) < len(cases):
+            print(f"resuming: {len(cases) - len(todo)} of {len(cases)} runs finished earlier", flush=True)
     results = {c.label: execute_case(c, cfg) for c in cases if c not in todo}   # finished: just load
     timing["reuse_check_s"] = time.perf_counter() - t0
     if not todo:

@@ -16,7 +16,7 @@ The parts are also replayed in a step's mix and order (the counted calls per ste
 steps, with the update after each): what that costs beyond their sum measured one part at a time is their
 interaction (caches: alone, a part finds its data where it left it); the loop's time per step less the replay is
 the rest of the step (predictor, norms and convergence tests, the log row, a compiled call per block). ``--target``
-[s per 0.1 s] gives the µs per step a target needs (issue 23: 3 s per 0.1 s of condition 3) and how much must go.
+[s per 0.1 s] gives the µs per step a target needs (the target: 3 s per 0.1 s of condition 3) and how much must go.
 """
 from __future__ import annotations
 

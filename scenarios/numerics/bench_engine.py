@@ -5,7 +5,7 @@ was measured on, timed on both engine paths.
     python -m scenarios.bench_engine [--sizes 10 50 100 250] [--steps 2000] [--repeats 3] [--json out.json]
     python -m scenarios.bench_engine --chain [--sizes 10 50 100 250] [--repeats 3]
 
-The chain (issue "Speed"): M planar bodies (3 g, 2e-8 kg·m²), body 0 tied to the ground and each body to
+The chain: M planar bodies (3 g, 2e-8 kg·m²), body 0 tied to the ground and each body to
 the next per coordinate by linear spring-dampers (x, y: 3e8 N/m, 50 N·s/m; rotation 1e3 N·m/rad), 100 N
 along x on the last body, 2000 fixed steps of 5 µs, HHT. Exudyn 1.13.6's fast module took 5.2 / 24.7 /
 49.9 / 139 µs per step for M = 10 / 50 / 100 / 250 on this kind of machine (``EXUDYN_US_PER_STEP``).

@@ -25,7 +25,7 @@ error ≤ 1 % (else the one that got furthest). Its wall time is scaled to the f
 simulated second) for the speed ratio; both the measured and scaled numbers are recorded.
 
 --compare-newton-tests: the whole window again with each of Newton's two convergence tests — per component
-(the engine's, issue 23) and the max norm's rate (the engine before) — interleaved ``--repeats`` times
+(the engine's) and the max norm's rate (the former test) — interleaved ``--repeats`` times
 (medians), each with its counters and its error against the same reference (``newton_tests`` in the JSON).
 
 per_step_over_eval = (wall / steps) / (one compiled residual + Jacobian evaluation, measured in this run).
@@ -216,7 +216,7 @@ def _engine_ratio(prob, s0, grid, alpha, h, newton_tol, repeats, log) -> dict:
 
 def _newton_tests(prob, s0, t1, grid, alpha, h, newton_tol, repeats, log) -> dict:
     """The window [s0.t, t1] with each of Newton's convergence tests (per component: the engine's; the max
-    norm's rate: the engine before issue 23), interleaved ``repeats`` times: median walls, the counters, and
+    norm's rate: the former test), interleaved ``repeats`` times: median walls, the counters, and
     the states on ``grid`` (for the error, filled in by the caller)."""
     tests = {"per_component": True, "max_norm": False}
     walls, rows = {k: [] for k in tests}, {}
@@ -317,7 +317,7 @@ def main(argv=None) -> int:
                     type=args.choice_list(("Radau", "BDF", "LSODA", "RK45", "RK23", "DOP853"), "scipy methods"))
     ap.add_argument("--repeats", type=args.count(1), default=3, help="interleaved repeats of each engine on the sub-window")
     ap.add_argument("--compare-newton-tests", action="store_true",
-                    help="also time the window with each of Newton's convergence tests, interleaved (before/after issue 23)")
+                    help="also time the window with each of Newton's convergence tests, interleaved (the former and the current test)")
     ap.add_argument("--stiff", default="10,100", type=_factors, help="contact-stiffness factors for the stiff comparison ('' skips)")
     ap.add_argument("--stiff-window", type=args.positive("s"), default=2e-3, help="window of the stiff comparison [s]")
     ap.add_argument("--stiff-settle", type=args.nonnegative("s"), default=0.01, help="settling time of the stiff cases [s]")

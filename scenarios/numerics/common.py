@@ -213,7 +213,7 @@ def run_hht(prob: Problem, state: mbd.State, t_end: float, grid, *, alpha: float
     (``h``) or adaptive (``atol_pos``; atol_rot = 100·atol_pos) from ``state``; ``newton_tol`` and ``tol``
     override the HHT defaults (error-floor study, references); ``freeze_internal`` holds element internal
     states (the equations the scipy adapter integrates); ``engine`` as in :func:`mbd.simulate`;
-    ``per_component=False`` runs Newton's convergence test of the engine before issue 23 (the max norm's
+    ``per_component=False`` runs Newton's former convergence test (the max norm's
     rate, :class:`mbd.hht.NewtonPolicy`) for before/after comparisons."""
     if (h is None) == (atol_pos is None):
         raise ValueError("give exactly one of h (fixed step) or atol_pos (adaptive)")

@@ -1,4 +1,4 @@
-"""The statistics of a compiled run are taken a block of steps at a time (issue 23 §1): the element outputs of
+"""The statistics of a compiled run are taken a block of steps at a time: the element outputs of
 every state of the block in one call per family (mbd.System.outputs_batch, vectorised; the contacts' from their
 compiled kernels, mbd.compiled.outputs), the per-step quantities of all of them at once
 (WindowStatistics.snapshots), then the compiled accumulators over the block. These tests hold that path to the

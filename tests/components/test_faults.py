@@ -38,7 +38,7 @@ def test_perfect_machine_reproduces_the_machine_before_errors_existed(condition,
     gave before errors existed (commit a223f98): bit-identical on the machine that wrote them. Another CPU
     rounds differently, and the contacts amplify it: a 1e-15 relative change of the start velocities moves
     the end state by up to 3.7e-12 max|q| and 1.3e-10 max|v| (measured), so the bound is 100× that.
-    The states were made with Newton's max-norm convergence test (the engine before issue 23), so they are
+    The states were made with Newton's max-norm convergence test (the former convergence test, kept to compare against), so they are
     compared with a run of that test (``per_component=False``; bit-identical here). The per-DOF test accepts
     other iterates, which the contacts amplify far above round-off (measured after 0.5 ms: 7.7e-5 to
     2.5e-4 of max|q|, 1.2e-3 to 3.1e-3 of max|v|): that would test the convergence rule, not the machine."""

@@ -1,5 +1,5 @@
 """Physically impossible error sizes are refused like the clearance check refuses a play the gears cannot take
-(issue 24 §5), naming the entry and the limit; possible ones pass."""
+, naming the entry and the limit; possible ones pass."""
 from __future__ import annotations
 
 import pytest

@@ -1,4 +1,4 @@
-"""Every ISO VG grade from VG 10 to VG 1500 is a lubricant the study takes (issue 24 §4): its Walther line passes
+"""Every ISO VG grade from VG 10 to VG 1500 is a lubricant the study takes: its Walther line passes
 through the grade at 40 °C (ISO 3448's definition) and its typical 100 °C value, and thicker grades are thicker at
 the bearings' 60 °C."""
 from __future__ import annotations
@@ -23,7 +23,7 @@ def test_every_grade_is_its_own_viscosity_at_40_degC_and_thicker_grades_are_thic
 
 
 def test_the_study_takes_any_grade_and_keeps_its_default_span(tmp_path):
-    a = lubricant_study.parse_args(["--grades", "VG46,VG220", "--conditions", "3", "--out", str(tmp_path)])
+    a = lubricant_study.parse_args(["--oil", "VG46,VG220", "--conditions", "3", "--out", str(tmp_path)])
     assert sorted(lubricant_study.lubricants(a)) == ["VG220", "VG46"]
     a = lubricant_study.parse_args(["--conditions", "3", "--out", str(tmp_path)])
     assert list(lubricant_study.lubricants(a)) == ["VG32", "VG68", "VG150"]

@@ -1,4 +1,4 @@
-"""The parameter package after its split (issue 27 §4): the SI classes are declared so that a type checker sees
+"""The parameter package after its split: the SI classes are declared so that a type checker sees
 their fields (mypy on a snippet), the declaration is checked against the parameter fields at import, and the
 package still offers every name the single module offered."""
 import dataclasses

@@ -1,4 +1,4 @@
-"""components.results (issue 27 §2): the typed summary, the reader and the writer, against truths they do not
+"""components.results: the typed summary, the reader and the writer, against truths they do not
 compute: a hand-written summary.json, the words and units table, a damaged file, a file the test writes itself."""
 from __future__ import annotations
 

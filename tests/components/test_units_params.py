@@ -27,7 +27,7 @@ def test_rpm_converts_to_rad_per_s():
 
 
 def test_a_frequency_given_as_a_rotation_speed_counts_revolutions_as_cycles():
-    """The pint trap (issue 24 §4): the radian is dimensionless in pint, so pint alone reads "600 rpm" as
+    """The pint trap: the radian is dimensionless in pint, so pint alone reads "600 rpm" as
     600·2π/60 = 62.83 Hz. One revolution is one cycle: 600 rpm = 600/60 = 10 Hz; 2π·10 rad/s = 10 Hz."""
     f = lambda v: to_si(quantity("rig.carrier_drive_bandwidth", v, "frequency"))
     assert f("600 rpm") == pytest.approx(10.0, rel=1e-14)                   # 600 rev / 60 s

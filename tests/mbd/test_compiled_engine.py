@@ -48,7 +48,7 @@ def test_compiled_assembly_equals_the_reference(dpgt_state):
 
 @pytest.mark.parametrize("per_component", [True, False], ids=["per-component test", "max-norm test"])
 def test_the_engines_take_the_same_steps_to_the_same_states(dpgt_state, per_component):
-    """Both Newton convergence tests (the production one and the one before issue 23) are compiled."""
+    """Both Newton convergence tests (the production one and the former max-norm one) are compiled."""
     model, s = dpgt_state
     st = dataclasses.replace(mbd.PRODUCTION.stepper(), per_component=per_component)
     c, r = _run(model, s, 150, "compiled", stepper=st), _run(model, s, 150, "numpy", stepper=st)

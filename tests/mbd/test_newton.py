@@ -94,7 +94,7 @@ class _Remaining(mbd.Observer):
 def test_accepted_steps_are_converged_on_the_loaded_dpgt():
     """The full DPGT 3 ms into its load ramp, 1000 fixed steps of 5 µs on the compiled engine, every accepted
     step checked from outside. Roller contacts switch in most steps and the largest Newton correction jumps
-    between DOFs. The test on the max norm's rate (``per_component=False``, the engine before issue 23),
+    between DOFs. The test on the max norm's rate (``per_component=False``, the former test),
     from this same state, accepted step 696 0.17·atol from its solution (3 steps above 1e-2, 11 above 3e-3;
     from the state its own ramp reaches: 0.014 at step 959, 0.019 at step 1499 in 2000 steps; 0.067 in the
     settled benchmark window, 0.13 with the adaptive production setting). Each DOF at its own rate: worst

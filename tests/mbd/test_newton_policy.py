@@ -82,7 +82,7 @@ def test_after_iteration_out_of_iterations():
     assert one.after_iteration(1, None, 0) is A.OUT_OF_ITERATIONS
 
 
-# --- the per-component test (issue 23) ---------------------------------------------------------------
+# --- the per-component test ---------------------------------------------------------------
 
 def test_converged_each_takes_every_component_at_its_own_rate():
     """Measured on the DPGT: after a refresh the largest correction moved from one DOF (6.1) to another

@@ -1,4 +1,4 @@
-"""Progress that is not written to a terminal is plain lines, not a bar's escape codes (issue 24 §4)."""
+"""Progress that is not written to a terminal is plain lines, not a bar's escape codes."""
 from __future__ import annotations
 
 import importlib

@@ -155,7 +155,7 @@ def test_an_instant_resting_on_a_force_jump_is_moved_within_its_mesh_phase():
     from components.dpgt import build_dpgt
     from scenarios import tolerance_study as ts
     from scenarios.core.points import points_of
-    a = ts.parse_args(["--samples", "1", "--classes", "7", "--conditions", "3", "--directions", "forward"])
+    a = ts.parse_args(["--samples", "1", "--gear-class", "7", "--conditions", "3", "--directions", "forward"])
     jump = {"mesh.damping_ramp": "0 m"}
     points = points_of(a, {})
     task = next(t for t in ts.static_tasks(a, Path("unused"), jump, points) if t.sample == 0)

@@ -1,4 +1,4 @@
-"""results.nc carries each planet bearing's load and cage slip as time series (issue 24 §4), with units, and
+"""results.nc carries each planet bearing's load and cage slip as time series, with units, and
 the file says what it is (Conventions, title). The series are samples of the quantities the statistics take on
 every step (held to closed forms in tests/components/test_statistics_truths.py and test_rig_statistics.py): their
 time means over the window agree with summary.json to the sampling."""

@@ -1,5 +1,5 @@
-"""Every command the documents name keeps working as written (issue 27 §5: scenarios/ in three kinds moved the
-numerics scripts and the machinery into subpackages): each ``python -m scenarios.NAME`` of README.md, docs/, the
+"""Every command the documents name keeps working as written (the numerics scripts and the
+machinery live in subpackages of scenarios/): each ``python -m scenarios.NAME`` of README.md, docs/, the
 Makefile and .ci/run, and each ``dpgt NAME`` of those and of ``dpgt --help``, shows its usage under its own name.
 
 Cheaply, in this process: ``python -m`` is runpy running the module as ``__main__`` (one real subprocess shows a

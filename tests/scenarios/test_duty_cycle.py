@@ -206,3 +206,147 @@ def test_a_machine_file_with_its_own_points_is_refused_beside_a_cycle(tmp_path, 
     c = _cycle(tmp_path, "c.toml", ONE_BIN)
     assert duty_cycle.main(["--cycle", str(c), "--params", str(m), "--out", str(tmp_path / "o")]) == 2
     assert "[[operating_point]] tables are not used here" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# --dynamic auto: the bins that carry the damage
+# ---------------------------------------------------------------------------------------------------------------
+def test_one_bearing_takes_its_most_damaging_bins_until_the_share_is_reached():
+    """One bearing: the bins in falling order of damage until the share (hand-sorted: 0.4, 0.3, 0.2, 0.1)."""
+    d = {"a": [0.1, 0.4, 0.2, 0.3]}
+    assert duty_cycle.dominant_bins(d, 0.5) == [1, 3]
+    assert duty_cycle.dominant_bins(d, 0.7) == [1, 3]          # exactly reached counts
+    assert duty_cycle.dominant_bins(d, 0.71) == [1, 2, 3]
+    assert duty_cycle.dominant_bins(d, 0.4) == [1]
+    assert duty_cycle.dominant_bins(d, 1.0) == [0, 1, 2, 3]
+
+
+def test_several_bearings_share_a_bin_that_matters_to_both():
+    """Picked by hand: bearing A needs {0, 1} or {0, 2} (0.91), bearing B needs bin 2 (0.9). Each bearing's own top
+    bins are A {0, 1}, B {2} — their union holds three bins; {0, 2} serves both with two. No single bin serves both
+    (A's largest is 0.46)."""
+    d = {"A": [0.46, 0.45, 0.45, 0.0, 0.0], "B": [0.0, 0.0, 0.9, 0.1, 0.0], "C": [0.2, 0.0, 0.7, 0.0, 0.1]}
+    assert duty_cycle.dominant_bins(d, 0.9) == [0, 2]
+    # equally few: {0, 2} and {1, 2} both serve A and B at 0.8; {0, 2} carries more (C: 0.9 against 0.7)
+    assert duty_cycle.dominant_bins(d, 0.8) == [0, 2]
+
+
+def test_the_chosen_bins_carry_the_share_of_every_bearing_and_no_fewer_bins_do():
+    """A random damage table: the chosen set reaches the share for every bearing, and no set of one bin fewer does
+    (every such subset enumerated)."""
+    import itertools
+    rng = np.random.default_rng(7)
+    raw = rng.dirichlet(np.full(7, 0.5), size=4)
+    d = {f"b{i}": list(r) for i, r in enumerate(raw)}
+    for share in (0.5, 0.8, 0.95):
+        got = duty_cycle.dominant_bins(d, share)
+        assert all(sum(r[i] for i in got) >= share - 1e-12 for r in raw)
+        assert not any(all(sum(r[i] for i in sub) >= share - 1e-12 for r in raw)
+                       for sub in itertools.combinations(range(7), len(got) - 1))
+
+
+def test_dynamic_share_needs_auto_and_a_share_in_range(tmp_path, capsys):
+    c = _cycle(tmp_path, "one.toml", ONE_BIN)
+    assert duty_cycle.main(["--cycle", str(c), "--dynamic-share", "0.9", "--out", str(tmp_path / "o")]) == 2
+    assert "--dynamic auto" in capsys.readouterr().err
+    assert duty_cycle.main(["--cycle", str(c), "--dynamic", "auto", "--dynamic-share", "1.5",
+                            "--out", str(tmp_path / "o")]) == 2
+    assert "(0, 1]" in capsys.readouterr().err
+
+
+DYN = ["--settle", "0.002", "--window", "0.002"]     # short dynamic runs: the truths here hold for any window
+
+
+@pytest.fixture(scope="module")
+def auto(tmp_path_factory):
+    """The two-bin cycle with --dynamic auto (its output kept), run twice (the second resumes); the one-bin cycle with
+    --dynamic auto beside the paper study's dynamic run of the same point and settings."""
+    tmp = tmp_path_factory.mktemp("auto")
+    two = _cycle(tmp, "two.toml", TWO_BINS)
+    one = _cycle(tmp, "one.toml", ONE_BIN)
+    common = ["--snapshots", SNAPSHOTS, "--workers", "1", "--no-progress", *DYN]
+    out = {}
+    for k in ("first", "again"):
+        import contextlib
+        import io as _io
+        buf = _io.StringIO()
+        with contextlib.redirect_stdout(buf):
+            assert duty_cycle.main(["--cycle", str(two), "--dynamic", "auto", "--out", str(tmp / "two"),
+                                    *common]) == 0
+        out[k] = buf.getvalue()
+    assert duty_cycle.main(["--cycle", str(one), "--dynamic", "auto", "--out", str(tmp / "one"), *common]) == 0
+    assert paper_study.main(["--conditions", "3", "--directions", "forward", "--out", str(tmp / "paper"),
+                             "--workers", "1", "--no-progress", *DYN]) == 0
+    return tmp, out
+
+
+def test_auto_chooses_the_bins_a_hand_count_of_the_static_damage_picks(auto):
+    """The damage shares by hand from the bins' static summaries, τ_i/L_h,i normalised per bearing: the fast bin
+    carries more than 0.9 of every bearing's damage and the reverse bin less, so the fewest bins for 0.9 are {fast};
+    said before the dynamic run starts, with the dynamic run in its own folder."""
+    tmp, out = auto
+    s = {n: _json(tmp / "two" / n / "summary.json") for n in ("fast", "back")}
+    assert s["fast"]["mode"] == "static" and s["back"]["mode"] == "static"
+    tau = {"fast": 0.75, "back": 0.25}
+    fast_share = []
+    for kind in ("inner", "outer"):
+        for key in ("iso281", "iso16281"):
+            for j in range(3):
+                dmg = {n: tau[n] / s[n][kind][f"life_{key}_per_planet_h"][j] for n in s}
+                fast_share.append(dmg["fast"] / (dmg["fast"] + dmg["back"]))
+    assert min(fast_share) > 0.9 > max(1 - x for x in fast_share)
+    rec = _json(tmp / "two" / "duty_cycle.json")
+    assert rec["dynamic_selection"]["bins"] == ["fast"]
+    carried = rec["dynamic_selection"]["carried"]
+    assert min(carried.values()) == pytest.approx(min(fast_share), rel=1e-12)
+    text = out["first"]
+    said = text.index("dynamic bins (--dynamic auto")
+    assert text.index("runs: 2 to run") < said < text.index("runs: 1 to run")      # statics, choice, dynamic run
+    assert "fast (1 of 2)" in text[said:said + 300]
+    dyn = _json(tmp / "two" / "fast_dynamic" / "summary.json")
+    assert dyn.get("mode") != "static" and "error_estimate" in dyn             # a time integration
+
+
+def test_auto_combines_the_dynamic_bins_dynamic_lives_with_the_static_bins_by_hand_miner(auto):
+    """L = 1/Σ(τ_i/L_h,i) with the fast bin's life from its dynamic run's summary and the reverse bin's from its
+    static one (1e-12); the static bin flagged in the record and its share of the damage stated."""
+    tmp, _ = auto
+    rec = _json(tmp / "two" / "duty_cycle.json")
+    s = {"fast": _json(tmp / "two" / "fast_dynamic" / "summary.json"),
+         "back": _json(tmp / "two" / "back" / "summary.json")}
+    tau = {"fast": 0.75, "back": 0.25}
+    for kind, letter in (("inner", "a"), ("outer", "b")):
+        for key in ("iso281", "iso16281"):
+            for j in range(3):
+                lh = {n: s[n][kind][f"life_{key}_per_planet_h"][j] for n in s}
+                hand = 1.0 / math.fsum(tau[n] / lh[n] for n in s)
+                assert rec["lives"][kind]["planets"][f"{letter}{j + 1}"][key]["life_h"] == \
+                    pytest.approx(hand, rel=1e-12, abs=0)
+                ign = rec["damage_share_ignoring_dynamic_load"][f"{kind} {letter}{j + 1} " +
+                                                                ("ISO 281" if key == "iso281" else "ISO/TS 16281-style")]
+                assert ign == pytest.approx(tau["back"] / lh["back"] * hand, rel=1e-12)
+    src = {b["name"]: (b["life_source"], b["dynamic_load_included"]) for b in rec["bins"]}
+    assert src == {"fast": ("dynamic", True), "back": ("static", False)}
+    assert rec["lives_ignore_dynamic_load"] == ["back"] and "no dynamic increment is carried" in rec["static_lives_note"]
+    assert "back" in (tmp / "two" / "duty_cycle.md").read_text().split("Note:")[0]
+
+
+def test_auto_resumes_every_run_and_chooses_the_same_bins(auto):
+    tmp, out = auto
+    assert "runs: 0 to run, 2 reused" in out["again"] and "runs: 0 to run, 1 reused" in out["again"]
+    assert "fast (1 of 2)" in out["again"]
+
+
+def test_a_one_bin_cycle_with_auto_has_the_single_dynamic_runs_life(auto):
+    """A one-bin cycle carries all its damage in its one bin: auto runs it dynamically, and the combined lives are
+    the paper study's dynamic run of the same point and settings, for every planet and both lives."""
+    tmp, _ = auto
+    rec = _json(tmp / "one" / "duty_cycle.json")
+    c3 = _json(tmp / "paper" / "c3_forward" / "summary.json")
+    assert c3.get("mode") != "static" and "error_estimate" in c3 and rec["dynamic_selection"]["bins"] == ["only"]
+    for kind, letter in (("inner", "a"), ("outer", "b")):
+        for key in ("iso281", "iso16281"):
+            for j in range(3):
+                got = rec["lives"][kind]["planets"][f"{letter}{j + 1}"][key]["life_h"]
+                assert got == pytest.approx(c3[kind][f"life_{key}_per_planet_h"][j], rel=1e-12, abs=0)
+    assert rec["lives_ignore_dynamic_load"] == [] and rec["static_lives_note"] is None

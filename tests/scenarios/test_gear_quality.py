@@ -38,7 +38,7 @@ def test_by_grade_takes_mean_range_and_reverse_change_over_the_seeds():
 @pytest.mark.slow
 def test_gear_quality_study_runs_end_to_end(tmp_path):
     out = tmp_path / "quality"
-    args = ["--conditions", "3", "--directions", "forward", "--grades", "6", "--seeds", "1", "--settle", "0.004",
+    args = ["--conditions", "3", "--directions", "forward", "--gear-class", "6", "--seeds", "1", "--settle", "0.004",
             "--window", "0.004", "--workers", "1", "--no-progress", "--out", str(out)]
     assert gear_quality.main(args) == 0
     rows = list(csv.DictReader((out / "runs.csv").open()))
@@ -60,7 +60,7 @@ def test_gear_quality_study_runs_end_to_end(tmp_path):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--grades", "12"], "--grades"), (["--grades", "6,6"], "--grades"), (["--seeds", "-1"], "--seeds"),
+    (["--gear-class", "12"], "--gear-class"), (["--gear-class", "6,6"], "--gear-class"), (["--seeds", "-1"], "--seeds"),
     (["--systematic-share", "1.5"], "--systematic-share"), (["--conditions", "5"], "--conditions")])
 def test_bad_arguments_name_the_option(argv, message, capsys):
     assert gear_quality.main(argv + ["--out", "/tmp/never_written_gq"]) == 2

@@ -54,8 +54,8 @@ def test_a_rerun_resumes_and_bad_oils_are_refused(study, capsys):
     before = (study / "summary.csv").read_text()
     assert lubricant_study.main(ARGS + ["--out", str(study)]) == 0    # every run finished: nothing recomputed
     assert (study / "summary.csv").read_text() == before
-    assert lubricant_study.main(ARGS[:4] + ["--grades", "VG47", "--out", str(study)]) == 2
-    assert "error: argument --grades: takes ISO VG grades" in capsys.readouterr().err
+    assert lubricant_study.main(ARGS[:4] + ["--oil", "VG47", "--out", str(study)]) == 2
+    assert "error: argument --oil: takes ISO VG grades" in capsys.readouterr().err
 
 
 def test_replot_redraws_the_figure_from_summary_csv_alone(study, tmp_path, capsys, monkeypatch):
@@ -76,8 +76,8 @@ def test_replot_redraws_the_figure_from_summary_csv_alone(study, tmp_path, capsy
     monkeypatch.setattr(lubricant_study.LubricantStudy, "run", lambda self: pytest.fail("--replot ran the study"))
     assert lubricant_study.main(["--replot", "--out", str(tmp_path)]) == 0
     assert drawn == [(rows, tmp_path)] and sorted(p.name for p in tmp_path.iterdir()) == ["summary.csv"]
-    assert lubricant_study.main(["--replot", "--out", str(tmp_path), "--grades", "VG68"]) == 2
-    assert "--replot redraws the figure from --out's summary.csv and runs nothing: --grades" in capsys.readouterr().err
+    assert lubricant_study.main(["--replot", "--out", str(tmp_path), "--oil", "VG68"]) == 2
+    assert "--replot redraws the figure from --out's summary.csv and runs nothing: --oil" in capsys.readouterr().err
     assert lubricant_study.main(["--replot", "--out", str(tmp_path / "empty")]) == 2
     assert "no summary.csv in" in capsys.readouterr().err
 

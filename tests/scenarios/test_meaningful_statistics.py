@@ -1,4 +1,4 @@
-"""Statistics that cannot mean anything are said, never reported silently or interpreted (issue 24 §1): a window
+"""Statistics that cannot mean anything are said, never reported silently or interpreted: a window
 shorter than one cage revolution relative to the carrier, a carrier drive not settled, a load ramp inside the
 window, a spectrum over fewer than four carrier revolutions."""
 from __future__ import annotations

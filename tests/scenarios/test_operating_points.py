@@ -97,7 +97,7 @@ def test_points_in_a_file_and_on_the_command_line(tmp_path):
     labels = [c.label for c in paper_study.make_cases(a, tmp_path / "o")]
     assert labels == ["c2_forward", "c2_reverse", "cruise_forward", "cruise_reverse", "idle"]
     assert [c.label for c in gear_quality.make_cases(gear_quality.parse_args(
-        ["--operating", "cruise: 1500 rpm, 120 kW", "--grades", "6", "--seeds", "1", "--directions", "forward"]),
+        ["--operating", "cruise: 1500 rpm, 120 kW", "--gear-class", "6", "--seeds", "1", "--directions", "forward"]),
         tmp_path / "g")] == ["cruise_forward_perfect", "cruise_forward_class6_seed1"]
     a = fault_study.parse_args(["--operating", "cruise: 1500 rpm, 120 kW", "--faults", "", "--out", str(tmp_path)])
     assert [c.label for c in fault_study.make_cases(a, tmp_path)] == ["cruise_forward_perfect", "cruise_reverse_perfect"]
@@ -122,7 +122,7 @@ def test_a_point_that_is_fought_is_refused_in_one_line(argv, message, machine, t
 def test_the_lubricant_study_takes_a_file_that_sets_an_oil_and_says_so(tmp_path, capsys):
     f = tmp_path / "oily.toml"
     f.write_text('[lubricant]\nviscosity_40 = "20 mm^2/s"\nviscosity_100 = "4 mm^2/s"\n[bearing]\nclearance = "30 um"\n')
-    a = lubricant_study.parse_args(["--params", str(f), "--grades", "VG150", "--directions", "forward"])
+    a = lubricant_study.parse_args(["--params", str(f), "--oil", "VG150", "--directions", "forward"])
     cases = lubricant_study.make_cases(a, tmp_path)
     out = capsys.readouterr().out.strip()
     assert out.count("\n") == 0 and "lubricant.viscosity_100, lubricant.viscosity_40" in out and "replace it" in out
@@ -152,7 +152,7 @@ def test_the_tolerance_study_scales_a_points_torque(tmp_path):
     """Its torques are fractions of the point's own load: at 0.5 and 1 × "120 kW" the machines run 60 and 120 kW at
     the point's speed; a point that transmits nothing is refused."""
     from scenarios import tolerance_study
-    a = tolerance_study.parse_args(["--samples", "2", "--classes", "5", "--torques", "0.5,1", "--operating",
+    a = tolerance_study.parse_args(["--samples", "2", "--gear-class", "5", "--torques", "0.5,1", "--operating",
                                     "cruise: 1500 rpm, 120 kW", "--directions", "forward", "--out", str(tmp_path)])
     tasks = tolerance_study.ToleranceStudy(a).tasks
     powers = {(t.torque, t.sample): build_params(t.case).si().operating for t in tasks}

@@ -1,4 +1,4 @@
-"""The refusal to replace a folder's finished results of other parameters names what differs (issue 24 §1)."""
+"""The refusal to replace a folder's finished results of other parameters names what differs."""
 from __future__ import annotations
 
 import warnings

@@ -1,4 +1,4 @@
-"""Nothing a user does loses results (issue 17): folders of other parameters, damaged files, disk full,
+"""Nothing a user does loses results: folders of other parameters, damaged files, disk full,
 interrupted sweeps — one test per class, on a tiny window (8 rollers, 0.5 ms settle + 0.5 ms window)."""
 from __future__ import annotations
 

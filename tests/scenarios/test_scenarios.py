@@ -54,7 +54,8 @@ def test_study_writes_documented_outputs(zero_power_study):
     rows = list(csv.DictReader((out / "comparison.csv").open()))
     assert {r["quantity"] for r in rows} >= {"bearing_load_mean_N", "roller_cage_rms_N", "life_L10_relative",
                                              "life_iso281_h", "life_iso16281_h"}
-    assert "| bearing | quantity | forward | reverse | difference % |" in (out / "comparison.md").read_text()
+    assert "| bearing | quantity | forward | reverse | reverse − forward | difference % |" in \
+        (out / "comparison.md").read_text()
     for name in ("bars.png", "bearing_load_life.png", "c4_bearing_loads.png", "c4_roller_contacts.png", "c4_cage.png",
                  "c4_mesh.png", "c4_cage_orbit_inner.png", "c4_cage_orbit_outer.png"):
         assert (out / name).stat().st_size > 10_000, name
@@ -430,7 +431,7 @@ def test_spectrum_rig_machine_errors_bring_the_cancelled_lines(tmp_path):
 
 
 def test_spectrum_params_file_is_a_users_machine_and_its_conflicts_are_refused(tmp_path):
-    """``--params FILE.toml`` puts a user's machine on the rig (its errors replace the --gear-grade ones); the
+    """``--params FILE.toml`` puts a user's machine on the rig (its errors replace the --gear-class ones); the
     operating point belongs to the command's options, and --perfect with errors given is a contradiction."""
     machine = tmp_path / "m.toml"
     machine.write_text('[[errors.tooth]]\ngear = "b1"\ntooth = 3\nflank = "both"\npitch = "5 um"\n')

@@ -1,4 +1,4 @@
-"""A study's sweep owns its axes (issue 24): an override of one by --set or a --params file would silently
+"""A study's sweep owns its axes: an override of one by --set or a --params file would silently
 relabel runs (a folder c3_forward holding a reverse run), so every study refuses it in one line naming the key,
 where it came from and the option to use; a --params file that is not UTF-8 TOML is a usage error naming it.
 Two exceptions, by design: a machine file's whole [operating] table (speed and power) is that machine's own
@@ -35,7 +35,7 @@ def files(tmp_path):
     (fault_study, ["--machine", "runout={dent}"], "the name 'runout' is a catalogue fault's"),
     (fault_study, ["--machine", "perfect={dent}"], "the name 'perfect' is the perfect machine's"),
     (fault_study, ["--machine", "mine={rev}"], "operating.direction is set by this study's --directions, not by --params"),
-    (gear_quality, ["--set", "errors.flank_class=[]"], "errors.flank_class is set by this study's --grades and --seeds"),
+    (gear_quality, ["--set", "errors.flank_class=[]"], "errors.flank_class is set by this study's --gear-class and --seeds"),
 ])
 def test_a_study_refuses_overrides_of_its_own_axes(study, argv, message, files, tmp_path, capsys):
     argv = [x.format(**files) for x in argv]
@@ -57,8 +57,8 @@ def test_other_overrides_still_pass(files, tmp_path):
 
 
 @pytest.mark.parametrize("module, argv, message", [
-    ("spectrum", ["--perfect", "--gear-grade", "8"], "--gear-grade 8 contradicts --perfect"),
-    ("spectrum", ["--params", "{dent}", "--gear-grade", "8"], "--gear-grade 8 contradicts the manufacturing errors"),
+    ("spectrum", ["--perfect", "--gear-class", "8"], "--gear-class 8 contradicts --perfect"),
+    ("spectrum", ["--params", "{dent}", "--gear-class", "8"], "--gear-class 8 contradicts the manufacturing errors"),
     ("modal", ["--dpgt", "--params", "{dent}"], "describes a single planetary set; with --dpgt"),
     ("modal", ["--dpgt", "--set", "bearing.clearence=30 um"], "bearing.clearence"),
 ])

@@ -249,8 +249,8 @@ def test_percentiles_read_the_right_tail_and_the_convergence_is_of_the_p90():
     (["--pinhole-tolerance", "10"], "argument --pinhole-tolerance: expected a length (e.g. '20 um'), got '10'"),
     (["--pinhole-tolerance", "10 kg"], "argument --pinhole-tolerance: expected a length"),
     (["--clearance-tolerance", "-5 um"], "argument --clearance-tolerance: must be a length >= 0"),
-    (["--classes", "12"], "argument --classes: must be a whole number in [1, 11], got '12'"),
-    (["--classes", "0,5"], "argument --classes: must be a whole number in [1, 11], got '0'"),
+    (["--gear-class", "12"], "argument --gear-class: must be a whole number in [1, 11], got '12'"),
+    (["--gear-class", "0,5"], "argument --gear-class: must be a whole number in [1, 11], got '0'"),
     (["--samples", "0"], "argument --samples: must be a whole number in [1, ∞], got '0'"),
     (["--samples", "-3"], "argument --samples: must be a whole number in [1, ∞], got '-3'"),
     (["--torques", "0.5,0"], "argument --torques: a fraction of the rated torque must be > 0, got '0'"),
@@ -267,7 +267,7 @@ def test_bad_input_is_one_line_naming_the_option(argv, words, tmp_path, capsys):
 
 
 def _study(out, *more):
-    return tolerance_study.main(["--samples", "3", "--snapshots", "1", "--dynamic", "0", "--classes", "5",
+    return tolerance_study.main(["--samples", "3", "--snapshots", "1", "--dynamic", "0", "--gear-class", "5",
                                  "--directions", "forward", "--workers", "1", "--no-progress", "--out", str(out), *more])
 
 

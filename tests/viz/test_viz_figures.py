@@ -136,11 +136,12 @@ def test_bar_chart_from_zero_with_the_change_and_only_existing_runs(tmp_path, ca
         lo, hi = ax.get_ylim()
         assert lo <= 0.0 <= hi and lo <= min(min(p) for p in by.values())  # the negative slip is inside
         texts = sorted(_pct_texts(ax), key=lambda t: t.get_position()[0])
-        for t, c in zip(texts, ("c3", "c4")):
+        same_sign = [c for c in ("c3", "c4") if by[c][0] * by[c][1] > 0]     # a sign change has no % change
+        for t, c in zip(texts, same_sign):
             f, r = by[c]
             shown, tol = _parse_pct(t.get_text())
             assert abs(shown - (r - f) / f * 100.0) <= tol + 1e-9
-        assert len(texts) == 2
+        assert len(texts) == len(same_sign) == (2 if q == "roller load RMS" else 1)
     assert "[kN]" in axes[0].get_ylabel()
     assert sorted(_legend_labels(fig)) == ["forward", "reverse"]
 
@@ -422,3 +423,110 @@ def test_against_viscosity_a_line_and_a_marker_per_condition(tmp_path, captured)
         assert {ln.get_marker() for ln in lines if ln.get_ydata()[0] == 0.5} != \
             {ln.get_marker() for ln in lines if ln.get_ydata()[0] == 1.5}
         assert [t.get_text() for t in ax.get_xticklabels()] == ["12.8\nVG32", "24.1\nVG68", "47.6\nVG150"]
+
+
+# ------------------------------------------------------------------------------ readable runs, envelopes, bands
+def test_separate_runs_put_forward_and_reverse_in_rows_of_their_own_on_one_scale(tmp_path, captured):
+    t = np.linspace(0.03, 0.05, 300)
+    rows = [("bearing load", "N", {"inner": {"forward": (t, 9e3 + 0 * t), "reverse": (t, 13e3 + 0 * t)},
+                                    "outer": {"forward": (t, 12e3 + 0 * t), "reverse": (t, 9e3 + 0 * t)}})]
+    plots.time_history_group(rows, tmp_path / "g.png", columns=["inner", "outer"], separate_runs=True)
+    axes = np.array(captured[-1].axes).reshape(2, 2)
+    assert [ln.get_label() for ax in axes[0] for ln in ax.get_lines()] == ["forward", "forward"]
+    assert [ln.get_label() for ax in axes[1] for ln in ax.get_lines()] == ["reverse", "reverse"]
+    assert "forward" in axes[0, 0].get_ylabel() and "reverse" in axes[1, 0].get_ylabel()
+    assert len({ax.get_ylim() for ax in axes.ravel()}) == 1            # one quantity, one scale
+    np.testing.assert_allclose(axes[1, 0].get_lines()[0].get_ydata(), 13.0)      # kN
+
+
+def test_a_history_sampled_a_few_times_per_period_is_drawn_as_its_envelope(tmp_path, captured):
+    """4.4 samples per period (the mesh at 25 kHz): a band from the running minimum to the running maximum of the
+    samples over one period (by hand here with a plain loop), their running mean as the line, and a note; 20
+    samples per period: the samples themselves."""
+    T = 1 / 5740.0
+    t = np.arange(0.03, 0.032, 1 / 25000.0)
+    y = 2000.0 + 500.0 * np.sin(2 * np.pi * t / T)
+    rows = [("mesh force", "N", {"m": {"forward": (t, y)}})]
+    plots.time_history_group(rows, tmp_path / "e.png", columns=["m"], envelope=T, envelope_words="mesh cycle")
+    fig = captured[-1]
+    ax = fig.axes[0]
+    (band,) = ax.collections
+    verts = band.get_paths()[0].vertices
+    k = 4                                                   # round(4.36)
+    hand_max = [max(y[max(0, i - k // 2):i - k // 2 + k]) for i in range(y.size)]
+    assert verts[:, 1].max() == pytest.approx(max(hand_max) / 1e3)
+    assert verts[:, 1].min() == pytest.approx(y.min() / 1e3, rel=1e-9)
+    line = ax.get_lines()[0].get_ydata()
+    assert np.all(line <= y.max() / 1e3 + 1e-12) and np.all(line >= y.min() / 1e3 - 1e-12)
+    assert any(tx.get_gid() == "envelope_note" and "4.4 samples per mesh cycle" in tx.get_text() for tx in fig.texts)
+    t2 = np.arange(0.03, 0.032, T / 20)
+    plots.time_history_group([("mesh force", "N", {"m": {"forward": (t2, 0 * t2 + 1.0)}})], tmp_path / "f.png",
+                             columns=["m"], envelope=T)
+    assert not captured[-1].axes[0].collections and not captured[-1].texts
+
+
+def test_a_cage_beyond_its_clearance_circle_is_drawn_in_the_land_deflection_band(tmp_path, captured):
+    """A trail 30 µm beyond the 150 µm circle: the band from the circle to the trail's farthest point is shaded and
+    the legend names its depth; a trail inside the circle: no band."""
+    t = np.linspace(0, 0.02, 200)
+    ang = np.linspace(0, 0.3, 200)
+    e = 180e-6 * np.column_stack([np.cos(ang), np.sin(ang)])
+    plots.cage_orbit_picture([("forward", t, e, 150e-6)], tmp_path / "o.png")
+    fig = captured[-1]
+    assert any(p.get_gid() == "land_deflection" for ax in fig.axes for p in ax.patches)
+    assert any("land contact's deflection (up to 30 µm)" in s for s in _legend_labels(fig))
+    plots.cage_orbit_picture([("forward", t, 0.5 * e, 150e-6)], tmp_path / "p.png")
+    fig = captured[-1]
+    assert not any(p.get_gid() == "land_deflection" for ax in fig.axes for p in ax.patches)
+
+
+def test_the_cage_orbit_animations_excursion_factor():
+    """A cage pressed into its land moving ±2 µm in a 150 µm clearance: half the clearance over 2 µm is 37.5,
+    rounded down to 20 (1, 2, 5 × 10^k); the smallest need of several panels wins; a cage already moving over half
+    its clearance is not magnified."""
+    from viz.animate import excursion_factor
+    ang = np.linspace(0, 2 * np.pi, 400)
+    circ = np.column_stack([np.cos(ang), np.sin(ang)])
+    small = np.array([0.0, -160e-6]) + 2e-6 * circ
+    assert excursion_factor({"a": small}, {"a": 150e-6}) == 20.0
+    assert excursion_factor({"a": small, "b": np.array([0, -160e-6]) + 6e-6 * circ}, {"a": 150e-6, "b": 150e-6}) == 10.0
+    assert excursion_factor({"a": 100e-6 * circ}, {"a": 150e-6}) == 1.0
+
+
+def test_no_percent_change_of_a_quantity_whose_sign_changes(tmp_path, captured):
+    """Cage slip +0.2 % forward, −0.3 % reverse: no '% change' on the bars (the two values are drawn); same-sign
+    values keep theirs, (rev − fwd)/fwd."""
+    from components.results import percent_change
+    assert percent_change(0.2, -0.3) is None and percent_change(0.0, 1.0) is None
+    assert percent_change(-0.2, -0.3) == pytest.approx(50.0) and percent_change(2.0, 3.0) == pytest.approx(50.0)
+    plots.bar_chart(["condition 3"], {"cage slip": {"condition 3": (0.2, -0.3)}, "load": {"condition 3": (2.0, 3.0)}},
+                    {"cage slip": "%", "load": "N"}, tmp_path / "b.png")
+    fig = captured[-1]
+    texts = [t.get_text() for ax in fig.axes for t in _pct_texts(ax)]
+    assert texts == ["+50 %"]
+
+
+def test_the_spectrum_zooms_on_the_side_bands_and_labels_them_there(tmp_path, captured):
+    f = np.linspace(0, 12000, 6001)
+    a = 1e-3 + np.exp(-((f - 5740) / 5) ** 2)
+    f_m, f_c = 5740.0, 70.0
+    marks = {"f_m": f_m, "f_m−1f_c": f_m - f_c, "f_m+1f_c": f_m + f_c, "2f_m": 2 * f_m}
+    plots.spectrum(f, a, marks, tmp_path / "s.png", zoom=(f_m - 5 * f_c, f_m + 5 * f_c))
+    full, zoom = captured[-1].axes
+    assert sorted(t.get_text() for t in full.texts) == ["2f_m"]
+    assert sorted(t.get_text() for t in zoom.texts) == sorted(["f_m", "f_m−1f_c", "f_m+1f_c"])
+    assert zoom.get_xlim() == pytest.approx((f_m - 5 * f_c, f_m + 5 * f_c))
+
+
+def test_a_small_difference_is_drawn_against_zero_in_the_oil_figure(tmp_path, captured):
+    """Cage-guide heat 100.0 W against 100.1 W (0.1 %): the linear axis holds zero, so the two lines lie together
+    as their values do; a signed quantity (slip −0.2 … +0.3 %) keeps both signs and zero in view."""
+    x = np.array([0.01, 0.03, 0.1])
+    series = {("heat", "inner", "forward"): (x, [100.0, 100.05, 100.1]),
+              ("heat", "inner", "reverse"): (x, [100.0, 100.0, 100.0]),
+              ("slip", "inner", "forward"): (x, [-0.2, 0.1, 0.3])}
+    plots.against_viscosity(series, [("heat", "heat", "W", False), ("slip", "slip", "%", False)], tmp_path / "z.png")
+    heat, slip = captured[-1].axes[:2]
+    assert heat.get_ylim()[0] == 0.0 and heat.get_ylim()[1] >= 100.1
+    lo, hi = slip.get_ylim()
+    assert lo <= -0.2 and hi >= 0.3 and lo < 0.0 < hi
