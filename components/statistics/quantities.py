@@ -23,7 +23,7 @@ from ..lubrication import bearing_film
 
 __all__ = ["bearing_map", "Plan", "plan_of", "owner", "quantities", "carrier_frame_motion", "to_carrier",
            "radial_tangential", "pin_reactions", "contact_film", "traction_heat", "film_extremes",
-           "reference_rollers", "CAGE_SPEED", "POCKET_FORCE"]
+           "reference_rollers", "slice_quantities", "CAGE_SPEED", "POCKET_FORCE"]
 
 # the quantities the accumulators read beyond their sums: the cage speed (its window's revolutions) and the
 # pocket force (impact peaks)
@@ -158,6 +158,23 @@ def roller_quantities(p: Plan, out) -> dict[str, np.ndarray]:
         snap["film_lambda"] = snap["film_thinnest"] / p.lubricant.roughness
     if p.pocket_bearing is not None:
         snap[POCKET_FORCE] = np.asarray(out[FAMILY["pocket"]]["force"], float)
+    if "max_slice_load" in ri:            # the sliced contact (bearing.model = "sliced", docs/model.md §8.8)
+        snap.update(slice_quantities(p, ri, ro))
+    return snap
+
+
+def slice_quantities(p: Plan, ri, ro) -> dict[str, np.ndarray]:
+    """Per roller: its largest slice load on each raceway, its pin contact's larger end-slice load and middle-slice
+    load; per bearing: the misalignment it sees, |σ_pin − σ_bore| [rad] (the pin's and the bore's slopes, read at
+    its first roller: every roller of a bearing sees the same two)."""
+    snap = {"roller_inner_slice_max": np.asarray(ri["max_slice_load"], float),
+            "roller_outer_slice_max": np.asarray(ro["max_slice_load"], float),
+            "roller_inner_edge_load": np.asarray(ri["edge_load"], float),
+            "roller_inner_mid_load": np.asarray(ri["mid_load"], float)}
+    first = np.searchsorted(p.roller_bearing, np.arange(p.planet.size))
+    dx = np.asarray(ri["race_slope_x"], float)[..., first] - np.asarray(ro["race_slope_x"], float)[..., first]
+    dy = np.asarray(ri["race_slope_y"], float)[..., first] - np.asarray(ro["race_slope_y"], float)[..., first]
+    snap["planet_misalignment"] = np.hypot(dx, dy)
     return snap
 
 
@@ -224,7 +241,7 @@ def carrier_frame_motion(model, t, q, v, a, omega_c: float, full=None):
     qf, vf = model.full_batch(t, q, v) if full is None else full
     af = np.zeros_like(qf)
     af[:, model.free] = a
-    X, V, A = (x.reshape(K, -1, 3) for x in (qf, vf, af))
+    X, V, A = (model.body_poses(x) for x in (qf, vf, af))          # (K, nb, 3): tilt coordinates left out
     fr = model.frame
     if fr.profile is None and fr.omega == omega_c:
         return X, V, A

@@ -15,6 +15,7 @@ import numpy as np
 from mbd.elements.ehl import thermal_factor
 
 from ..bearing import cage_slip_pct
+from ..sliced_bearing import pressure_scales
 from ..life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
                     iso281_rating, lundberg_palmgren_life)
 
@@ -50,6 +51,8 @@ def bearing_summary(sums, p, kind: str, ref_roller, w_rel: float) -> dict:
     load_summary(d, sums, ref, sel)
     if p.rollers:
         roller_summary(d, sums, p, ref_roller[0 if kind == "inner" else 1], sel)
+        if "roller_inner_slice_max" in sums.acc:
+            slice_summary(d, sums, p, ref, sel)
         heat_summary(d, sums, ref, sel)
         if p.lubricant is not None:
             film_summary(d, sums, sel)
@@ -102,6 +105,25 @@ def roller_summary(d, sums, p, r: int, sel) -> None:
         if sums.impact is not None:
             impact_summary(d, sums, pk, sel)
     d["all_rollers"] = al
+
+
+def slice_summary(d, sums, p, ref, sel) -> None:
+    """The sliced contact's statistics (docs/model.md §8.8): the largest slice load of any roller of these bearings
+    on the pin and on the bore, and the largest contact pressure (the pin's, the convex raceway); the edge ratio of
+    the reference bearing, its largest end-slice pin pressure over its largest middle-slice one in the window
+    (√ of the loads' ratio); the misalignment each bearing sees, its time mean (reference, per planet) and maximum."""
+    mine = np.isin(p.roller_bearing, sel)
+    own = p.roller_bearing == ref
+    q_in, q_out = (float(sums.stats(k)["max"][mine].max()) for k in ("roller_inner_slice_max", "roller_outer_slice_max"))
+    c_pin, c_bore = pressure_scales(p.bearing, p.bearing.slicing.slices)
+    d["slice_load_max_pin_N"], d["slice_load_max_bore_N"] = q_in, q_out
+    d["contact_pressure_max_Pa"] = float(max(c_pin * np.sqrt(q_in), c_bore * np.sqrt(q_out)))
+    edge, mid = (float(sums.stats(k)["max"][own].max()) for k in ("roller_inner_edge_load", "roller_inner_mid_load"))
+    d["edge_pressure_ratio"] = float(np.sqrt(edge / mid)) if mid > 0 else None
+    mis = sums.stats("planet_misalignment")
+    d["misalignment_mean_rad"] = float(mis["mean"][ref])
+    d["misalignment_max_rad"] = float(mis["max"][ref])
+    d["misalignment_mean_per_planet_rad"] = [float(x) for x in mis["mean"][sel]]
 
 
 def impact_summary(d, sums, pk, sel) -> None:

@@ -459,6 +459,7 @@ class SlicedGearMesh(GearMesh):
     (no tooth pairs). Outputs: GearMesh's and "tilt_moment" M_+ − M_− [N m], "relative_slope" g·Δs of the loaded
     flank's line [rad]."""
     compiled_twin = None
+    batched = False            # its slices flatten the instance axis: one state at a time
 
     def __init__(self, name, gear1, gear2, *, slopes1=None, slopes2=None, face_width, slices, **kw):
         super().__init__(name, gear1, gear2, **kw)

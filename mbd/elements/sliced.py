@@ -40,7 +40,6 @@ import numpy as np
 from .. import ad
 from ..element import Element, marker, marker_velocity, point_force
 from ..errors import ModelError
-from ..model import FrameState
 from .contact import Traction
 
 __all__ = ["SLICE_STIFFNESS", "ISO_16281_LAMINA_COEFFICIENT", "slice_stations", "iso_16281_stiffness",
@@ -197,8 +196,9 @@ class SlicedRaceContact(Element):
     rolling resistance (the planar contact has them). Outputs as RaceContact's ("load" Q, "deflection" δ_0,
     "traction", "slip_velocity", "angle", "rolling_speed", "fx", "fy"), and "tilt" τ, "slope" the race's slope
     against the roller's along e [rad] (what the contact sees), "centroid" z̄ [m], "max_slice_load" [N], "edge_load"
-    the larger of the two end slices' loads [N], "mid_load" the middle slice's [N], "loaded_slices" the number
-    loaded; ``slice_loads`` (n, n_s) [N] by :meth:`slice_loads`.
+    the larger of the two end slices' loads [N], "mid_load" the middle slice's [N] (slice (n_s + 1)/2, the middle
+    one of an odd count), "loaded_slices" the number loaded, "race_slope_x", "race_slope_y" the race's slope σ_c in
+    R [rad]; ``slice_loads`` (n, n_s) [N] by :meth:`slice_loads`.
     """
     batched = False
 
@@ -328,7 +328,7 @@ class SlicedRaceContact(Element):
         Fx, Fy = kap * qk * nx, kap * qk * ny
         m = idx.size
         S = lambda x: ad.group_sum(x, m, ns)                                              # noqa: E731
-        P = lambda x: ad.spread(x, idx, n, m_der) if m_der else ad.spread(x, idx, n, 0)   # noqa: E731
+        P = lambda x: ad.spread(x, idx, n, m_der)                                 # noqa: E731
         Q = P(S(qk))
         S0x, S0y = P(S(Fx)), P(S(Fy))
         S1x, S1y = P(S(zk * Fx)), P(S(zk * Fy))
@@ -387,12 +387,11 @@ class SlicedRaceContact(Element):
                    "slope": ad.value(scx) * ad.value(ex) + ad.value(scy) * ad.value(ey) - ad.value(tau),
                    "centroid": zbar, "max_slice_load": qv.max(axis=1),
                    "edge_load": np.maximum(qv[:, 0], qv[:, -1]), "mid_load": qv[:, ns // 2],
+                   "race_slope_x": ad.value(scx), "race_slope_y": ad.value(scy),
                    "loaded_slices": (qv > 0.0).sum(axis=1).astype(float)}
-        self._last_slice_loads = qv
         return forces, outputs
 
-    def slice_loads(self, q_full, v_full, fs=None):
+    def slice_loads(self, q_full, v_full) -> np.ndarray:
         """(n, n_s) slice loads [N] at full coordinates (q_full, v_full) (damping included)."""
-        fs = fs if fs is not None else FrameState(0.0, 0.0, 0.0)
-        self.kernel(0.0, fs, list(np.asarray(q_full)[self.dofs].T), list(np.asarray(v_full)[self.dofs].T), None)
-        return self._last_slice_loads
+        g = self._geometry(list(np.asarray(q_full)[self.dofs].T), list(np.asarray(v_full)[self.dofs].T))
+        return self._slices(g, np.arange(self.n))["q"].reshape(self.n, self.n_s)

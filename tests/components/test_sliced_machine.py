@@ -193,3 +193,64 @@ def test_a_pin_slope_needs_the_sliced_model():
                                                                     direction=Q_("0 deg")),)))
     with pytest.raises(ParameterError, match="errors.pin_slope.*sliced"):
         build_dpgt(p)
+
+
+def test_the_summary_reports_the_slices_and_the_misalignment_each_bearing_sees():
+    """Static statistics (2 snapshots) of the sliced machine. Aligned: every slice carries Q/n_s, so the largest
+    slice load is the largest roller load over n_s, the edge ratio is 1 and no bearing sees a slope. With a1's pin
+    sloped 4′ tangentially: a1's bearing sees |γ − s_a1| (the planet's slope from the solutions), the others what
+    their planets' slopes are, and a1's rollers load their ends."""
+    from components import static
+    from components.params.errors import PinSlopeParams
+    from components.units import Q_
+    p = reference_dpgt(3, "forward")
+    ps = p.replace(bearing=p.bearing.replace(model="sliced"))
+    n_s = ps.si().bearing.slicing.slices
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        aligned = static.static_summary(build_dpgt(ps), 2)
+        gamma = np.radians(4.0 / 60.0)
+        pg = ps.replace(errors=ps.errors.replace(pin_slope=(PinSlopeParams(planet="a1", slope=Q_("4 arcmin"),
+                                                                           direction=Q_("90 deg")),)))
+        scene = build_dpgt(pg)
+        stats, sols = static.static_statistics(scene, 2)
+    for kind in ("inner", "outer"):
+        d = aligned[kind]
+        assert d["slice_load_max_pin_N"] * n_s == pytest.approx(d["all_rollers"]["roller_inner_race_max_N"], rel=1e-9)
+        assert d["edge_pressure_ratio"] == pytest.approx(1.0, abs=1e-9)
+        assert d["misalignment_max_rad"] < 1e-12 * gamma
+    d = stats.summary()["inner"]
+    m = scene.model
+    psi = pg.si().layout.psi_a[0]
+    pin = gamma * np.array([-np.sin(psi), np.cos(psi)])
+    pairs = {m.body_names[m.extra_owner[i - m.n_body_coords]]: (i, j) for i, j in m.slope_pairs}
+    seen = []
+    for s in sols:
+        qf, _ = m.full(s.t, s.q, s.v)
+        seen.append(np.hypot(*(pin - qf[list(pairs["a1"])])))
+    assert d["misalignment_mean_rad"] == pytest.approx(np.mean(seen), rel=1e-9)
+    assert 0.7 * gamma < d["misalignment_mean_rad"] < 1.0 * gamma        # the planet follows its pin by a little
+    assert max(d["misalignment_mean_per_planet_rad"][1:]) < 0.1 * gamma
+    assert d["edge_pressure_ratio"] > 1.01          # one end loaded more (the roller takes half the slope: a few %)
+
+
+def test_pin_slopes_and_windup_round_trip_through_toml_and_name_what_is_wrong(tmp_path):
+    import re
+    from components.params import to_toml, with_overrides
+    from components.presets import load_toml
+    over = {"bearing.model": "sliced", "gears.carrier_windup": True,
+            "errors.pin_slope": [{"planet": "b2", "slope": "3 arcmin", "direction": "90 deg"}]}
+    p = with_overrides(reference_dpgt(), over)
+    f = tmp_path / "tilted.toml"
+    f.write_text(to_toml(p))
+    back = load_toml(f)
+    assert back.errors == p.errors and back.gears == p.gears and back.bearing.model == "sliced"
+    assert back.si().errors.pin_slope[0].slope == pytest.approx(np.radians(3 / 60), rel=1e-12)
+    for entry, where in (({"planet": "b2", "slope": "3 mm", "direction": "0 deg"}, "errors.pin_slope[0].slope"),
+                         ({"planet": "c2", "slope": "3 arcmin", "direction": "0 deg"}, "errors.pin_slope[0].planet"),
+                         ({"planet": "b2", "slope": "-1 arcmin", "direction": "0 deg"}, "errors.pin_slope[0].slope")):
+        with pytest.raises(ParameterError, match="^" + re.escape(where)) as info:
+            with_overrides(reference_dpgt(), {"errors.pin_slope": [entry]})
+        assert "\n" not in str(info.value)
+    with pytest.raises(ParameterError, match="^bearing.model"):
+        with_overrides(reference_dpgt(), {"bearing.model": "tilted"})
