@@ -10,7 +10,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mbd.elements import BodySpring
+from mbd.elements import BodySpring, SlopeGyroscopic
 from mbd.elements.sliced import SlicedRaceContact, iso_16281_stiffness, slice_stations
 from mbd.elements.contact import (IMPACT_LAWS, ROLLING_LAWS, TRACTION_LAWS, DryLand, EHLTraction, GuideContact,
                                   HoupertRolling, HydrodynamicLand, LubricantDrag, PocketContact, RaceContact,
@@ -116,7 +116,8 @@ def cage_slip_pct(b: BearingSI, cage_speed_rel, planet_speed_rel):
 
 def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, outer_body: str, bearing: BearingSI,
                        lubricant: LubricantSI | None, pin_xy, pin_vel, omega_pin: float, omega_outer: float,
-                       damage: dict, bore_tilt_inertia: float | None = None, pin_slope=(0.0, 0.0)) -> BearingHandles:
+                       damage: dict, bore_tilt_inertia: float | None = None, bore_spin_inertia: float | None = None,
+                       pin_slope=(0.0, 0.0)) -> BearingHandles:
     """Add one bearing (``bearing``: ``params.si().bearing``; ``lubricant``: ``params.si().lubricant``,
     needed when the scene has drag on). ``pin_local`` is the raceway centre in pin_body axes;
     ``pin_xy``/``pin_vel`` its position/velocity in the fixed frame at t = 0 (the kinematic steady
@@ -125,8 +126,8 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
     orbit) or "none". ``damage``: {} for a perfect bearing, else (:mod:`components.faults`) ``D`` the (Z,)
     roller diameters and ``inner``/``outer`` the raceways' spall parameters. With ``bearing.model = "sliced"``
     (docs/model.md §8.8) the contacts are sliced: the bore body gets a slope pair of diametral inertia
-    ``bore_tilt_inertia`` [kg·m²], every roller a tilt, and ``pin_slope`` (2,) is the pin's prescribed slope in
-    pin-body axes [rad]. Returns handles."""
+    ``bore_tilt_inertia`` [kg·m²] with its gyroscopic terms (polar inertia ``bore_spin_inertia``, §2.4), every roller
+    a tilt, and ``pin_slope`` (2,) is the pin's prescribed slope in pin-body axes [rad]. Returns handles."""
     b, opt = bearing, scene.options
     pin_local = np.asarray(pin_local, float)
     if opt.bearings == "linear":
@@ -161,7 +162,7 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
         law["rolling"] = rolling
     if b.model == "sliced":
         return _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local, outer_body, lubricant,
-                                    pin_xy, pin_vel, damage, law, bore_tilt_inertia, pin_slope)
+                                    pin_xy, pin_vel, damage, law, bore_tilt_inertia, bore_spin_inertia, pin_slope)
     inner = scene.family(FAMILY["race_inner"], RaceContact, ("roller", "race_body"), kind="inner", **law)
     s_in = inner.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker, R_race=b.inner_raceway_radius,
                      **common, **damage.get("inner", {}))
@@ -227,8 +228,15 @@ def _sliced_dofs(kind: str):
     return resolve
 
 
+def _gyro_dofs(cat, scene):
+    """The gyroscopic family's arguments: each body's θ and slope pair (known at build)."""
+    names = [str(x) for x in cat.pop("body")]
+    return dict(spin=np.array([3 * scene.index[nm] + 2 for nm in names], np.int64),
+                slopes=np.array([scene.slope_index[nm] for nm in names], np.int64), **cat)
+
+
 def _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local, outer_body, lubricant, pin_xy,
-                         pin_vel, damage, law, bore_tilt_inertia, pin_slope):
+                         pin_vel, damage, law, bore_tilt_inertia, bore_spin_inertia, pin_slope):
     """The sliced raceway contacts of one bearing (:class:`mbd.elements.sliced.SlicedRaceContact`), the bore's slope
     pair and the rollers' tilts; then drag and cage as the planar model's."""
     if b.rows != 1:
@@ -237,12 +245,15 @@ def _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local,
     if "inner" in damage or "outer" in damage or "rolling" in law:
         raise ParameterError.at("bearing.model", "'sliced' has no raceway spall and no rolling resistance; use "
                                                  "'planar' for those")
-    if bore_tilt_inertia is None or not bore_tilt_inertia > 0.0:
-        raise ParameterError.at("bearing.model", f"'sliced' needs the bore body's diametral inertia > 0 kg m^2 "
-                                                 f"(this scene gives {bore_tilt_inertia!r})")
+    for what, J in (("diametral", bore_tilt_inertia), ("polar", bore_spin_inertia)):
+        if J is None or not J > 0.0:
+            raise ParameterError.at("bearing.model", f"'sliced' needs the bore body's {what} inertia > 0 kg m^2 "
+                                                     f"(this scene gives {J!r})")
     Z = len(names)
     if outer_body not in scene._slopes:
         scene.slopes(outer_body, bore_tilt_inertia)
+        scene.family(FAMILY["gyroscopic"], SlopeGyroscopic, (), resolve=_gyro_dofs).add(
+            1, body=[outer_body], polar_inertia=bore_spin_inertia)
     J_r = roller_tilt_inertia(b)
     for nm in names:
         scene.tilt(nm, J_r)

@@ -168,7 +168,8 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
         scene.body(a_names[n], G.inner_planet.mass, G.inner_planet.inertia, pose=(*pa, ph.gamma_inner[n]), vel=(*va, speed["a"]))
         scene.body(b_names[n], G.outer_planet.mass, G.outer_planet.inertia, pose=(*pb, ph.gamma_outer[n]), vel=(*vb, speed["b"]))
         tilt = {} if b.model == "planar" else {
-            planet: dict(bore_tilt_inertia=planet_tilt_inertia(gear), pin_slope=faults.pin_slope(si, planet, c))
+            planet: dict(bore_tilt_inertia=planet_tilt_inertia(gear), bore_spin_inertia=gear.inertia,
+                         pin_slope=faults.pin_slope(si, planet, c))
             for planet, gear, c in ((a_names[n], G.inner_planet, lay.centres_a[n]),
                                     (b_names[n], G.outer_planet, lay.centres_b[n]))}
         bearings = [add_planet_bearing(scene, f"{planet}.pb", pin_body="carrier", pin_local=p, outer_body=planet,

@@ -125,8 +125,9 @@ def _family_stiffness(model, names, t, q, v, z):
 def test_a_planet_follows_its_sloped_pin_by_the_bearing_share_of_the_tilt_stiffness(machines):
     """A small pin slope γ on a1 (tangential), the machine linearised at a loaded state: the planets' and rollers'
     static tilt response (K_TT s = f_γ over every loaded tilt coordinate) puts a1's slope at
-    (k_b + k_m)⁻¹ k_b γ, k_b the bearing's tilt stiffness with its rollers' tilts condensed, k_m its two meshes' (2×2
-    matrices: a mesh resists a slope along its line of action only); the bearing sees the rest of γ."""
+    (k_b + k_m + k_own)⁻¹ k_b γ, k_b the bearing's tilt stiffness with its rollers' tilts condensed, k_m its two
+    meshes' (2×2 matrices: a mesh resists a slope along its line of action only), k_own = Ω(J_p ω − J_d Ω) I the
+    slope's own stiffness in the rotating frame; the bearing sees the rest of γ."""
     from components.params.errors import PinSlopeParams
     from components.units import Q_
     sp, ss, s = machines
@@ -159,7 +160,14 @@ def test_a_planet_follows_its_sloped_pin_by_the_bearing_share_of_the_tilt_stiffn
     rollers = [r for r in rollers if Kb[r, r] > 1e-9 * np.abs(Kb).max()]
     k_b = Kb[np.ix_(a1, a1)] - Kb[np.ix_(a1, rollers)] @ np.linalg.solve(Kb[np.ix_(rollers, rollers)],
                                                                           Kb[np.ix_(rollers, a1)])
-    split = np.linalg.solve(k_b + Km, k_b @ gamma)
+    # the slope's own stiffness in R: centrifugal −J_d Ω² and gyroscopic Ω J_p ω (§2.4), ≈ 400 N m/rad at condition 3
+    i = m.full_to_free[a1]
+    k_own = K[np.ix_(i, i)] - Km - Kb[np.ix_(a1, a1)]
+    W = m.frame.omega
+    spin = W + s.v[m.full_to_free[3 * m.body("a1").index + 2]]
+    J_p, J_d = m.element("planet_gyroscopic").polar_inertia[0], m.mdiag[i[0]]
+    np.testing.assert_allclose(k_own, W * (J_p * spin - J_d * W) * np.eye(2), rtol=1e-9, atol=1e-9 * abs(W * J_p * spin))
+    split = np.linalg.solve(k_b + Km + k_own, k_b @ gamma)
     np.testing.assert_allclose(got, split, rtol=0, atol=0.12 * np.linalg.norm(split))
     # the meshes are ~20 times stiffer in tilt than the bearing: the planet follows by a few %, the bearing sees ~95 %
     assert 0.01 < np.linalg.norm(got) / np.linalg.norm(gamma) < 0.1
@@ -254,3 +262,16 @@ def test_pin_slopes_and_windup_round_trip_through_toml_and_name_what_is_wrong(tm
         assert "\n" not in str(info.value)
     with pytest.raises(ParameterError, match="^bearing.model"):
         with_overrides(reference_dpgt(), {"bearing.model": "tilted"})
+
+
+def test_every_planet_of_the_sliced_machine_has_its_gyroscopic_terms(machines):
+    """One SlopeGyroscopic instance per planet, on its θ and slope pair, with its polar inertia."""
+    sp, ss, _ = machines
+    m = ss.model
+    gyro = m.element("planet_gyroscopic")
+    si = reference_dpgt(3, "forward").si()
+    assert gyro.n == 2 * len(sp.pairs)
+    for dofs, J in zip(gyro.dofs, gyro.polar_inertia):
+        body = m.body_names[dofs[0] // 3]
+        assert dofs[0] % 3 == 2 and m.coordinate_name(dofs[1]) == f"{body}.s_x" and m.coordinate_name(dofs[2]) == f"{body}.s_y"
+        assert J == (si.gears.inner_planet if body.startswith("a") else si.gears.outer_planet).inertia
