@@ -275,3 +275,58 @@ def test_every_planet_of_the_sliced_machine_has_its_gyroscopic_terms(machines):
         body = m.body_names[dofs[0] // 3]
         assert dofs[0] % 3 == 2 and m.coordinate_name(dofs[1]) == f"{body}.s_x" and m.coordinate_name(dofs[2]) == f"{body}.s_y"
         assert J == (si.gears.inner_planet if body.startswith("a") else si.gears.outer_planet).inertia
+
+
+def test_the_sliced_machine_accelerates_alike_in_the_rotating_and_the_fixed_frame(machines):
+    """One state of the sliced machine with a sloped pin, tilted planets and rollers and their rates, seen from R and
+    from I: every acceleration (bodies, slopes as points of R, tilts as they are) maps from R to I to round-off —
+    the frame terms of the slopes, the gyroscopic family's ω = Ω + θ̇ and the pin slope turning with the carrier."""
+    from components.params.errors import PinSlopeParams
+    from components.scene import SceneOptions
+    from components.units import Q_
+    sp, _, s = machines
+    p = reference_dpgt(3, "forward")
+    pg = p.replace(bearing=p.bearing.replace(model="sliced"),
+                   errors=p.errors.replace(pin_slope=(PinSlopeParams(planet="a1", slope=Q_("4 arcmin"),
+                                                                     direction=Q_("30 deg")),)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rot, fix = build_dpgt(pg), build_dpgt(pg, SceneOptions(frame="fixed"))
+    mR, mI = rot.model, fix.model
+    assert mR.frame.omega != 0.0 and mI.frame.is_inertial and np.array_equal(mR.free, mI.free)
+    rng = np.random.default_rng(21)
+    q, v = _extended(rot, sp, s.q), _extended(rot, sp, s.v)
+    nP = sp.model.ndof
+    q[nP:] = rng.uniform(-1e-4, 1e-4, mR.ndof - nP)
+    v[nP:] = rng.uniform(-0.05, 0.05, mR.ndof - nP)
+    F = mbd.System(mR).evaluate(s.t, q, v, s.z).F
+    qf, vf = mR.full(s.t, q, v)
+    af = np.zeros_like(qf)
+    af[mR.free] = F / mR.mdiag
+    fs = mR.frame.at(s.t)
+
+    def to_I(x_full, v_full, a_full):
+        """Bodies' (x, y, θ) and slope pairs (as points of R) into I; tilts unchanged."""
+        X, V, A = (mR.poses(x) for x in (x_full, v_full, a_full))
+        XI, VI, AI = mbd.to_fixed(X, V, fs, A)
+        out = [np.array(x_full, float), np.array(v_full, float), np.array(a_full, float)]
+        for o, arr in zip(out, (XI, VI, AI)):
+            o[: mR.n_body_coords] = arr.ravel()
+        for ix, iy in mR.slope_pairs:
+            P = np.array([[x_full[ix], x_full[iy], 0.0]])
+            Vs = np.array([[v_full[ix], v_full[iy], 0.0]])
+            As = np.array([[a_full[ix], a_full[iy], 0.0]])
+            pI, vI, aI = mbd.to_fixed(P, Vs, fs, As)
+            for o, arr in zip(out, (pI, vI, aI)):
+                o[ix], o[iy] = arr[0, 0], arr[0, 1]
+        return out
+
+    qI, vI, a_expect = to_I(qf, vf, af)
+    FI = mbd.System(mI).evaluate(s.t, qI[mI.free], vI[mI.free], s.z).F
+    a_I = FI / mI.mdiag
+    got = a_expect[mI.free]
+    tilt = mI.free >= mI.n_body_coords
+    for part in (~tilt, tilt):
+        scale = np.abs(got[part]).max()
+        np.testing.assert_allclose(a_I[part], got[part], rtol=0, atol=1e-9 * scale)
+    assert np.abs(got[tilt]).max() > 1.0                 # the tilts do accelerate
