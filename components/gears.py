@@ -55,11 +55,8 @@ def add_mesh_family(scene: Scene, family: str, mg, *, gear1: list[str], gear2: l
         shape = StiffnessShape.constant()
         p0 = np.zeros_like(phi)
     if face_slices is not None:
-        if pairs is not None:
-            raise ParameterError.at("bearing.model", "'sliced' tilts the planets, and the face-sliced mesh takes the "
-                                                     "lumped law: the machine's teeth must be perfect (errors.teeth)")
         fam = scene.family(family, SlicedGearMesh, (), resolve=_sliced_mesh_dofs, internal=mg.internal,
-                           stiffness=shape, slices=int(face_slices))
+                           stiffness=shape, slices=int(face_slices), pairs=pairs)
         n = phi.size
         return fam.add(n, gear1=gear1, gear2=gear2, rb1=rb1, rb2=rb2, alpha=mg.pressure_angle, a0=mg.centre_distance,
                        teeth1=mg.z1, k_mean=mg.k_mean, c_mesh=mg.damping, damping_ramp=damping_ramp, u0=u0, p0=p0,

@@ -454,17 +454,18 @@ class SlicedGearMesh(GearMesh):
     line of action with the centre distance. With every slice in contact the mesh's tilt stiffness along g_f is
     k b²(1 − 1/n_m²)/12 ≈ c_γ b³/12 (c_γ = k/b per unit face width).
 
+    With ``pairs`` the tooth-pair law (mbd.elements.tooth_pairs) takes the lumped law's place slice by slice: every
+    slice has its mesh's teeth, gaps and pairs' shares, with 1/n_m of the stiffness and damping (uniform slices: the
+    tooth-pair mesh to round-off).
+
     Local coordinates: gear 1 (x, y, θ), gear 2 (x, y, θ), then gear 1's slopes (if ``slopes1``), gear 2's (if
-    ``slopes2``): full indices (n, 2) or None. ``face_width`` b [m] per mesh; ``slices`` n_m. The lumped law only
-    (no tooth pairs). Outputs: GearMesh's and "tilt_moment" M_+ − M_− [N m], "relative_slope" g·Δs of the loaded
+    ``slopes2``): full indices (n, 2) or None. ``face_width`` b [m] per mesh; ``slices`` n_m. Outputs: GearMesh's and "tilt_moment" M_+ − M_− [N m], "relative_slope" g·Δs of the loaded
     flank's line [rad]."""
     compiled_twin = None
     batched = False            # its slices flatten the instance axis: one state at a time
 
     def __init__(self, name, gear1, gear2, *, slopes1=None, slopes2=None, face_width, slices, **kw):
         super().__init__(name, gear1, gear2, **kw)
-        if self.pairs is not None:
-            raise ModelError(f"{name}: the face-sliced mesh takes the lumped law (no tooth pairs)")
         self.has1, self.has2 = slopes1 is not None, slopes2 is not None
         cols = [self.dofs]
         for has, sl, key in ((self.has1, slopes1, "slopes1"), (self.has2, slopes2, "slopes2")):
@@ -481,6 +482,11 @@ class SlicedGearMesh(GearMesh):
             raise ModelError(f"{name}: parameter 'slices' must be an integer >= 1, got {slices!r}")
         self.n_m = n_m
         self._unit = np.arange(1, n_m + 1) - 0.5 * (n_m + 1)          # ζ_k / (b/n_m)
+        if self.pairs is not None:      # every slice of a mesh has its mesh's teeth: the per-mesh rows repeated
+            pp = self.pairs
+            rep = lambda a: np.repeat(a, n_m, axis=0)                     # noqa: E731
+            self._slice_pairs = ToothPairs(rep(pp.entry), rep(pp.phase2), rep(pp.relief1), rep(pp.relief2), pp.table,
+                                           rep(pp.start1), rep(pp.start2))
 
     def fuse_key(self):
         return None
@@ -502,8 +508,14 @@ class SlicedGearMesh(GearMesh):
         t_dd, e_dd, sa = g["t_dd"], g["e_dd"], self.sin_alpha
         t_s, e_s = tx * dsx + ty * dsy, ex * dsx + ey * dsy           # t·Δs, e·Δs
         # rates of e, t, κ (ė = t (t·ḋ)/a, ṫ = −e (t·ḋ)/a, κ̇ = −κ (e·ḋ)/a)
-        kp = self.k_mean * self._factor(g["p"])
+        kp = self.k_mean * self._factor(g["p"]) if self.pairs is None else None
         zeta = ad.repeat_each(self.face_width / nm, nm) * np.tile(self._unit, n)
+        R = lambda x: ad.repeat_each(x, nm)                                   # noqa: E731
+        if self.pairs is not None:      # the tooth-pair law per slice, each slice 1/n_m of the mesh's stiffness
+            pair_args = (self._slice_pairs, R(sig), R(self.teeth1), R(self.teeth2), R(self.k_mean / nm),
+                         R(self.c_mesh / nm), R(self.damping_ramp), tuple(R(x) for x in self._shape_args),
+                         R(g["th1"]), R(g["th2"]), R(g["phi_e"]), R(t_dd * g["inv_a"]), R(g["w1"]))
+            K_sum = 0.0
         F, M, gvec, gsv = {}, {}, {}, {}
         for f, d_f, r_f in ((1.0, g["d_plus"], g["r_plus"]), (-1.0, g["d_minus"], g["r_minus"])):
             gx = -sig * f * kappa * tx - sa * ex
@@ -511,11 +523,16 @@ class SlicedGearMesh(GearMesh):
             gs = gx * dsx + gy * dsy
             # (g·Δs)˙ = ġ·Δs + g·Δṡ, ġ = σ f κ ((e·ḋ) t + (t·ḋ) e)/a − sin α t (t·ḋ)/a
             gs_dot = (sig * f * kappa * (e_dd * t_s + t_dd * e_s) - sa * t_dd * t_s) / a + gx * dvx + gy * dvy
-            d_k = ad.repeat_each(d_f, nm) + zeta * ad.repeat_each(gs, nm)
-            r_k = ad.repeat_each(r_f, nm) + zeta * ad.repeat_each(gs_dot, nm)
-            k_k, c_k = ad.repeat_each(kp / nm, nm), ad.repeat_each(self.c_mesh / nm, nm)
-            F_k = ad.where(d_k > 0.0, ad.pos(k_k * d_k + c_k * damping_share(d_k, ad.repeat_each(self.damping_ramp, nm)) * r_k),
-                           0.0)
+            d_k = R(d_f) + zeta * R(gs)
+            r_k = R(r_f) + zeta * R(gs_dot)
+            if self.pairs is not None:
+                F_k, K_k = flank_force(pair_args[0], int(f), *pair_args[1:], d_k, r_k)
+                if f > 0:
+                    K_sum = ad.group_sum(K_k, n, nm)
+            else:
+                k_k, c_k = R(kp / nm), R(self.c_mesh / nm)
+                F_k = ad.where(d_k > 0.0, ad.pos(k_k * d_k + c_k * damping_share(d_k, R(self.damping_ramp)) * r_k),
+                               0.0)
             F[f], M[f] = ad.group_sum(F_k, n, nm), ad.group_sum(zeta * F_k, n, nm)
             gvec[f], gsv[f] = (gx, gy), gs
         # −Σ_f M_f ∂(g_f·Δs)/∂d on the head of d; ∂(g_f·Δs)/∂d = σ f κ ((t·Δs) e + (e·Δs) t)/a − sin α (t·Δs) t/a
@@ -525,7 +542,7 @@ class SlicedGearMesh(GearMesh):
             ct = (sig * f * kappa * e_s - sa * t_s) / a
             hx = hx - M[f] * (cx * ex + ct * tx)
             hy = hy - M[f] * (cx * ey + ct * ty)
-        forces, outputs = self._forces(g, F[1.0], F[-1.0], kp, extra=(hx, hy))
+        forces, outputs = self._forces(g, F[1.0], F[-1.0], kp if self.pairs is None else K_sum, extra=(hx, hy))
         qsx = M[1.0] * gvec[1.0][0] + M[-1.0] * gvec[-1.0][0]
         qsy = M[1.0] * gvec[1.0][1] + M[-1.0] * gvec[-1.0][1]
         if self.has1:

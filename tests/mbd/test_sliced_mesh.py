@@ -17,14 +17,14 @@ A0 = (RB1 + RB2) / np.cos(ALPHA)
 K_MESH, B = 4.0e8, 0.02
 
 
-def _meshes(n_m=15, shape=None, c=0.0, backlash=0.0, offset2=None, internal=False):
+def _meshes(n_m=15, shape=None, c=0.0, backlash=0.0, offset2=None, internal=False, pairs=None):
     b = mbd.ModelBuilder()
     g1 = b.add_body("g1", 1.0, 1e-3)
     g2 = b.add_body("g2", 2.0, 3e-3, pose=(A0, 0.0, 0.0))
     s1, s2 = b.add_slopes(g1, 5e-4), b.add_slopes(g2, 8e-4)
     kw = dict(internal=internal, rb1=RB1, rb2=RB2, alpha=ALPHA, a0=A0, teeth1=Z1, k_mean=K_MESH, c_mesh=c,
               damping_ramp=1e-6 if c else 0.0, u0=mesh_u0(False, RB1, RB2, (0, 0, 0), (A0, 0, 0)), backlash=backlash,
-              stiffness=shape, offset2=offset2)
+              stiffness=shape, offset2=offset2, pairs=pairs)
     sliced = SlicedGearMesh("sliced", [g1], [g2], slopes1=[s1], slopes2=[s2], face_width=B, slices=n_m, **kw)
     b.add(sliced)
     model = b.build()
@@ -123,6 +123,58 @@ def test_sliced_mesh_jacobians_match_finite_differences():
                                    offset2=(3e-6, -2e-6))
     system = mbd.System(model)
     rng = np.random.default_rng(5)
+    q, v = _state(model, sl, theta2=1e-4, ds=(3e-4, -2e-4), rng=rng)
+    qf, vf = q[model.free], v[model.free]
+    ev = system.evaluate(0.0, qf, vf, {}, jac=True)
+    _, C, K = system.matrices(ev)
+    hq = np.r_[1e-10, 1e-10, 1e-8, 1e-10, 1e-10, 1e-8, [1e-8] * 4]
+    hv = np.r_[1e-5, 1e-5, 1e-3, 1e-5, 1e-5, 1e-3, [1e-4] * 4]
+    for j in range(model.ndof):
+        dq, dv = np.zeros_like(qf), np.zeros_like(vf)
+        dq[j], dv[j] = hq[j], hv[j]
+        fq = (system.forces(0.0, qf + dq, vf, {}) - system.forces(0.0, qf - dq, vf, {})) / (2 * hq[j])
+        fv = (system.forces(0.0, qf, vf + dv, {}) - system.forces(0.0, qf, vf - dv, {})) / (2 * hv[j])
+        np.testing.assert_allclose(-K.toarray()[:, j], fq, rtol=1e-5, atol=1e-6 * np.abs(fq).max() + 1e-3,
+                                   err_msg=model.coordinate_name(j))
+        np.testing.assert_allclose(-C.toarray()[:, j], fv, rtol=1e-5, atol=1e-6 * np.abs(fv).max() + 1e-6,
+                                   err_msg=model.coordinate_name(j))
+
+
+def _tooth_pairs(rng):
+    """Tooth-pair data of the test mesh: deviations on every flank, a cracked tooth, tip relief on both gears."""
+    from mbd.elements.tooth_pairs import ToothPairs, tooth_table
+    f1 = np.ones(Z1)
+    f1[3] = 0.4
+    t1 = tooth_table(Z1, rng.normal(0, 4e-6, (Z1, 2, 4)), f1)
+    t2 = tooth_table(30, rng.normal(0, 4e-6, (30, 2, 4)), None)
+    return ToothPairs(entry=np.array([[0.3, 0.6]]), phase2=np.array([[0.1, -0.2]]), relief1=np.array([6e-6, 0.7, 2.0]),
+                      relief2=np.array([5e-6, 0.75, 1.0]), table=np.concatenate([t1, t2]), start1=np.zeros(1),
+                      start2=np.full(1, float(t1.size)))
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_uniform_slices_are_the_tooth_pair_mesh_to_round_off(seed):
+    rng = np.random.default_rng(seed)
+    shape = StiffnessShape.rectangular(1.6, 1.5, 0.1)
+    model, sliced, lumped, sl = _meshes(n_m=7, shape=shape, c=2e3, backlash=1e-6, pairs=_tooth_pairs(rng))
+    q, v = _state(model, sl, theta2=2e-4, rng=rng)
+    q[6:10], v[6:10] = 0.0, 0.0
+    fs = mbd.FrameState(0.0, 0.0, 0.0)
+    Fs, outs = sliced.kernel(0.0, fs, list(q[sliced.dofs].T), list(v[sliced.dofs].T), None)
+    Fl, outl = lumped.kernel(0.0, fs, list(q[lumped.dofs].T), list(v[lumped.dofs].T), None)
+    scale = abs(outl["force"][0])
+    assert scale > 1e3
+    for i in range(6):
+        assert np.asarray(Fs[i])[0] == pytest.approx(np.asarray(Fl[i])[0], rel=1e-11, abs=1e-11 * scale)
+    for key in ("force", "force_drive", "force_coast", "stiffness"):
+        assert outs[key][0] == pytest.approx(np.asarray(outl[key])[0], rel=1e-11, abs=1e-11 * scale), key
+
+
+def test_tooth_pair_sliced_mesh_jacobians_match_finite_differences():
+    rng = np.random.default_rng(6)
+    model, sliced, _, sl = _meshes(n_m=5, shape=StiffnessShape.rectangular(1.6, 1.5, 0.1), c=2e3, backlash=1e-6,
+                                   pairs=_tooth_pairs(rng))
+    system = mbd.System(model)
     q, v = _state(model, sl, theta2=1e-4, ds=(3e-4, -2e-4), rng=rng)
     qf, vf = q[model.free], v[model.free]
     ev = system.evaluate(0.0, qf, vf, {}, jac=True)
