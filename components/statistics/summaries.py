@@ -17,7 +17,7 @@ from mbd.elements.ehl import thermal_factor
 from ..bearing import cage_slip_pct
 from ..sliced_bearing import pressure_scales
 from ..life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
-                    iso281_rating, lundberg_palmgren_life)
+                    iso281_rating, lundberg_palmgren_life, sliced_life, sliced_raceway_ratings)
 
 __all__ = ["run_summary", "bearing_summary", "load_summary", "roller_summary", "impact_summary", "life_summary",
            "heat_summary", "film_summary", "cage_summary", "mesh_summary"]
@@ -167,9 +167,27 @@ def life_summary(d, sums, p, w_rel, ref, sel) -> None:
         out["roller_equivalent_load_pin_N"], out["roller_equivalent_load_bore_N"] = q_pin, q_bore
         out["life_iso16281_Mrev"] = lundberg_palmgren_life(q_pin, q_bore, b)
         out["life_iso16281_h"] = hours(out["life_iso16281_Mrev"], w_rel)
+        if "slice_inner_fatigue" in sums.acc:
+            out["life_iso16281_sliced_Mrev"] = _sliced_life(sums, p, bearings)
+            out["life_iso16281_sliced_h"] = hours(out["life_iso16281_sliced_Mrev"], w_rel)
     d["life_iso281_per_planet_h"] = [e["life_iso281_h"] for e, _ in each]
     if p.rollers:
         d["life_iso16281_per_planet_h"] = [e["life_iso16281_h"] for e, _ in each]
+    if "slice_inner_fatigue" in sums.acc:
+        d["life_iso16281_sliced_per_planet_h"] = [e["life_iso16281_sliced_h"] for e, _ in each]
+
+
+def _sliced_life(sums, p, bearings) -> float | None:
+    """ISO/TS 16281 life with slices of the bearings ``bearings`` [10^6 revolutions] (components.life.sliced_life):
+    per slice, the equivalent loads of the pin and the bore over the window and over the bearings' rollers, as the
+    roller loads' life takes them, q_e,k = q_c,k (mean (q_k/q_c,k)^e)^(1/e)."""
+    b = p.bearing
+    mine = np.isin(np.repeat(p.roller_bearing, p.slices), bearings)
+    qc = sliced_raceway_ratings(b, p.slices)
+    q = [c * equivalent_load(sums.stats(key)["mean"][mine].reshape(-1, p.slices).mean(axis=0), e)
+         for key, c, e in (("slice_inner_fatigue", qc[0], STATIONARY_EXPONENT),
+                           ("slice_outer_fatigue", qc[1], ROTATING_EXPONENT))]
+    return sliced_life(q[0], q[1], b)
 
 
 def heat_summary(d, sums, ref, sel) -> None:

@@ -198,7 +198,7 @@ class SlicedRaceContact(Element):
     against the roller's along e [rad] (what the contact sees), "centroid" z̄ [m], "max_slice_load" [N], "edge_load"
     the larger of the two end slices' loads [N], "mid_load" the middle slice's [N] (slice (n_s + 1)/2, the middle
     one of an odd count), "loaded_slices" the number loaded, "race_slope_x", "race_slope_y" the race's slope σ_c in
-    R [rad]; ``slice_loads`` (n, n_s) [N] by :meth:`slice_loads`.
+    R [rad], "slice_load_<k>" slice k's load (k = 0..n_s − 1) [N]; ``slice_loads`` (n, n_s) [N] by :meth:`slice_loads`.
     """
     batched = False
 
@@ -388,6 +388,7 @@ class SlicedRaceContact(Element):
                    "centroid": zbar, "max_slice_load": qv.max(axis=1),
                    "edge_load": np.maximum(qv[:, 0], qv[:, -1]), "mid_load": qv[:, ns // 2],
                    "race_slope_x": ad.value(scx), "race_slope_y": ad.value(scy),
+                   **{f"slice_load_{k}": qv[:, k] for k in range(ns)},
                    "loaded_slices": (qv > 0.0).sum(axis=1).astype(float)}
         return forces, outputs
 

@@ -224,6 +224,9 @@ def test_the_summary_reports_the_slices_and_the_misalignment_each_bearing_sees()
         stats, sols = static.static_statistics(scene, 2)
     for kind in ("inner", "outer"):
         d = aligned[kind]
+        # uniform slices: q_k = Q/n_s and q_c,k = Q_c n_s^(-7/9), so the sliced life is the roller loads' life
+        assert d["life_iso16281_sliced_h"] == pytest.approx(d["life_iso16281_h"], rel=1e-9)
+        assert d["all_rollers"]["life_iso16281_sliced_h"] == pytest.approx(d["all_rollers"]["life_iso16281_h"], rel=1e-9)
         assert d["slice_load_max_pin_N"] * n_s == pytest.approx(d["all_rollers"]["roller_inner_race_max_N"], rel=1e-9)
         assert d["edge_pressure_ratio"] == pytest.approx(1.0, abs=1e-9)
         assert d["misalignment_max_rad"] < 1e-12 * gamma
@@ -240,6 +243,10 @@ def test_the_summary_reports_the_slices_and_the_misalignment_each_bearing_sees()
     assert 0.7 * gamma < d["misalignment_mean_rad"] < 1.0 * gamma        # the planet follows its pin by a little
     assert max(d["misalignment_mean_per_planet_rad"][1:]) < 0.1 * gamma
     assert d["edge_pressure_ratio"] > 1.01          # one end loaded more (the roller takes half the slope: a few %)
+    # the misaligned bearing's slices cost it life; the aligned ones' sliced life stays their roller loads' life
+    assert d["life_iso16281_sliced_h"] < d["life_iso16281_h"] * (1 - 1e-3)
+    lives = d["life_iso16281_sliced_per_planet_h"], d["life_iso16281_per_planet_h"]
+    np.testing.assert_allclose(lives[0][1:], lives[1][1:], rtol=1e-3)
 
 
 def test_pin_slopes_and_windup_round_trip_through_toml_and_name_what_is_wrong(tmp_path):
