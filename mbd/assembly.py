@@ -72,7 +72,7 @@ class System:
             rows.append(r.ravel()[keep])
             cols.append(c.ravel()[keep])
         # frame terms: 2×2 (x, y) block of every free body when R rotates, then of every slope pair (a point of
-        # mass J_d at s, docs/model.md §2.3); gravity acts on the bodies alone (the first len(_J) entries)
+        # mass J_d at s, docs/model.md §2.4); gravity acts on the bodies alone (the first len(_J) entries)
         self.rotating = not m.frame.is_inertial
         free_bodies = np.flatnonzero(~m.fixed)
         self._free_bodies = free_bodies
@@ -148,7 +148,7 @@ class System:
         return self.evaluate(t, q, v, z).F
 
     def _add_frame_terms(self, F, Jq, Jv, fs, q, v):
-        """Centrifugal, Coriolis, Euler and gravity terms of every free body (docs/model.md §2.3), added in
+        """Centrifugal, Coriolis, Euler and gravity terms of every free body and slope pair (docs/model.md §2.3, §2.4), added in
         place to F and, when given (not None), to the Jacobian data Jq, Jv."""
         m = self.model
         bx, by, bt, mx = self._bx, self._by, self._bt, self._mx

@@ -120,7 +120,7 @@ class ModelBuilder:
         """Give ``body`` two slope coordinates (s_x, s_y): its axis through its centre c passes through
         c + ζ·s at axial station ζ, s in R. ``inertia``: its diametral moment of inertia J_d [kg·m²] about
         its centre, which is each slope's mass. In a rotating R the engine adds the slope pair's frame terms,
-        those of a point of mass J_d at position s (docs/model.md §2.3); a spinning body's gyroscopic terms are
+        those of a point of mass J_d at position s (docs/model.md §2.3, §2.4); a spinning body's gyroscopic terms are
         an element family (:class:`mbd.elements.SlopeGyroscopic`). Returns the pair's full indices."""
         b = self._body_index(body, "add_slopes")
         if b in [o for o, k in zip(self._extra_owner, self._extra_kind) if k == SLOPE_X]:
