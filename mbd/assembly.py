@@ -148,8 +148,8 @@ class System:
         return self.evaluate(t, q, v, z).F
 
     def _add_frame_terms(self, F, Jq, Jv, fs, q, v):
-        """Centrifugal, Coriolis, Euler and gravity terms of every free body and slope pair (docs/model.md §2.3, §2.4), added in
-        place to F and, when given (not None), to the Jacobian data Jq, Jv."""
+        """Centrifugal, Coriolis, Euler and gravity terms of every free body and slope pair (docs/model.md §2.3,
+        §2.4), added in place to F and, when given (not None), to the Jacobian data Jq, Jv."""
         m = self.model
         bx, by, bt, mx = self._bx, self._by, self._bt, self._mx
         if self.has_gravity:

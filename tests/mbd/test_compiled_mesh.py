@@ -20,8 +20,8 @@ import mbd.elements
 from mbd.compiled import generic, mesh
 from mbd.compiled.registry import kind_of
 from mbd.element import evaluate
-from mbd.elements import (BodySpring, CoordinateSpring, SlopeGyroscopic, ForceSource, GearMesh, GroundSupport, Ramp, SpeedDrive, StiffnessShape,
-                          TorqueSource, TorsionalSpring)
+from mbd.elements import (BodySpring, CoordinateSpring, ForceSource, GearMesh, GroundSupport, Ramp, SlopeGyroscopic,
+                          SpeedDrive, StiffnessShape, TorqueSource, TorsionalSpring)
 from mbd.elements.gear_mesh import RectangularStiffness
 from mbd.model import FrameState
 
