@@ -10,7 +10,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mbd.elements import BodySpring
+from mbd.elements import BodySpring, SlopeGyroscopic
+from mbd.elements.sliced import SlicedRaceContact, iso_16281_stiffness, slice_stations
 from mbd.elements.contact import (IMPACT_LAWS, ROLLING_LAWS, TRACTION_LAWS, DryLand, EHLTraction, GuideContact,
                                   HoupertRolling, HydrodynamicLand, LubricantDrag, PocketContact, RaceContact,
                                   RollingResistance, SlideRollTraction, TanhTraction, Traction)
@@ -18,6 +19,7 @@ from mbd.elements.contact import (IMPACT_LAWS, ROLLING_LAWS, TRACTION_LAWS, DryL
 from .families import FAMILY
 from .lubrication import oil_density, reduced_modulus
 from .params import BearingSI, LubricantSI
+from .profiles import roller_drop
 from .scene import Scene
 from .units import ParameterError
 
@@ -114,14 +116,18 @@ def cage_slip_pct(b: BearingSI, cage_speed_rel, planet_speed_rel):
 
 def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, outer_body: str, bearing: BearingSI,
                        lubricant: LubricantSI | None, pin_xy, pin_vel, omega_pin: float, omega_outer: float,
-                       damage: dict) -> BearingHandles:
+                       damage: dict, bore_tilt_inertia: float | None = None, bore_spin_inertia: float | None = None,
+                       pin_slope=(0.0, 0.0)) -> BearingHandles:
     """Add one bearing (``bearing``: ``params.si().bearing``; ``lubricant``: ``params.si().lubricant``,
     needed when the scene has drag on). ``pin_local`` is the raceway centre in pin_body axes;
     ``pin_xy``/``pin_vel`` its position/velocity in the fixed frame at t = 0 (the kinematic steady
     state); ``omega_pin`` and ``omega_outer`` the absolute spin speeds of the inner and outer raceway
     bodies. The scene's option ``cage`` says "free", "held" (a fixed cage body: the rollers cannot
     orbit) or "none". ``damage``: {} for a perfect bearing, else (:mod:`components.faults`) ``D`` the (Z,)
-    roller diameters and ``inner``/``outer`` the raceways' spall parameters. Returns handles."""
+    roller diameters and ``inner``/``outer`` the raceways' spall parameters. With ``bearing.model = "sliced"``
+    (docs/model.md §8.8) the contacts are sliced: the bore body gets a slope pair of diametral inertia
+    ``bore_tilt_inertia`` [kg·m²] with its gyroscopic terms (polar inertia ``bore_spin_inertia``, §2.4), every roller
+    a tilt, and ``pin_slope`` (2,) is the pin's prescribed slope in pin-body axes [rad]. Returns handles."""
     b, opt = bearing, scene.options
     pin_local = np.asarray(pin_local, float)
     if opt.bearings == "linear":
@@ -154,6 +160,9 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
     rolling = rolling_resistance(b, lubricant)
     if rolling is not None:
         law["rolling"] = rolling
+    if b.model == "sliced":
+        return _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local, outer_body, lubricant,
+                                    pin_xy, pin_vel, damage, law, bore_tilt_inertia, bore_spin_inertia, pin_slope)
     inner = scene.family(FAMILY["race_inner"], RaceContact, ("roller", "race_body"), kind="inner", **law)
     s_in = inner.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker, R_race=b.inner_raceway_radius,
                      **common, **damage.get("inner", {}))
@@ -162,6 +171,14 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
                       R_race=b.outer_raceway_radius, **common, **damage.get("outer", {}))
     handles = BearingHandles("rollers", rollers=tuple(names), race_inner=s_in, race_outer=s_out, omega_cage=wm,
                              omega_roller=wr)
+    return _add_drag_and_cage(scene, tag, b, names, psi, wm, pin_body, marker, outer_body, lubricant, pin_xy,
+                              pin_vel, handles)
+
+
+def _add_drag_and_cage(scene, tag, b, names, psi, wm, pin_body, marker, outer_body, lubricant, pin_xy, pin_vel,
+                       handles):
+    """The rollers' lubricant drag and the cage (as the scene's options ask), for either contact model."""
+    opt, Z, D, d_m = scene.options, len(names), b.roller_diameter, b.pitch_diameter
     if opt.drag:
         if lubricant is None:
             raise ParameterError.at("lubricant", "the scene has lubricant drag on (option drag) but no lubricant "
@@ -180,6 +197,86 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
         handles = replace(handles, **_add_cage(scene, tag, b, names, psi, pin_xy, pin_vel, wm, outer_body,
                                                opt.cage == "held", lubricant))
     return handles
+
+
+def sliced_law(b: BearingSI) -> dict:
+    """The sliced contact's slice stations ``z``, profile drops ``drop`` and constant ``K`` from the bearing's
+    parameters (bearing.slicing, bearing.profile; docs/model.md §8.8)."""
+    z, _ = slice_stations(b.roller_length, b.slicing.slices)
+    K = b.contact_stiffness if b.slicing.stiffness == "palmgren" else iso_16281_stiffness(b.roller_length)
+    return dict(z=z, drop=roller_drop(b, z), K=K)
+
+
+def roller_tilt_inertia(b: BearingSI) -> float:
+    """One roller's diametral moment of inertia [kg·m²], a solid cylinder: m (D²/16 + l²/12)."""
+    return b.roller_mass * (b.roller_diameter ** 2 / 16.0 + b.roller_length ** 2 / 12.0)
+
+
+def _sliced_dofs(kind: str):
+    """resolve(columns, scene) of a sliced family: its (n, n_local) dofs from the body names and the scene's tilt
+    coordinates (known at build), the other columns as they are."""
+    def resolve(cat, scene):
+        idx = lambda names: np.array([scene.index[nm] for nm in names], np.int64)     # noqa: E731
+        r, rb, pb = idx(cat.pop("roller")), idx(cat.pop("race_body")), idx(cat.pop("pin_body"))
+        tilt = np.array([scene.tilt_index[nm] for nm in cat.pop("roller_name")], np.int64)
+        cols = [3 * r, 3 * r + 1, 3 * r + 2, tilt, 3 * rb, 3 * rb + 1, 3 * rb + 2]
+        slope_of = cat.pop("slope_body")
+        if kind == "outer":
+            s = np.array([scene.slope_index[nm] for nm in slope_of], np.int64)
+            cols += [s[:, 0], s[:, 1], 3 * pb, 3 * pb + 1, 3 * pb + 2]
+        return dict(dofs=np.column_stack(cols), **cat)
+    return resolve
+
+
+def _gyro_dofs(cat, scene):
+    """The gyroscopic family's arguments: each body's θ and slope pair (known at build)."""
+    names = [str(x) for x in cat.pop("body")]
+    return dict(spin=np.array([3 * scene.index[nm] + 2 for nm in names], np.int64),
+                slopes=np.array([scene.slope_index[nm] for nm in names], np.int64), **cat)
+
+
+def _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local, outer_body, lubricant, pin_xy,
+                         pin_vel, damage, law, bore_tilt_inertia, bore_spin_inertia, pin_slope):
+    """The sliced raceway contacts of one bearing (:class:`mbd.elements.sliced.SlicedRaceContact`), the bore's slope
+    pair and the rollers' tilts; then drag and cage as the planar model's."""
+    if b.rows != 1:
+        raise ParameterError.at("bearing.rows", f"the sliced model takes one row (two rows at their axial stations "
+                                                f"are not built), got {b.rows}")
+    if "inner" in damage or "outer" in damage or "rolling" in law:
+        raise ParameterError.at("bearing.model", "'sliced' has no raceway spall and no rolling resistance; use "
+                                                 "'planar' for those")
+    for what, J in (("diametral", bore_tilt_inertia), ("polar", bore_spin_inertia)):
+        if J is None or not J > 0.0:
+            raise ParameterError.at("bearing.model", f"'sliced' needs the bore body's {what} inertia > 0 kg m^2 "
+                                                     f"(this scene gives {J!r})")
+    Z = len(names)
+    if outer_body not in scene._slopes:
+        scene.slopes(outer_body, bore_tilt_inertia)
+        scene.family(FAMILY["gyroscopic"], SlopeGyroscopic, (), resolve=_gyro_dofs).add(
+            1, body=[outer_body], polar_inertia=bore_spin_inertia)
+    J_r = roller_tilt_inertia(b)
+    for nm in names:
+        scene.tilt(nm, J_r)
+    sl = sliced_law(b)
+    pin_local = np.asarray(pin_local, float)
+    marker = np.tile(pin_local, (Z, 1))
+    common = dict(D=damage.get("D", b.roller_diameter), K=sl["K"], zeta=b.contact_damping_ratio, m_roller=b.roller_mass)
+    fam_law = dict(traction=law["traction"], exponent=law["exponent"], z=sl["z"], drop=sl["drop"])
+    slope = np.tile(np.asarray(pin_slope, float), (Z, 1))
+    inner = scene.family(FAMILY["race_inner"], SlicedRaceContact, (), resolve=_sliced_dofs("inner"), kind="inner",
+                         **fam_law)
+    s_in = inner.add(Z, roller=names, roller_name=names, race_body=[pin_body] * Z, pin_body=[pin_body] * Z,
+                     slope_body=[outer_body] * Z, race_marker=marker, pin_marker=marker, race_slope=slope,
+                     R_race=b.inner_raceway_radius, **common)
+    outer = scene.family(FAMILY["race_outer"], SlicedRaceContact, (), resolve=_sliced_dofs("outer"), kind="outer",
+                         **fam_law)
+    s_out = outer.add(Z, roller=names, roller_name=names, race_body=[outer_body] * Z, pin_body=[pin_body] * Z,
+                      slope_body=[outer_body] * Z, race_marker=np.zeros((Z, 2)), pin_marker=marker,
+                      race_slope=np.zeros((Z, 2)), R_race=b.outer_raceway_radius, **common)
+    handles = BearingHandles("rollers", rollers=tuple(names), race_inner=s_in, race_outer=s_out, omega_cage=wm,
+                             omega_roller=wr)
+    return _add_drag_and_cage(scene, tag, b, names, psi, wm, pin_body, marker, outer_body, lubricant, pin_xy,
+                              pin_vel, handles)
 
 
 def _land(c, lubricant):

@@ -121,6 +121,12 @@ def carrier_ripple(ripple, wc: float) -> list[tuple[float, float, float]] | None
     return [(k * wc, getattr(ripple, f"amplitude_{k}"), getattr(ripple, f"phase_{k}")) for k in orders] or None
 
 
+def planet_tilt_inertia(gear) -> float:
+    """A planet's diametral moment of inertia [kg·m²] about its centre, from its polar one as a hollow cylinder of
+    its face width b: J_d = J_p/2 + m b²/12 (J_p = m (r_o² + r_i²)/2)."""
+    return 0.5 * gear.inertia + gear.mass * gear.face_width ** 2 / 12.0
+
+
 def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: bool = True) -> DPGTScene:
     """Build the DPGT scene. Design errors raise ParameterError; design warnings are issued."""
     opt = (options or SceneOptions()).resolved()
@@ -129,6 +135,9 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     check_design(params, strict=strict)
     si = params.si()
     faults.check_errors(si)
+    if si.bearing.model == "planar" and (si.errors.pin_slope or si.gears.carrier_windup):
+        raise ParameterError.at("errors.pin_slope" if si.errors.pin_slope else "gears.carrier_windup",
+                                "a pin slope is seen only by the sliced bearing model: set bearing.model = 'sliced'")
     lay = si.layout
     G, op, sup, ms = si.gears, si.operating, si.support, si.mesh
     wc = op.carrier_speed
@@ -158,9 +167,14 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
         va, vb = wc * np.array([-pa[1], pa[0]]), wc * np.array([-pb[1], pb[0]])
         scene.body(a_names[n], G.inner_planet.mass, G.inner_planet.inertia, pose=(*pa, ph.gamma_inner[n]), vel=(*va, speed["a"]))
         scene.body(b_names[n], G.outer_planet.mass, G.outer_planet.inertia, pose=(*pb, ph.gamma_outer[n]), vel=(*vb, speed["b"]))
+        tilt = {} if b.model == "planar" else {
+            planet: dict(bore_tilt_inertia=planet_tilt_inertia(gear), bore_spin_inertia=gear.inertia,
+                         pin_slope=faults.pin_slope(si, planet, c))
+            for planet, gear, c in ((a_names[n], G.inner_planet, lay.centres_a[n]),
+                                    (b_names[n], G.outer_planet, lay.centres_b[n]))}
         bearings = [add_planet_bearing(scene, f"{planet}.pb", pin_body="carrier", pin_local=p, outer_body=planet,
                                        bearing=b, lubricant=si.lubricant, pin_xy=p, pin_vel=v, omega_pin=wc,
-                                       omega_outer=w, damage=_bearing_damage(si, planet, psi))
+                                       omega_outer=w, damage=_bearing_damage(si, planet, psi), **tilt.get(planet, {}))
                     for planet, p, v, w, psi in ((a_names[n], pa, va, speed["a"], lay.psi_a[n]),
                                                  (b_names[n], pb, vb, speed["b"], lay.psi_b[n]))]
         pairs.append(PairHandles(a_names[n], b_names[n], float(lay.psi_a[n]), float(lay.psi_b[n]), *bearings))
@@ -177,7 +191,8 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
                                   ("outer_ring", b_names, ["ring"] * N, ph.gamma_outer, np.full(N, ph.gamma_ring))):
         add_mesh_family(scene, MESH_FAMILY[key], M[key], gear1=g1, gear2=g2, theta1_0=th1, theta2_0=th2,
                         flank=flanks[key], errors=faults.mesh_error_args(si, g1, g2),
-                        pairs=teeth.mesh_pairs(si, M[key], g1, g2) if tooth_pairs else None, **common)
+                        pairs=teeth.mesh_pairs(si, M[key], g1, g2) if tooth_pairs else None,
+                        face_slices=ms.face_slices if b.model == "sliced" else None, **common)
 
     # drives: sun torque (driving motor), carrier speed drive (loading motor)
     f_m = op.mesh_frequency

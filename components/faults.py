@@ -48,6 +48,8 @@ def check_errors(si) -> None:
 
     for i, x in enumerate(e.pinhole):
         planet(f"errors.pinhole[{i}].planet", x.planet)
+    for i, x in enumerate(e.pin_slope):
+        planet(f"errors.pin_slope[{i}].planet", x.planet)
     for i, x in enumerate(e.runout):
         planet(f"errors.runout[{i}].gear", x.gear)
     for i, x in enumerate(e.roller_diameter):
@@ -126,6 +128,28 @@ def pin_position(si, planet: str, nominal) -> np.ndarray:
     for x in si.errors.pinhole:
         if x.planet == planet:
             out = out + x.radial * er + x.tangential * et
+    return out
+
+
+def pin_slope(si, planet: str, nominal) -> np.ndarray:
+    """The slope (2,) [rad] of ``planet``'s pin axis in the carrier's axes (docs/model.md §8.8): its errors.pin_slope
+    entries (γ along the direction χ from the planet's radial line) plus, with gears.carrier_windup, the carrier's
+    wind-up: the shaft-side plate (at +ζ) turns by Δθ = T_c/k_tc against the far plate (T_c the carrier's torque,
+    k_tc gears.carrier_torsional_stiffness), so a pin at radius r_p (``nominal`` its centre) slopes by r_p Δθ/L_c
+    along the tangential direction (L_c gears.carrier_plate_span): forward and reverse tilt it opposite ways."""
+    n = _planet_index(planet)
+    psi = (si.layout.psi_a if planet[0] == "a" else si.layout.psi_b)[n]
+    out = np.zeros(2)
+    for x in si.errors.pin_slope:
+        if x.planet == planet:
+            out = out + x.slope * np.array([np.cos(psi + x.direction), np.sin(psi + x.direction)])
+    G = si.gears
+    if G.carrier_windup:
+        nominal = np.asarray(nominal, float)
+        r_p = float(np.hypot(*nominal))
+        e_t = np.array([-nominal[1], nominal[0]]) / r_p
+        dtheta = si.operating.carrier_torque / G.carrier_torsional_stiffness
+        out = out + r_p * dtheta / G.carrier_plate_span * e_t
     return out
 
 

@@ -68,6 +68,14 @@ def reference_gears() -> GearSetParams:
         outer_planet=_gear(24, "32 mm", "0.557 kg"),
         ring=_gear(82, "33 mm", "6.07 kg", internal=True),
         carrier_mass=paper("7.751 kg"),
+        carrier_torsional_stiffness=assumed("5e6 N*m/rad", "the source gives none: three bridges 20 x 20 mm, 40 mm "
+                                                       "long, clamped at both plates (12 E I/L^3 = 5.3e8 N/m each) at "
+                                                       "85 mm radius give 1.1e7 N m/rad, halved for the plates' own "
+                                                       "flexibility", span=Span("2e6 N*m/rad", "2e7 N*m/rad",
+                                                                                "bridged two-plate carriers of this size",
+                                                                                log=True)),
+        carrier_plate_span=assumed("40 mm", "the planets' 32 mm face width and 4 mm on each side for washers"),
+        carrier_windup=assumed(False, "the source's carrier is rigid; on: the pins tilt under the carrier torque"),
         planets=paper(3, "default planet count of the study"),
         handedness=assumed(-1, "outer planet trails its inner planet by delta_psi in the forward "
                                "(counter-clockwise) carrier direction"),
@@ -128,6 +136,7 @@ def reference_bearing() -> BearingParams:
         roller_length=paper("9 mm"),
         rollers=paper(12),
         rows=paper(1, "one row in the source's table"),
+        model=assumed("planar", "the source's model; sliced: edge loading under misalignment (docs/model.md §8.8)"),
         clearance=assumed("20 um", "diametral", span=Span("5 um", "40 um", "mounted clearance: ISO 5753-1 groups 2 to N at this bore, less fit and warm pin")),
         roller_density=assumed("7850 kg/m^3", "bearing steel"),
         contact_exponent=derived(10.0 / 9.0, "Palmgren line contact Q = K delta^(10/9) (docs/model.md §8.1)"),
@@ -170,7 +179,7 @@ def perfect_machine() -> ErrorsParams:
     """No manufacturing errors or faults: the machine the source models (docs/model.md §11)."""
     return ErrorsParams(**{f: paper((), "the source models a perfect machine")
                            for f in ("pinhole", "runout", "roller_diameter", "spall", "tooth_fault", "tooth",
-                                     "flank_class")})
+                                     "flank_class", "pin_slope")})
 
 
 def typical_errors(params: DPGTParams, grade: int) -> ErrorsParams:
@@ -338,6 +347,8 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
                                          "the ring mesh at condition 3; up to 18 um at condition 1), so loaded "
                                          "flanks keep their whole damping",
                                  span=Span("0 um", "2 um", "no ramp (the Kelvin-Voigt jump) to two thirds of the least compressed loaded flank")),
+            face_slices=assumed(11, "odd (a slice on the mid-plane); the tilt stiffness k b^2 (1 - 1/n_m^2)/12 is "
+                                    "within 1 % of c_gamma b^3/12"),
         ),
         operating=operating_point(condition, direction),
         rig=RigParams(

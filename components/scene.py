@@ -76,8 +76,9 @@ class SceneOptions:
 class FamilyCollector:
     """Instances of one element family, accumulated by components, created once at build."""
 
-    def __init__(self, cls, name: str, body_args: tuple[str, ...], **common):
+    def __init__(self, cls, name: str, body_args: tuple[str, ...], resolve=None, **common):
         self.cls, self.name, self.body_args, self.common = cls, name, body_args, common
+        self.resolve = resolve        # resolve(columns, scene) -> the family's arguments (families on tilt coordinates)
         self.rows: list[dict[str, np.ndarray]] = []
 
     def add(self, n: int, **kw) -> slice:
@@ -100,9 +101,11 @@ class FamilyCollector:
     def n(self) -> int:
         return sum(r["__n"] for r in self.rows)
 
-    def make(self, body_index):
+    def make(self, body_index, scene=None):
         keys = [k for k in self.rows[0] if k != "__n"]
         cat = {k: np.concatenate([r[k] for r in self.rows]) for k in keys}
+        if self.resolve is not None:
+            return self.cls(self.name, **self.resolve(cat, scene), **self.common)
         for b in self.body_args:
             cat[b] = np.array([body_index[x] if isinstance(x, str) else int(x) for x in cat[b]], dtype=np.int64)
         return self.cls(self.name, **{b: cat.pop(b) for b in self.body_args}, **cat, **self.common)
@@ -134,6 +137,11 @@ class Scene:
         self.index: dict[str, int] = {}
         self.families: dict[str, FamilyCollector] = {}
         self._direct: list = []
+        self._slopes: dict[str, float] = {}        # tilt coordinates asked for: body name -> diametral inertia
+        self._tilts: dict[str, float] = {}
+        self.slope_index: dict[str, tuple[int, int]] = {}    # filled by build(): full indices
+        self.tilt_index: dict[str, int] = {}
+        self._extras: list = []                    # elements built after the tilt coordinates: fn(scene) -> element
 
     def body(self, name, mass, inertia, pose=(0.0, 0.0, 0.0), vel=(0.0, 0.0, 0.0), fixed=False) -> int:
         """Add a body with its initial pose and velocity in the fixed frame; returns its index."""
@@ -158,11 +166,25 @@ class Scene:
         u = np.array(self._vel) / speed
         return float(np.sum(m * (u[:, 0] ** 2 + u[:, 1] ** 2) + J * u[:, 2] ** 2))
 
-    def family(self, key: str, cls, body_args: tuple[str, ...], **common) -> FamilyCollector:
-        """The collector for family ``key`` (created on first use)."""
+    def family(self, key: str, cls, body_args: tuple[str, ...], resolve=None, **common) -> FamilyCollector:
+        """The collector for family ``key`` (created on first use). ``resolve(columns, scene)``: the family's arguments
+        from its collected columns, for families that index tilt coordinates (known only at build)."""
         if key not in self.families:
-            self.families[key] = FamilyCollector(cls, key, body_args, **common)
+            self.families[key] = FamilyCollector(cls, key, body_args, resolve=resolve, **common)
         return self.families[key]
+
+    def slopes(self, name: str, inertia: float) -> None:
+        """Give body ``name`` a slope pair (mbd.ModelBuilder.add_slopes) of diametral inertia ``inertia`` [kg·m²];
+        declared at build, after every body."""
+        self._slopes[name] = float(inertia)
+
+    def tilt(self, name: str, inertia: float) -> None:
+        """Give body ``name`` a scalar tilt (mbd.ModelBuilder.add_tilts) of inertia ``inertia`` [kg·m²]."""
+        self._tilts[name] = float(inertia)
+
+    def add_late_element(self, make) -> None:
+        """An element family made at build, after the tilt coordinates: ``make(scene)`` returns it."""
+        self._extras.append(make)
 
     def add_element(self, element) -> None:
         """A ready-made element family (e.g. one drive)."""
@@ -171,13 +193,22 @@ class Scene:
     def build(self, kind: type[S], **fields) -> S:
         """Freeze the model; returns ``kind`` (a :class:`BuiltScene` type) with the initial state and
         ``fields``, the scene type's own (what its outputs read)."""
+        for name, J in self._slopes.items():          # tilt coordinates after every body (their indices follow)
+            self.slope_index[name] = self.mb.add_slopes(self.index[name], J)
+        if self._tilts:
+            idx = self.mb.add_tilts([self.index[nm] for nm in self._tilts], list(self._tilts.values()))
+            self.tilt_index.update(zip(self._tilts, (int(i) for i in idx)))
         for fam in self.families.values():
             if fam.n:
-                self.mb.add(fam.make(self.index))
+                self.mb.add(fam.make(self.index, self))
         for e in self._direct:
             self.mb.add(e)
+        for make in self._extras:
+            self.mb.add(make(self))
         model = self.mb.build()
         fs = model.frame.at(0.0)
         q, v = to_reference(self.mb.poses(), np.array(self._vel), fs)
         qf, vf = q.ravel(), v.ravel()
+        if model.has_tilt:      # every slope and tilt starts at zero, at rest in R
+            qf, vf = model.full_of_poses(q), model.full_of_poses(v)
         return kind(model=model, q0=qf[model.free].copy(), v0=vf[model.free].copy(), **fields)

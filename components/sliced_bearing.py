@@ -44,7 +44,7 @@ from . import life
 from .profiles import reduced_modulus, roller_drop
 
 __all__ = ["ARCMIN", "MISALIGNMENT_DIRECTIONS", "SlicedBearing", "SlicedBearingState", "sliced_bearing_life",
-           "misalignment_sweep"]
+           "misalignment_sweep", "pressure_scales"]
 
 ARCMIN = math.pi / (180.0 * 60.0)
 MISALIGNMENT_DIRECTIONS = ("radial", "tangential")
@@ -99,6 +99,14 @@ class SlicedBearingState:
         return float(np.count_nonzero(self.q_pin[r, j] > 0.0) / self.q_pin.shape[2])
 
 
+def pressure_scales(b, slices: int) -> tuple[float, float]:
+    """(pin, bore) factors c of a slice's Hertz line-contact pressure p = c √q [Pa] from its load q [N]:
+    p = √(w E*/(π R)), w = q/Δ, Δ = l/n_s, 1/R = 2/D ± 2/d_race (pin +, bore −)."""
+    E, D, width = reduced_modulus(b), b.roller_diameter, b.roller_length / slices
+    return tuple(math.sqrt(E / (math.pi * width) * (2.0 / D + s / R))
+                 for s, R in ((1.0, b.inner_raceway_radius), (-1.0, b.outer_raceway_radius)))
+
+
 class SlicedBearing:
     """The quasi-static sliced bearing ``b`` (:class:`~components.params.BearingSI`; profile and slicing from
     ``b.profile``, ``b.slicing``; ``slices`` overrides the slice count). See the module docstring."""
@@ -121,8 +129,7 @@ class SlicedBearing:
         self.outer = SlicedContact(kind="outer", R_race=b.outer_raceway_radius, **common)
         E = reduced_modulus(b)
         D = b.roller_diameter
-        self._p_scale = [math.sqrt(E / (math.pi * self.width) * (2.0 / D + s / R))
-                         for s, R in ((1.0, b.inner_raceway_radius), (-1.0, b.outer_raceway_radius))]
+        self._p_scale = list(pressure_scales(b, self.z.size))
 
     # ------------------------------------------------------------------ the rollers for a given bore pose
     def _contacts(self, e, r, tau, u, s_pin):

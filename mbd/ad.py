@@ -14,7 +14,7 @@ import numpy as np
 
 __all__ = [
     "Dual", "seed", "value", "sin", "cos", "tanh", "exp", "sqrt", "abs_", "where", "pos", "power",
-    "arctan2", "hypot", "sign", "wrap_angle", "clip_min",
+    "arctan2", "hypot", "sign", "wrap_angle", "clip_min", "repeat_each", "group_sum", "take", "spread",
 ]
 
 
@@ -210,3 +210,37 @@ def wrap_angle(x):
     if isinstance(x, Dual):
         return Dual(w, x.der)
     return w
+
+
+# instances × sub-points (slices): a family that evaluates k points per instance flattens them into the instance axis
+def repeat_each(x, k: int):
+    """Each instance's value repeated k times: (n,) → (n·k,) (a Dual's derivative rows with it; scalars pass)."""
+    if isinstance(x, Dual):
+        return Dual(np.repeat(x.val, k), np.repeat(x.der, k, axis=0))
+    return np.repeat(x, k) if np.ndim(x) else x
+
+
+def group_sum(x, n: int, k: int):
+    """The sum over each instance's k points: (n·k,) → (n,)."""
+    if isinstance(x, Dual):
+        return Dual(x.val.reshape(n, k).sum(axis=1), x.der.reshape(n, k, x.der.shape[-1]).sum(axis=1))
+    return np.asarray(x).reshape(n, k).sum(axis=1)
+
+
+def take(x, idx):
+    """Instances ``idx`` of a Dual or an array (scalars pass)."""
+    if isinstance(x, Dual):
+        return Dual(x.val[idx], x.der[idx])
+    return x[idx] if np.ndim(x) else x
+
+
+def spread(x, idx, n: int, m: int):
+    """Values over the instances ``idx`` put back on all n instances (0 elsewhere); m the derivative count (0: an
+    array)."""
+    if isinstance(x, Dual):
+        val, der = np.zeros(n), np.zeros((n, m))
+        val[idx], der[idx] = x.val, x.der
+        return Dual(val, der)
+    out = np.zeros(n)
+    out[idx] = x
+    return out

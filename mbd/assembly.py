@@ -71,11 +71,17 @@ class System:
             self._blocks.append(np.flatnonzero(keep))
             rows.append(r.ravel()[keep])
             cols.append(c.ravel()[keep])
-        # frame terms: 2×2 (x, y) block of every free body when R rotates
+        # frame terms: 2×2 (x, y) block of every free body when R rotates, then of every slope pair (a point of
+        # mass J_d at s, docs/model.md §2.4); gravity acts on the bodies alone (the first len(_J) entries)
         self.rotating = not m.frame.is_inertial
         free_bodies = np.flatnonzero(~m.fixed)
         self._free_bodies = free_bodies
         bx, by = f2f[3 * free_bodies], f2f[3 * free_bodies + 1]
+        mx = m.mass[free_bodies]
+        if m.slope_pairs.size:
+            sp_ = m.slope_pairs
+            bx, by = np.concatenate([bx, f2f[sp_[:, 0]]]), np.concatenate([by, f2f[sp_[:, 1]]])
+            mx = np.concatenate([mx, m.extra_inertia[sp_[:, 0] - m.n_body_coords]])
         if self.rotating:
             rows.append(np.concatenate([bx, bx, by, by]))
             cols.append(np.concatenate([bx, by, bx, by]))
@@ -97,12 +103,12 @@ class System:
             self._maps.append((keep, inv[off: off + r.size]))
             off += r.size
         if self.rotating:
-            self._frame_map = inv[off: off + 4 * free_bodies.size]
-            off += 4 * free_bodies.size
+            self._frame_map = inv[off: off + 4 * bx.size]
+            off += 4 * bx.size
         self._diag_map = inv[off: off + n]
         self._M = np.zeros(self.nnz)
         self._M[self._diag_map] = m.mdiag
-        self._mx = m.mass[free_bodies]
+        self._mx = mx
         self._J = m.inertia[free_bodies]
         self._bx, self._by = bx, by
         self._bt = f2f[3 * free_bodies + 2]
@@ -124,7 +130,7 @@ class System:
         m = self.model
         fs = m.frame.at(t)
         qf, vf = m.full(t, q, v)
-        Ffull = np.zeros(3 * m.n_bodies)
+        Ffull = np.zeros(m.n_full)
         Jq_all = np.zeros(self.nnz) if jac else None
         Jv_all = np.zeros(self.nnz) if jac else None
         for (e, parts), flat, (keep, mp) in zip(self._evals, self._dofs_flat, self._maps):
@@ -142,15 +148,16 @@ class System:
         return self.evaluate(t, q, v, z).F
 
     def _add_frame_terms(self, F, Jq, Jv, fs, q, v):
-        """Centrifugal, Coriolis, Euler and gravity terms of every free body (docs/model.md §2.3), added in
-        place to F and, when given (not None), to the Jacobian data Jq, Jv."""
+        """Centrifugal, Coriolis, Euler and gravity terms of every free body and slope pair (docs/model.md §2.3,
+        §2.4), added in place to F and, when given (not None), to the Jacobian data Jq, Jv."""
         m = self.model
         bx, by, bt, mx = self._bx, self._by, self._bt, self._mx
         if self.has_gravity:
             c, s = np.cos(fs.phi), np.sin(fs.phi)
             gx, gy = m.gravity
-            F[bx] += mx * (c * gx + s * gy)
-            F[by] += mx * (-s * gx + c * gy)
+            nb = self._J.size           # the bodies; slope pairs (after them) feel no gravity
+            F[bx[:nb]] += mx[:nb] * (c * gx + s * gy)
+            F[by[:nb]] += mx[:nb] * (-s * gx + c * gy)
         if not self.rotating:
             return
         W, dW = fs.omega, fs.domega

@@ -185,10 +185,11 @@ class HHT:
         for label, x in (("q0", q0), ("v0", v0)):
             bad = np.flatnonzero(~np.isfinite(x))
             if bad.size:   # name the parameter and the first offending body coordinate
-                full = system.model.free[bad[0]]
-                body = system.model.body_names[full // 3]
+                full = int(system.model.free[bad[0]])
+                body, _, coord = system.model.coordinate_name(full).rpartition(".")
+                coord = {"θ": "theta"}.get(coord, coord)
                 raise ModelError(f"initial state: {label} contains NaN or inf at {bad.size} free DOF(s), first "
-                                 f"{label}[{bad[0]}] = {x[bad[0]]} ({'x y theta'.split()[full % 3]} of body {body!r})")
+                                 f"{label}[{bad[0]}] = {x[bad[0]]} ({coord} of body {body!r})")
         z = system.init_internal() if z is None else z
         f = system.forces(t0, q0, v0, z)
         system.check_finite(t0, f, q0, v0, z)

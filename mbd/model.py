@@ -2,9 +2,13 @@
 
 Coordinates: every body b has q_b = (x_b, y_b, θ_b), its centre of mass in the reference frame R and
 its angle relative to R. R rotates about the fixed z axis at a prescribed Ω(t) (Ω = 0: R is inertial).
-The *full* coordinate vector holds 3 entries per body; bodies fixed to ground have prescribed motion
-(constant pose in the inertial frame) and are not degrees of freedom. Elements index the full vector;
-the integrator sees only the free DOFs.
+The *full* coordinate vector holds 3 entries per body (body b at 3b, 3b + 1, 3b + 2), then the *tilt
+coordinates* some bodies declare, appended after every body's three: a pair of out-of-plane slopes
+s = (s_x, s_y) of the body's axis in R (:meth:`ModelBuilder.add_slopes`, inertia J_d each) or a scalar tilt
+in a plane the body's own elements define (:meth:`ModelBuilder.add_tilts`). Tilt coordinates are always
+free. Bodies fixed to ground have prescribed motion (constant pose in the inertial frame) and are not
+degrees of freedom. Elements index the full vector; the integrator sees only the free DOFs. A model
+without tilt coordinates is the planar model, entry for entry.
 """
 from __future__ import annotations
 
@@ -16,7 +20,10 @@ import numpy as np
 
 from .errors import ModelError
 
-__all__ = ["Frame", "FrameState", "BodyRef", "ModelBuilder", "Model", "State"]
+__all__ = ["Frame", "FrameState", "BodyRef", "ModelBuilder", "Model", "State", "SLOPE_X", "SLOPE_Y", "TILT"]
+
+# kinds of tilt coordinate (Model.extra_kind)
+SLOPE_X, SLOPE_Y, TILT = 0, 1, 2
 
 
 @dataclass(frozen=True)
@@ -85,6 +92,9 @@ class ModelBuilder:
         self._fixed: list[bool] = []
         self._pose: list[np.ndarray] = []
         self._elements: list = []
+        self._extra_owner: list[int] = []      # tilt coordinates: owning body, kind, inertia [kg·m²]
+        self._extra_kind: list[int] = []
+        self._extra_inertia: list[float] = []
 
     def add_body(self, name: str, mass: float, inertia: float, pose=(0.0, 0.0, 0.0),
                  fixed: bool = False) -> BodyRef:
@@ -92,6 +102,8 @@ class ModelBuilder:
         for a fixed body it is the pose it keeps for ever."""
         if name in self._names:
             raise ModelError(f"body name {name!r} is used twice")
+        if self._extra_owner:     # tilt coordinates sit after every body's three: their indices would move
+            raise ModelError(f"body {name!r}: add every body before the first add_slopes/add_tilts")
         if not (np.isfinite(mass) and mass > 0):
             raise ModelError(f"body {name!r}: mass must be > 0 kg, got {mass!r}")
         if not (np.isfinite(inertia) and inertia > 0):
@@ -103,6 +115,45 @@ class ModelBuilder:
         self._fixed.append(bool(fixed))
         self._pose.append(pose)
         return BodyRef(len(self._names) - 1, name)
+
+    def add_slopes(self, body: BodyRef, inertia: float) -> tuple[int, int]:
+        """Give ``body`` two slope coordinates (s_x, s_y): its axis through its centre c passes through
+        c + ζ·s at axial station ζ, s in R. ``inertia``: its diametral moment of inertia J_d [kg·m²] about
+        its centre, which is each slope's mass. In a rotating R the engine adds the slope pair's frame terms,
+        those of a point of mass J_d at position s (docs/model.md §2.3, §2.4); a spinning body's gyroscopic terms are
+        an element family (:class:`mbd.elements.SlopeGyroscopic`). Returns the pair's full indices."""
+        b = self._body_index(body, "add_slopes")
+        if b in [o for o, k in zip(self._extra_owner, self._extra_kind) if k == SLOPE_X]:
+            raise ModelError(f"body {self._names[b]!r} has slope coordinates already")
+        if not (np.isfinite(inertia) and inertia > 0):
+            raise ModelError(f"body {self._names[b]!r}: diametral inertia must be > 0 kg*m^2, got {inertia!r}")
+        first = 3 * len(self._names) + len(self._extra_owner)
+        self._extra_owner += [b, b]
+        self._extra_kind += [SLOPE_X, SLOPE_Y]
+        self._extra_inertia += [float(inertia)] * 2
+        return first, first + 1
+
+    def add_tilts(self, bodies, inertia) -> np.ndarray:
+        """Give each body of ``bodies`` one scalar tilt coordinate (a slope in a plane its elements define, e.g. a
+        roller's radial–axial plane), of inertia ``inertia`` [kg·m²] (scalar or one per body). No frame terms:
+        a tilt is measured in a plane that turns with the body's own elements. Returns the full indices."""
+        idx = [self._body_index(b, "add_tilts") for b in np.atleast_1d(np.asarray(bodies, dtype=object))]
+        J = np.broadcast_to(np.asarray(inertia, float), (len(idx),))
+        if not np.all(np.isfinite(J) & (J > 0)):
+            raise ModelError(f"add_tilts: tilt inertia must be > 0 kg*m^2, got {inertia!r}")
+        if set(idx) & {o for o, k in zip(self._extra_owner, self._extra_kind) if k == TILT} or len(set(idx)) < len(idx):
+            raise ModelError("add_tilts: a body has a tilt coordinate already")
+        first = 3 * len(self._names) + len(self._extra_owner)
+        self._extra_owner += idx
+        self._extra_kind += [TILT] * len(idx)
+        self._extra_inertia += [float(j) for j in J]
+        return first + np.arange(len(idx), dtype=np.int64)
+
+    def _body_index(self, body, what: str) -> int:
+        b = getattr(body, "index", body)
+        if not (isinstance(b, (int, np.integer)) and 0 <= b < len(self._names)):
+            raise ModelError(f"{what}: body must be a BodyRef or an index in [0, {len(self._names)}), got {body!r}")
+        return int(b)
 
     def set_pose(self, index: int, pose) -> None:
         """Change body ``index``'s nominal pose (x, y, θ) in the fixed frame at t = 0 before :meth:`build`
@@ -141,7 +192,7 @@ class ModelBuilder:
         nb = len(self._names)
         if nb == 0:
             raise ModelError("a model needs at least one body")
-        nfull = 3 * nb
+        nfull = 3 * nb + len(self._extra_owner)
         for e in self._elements:
             d = np.asarray(e.dofs)
             if d.ndim != 2 or d.shape[1] != e.n_local or d.dtype.kind not in "iu":
@@ -151,18 +202,19 @@ class ModelBuilder:
                                  "does it refer to a body of another model?")
             e.check()
         fixed = np.array(self._fixed)
-        dof_fixed = np.repeat(fixed, 3)
+        dof_fixed = np.concatenate([np.repeat(fixed, 3), np.zeros(len(self._extra_owner), bool)])
         free = np.flatnonzero(~dof_fixed)
         full_to_free = -np.ones(nfull, dtype=np.int64)
         full_to_free[free] = np.arange(free.size)
         mass = np.array(self._mass)
         inertia = np.array(self._inertia)
-        mdiag_full = np.column_stack([mass, mass, inertia]).ravel()
+        mdiag_full = np.concatenate([np.column_stack([mass, mass, inertia]).ravel(), self._extra_inertia])
         return Model(
             body_names=tuple(self._names), mass=mass, inertia=inertia, fixed=fixed,
             pose0=np.array(self._pose), frame=self.frame, gravity=self.gravity,
             elements=tuple(self._elements), free=free, full_to_free=full_to_free,
-            mdiag=mdiag_full[free],
+            mdiag=mdiag_full[free], extra_owner=np.array(self._extra_owner, np.int64),
+            extra_kind=np.array(self._extra_kind, np.int64), extra_inertia=np.array(self._extra_inertia, float),
         )
 
 
@@ -177,8 +229,12 @@ class Model:
     gravity: np.ndarray      # (2,) in the fixed frame
     elements: tuple
     free: np.ndarray         # full indices of the free DOFs
-    full_to_free: np.ndarray  # (3 nb,) free index or -1
+    full_to_free: np.ndarray  # (n_full,) free index or -1
     mdiag: np.ndarray        # (ndof,) diagonal mass matrix on the free DOFs
+    # tilt coordinates, full index 3 nb + j: owning body, kind (SLOPE_X, SLOPE_Y, TILT), inertia [kg·m²]
+    extra_owner: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    extra_kind: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    extra_inertia: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def n_bodies(self) -> int:
@@ -188,10 +244,50 @@ class Model:
     def ndof(self) -> int:
         return self.free.size
 
+    @property
+    def n_body_coords(self) -> int:
+        """3 per body: the full indices below it are bodies' (x, y, θ), those from it tilt coordinates."""
+        return 3 * len(self.body_names)
+
+    @property
+    def n_full(self) -> int:
+        return 3 * len(self.body_names) + self.extra_owner.size
+
+    @property
+    def has_tilt(self) -> bool:
+        return self.extra_owner.size > 0
+
+    @functools.cached_property
+    def slope_pairs(self) -> np.ndarray:
+        """(n_pairs, 2) full indices (s_x, s_y) of every slope pair, in declaration order."""
+        j = np.flatnonzero(self.extra_kind == SLOPE_X)
+        return np.column_stack([j, j + 1]).astype(np.int64) + self.n_body_coords
+
     @functools.cached_property
     def angle_dofs(self) -> np.ndarray:
-        """(ndof,) True where a free DOF is an angle θ (else a length x or y)."""
-        return (self.free % 3) == 2
+        """(ndof,) True where a free DOF is an angle θ or a tilt coordinate (else a length x or y)."""
+        return np.where(self.free < self.n_body_coords, (self.free % 3) == 2, True)
+
+    def coordinate_name(self, full: int) -> str:
+        """A readable name of full coordinate ``full``: 'body.x', 'body.θ', 'body.s_x', 'body.tilt'."""
+        nb3 = self.n_body_coords
+        if full < nb3:
+            return f"{self.body_names[full // 3]}.{'xyθ'[full % 3]}"
+        j = full - nb3
+        return f"{self.body_names[self.extra_owner[j]]}.{('s_x', 's_y', 'tilt')[self.extra_kind[j]]}"
+
+    def body_poses(self, q_full: np.ndarray) -> np.ndarray:
+        """(..., nb, 3) the bodies' (x, y, θ) from full vectors (..., n_full) (tilt coordinates left out)."""
+        q_full = np.asarray(q_full)
+        return q_full[..., : self.n_body_coords].reshape(q_full.shape[:-1] + (-1, 3))
+
+    def full_of_poses(self, X: np.ndarray, extra: np.ndarray | None = None) -> np.ndarray:
+        """The full vector of body poses X (nb, 3) and tilt coordinates ``extra`` (default 0)."""
+        out = np.zeros(self.n_full)
+        out[: self.n_body_coords] = np.asarray(X).ravel()
+        if extra is not None:
+            out[self.n_body_coords:] = extra
+        return out
 
     def body(self, name: str) -> BodyRef:
         try:
@@ -209,8 +305,8 @@ class Model:
     def fixed_body_motion(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """Full-vector (q, v) of the fixed bodies in R at time t (zeros elsewhere)."""
         fs = self.frame.at(t)
-        q = np.zeros(3 * self.n_bodies)
-        v = np.zeros(3 * self.n_bodies)
+        q = np.zeros(self.n_full)
+        v = np.zeros(self.n_full)
         if self.fixed.any():
             idx = np.flatnonzero(self.fixed)
             p = self.pose0[idx]
@@ -224,15 +320,15 @@ class Model:
         if self.fixed.any():
             qf, vf = self.fixed_body_motion(t)
         else:  # two distinct arrays: (np.zeros(n),) * 2 would alias q and v
-            qf, vf = np.zeros(3 * self.n_bodies), np.zeros(3 * self.n_bodies)
+            qf, vf = np.zeros(self.n_full), np.zeros(self.n_full)
         qf[self.free] = q
         vf[self.free] = v
         return qf, vf
 
     def full_batch(self, t, q, v) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`full` at K states: ``t`` (K,), ``q``, ``v`` (K, n_free) → (K, 3·n_bodies) each."""
+        """:meth:`full` at K states: ``t`` (K,), ``q``, ``v`` (K, n_free) → (K, n_full) each."""
         t = np.asarray(t, float)
-        qf, vf = np.zeros((t.size, 3 * self.n_bodies)), np.zeros((t.size, 3 * self.n_bodies))
+        qf, vf = np.zeros((t.size, self.n_full)), np.zeros((t.size, self.n_full))
         if self.fixed.any():          # at rest in I: seen from R (as fixed_body_motion, K times at once)
             idx = np.flatnonzero(self.fixed)
             p = self.pose0[idx]
@@ -255,7 +351,8 @@ class Model:
         return FrameState(col("phi"), col("omega"), col("domega"))
 
     def poses(self, q_full: np.ndarray) -> np.ndarray:
-        return q_full.reshape(-1, 3)
+        """(nb, 3) the bodies' (x, y, θ) of a full vector (tilt coordinates left out)."""
+        return q_full[: self.n_body_coords].reshape(-1, 3)
 
 
 def _checked_pose(name: str, pose) -> np.ndarray:

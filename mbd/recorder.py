@@ -284,7 +284,7 @@ class Recorder:
             _fixed_body_acceleration(m, fs, qf, vf, af)
         for kind, p, sel in self._plan:
             if kind == "body":
-                Q, V, A = qf.reshape(-1, 3)[sel], vf.reshape(-1, 3)[sel], af.reshape(-1, 3)[sel]
+                Q, V, A = m.poses(qf)[sel], m.poses(vf)[sel], m.poses(af)[sel]
                 if p.frame == "fixed":
                     Q, V, A = to_fixed(Q, V, fs, A)
                 for qty, arr in zip("qva", (Q, V, A)):
@@ -296,7 +296,7 @@ class Recorder:
                 if outs is None:
                     outs = self.system.outputs(t, q, v, z)
                 if kind == "derived":
-                    X, V, A = qf.reshape(-1, 3), vf.reshape(-1, 3), af.reshape(-1, 3)
+                    X, V, A = m.poses(qf), m.poses(vf), m.poses(af)
                     self._buf[p.name].append(np.asarray(p.fn(t, X, V, A, outs), dtype=float).reshape(-1).copy())
                     continue
                 o = p.evaluate(outs[p.element])

@@ -65,6 +65,21 @@ class SteadyMotion:
     centre: np.ndarray  # (nb, 2) orbit centre in R [m], its host at its steady pose
     host: np.ndarray    # (nb,) host body index or −1
     placed: np.ndarray  # (nb,) bool: resting, but kept on a circle about its centre
+    extra: np.ndarray | None = None   # the tilt coordinates' values at t0 (they rest in R); None: the model has none
+
+    def full(self, model: Model, X: np.ndarray, extra: np.ndarray | None = None) -> np.ndarray:
+        """The free DOFs of body poses (or velocities) X (nb, 3) and tilt coordinates ``extra`` (default: the
+        steady ones for poses; pass zeros for velocities)."""
+        if not model.has_tilt:
+            return X.ravel()[model.free]
+        return model.full_of_poses(X, self.extra if extra is None else extra)[model.free]
+
+    @staticmethod
+    def split(model: Model, q: np.ndarray) -> np.ndarray:
+        """(nb, 3) body poses of free DOFs q (fixed bodies' entries 0; tilt coordinates dropped)."""
+        X = np.zeros(model.n_full)
+        X[model.free] = q
+        return model.poses(X)
 
     def circling(self, model: Model) -> np.ndarray:
         """Indices of the free bodies moved only along (and, optionally, around) a circle: orbiting or placed."""
@@ -78,7 +93,11 @@ class SteadyMotion:
         for resting bodies kept on a circle about that centre (placed). A body declared resting must not move in
         R (speed below ``rest_tol`` [m/s]): its steady motion would be unknown, and it is refused."""
         qf, vf = model.full(t0, q0, v0)
-        P, V = qf.reshape(-1, 3), vf.reshape(-1, 3)
+        P, V = model.poses(qf), model.poses(vf)
+        extra = qf[model.n_body_coords:].copy() if model.has_tilt else None
+        if model.has_tilt and np.any(np.abs(vf[model.n_body_coords:]) > rest_tol):
+            raise ModelError("steady motion: a tilt coordinate moves in the reference frame; a static solution needs "
+                             "every slope and tilt at rest in R")
         nb = model.n_bodies
         w = np.asarray(orbit, float)
         if w.shape != (nb,) or not np.all(np.isfinite(w)):
@@ -106,7 +125,7 @@ class SteadyMotion:
             raise ModelError(f"steady motion: body {model.body_names[i]!r} moves in the reference frame "
                              f"({np.hypot(*V[i, :2]):.3g} m/s) but has no orbit rate; a static solution needs every "
                              "body's centre at rest in R or circling a point of R")
-        return SteadyMotion(float(t0), P.copy(), np.where(model.fixed, 0.0, V[:, 2]), w, centre, host, placed)
+        return SteadyMotion(float(t0), P.copy(), np.where(model.fixed, 0.0, V[:, 2]), w, centre, host, placed, extra)
 
     def poses(self, t: float) -> np.ndarray:
         """(nb, 3) steady poses at time t."""
@@ -124,15 +143,15 @@ class SteadyMotion:
         """(q, v, a) on the free DOFs at time t: the steady pose, or — given ``q_free`` — the steady velocity and
         acceleration at that displaced pose, v = ω k × (x − c), a = −ω² (x − c), with the spin and orbital rates
         changed by ``d_spin``, ``d_orbit`` (nb,)."""
-        q = self.poses(t).ravel()[model.free] if q_free is None else np.asarray(q_free, float)
-        X = np.zeros((model.n_bodies, 3))
-        X.ravel()[model.free] = q
+        q = self.full(model, self.poses(t)) if q_free is None else np.asarray(q_free, float)
+        X = self.split(model, q)
         r = X[:, :2] - self.centre          # the motion is about the fixed centre (a host only carries the place)
         w = self.orbit if d_orbit is None else self.orbit + d_orbit
         spin = self.spin if d_spin is None else self.spin + d_spin
         V = np.column_stack([-w * r[:, 1], w * r[:, 0], spin])
         A = np.column_stack([-w * w * r[:, 0], -w * w * r[:, 1], np.zeros(model.n_bodies)])
-        return q, V.ravel()[model.free], A.ravel()[model.free]
+        rest = None if self.extra is None else np.zeros_like(self.extra)
+        return q, self.full(model, V, rest), self.full(model, A, rest)
 
 
 @dataclass
@@ -167,7 +186,7 @@ class _Problem:
         self.system, self.evaluate, self.motion, self.t, self.B, self.z = system, evaluator, motion, t, B, z
         self.model = m
         f2f = m.full_to_free
-        self.q_ref = motion.poses(t).ravel()[m.free]
+        self.q_ref = motion.full(m, motion.poses(t))
         self.Bt = B.T.tocsr()
         self.Bd = B.toarray()
         sysm = system
@@ -197,20 +216,19 @@ class _Problem:
         if i >= self.nB:
             return self.names[i - self.nB] + ".rate"
         rows = self.B[:, i].nonzero()[0]
-        if rows.size == 2 and int(m.free[rows[0]]) // 3 == int(m.free[rows[1]]) // 3:
+        if rows.size == 2 and int(m.free[rows[0]]) // 3 == int(m.free[rows[1]]) // 3 \
+                and int(m.free[rows[0]]) < m.n_body_coords:
             vals = self.B[rows, i].toarray().ravel()
             body = int(m.free[rows[0]]) // 3
             r = self.motion.poses(self.t)[body, :2] - self.motion.centre[body]
             return f"{m.body_names[body]}.{'radial' if abs(vals @ r) > 0.5 * np.hypot(*r) else 'tangential'}"
-        dof = int(m.free[rows[0]])
-        return f"{m.body_names[dof // 3]}.{'xyθ'[dof % 3]}"
+        return m.coordinate_name(int(m.free[rows[0]]))
 
     def _parts(self, x: np.ndarray):
         """(q, X (nb, 3) poses, d_spin, d_orbit) at the unknowns x."""
         m = self.model
         q = self.q_ref + self.B @ x[: self.nB]
-        X = np.zeros((m.n_bodies, 3))
-        X.ravel()[m.free] = q
+        X = self.motion.split(m, q)
         u = x[self.nB:]
         ds, do = np.zeros(m.n_bodies), np.zeros(m.n_bodies)
         ds[self.spin_b] = u[self.spin_g]
@@ -388,8 +406,10 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
         if sb >= 0 and not ob and motion.orbit[sb] != 0.0:
             own[sb] = nB + j
     local = np.column_stack([groups, own[orbiting]])           # (L, 3): radius, place, own spin rate
-    body = model.free // 3
-    gyr = np.where(model.angle_dofs, np.sqrt(model.inertia[body] / model.mass[body]), 1.0)
+    nbod = model.n_bodies         # each free DOF's body, and its inertia (an angle's scale: the radius of gyration)
+    body = np.concatenate([np.repeat(np.arange(nbod), 3), model.extra_owner])[model.free]
+    J = np.concatenate([np.repeat(model.inertia, 3), model.extra_inertia])[model.free]
+    gyr = np.where(model.angle_dofs, np.sqrt(J / model.mass[body]), 1.0)
     scale = np.asarray(abs(B).T @ gyr).ravel() / np.asarray(abs(B).sum(axis=0)).ravel()
     tol = np.concatenate([length_tol / scale, np.full(len(rates), rate_tol)])
     cap = np.concatenate([max_step / scale, np.full(len(rates), max_rate_step)])
@@ -415,8 +435,7 @@ def carry(model: Model, motion: SteadyMotion, sol: StaticSolution, t: float, rat
     rollers: the load zone stays where it was); so are the rates of groups that spin one such body. Returns
     (q_start, rates_start) for :func:`solve_static` with the same ``rates``."""
     P0, P1 = motion.poses(sol.t), motion.poses(t)
-    X = np.zeros((model.n_bodies, 3))
-    X.ravel()[model.free] = sol.q
+    X = motion.split(model, sol.q)
     D = X - P0
     D[model.fixed] = 0.0
     orb = motion.circling(model)
@@ -439,7 +458,12 @@ def carry(model: Model, motion: SteadyMotion, sol: StaticSolution, t: float, rat
         idx = [own.get(int(b), -1) for b in grp]
         if all(i >= 0 for i in idx):
             u[idx] = per(u[idx])
-    return (P1 + D).ravel()[model.free], u
+    extra = None
+    if model.has_tilt:          # the tilt coordinates carried over as they are
+        full = np.zeros(model.n_full)
+        full[model.free] = sol.q
+        extra = full[model.n_body_coords:]
+    return motion.full(model, P1 + D, extra), u
 
 
 

@@ -102,7 +102,7 @@ def run(a) -> dict:
     built, f, X, kind, groups = dpgt(a) if a.dpgt else planetary(a)
     mult = _multiplicity(groups, f.size)
     m = built.model
-    labels = [f"{m.body_names[i // 3]}.{'xyθ'[i % 3]}" for i in m.free]
+    labels = [m.coordinate_name(int(i)) for i in m.free]
     summary = {"model": "dpgt_linear_bearings" if a.dpgt else "single_planetary",
                "frequencies_hz": [float(x) for x in f], "mode_class": kind, "multiplicity": mult.tolist(),
                "dof": int(m.ndof), **identity}

@@ -152,7 +152,8 @@ class ProfileSI(SI):
 @dataclass(frozen=True, kw_only=True)
 class SlicingParams(Params["SlicingSI"]):
     """The sliced (quasi-3D) roller contact (:mod:`mbd.elements.sliced`, docs/model.md §8.8): slice count and
-    the slice law's constant. Used by the quasi-static sliced bearing (:mod:`components.sliced_bearing`)."""
+    the slice law's constant. Used by the quasi-static sliced bearing (:mod:`components.sliced_bearing`) and, with
+    bearing.model = "sliced", by the dynamic scenes' planet bearings."""
     _prefix: ClassVar[str] = "bearing.slicing"
     slices: int = param("count", "slices n_s per roller", lo=1, bound_text=">= 1")
     stiffness: str = param("choice", "slice law constant: palmgren (the planar law's K, K/n_s per slice) or "
@@ -182,6 +183,9 @@ class BearingParams(Params["BearingSI"]):
     rollers: int = param("count", "rollers Z per bearing", lo=3, bound_text=">= 3")
     rows: int = param("count", "roller rows (identical rows move as one in the planar model)", lo=1,
                       bound_text=">= 1")
+    model: str = param("choice", "roller-raceway contact model: planar (one line contact per roller) or sliced "
+                                 "(bearing.slicing slices per roller, the planets' slopes and the rollers' tilts "
+                                 "as degrees of freedom; one row)", choices=("planar", "sliced"))
     clearance: Quantity = nonneg("length", "diametral clearance P_d")
     roller_density: Quantity = positive("density", "roller material density")
     roller_mass: Quantity | None = rule("mass", "derived", "solid cylinder: density x pi D^2 l / 4")
@@ -236,6 +240,7 @@ class BearingSI(SI):
     roller_length: float
     rollers: int
     rows: int
+    model: str
     clearance: float
     roller_density: float
     roller_mass: float = computed("mass of one physical roller [kg] (given, or the rule)")

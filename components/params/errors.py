@@ -10,7 +10,8 @@ from ._machinery import SI, Params, entries, named, nonneg, param, param_fields,
 
 __all__ = ["PinholeErrorParams", "PinholeErrorSI", "RunoutParams", "RunoutSI", "RollerDiameterErrorParams",
            "RollerDiameterErrorSI", "SpallParams", "SpallSI", "ToothFaultParams", "ToothFaultSI",
-           "ToothDeviationParams", "ToothDeviationSI", "FlankClassParams", "FlankClassSI", "ErrorsParams", "ErrorsSI"]
+           "ToothDeviationParams", "ToothDeviationSI", "FlankClassParams", "FlankClassSI", "PinSlopeParams",
+           "PinSlopeSI", "ErrorsParams", "ErrorsSI"]
 
 
 _PLANET = r"[ab][1-9][0-9]*"
@@ -35,6 +36,25 @@ class PinholeErrorSI(SI):
     planet: str
     radial: float
     tangential: float
+
+
+@dataclass(frozen=True, kw_only=True)
+class PinSlopeParams(Params["PinSlopeSI"]):
+    """A planet's pin not parallel to the carrier axis (a pinhole's two ends off by different amounts across the
+    face): the pin's axis slopes by ``slope`` in the direction ``direction`` measured in the carrier from the
+    planet's radial line (0: radial, outwards at +ζ; 90 deg: tangential, with the planet angle). Seen only by the
+    sliced bearing model (bearing.model = "sliced", docs/model.md §8.8)."""
+    _prefix: ClassVar[str] = "errors.pin_slope"
+    planet: str = named(_PLANET, _PLANET_TEXT, "the planet whose pin slopes")
+    slope: Quantity = nonneg("angle", "the pin's slope against the carrier axis (e.g. '4 arcmin')")
+    direction: Quantity = param("angle", "its direction from the planet's radial line (0 radial, 90 deg tangential)")
+
+
+@si_of(PinSlopeParams)
+class PinSlopeSI(SI):
+    planet: str
+    slope: float
+    direction: float
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -193,6 +213,8 @@ class ErrorsParams(Params["ErrorsSI"]):
     tooth: tuple[ToothDeviationParams, ...] = entries(ToothDeviationParams, "tooth flank deviations, tooth by tooth")
     flank_class: tuple[FlankClassParams, ...] = entries(FlankClassParams, "tooth deviations drawn for an ISO 1328-1 "
                                                                           "flank tolerance class")
+    pin_slope: tuple[PinSlopeParams, ...] = entries(PinSlopeParams, "pin slopes (misalignment; the sliced bearing "
+                                                                   "model)")
 
     @property
     def perfect(self) -> bool:
@@ -208,3 +230,4 @@ class ErrorsSI(SI):
     tooth_fault: tuple[ToothFaultSI, ...]
     tooth: tuple[ToothDeviationSI, ...]
     flank_class: tuple[FlankClassSI, ...]
+    pin_slope: tuple[PinSlopeSI, ...]

@@ -95,6 +95,12 @@ class GearSetParams(Params["GearSetSI"]):
     ring: GearParams = nested(GearParams, "ring gear (internal)")
     carrier_mass: Quantity = positive("mass", "carrier mass")
     carrier_inertia: Quantity | None = rule("inertia", "assumed", "disc of radius 1.2 r_cb, m (1.2 r_cb)^2/2")
+    carrier_torsional_stiffness: Quantity = positive("torsional_stiffness", "torsional stiffness k_tc of the carrier's "
+                                                     "shaft-side plate against its far plate (wind-up)")
+    carrier_plate_span: Quantity = positive("length", "axial distance L_c between the carrier's two plates (the pins' "
+                                                      "supports)")
+    carrier_windup: bool = param("flag", "tilt the pins by the carrier's wind-up under its torque (the sliced "
+                                         "bearing model; docs/model.md §8.8)")
     planets: int = param("count", "planet pairs N", lo=1, bound_text=">= 1")
     handedness: int = param("sign", "planet-pair handedness h = +1 or -1")
     planet_angle: Quantity = param("angle", "angle psi_0 of the first inner planet", default="0 deg")
@@ -114,6 +120,9 @@ class GearSetSI(SI):
     ring: GearSI
     carrier_mass: float
     carrier_inertia: float = computed("carrier polar moment of inertia [kg m^2] (given, or the rule)")
+    carrier_torsional_stiffness: float
+    carrier_plate_span: float
+    carrier_windup: bool
     planets: int
     handedness: int
     planet_angle: float
@@ -148,6 +157,8 @@ class MeshParams(Params["MeshSI"]):
     damping_ratio: Quantity = nonneg("dimensionless", "mesh damping ratio zeta_m")
     damping_ramp: Quantity = nonneg("length", "compression over which a flank's (a tooth pair's) damping grows from 0 "
                                               "at first touch to zeta_m's (0: all of it at first touch)")
+    face_slices: int = param("count", "slices n_m of each mesh's face width when the planets tilt (bearing.model = "
+                                      "sliced; docs/model.md §6.6)", lo=1, bound_text=">= 1")
     backlash_sun_inner: Quantity | None = _backlash("sun-inner planet meshes")
     backlash_inner_outer: Quantity | None = _backlash("inner-outer planet meshes")
     backlash_outer_ring: Quantity | None = _backlash("outer planet-ring meshes")
@@ -167,6 +178,7 @@ class MeshSI(SI):
     smoothing_width: float
     damping_ratio: float
     damping_ramp: float
+    face_slices: int
     backlash_sun_inner: float | None
     backlash_inner_outer: float | None
     backlash_outer_ring: float | None

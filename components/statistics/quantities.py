@@ -18,12 +18,12 @@ from mbd.ad import wrap_angle
 
 from ..bearing import bearing_kinematics
 from ..families import FAMILY, MESH_FAMILY
-from ..life import LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, raceway_ratings
+from ..life import LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, raceway_ratings, sliced_raceway_ratings
 from ..lubrication import bearing_film
 
 __all__ = ["bearing_map", "Plan", "plan_of", "owner", "quantities", "carrier_frame_motion", "to_carrier",
            "radial_tangential", "pin_reactions", "contact_film", "traction_heat", "film_extremes",
-           "reference_rollers", "CAGE_SPEED", "POCKET_FORCE"]
+           "reference_rollers", "slice_quantities", "CAGE_SPEED", "POCKET_FORCE"]
 
 # the quantities the accumulators read beyond their sums: the cage speed (its window's revolutions) and the
 # pocket force (impact peaks)
@@ -78,6 +78,7 @@ class Plan:
     lubricant: object | None     # None: no film (e.g. the bearing rig)
     qc: tuple                    # (pin, bore) roller contact ratings [N]
     families: frozenset          # the element families whose outputs the quantities read
+    slices: int = 0              # slices per roller of the sliced contact (0: the planar contact)
 
 
 def plan_of(scene, model) -> Plan:
@@ -107,13 +108,16 @@ def plan_of(scene, model) -> Plan:
         rows=int(getattr(b, "rows", 1)), omega_c=float(scene.speeds.carrier),
         meshes=meshes, flanks=dict(scene.flanks), bearing=b, lubricant=scene.lubricant, qc=raceway_ratings(b),
         families=frozenset({FAMILY[k] for k in ("race_inner", "race_outer", "pocket", "guide", "linear")}
-                           | set(meshes.values())))
+                           | set(meshes.values())),
+        slices=int(b.slicing.slices) if rollers and getattr(b, "model", "planar") == "sliced" else 0)
 
 
 def owner(p: Plan, key: str):
     """Bearing index of each instance of the quantity ``key``, or None: a mesh quantity (the global window)."""
     if key.startswith("roller_"):
         return p.roller_bearing
+    if key.startswith("slice_"):           # per roller and slice, roller by roller
+        return np.repeat(p.roller_bearing, p.slices)
     if key == POCKET_FORCE:
         return p.pocket_bearing
     if key.startswith(("load_", "cage_", "guide_", "planet_", "film_", "heat_", "traction_")):
@@ -158,6 +162,29 @@ def roller_quantities(p: Plan, out) -> dict[str, np.ndarray]:
         snap["film_lambda"] = snap["film_thinnest"] / p.lubricant.roughness
     if p.pocket_bearing is not None:
         snap[POCKET_FORCE] = np.asarray(out[FAMILY["pocket"]]["force"], float)
+    if "max_slice_load" in ri:            # the sliced contact (bearing.model = "sliced", docs/model.md §8.8)
+        snap.update(slice_quantities(p, ri, ro))
+    return snap
+
+
+def slice_quantities(p: Plan, ri, ro) -> dict[str, np.ndarray]:
+    """Per roller: its largest slice load on each raceway, its pin contact's larger end-slice load and middle-slice
+    load; per bearing: the misalignment it sees, |σ_pin − σ_bore| [rad] (the pin's and the bore's slopes, read at
+    its first roller: every roller of a bearing sees the same two)."""
+    snap = {"roller_inner_slice_max": np.asarray(ri["max_slice_load"], float),
+            "roller_outer_slice_max": np.asarray(ro["max_slice_load"], float),
+            "roller_inner_edge_load": np.asarray(ri["edge_load"], float),
+            "roller_inner_mid_load": np.asarray(ri["mid_load"], float)}
+    first = np.searchsorted(p.roller_bearing, np.arange(p.planet.size))
+    dx = np.asarray(ri["race_slope_x"], float)[..., first] - np.asarray(ro["race_slope_x"], float)[..., first]
+    dy = np.asarray(ri["race_slope_y"], float)[..., first] - np.asarray(ro["race_slope_y"], float)[..., first]
+    snap["planet_misalignment"] = np.hypot(dx, dy)
+    # per roller and slice, the ISO/TS 16281 slice terms (q_k/q_c,k)^e (pin stationary, bore rotating relative to the
+    # load, as the roller loads' life): (K, rollers·n_s), roller by roller
+    qc = sliced_raceway_ratings(p.bearing, p.slices)
+    for race, out, e, c in (("inner", ri, STATIONARY_EXPONENT, qc[0]), ("outer", ro, ROTATING_EXPONENT, qc[1])):
+        q = np.stack([np.asarray(out[f"slice_load_{k}"], float) for k in range(p.slices)], axis=-1)
+        snap[f"slice_{race}_fatigue"] = ((q / c) ** e).reshape(q.shape[:-2] + (-1,))
     return snap
 
 
@@ -224,7 +251,7 @@ def carrier_frame_motion(model, t, q, v, a, omega_c: float, full=None):
     qf, vf = model.full_batch(t, q, v) if full is None else full
     af = np.zeros_like(qf)
     af[:, model.free] = a
-    X, V, A = (x.reshape(K, -1, 3) for x in (qf, vf, af))
+    X, V, A = (model.body_poses(x) for x in (qf, vf, af))          # (K, nb, 3): tilt coordinates left out
     fr = model.frame
     if fr.profile is None and fr.omega == omega_c:
         return X, V, A

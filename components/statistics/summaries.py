@@ -15,8 +15,9 @@ import numpy as np
 from mbd.elements.ehl import thermal_factor
 
 from ..bearing import cage_slip_pct
+from ..sliced_bearing import pressure_scales
 from ..life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
-                    iso281_rating, lundberg_palmgren_life)
+                    iso281_rating, lundberg_palmgren_life, sliced_life, sliced_raceway_ratings)
 
 __all__ = ["run_summary", "bearing_summary", "load_summary", "roller_summary", "impact_summary", "life_summary",
            "heat_summary", "film_summary", "cage_summary", "mesh_summary"]
@@ -50,6 +51,8 @@ def bearing_summary(sums, p, kind: str, ref_roller, w_rel: float) -> dict:
     load_summary(d, sums, ref, sel)
     if p.rollers:
         roller_summary(d, sums, p, ref_roller[0 if kind == "inner" else 1], sel)
+        if "roller_inner_slice_max" in sums.acc:
+            slice_summary(d, sums, p, ref, sel)
         heat_summary(d, sums, ref, sel)
         if p.lubricant is not None:
             film_summary(d, sums, sel)
@@ -104,6 +107,25 @@ def roller_summary(d, sums, p, r: int, sel) -> None:
     d["all_rollers"] = al
 
 
+def slice_summary(d, sums, p, ref, sel) -> None:
+    """The sliced contact's statistics (docs/model.md §8.8): the largest slice load of any roller of these bearings
+    on the pin and on the bore, and the largest contact pressure (the pin's, the convex raceway); the edge ratio of
+    the reference bearing, its largest end-slice pin pressure over its largest middle-slice one in the window
+    (√ of the loads' ratio); the misalignment each bearing sees, its time mean (reference, per planet) and maximum."""
+    mine = np.isin(p.roller_bearing, sel)
+    own = p.roller_bearing == ref
+    q_in, q_out = (float(sums.stats(k)["max"][mine].max()) for k in ("roller_inner_slice_max", "roller_outer_slice_max"))
+    c_pin, c_bore = pressure_scales(p.bearing, p.bearing.slicing.slices)
+    d["slice_load_max_pin_N"], d["slice_load_max_bore_N"] = q_in, q_out
+    d["contact_pressure_max_Pa"] = float(max(c_pin * np.sqrt(q_in), c_bore * np.sqrt(q_out)))
+    edge, mid = (float(sums.stats(k)["max"][own].max()) for k in ("roller_inner_edge_load", "roller_inner_mid_load"))
+    d["edge_pressure_ratio"] = float(np.sqrt(edge / mid)) if mid > 0 else None
+    mis = sums.stats("planet_misalignment")
+    d["misalignment_mean_rad"] = float(mis["mean"][ref])
+    d["misalignment_max_rad"] = float(mis["max"][ref])
+    d["misalignment_mean_per_planet_rad"] = [float(x) for x in mis["mean"][sel]]
+
+
 def impact_summary(d, sums, pk, sel) -> None:
     """Pocket impacts of the pockets ``pk`` (a mask) in the windows of the bearings ``sel``: their count, per cage
     revolution relative to the carrier (touches too), approach speed and peak force (max and mean)."""
@@ -145,9 +167,27 @@ def life_summary(d, sums, p, w_rel, ref, sel) -> None:
         out["roller_equivalent_load_pin_N"], out["roller_equivalent_load_bore_N"] = q_pin, q_bore
         out["life_iso16281_Mrev"] = lundberg_palmgren_life(q_pin, q_bore, b)
         out["life_iso16281_h"] = hours(out["life_iso16281_Mrev"], w_rel)
+        if "slice_inner_fatigue" in sums.acc:
+            out["life_iso16281_sliced_Mrev"] = _sliced_life(sums, p, bearings)
+            out["life_iso16281_sliced_h"] = hours(out["life_iso16281_sliced_Mrev"], w_rel)
     d["life_iso281_per_planet_h"] = [e["life_iso281_h"] for e, _ in each]
     if p.rollers:
         d["life_iso16281_per_planet_h"] = [e["life_iso16281_h"] for e, _ in each]
+    if "slice_inner_fatigue" in sums.acc:
+        d["life_iso16281_sliced_per_planet_h"] = [e["life_iso16281_sliced_h"] for e, _ in each]
+
+
+def _sliced_life(sums, p, bearings) -> float | None:
+    """ISO/TS 16281 life with slices of the bearings ``bearings`` [10^6 revolutions] (components.life.sliced_life):
+    per slice, the equivalent loads of the pin and the bore over the window and over the bearings' rollers, as the
+    roller loads' life takes them, q_e,k = q_c,k (mean (q_k/q_c,k)^e)^(1/e)."""
+    b = p.bearing
+    mine = np.isin(np.repeat(p.roller_bearing, p.slices), bearings)
+    qc = sliced_raceway_ratings(b, p.slices)
+    q = [c * equivalent_load(sums.stats(key)["mean"][mine].reshape(-1, p.slices).mean(axis=0), e)
+         for key, c, e in (("slice_inner_fatigue", qc[0], STATIONARY_EXPONENT),
+                           ("slice_outer_fatigue", qc[1], ROTATING_EXPONENT))]
+    return sliced_life(q[0], q[1], b)
 
 
 def heat_summary(d, sums, ref, sel) -> None:

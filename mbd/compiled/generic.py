@@ -9,6 +9,8 @@ TorsionalSpring  P = [k, c, θ0]                                               G
 TorqueSource     P = [torque]                                                 G = RAMP
 ForceSource      P = [F_X, F_Y] (fixed frame)                                 G = RAMP
 SpeedDrive       P = [k, c, k_i, θ0, ω_ref]                                   G = [Ω_j, A_j, φ_j per ripple harmonic]
+SlopeGyroscopic  P = [J_p]                                                    G = []
+CoordinateSpring P = [k, c, q0]                                               G = []
 
 RAMP = [has_ramp (1/0), t0, t1]: a :class:`~mbd.elements.drives.Ramp` (or none). A load or speed
 profile given as an arbitrary Python callable of t cannot be compiled: ``pack`` raises
@@ -27,11 +29,13 @@ from numba import njit
 from ..elements.drives import Ramp, SpeedDrive, TorqueSource
 from ..elements.loads import ForceSource
 from ..elements.springs import BodySpring, GroundSupport, TorsionalSpring
+from ..elements.tilt import CoordinateSpring, SlopeGyroscopic
 
 __all__ = ["pack_ground_support", "evaluate_ground_support", "pack_body_spring", "evaluate_body_spring",
            "pack_torsional_spring", "evaluate_torsional_spring", "pack_torque_source", "evaluate_torque_source",
            "pack_force_source", "evaluate_force_source", "pack_speed_drive", "evaluate_speed_drive",
-           "update_speed_drive"]
+           "update_speed_drive", "pack_slope_gyroscopic", "evaluate_slope_gyroscopic", "pack_coordinate_spring",
+           "evaluate_coordinate_spring"]
 
 _NO_G = np.zeros(0)
 
@@ -305,3 +309,38 @@ def update_speed_drive(z, t0, t1, ql0, vl0, ql1, vl1, P, G, phi0, phi1):
         z1[i, 0] = z[i, 0] + 0.5 * (t1 - t0) * (e0 + e1)
     return z1
 
+
+
+# ---------------------------------------------------------------------------------- SlopeGyroscopic
+def pack_slope_gyroscopic(elem: SlopeGyroscopic):
+    return _columns(elem.n, elem.polar_inertia), _NO_G
+
+
+@njit(cache=True)
+def evaluate_slope_gyroscopic(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    for i in range(ql.shape[0]):
+        Jp = P[i, 0]
+        H = Jp * (omega + vl[i, 0])
+        ax = vl[i, 2] + omega * ql[i, 1]
+        ay = vl[i, 1] - omega * ql[i, 2]
+        F[i, 0], F[i, 1], F[i, 2] = 0.0 * ql[i, 0], -H * ax, H * ay
+        if not jac:
+            continue
+        _zero_jacobians(Jq, Jv, i)
+        Jq[i, 1, 1] = -H * omega
+        Jq[i, 2, 2] = -H * omega
+        Jv[i, 1, 0], Jv[i, 1, 2] = -Jp * ax, -H
+        Jv[i, 2, 0], Jv[i, 2, 1] = Jp * ay, H
+
+
+# --------------------------------------------------------------------------------- CoordinateSpring
+def pack_coordinate_spring(elem: CoordinateSpring):
+    return _columns(elem.n, elem.stiffness, elem.damping, elem.q0), _NO_G
+
+
+@njit(cache=True)
+def evaluate_coordinate_spring(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    for i in range(ql.shape[0]):
+        F[i, 0] = -P[i, 0] * (ql[i, 0] - P[i, 2]) - P[i, 1] * vl[i, 0]
+        if jac:
+            Jq[i, 0, 0], Jv[i, 0, 0] = -P[i, 0], -P[i, 1]

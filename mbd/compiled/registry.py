@@ -45,7 +45,8 @@ class Kind:
     group: int                # its kernel module's bit in GROUPS
 
 
-_RACE, _POCKET, _GUIDE, _DRAG, _MESH, _SUPPORT, _BODY_SPRING, _TORSION, _TORQUE, _FORCE, _SPEED = range(11)
+(_RACE, _POCKET, _GUIDE, _DRAG, _MESH, _SUPPORT, _BODY_SPRING, _TORSION, _TORQUE, _FORCE, _SPEED, _GYRO,
+ _COORD_SPRING) = range(13)
 
 # compiled twin (as the families declare it) -> its id in the dispatch below
 KIND_IDS = {
@@ -53,6 +54,7 @@ KIND_IDS = {
     "mesh.gear_mesh": _MESH,
     "generic.ground_support": _SUPPORT, "generic.body_spring": _BODY_SPRING, "generic.torsional_spring": _TORSION,
     "generic.torque_source": _TORQUE, "generic.force_source": _FORCE, "generic.speed_drive": _SPEED,
+    "generic.slope_gyroscopic": _GYRO, "generic.coordinate_spring": _COORD_SPRING,
 }
 _MODULES = {"contact": contact, "generic": generic, "mesh": mesh}
 # kernel module -> its bit in a system's ``groups`` (the unit of the lazy compile)
@@ -220,6 +222,10 @@ def evaluate_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, J
         generic.evaluate_force_source(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     elif kind == _SPEED:
         generic.evaluate_speed_drive(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _GYRO:
+        generic.evaluate_slope_gyroscopic(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _COORD_SPRING:
+        generic.evaluate_coordinate_spring(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
 
 
 def update_kind(groups, kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):

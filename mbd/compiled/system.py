@@ -85,10 +85,11 @@ def assemble(groups, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
     c, s = np.cos(phi), np.sin(phi)
     W2 = omega * omega
     nb = bx.size
-    for b in range(nb):                       # gravity (given in I), then the frame's inertial forces,
-        x, y, vx, vy = q[bx[b]], q[by[b]], v[bx[b]], v[by[b]]     # added in the numpy path's order
-        F[bx[b]] += mx[b] * (c * gx + s * gy)
-        F[by[b]] += mx[b] * (-s * gx + c * gy)
+    for b in range(nb):                       # gravity (given in I) on the bodies (the first Jb.size entries; slope
+        x, y, vx, vy = q[bx[b]], q[by[b]], v[bx[b]], v[by[b]]     # pairs follow), then the frame's inertial forces,
+        if b < Jb.size:                                            # added in the numpy path's order
+            F[bx[b]] += mx[b] * (c * gx + s * gy)
+            F[by[b]] += mx[b] * (-s * gx + c * gy)
         F[bx[b]] += mx[b] * (W2 * x + 2 * omega * vy)
         F[by[b]] += mx[b] * (W2 * y - 2 * omega * vx)
     if jac and frame_map.size:                # pattern order: (bx,bx), (bx,by), (by,bx), (by,by)
@@ -164,7 +165,7 @@ class CompiledSystem:
                      float(m.frame.omega), float(m.gravity[0]), float(m.gravity[1]),
                      np.asarray(system._mx, float), np.asarray(system._J, float), system._bx.astype(np.int64),
                      system._by.astype(np.int64), system._bt.astype(np.int64), np.asarray(frame_map, np.int64),
-                     3 * m.n_bodies)
+                     m.n_full)
         self._assemble: dict = {}     # the compiled assembly per fingerprint of q and v (:meth:`evaluate`)
 
     def set_internal(self, z: dict) -> None:

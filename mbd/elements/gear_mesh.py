@@ -63,6 +63,7 @@ from ..errors import ModelError
 from .tooth_pairs import ToothPairs, damping_share, flank_force, smooth_box
 
 __all__ = ["StiffnessShape", "ConstantStiffness", "RectangularStiffness", "FourierStiffness", "STIFFNESS_SHAPES",
+           "SlicedGearMesh",
            "GearMesh", "mesh_offset", "mesh_u0", "contact_ratio_to_fraction"]
 
 _TWO_PI = 2.0 * np.pi
@@ -344,8 +345,35 @@ class GearMesh(Element):
         return self.stiffness.family_factor(p, self._shape_args)
 
     def kernel(self, t, fs, q, v, z):
-        x1, y1, th1, x2, y2, th2 = q
-        vx1, vy1, w1, vx2, vy2, w2 = v
+        g = self._geometry(q, v)
+        F_plus, F_minus, kp = self._flank_forces(g, g["d_plus"], g["d_minus"], g["r_plus"], g["r_minus"])
+        return self._forces(g, F_plus, F_minus, kp)
+
+    def _flank_forces(self, g, d_plus, d_minus, r_plus, r_minus, scale=1.0):
+        """(F_+, F_−, k(p)) of flank compressions and rates (lumped or tooth-pair law); ``scale`` multiplies the
+        stiffness and damping (a face slice's share)."""
+        p = g["p"]
+        if self.pairs is not None:     # tooth by tooth (tooth_pairs), each flank over its own pairs
+            sig, th1, th2, phi_e, t_dd, inv_a, w1 = (g[k] for k in ("sig", "th1", "th2", "phi_e", "t_dd", "inv_a", "w1"))
+            pair_args = (self.pairs, sig, self.teeth1, self.teeth2, self.k_mean * scale if scale != 1.0 else self.k_mean,
+                         self.c_mesh * scale if scale != 1.0 else self.c_mesh, self.damping_ramp,
+                         self._shape_args, th1, th2, phi_e, t_dd * inv_a, w1)
+            F_plus, kp = flank_force(pair_args[0], 1, *pair_args[1:], d_plus, r_plus)
+            F_minus, _ = flank_force(pair_args[0], -1, *pair_args[1:], d_minus, r_minus)
+        else:
+            kp = self.k_mean * self._factor(p)
+            c, ramp = self.c_mesh, self.damping_ramp
+            if scale != 1.0:
+                kp, c = kp * scale, c * scale
+            F_plus = ad.where(d_plus > 0.0, ad.pos(kp * d_plus + c * damping_share(d_plus, ramp) * r_plus), 0.0)
+            F_minus = ad.where(d_minus > 0.0, ad.pos(kp * d_minus + c * damping_share(d_minus, ramp) * r_minus), 0.0)
+        return F_plus, F_minus, kp
+
+    def _geometry(self, q, v):
+        """The flank compressions, their rates and the mesh geometry (module docstring) as a dict."""
+        x1, y1, th1, x2, y2, th2 = q[:6]
+        vx1, vy1, w1, vx2, vy2, w2 = v[:6]
+        r1 = r2 = None
         if self.has_offset:   # the law in the geometric centres c + R(θ)·offset (eccentricity / runout)
             (x1, y1), r1 = marker((x1, y1, th1), self.offset1)
             (x2, y2), r2 = marker((x2, y2, th2), self.offset2)
@@ -377,21 +405,22 @@ class GearMesh(Element):
         r_plus = s_dot - radial_dot
         r_minus = -1.0 * s_dot - radial_dot
         p = self.teeth1 * (th1 - phi_e) * (1.0 / _TWO_PI) + self.p0
-        if self.pairs is not None:     # tooth by tooth (tooth_pairs), each flank over its own pairs
-            pair_args = (self.pairs, sig, self.teeth1, self.teeth2, self.k_mean, self.c_mesh, self.damping_ramp,
-                         self._shape_args, th1, th2, phi_e, t_dd * inv_a, w1)
-            F_plus, kp = flank_force(pair_args[0], 1, *pair_args[1:], d_plus, r_plus)
-            F_minus, _ = flank_force(pair_args[0], -1, *pair_args[1:], d_minus, r_minus)
-        else:
-            kp = self.k_mean * self._factor(p)
-            c, ramp = self.c_mesh, self.damping_ramp
-            F_plus = ad.where(d_plus > 0.0, ad.pos(kp * d_plus + c * damping_share(d_plus, ramp) * r_plus), 0.0)
-            F_minus = ad.where(d_minus > 0.0, ad.pos(kp * d_minus + c * damping_share(d_minus, ramp) * r_minus), 0.0)
+        return dict(sig=sig, th1=th1, th2=th2, w1=w1, phi_e=phi_e, t_dd=t_dd, inv_a=inv_a, a=a, e_dd=e_dd,
+                    kappa=kappa, ex=ex, ey=ey, tx=tx, ty=ty, r1=r1, r2=r2, p=p, d_plus=d_plus, d_minus=d_minus,
+                    r_plus=r_plus, r_minus=r_minus)
+
+    def _forces(self, g, F_plus, F_minus, kp, extra=None):
+        """Generalized forces and outputs of the flank forces; ``extra`` (x, y): a further force on the body at the
+        head of d (the face slices' terms)."""
+        sig, kappa, ex, ey, tx, ty, r1, r2, p = (g[k] for k in ("sig", "kappa", "ex", "ey", "tx", "ty", "r1", "r2",
+                                                                  "p"))
         # Q = −Σ F_f ∇δ_f; on the body at the head of d: (F+ − F−) κ t + σ (F+ + F−) sin α e
         F_net = F_plus - F_minus
         F_sum = F_plus + F_minus
         Fx_head = F_net * kappa * tx + sig * self.sin_alpha * F_sum * ex
         Fy_head = F_net * kappa * ty + sig * self.sin_alpha * F_sum * ey
+        if extra is not None:
+            Fx_head, Fy_head = Fx_head + extra[0], Fy_head + extra[1]
         T1 = -sig * self.rb1 * F_net
         T2 = -1.0 * self.rb2 * F_net
         # the head of d is gear 2 (external) or gear 1, the planet (internal)
@@ -401,10 +430,125 @@ class GearMesh(Element):
             T2 = T2 + (r2[0] * f2y - r2[1] * f2x)
         outputs = {
             "force": F_net, "force_drive": F_plus, "force_coast": F_minus,
-            "deflection": d_plus, "deflection_coast": d_minus,
-            "deflection_rate": r_plus, "deflection_rate_coast": r_minus,
+            "deflection": g["d_plus"], "deflection_coast": g["d_minus"],
+            "deflection_rate": g["r_plus"], "deflection_rate_coast": g["r_minus"],
             "stiffness": np.broadcast_to(ad.value(kp), np.shape(ad.value(p))).astype(float),
             "position": np.mod(ad.value(p), 1.0),
             "fx": f2x, "fy": f2y,
         }
         return [f1x, f1y, T1, f2x, f2y, T2], outputs
+
+
+class SlicedGearMesh(GearMesh):
+    """The lumped mesh law of :class:`GearMesh` with each flank cut into n_m slices across the face width b, so that
+    the mesh resists its gears' relative slope (docs/model.md §6.6). Gear i's section at axial station ζ is displaced
+    by ζ s_i (s_i its slope pair, or none: a gear without slopes), so flank f's compression there is
+
+        δ_f(ζ) = δ_f + ζ g_f·(s_2 − s_1),   g_f = ∂δ_f/∂c_2 = −σ f κ t − sin α e,
+
+    the planar compression's gradient in gear 2's centre (at a = a0, |g_f| = 1: the line of action). Slice k, at
+    ζ_k = (k − (n_m + 1)/2) b/n_m, carries (k(p)/n_m) δ_f(ζ_k) + (c_m/n_m) S(δ_f(ζ_k)/δ_c) δ̇_f(ζ_k) while δ_f(ζ_k) > 0
+    (clipped at ≥ 0): with s_1 = s_2 every slice carries 1/n_m of today's flank force and their sum is the lumped law.
+    Generalised forces −Σ_k F_fk ∇δ_f(ζ_k): the lumped ones with F_f = Σ_k F_fk, on the slopes ∓Σ_f M_f g_f
+    (M_f = Σ_k ζ_k F_fk, the flank's moment), and on the centres −Σ_f M_f ∂(g_f·Δs)/∂d, the second-order change of the
+    line of action with the centre distance. With every slice in contact the mesh's tilt stiffness along g_f is
+    k b²(1 − 1/n_m²)/12 ≈ c_γ b³/12 (c_γ = k/b per unit face width).
+
+    With ``pairs`` the tooth-pair law (mbd.elements.tooth_pairs) takes the lumped law's place slice by slice: every
+    slice has its mesh's teeth, gaps and pairs' shares, with 1/n_m of the stiffness and damping (uniform slices: the
+    tooth-pair mesh to round-off).
+
+    Local coordinates: gear 1 (x, y, θ), gear 2 (x, y, θ), then gear 1's slopes (if ``slopes1``), gear 2's (if
+    ``slopes2``): full indices (n, 2) or None. ``face_width`` b [m] per mesh; ``slices`` n_m. Outputs: GearMesh's and "tilt_moment" M_+ − M_− [N m], "relative_slope" g·Δs of the loaded
+    flank's line [rad]."""
+    compiled_twin = None
+    batched = False            # its slices flatten the instance axis: one state at a time
+
+    def __init__(self, name, gear1, gear2, *, slopes1=None, slopes2=None, face_width, slices, **kw):
+        super().__init__(name, gear1, gear2, **kw)
+        self.has1, self.has2 = slopes1 is not None, slopes2 is not None
+        cols = [self.dofs]
+        for has, sl, key in ((self.has1, slopes1, "slopes1"), (self.has2, slopes2, "slopes2")):
+            if has:
+                sl = np.asarray(sl, np.int64)
+                if sl.shape != (self.n, 2):
+                    raise ModelError(f"{name}: parameter {key!r} must be ({self.n}, 2) full slope indices, got {sl.shape}")
+                cols.append(sl)
+        self.dofs = np.hstack(cols)
+        self.n_local = self.dofs.shape[1]
+        self.face_width = self._per_instance("face_width", face_width, positive=True)
+        n_m = int(slices)
+        if n_m < 1 or n_m != slices:
+            raise ModelError(f"{name}: parameter 'slices' must be an integer >= 1, got {slices!r}")
+        self.n_m = n_m
+        self._unit = np.arange(1, n_m + 1) - 0.5 * (n_m + 1)          # ζ_k / (b/n_m)
+        if self.pairs is not None:      # every slice of a mesh has its mesh's teeth: the per-mesh rows repeated
+            pp = self.pairs
+            rep = lambda a: np.repeat(a, n_m, axis=0)                     # noqa: E731
+            self._slice_pairs = ToothPairs(rep(pp.entry), rep(pp.phase2), rep(pp.relief1), rep(pp.relief2), pp.table,
+                                           rep(pp.start1), rep(pp.start2))
+
+    def fuse_key(self):
+        return None
+
+    def kernel(self, t, fs, q, v, z):
+        g = self._geometry(q, v)
+        n, nm = self.n, self.n_m
+        j = 6
+        zero = 0.0 * q[0]
+        s1x = s1y = v1x = v1y = zero
+        s2x = s2y = v2x = v2y = zero
+        if self.has1:
+            s1x, s1y, v1x, v1y = q[j], q[j + 1], v[j], v[j + 1]
+            j += 2
+        if self.has2:
+            s2x, s2y, v2x, v2y = q[j], q[j + 1], v[j], v[j + 1]
+        dsx, dsy, dvx, dvy = s2x - s1x, s2y - s1y, v2x - v1x, v2y - v1y
+        sig, kappa, ex, ey, tx, ty, a = (g[k] for k in ("sig", "kappa", "ex", "ey", "tx", "ty", "a"))
+        t_dd, e_dd, sa = g["t_dd"], g["e_dd"], self.sin_alpha
+        t_s, e_s = tx * dsx + ty * dsy, ex * dsx + ey * dsy           # t·Δs, e·Δs
+        # rates of e, t, κ (ė = t (t·ḋ)/a, ṫ = −e (t·ḋ)/a, κ̇ = −κ (e·ḋ)/a)
+        kp = self.k_mean * self._factor(g["p"]) if self.pairs is None else None
+        zeta = ad.repeat_each(self.face_width / nm, nm) * np.tile(self._unit, n)
+        R = lambda x: ad.repeat_each(x, nm)                                   # noqa: E731
+        if self.pairs is not None:      # the tooth-pair law per slice, each slice 1/n_m of the mesh's stiffness
+            pair_args = (self._slice_pairs, R(sig), R(self.teeth1), R(self.teeth2), R(self.k_mean / nm),
+                         R(self.c_mesh / nm), R(self.damping_ramp), tuple(R(x) for x in self._shape_args),
+                         R(g["th1"]), R(g["th2"]), R(g["phi_e"]), R(t_dd * g["inv_a"]), R(g["w1"]))
+            K_sum = 0.0
+        F, M, gvec, gsv = {}, {}, {}, {}
+        for f, d_f, r_f in ((1.0, g["d_plus"], g["r_plus"]), (-1.0, g["d_minus"], g["r_minus"])):
+            gx = -sig * f * kappa * tx - sa * ex
+            gy = -sig * f * kappa * ty - sa * ey
+            gs = gx * dsx + gy * dsy
+            # (g·Δs)˙ = ġ·Δs + g·Δṡ, ġ = σ f κ ((e·ḋ) t + (t·ḋ) e)/a − sin α t (t·ḋ)/a
+            gs_dot = (sig * f * kappa * (e_dd * t_s + t_dd * e_s) - sa * t_dd * t_s) / a + gx * dvx + gy * dvy
+            d_k = R(d_f) + zeta * R(gs)
+            r_k = R(r_f) + zeta * R(gs_dot)
+            if self.pairs is not None:
+                F_k, K_k = flank_force(pair_args[0], int(f), *pair_args[1:], d_k, r_k)
+                if f > 0:
+                    K_sum = ad.group_sum(K_k, n, nm)
+            else:
+                k_k, c_k = R(kp / nm), R(self.c_mesh / nm)
+                F_k = ad.where(d_k > 0.0, ad.pos(k_k * d_k + c_k * damping_share(d_k, R(self.damping_ramp)) * r_k),
+                               0.0)
+            F[f], M[f] = ad.group_sum(F_k, n, nm), ad.group_sum(zeta * F_k, n, nm)
+            gvec[f], gsv[f] = (gx, gy), gs
+        # −Σ_f M_f ∂(g_f·Δs)/∂d on the head of d; ∂(g_f·Δs)/∂d = σ f κ ((t·Δs) e + (e·Δs) t)/a − sin α (t·Δs) t/a
+        hx = hy = zero
+        for f in (1.0, -1.0):
+            cx = (sig * f * kappa * t_s) / a
+            ct = (sig * f * kappa * e_s - sa * t_s) / a
+            hx = hx - M[f] * (cx * ex + ct * tx)
+            hy = hy - M[f] * (cx * ey + ct * ty)
+        forces, outputs = self._forces(g, F[1.0], F[-1.0], kp if self.pairs is None else K_sum, extra=(hx, hy))
+        qsx = M[1.0] * gvec[1.0][0] + M[-1.0] * gvec[-1.0][0]
+        qsy = M[1.0] * gvec[1.0][1] + M[-1.0] * gvec[-1.0][1]
+        if self.has1:
+            forces += [qsx, qsy]
+        if self.has2:
+            forces += [-1.0 * qsx, -1.0 * qsy]
+        outputs["tilt_moment"] = M[1.0] - M[-1.0]
+        outputs["relative_slope"] = ad.value(gsv[1.0])
+        return forces, outputs

@@ -20,8 +20,8 @@ import mbd.elements
 from mbd.compiled import generic, mesh
 from mbd.compiled.registry import kind_of
 from mbd.element import evaluate
-from mbd.elements import (BodySpring, ForceSource, GearMesh, GroundSupport, Ramp, SpeedDrive, StiffnessShape,
-                          TorqueSource, TorsionalSpring)
+from mbd.elements import (BodySpring, CoordinateSpring, ForceSource, GearMesh, GroundSupport, Ramp, SlopeGyroscopic,
+                          SpeedDrive, StiffnessShape, TorqueSource, TorsionalSpring)
 from mbd.elements.gear_mesh import RectangularStiffness
 from mbd.model import FrameState
 
@@ -268,7 +268,8 @@ def test_kernel_tables():
                                if isinstance(c, type) and str(getattr(c, "compiled_twin", None)).startswith(module)}
     tables = families("mesh."), families("generic.")
     assert set(tables[0]) == {GearMesh}
-    assert set(tables[1]) == {GroundSupport, BodySpring, TorsionalSpring, TorqueSource, ForceSource, SpeedDrive}
+    assert set(tables[1]) == {GroundSupport, BodySpring, TorsionalSpring, TorqueSource, ForceSource, SpeedDrive,
+                              SlopeGyroscopic, CoordinateSpring}
     for table in tables:
         for cls, twin in table.items():
             assert callable(twin.pack) and callable(twin.evaluate)

@@ -1,0 +1,85 @@
+"""What the sliced planet bearings cost (bearing.model = "sliced", docs/model.md §8.8): the DPGT's step at one
+condition with the planar contacts and with the sliced ones, from the same loaded state, interleaved, medians.
+
+    python -m scenarios.bench_sliced [--conditions 3] [--slices 21] [--steps 20] [--repeats 5]
+
+The loaded state is the planar machine ``--settle`` seconds into its load ramp (compiled engine); the sliced
+machine starts from it with every slope and tilt at zero. Each repeat times ``--steps`` fixed steps of 5 µs of:
+the planar machine on the compiled path, the planar machine on the numpy path, the sliced machine on the numpy
+path (its only path: the sliced contact has no compiled twin yet). Prints one JSON object: seconds per step
+(medians) and the ratios sliced/planar on the numpy path and sliced (numpy) / planar (compiled).
+"""
+from __future__ import annotations
+
+import json
+import statistics
+import sys
+import time
+import warnings
+
+import numpy as np
+
+import mbd
+from components.dpgt import build_dpgt
+from components.presets import reference_dpgt
+
+from ..core import args
+from ..core.command import command
+
+EXAMPLES = ["{prog}", "{prog} --conditions 3 --slices 31 --steps 40 --repeats 3"]
+WRITES = "one JSON object on the screen: seconds per step (medians over --repeats) and the ratios"
+H = 5e-6
+
+
+def parse_args(argv):
+    p = args.parser("bench_sliced", __doc__, examples=EXAMPLES, writes=WRITES, out=None)
+    p.add_argument("--slices", type=args.count(1), default=21, help="slices per roller n_s (default 21)")
+    p.add_argument("--steps", type=args.count(1), default=20, help="fixed steps of 5 us per timing (default 20)")
+    p.add_argument("--repeats", type=args.count(1), default=5, help="interleaved timed repeats (default 5)")
+    p.add_argument("--settle", type=float, default=0.004, help="seconds of load ramp before timing (default 0.004)")
+    args.add_shared(p, "conditions", conditions="3", one_condition_only=True)
+    return p.parse_args(argv)
+
+
+def _run(model, state, steps, engine):
+    t0 = time.perf_counter()
+    res = mbd.simulate(model, t_end=state.t + steps * H, state=state.copy(), stepper=mbd.PRODUCTION.stepper(),
+                       controller=mbd.FixedStep(H), progress=False, engine=engine)
+    return (time.perf_counter() - t0) / max(res.counters["accepted"], 1)
+
+
+def measure(condition: int, slices: int, steps: int, repeats: int, settle: float) -> dict:
+    p = reference_dpgt(condition, "forward")
+    ps = p.replace(bearing=p.bearing.replace(model="sliced", slicing=p.bearing.slicing.replace(slices=slices)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        planar, sliced = build_dpgt(p), build_dpgt(ps)
+    res = mbd.simulate(planar.model, planar.q0, planar.v0, settle, stepper=mbd.PRODUCTION.stepper(),
+                       controller=mbd.PRODUCTION.controller(), progress=False, engine="compiled")
+    s = res.state
+    n = planar.model.ndof
+    ext = lambda x: np.concatenate([x, np.zeros(sliced.model.ndof - n)])          # noqa: E731
+    s_sl = mbd.State(s.t, ext(s.q), ext(s.v), ext(s.a), ext(s.f), dict(s.z))
+    for model, st, eng in ((planar.model, s, "compiled"), (planar.model, s, "numpy"), (sliced.model, s_sl, "numpy")):
+        _run(model, st, 2, eng)                                                   # kernels loaded, caches warm
+    t = {"planar_compiled": [], "planar_numpy": [], "sliced_numpy": []}
+    for _ in range(repeats):
+        t["planar_compiled"].append(_run(planar.model, s, steps, "compiled"))
+        t["planar_numpy"].append(_run(planar.model, s, steps, "numpy"))
+        t["sliced_numpy"].append(_run(sliced.model, s_sl, steps, "numpy"))
+    med = {k: statistics.median(v) for k, v in t.items()}
+    return {"condition": condition, "slices": slices, "steps": steps, "repeats": repeats,
+            "dofs_planar": n, "dofs_sliced": sliced.model.ndof, **{f"{k}_s_per_step": v for k, v in med.items()},
+            "sliced_over_planar_numpy": med["sliced_numpy"] / med["planar_numpy"],
+            "sliced_numpy_over_planar_compiled": med["sliced_numpy"] / med["planar_compiled"]}
+
+
+@command
+def main(argv=None) -> int:
+    a = parse_args(sys.argv[1:] if argv is None else argv)
+    print(json.dumps(measure(int(a.conditions), a.slices, a.steps, a.repeats, a.settle), indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
