@@ -1,0 +1,45 @@
+"""The skidding study (scenarios.skidding_study): its cases are the operating points it says, with the skid laws
+unless --set says otherwise, and its answer reads synthetic rows as they are."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from scenarios import skidding_study
+from scenarios.core.sweep import build_params
+
+
+def test_the_cases_are_every_power_oil_and_direction_at_the_speed_with_the_skid_laws(tmp_path):
+    a = skidding_study.parse_args(["--speed", "1500 rpm", "--powers", "0,50", "--oil-temperatures", "30,90",
+                                   "--directions", "reverse", "--set", "bearing.drag_law=inertial",
+                                   "--out", str(tmp_path)])
+    cases = skidding_study.make_cases(a, Path(tmp_path))
+    assert [c.label for c in cases] == ["p0kW_oil30C_reverse", "p0kW_oil90C_reverse", "p50kW_oil30C_reverse",
+                                        "p50kW_oil90C_reverse"]
+    seen = set()
+    for c in cases:
+        si = build_params(c).si()
+        assert abs(si.operating.carrier_speed) == pytest.approx(1500 * 2 * math.pi / 60)     # 1500 r/min in rad/s
+        seen.add((round(abs(si.operating.output_power)), round(si.lubricant.temperature - 273.15, 6)))
+        assert si.bearing.traction_law == "ehl" and si.bearing.rolling_resistance == "houpert"
+        assert si.bearing.drag_law == "inertial"                   # --set replaces the study's law
+    assert seen == {(0, 30.0), (0, 90.0), (50000, 30.0), (50000, 90.0)}
+
+
+def _row(P, T, d, kind, slip, ratio):
+    return {"power_kW": P, "oil_temperature_C": T, "direction": d, "bearing": kind, "cage_slip_pct": slip,
+            "load_over_minimum": ratio}
+
+
+def test_the_answer_reads_skid_and_trends_from_synthetic_rows():
+    """Slip 8 % at 2 kW (above SKID_PCT = 5 %) and 0.5 % at 200 kW in cold oil, 3 % and 0.2 % in warm oil: the
+    cold 2 kW point skids, nothing else; |slip| falls with load in both series and with temperature in both."""
+    rows = [_row(2, 40, "forward", "inner", 8.0, 0.9), _row(200, 40, "forward", "inner", 0.5, 12.0),
+            _row(2, 80, "forward", "inner", 3.0, 0.9), _row(200, 80, "forward", "inner", -0.2, 12.0)]
+    text = skidding_study.answer(rows)
+    assert "oil 40 °C, forward, inner: 2 kW +8.00 (0.90), 200 kW +0.50 (12.00) -> skids at 2 kW" in text
+    assert "oil 80 °C, forward, inner: 2 kW +3.00 (0.90), 200 kW -0.20 (12.00) -> no skid" in text
+    assert "|slip| falls as the load rises in 2 of 2 series, rises in 0." in text
+    assert "|slip| falls as the oil temperature rises in 2 of 2 series, rises in 0." in text
