@@ -158,17 +158,19 @@ def answer(rows: list[dict]) -> str:
                      + (f"; roller slip at load-zone entry / out of the load zone: {rol}"
                         if any(r.get("roller_slip_entry_pct") is not None for r in rr) else ""))
     lines.append("")
-    for what, axis in (("load", "power_kW"), ("oil temperature", "oil_temperature_C")):
-        falls = rises = 0
-        other = [c for c in ("power_kW", "oil_temperature_C") if c != axis][0]
-        for k in {(r[other], r["direction"], r["bearing"]) for r in rows}:
-            rr = sorted((r for r in rows if (r[other], r["direction"], r["bearing"]) == k), key=lambda r: r[axis])
-            if len(rr) > 1:
-                lo, hi = abs(rr[0]["cage_slip_pct"]), abs(rr[-1]["cage_slip_pct"])
-                falls += hi < lo
-                rises += hi > lo
-        if falls + rises:
-            lines.append(f"|slip| falls as the {what} rises in {falls} of {falls + rises} series, rises in {rises}.")
+    for col, words in (("cage_slip_pct", "cage |slip|"), ("roller_slip_unloaded_pct", "roller slip out of the load zone")):
+        for what, axis in (("load", "power_kW"), ("oil temperature", "oil_temperature_C")):
+            falls = rises = 0
+            other = [c for c in ("power_kW", "oil_temperature_C") if c != axis][0]
+            for k in {(r[other], r["direction"], r["bearing"]) for r in rows}:
+                rr = sorted((r for r in rows if (r[other], r["direction"], r["bearing"]) == k and r.get(col) is not None),
+                            key=lambda r: r[axis])
+                if len(rr) > 1:
+                    lo, hi = abs(rr[0][col]), abs(rr[-1][col])
+                    falls += hi < lo
+                    rises += hi > lo
+            if falls + rises:
+                lines.append(f"{words} falls as the {what} rises in {falls} of {falls + rises} series, rises in {rises}.")
     return "\n".join(lines)
 
 
@@ -209,9 +211,9 @@ def plot(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
                                        ("roller_slip_entry_pct", "roller slip at load-zone entry", "%", False),
                                        ("lambda_min", "film parameter Λ_min", "1", True)],
                               out / "slip_against_load.png",
-                              title="Cage slip against the bearing load" + (f" — {machine}" if machine else ""),
+                              title="Cage and roller slip against the bearing load" + (f" — {machine}" if machine else ""),
                               levels={"cage_slip_pct": {SKID_PCT: f"{SKID_PCT:g} %: skidding above"}},
-                              xaxis=("mean bearing load / catalogue minimum 0.02 C_r", None, 1.0))]
+                              xaxis=("bearing load / catalogue minimum 0.02 C_r", None, 1.0))]
 
 
 class SkiddingStudy(Study):

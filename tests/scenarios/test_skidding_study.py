@@ -41,5 +41,19 @@ def test_the_answer_reads_skid_and_trends_from_synthetic_rows():
     text = skidding_study.answer(rows)
     assert "oil 40 °C, forward, inner: 2 kW +8.00 (0.90), 200 kW +0.50 (12.00) -> skids at 2 kW" in text
     assert "oil 80 °C, forward, inner: 2 kW +3.00 (0.90), 200 kW -0.20 (12.00) -> no skid" in text
-    assert "|slip| falls as the load rises in 2 of 2 series, rises in 0." in text
-    assert "|slip| falls as the oil temperature rises in 2 of 2 series, rises in 0." in text
+    assert "cage |slip| falls as the load rises in 2 of 2 series, rises in 0." in text
+    assert "cage |slip| falls as the oil temperature rises in 2 of 2 series, rises in 0." in text
+    assert "roller slip" not in text                  # rows without a recording: no roller numbers
+
+
+def test_the_answer_counts_the_rollers_trends_where_the_rows_have_them():
+    """Roller slip out of the load zone 60 → 2 % from 2 to 200 kW and 60 → 50 % from 40 to 80 °C: it falls with load
+    and with oil temperature in every series, and each line names the rollers' numbers."""
+    rows = [_row(2, 40, "forward", "outer", 0.7, 1.1), _row(200, 40, "forward", "outer", 0.1, 19.0),
+            _row(2, 80, "forward", "outer", 0.7, 1.1)]
+    for r, unloaded, entry in zip(rows, (60.0, 2.0, 50.0), (75.0, 3.0, 65.0)):
+        r.update(roller_slip_unloaded_pct=unloaded, roller_slip_entry_pct=entry)
+    text = skidding_study.answer(rows)
+    assert "roller slip at load-zone entry / out of the load zone: 2 kW 75.0 % / 60.0 %, 200 kW 3.0 % / 2.0 %" in text
+    assert "roller slip out of the load zone falls as the load rises in 1 of 1 series, rises in 0." in text
+    assert "roller slip out of the load zone falls as the oil temperature rises in 1 of 1 series, rises in 0." in text
