@@ -54,7 +54,7 @@ def check_static(traction_law: str) -> None:
     if traction_law not in STATIC_TRACTION_LAWS:
         raise ParameterError.at("bearing.traction_law", f"the quasi-static solution takes {' or '.join(STATIC_TRACTION_LAWS)}"
                                 f", not {traction_law!r} (its traction saturates within ≈ 0.1 m/s of slip: the cage "
-                                "rate's continuation does not converge); run it with --mode dynamic")
+                                "rate's continuation does not converge); its speeds come from dynamic runs")
 
 
 def _rollers(scene):
