@@ -17,8 +17,9 @@ minimum load 0.02 C_r with the load over it, cage slip of the reference bearing 
 the rollers' slip in the load zone, out of it and at its entry with the slide-to-roll ratio there
 (:func:`components.skid.roller_slip_zones`, every bearing of the type pooled), traction coefficient, film parameter,
 heat of traction and land), ``slip_against_load.png`` (cage slip, roller slip out of the load zone and at its entry,
-and the film parameter against the load over the catalogue minimum, a marker per oil temperature) and the answer
-in words
+and the film parameter against the load over the catalogue minimum, a marker per oil temperature),
+``roller_slip_by_angle.png`` (the rollers' slip and the share loaded against their angle about the pin from the
+planet's radial direction, at the coldest oil, a marker per power) and the answer in words
 (``answer.md``, printed): per oil temperature and direction each bearing type's cage slip from the lightest to
 the heaviest load, whether a cage skids (more than :data:`SKID_PCT` % below its rolling speed) and how the slip
 moves with load and with the oil's temperature.
@@ -60,7 +61,7 @@ EXAMPLES = ["{prog} --out results/skidding", '{prog} --speed "1500 rpm" --powers
             "{prog} --set bearing.clearance=40um --directions forward --workers 2"]
 WRITES = ("p{power}kW_oil{T}C_{direction}/{results.nc, summary.json} per run; summary.csv and summary.md (a row per "
           "run and bearing type: load and catalogue minimum load, cage slip, traction, film, heat); answer.md (the "
-          "answer in words, also printed); slip_against_load.png; study.json")
+          "answer in words, also printed); slip_against_load.png, roller_slip_by_angle.png; study.json")
 
 
 def _numbers(unit: str):
@@ -128,6 +129,8 @@ def rows_of(cases: list[Case], results: dict) -> list[dict]:
             row = {"power_kW": P, "oil_temperature_C": T, "direction": case.direction, "bearing": kind}
             row.update({c: d.get(c) for c in _NUMBERS})
             row.update({c: zones.get(kind, {}).get(k) for c, k in _ROLLERS.items()})
+            if kind in zones:        # by angle about the pin, for the figure (not a column)
+                row["by_angle"] = {k: zones[kind][k] for k in ("angle_deg", "slip_by_angle_pct", "loaded_by_angle")}
             rows.append(row)
     return rows
 
@@ -182,7 +185,7 @@ def write_tables(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
     """summary.csv, summary.md and answer.md (the markdown files headed by ``machine``)."""
     head = [f"Machine: {machine}", ""] if machine else []
     buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=COLUMNS)
+    w = csv.DictWriter(buf, fieldnames=COLUMNS, extrasaction="ignore")
     w.writeheader()
     w.writerows(rows)
     atomic_write_text(out / "summary.csv", buf.getvalue())
@@ -196,7 +199,8 @@ def write_tables(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
 
 def plot(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
     """slip_against_load.png: cage slip, roller slip out of the load zone and at its entry, and the film parameter
-    against the mean bearing load over the catalogue minimum, forward vs reverse, a marker per oil temperature."""
+    against the mean bearing load over the catalogue minimum, forward vs reverse, a marker per oil temperature; and
+    roller_slip_by_angle.png (:func:`_by_angle`)."""
     from viz.plots import against_viscosity  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     series = {}
@@ -213,7 +217,30 @@ def plot(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
                               out / "slip_against_load.png",
                               title="Cage and roller slip against the bearing load" + (f" — {machine}" if machine else ""),
                               levels={"cage_slip_pct": {SKID_PCT: f"{SKID_PCT:g} %: skidding above"}},
-                              xaxis=("bearing load / catalogue minimum 0.02 C_r", None, 1.0))]
+                              xaxis=("bearing load / catalogue minimum 0.02 C_r", None, 1.0))] + _by_angle(rows, out, machine)
+
+
+def _by_angle(rows: list[dict], out: Path, machine: str) -> list[Path]:
+    """roller_slip_by_angle.png: the rollers' slip and the share of them loaded on the pin against their angle about
+    the pin from the planet's radial direction, at the coldest oil, forward vs reverse, a marker per power."""
+    from viz.plots import against_viscosity  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
+
+    have = [r for r in rows if "by_angle" in r]
+    if not have:
+        return []
+    cold = min(r["oil_temperature_C"] for r in have)
+    series = {}
+    for r in sorted(have, key=lambda r: r["power_kW"]):
+        if r["oil_temperature_C"] != cold:
+            continue
+        a = r["by_angle"]
+        for key, values in (("slip", a["slip_by_angle_pct"]), ("loaded", a["loaded_by_angle"])):
+            series[(key, r["bearing"], r["direction"], f"{r['power_kW']:g} kW")] = (a["angle_deg"], values)
+    return [against_viscosity(series, [("slip", "roller slip", "%", False),
+                                       ("loaded", "share of the rollers loaded on the pin", "1", False)],
+                              out / "roller_slip_by_angle.png",
+                              title=f"Roller slip around the pin, oil {cold:g} °C" + (f" — {machine}" if machine else ""),
+                              xaxis=("roller angle from the planet's radial line", "°", 1.0, False))]
 
 
 class SkiddingStudy(Study):

@@ -377,9 +377,9 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
     quantities: (key, words, SI unit, log scale) — one row each, shown in a unit that suits the range (a film in
     µm); levels: quantity key -> {value: words}, dotted horizontal lines (e.g. the film regimes' bounds of Λ),
     each inside its panel with its words (below the line where there is no room above it); names: oil name ->
-    its viscosity [Pa·s], written under the bottom row's ticks at the oils; xaxis: (words, unit, factor) of the
-    abscissa, its SI values times the factor (default the viscosity in mPa·s; another abscissa, e.g. a load ratio,
-    the same way). Bearings, directions and groups are read from the series' keys."""
+    its viscosity [Pa·s], written under the bottom row's ticks at the oils; xaxis: (words, unit, factor[, log]) of
+    the abscissa, its SI values times the factor, on a log scale unless ``log`` is False (default the viscosity in
+    mPa·s; another abscissa, e.g. a load ratio or an angle, the same way). Bearings, directions and groups are read from the series' keys."""
 
     bearings = sorted({k[1] for k in series})
     present = sorted({k[2] for k in series}, key=lambda d: {"forward": 0, "reverse": 1}.get(d, 2))
@@ -400,8 +400,9 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
                             x, y = series[k]
                             y = np.array([np.nan if v is None else v for v in y], float)
                             ax.plot(np.asarray(x) * xaxis[2], y * scale, marker=marker[g], ms=4.5, **style)
-                ax.set_xscale("log")
-                _plain_log(ax.xaxis)
+                if len(xaxis) < 4 or xaxis[3]:
+                    ax.set_xscale("log")
+                    _plain_log(ax.xaxis)
                 if log:
                     ax.set_yscale("log")
                 _levels(ax, {v * scale: words for v, words in (levels or {}).get(key, {}).items()})

@@ -57,3 +57,18 @@ def test_the_answer_counts_the_rollers_trends_where_the_rows_have_them():
     assert "roller slip at load-zone entry / out of the load zone: 2 kW 75.0 % / 60.0 %, 200 kW 3.0 % / 2.0 %" in text
     assert "roller slip out of the load zone falls as the load rises in 1 of 1 series, rises in 0." in text
     assert "roller slip out of the load zone falls as the oil temperature rises in 1 of 1 series, rises in 0." in text
+
+
+def test_the_figures_are_drawn_from_rows_with_and_without_a_recording(tmp_path):
+    """slip_against_load.png always; roller_slip_by_angle.png from the coldest oil's rows that carry angles."""
+    rows = [_row(2, 40, "forward", "inner", 0.7, 0.9), _row(200, 40, "forward", "inner", -1.2, 6.4)]
+    for r in rows:
+        r.update(roller_slip_unloaded_pct=50.0, roller_slip_entry_pct=70.0, lambda_min=2.5,
+                 by_angle={"angle_deg": [45.0, 135.0, 225.0, 315.0], "slip_by_angle_pct": [80.0, 0.0, 20.0, 60.0],
+                           "loaded_by_angle": [0.0, 1.0, 0.0, 0.0]})
+    files = skidding_study.plot(rows, tmp_path)
+    assert [f.name for f in files] == ["slip_against_load.png", "roller_slip_by_angle.png"]
+    assert all(f.stat().st_size > 10_000 for f in files)
+    for r in rows:
+        del r["by_angle"]
+    assert [f.name for f in skidding_study.plot(rows, tmp_path / "x")] == ["slip_against_load.png"]
