@@ -23,7 +23,7 @@ from .profiles import roller_drop
 from .scene import Scene
 from .units import ParameterError
 
-__all__ = ["BearingHandles", "add_planet_bearing", "bearing_kinematics", "traction"]
+__all__ = ["BearingHandles", "add_planet_bearing", "bearing_kinematics", "cage_slip_pct", "roller_slip_pct", "traction"]
 
 
 @dataclass(frozen=True)
@@ -112,6 +112,15 @@ def cage_slip_pct(b: BearingSI, cage_speed_rel, planet_speed_rel):
     NaN where the planet does not turn relative to its pin (no rolling speed to slip from)."""
     w_m, _ = bearing_kinematics(b, 0.0, np.asarray(planet_speed_rel, float))
     return 100.0 * (1.0 - np.asarray(cage_speed_rel, float) / np.where(w_m != 0.0, w_m, np.nan))
+
+
+def roller_slip_pct(b: BearingSI, roller_speed_rel, planet_speed_rel):
+    """Roller slip [%], the one definition: how far a roller spins below its pure-rolling spin, both speeds relative to
+    the pin (the carrier), 100 (1 − ω_R/ω_R,epi) with ω_R,epi from :func:`bearing_kinematics` (pin at rest, the
+    planet's bore at ``planet_speed_rel``) — the measure of Guo & Keller (NREL 2020), the rollers' speed against
+    their epicyclic speed. Arrays or scalars; NaN where the planet does not turn relative to its pin."""
+    _, w_r = bearing_kinematics(b, 0.0, np.asarray(planet_speed_rel, float))
+    return 100.0 * (1.0 - np.asarray(roller_speed_rel, float) / np.where(w_r != 0.0, w_r, np.nan))
 
 
 def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, outer_body: str, bearing: BearingSI,

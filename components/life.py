@@ -103,6 +103,21 @@ def iso281_rating(b) -> float:
     return lf.material_factor * fc * (b.rows * l) ** (7 / 9) * b.rollers ** 0.75 * D ** (29 / 27)
 
 
+# a roller bearing's requisite minimum load as a fraction of its basic dynamic load rating: SKF's rule for roller
+# bearings (SKF, Rolling bearings catalogue, PUB BU/P1 17000 EN, 2018, "Requisite minimum load": 0.02 C for roller
+# bearings, 0.01 C for ball bearings; below it "skidding and smearing of raceways or cage damage often prevail").
+# SKF's product sections refine it per bearing with catalogue factors (cylindrical roller bearings:
+# F_rm = k_r (6 + 4 n/n_r)(d_m/100)² kN, k_r and the reference speed n_r from the product tables), which a planet
+# bearing without a catalogue designation does not have.
+MINIMUM_LOAD_RATIO = 0.02
+
+
+def minimum_load(b) -> float:
+    """The catalogue minimum load [N] of bearing ``b``: SKF's rule F_min = 0.02 C (:data:`MINIMUM_LOAD_RATIO`), C
+    the basic dynamic load rating of ISO 281 (:func:`iso281_rating`)."""
+    return MINIMUM_LOAD_RATIO * iso281_rating(b)
+
+
 def iso281_life(P: float, b) -> float | None:
     """ISO 281 basic rating life L10 = (C_r/P)^(10/3) [10^6 revolutions] (None for P ≤ 0)."""
     return float((iso281_rating(b) / P) ** LIFE_EXPONENT) if P > 0 else None

@@ -19,6 +19,8 @@ SCENARIOS = {
     "demo": "the default job: forward vs reverse study at condition 3 (what `make demo` runs)",
     "paper_study": "forward/reverse study over operating conditions, comparison tables and plots",
     "lubricant_study": "which oil for which direction: film, traction, cage slip and heat against viscosity",
+    "skidding_study": "do the planet bearings skid? cage slip against load, oil temperature and direction, "
+                      "held against the catalogue minimum load",
     "fault_study": "what errors and faults do to the planet bearings and the rig's sensor",
     "gear_quality": "the forward/reverse study with real teeth: ISO 1328-1 tooth classes and seeds against perfect teeth",
     "tolerance_study": "load sharing K_γ, bearing loads and lives of machines drawn from their tolerances (static + dynamic)",

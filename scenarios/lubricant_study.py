@@ -38,6 +38,7 @@ DEFAULT_GRADES = ("VG32", "VG68", "VG150")     # thin, the reference oil, thick:
 from components.units import ParameterError, quantity, to_si
 from mbd.elements.ehl import FILM_MIN_U_EXPONENT, thermal_factor
 from components.results.io import atomic_write_text
+from components.skid import SKID_PCT
 
 from .core.runner import RunConfig
 from .core.study import Study, StudyRun
@@ -50,7 +51,6 @@ from .core.lock import holds_out_folder
 __all__ = ["main", "run", "LAMBDA_LEVELS", "SKID_PCT", "COLUMNS", "regime", "least_viscosity"]
 
 LAMBDA_LEVELS = (1.5, FULL_FILM_LAMBDA)   # the least viscosity is reported for each: Λ ≥ 1.5, and full film
-SKID_PCT = 5.0               # cage slip beyond this: skidding
 COLUMNS = ["condition", "direction", "lubricant", "viscosity_Pa_s", "bearing", "h_min_m", "h_min_isothermal_m",
            "h_mean_m", "thermal_factor_min", "thermal_loading_max", "lambda_min", "lambda_mean", "regime",
            "traction_coefficient_max", "roller_inner_race_rms_N", "roller_inner_race_max_N",

@@ -580,7 +580,7 @@ class SensitivityStudy(Study):
 
     def prepare(self, cfg: RunConfig, cases: list[Case]) -> None:
         a = self.a
-        validate_cases([Case(c, d, "", self.base, a.params) for c, d in self.points])
+        validate_cases([Case(c, d, "", self.base, a.params) for c, d in self.points], mode="static")
         self._refuse_other_settings()
         fs = self.factors
         X = morris_design(fs, a.trajectories, a.levels, a.seed)

@@ -85,6 +85,9 @@ BAD_ARGUMENTS = [
     ("paper_study", ["--frobnicate"], "unrecognized arguments: --frobnicate"),
     ("lubricant_study", ["--oil", "VG999"], "--oil: takes ISO VG grades"),
     ("lubricant_study", ["--directions", ""], "--directions: expected a comma list"),
+    ("skidding_study", ["--powers", "2,-20"], "--powers: must be >= 0 kW"),
+    ("skidding_study", ["--oil-temperatures", "warm"], "--oil-temperatures: expected a number"),
+    ("skidding_study", ["--speed", "1000 kW"], "--speed: expected an angular velocity"),
     ("spectrum", ["--power", "200 kg"], "--power: expected a power"),
     ("spectrum", ["--carrier-rpm", "-5"], "--carrier-rpm: must be > 0 r/min"),
     ("bearing_rig", ["--radial-load", "0 N"], "--radial-load: must be > 0"),
@@ -198,7 +201,9 @@ STUDIES = {"paper_study": "results/study", "demo": "results/demo", "lubricant_st
 OTHERS = {"spectrum": "results/spectrum", "bearing_rig": "results/bearing_rig", "modal": "results/modal",
           "work_precision": "results/numerics", "stability": "results/numerics", "benchmark": "results/numerics",
           "bench_engine": None, "params": None, "animate": None, "duty_cycle": "results/duty_cycle",
-          "bearing_misalignment": "results/bearing_misalignment"}
+          "bearing_misalignment": "results/bearing_misalignment",
+          # its own axes (carrier speed, powers, oil temperatures) in place of --conditions/--operating
+          "skidding_study": "results/skidding"}
 SHARED_OPTIONS = ("--params", "--set", "--out", "--overwrite", "--force", "--no-progress", "--workers",
                   "--scheduler", "--conditions")
 

@@ -105,6 +105,17 @@ def test_every_numeric_key_has_a_unit_suffix_or_is_declared_dimensionless(summar
                                            "atol_rot_rad", "engine"}
 
 
+def test_each_runs_bearing_load_is_held_against_the_catalogue_minimum(summary):
+    """summary.json's minimum load is 0.02 C_r (SKF's rule for roller bearings) and the load against it the mean
+    bearing load over it, per planet too."""
+    for kind in ("inner", "outer"):
+        d = summary[kind]
+        assert d["minimum_load_N"] == pytest.approx(0.02 * d["dynamic_load_rating_N"], rel=1e-12)
+        assert d["load_over_minimum"] == pytest.approx(d["bearing_load_mean_N"] / d["minimum_load_N"], rel=1e-12)
+        assert d["load_over_minimum_per_planet"] == pytest.approx(
+            [x / d["minimum_load_N"] for x in d["bearing_load_mean_per_planet_N"]], rel=1e-12)
+
+
 def test_the_check_catches_a_key_without_its_unit():
     """The check is not vacuous: the old names and a unit-less speed fail it; a mapping named with a unit passes."""
     assert unit_problems({"inner": {"cage_acc_radial_rms": 1.0, "pocket_impact_speed_max": 2.0}}) == \

@@ -382,7 +382,8 @@ _GROUP_MARKERS = "osD^vP"
 
 def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple], path, *,
                       title: str | None = None, levels: Mapping[str, Mapping[float, str]] | None = None,
-                      names: Mapping[str, float] | None = None) -> Path:
+                      names: Mapping[str, float] | None = None,
+                      xaxis: tuple = ("oil viscosity η", "mPa·s", 1e3)) -> Path:
     """Quantities against the oil's viscosity, forward vs reverse, one column per bearing type, one legend.
 
     series: (quantity key, bearing, direction[, group]) -> (viscosities [Pa·s], values [SI]); a group (e.g.
@@ -390,8 +391,9 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
     quantities: (key, words, SI unit, log scale) — one row each, shown in a unit that suits the range (a film in
     µm); levels: quantity key -> {value: words}, dotted horizontal lines (e.g. the film regimes' bounds of Λ),
     each inside its panel with its words (below the line where there is no room above it); names: oil name ->
-    its viscosity [Pa·s], written under the bottom row's ticks at the oils. Bearings, directions and groups are
-    read from the series' keys."""
+    its viscosity [Pa·s], written under the bottom row's ticks at the oils; xaxis: (words, unit, factor[, log]) of
+    the abscissa, its SI values times the factor, on a log scale unless ``log`` is False (default the viscosity in
+    mPa·s; another abscissa, e.g. a load ratio or an angle, the same way). Bearings, directions and groups are read from the series' keys."""
 
     bearings = sorted({k[1] for k in series})
     present = sorted({k[2] for k in series}, key=lambda d: {"forward": 0, "reverse": 1}.get(d, 2))
@@ -411,9 +413,10 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
                         if k in series:
                             x, y = series[k]
                             y = np.array([np.nan if v is None else v for v in y], float)
-                            ax.plot(np.asarray(x) * 1e3, y * scale, marker=marker[g], ms=4.5, **style)
-                ax.set_xscale("log")
-                _plain_log(ax.xaxis)
+                            ax.plot(np.asarray(x) * xaxis[2], y * scale, marker=marker[g], ms=4.5, **style)
+                if len(xaxis) < 4 or xaxis[3]:
+                    ax.set_xscale("log")
+                    _plain_log(ax.xaxis)
                 if log:
                     ax.set_yscale("log")
                 else:                 # from zero: auto-scaling would stretch a 0.1 % difference over the panel
@@ -425,7 +428,7 @@ def against_viscosity(series: Mapping[tuple, tuple], quantities: Sequence[tuple]
                     ax.set_title(f"{b} planet bearings")
                 ax.set_ylabel(_axis_label(_wrap(words, 24), shown))
                 if r == len(quantities) - 1:
-                    ax.set_xlabel(_axis_label("oil viscosity η", "mPa·s"))
+                    ax.set_xlabel(_axis_label(xaxis[0], xaxis[1]))
                     if names:
                         ax.set_xticks([1e3 * v for v in names.values()],
                                       [f"{1e3 * v:.3g}\n{n}" for n, v in names.items()])

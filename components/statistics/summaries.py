@@ -17,7 +17,7 @@ from mbd.elements.ehl import thermal_factor
 from ..bearing import cage_slip_pct
 from ..sliced_bearing import pressure_scales
 from ..life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
-                    iso281_rating, lundberg_palmgren_life, sliced_life, sliced_raceway_ratings)
+                    iso281_rating, lundberg_palmgren_life, minimum_load, sliced_life, sliced_raceway_ratings)
 
 __all__ = ["run_summary", "bearing_summary", "load_summary", "roller_summary", "impact_summary", "life_summary",
            "heat_summary", "film_summary", "cage_summary", "mesh_summary"]
@@ -148,6 +148,10 @@ def life_summary(d, sums, p, w_rel, ref, sel) -> None:
     and each planet's own."""
     b = p.bearing
     d["dynamic_load_rating_N"] = iso281_rating(b)
+    # the catalogue minimum load and the mean bearing load against it (below 1: under the catalogue's minimum)
+    d["minimum_load_N"] = minimum_load(b)
+    d["load_over_minimum"] = d["bearing_load_mean_N"] / d["minimum_load_N"]
+    d["load_over_minimum_per_planet"] = [x / d["minimum_load_N"] for x in d["bearing_load_mean_per_planet_N"]]
     cases = [(d, np.array([ref]))]
     if p.rollers:
         cases.append((d["all_rollers"], sel))

@@ -51,6 +51,19 @@ def test_iso281_rating_factor_reproduces_its_table(gamma, table):
     assert fc == pytest.approx(table, abs=0.05)
 
 
+@pytest.mark.parametrize("gamma, table", [(0.10, 84.2), (0.20, 88.7)])
+def test_minimum_load_is_skfs_rule_on_the_iso281_rating(gamma, table):
+    """The catalogue minimum load is SKF's rule for roller bearings, 0.02 C (SKF Rolling bearings catalogue 2018,
+    "Requisite minimum load"), C from ISO 281 eq. (7) with f_c of its Table 7 (printed to 0.1): for the reference
+    roller set 0.02·1.1·f_c·l^(7/9)·Z^(3/4)·D^(29/27) [N, mm]."""
+    b = bearing()
+    b = dataclasses.replace(b, pitch_diameter=b.roller_diameter / gamma)
+    D, l = 1e3 * b.roller_diameter, 1e3 * b.roller_length
+    want = 0.02 * 1.1 * table * l ** (7 / 9) * b.rollers ** 0.75 * D ** (29 / 27)
+    assert b.life.material_factor == 1.1
+    assert life.minimum_load(b) == pytest.approx(want, rel=0.05 / table)
+
+
 @pytest.mark.parametrize("rows, d_m", [(1, 0.039), (2, 0.039), (1, 0.075)])
 def test_iso281_rating_is_the_reduced_lundberg_palmgren_rating(rows, d_m):
     """ISO 281's C_r is λν times the roller sum's rating for its own case (inner ring rotating, Palmgren

@@ -8,7 +8,7 @@ import pytest
 
 from components.presets import CONDITIONS, reference_dpgt
 from components.units import ParameterError
-from scenarios import fault_study, gear_quality, lubricant_study, paper_study
+from scenarios import fault_study, gear_quality, lubricant_study, paper_study, tolerance_study
 from scenarios.core.points import Point, parse_point, point_overrides, preset
 from scenarios.core.sweep import Case, build_params
 
@@ -162,3 +162,32 @@ def test_the_tolerance_study_scales_a_points_torque(tmp_path):
     a = tolerance_study.parse_args(["--operating", "idle: 1500 rpm, 0 kW", "--out", str(tmp_path)])
     with pytest.raises(ParameterError, match="point idle: transmits no torque"):
         tolerance_study.ToleranceStudy(a)
+
+
+@pytest.mark.parametrize("study, argv", [
+    (paper_study, ["--mode", "static", "--conditions", "2"]),
+    (tolerance_study, ["--samples", "2", "--conditions", "2", "--classes", "7", "--dynamic", "0"]),
+])
+def test_a_traction_law_the_static_solution_cannot_take_is_refused_before_any_run(study, argv, tmp_path, capsys):
+    """The EHL traction law has no static solve of the cage rate (components.static.STATIC_TRACTION_LAWS): a static
+    run of it is refused in one line naming the parameter, and nothing is written."""
+    out = tmp_path / "out"
+    assert study.main([*argv, "--set", "bearing.traction_law=ehl", "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("error: bearing.traction_law: the quasi-static solution takes tanh or slide_roll, not 'ehl'"), err
+    assert not out.exists() or not any(out.rglob("*.json"))
+
+
+def test_the_static_solution_refuses_the_ehl_law_before_solving():
+    """components.static's own gate (a script calling it directly): the scene of the EHL law is refused at once."""
+    import warnings
+    from components.dpgt import build_dpgt
+    from components.params import with_overrides
+    from components.static import check_static, static_statistics
+    for law in ("tanh", "slide_roll"):
+        check_static(law)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = build_dpgt(with_overrides(reference_dpgt(2, "forward"), {"bearing.traction_law": "ehl"}))
+    with pytest.raises(ParameterError, match="bearing.traction_law"):
+        static_statistics(scene, 2)

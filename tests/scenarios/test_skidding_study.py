@@ -1,0 +1,74 @@
+"""The skidding study (scenarios.skidding_study): its cases are the operating points it says, with the skid laws
+unless --set says otherwise, and its answer reads synthetic rows as they are."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from scenarios import skidding_study
+from scenarios.core.sweep import build_params
+
+
+def test_the_cases_are_every_power_oil_and_direction_at_the_speed_with_the_skid_laws(tmp_path):
+    a = skidding_study.parse_args(["--speed", "1500 rpm", "--powers", "0,50", "--oil-temperatures", "30,90",
+                                   "--directions", "reverse", "--set", "bearing.drag_law=inertial",
+                                   "--out", str(tmp_path)])
+    cases = skidding_study.make_cases(a, Path(tmp_path))
+    assert [c.label for c in cases] == ["p0kW_oil30C_reverse", "p0kW_oil90C_reverse", "p50kW_oil30C_reverse",
+                                        "p50kW_oil90C_reverse"]
+    seen = set()
+    for c in cases:
+        si = build_params(c).si()
+        assert abs(si.operating.carrier_speed) == pytest.approx(1500 * 2 * math.pi / 60)     # 1500 r/min in rad/s
+        seen.add((round(abs(si.operating.output_power)), round(si.lubricant.temperature - 273.15, 6)))
+        assert si.bearing.traction_law == "ehl" and si.bearing.rolling_resistance == "houpert"
+        assert si.bearing.drag_law == "inertial"                   # --set replaces the study's law
+    assert seen == {(0, 30.0), (0, 90.0), (50000, 30.0), (50000, 90.0)}
+
+
+def _row(P, T, d, kind, slip, ratio):
+    return {"power_kW": P, "oil_temperature_C": T, "direction": d, "bearing": kind, "cage_slip_pct": slip,
+            "load_over_minimum": ratio}
+
+
+def test_the_answer_reads_skid_and_trends_from_synthetic_rows():
+    """Slip 8 % at 2 kW (above SKID_PCT = 5 %) and 0.5 % at 200 kW in cold oil, 3 % and 0.2 % in warm oil: the
+    cold 2 kW point skids, nothing else; |slip| falls with load in both series and with temperature in both."""
+    rows = [_row(2, 40, "forward", "inner", 8.0, 0.9), _row(200, 40, "forward", "inner", 0.5, 12.0),
+            _row(2, 80, "forward", "inner", 3.0, 0.9), _row(200, 80, "forward", "inner", -0.2, 12.0)]
+    text = skidding_study.answer(rows)
+    assert "oil 40 °C, forward, inner: 2 kW +8.00 (0.90), 200 kW +0.50 (12.00) -> skids at 2 kW" in text
+    assert "oil 80 °C, forward, inner: 2 kW +3.00 (0.90), 200 kW -0.20 (12.00) -> no skid" in text
+    assert "cage |slip| falls as the load rises in 2 of 2 series, rises in 0." in text
+    assert "cage |slip| falls as the oil temperature rises in 2 of 2 series, rises in 0." in text
+    assert "roller slip" not in text                  # rows without a recording: no roller numbers
+
+
+def test_the_answer_counts_the_rollers_trends_where_the_rows_have_them():
+    """Roller slip out of the load zone 60 → 2 % from 2 to 200 kW and 60 → 50 % from 40 to 80 °C: it falls with load
+    and with oil temperature in every series, and each line names the rollers' numbers."""
+    rows = [_row(2, 40, "forward", "outer", 0.7, 1.1), _row(200, 40, "forward", "outer", 0.1, 19.0),
+            _row(2, 80, "forward", "outer", 0.7, 1.1)]
+    for r, unloaded, entry in zip(rows, (60.0, 2.0, 50.0), (75.0, 3.0, 65.0)):
+        r.update(roller_slip_unloaded_pct=unloaded, roller_slip_entry_pct=entry)
+    text = skidding_study.answer(rows)
+    assert "roller slip at load-zone entry / out of the load zone: 2 kW 75.0 % / 60.0 %, 200 kW 3.0 % / 2.0 %" in text
+    assert "roller slip out of the load zone falls as the load rises in 1 of 1 series, rises in 0." in text
+    assert "roller slip out of the load zone falls as the oil temperature rises in 1 of 1 series, rises in 0." in text
+
+
+def test_the_figures_are_drawn_from_rows_with_and_without_a_recording(tmp_path):
+    """slip_against_load.png always; roller_slip_by_angle.png from the coldest oil's rows that carry angles."""
+    rows = [_row(2, 40, "forward", "inner", 0.7, 0.9), _row(200, 40, "forward", "inner", -1.2, 6.4)]
+    for r in rows:
+        r.update(roller_slip_unloaded_pct=50.0, roller_slip_entry_pct=70.0, lambda_min=2.5,
+                 by_angle={"angle_deg": [45.0, 135.0, 225.0, 315.0], "slip_by_angle_pct": [80.0, 0.0, 20.0, 60.0],
+                           "loaded_by_angle": [0.0, 1.0, 0.0, 0.0]})
+    files = skidding_study.plot(rows, tmp_path)
+    assert [f.name for f in files] == ["slip_against_load.png", "roller_slip_by_angle.png"]
+    assert all(f.stat().st_size > 10_000 for f in files)
+    for r in rows:
+        del r["by_angle"]
+    assert [f.name for f in skidding_study.plot(rows, tmp_path / "x")] == ["slip_against_load.png"]
