@@ -63,7 +63,8 @@ def solve_tasks(fn: Callable[..., R], todo: Iterable[T], *, workers: int | None,
     """``[fn(task, *extra) for task in todo]`` in the order they finish, each written by ``write(task, result)`` here as
     it arrives; on Dask unless one worker (``workers`` 1 or one task) and no ``scheduler`` is asked. ``what``: the tasks'
     name in progress lines ("static solutions"); ``failed(result)``: whether a result is a failure (counted in the
-    progress lines). ``stats``: a dict to fill with ``tasks``, ``batches``, ``workers``, ``wall_s`` and ``task_s`` (the
+    progress lines). ``stats``: a dict to fill with ``tasks``, ``batches``, ``workers``, ``start_s`` (Dask imported and
+    the cluster started or reached), ``wall_s`` (from the first submission to the last result) and ``task_s`` (the
     seconds the tasks themselves took, summed), from which the scheduling's share of the workers' time is
     ``1 - task_s / (workers × wall_s)`` (:func:`scheduling_share`)."""
     todo = list(todo)
@@ -87,7 +88,7 @@ def solve_tasks(fn: Callable[..., R], todo: Iterable[T], *, workers: int | None,
                   file=sys.stderr, flush=True)
 
     n = workers or min(len(todo), os.cpu_count() or 1)
-    busy, batches = 0.0, 0
+    busy, batches, t_runs = 0.0, 0, t0
     try:
         if scheduler is None and n <= 1:
             n = 1
@@ -117,6 +118,7 @@ def solve_tasks(fn: Callable[..., R], todo: Iterable[T], *, workers: int | None,
                     running.add(fut)
 
                 try:
+                    t_runs = time.perf_counter()     # the cluster is up: the tasks' phase starts
                     for _ in range(2 * n):
                         if left:
                             submit()
@@ -135,7 +137,8 @@ def solve_tasks(fn: Callable[..., R], todo: Iterable[T], *, workers: int | None,
                     raise
     finally:
         bar.close()
-        stats.update(tasks=len(out), batches=batches, workers=n, wall_s=time.perf_counter() - t0, task_s=busy)
+        stats.update(tasks=len(out), batches=batches, workers=n, start_s=t_runs - t0,
+                     wall_s=time.perf_counter() - t_runs, task_s=busy)
     return out
 
 
