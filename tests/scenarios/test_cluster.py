@@ -4,6 +4,7 @@ directory, so neither sees the client's --out), importing this checkout (its num
 it first). What the client finds in its --out is compared with the same study on a local cluster."""
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import os
@@ -274,3 +275,37 @@ def test_a_run_s_files_land_atomically_with_the_summary_last(tmp_path, monkeypat
     clusterlib.land(tmp_path / "run", files)
     assert order[-1] == "summary.json" and sorted(order) == sorted(files)
     assert clusterlib.folder_files(tmp_path / "run") == files
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("when", ["cluster starting", "runs running"])
+def test_ctrl_c_of_a_study_on_a_local_cluster_says_interrupted_and_nothing_else(when, tmp_path):
+    """Ctrl-C reaches the terminal's whole process group: the local cluster's workers too. The command ends with its
+    one line, no worker's or nanny's traceback, and leaves no process behind."""
+    out = tmp_path / "out"
+    p = subprocess.Popen([sys.executable, "-m", "scenarios.paper_study", "--conditions", "4", "--directions",
+                          "forward,reverse", "--settle", "0.002", "--window", "0.05", "--workers", "2", "--no-progress",
+                          "--out", str(out)], cwd=ROOT, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + STUDY_S
+        if when == "cluster starting":      # the sweep says how many runs it has, then starts its cluster
+            for line in p.stdout:
+                if line.startswith("runs:") or time.monotonic() > deadline:
+                    break
+        else:                               # a run writes its progress once it integrates
+            while not list(out.glob("*/progress.json")) and p.poll() is None and time.monotonic() < deadline:
+                time.sleep(0.2)
+        assert p.poll() is None, p.stderr.read()
+        os.killpg(p.pid, signal.SIGINT)
+        _, err = p.communicate(timeout=120)
+        assert p.returncode == 130, err
+        assert err.strip().splitlines()[-1].startswith("interrupted: finished runs and checkpoints are kept"), err
+        assert "Traceback" not in err and "CancelledError" not in err and "Error" not in err, err
+        time.sleep(2.0)
+        with pytest.raises(ProcessLookupError):    # the workers stopped with it
+            os.killpg(p.pid, 0)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(p.pid, signal.SIGKILL)
+        p.wait(timeout=30)
