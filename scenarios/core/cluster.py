@@ -37,6 +37,7 @@ __all__ = ["worker_state", "check_workers", "other_code", "scratch_folder", "fol
 
 SCRATCH = "dpgt-scratch"       # the folder of the workers' scratch folders, in their temporary directory
 WORKER_WAIT_S = 60.0           # how long a study waits for the first worker to join the scheduler
+_NAMED_COLD: set = set()       # (scheduler, worker) named cold already by this process (a study connects more than once)
 _LEFT_BEHIND = ("checkpoint.npz", "progress.json", ".dpgt.lock")   # a run's working files: they stay on the worker
 
 
@@ -74,7 +75,8 @@ def check_workers(client, scheduler: str, wait_s: float = WORKER_WAIT_S) -> dict
         raise SystemExit(f"error: refused: {named}, this client {mine[:16]}; install the client's version of the "
                          f"project on every worker (pip install, README: On a cluster) and restart them")
     for w, s in sorted(states.items()):
-        if not s["warm"]:
+        if not s["warm"] and (scheduler, w) not in _NAMED_COLD:
+            _NAMED_COLD.add((scheduler, w))
             print(f"worker {w} ({s['host']}): the engine's kernels of this code are not compiled there yet; its first "
                   f"run compiles them (about a minute; `python -m scenarios.warm` on it does it beforehand)", flush=True)
     return states

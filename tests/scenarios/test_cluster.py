@@ -263,6 +263,8 @@ def test_a_cold_worker_is_named_once_and_no_worker_is_a_one_line_error(capsys):
     clusterlib.check_workers(_Client(states), "tcp://s:1")
     out = capsys.readouterr().out
     assert out.count("not compiled") == 1 and "tcp://a:1" in out and "tcp://b:1" not in out
+    clusterlib.check_workers(_Client(states), "tcp://s:1")       # the study's next connection: said already
+    assert "not compiled" not in capsys.readouterr().out
     with pytest.raises(SystemExit, match="no worker joined the scheduler tcp://s:1"):
         clusterlib.check_workers(_Client({}), "tcp://s:1", wait_s=0.1)
 
