@@ -269,8 +269,8 @@ def _evaluator_name(fn: Callable) -> str:
 
 
 def evaluate(task: Evaluation, evaluator: Callable) -> Summary:
-    """Evaluate one machine (on whichever process) and write its file atomically; a failure is written too, with
-    its error (deterministic: the same parameters and code fail again)."""
+    """Evaluate one machine (on whichever process): its record, which :func:`write_evaluation` writes; a failure is a
+    record too, with its error (deterministic: the same parameters and code fail again)."""
     asked, full = task.fingerprints()
     head = {"condition": task.condition, "direction": task.direction, "overrides": task.overrides,
             "parameters_fingerprint": asked, "fingerprint": full}
@@ -283,9 +283,14 @@ def evaluate(task: Evaluation, evaluator: Callable) -> Summary:
         rec = Summary({**head, "outputs": evaluator(params, task.snapshots), "wall_s": time.perf_counter() - t0})
     except Exception as exc:          # reported, never hidden; the others go on
         rec = Summary({**head, "error": f"{type(exc).__name__}: {' '.join(str(exc).split())}"})
+    return rec
+
+
+def write_evaluation(task: Evaluation, rec: Summary) -> None:
+    """Write an evaluation's record as its file, atomically (by the study's process: workers need not share its
+    filesystem)."""
     task.path.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(task.path, json.dumps(rec, indent=1, default=float))
-    return rec
 
 
 @functools.lru_cache(maxsize=8)
@@ -559,7 +564,7 @@ class SensitivityStudy(Study):
         done, todo = _earlier(tasks)
         t0 = time.perf_counter()
         new = solve_tasks(evaluate, todo, workers=self.a.workers, scheduler=self.a.scheduler,
-                          progress=not self.a.no_progress, what=what, failed=_failed,
+                          progress=not self.a.no_progress, what=what, write=write_evaluation, failed=_failed,
                           extra=(self.evaluator,))
         self.cost["wall_s"] += time.perf_counter() - t0
         self.cost["evaluated"] += len(new)

@@ -57,7 +57,7 @@ from .core.runner import RunConfig, code_digest
 from .core.study import Study, StudyRun
 from .core.points import Point, machine_overrides, point_label, point_order, point_words, points_of
 from .core.sweep import Case, build_params, user_overrides, validate_cases
-from .core.tasks import solve_tasks
+from .core.tasks import scheduling_share, solve_tasks
 
 __all__ = ["main", "run", "parse_args", "QUANTITIES", "MESHES", "quantities_of", "percentile_ci", "statistics",
            "agreement_rows", "sample_rows", "sample_columns", "answer", "StaticTask", "static_tasks", "solve_static_task"]
@@ -277,8 +277,8 @@ def quantities_of(s: dict) -> dict:
 
 
 def solve_static_task(task: StaticTask) -> Summary:
-    """Solve one machine (on whichever process) and write its result file atomically. A failure is written too
-    (with its error): the solution is deterministic, so the same parameters and code fail again — a re-run does
+    """Solve one machine (on whichever process): its record, which :func:`write_static` writes. A failure is a record
+    too (with its error): the solution is deterministic, so the same parameters and code fail again — a re-run does
     not try it again unless the code changed."""
     asked, full = task.fingerprints()
     head = {"class": task.flank_class, "condition": task.case.condition, "direction": task.case.direction,
@@ -295,9 +295,14 @@ def solve_static_task(task: StaticTask) -> Summary:
                        "static_solver": s["static_solver"], "snapshots": s["snapshots"]})
     except Exception as exc:      # reported in the tables, never hidden; the others go on
         rec = Summary({**head, "error": f"{type(exc).__name__}: {' '.join(str(exc).split())}"})
+    return rec
+
+
+def write_static(task: StaticTask, rec: Summary) -> None:
+    """Write a machine's record as its result file, atomically (by the study's process: workers need not share its
+    filesystem)."""
     Path(task.path).parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(Path(task.path), json.dumps(rec, indent=1, default=float))
-    return rec
 
 
 # what a result file keeps of a summary: what :func:`quantities_of` reads (so a change of the study's quantities
@@ -342,11 +347,13 @@ def _earlier(tasks: list[StaticTask], overwrite: bool) -> tuple[dict, list[Stati
     return done, todo
 
 
-def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None, progress: bool) -> dict:
+def solve_all(todo: list[StaticTask], workers: int | None, scheduler: str | None, progress: bool,
+              stats: dict | None = None) -> dict:
     """{key: record} of ``todo`` solved in this process (one worker) or on Dask (:func:`scenarios.core.tasks.solve_tasks`:
-    a few tasks per worker in flight; a line every 10 s, or a bar on a terminal, says how far it is)."""
+    in batches of about a second of work, two per worker in flight; a line every 10 s, or a bar on a terminal, says how
+    far it is), each result file written here as it arrives. ``stats``: filled as :func:`solve_tasks` does."""
     recs = solve_tasks(solve_static_task, todo, workers=workers, scheduler=scheduler, progress=progress,
-                       what="static solutions", failed=lambda r: r.failed)
+                       what="static solutions", write=write_static, failed=lambda r: r.failed, stats=stats)
     return {(r["class"], r["condition"], r["direction"], r["torque_fraction"], r["sample"]): r for r in recs}
 
 
@@ -756,19 +763,22 @@ class ToleranceStudy(Study):
         print(f"static: {len(todo)} solutions to solve, {len(done)} reused (same parameters and code"
               + (f"; {failed} of them failed, and fail again with them" if failed else "") + f"); "
               f"{len(self.tasks)} machines × operating points", flush=True)
-        t0 = time.perf_counter()
-        new = solve_all(todo, self.a.workers, self.a.scheduler, not self.a.no_progress)
+        t0, dask_stats = time.perf_counter(), {}
+        new = solve_all(todo, self.a.workers, self.a.scheduler, not self.a.no_progress, dask_stats)
         wall = time.perf_counter() - t0
         self.records = {k: _with_quantities(r) for k, r in {**done, **new}.items()}
         solved = [r["static_solver"]["wall_s"] for r in new.values() if "static_solver" in r]
         self.cost = {"solved_now": len(solved), "reused": len(done),
                      "failed": sum(r.failed for r in self.records.values()),
                      "wall_s": wall, "per_machine_s_median": float(np.median(solved)) if solved else None,
-                     "per_snapshot_s_median": float(np.median(solved)) / self.a.snapshots if solved else None}
+                     "per_snapshot_s_median": float(np.median(solved)) / self.a.snapshots if solved else None,
+                     "batches": dask_stats.get("batches", 0), "scheduling_share": scheduling_share(dask_stats)}
         if solved:
-            print(f"static: {len(solved)} solved in {wall:.0f} s wall ({self.a.workers or 'one per core'} workers), "
-                  f"{self.cost['per_machine_s_median']:.2f} s per machine ({self.a.snapshots} snapshots; median)",
-                  flush=True)
+            share = self.cost["scheduling_share"]
+            print(f"static: {len(solved)} solved in {wall:.0f} s wall ({dask_stats.get('workers', 1)} workers, "
+                  f"{self.cost['batches']} batches), {self.cost['per_machine_s_median']:.2f} s per machine "
+                  f"({self.a.snapshots} snapshots; median); the workers spent {100 * (1 - share):.1f} % of their time "
+                  f"solving", flush=True)
 
     def report(self, run: StudyRun) -> dict:
         a = self.a

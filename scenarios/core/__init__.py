@@ -1,7 +1,8 @@
 """The machinery every command shares — no command lives here.
 
-One run end to end (:mod:`.runner`), sweeps of runs on Dask (:mod:`.sweep`) and the skeleton every sweep study
-follows (:mod:`.study`); the argument grammar (:mod:`.args`) and how every command ends (:mod:`.command`); one run
+One run end to end (:mod:`.runner`), sweeps of runs on Dask (:mod:`.sweep`), many small tasks on it in batches
+(:mod:`.tasks`), runs on workers that share no filesystem with the client (:mod:`.cluster`) and the skeleton every
+sweep study follows (:mod:`.study`); the argument grammar (:mod:`.args`) and how every command ends (:mod:`.command`); one run
 per output folder (:mod:`.lock`), a run's own peak memory (:mod:`.memory`), what a run folder holds checked before it is used (:mod:`.integrity`), requests
 refused before they run (:mod:`.plausibility`); spectra and the housing sensor's signals (:mod:`.analysis`).
 

@@ -5,21 +5,33 @@ travels to any worker; the worker rebuilds the pint parameters itself. What beco
 :class:`Outcome`: ``finished`` (run now), ``reused`` (its summary.json was made from the same parameters,
 settings and code — its fingerprint, :func:`runner.run_fingerprint` — so a restarted sweep resumes; a stale
 one is recomputed) or ``failed`` (it wrote error.json with its traceback and did not stop the others); every
-file is written atomically. An interrupted client
-(Ctrl-C) cancels its runs on the scheduler, and a local cluster's workers stop with it.
+file is written atomically. Which runs are reused is decided here, on the client, from the client's folders.
+
+A local cluster's workers write into the case folders themselves (they share this machine's filesystem). On an
+existing scheduler no filesystem is assumed shared (:mod:`scenarios.core.cluster`): its workers must run this
+client's code (checked first), each runs a case in a scratch folder of its own and returns the run's files, which
+this process writes into the case's folder under ``--out``; a run whose worker died is given to another worker by
+the scheduler (up to Dask's ``distributed.scheduler.allowed-failures``, 3 by default), and the runs that finished
+before it have landed already. An interrupted client (Ctrl-C) cancels its runs on the scheduler, and a local
+cluster's workers stop with it.
 """
 from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import os
+import signal
 import sys
+import threading
 import time
 import traceback
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, replace
 from enum import Enum
 from pathlib import Path
+
+from multiprocessing import resource_tracker
 
 from tqdm.auto import tqdm
 
@@ -33,11 +45,15 @@ from components.static import check_static
 from components.units import ParameterError
 
 from .points import Point, file_overrides, point_overrides
+from .cluster import check_workers, done_on_worker, folder_files, land, other_code, params_texts, relocated, scratch_folder
 from .integrity import OtherResults, claim_folder, differences, read_summary
-from .runner import finished_run, parameters_fingerprint, run_case, run_description, run_fingerprint
+from .runner import code_digest, finished_run, parameters_fingerprint, run_case, run_description, run_fingerprint
 
-__all__ = ["Case", "Status", "Outcome", "sweep", "run_sweep", "execute_case", "check_folders", "user_overrides",
-           "validate_cases", "dask_client", "OPERATING_AXES", "say_design_warnings"]
+__all__ = ["Case", "Status", "Outcome", "Travelled", "sweep", "run_sweep", "execute_case", "execute_on_worker",
+           "check_folders", "user_overrides", "validate_cases", "dask_client", "OPERATING_AXES", "RETRIES",
+           "say_design_warnings"]
+
+RETRIES = 2      # a task that raised (not a failed run: that is an Outcome) is tried again this many times
 
 
 @dataclass(frozen=True)
@@ -258,6 +274,39 @@ def _execute(case: Case, cfg, overwrite: bool) -> Outcome:
 SETTLED_ESTIMATE = 0.1      # share of a run's simulated time after which its time left is shown
 
 
+@dataclass
+class Travelled:
+    """What a worker that shares no filesystem with the client returns for a case: its :class:`Outcome` and the files
+    the run left in the worker's scratch folder ({name: content}), for the client to write into the case's folder."""
+    outcome: Outcome
+    files: dict = field(default_factory=dict)
+
+
+def execute_on_worker(case: Case, cfg, overwrite: bool, code: str, texts: dict) -> Travelled:
+    """:func:`execute_case` on a worker of another machine: refused (a failed outcome naming both fingerprints) when
+    this worker runs other code than the client (``code``, its :func:`~scenarios.core.runner.code_digest`); else run in
+    a scratch folder of this worker (:func:`scenarios.core.cluster.scratch_folder`; the ``--params`` file from its text,
+    ``texts``) and return the files the run left there. A finished run's scratch folder is removed; a failed one stays
+    (a retry here resumes from its checkpoint)."""
+    start = time.time()
+    refused = other_code(code)
+    if refused is not None:
+        o = Outcome(case, Status.FAILED, error=refused)
+        o.span = {"pid": os.getpid(), "start_unix_s": start, "end_unix_s": time.time()}
+        return Travelled(o)
+    what = json.dumps({"case": {**asdict(case), "out_dir": ""}, "params": texts.get(case.params_file or ""),
+                       "cfg": repr(cfg), "code": code}, sort_keys=True, default=repr)
+    scratch = scratch_folder(what, case.label)
+    o = execute_case(replace(relocated(case, texts), out_dir=str(scratch)), cfg, overwrite)
+    files = folder_files(scratch)
+    if o.ok:
+        done_on_worker(scratch)
+    if o.status is Status.REUSED:      # finished here by an attempt whose result never reached the client
+        o.status = Status.FINISHED
+    o.case = case
+    return Travelled(o, files)
+
+
 class _RunBars:
     """One bar per running case, fed from the progress.json each worker writes (simulated time)."""
 
@@ -344,7 +393,14 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
         timing["cluster_start_s"] = time.perf_counter() - t_start
         timing["runs_start_unix_s"] = time.time()
         try:
-            futs = {client.submit(execute_case, c, wcfg, overwrite, pure=False, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
+            if scheduler is None:     # a local cluster: its workers write into the case folders (absolute paths)
+                futs = {client.submit(execute_case, replace(c, out_dir=str(Path(c.out_dir).resolve())), wcfg,
+                                      overwrite, pure=False, retries=RETRIES, key=f"{c.label}-{time.time_ns()}"): c
+                        for c in todo}
+            else:                     # no shared filesystem: the runs' files travel back (scenarios.core.cluster)
+                code, texts = code_digest(), params_texts(todo)
+                futs = {client.submit(execute_on_worker, c, wcfg, overwrite, code, texts, pure=False,
+                                      retries=RETRIES, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
             bar = tqdm(total=len(futs), desc="runs", disable=not bars, position=0)
             runs = _RunBars(todo, bars)
             while True:
@@ -358,9 +414,16 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
                 fut = done[0]
                 c = futs[fut]
                 try:
-                    results[c.label] = fut.result()
-                except Exception as exc:   # worker died: report, keep going
-                    results[c.label] = Outcome(c, Status.FAILED, error=f"worker failure: {exc}")
+                    got = fut.result()
+                except Exception as exc:   # its workers died (Dask gave it to others, then gave up): report, go on
+                    got = _worker_failure(c, exc)
+                if isinstance(got, Travelled):
+                    land(c.out_dir, got.files)         # the run's files, written here (the summary last)
+                    got = got.outcome
+                    if got.ok:                         # an earlier failure's report no longer holds
+                        (Path(c.out_dir) / "error.json").unlink(missing_ok=True)
+                got.case = c
+                results[c.label] = got
                 bar.update(1)
                 runs.finish(c)
                 if plain:
@@ -380,24 +443,85 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
     return results
 
 
+def _worker_failure(case: Case, exc: BaseException) -> Outcome:
+    """A case whose task never returned (its workers died, or it raised ``RETRIES`` + 1 times): a failed outcome, and
+    error.json in the case's folder saying so."""
+    what = f"{type(exc).__name__}: {exc}"
+    info = Summary.failure(case.label, f"worker failure: {' '.join(what.split())}; run the same command again to "
+                                       f"retry it", "")
+    try:
+        Path(case.out_dir).mkdir(parents=True, exist_ok=True)
+        atomic_write_text(Path(case.out_dir) / "error.json", json.dumps(info, indent=2))
+    except OSError:
+        pass
+    return Outcome(case, Status.FAILED, error=info.error)
+
+
 @contextlib.contextmanager
 def dask_client(n_workers: int, scheduler: str | None = None):
-    """A Dask client of the scheduler at ``scheduler``, or of a local cluster of ``n_workers`` single-threaded
-    processes that stops with it (its workers with it)."""
-    from dask.distributed import Client, LocalCluster  # deferred: Dask (≈ 0.2–0.4 s) only when a sweep runs on it
+    """A Dask client of the scheduler at ``scheduler`` (its workers checked first:
+    :func:`scenarios.core.cluster.check_workers`), or of a local cluster of ``n_workers`` single-threaded processes
+    that stops with it (its workers with it).
 
-    cluster = None
-    if scheduler is None:
-        # ":0": the scheduler's HTTP server on a free port (None still asks for 8787, and a second study running
-        # beside the first warned that it was taken)
-        cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                               dashboard_address=":0", silence_logs=40)
-        client = Client(cluster)
-    else:
-        client = Client(scheduler)
+    A Ctrl-C at the terminal reaches the whole foreground process group: a local cluster's workers hit by it printed
+    their own tracebacks (and the nanny its ``CancelledError``) while this process stopped them. So its processes are
+    started with SIGINT blocked, a mask they keep (:func:`_ctrl_c_held`), and only this process takes the Ctrl-C: held
+    while the cluster starts, raised once it has (then it is stopped cleanly), and the command says "interrupted: ..."
+    alone. Its log messages are silenced below CRITICAL for the same reason (a failed run is reported by its
+    outcome)."""
+    cluster = client = None
+    with _ctrl_c_held(scheduler is None) as release:
+        try:
+            from dask.distributed import Client, LocalCluster  # deferred: Dask (≈ 0.2–0.4 s) only when a sweep runs on it
+
+            if scheduler is None:
+                # ":0": the scheduler's HTTP server on a free port (None still asks for 8787, and a second study running
+                # beside the first warned that it was taken)
+                cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                                       dashboard_address=":0", silence_logs=logging.CRITICAL)
+                client = Client(cluster)
+            else:
+                client = Client(scheduler)
+            release()               # a Ctrl-C pressed while the cluster started is raised here
+            if scheduler is not None:
+                check_workers(client, scheduler)      # same code everywhere; cold workers named
+            yield client
+        finally:
+            if client is not None:
+                client.close()
+            if cluster is not None:
+                cluster.close()
+
+
+@contextlib.contextmanager
+def _ctrl_c_held(hold: bool):
+    """While the block starts processes (``hold``, in the main thread): SIGINT blocked in this thread — before Dask
+    starts any thread, as a thread inherits the mask of the one that starts it and a process the mask of the thread
+    that spawns it (multiprocessing's resource tracker, started first, unblocks SIGINT in the thread that starts it;
+    running already, it leaves the mask alone) — and a Ctrl-C delivered to another thread of this process noted
+    instead of raised. Yields ``release()``: from then on Ctrl-C is this process's again, and one pressed meanwhile is
+    raised (KeyboardInterrupt); the block's end releases too."""
+    if not hold or threading.current_thread() is not threading.main_thread():
+        yield lambda: None
+        return
+    pressed = []
+    resource_tracker.ensure_running()
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    handler = signal.signal(signal.SIGINT, lambda *_: pressed.append(True))
+    state = {"held": True}
+
+    def release():
+        if state["held"]:
+            state["held"] = False
+            signal.signal(signal.SIGINT, handler)
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+            if pressed:
+                raise KeyboardInterrupt
+
     try:
-        yield client
+        yield release
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        if state["held"]:
+            state["held"] = False
+            signal.signal(signal.SIGINT, handler)
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
