@@ -153,7 +153,7 @@ def test_a_paper_study_lands_in_the_client_s_relative_out_as_on_a_local_cluster(
 
 @pytest.mark.slow
 def test_a_tolerance_study_s_batches_and_runs_land_as_on_a_local_cluster(cluster, tmp_path):
-    argv = ["--samples", "3", "--dynamic", "1", "--classes", "5", "--torques", "1", "--conditions", "3",
+    argv = ["--samples", "3", "--dynamic", "1", "--gear-class", "5", "--torques", "1", "--conditions", "3",
             "--directions", "forward", "--snapshots", "2", *SHORT]
     remote, local = tmp_path / "remote", tmp_path / "local"
     _study("tolerance_study", [*argv, "--scheduler", cluster.address, "--out", str(remote)], tmp_path / "client")

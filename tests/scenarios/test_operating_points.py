@@ -166,7 +166,7 @@ def test_the_tolerance_study_scales_a_points_torque(tmp_path):
 
 @pytest.mark.parametrize("study, argv", [
     (paper_study, ["--mode", "static", "--conditions", "2"]),
-    (tolerance_study, ["--samples", "2", "--conditions", "2", "--classes", "7", "--dynamic", "0"]),
+    (tolerance_study, ["--samples", "2", "--conditions", "2", "--gear-class", "7", "--dynamic", "0"]),
 ])
 def test_a_traction_law_the_static_solution_cannot_take_is_refused_before_any_run(study, argv, tmp_path, capsys):
     """The EHL traction law has no static solve of the cage rate (components.static.STATIC_TRACTION_LAWS): a static
