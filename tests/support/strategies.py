@@ -172,15 +172,17 @@ def fd_jacobians_full(elem, t, fs, q, v, z=None, rel=1e-6):
     return JQ, JV
 
 
-def assert_jacobians_match(elem, t, fs, q, v, z=None, rtol=1e-6, rel=1e-6):
-    """Exact Jacobians of ``elem`` equal central finite differences to within rtol·max|J|."""
+def assert_jacobians_match(elem, t, fs, q, v, z=None, rtol=1e-6, rel=1e-6, force_noise=0.0):
+    """Exact Jacobians of ``elem`` equal central finite differences to within rtol·max|J| plus the differences'
+    resolution: the forces' round-off (eps·|F|, and ``force_noise`` [N] where a force is computed from terms much
+    larger than itself, e.g. a mesh deflection from base radius × an angle of many turns) over the step."""
     F, JQ, JV = element_jacobians_full(elem, t, fs, q, v, z)
     FQ, FV = fd_jacobians_full(elem, t, fs, q, v, z, rel=rel)
     F0, _, _, _ = evaluate(elem, t, fs, q, v, z, jac=False)
     np.testing.assert_allclose(F, scatter_forces(elem, F0, q.size), rtol=1e-12, atol=1e-12 * (1 + np.abs(F).max()),
                                err_msg=f"{elem.name}: forces with and without Jacobians differ")
     # a central difference cannot resolve below the round-off of the forces it subtracts
-    fd_noise = 16 * np.finfo(float).eps * (1.0 + np.abs(F).max()) / rel
+    fd_noise = (16 * np.finfo(float).eps * (1.0 + np.abs(F).max()) + force_noise) / rel
     for name, A, B in (("dF/dq", JQ, FQ), ("dF/dv", JV, FV)):
         scale = max(np.abs(A).max(), np.abs(B).max(), 1e-300)
         err = np.abs(A - B).max()
