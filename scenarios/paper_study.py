@@ -33,7 +33,7 @@ from .core.integrity import read_summary
 from .core.runner import SETTLED_SPEED_ERROR_PCT, RunConfig
 from .core.study import Study, StudyRun
 from .core.points import machine_identity, machine_overrides, point_label, point_order, point_tag, points_of
-from .core.sweep import Case, user_overrides
+from .core.sweep import Beside, Case, user_overrides
 from .core import args
 from .core.command import command
 from .core.lock import holds_out_folder
@@ -343,30 +343,47 @@ def headline_values(results: dict) -> dict[tuple, float | None]:
     return vals
 
 
-def plots(results: dict, out: Path, machine: str = "") -> list[Path]:
-    """Every figure of a dynamic study; ``machine``: the machine's label, in the headline figure's title."""
+def point_figures(results: dict, out: Path, c) -> list[Path]:
+    """Point ``c``'s own figures: its time histories in groups and its cage orbits, forward and reverse."""
     # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
     from viz import plots as vp
     from viz.results import study_cage_pictures
 
+    runs = _runs_of(results, out, c)
+    if not runs:
+        return []
+    paths = []
+    f_m = [results[_label_of(results, c, d)].get("f_m_hz") for d in runs]
+    mesh_period = 1.0 / f_m[0] if f_m and f_m[0] else None
+    for g, (rows, cols) in history_groups(runs).items():
+        titles = {"inner": "inner planet bearing", "outer": "outer planet bearing", **MESH_COLUMNS}
+        # forward and reverse in rows of their own; the mesh histories, sampled a few times per mesh cycle, as
+        # their envelope over a mesh period
+        paths.append(vp.time_history_group(rows, out / f"{point_tag(c)}_{g}.png", columns=cols,
+                                           column_titles=titles, title=f"{_title(c)}: {HISTORY_GROUPS[g]}",
+                                           separate_runs=True, envelope=mesh_period if g == "mesh" else None,
+                                           envelope_words="mesh cycle"))
+    paths += study_cage_pictures(runs, out, prefix=f"{point_tag(c)}_",
+                                 title=f"{_title(c)}: cage orbits in the guide clearance")
+    return paths
+
+
+def point_work(results: dict, out: Path, c, with_animation: bool) -> list[Path]:
+    """What a point's finished runs give on their own — its figures and (``with_animation``) its animation — done
+    beside the other points' runs (:meth:`PaperStudy.beside`)."""
+    return point_figures(results, out, c) + (animate(results, out, only=[c]) if with_animation else [])
+
+
+def plots(results: dict, out: Path, machine: str = "", drawn=()) -> list[Path]:
+    """Every figure of a dynamic study, the points in ``drawn`` (their figures made beside the runs) left out of the
+    per-point ones; ``machine``: the machine's label, in the headline figure's title."""
+    from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
+
     paths = []
     conds = _conds(results)
     for c in conds:
-        runs = _runs_of(results, out, c)
-        if not runs:
-            continue
-        f_m = [results[_label_of(results, c, d)].get("f_m_hz") for d in runs]
-        mesh_period = 1.0 / f_m[0] if f_m and f_m[0] else None
-        for g, (rows, cols) in history_groups(runs).items():
-            titles = {"inner": "inner planet bearing", "outer": "outer planet bearing", **MESH_COLUMNS}
-            # forward and reverse in rows of their own; the mesh histories, sampled a few times per mesh cycle, as
-            # their envelope over a mesh period
-            paths.append(vp.time_history_group(rows, out / f"{point_tag(c)}_{g}.png", columns=cols,
-                                               column_titles=titles, title=f"{_title(c)}: {HISTORY_GROUPS[g]}",
-                                               separate_runs=True, envelope=mesh_period if g == "mesh" else None,
-                                               envelope_words="mesh cycle"))
-        paths += study_cage_pictures(runs, out, prefix=f"{point_tag(c)}_",
-                                     title=f"{_title(c)}: cage orbits in the guide clearance")
+        if c not in drawn:
+            paths += point_figures(results, out, c)
     vals = headline_values(results)
     if vals:
         one = f", {_title(conds[0]).lower()}" if len(conds) == 1 else ""
@@ -410,7 +427,8 @@ def static_plots(results: dict, out: Path, machine: str = "") -> list[Path]:
                                               f"forward vs reverse{one}" + (f"\n{machine}" if machine else ""))]
 
 
-def animate(results: dict, out: Path) -> list[Path]:
+def animate(results: dict, out: Path, only=None) -> list[Path]:
+    """The cage-orbit animation of every point (``only``: of those), forward beside reverse."""
     paths = []
     try:
         from viz.results import study_cage_animation  # deferred: matplotlib and VTK (viz), only for --animate
@@ -423,7 +441,7 @@ def animate(results: dict, out: Path) -> list[Path]:
     if not ok:
         print(f"animation skipped: {msg}")
         return paths
-    for c in _conds(results):
+    for c in (_conds(results) if only is None else only):
         f = out / str(_label_of(results, c, "forward")) / "results.nc"
         r = out / str(_label_of(results, c, "reverse")) / "results.nc"
         if f.exists() and r.exists():
@@ -448,6 +466,20 @@ class PaperStudy(Study):
 
     def cases(self) -> list[Case]:
         return make_cases(self.a, self.out)
+
+    def beside(self, cfg: RunConfig) -> Beside | None:
+        """A dynamic study draws each point's figures (and animation) as soon as both its runs are in, on a worker
+        while the other points run; the tables and the figures across points wait for every run."""
+        if cfg.mode == "static":
+            return None
+        out, animation = self.out, bool(self.a.animate)
+
+        def task(c, outcomes):
+            if not all(o.ok for o in outcomes.values()):    # a failed run: the report draws what it can
+                return None
+            results = {label: Summary.of(o.summary) for label, o in outcomes.items()}
+            return point_work, (results, out, c, animation)
+        return Beside(key=lambda case: case.condition, task=task)
 
     def machine_identity(self) -> dict:
         over = {k: v for k, v in args.parse_sets(self.a.set).items() if not k.startswith("operating.")}
@@ -480,9 +512,17 @@ class PaperStudy(Study):
             print(f"note: {STATIC_LIVES_NOTE}")
             atomic_write_text(md_p, text + f"\nNote: {STATIC_LIVES_NOTE}.\n")
         run.step("tables", lambda: [csv_p, md_p])
-        figs = run.step("figures", plots, results, self.out, machine["label"]) if not static else \
-            run.step("figures", static_plots, results, self.out, machine["label"])
-        anims = run.step("animation", animate, results, self.out) if self.a.animate and not static else []
+        made = {c: v for c, v in run.beside.items() if isinstance(v, list)}      # figures made beside the runs
+        for c, v in run.beside.items():
+            if not isinstance(v, list):
+                print(f"figures of {_title(c).lower()} beside the runs failed ({v}); drawn now")
+        early = run.step("figures beside the runs", lambda: [p for v in made.values() for p in v])
+        figs = [p for p in early if p.suffix != ".gif"] + (run.step("figures", plots, results, self.out, machine["label"], drawn=set(made)) if not static
+                        else run.step("figures", static_plots, results, self.out, machine["label"]))
+        anims = [p for p in early if p.suffix == ".gif"]
+        left = [c for c in _conds(results) if c not in made]
+        if self.a.animate and not static and left:
+            anims += run.step("animation", animate, results, self.out, only=left)
         return {"rows": rows, "figures": figs, "animations": anims}
 
 

@@ -40,7 +40,7 @@ from .points import machine_identity
 from .memory import process_peak_mb
 from .plausibility import check_runs, estimated_wall_s
 from .runner import RunConfig, run_report
-from .sweep import Case, Outcome, Status, _case_cfg, _is_finished, build_params, check_folders, sweep, validate_cases
+from .sweep import Beside, Case, Outcome, Status, _case_cfg, _is_finished, build_params, check_folders, sweep, validate_cases
 
 __all__ = ["Study", "StudyRun", "run_lines", "runs_line", "TIMING_ENV"]
 
@@ -58,6 +58,7 @@ class StudyRun:
     files: list[Path] = field(default_factory=list)
     kept: dict[str, dict] = field(default_factory=dict)    # failed now, but finished before: the earlier summary
     step_s: dict[str, float] = field(default_factory=dict)  # wall seconds of each post-processing step
+    beside: dict = field(default_factory=dict)   # what the work beside the runs gave, per group (Study.beside)
 
     @property
     def results(self) -> dict[str, Summary]:
@@ -145,6 +146,11 @@ class Study(abc.ABC):
     def prepare(self, cfg: RunConfig, cases: list[Case]) -> None:
         """A study's own work after every check and before its sweep (the tolerance study's static solutions)."""
 
+    def beside(self, cfg: RunConfig) -> Beside | None:
+        """Work done group by group while the other runs go on (:class:`~scenarios.core.sweep.Beside`: a point's
+        figures as soon as its runs are in); its results reach :meth:`report` as ``run.beside``. None by default."""
+        return None
+
     def second_phase(self, run: StudyRun) -> list[Case]:
         """Cases chosen from the first sweep's results, run in a second sweep with the same checks before it starts
         (the duty cycle's dynamic runs of the bins that carry the damage); none by default."""
@@ -172,10 +178,11 @@ class Study(abc.ABC):
         t_prepare = time.perf_counter()
         self.prepare(cfg, cases)
         t_sweep, sweep_timing = time.perf_counter(), {}
+        beside = self.beside(cfg)
         outcomes = sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
-                         overwrite=a.overwrite, announce=True, timing=sweep_timing)
+                         overwrite=a.overwrite, announce=True, timing=sweep_timing, beside=beside)
         self._stamp(outcomes, machine)
-        run = StudyRun(self.out, cases, outcomes)
+        run = StudyRun(self.out, cases, outcomes, beside=beside.done if beside is not None else {})
         more = self.second_phase(run)
         if more:                          # the same checks, then a second sweep; its outcomes join the first's
             validate_cases(more, lambda c: self.check(c, cfg))
@@ -190,7 +197,7 @@ class Study(abc.ABC):
             self._stamp(second, machine)
             outcomes = {**outcomes, **second}
             cases = [*cases, *more]
-            run = StudyRun(self.out, cases, outcomes)
+            run = StudyRun(self.out, cases, outcomes, beside=run.beside)
         print(runs_line(outcomes), flush=True)
         t_report = time.perf_counter()
         if self.keep_earlier:

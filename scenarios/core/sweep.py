@@ -30,6 +30,7 @@ import warnings
 from dataclasses import asdict, dataclass, field, replace
 from enum import Enum
 from pathlib import Path
+from typing import Callable
 
 from multiprocessing import resource_tracker
 
@@ -49,7 +50,7 @@ from .cluster import check_workers, done_on_worker, folder_files, land, other_co
 from .integrity import OtherResults, claim_folder, differences, read_summary
 from .runner import code_digest, finished_run, parameters_fingerprint, run_case, run_description, run_fingerprint
 
-__all__ = ["Case", "Status", "Outcome", "Travelled", "sweep", "run_sweep", "execute_case", "execute_on_worker",
+__all__ = ["Case", "Status", "Outcome", "Beside", "Travelled", "sweep", "run_sweep", "execute_case", "execute_on_worker",
            "check_folders", "user_overrides", "validate_cases", "dask_client", "OPERATING_AXES", "RETRIES",
            "say_design_warnings"]
 
@@ -307,6 +308,42 @@ def execute_on_worker(case: Case, cfg, overwrite: bool, code: str, texts: dict) 
     return Travelled(o, files)
 
 
+@dataclass
+class Beside:
+    """Work to do beside the runs, e.g. one operating point's figures: the cases fall into groups (``key(case)``;
+    None: in none), and once every case of a group has its outcome, ``task(key, {label: outcome})`` gives
+    ``(function, args)`` or None. On a local cluster the function runs on a worker, ahead of the runs still
+    queued, while the other runs go on; without Dask, or on a cluster whose workers share no filesystem with this
+    process, it runs here at that moment. ``done``: {key: its return value, or the exception it raised}."""
+    key: Callable[[Case], object]
+    task: Callable[[object, dict], tuple | None]
+    done: dict = field(default_factory=dict)
+
+    def groups(self, cases: list[Case]) -> dict:
+        out: dict = {}
+        for c in cases:
+            k = self.key(c)
+            if k is not None:
+                out.setdefault(k, []).append(c.label)
+        return out
+
+    def ready(self, groups: dict, results: dict, started: set):
+        """(key, (function, args)) of every group whose cases all have outcomes now, each once."""
+        for k, labels in groups.items():
+            if k not in started and all(lab in results for lab in labels):
+                started.add(k)
+                work = self.task(k, {lab: results[lab] for lab in labels})
+                if work is not None:
+                    yield k, work
+
+    def here(self, k, work) -> None:
+        fn, fargs = work
+        try:
+            self.done[k] = fn(*fargs)
+        except Exception as exc:      # a figure that fails is reported with the study's files, not fatal
+            self.done[k] = exc
+
+
 class _RunBars:
     """One bar per running case, fed from the progress.json each worker writes (simulated time)."""
 
@@ -354,14 +391,20 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
 
 def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | None = None,
           progress: bool = True, overwrite: bool = False, announce: bool = False,
-          timing: dict | None = None) -> dict[str, Outcome]:
+          timing: dict | None = None, beside: Beside | None = None) -> dict[str, Outcome]:
     """Run every case; returns {label: :class:`Outcome`}. One case runs in-process (no cluster).
     ``overwrite``: replace finished results of other parameters (else :func:`check_folders` refuses);
     ``announce``: say first how many runs will run and how many are reused; ``timing``: a dict to fill with the
     sweep's phases (wall seconds: ``reuse_check_s``, on Dask ``cluster_start_s`` — Dask imported, scheduler and
     workers started —, ``runs_s`` from the first submission to the last result, ``cluster_close_s``; the runs'
-    phase as wall-clock stamps ``runs_start_unix_s``, ``runs_end_unix_s``; ``workers``, ``dask``)."""
+    phase as wall-clock stamps ``runs_start_unix_s``, ``runs_end_unix_s``; ``workers``, ``dask``); ``beside``: work
+    done group by group as the runs finish (:class:`Beside`), its wall seconds after the last run ``beside_tail_s``."""
     timing = {} if timing is None else timing
+    groups, started = (beside.groups(cases), set()) if beside is not None else ({}, set())
+
+    def ready(results):
+        return list(beside.ready(groups, results, started)) if beside is not None else []
+
     t0 = time.perf_counter()
     todo = [c for c in cases if not _is_finished(c, cfg)]
     if announce:
@@ -372,6 +415,8 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
     results = {c.label: execute_case(c, cfg) for c in cases if c not in todo}   # finished: just load
     timing["reuse_check_s"] = time.perf_counter() - t0
     if not todo:
+        for k, work in ready(results):
+            beside.here(k, work)
         return results
     n_workers = workers or min(len(todo), os.cpu_count() or 1)
     timing.update(workers=n_workers, dask=not (scheduler is None and n_workers <= 1), runs_start_unix_s=time.time())
@@ -383,11 +428,13 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
             results[c.label] = execute_case(c, cfg, overwrite)
             if plain:
                 print(f"runs: {i + 1}/{len(todo)} done ({c.label})", file=sys.stderr, flush=True)
+            for k, work in ready(results):
+                beside.here(k, work)
         timing["runs_end_unix_s"] = time.time()
         timing["runs_s"] = timing["runs_end_unix_s"] - timing["runs_start_unix_s"]
         return results
     wcfg = replace(cfg, progress=False)   # per-run bars would interleave; the sweep bar shows progress
-    futs = {}
+    futs, side = {}, {}
     t_start = time.perf_counter()
     with dask_client(n_workers, scheduler) as client:
         timing["cluster_start_s"] = time.perf_counter() - t_start
@@ -431,13 +478,24 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
                     print(f"runs: {n_done}/{len(futs)} done ({c.label})", file=sys.stderr, flush=True)
                 if not results[c.label].ok:
                     bar.write(f"run {c.label} failed: {results[c.label].error}")
+                for k, (fn, fargs) in ready(results):
+                    if scheduler is None:       # a worker shares this filesystem: there, ahead of the queued runs
+                        side[k] = client.submit(fn, *fargs, pure=False, priority=1, key=f"beside-{time.time_ns()}")
+                    else:
+                        beside.here(k, (fn, fargs))
             runs.close()
             bar.close()
+            timing["runs_end_unix_s"] = time.time()
+            for k, f in side.items():
+                try:
+                    beside.done[k] = f.result()
+                except Exception as exc:
+                    beside.done[k] = exc
         except BaseException:       # Ctrl-C or a failure of the client: take its runs off the scheduler
-            client.cancel(list(futs), force=True)
+            client.cancel([*futs, *side.values()], force=True)
             raise
-        timing["runs_end_unix_s"] = time.time()
         timing["runs_s"] = timing["runs_end_unix_s"] - timing["runs_start_unix_s"]
+        timing["beside_tail_s"] = time.time() - timing["runs_end_unix_s"]
         t_close = time.perf_counter()
     timing["cluster_close_s"] = time.perf_counter() - t_close
     return results
