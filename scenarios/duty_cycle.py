@@ -399,7 +399,7 @@ def mesh_spectrum(summaries: list[dict], names: list[str], hours: list[float | N
                          "drive_force_mean_N": m.get("drive_force_mean_N"),
                          "drive_force_mean_all_N": float(np.mean(per)) if per else None,
                          "drive_force_max_N": m.get("drive_force_max_N"),
-                         "mesh_cycles": s["f_m_hz"] * t, "cycles_per": "cycle" if h is not None else "hour of cycle"})
+                         "mesh_cycles": s["f_m_hz"] * t, "cycles_per": "duty cycle" if h is not None else "hour of the duty cycle"})
     return rows
 
 
