@@ -32,10 +32,15 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..elements.gear_mesh import SlicedGearMesh
 from ..elements.sliced import SlicedRaceContact
+from . import mesh, tooth_pairs
 from .contact import EHL, _ehl_traction, _traction, traction_g
 
-__all__ = ["pack_sliced_race", "evaluate_sliced_race", "SLICED_COLS"]
+__all__ = ["pack_sliced_race", "evaluate_sliced_race", "pack_sliced_gear_mesh", "evaluate_sliced_gear_mesh",
+           "SLICED_COLS", "MESH_EXTRA"]
+
+_TWO_PI = 2.0 * np.pi
 
 _ETA2 = 1e-24            # the reference's η² (mbd.elements.sliced._ETA2)
 SLICED_COLS = 13         # P columns before the profile drops
@@ -320,3 +325,197 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
                 J[i, 9, c], J[i, 10, c], J[i, 11, c] = -dGx, -dGy, dpin
             else:
                 J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4 - dGx, f5 - dGy, f6 + dpin
+
+
+# ------------------------------------------------------------------------------------------------ SlicedGearMesh
+# P: the GearMesh layout (mbd.compiled.mesh, without eccentricity or the tooth-pair law), then 4 columns:
+# face width b [m], slices n_m, gear 1 has slopes (1/0), gear 2 has slopes (1/0);  G: the GearMesh layout.
+MESH_EXTRA = 4
+
+
+def pack_sliced_gear_mesh(elem):
+    if type(elem) is not SlicedGearMesh:
+        raise NotImplementedError(f"{elem.name}: the compiled SlicedGearMesh kernel does not cover "
+                                  f"{type(elem).__name__}")
+    if elem.has_offset or elem.pairs is not None:
+        raise NotImplementedError(f"SlicedGearMesh {elem.name!r}: the compiled path has no face-sliced mesh with "
+                                  "eccentricity or the tooth-pair law (use the numpy path)")
+    P, G = mesh.pack_gear_mesh(elem)
+    n = elem.n
+    extra = np.column_stack([elem.face_width, np.full(n, float(elem.n_m)), np.full(n, float(elem.has1)),
+                             np.full(n, float(elem.has2))])
+    return np.ascontiguousarray(np.hstack([P, extra])), G
+
+
+@njit(cache=True)
+def evaluate_sliced_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    """The face-sliced lumped mesh law (SlicedGearMesh.kernel, docs/model.md §6.6) and its exact Jacobian: the slice
+    loop once per flank, its derivative blocks summed against the powers of ζ_k, then every direction of the local
+    coordinates at the mesh level (the differential of every line of the reference)."""
+    shape = int(G[mesh.G_SHAPE])
+    nl = ql.shape[1]
+    e0 = P.shape[1] - MESH_EXTRA
+    mom = np.zeros((2, 9))          # per flank: Σ ζ^m A_k, Σ ζ^m B_k, Σ ζ^m d_k (m = 0, 1, 2)
+    Ff, Mf = np.zeros(2), np.zeros(2)
+    dq, dv = np.zeros(nl), np.zeros(nl)
+    for i in range(ql.shape[0]):
+        sig, rb1, rb2 = P[i, mesh.P_SIGMA], P[i, mesh.P_RB1], P[i, mesh.P_RB2]
+        sa, kappa0, pb, z1 = P[i, mesh.P_SIN_ALPHA], P[i, mesh.P_KAPPA0], P[i, mesh.P_PITCH], P[i, mesh.P_TEETH1]
+        bw, nm, has1, has2 = P[i, e0], int(P[i, e0 + 1]), P[i, e0 + 2] != 0.0, P[i, e0 + 3] != 0.0
+        x1, y1, th1, x2, y2, th2 = ql[i, 0], ql[i, 1], ql[i, 2], ql[i, 3], ql[i, 4], ql[i, 5]
+        vx1, vy1, w1, vx2, vy2, w2 = vl[i, 0], vl[i, 1], vl[i, 2], vl[i, 3], vl[i, 4], vl[i, 5]
+        j1 = 6
+        s1x, s1y, u1x, u1y, s2x, s2y, u2x, u2y = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        if has1:
+            s1x, s1y, u1x, u1y = ql[i, 6], ql[i, 7], vl[i, 6], vl[i, 7]
+            j1 = 8
+        if has2:
+            s2x, s2y, u2x, u2y = ql[i, j1], ql[i, j1 + 1], vl[i, j1], vl[i, j1 + 1]
+        dsx, dsy, dvx, dvy = s2x - s1x, s2y - s1y, u2x - u1x, u2y - u1y
+        # the mesh geometry (GearMesh._geometry, mbd.compiled.mesh._meshes)
+        dx, dy, ddx, ddy = sig * (x2 - x1), sig * (y2 - y1), sig * (vx2 - vx1), sig * (vy2 - vy1)
+        r2 = dx * dx + dy * dy
+        a = np.sqrt(r2)
+        inv_a = 1.0 / a
+        ex, ey = dx * inv_a, dy * inv_a
+        tx, ty = -ey, ex
+        phi_ref = P[i, mesh.P_PHI_REF]
+        phi_e = phi_ref + mesh._wrap(np.arctan2(dy, dx) - phi_ref)
+        raw = sig * rb1 * (th1 - phi_e) + rb2 * (th2 - phi_e) - P[i, mesh.P_U0]
+        roll = sig * rb1 * w1 + rb2 * w2
+        s = mesh._wrap(raw * (_TWO_PI / pb)) * (pb / _TWO_PI)
+        kappa = kappa0 * inv_a
+        radial = sig * sa * (a - P[i, mesh.P_A0])
+        half_b = 0.5 * P[i, mesh.P_BACKLASH]
+        t_dd = tx * ddx + ty * ddy
+        e_dd = ex * ddx + ey * ddy
+        s_dot = roll - kappa * t_dd
+        radial_dot = sig * sa * e_dd
+        fac, dfac = mesh._factor(shape, z1 * (th1 - phi_e) * (1.0 / _TWO_PI) + P[i, mesh.P_P0], P, i, G)
+        k_mean, c_m, ramp = P[i, mesh.P_K_MEAN], P[i, mesh.P_C_MESH], P[i, mesh.P_RAMP]
+        kp = k_mean * fac
+        kk, cc = kp / nm, c_m / nm
+        t_s, e_s = tx * dsx + ty * dsy, ex * dsx + ey * dsy
+        hx, hy, qsx, qsy = 0.0, 0.0, 0.0, 0.0
+        if jac:
+            mom[:, :] = 0.0
+        for fi in range(2):
+            f = 1.0 if fi == 0 else -1.0
+            d_f = f * s - radial - half_b
+            r_f = f * s_dot - radial_dot
+            gx = -sig * f * kappa * tx - sa * ex
+            gy = -sig * f * kappa * ty - sa * ey
+            gs = gx * dsx + gy * dsy
+            gs_dot = (sig * f * kappa * (e_dd * t_s + t_dd * e_s) - sa * t_dd * t_s) / a + gx * dvx + gy * dvy
+            FF, MM = 0.0, 0.0
+            for k in range(nm):
+                zeta = bw / nm * (k + 1 - 0.5 * (nm + 1))
+                d_k = d_f + zeta * gs
+                if not d_k > 0.0:
+                    continue
+                r_k = r_f + zeta * gs_dot
+                S, dS = tooth_pairs.damping_share(d_k, ramp)
+                F_k = kk * d_k + cc * S * r_k
+                if not F_k > 0.0:
+                    continue
+                FF += F_k
+                MM += zeta * F_k
+                if jac:
+                    A_k, B_k = kk + cc * dS * r_k, cc * S
+                    zm = 1.0
+                    for m in range(3):
+                        mom[fi, m] += zm * A_k
+                        mom[fi, 3 + m] += zm * B_k
+                        mom[fi, 6 + m] += zm * d_k
+                        zm *= zeta
+            Ff[fi], Mf[fi] = FF, MM
+            cx = (sig * f * kappa * t_s) / a
+            ct = (sig * f * kappa * e_s - sa * t_s) / a
+            hx = hx - MM * (cx * ex + ct * tx)
+            hy = hy - MM * (cx * ey + ct * ty)
+            qsx += MM * gx
+            qsy += MM * gy
+        F_net, F_sum = Ff[0] - Ff[1], Ff[0] + Ff[1]
+        Fhx = F_net * kappa * tx + sig * sa * F_sum * ex + hx
+        Fhy = F_net * kappa * ty + sig * sa * F_sum * ey + hy
+        F[i, 0], F[i, 1], F[i, 2] = -sig * Fhx, -sig * Fhy, -sig * rb1 * F_net
+        F[i, 3], F[i, 4], F[i, 5] = sig * Fhx, sig * Fhy, -1.0 * rb2 * F_net
+        if has1:
+            F[i, 6], F[i, 7] = qsx, qsy
+        if has2:
+            F[i, j1], F[i, j1 + 1] = -qsx, -qsy
+        if not jac:
+            continue
+        for j in range(2 * nl):
+            dq[:] = 0.0
+            dv[:] = 0.0
+            if j < nl:
+                dq[j] = 1.0
+            else:
+                dv[j - nl] = 1.0
+            # direction → (δd, θ1, θ2, δḋ, ω1, ω2, Δs, Δṡ)
+            pdx, pdy, pth1, pth2 = sig * (dq[3] - dq[0]), sig * (dq[4] - dq[1]), dq[2], dq[5]
+            vdx, vdy, pw1, pw2 = sig * (dv[3] - dv[0]), sig * (dv[4] - dv[1]), dv[2], dv[5]
+            pdsx, pdsy, pdvx, pdvy = 0.0, 0.0, 0.0, 0.0
+            if has1:
+                pdsx, pdsy, pdvx, pdvy = -dq[6], -dq[7], -dv[6], -dv[7]
+            if has2:
+                pdsx, pdsy = pdsx + dq[j1], pdsy + dq[j1 + 1]
+                pdvx, pdvy = pdvx + dv[j1], pdvy + dv[j1 + 1]
+            tdd_ = tx * pdx + ty * pdy                          # t·δd
+            da = ex * pdx + ey * pdy
+            dex, dey = tx * tdd_ * inv_a, ty * tdd_ * inv_a
+            dtx, dty = -ex * tdd_ * inv_a, -ey * tdd_ * inv_a
+            dkappa = -kappa * da * inv_a
+            dphi = (-dy * pdx + dx * pdy) / r2
+            ds = sig * rb1 * (pth1 - dphi) + rb2 * (pth2 - dphi)
+            droll = sig * rb1 * pw1 + rb2 * pw2
+            dradial = sig * sa * da
+            dt_dd = dtx * ddx + dty * ddy + tx * vdx + ty * vdy
+            de_dd = dex * ddx + dey * ddy + ex * vdx + ey * vdy
+            ds_dot = droll - dkappa * t_dd - kappa * dt_dd
+            dradial_dot = sig * sa * de_dd
+            dkp = k_mean * dfac * z1 * (pth1 - dphi) * (1.0 / _TWO_PI)
+            dt_s = dtx * dsx + dty * dsy + tx * pdsx + ty * pdsy
+            de_s = dex * dsx + dey * dsy + ex * pdsx + ey * pdsy
+            dFnet, dFsum, dhx, dhy, dqsx, dqsy = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            for fi in range(2):
+                f = 1.0 if fi == 0 else -1.0
+                dd_f = f * ds - dradial
+                dr_f = f * ds_dot - dradial_dot
+                gx = -sig * f * kappa * tx - sa * ex
+                gy = -sig * f * kappa * ty - sa * ey
+                dgx = -sig * f * (dkappa * tx + kappa * dtx) - sa * dex
+                dgy = -sig * f * (dkappa * ty + kappa * dty) - sa * dey
+                dgs = dgx * dsx + dgy * dsy + gx * pdsx + gy * pdsy
+                Nn = sig * f * kappa * (e_dd * t_s + t_dd * e_s) - sa * t_dd * t_s
+                dN = (sig * f * (dkappa * (e_dd * t_s + t_dd * e_s)
+                                 + kappa * (de_dd * t_s + e_dd * dt_s + dt_dd * e_s + t_dd * de_s))
+                      - sa * (dt_dd * t_s + t_dd * dt_s))
+                dgs_dot = dN / a - Nn * da / (a * a) + dgx * dvx + dgy * dvy + gx * pdvx + gy * pdvy
+                mo = mom[fi]
+                dF = mo[0] * dd_f + mo[1] * dgs + mo[3] * dr_f + mo[4] * dgs_dot + dkp * mo[6] / nm
+                dM = mo[1] * dd_f + mo[2] * dgs + mo[4] * dr_f + mo[5] * dgs_dot + dkp * mo[7] / nm
+                MM = Mf[fi]
+                dFnet += f * dF
+                dFsum += dF
+                cx = (sig * f * kappa * t_s) / a
+                ct = (sig * f * kappa * e_s - sa * t_s) / a
+                dcx = sig * f * (dkappa * t_s + kappa * dt_s) / a - cx * da / a
+                dct = (sig * f * (dkappa * e_s + kappa * de_s) - sa * dt_s) / a - ct * da / a
+                dhx -= dM * (cx * ex + ct * tx) + MM * (dcx * ex + cx * dex + dct * tx + ct * dtx)
+                dhy -= dM * (cx * ey + ct * ty) + MM * (dcx * ey + cx * dey + dct * ty + ct * dty)
+                dqsx += dM * gx + MM * dgx
+                dqsy += dM * gy + MM * dgy
+            dFhx = (dFnet * kappa * tx + F_net * (dkappa * tx + kappa * dtx)
+                    + sig * sa * (dFsum * ex + F_sum * dex) + dhx)
+            dFhy = (dFnet * kappa * ty + F_net * (dkappa * ty + kappa * dty)
+                    + sig * sa * (dFsum * ey + F_sum * dey) + dhy)
+            J = Jq if j < nl else Jv
+            c = j if j < nl else j - nl
+            J[i, 0, c], J[i, 1, c], J[i, 2, c] = -sig * dFhx, -sig * dFhy, -sig * rb1 * dFnet
+            J[i, 3, c], J[i, 4, c], J[i, 5, c] = sig * dFhx, sig * dFhy, -1.0 * rb2 * dFnet
+            if has1:
+                J[i, 6, c], J[i, 7, c] = dqsx, dqsy
+            if has2:
+                J[i, j1, c], J[i, j1 + 1, c] = -dqsx, -dqsy

@@ -10,6 +10,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from mbd.compiled.registry import kind_of
+from mbd.elements import StiffnessShape
+from mbd.elements.gear_mesh import SlicedGearMesh, mesh_u0
 from mbd.elements.sliced import SlicedRaceContact, slice_stations
 
 from tests.support.contact import DR, EHL, FILM, FS, K_HZ, LR, M_ROLLER, TANH, assert_matches_reference, compiled
@@ -97,3 +99,77 @@ def test_loaded_open_and_edge_contacts_in_one_family():
 
 def test_family_declares_its_twin():
     assert kind_of(SlicedRaceContact).evaluate.__name__ == "evaluate_sliced_race"
+
+
+# ------------------------------------------------------------------------------------------------ SlicedGearMesh
+RB1, RB2, ALPHA, Z1 = 0.03, 0.045, np.radians(20.0), 20
+RBR = 0.12                               # a ring's base radius (internal meshes: gear 1 the planet, gear 2 the ring)
+K_MESH, BW = 4.0e8, 0.02
+SHAPES = {"constant": StiffnessShape.constant(), "rectangular": StiffnessShape.rectangular(1.6, 1.5, 0.1),
+          "fourier": StiffnessShape.fourier(a=(0.1, 0.03), b=(0.05,))}
+
+
+def _mesh_family(internal, shape, n_m, c, backlash, has1, has2):
+    """Three meshes of one kind (gear bodies 0..5, slopes from 18), their slope pairs as asked."""
+    rb2 = RBR if internal else RB2
+    a0 = ((rb2 - RB1) if internal else (RB1 + rb2)) / np.cos(ALPHA)
+    g1, g2 = np.arange(0, 3), np.arange(3, 6)
+    s1 = np.array([[18 + 2 * m, 19 + 2 * m] for m in range(3)]) if has1 else None
+    s2 = np.array([[24 + 2 * m, 25 + 2 * m] for m in range(3)]) if has2 else None
+    poses1, poses2 = _nominal(a0, internal)
+    return SlicedGearMesh("mesh", g1, g2, slopes1=s1, slopes2=s2, face_width=BW, slices=n_m, internal=internal,
+                          rb1=RB1, rb2=rb2, alpha=ALPHA, a0=a0, teeth1=Z1, k_mean=K_MESH, c_mesh=c,
+                          damping_ramp=1e-6 if c else 0.0, backlash=backlash, stiffness=shape,
+                          u0=mesh_u0(internal, RB1, rb2, poses1, poses2), phi_ref=LINE), a0
+
+
+# the meshes' lines of centres [rad], and gear 1 near the origin: the transmission error is the small difference of
+# terms r_b (θ − φ_e) that grow with φ_e, whose round-off (an ulp of arctan2 apart between numpy and numba) the
+# damping share's slope 60/δ_c² carries into J to ≈ 2e-10 of the block at φ_e ≈ 4.4 rad; at |φ_e| ≤ 1.1 it stays
+# at the contact tests' 1e-10
+LINE = np.array([0.4, 1.1, -0.7])
+
+
+def _nominal(a0, internal):
+    """(3, 3) nominal poses of gears 1 and 2: gear 2 at a0 along LINE (internal: the planet, gear 1, at a0 from the
+    ring along LINE)."""
+    p1 = np.column_stack([0.01 * np.arange(3), -0.01 * np.arange(3), np.zeros(3)])
+    e = np.column_stack([np.cos(LINE), np.sin(LINE), np.zeros(3)])
+    return p1, p1 + (-1.0 if internal else 1.0) * a0 * e
+
+
+def _mesh_state(rng, a0, internal, turn, slope):
+    """Gear 2 of mesh m at a0 from gear 1 (internal: the planet, gear 1, inside at a0 from the ring), turned by turn[m]
+    (flank + compressed by ≈ r_b2 θ_2); slopes of ≈ ``slope``; random offsets and velocities."""
+    q, v = np.zeros(30), np.zeros(30)
+    p1, p2 = _nominal(a0, internal)
+    q[:9], q[9:18] = p1.ravel(), p2.ravel()
+    q[11:18:3] = turn
+    q[:18] += rng.standard_normal(18) * np.tile([1e-7, 1e-7, 1e-6], 6)
+    q[18:] = rng.standard_normal(12) * slope
+    v[:18] = rng.standard_normal(18) * np.tile([1e-2, 1e-2, 10.0], 6)
+    v[18:] = rng.standard_normal(12) * 0.1
+    return q, v
+
+
+@pytest.mark.parametrize("internal", [False, True])
+@pytest.mark.parametrize("shape", sorted(SHAPES))
+@SETTINGS
+@given(fs=frame_states(), n_m=st.sampled_from([1, 4, 11]), c=st.sampled_from([0.0, 2e3]),
+       backlash=st.sampled_from([0.0, 1e-5]), has=st.sampled_from([(True, True), (True, False), (False, True)]),
+       turn=st.lists(st.sampled_from([-3e-4, -2e-5, 2e-5, 3e-4]), min_size=3, max_size=3),
+       slope=st.sampled_from([1e-5, 1e-4, 1e-3]), seed=st.integers(0, 2 ** 31))
+def test_sliced_mesh_matches_reference(internal, shape, fs, n_m, c, backlash, has, turn, slope, seed):
+    """Flanks open, in the damping ramp (r_b2 · 2e-5 ≈ 0.9 δ_c) and beyond it, slices partly open. Not a flank at
+    ≈ 1e-8 m in the ramp: its compression is the difference of terms ≈ 0.05 m, so its round-off is ≈ 1e-9 of itself
+    and the share S ∝ δ³ carries that into J_v (seen 3e-10 of the block, structured, in both kernels alike)."""
+    elem, a0 = _mesh_family(internal, SHAPES[shape], n_m, c, backlash, *has)
+    qf, vf = _mesh_state(np.random.default_rng(seed), a0, internal, turn, slope)
+    assert_matches_reference(elem, fs, qf, vf)
+
+
+def test_sliced_mesh_with_teeth_or_runout_is_refused_by_the_compiled_path():
+    elem, _ = _mesh_family(False, SHAPES["rectangular"], 5, 0.0, 0.0, True, True)
+    elem.has_offset = True
+    with pytest.raises(NotImplementedError, match="eccentricity or the tooth-pair law"):
+        kind_of(SlicedGearMesh).pack(elem)
