@@ -62,6 +62,42 @@ def pack_sliced_race(elem):
 
 
 @njit(cache=True)
+def _zero(F, Jq, Jv, i, jac):
+    """A contact without load: no force and (ad.where) no derivative."""
+    nl = F.shape[1]
+    for a in range(nl):
+        F[i, a] = 0.0
+        if jac:
+            for b in range(nl):
+                Jq[i, a, b] = 0.0
+                Jv[i, a, b] = 0.0
+
+
+@njit(cache=True)
+def _accumulate(acc, zk, *vals):
+    """acc[m, :] += z_k^m · vals, m = 0, 1, 2."""
+    z2 = zk * zk
+    for c in range(12):
+        x = vals[c]
+        acc[0, c] += x
+        acc[1, c] += zk * x
+        acc[2, c] += z2 * x
+
+
+@njit(cache=True)
+def _race_col(J, i, c, outer, f0, f1, f2, f3, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin):
+    """Column c of instance i's block (J_q or J_v: passed in, not chosen by a branch in the caller, whose every
+    write then cost array bookkeeping: mbd.compiled.contact._col)."""
+    J[i, 0, c], J[i, 1, c], J[i, 2, c], J[i, 3, c] = f0, f1, f2, f3
+    if outer:
+        J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4, f5, f6
+        J[i, 7, c], J[i, 8, c] = -dT2x, -dT2y
+        J[i, 9, c], J[i, 10, c], J[i, 11, c] = -dGx, -dGy, dpin
+    else:
+        J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4 - dGx, f5 - dGy, f6 + dpin
+
+
+@njit(cache=True)
 def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     p, law = G[0], int(G[1])
     pe = 0.5 * (p - 1.0)
@@ -74,7 +110,6 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     outer = nl == 12
     acc = np.zeros((3, 12))          # moments m = 0, 1, 2 of M_k (4), N_k (4), g_k (2), ∂q_k/∂ẇ_k (2)
     dq, dv = np.zeros(12), np.zeros(12)
-    dS, dQm = np.zeros((2, 2)), np.zeros(2)
     for i in range(ql.shape[0]):
         kap, mx, my, pmx, pmy, s0x, s0y = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
         R, D, K, c0, row, Rr = P[i, 7], P[i, 8], P[i, 9], P[i, 10], P[i, 11], P[i, 12]
@@ -113,17 +148,11 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         dsrx, dsry = dtau * ex + tau * edx, dtau * ey + tau * edy
         pcx_, pcy_ = xr - cx, yr - cy
         wvx, wvy = vr0 - Vcx, vr1 - Vcy
-        for j in range(F.shape[1]):
-            F[i, j] = 0.0
-        if jac:
-            for a in range(nl):
-                for b in range(nl):
-                    Jq[i, a, b] = 0.0
-                    Jv[i, a, b] = 0.0
         # the open bound (SlicedRaceContact._open_bound)
         delta0 = 0.5 * D - kap * (np.sqrt(pcx_ * pcx_ + pcy_ * pcy_) - R)
         reach = zmax * abs(tau) + (abs(row) + zmax) * np.sqrt(scx * scx + scy * scy)
         if delta0 + reach <= 0.0:
+            _zero(F, Jq, Jv, i, jac)
             continue
         # the slice loop
         S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -144,8 +173,9 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
                 continue
             nv = nx * vwx + ny * vwy
             delta_dot = -kap * nv
-            dpe = delta ** pe
-            q = Ks * delta ** p + c0s * dpe * delta_dot
+            dpe = delta ** pe                       # δ^((p−1)/2); δ^p = δ (δ^((p−1)/2))², one power a slice
+            dp1 = dpe * dpe
+            q = Ks * (delta * dp1) + c0s * dpe * delta_dot
             if not q > 0.0:
                 continue
             Fx, Fy = kap * q * nx, kap * q * ny
@@ -159,7 +189,7 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             Qz += zk * q
             if not jac:
                 continue
-            q_d = Ks * p * delta ** (p - 1.0) + c0s * pe * delta ** (pe - 1.0) * delta_dot     # ∂q/∂δ
+            q_d = Ks * p * dp1 + c0s * pe * (dpe / delta) * delta_dot                         # ∂q/∂δ
             q_r = c0s * dpe                                                                   # ∂q/∂δ̇
             hx, hy = (vwx - nx * nv) / d, (vwy - ny * nv) / d
             gqx, gqy = -kap * (q_d * nx + q_r * hx), -kap * (q_d * ny + q_r * hy)
@@ -169,22 +199,10 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             m01 = kap * nx * gqy - qd * nx * ny
             m10 = kap * ny * gqx - qd * nx * ny
             m11 = kap * ny * gqy + qd * (1.0 - ny * ny)
-            zm = 1.0
-            for m in range(3):
-                acc[m, 0] += zm * m00
-                acc[m, 1] += zm * m01
-                acc[m, 2] += zm * m10
-                acc[m, 3] += zm * m11
-                acc[m, 4] += zm * (kap * nx * gvx)
-                acc[m, 5] += zm * (kap * nx * gvy)
-                acc[m, 6] += zm * (kap * ny * gvx)
-                acc[m, 7] += zm * (kap * ny * gvy)
-                acc[m, 8] += zm * gqx
-                acc[m, 9] += zm * gqy
-                acc[m, 10] += zm * gvx
-                acc[m, 11] += zm * gvy
-                zm *= zk
+            _accumulate(acc, zk, m00, m01, m10, m11, kap * nx * gvx, kap * nx * gvy, kap * ny * gvx,
+                        kap * ny * gvy, gqx, gqy, gvx, gvy)
         if not Q > 0.0:
+            _zero(F, Jq, Jv, i, jac)
             continue
         # traction as the planar contact's on Q, applied at the load centroid z̄
         rho = np.sqrt(pcx_ * pcx_ + pcy_ * pcy_ + _ETA2)
@@ -228,6 +246,16 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             F[i, 6] += pin_t
         if not jac:
             continue
+        a0_0, a0_1, a0_2, a0_3, a0_4, a0_5, a0_6, a0_7, a0_8, a0_9, a0_10, a0_11 = (
+            acc[0, 0], acc[0, 1], acc[0, 2], acc[0, 3], acc[0, 4], acc[0, 5],
+            acc[0, 6], acc[0, 7], acc[0, 8], acc[0, 9], acc[0, 10], acc[0, 11])
+        a1_0, a1_1, a1_2, a1_3, a1_4, a1_5, a1_6, a1_7, a1_8, a1_9, a1_10, a1_11 = (
+            acc[1, 0], acc[1, 1], acc[1, 2], acc[1, 3], acc[1, 4], acc[1, 5],
+            acc[1, 6], acc[1, 7], acc[1, 8], acc[1, 9], acc[1, 10], acc[1, 11])
+        a2_0, a2_1, a2_2, a2_3, a2_4, a2_5, a2_6, a2_7, a2_8, a2_9, a2_10, a2_11 = (
+            acc[2, 0], acc[2, 1], acc[2, 2], acc[2, 3], acc[2, 4], acc[2, 5],
+            acc[2, 6], acc[2, 7], acc[2, 8], acc[2, 9], acc[2, 10], acc[2, 11])
+        irp, irho, iQ = 1.0 / rho_p, 1.0 / rho, 1.0 / Q
         # every direction: position (j < nl) and velocity (j ≥ nl) unit vectors of the local coordinates
         for j in range(2 * nl):
             dq[:] = 0.0
@@ -251,12 +279,12 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             dVpx = dvp0 - dvp2 * rpy - vp2 * drpy
             dVpy = dvp1 + dvp2 * rpx + vp2 * drpx
             dux, duy = dxr - (dxp + drpx), dyr - (dyp + drpy)
-            drho_p = (ux * dux + uy * duy) / rho_p
-            dex, dey = (dux - ex * drho_p) / rho_p, (duy - ey * drho_p) / rho_p
+            drho_p = (ux * dux + uy * duy) * irp
+            dex, dey = (dux - ex * drho_p) * irp, (duy - ey * drho_p) * irp
             dgx, dgy = dvr0 - dVpx, dvr1 - dVpy
             dge = dex * gx + ex * dgx + dey * gy + ey * dgy
-            dedx = (dgx - dge * ex - ge * dex - edx * drho_p) / rho_p
-            dedy = (dgy - dge * ey - ge * dey - edy * drho_p) / rho_p
+            dedx = (dgx - dge * ex - ge * dex - edx * drho_p) * irp
+            dedy = (dgy - dge * ey - ge * dey - edy * drho_p) * irp
             ds0cx, ds0cy = -dthb * s0cy, dthb * s0cx
             dscx_ = ds0cx + dsx
             dscy_ = ds0cy + dsy
@@ -272,21 +300,23 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             Bx, By = dsrx_ - dscx_, dsry_ - dscy_
             Avx, Avy = dwvx - row * ddscx, dwvy - row * ddscy
             Bvx, Bvy = ddsrx - ddscx, ddsry - ddscy
-            # d Σ z^m F_k and d Σ z^m q_k, m = 0, 1
-            for m in range(2):
-                a0, a1 = acc[m], acc[m + 1]
-                dS[m, 0] = (a0[0] * Ax + a0[1] * Ay + a1[0] * Bx + a1[1] * By
-                            + a0[4] * Avx + a0[5] * Avy + a1[4] * Bvx + a1[5] * Bvy)
-                dS[m, 1] = (a0[2] * Ax + a0[3] * Ay + a1[2] * Bx + a1[3] * By
-                            + a0[6] * Avx + a0[7] * Avy + a1[6] * Bvx + a1[7] * Bvy)
-                dQm[m] = (a0[8] * Ax + a0[9] * Ay + a1[8] * Bx + a1[9] * By
-                          + a0[10] * Avx + a0[11] * Avy + a1[10] * Bvx + a1[11] * Bvy)
-            dS0x, dS0y, dS1x, dS1y = dS[0, 0], dS[0, 1], dS[1, 0], dS[1, 1]
+            # d Σ z^m F_k and d Σ z^m q_k, m = 0, 1 (the moments as scalars: no array views in this loop)
+            dS0x = (a0_0 * Ax + a0_1 * Ay + a1_0 * Bx + a1_1 * By
+                  + a0_4 * Avx + a0_5 * Avy + a1_4 * Bvx + a1_5 * Bvy)
+            dS0y = (a0_2 * Ax + a0_3 * Ay + a1_2 * Bx + a1_3 * By
+                  + a0_6 * Avx + a0_7 * Avy + a1_6 * Bvx + a1_7 * Bvy)
+            dQ = (a0_8 * Ax + a0_9 * Ay + a1_8 * Bx + a1_9 * By
+                  + a0_10 * Avx + a0_11 * Avy + a1_10 * Bvx + a1_11 * Bvy)
+            dS1x = (a1_0 * Ax + a1_1 * Ay + a2_0 * Bx + a2_1 * By
+                  + a1_4 * Avx + a1_5 * Avy + a2_4 * Bvx + a2_5 * Bvy)
+            dS1y = (a1_2 * Ax + a1_3 * Ay + a2_2 * Bx + a2_3 * By
+                  + a1_6 * Avx + a1_7 * Avy + a2_6 * Bvx + a2_7 * Bvy)
+            dQz = (a1_8 * Ax + a1_9 * Ay + a2_8 * Bx + a2_9 * By
+                  + a1_10 * Avx + a1_11 * Avy + a2_10 * Bvx + a2_11 * Bvy)
             dS2x, dS2y = row * dS0x + dS1x, row * dS0y + dS1y
-            dQ, dQz = dQm[0], dQm[1]
             # traction
-            drho = (pcx_ * ddx + pcy_ * ddy) / rho
-            decx, decy = (ddx - ecx * drho) / rho, (ddy - ecy * drho) / rho
+            drho = (pcx_ * ddx + pcy_ * ddy) * irho
+            decx, decy = (ddx - ecx * drho) * irho, (ddy - ecy * drho) * irho
             dtx, dty = -decy, decx
             drrx, drry = -drho * ecx + rl * decx, -drho * ecy + rl * decy
             drbx, drby = drcx + R * decx, drcy + R * decy
@@ -295,19 +325,19 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             dur = dVrx * tx + Vrx * dtx + dVry * ty + Vry * dty
             dub = dVbx * tx + Vbx * dtx + dVby * ty + Vby * dty
             dwt = dwvx * tx + wvx * dtx + dwvy * ty + wvy * dty
-            dvP = dVcx * tx + Vcx * dtx + dVcy * ty + Vcy * dty + R * (dwt - wt * drho / rho) / rho
+            dvP = dVcx * tx + Vcx * dtx + dVcy * ty + Vcy * dty + R * (dwt - wt * drho * irho) * irho
             du = 0.5 * (dur + dub) - dvP
             dmu = mu_s * (dur - dub) + mu_u * du + mu_Q * dQ
             dFt = -(dmu * Q + mu * dQ)
             dFtx, dFty = dFt * tx + Ft * dtx, dFt * ty + Ft * dty
-            dzbar = (dQz - zbar * dQ) / Q
+            dzbar = (dQz - zbar * dQ) * iQ
             dT1x = dS1x + dzbar * Ftx + zbar * dFtx
             dT1y = dS1y + dzbar * Fty + zbar * dFty
             dT2x = dS2x + dzbar * Ftx + (zbar + row) * dFtx
             dT2y = dS2y + dzbar * Fty + (zbar + row) * dFty
             ds1e = dex * T1x + ex * dT1x + dey * T1y + ey * dT1y
-            dGx = (dta * (T1x - s1e * ex) + tau * (dT1x - ds1e * ex - s1e * dex) - Gx * drho_p) / rho_p
-            dGy = (dta * (T1y - s1e * ey) + tau * (dT1y - ds1e * ey - s1e * dey) - Gy * drho_p) / rho_p
+            dGx = (dta * (T1x - s1e * ex) + tau * (dT1x - ds1e * ex - s1e * dex) - Gx * drho_p) * irp
+            dGy = (dta * (T1y - s1e * ey) + tau * (dT1y - ds1e * ey - s1e * dey) - Gy * drho_p) * irp
             f0 = dS0x + dGx + dFtx
             f1 = dS0y + dGy + dFty
             f2 = drrx * Fty + rrx * dFty - drry * Ftx - rry * dFtx
@@ -316,15 +346,10 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
                   - (drbx * Fty + rbx * dFty - drby * Ftx - rby * dFtx)
                   + dT2x * k0x + T2x * dk0x + dT2y * k0y + T2y * dk0y)
             dpin = -(drpx * Gy + rpx * dGy - drpy * Gx - rpy * dGx)
-            J = Jq if j < nl else Jv
-            c = j if j < nl else j - nl
-            J[i, 0, c], J[i, 1, c], J[i, 2, c], J[i, 3, c] = f0, f1, f2, ds1e
-            if outer:
-                J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4, f5, f6
-                J[i, 7, c], J[i, 8, c] = -dT2x, -dT2y
-                J[i, 9, c], J[i, 10, c], J[i, 11, c] = -dGx, -dGy, dpin
+            if j < nl:
+                _race_col(Jq, i, j, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
             else:
-                J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4 - dGx, f5 - dGy, f6 + dpin
+                _race_col(Jv, i, j - nl, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
 
 
 # ------------------------------------------------------------------------------------------------ SlicedGearMesh
