@@ -355,7 +355,7 @@ def test_the_sliced_machine_runs_compiled_as_on_the_numpy_path(machines):
     for name in ("F", "Jq", "Jv"):
         a, b = getattr(got, name), getattr(ref, name)
         assert np.abs(a - b).max() <= 1e-10 * np.abs(b).max(), name
-    assert np.abs(ref.F[nP:]).max() > 1e-3 * np.abs(ref.F).max() * 1e-2       # the tilts and slopes are loaded
+    assert np.abs(ref.F[nP:]).max() > 1.0           # the tilts and slopes carry moments (≈ 20 N m at most here)
     st = mbd.State(s.t, q, v, _extended(ss, sp, s.a), _extended(ss, sp, s.f), dict(s.z))
     run = lambda eng: mbd.simulate(ss.model, t_end=s.t + 20 * H, state=st.copy(), stepper=mbd.PRODUCTION.stepper(),
                                    controller=mbd.FixedStep(H), progress=False, engine=eng)           # noqa: E731
