@@ -1,7 +1,7 @@
 """What the sliced planet bearings cost (bearing.model = "sliced", docs/model.md §8.8): the DPGT's step at one
 condition with the planar contacts and with the sliced ones, from the same loaded state, interleaved, medians.
 
-    python -m scenarios.bench_sliced [--conditions 3] [--slices 21] [--steps 20] [--repeats 5]
+    python -m scenarios.bench_sliced [--conditions 3] [--slices 21] [--steps 20] [--repeats 5] [--no-numpy]
 
 The loaded state is the planar machine ``--settle`` seconds into its load ramp (compiled engine); the sliced
 machine starts from it with every slope and tilt at zero. Each repeat times ``--steps`` fixed steps of 5 µs of:
