@@ -49,7 +49,7 @@ from ..elements import ehl
 from ..elements.contact import (DryLand, EHLTraction, GuideContact, HoupertRolling, HydrodynamicLand, LubricantDrag,
                                 PocketContact, RaceContact, SlideRollTraction, TanhTraction)
 
-__all__ = ["pack_race", "evaluate_race", "outputs_race", "pack_pocket", "evaluate_pocket", "outputs_pocket",
+__all__ = ["traction_g", "pack_race", "evaluate_race", "outputs_race", "pack_pocket", "evaluate_pocket", "outputs_pocket",
            "update_pocket", "pack_guide", "evaluate_guide", "outputs_guide", "update_guide", "pack_drag",
            "evaluate_drag", "TRACTION_IDS", "RACE_OUTPUTS", "POCKET_OUTPUTS", "GUIDE_OUTPUTS"]
 
@@ -72,9 +72,8 @@ def _require(elem, cls):
                                   f"{type(elem).__name__}")
 
 
-def pack_race(elem):
-    _require(elem, RaceContact)
-    tr = elem.traction
+def traction_g(name, tr, exponent) -> np.ndarray:
+    """G (11,) of a race law: the exponent, the traction law's id and its coefficients (module docstring)."""
     law = TRACTION_IDS.get(type(tr))
     if law == TANH:
         coef = [tr.mu_max, tr.v0]
@@ -84,15 +83,21 @@ def pack_race(elem):
         coef = [tr.eta0, tr.alpha_p, tr.E_red, tr.length, tr.tau_L0, tr.gamma_L, tr.G_e, tr.u_reg,
                 tr.beta * tr.eta0 / tr.k_oil]
     else:
-        raise NotImplementedError(f"{elem.name}: RaceContact with traction law {type(tr).__name__} has no "
+        raise NotImplementedError(f"{name}: traction law {type(tr).__name__} has no "
                                   f"compiled kernel (compiled: {sorted(c.__name__ for c in TRACTION_IDS)})")
+    G = np.zeros(11)
+    G[:2 + len(coef)] = [exponent, float(law), *coef]
+    return G
+
+
+def pack_race(elem):
+    _require(elem, RaceContact)
+    G = traction_g(elem.name, elem.traction, elem.exponent)
     mk = elem.race_marker
     cols = [elem.kappa, mk[:, 0], mk[:, 1], elem.R_race, elem.D, elem.K, elem._c0, elem.multiplicity]
     if elem.has_spall:
         cols += [elem.spall_angle, elem._spall_hi, elem.spall_depth, elem.spall_edge]
     P = _rows(*cols)
-    G = np.zeros(11)
-    G[:2 + len(coef)] = [elem.exponent, float(law), *coef]
     roll = elem.rolling
     if roll is not None:
         if type(roll) is not HoupertRolling:

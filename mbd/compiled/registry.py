@@ -30,7 +30,7 @@ from numba.core import types as nbtypes
 from numba.core.errors import TypingError
 from numba.extending import overload
 
-from . import contact, generic, mesh
+from . import contact, generic, mesh, sliced
 
 __all__ = ["Kind", "KIND_IDS", "GROUPS", "OUTPUT_NAMES", "kind_of", "groups_of", "groups_to_compile", "call",
            "evaluate_for", "update_for", "outputs_for"]
@@ -46,7 +46,7 @@ class Kind:
 
 
 (_RACE, _POCKET, _GUIDE, _DRAG, _MESH, _SUPPORT, _BODY_SPRING, _TORSION, _TORQUE, _FORCE, _SPEED, _GYRO,
- _COORD_SPRING) = range(13)
+ _COORD_SPRING, _SLICED_RACE, _SLICED_MESH) = range(15)
 
 # compiled twin (as the families declare it) -> its id in the dispatch below
 KIND_IDS = {
@@ -55,10 +55,11 @@ KIND_IDS = {
     "generic.ground_support": _SUPPORT, "generic.body_spring": _BODY_SPRING, "generic.torsional_spring": _TORSION,
     "generic.torque_source": _TORQUE, "generic.force_source": _FORCE, "generic.speed_drive": _SPEED,
     "generic.slope_gyroscopic": _GYRO, "generic.coordinate_spring": _COORD_SPRING,
+    "sliced.sliced_race": _SLICED_RACE, "sliced.sliced_gear_mesh": _SLICED_MESH,
 }
-_MODULES = {"contact": contact, "generic": generic, "mesh": mesh}
+_MODULES = {"contact": contact, "generic": generic, "mesh": mesh, "sliced": sliced}
 # kernel module -> its bit in a system's ``groups`` (the unit of the lazy compile)
-GROUPS = {"contact": 1, "generic": 2, "mesh": 4}
+GROUPS = {"contact": 1, "generic": 2, "mesh": 4, "sliced": 8}
 # twins that give their outputs (outputs_kind) -> the reference's names of the rows they write
 # (the meshes' are not among them: numpy's batched mesh kernel takes as long over a block as the compiled one)
 OUTPUT_NAMES = {"contact.race": contact.RACE_OUTPUTS, "contact.pocket": contact.POCKET_OUTPUTS,
@@ -226,6 +227,10 @@ def evaluate_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, J
         generic.evaluate_slope_gyroscopic(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     elif kind == _COORD_SPRING:
         generic.evaluate_coordinate_spring(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _SLICED_RACE:
+        sliced.evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _SLICED_MESH:
+        sliced.evaluate_sliced_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
 
 
 def update_kind(groups, kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):

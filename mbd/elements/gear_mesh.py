@@ -461,7 +461,7 @@ class SlicedGearMesh(GearMesh):
     Local coordinates: gear 1 (x, y, θ), gear 2 (x, y, θ), then gear 1's slopes (if ``slopes1``), gear 2's (if
     ``slopes2``): full indices (n, 2) or None. ``face_width`` b [m] per mesh; ``slices`` n_m. Outputs: GearMesh's and "tilt_moment" M_+ − M_− [N m], "relative_slope" g·Δs of the loaded
     flank's line [rad]."""
-    compiled_twin = None
+    compiled_twin = "sliced.sliced_gear_mesh"
     batched = False            # its slices flatten the instance axis: one state at a time
 
     def __init__(self, name, gear1, gear2, *, slopes1=None, slopes2=None, face_width, slices, **kw):

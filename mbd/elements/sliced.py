@@ -201,6 +201,7 @@ class SlicedRaceContact(Element):
     R [rad], "slice_load_<k>" slice k's load (k = 0..n_s − 1) [N]; ``slice_loads`` (n, n_s) [N] by :meth:`slice_loads`.
     """
     batched = False
+    compiled_twin = "sliced.sliced_race"
 
     def __init__(self, name, dofs, *, kind, race_marker, pin_marker, R_race, D, K, exponent, zeta, m_roller,
                  traction, z, drop, row_offset=0.0, race_slope=(0.0, 0.0)):

@@ -1,13 +1,13 @@
 """What the sliced planet bearings cost (bearing.model = "sliced", docs/model.md §8.8): the DPGT's step at one
 condition with the planar contacts and with the sliced ones, from the same loaded state, interleaved, medians.
 
-    python -m scenarios.bench_sliced [--conditions 3] [--slices 21] [--steps 20] [--repeats 5]
+    python -m scenarios.bench_sliced [--conditions 3] [--slices 21] [--steps 20] [--repeats 5] [--no-numpy]
 
 The loaded state is the planar machine ``--settle`` seconds into its load ramp (compiled engine); the sliced
 machine starts from it with every slope and tilt at zero. Each repeat times ``--steps`` fixed steps of 5 µs of:
-the planar machine on the compiled path, the planar machine on the numpy path, the sliced machine on the numpy
-path (its only path: the sliced contact has no compiled twin yet). Prints one JSON object: seconds per step
-(medians) and the ratios sliced/planar on the numpy path and sliced (numpy) / planar (compiled).
+the planar machine on the compiled path and on the numpy path, the sliced machine on the compiled path and on the
+numpy path (``--no-numpy``: the compiled paths only). Prints one JSON object: seconds per step (medians) and the
+ratios sliced/planar on each path and sliced (numpy) / planar (compiled).
 """
 from __future__ import annotations
 
@@ -37,6 +37,7 @@ def parse_args(argv):
     p.add_argument("--steps", type=args.count(1), default=20, help="fixed steps of 5 us per timing (default 20)")
     p.add_argument("--repeats", type=args.count(1), default=5, help="interleaved timed repeats (default 5)")
     p.add_argument("--settle", type=float, default=0.004, help="seconds of load ramp before timing (default 0.004)")
+    p.add_argument("--no-numpy", action="store_true", help="time the compiled paths only")
     args.add_shared(p, "conditions", conditions="3", one_condition_only=True)
     return p.parse_args(argv)
 
@@ -48,7 +49,7 @@ def _run(model, state, steps, engine):
     return (time.perf_counter() - t0) / max(res.counters["accepted"], 1)
 
 
-def measure(condition: int, slices: int, steps: int, repeats: int, settle: float) -> dict:
+def measure(condition: int, slices: int, steps: int, repeats: int, settle: float, numpy: bool = True) -> dict:
     p = reference_dpgt(condition, "forward")
     ps = p.replace(bearing=p.bearing.replace(model="sliced", slicing=p.bearing.slicing.replace(slices=slices)))
     with warnings.catch_warnings():
@@ -60,24 +61,29 @@ def measure(condition: int, slices: int, steps: int, repeats: int, settle: float
     n = planar.model.ndof
     ext = lambda x: np.concatenate([x, np.zeros(sliced.model.ndof - n)])          # noqa: E731
     s_sl = mbd.State(s.t, ext(s.q), ext(s.v), ext(s.a), ext(s.f), dict(s.z))
-    for model, st, eng in ((planar.model, s, "compiled"), (planar.model, s, "numpy"), (sliced.model, s_sl, "numpy")):
+    runs = {"planar_compiled": (planar.model, s, "compiled"), "sliced_compiled": (sliced.model, s_sl, "compiled")}
+    if numpy:
+        runs.update(planar_numpy=(planar.model, s, "numpy"), sliced_numpy=(sliced.model, s_sl, "numpy"))
+    for model, st, eng in runs.values():
         _run(model, st, 2, eng)                                                   # kernels loaded, caches warm
-    t = {"planar_compiled": [], "planar_numpy": [], "sliced_numpy": []}
-    for _ in range(repeats):
-        t["planar_compiled"].append(_run(planar.model, s, steps, "compiled"))
-        t["planar_numpy"].append(_run(planar.model, s, steps, "numpy"))
-        t["sliced_numpy"].append(_run(sliced.model, s_sl, steps, "numpy"))
+    t = {k: [] for k in runs}
+    for _ in range(repeats):                                                      # interleaved
+        for k, (model, st, eng) in runs.items():
+            t[k].append(_run(model, st, steps, eng))
     med = {k: statistics.median(v) for k, v in t.items()}
-    return {"condition": condition, "slices": slices, "steps": steps, "repeats": repeats,
-            "dofs_planar": n, "dofs_sliced": sliced.model.ndof, **{f"{k}_s_per_step": v for k, v in med.items()},
-            "sliced_over_planar_numpy": med["sliced_numpy"] / med["planar_numpy"],
-            "sliced_numpy_over_planar_compiled": med["sliced_numpy"] / med["planar_compiled"]}
+    out = {"condition": condition, "slices": slices, "steps": steps, "repeats": repeats,
+           "dofs_planar": n, "dofs_sliced": sliced.model.ndof, **{f"{k}_s_per_step": v for k, v in med.items()},
+           "sliced_over_planar_compiled": med["sliced_compiled"] / med["planar_compiled"]}
+    if numpy:
+        out.update(sliced_over_planar_numpy=med["sliced_numpy"] / med["planar_numpy"],
+                   sliced_numpy_over_planar_compiled=med["sliced_numpy"] / med["planar_compiled"])
+    return out
 
 
 @command
 def main(argv=None) -> int:
     a = parse_args(sys.argv[1:] if argv is None else argv)
-    print(json.dumps(measure(int(a.conditions), a.slices, a.steps, a.repeats, a.settle), indent=1))
+    print(json.dumps(measure(int(a.conditions), a.slices, a.steps, a.repeats, a.settle, not a.no_numpy), indent=1))
     return 0
 
 

@@ -1,0 +1,546 @@
+"""Compiled kernel of the sliced roller–raceway contact (:class:`mbd.elements.sliced.SlicedRaceContact`,
+docs/model.md §8.8), following the convention of :mod:`mbd.compiled`. The numpy kernel stays the reference.
+
+Layout (one row of P per instance; G family-wide):
+
+``SlicedRaceContact``  P (n, 13 + n_s): κ, race_marker x, y [m], pin_marker x, y [m], race slope s_0 x, y [rad],
+                       R_race [m], D [m], K, c₀ = 2ζ·sqrt(m_roller·p·K), ζ_row [m], R_red [m], then the n_s profile
+                       drops P_k [m];  G (11 + n_s,): exponent p, traction law id and coefficients (the race
+                       contact's layout, :func:`mbd.compiled.contact.traction_g`), then the n_s slice stations z_k [m].
+                       The local coordinates' count tells the kind: 7 inner, 12 outer.
+
+How the Jacobian is made. The slice loop runs once per contact: it gives the slice loads and the sums the forces
+need (Σ F_k, Σ z_k F_k, Σ ζ_k F_k, Q = Σ q_k, Σ z_k q_k) and, with ``jac``, the slices' derivative blocks summed
+against the powers of z_k. Every slice's offset is w_k = (p − c) + z_k σ_r − ζ_k σ_c with ζ_k = ζ_row + z_k, so along
+any direction its change is dw_k = A + z_k B (A = d(p − c) − ζ_row dσ_c, B = dσ_r − dσ_c), the same for its rate; the
+slice force's change is dF_k = M_k dw_k + N_k dẇ_k with
+
+    M_k = κ n_k g_kᵀ + κ q_k (I − n_k n_kᵀ)/d_k,   N_k = −(∂q_k/∂δ̇_k) n_k n_kᵀ,
+    g_k = ∂q_k/∂w_k = −κ (∂q_k/∂δ_k n_k + ∂q_k/∂δ̇_k (ẇ_k − n_k (n_k·ẇ_k))/d_k),   ∂q_k/∂ẇ_k = −κ ∂q_k/∂δ̇_k n_k,
+
+so d Σ z_k^m F_k = Σ z_k^m M_k A + Σ z_k^(m+1) M_k B + (the same with N_k and the rates): the moments m = 0, 1, 2 of
+M_k, N_k and of the load gradients carry every slice into the contact's 2 n_local directions, which are then
+contact-level scalars (the geometry of e, σ_r, σ_c, the traction law, the generalised forces; the differential of
+every line of the reference evaluated along each unit direction, as :mod:`mbd.compiled.contact`). Exact, no
+differencing; the values are the reference's in its operation order up to the order of the slice sums.
+
+Contacts whose every slice is open by the reference's bound (δ_0 + max_k |z_k σ_r − ζ_k σ_c| ≤ 0) are skipped before
+the slice loop; a contact without load has no force and (ad.where) no derivative.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..elements.gear_mesh import SlicedGearMesh
+from ..elements.sliced import SlicedRaceContact
+from . import mesh, tooth_pairs
+from .contact import EHL, _ehl_traction, _traction, traction_g
+
+__all__ = ["pack_sliced_race", "evaluate_sliced_race", "pack_sliced_gear_mesh", "evaluate_sliced_gear_mesh",
+           "SLICED_COLS", "MESH_EXTRA"]
+
+_TWO_PI = 2.0 * np.pi
+
+_ETA2 = 1e-24            # the reference's η² (mbd.elements.sliced._ETA2)
+SLICED_COLS = 13         # P columns before the profile drops
+_GZ = 11                 # G index of the first slice station
+
+
+def pack_sliced_race(elem):
+    if type(elem) is not SlicedRaceContact:
+        raise NotImplementedError(f"{elem.name}: the compiled SlicedRaceContact kernel does not cover "
+                                  f"{type(elem).__name__}")
+    n = elem.n
+    col = lambda a: np.broadcast_to(np.asarray(a, float), (n,))                       # noqa: E731
+    cols = [col(elem.kappa), elem.race_marker[:, 0], elem.race_marker[:, 1], elem.pin_marker[:, 0],
+            elem.pin_marker[:, 1], elem.race_slope[:, 0], elem.race_slope[:, 1], elem.R_race, elem.D, elem.K,
+            elem._c0, elem.row_offset, elem.R_red]
+    P = np.ascontiguousarray(np.column_stack([col(c) for c in cols] + [elem.drop]), dtype=np.float64)
+    G = np.concatenate([traction_g(elem.name, elem.traction, elem.exponent), elem.z]).astype(np.float64)
+    return P, G
+
+
+@njit(cache=True)
+def _zero(F, Jq, Jv, i, jac):
+    """A contact without load: no force and (ad.where) no derivative."""
+    nl = F.shape[1]
+    for a in range(nl):
+        F[i, a] = 0.0
+        if jac:
+            for b in range(nl):
+                Jq[i, a, b] = 0.0
+                Jv[i, a, b] = 0.0
+
+
+@njit(cache=True)
+def _accumulate(acc, zk, *vals):
+    """acc[m, :] += z_k^m · vals, m = 0, 1, 2."""
+    z2 = zk * zk
+    for c in range(12):
+        x = vals[c]
+        acc[0, c] += x
+        acc[1, c] += zk * x
+        acc[2, c] += z2 * x
+
+
+@njit(cache=True)
+def _race_col(J, i, c, outer, f0, f1, f2, f3, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin):
+    """Column c of instance i's block (J_q or J_v: passed in, not chosen by a branch in the caller, whose every
+    write then cost array bookkeeping: mbd.compiled.contact._col)."""
+    J[i, 0, c], J[i, 1, c], J[i, 2, c], J[i, 3, c] = f0, f1, f2, f3
+    if outer:
+        J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4, f5, f6
+        J[i, 7, c], J[i, 8, c] = -dT2x, -dT2y
+        J[i, 9, c], J[i, 10, c], J[i, 11, c] = -dGx, -dGy, dpin
+    else:
+        J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4 - dGx, f5 - dGy, f6 + dpin
+
+
+@njit(cache=True)
+def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    p, law = G[0], int(G[1])
+    pe = 0.5 * (p - 1.0)
+    ns = G.shape[0] - _GZ
+    zs = G[_GZ:]
+    zmax = 0.0
+    for k in range(ns):
+        zmax = max(zmax, abs(zs[k]))
+    nl = ql.shape[1]
+    outer = nl == 12
+    acc = np.zeros((3, 12))          # moments m = 0, 1, 2 of M_k (4), N_k (4), g_k (2), ∂q_k/∂ẇ_k (2)
+    dq, dv = np.zeros(12), np.zeros(12)
+    for i in range(ql.shape[0]):
+        kap, mx, my, pmx, pmy, s0x, s0y = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
+        R, D, K, c0, row, Rr = P[i, 7], P[i, 8], P[i, 9], P[i, 10], P[i, 11], P[i, 12]
+        xr, yr, tau = ql[i, 0], ql[i, 1], ql[i, 3]
+        xb, yb, thb = ql[i, 4], ql[i, 5], ql[i, 6]
+        vr0, vr1, vr2, dtau = vl[i, 0], vl[i, 1], vl[i, 2], vl[i, 3]
+        vb0, vb1, vb2 = vl[i, 4], vl[i, 5], vl[i, 6]
+        if outer:
+            sx, sy, vsx, vsy = ql[i, 7], ql[i, 8], vl[i, 7], vl[i, 8]
+            xp, yp, thp, vp0, vp1, vp2 = ql[i, 9], ql[i, 10], ql[i, 11], vl[i, 9], vl[i, 10], vl[i, 11]
+        else:
+            sx, sy, vsx, vsy = 0.0, 0.0, 0.0, 0.0
+            xp, yp, thp, vp0, vp1, vp2 = xb, yb, thb, vb0, vb1, vb2
+        # the raceway's centre and its velocity; the pin's centre and its velocity (SlicedRaceContact._geometry)
+        cb, sb = np.cos(thb), np.sin(thb)
+        rcx, rcy = cb * mx - sb * my, sb * mx + cb * my
+        cx, cy = xb + rcx, yb + rcy
+        Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
+        cp, sp = np.cos(thp), np.sin(thp)
+        rpx, rpy = cp * pmx - sp * pmy, sp * pmx + cp * pmy
+        pcx, pcy = xp + rpx, yp + rpy
+        Vpx, Vpy = vp0 - vp2 * rpy, vp1 + vp2 * rpx
+        # e: pin centre → roller centre, and ė
+        ux, uy = xr - pcx, yr - pcy
+        rho_p = np.sqrt(ux * ux + uy * uy + _ETA2)
+        ex, ey = ux / rho_p, uy / rho_p
+        gx, gy = vr0 - Vpx, vr1 - Vpy
+        ge = ex * gx + ey * gy
+        edx, edy = (gx - ge * ex) / rho_p, (gy - ge * ey) / rho_p
+        # the race's slope σ_c and its rate; k0 = ∂σ_c/∂θ_b turned (the θ_b force's lever)
+        s0cx, s0cy = cb * s0x - sb * s0y, sb * s0x + cb * s0y
+        scx, scy = s0cx + sx, s0cy + sy
+        dscx, dscy = -1.0 * vb2 * s0cy + vsx, vb2 * s0cx + vsy
+        k0x, k0y = s0cy, -1.0 * s0cx
+        srx, sry = tau * ex, tau * ey
+        dsrx, dsry = dtau * ex + tau * edx, dtau * ey + tau * edy
+        pcx_, pcy_ = xr - cx, yr - cy
+        wvx, wvy = vr0 - Vcx, vr1 - Vcy
+        # the open bound (SlicedRaceContact._open_bound)
+        delta0 = 0.5 * D - kap * (np.sqrt(pcx_ * pcx_ + pcy_ * pcy_) - R)
+        reach = zmax * abs(tau) + (abs(row) + zmax) * np.sqrt(scx * scx + scy * scy)
+        if delta0 + reach <= 0.0:
+            _zero(F, Jq, Jv, i, jac)
+            continue
+        # the slice loop
+        S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        if jac:
+            acc[:, :] = 0.0
+        Ks, c0s = K / ns, c0 / ns
+        for k in range(ns):
+            zk = zs[k]
+            zeta = row + zk
+            wx = pcx_ + zk * srx - zeta * scx
+            wy = pcy_ + zk * sry - zeta * scy
+            vwx = wvx + zk * dsrx - zeta * dscx
+            vwy = wvy + zk * dsry - zeta * dscy
+            d = np.sqrt(wx * wx + wy * wy + _ETA2)
+            nx, ny = wx / d, wy / d
+            delta = 0.5 * D - kap * (d - R) - P[i, SLICED_COLS + k]
+            if not delta > 0.0:
+                continue
+            nv = nx * vwx + ny * vwy
+            delta_dot = -kap * nv
+            dpe = delta ** pe                       # δ^((p−1)/2); δ^p = δ (δ^((p−1)/2))², one power a slice
+            dp1 = dpe * dpe
+            q = Ks * (delta * dp1) + c0s * dpe * delta_dot
+            if not q > 0.0:
+                continue
+            Fx, Fy = kap * q * nx, kap * q * ny
+            S0x += Fx
+            S0y += Fy
+            S1x += zk * Fx
+            S1y += zk * Fy
+            S2x += zeta * Fx
+            S2y += zeta * Fy
+            Q += q
+            Qz += zk * q
+            if not jac:
+                continue
+            q_d = Ks * p * dp1 + c0s * pe * (dpe / delta) * delta_dot                         # ∂q/∂δ
+            q_r = c0s * dpe                                                                   # ∂q/∂δ̇
+            hx, hy = (vwx - nx * nv) / d, (vwy - ny * nv) / d
+            gqx, gqy = -kap * (q_d * nx + q_r * hx), -kap * (q_d * ny + q_r * hy)
+            gvx, gvy = -kap * q_r * nx, -kap * q_r * ny
+            qd = kap * q / d
+            m00 = kap * nx * gqx + qd * (1.0 - nx * nx)
+            m01 = kap * nx * gqy - qd * nx * ny
+            m10 = kap * ny * gqx - qd * nx * ny
+            m11 = kap * ny * gqy + qd * (1.0 - ny * ny)
+            _accumulate(acc, zk, m00, m01, m10, m11, kap * nx * gvx, kap * nx * gvy, kap * ny * gvx,
+                        kap * ny * gvy, gqx, gqy, gvx, gvy)
+        if not Q > 0.0:
+            _zero(F, Jq, Jv, i, jac)
+            continue
+        # traction as the planar contact's on Q, applied at the load centroid z̄
+        rho = np.sqrt(pcx_ * pcx_ + pcy_ * pcy_ + _ETA2)
+        ecx, ecy = pcx_ / rho, pcy_ / rho
+        tx, ty = -ecy, ecx
+        rl = R - rho
+        rrx, rry = rl * ecx, rl * ecy
+        rbx, rby = rcx + R * ecx, rcy + R * ecy
+        Vrx, Vry = vr0 - vr2 * rry, vr1 + vr2 * rrx
+        Vbx, Vby = vb0 - vb2 * rby, vb1 + vb2 * rbx
+        ur, ub = Vrx * tx + Vry * ty, Vbx * tx + Vby * ty
+        v_s = ur - ub
+        wt = wvx * tx + wvy * ty
+        u_e = 0.5 * (ur + ub) - (Vcx * tx + Vcy * ty + R * wt / rho)
+        mu_Q = 0.0
+        if law == EHL:
+            mu, mu_s, mu_u, mu_Q = _ehl_traction(G, v_s, u_e, Q, Rr)
+        else:
+            mu, mu_s, mu_u = _traction(law, G, v_s, u_e)
+        Ft = -mu * Q
+        Ftx, Fty = Ft * tx, Ft * ty
+        zbar = Qz / Q
+        T1x, T1y = S1x + zbar * Ftx, S1y + zbar * Fty
+        T2x, T2y = S2x + (zbar + row) * Ftx, S2y + (zbar + row) * Fty
+        s1e = ex * T1x + ey * T1y
+        Gx, Gy = tau * (T1x - s1e * ex) / rho_p, tau * (T1y - s1e * ey) / rho_p
+        F[i, 0] = S0x + Gx + Ftx
+        F[i, 1] = S0y + Gy + Fty
+        F[i, 2] = rrx * Fty - rry * Ftx
+        F[i, 3] = s1e
+        F[i, 4] = -S0x - Ftx
+        F[i, 5] = -S0y - Fty
+        F[i, 6] = -(rcx * S0y - rcy * S0x) + (rbx * (-Fty) - rby * (-Ftx)) + (T2x * k0x + T2y * k0y)
+        pin_t = -(rpx * Gy - rpy * Gx)
+        if outer:
+            F[i, 7], F[i, 8] = -T2x, -T2y
+            F[i, 9], F[i, 10], F[i, 11] = -Gx, -Gy, pin_t
+        else:
+            F[i, 4] += -Gx
+            F[i, 5] += -Gy
+            F[i, 6] += pin_t
+        if not jac:
+            continue
+        a0_0, a0_1, a0_2, a0_3, a0_4, a0_5, a0_6, a0_7, a0_8, a0_9, a0_10, a0_11 = (
+            acc[0, 0], acc[0, 1], acc[0, 2], acc[0, 3], acc[0, 4], acc[0, 5],
+            acc[0, 6], acc[0, 7], acc[0, 8], acc[0, 9], acc[0, 10], acc[0, 11])
+        a1_0, a1_1, a1_2, a1_3, a1_4, a1_5, a1_6, a1_7, a1_8, a1_9, a1_10, a1_11 = (
+            acc[1, 0], acc[1, 1], acc[1, 2], acc[1, 3], acc[1, 4], acc[1, 5],
+            acc[1, 6], acc[1, 7], acc[1, 8], acc[1, 9], acc[1, 10], acc[1, 11])
+        a2_0, a2_1, a2_2, a2_3, a2_4, a2_5, a2_6, a2_7, a2_8, a2_9, a2_10, a2_11 = (
+            acc[2, 0], acc[2, 1], acc[2, 2], acc[2, 3], acc[2, 4], acc[2, 5],
+            acc[2, 6], acc[2, 7], acc[2, 8], acc[2, 9], acc[2, 10], acc[2, 11])
+        irp, irho, iQ = 1.0 / rho_p, 1.0 / rho, 1.0 / Q
+        # every direction: position (j < nl) and velocity (j ≥ nl) unit vectors of the local coordinates
+        for j in range(2 * nl):
+            dq[:] = 0.0
+            dv[:] = 0.0
+            if j < nl:
+                dq[j] = 1.0
+            else:
+                dv[j - nl] = 1.0
+            dxr, dyr, dta, dxb, dyb, dthb = dq[0], dq[1], dq[3], dq[4], dq[5], dq[6]
+            dvr0, dvr1, dvr2, ddta, dvb0, dvb1, dvb2 = dv[0], dv[1], dv[2], dv[3], dv[4], dv[5], dv[6]
+            if outer:
+                dsx, dsy, dvsx, dvsy = dq[7], dq[8], dv[7], dv[8]
+                dxp, dyp, dthp, dvp0, dvp1, dvp2 = dq[9], dq[10], dq[11], dv[9], dv[10], dv[11]
+            else:
+                dsx, dsy, dvsx, dvsy = 0.0, 0.0, 0.0, 0.0
+                dxp, dyp, dthp, dvp0, dvp1, dvp2 = dxb, dyb, dthb, dvb0, dvb1, dvb2
+            drcx, drcy = -dthb * rcy, dthb * rcx
+            dVcx = dvb0 - dvb2 * rcy - vb2 * drcy
+            dVcy = dvb1 + dvb2 * rcx + vb2 * drcx
+            drpx, drpy = -dthp * rpy, dthp * rpx
+            dVpx = dvp0 - dvp2 * rpy - vp2 * drpy
+            dVpy = dvp1 + dvp2 * rpx + vp2 * drpx
+            dux, duy = dxr - (dxp + drpx), dyr - (dyp + drpy)
+            drho_p = (ux * dux + uy * duy) * irp
+            dex, dey = (dux - ex * drho_p) * irp, (duy - ey * drho_p) * irp
+            dgx, dgy = dvr0 - dVpx, dvr1 - dVpy
+            dge = dex * gx + ex * dgx + dey * gy + ey * dgy
+            dedx = (dgx - dge * ex - ge * dex - edx * drho_p) * irp
+            dedy = (dgy - dge * ey - ge * dey - edy * drho_p) * irp
+            ds0cx, ds0cy = -dthb * s0cy, dthb * s0cx
+            dscx_ = ds0cx + dsx
+            dscy_ = ds0cy + dsy
+            ddscx = -dvb2 * s0cy - vb2 * ds0cy + dvsx
+            ddscy = dvb2 * s0cx + vb2 * ds0cx + dvsy
+            dk0x, dk0y = ds0cy, -ds0cx
+            dsrx_, dsry_ = dta * ex + tau * dex, dta * ey + tau * dey
+            ddsrx = ddta * ex + dtau * dex + dta * edx + tau * dedx
+            ddsry = ddta * ey + dtau * dey + dta * edy + tau * dedy
+            ddx, ddy = dxr - (dxb + drcx), dyr - (dyb + drcy)          # d(p − c)
+            dwvx, dwvy = dvr0 - dVcx, dvr1 - dVcy                      # d(ṗ − ċ)
+            Ax, Ay = ddx - row * dscx_, ddy - row * dscy_
+            Bx, By = dsrx_ - dscx_, dsry_ - dscy_
+            Avx, Avy = dwvx - row * ddscx, dwvy - row * ddscy
+            Bvx, Bvy = ddsrx - ddscx, ddsry - ddscy
+            # d Σ z^m F_k and d Σ z^m q_k, m = 0, 1 (the moments as scalars: no array views in this loop)
+            dS0x = (a0_0 * Ax + a0_1 * Ay + a1_0 * Bx + a1_1 * By
+                  + a0_4 * Avx + a0_5 * Avy + a1_4 * Bvx + a1_5 * Bvy)
+            dS0y = (a0_2 * Ax + a0_3 * Ay + a1_2 * Bx + a1_3 * By
+                  + a0_6 * Avx + a0_7 * Avy + a1_6 * Bvx + a1_7 * Bvy)
+            dQ = (a0_8 * Ax + a0_9 * Ay + a1_8 * Bx + a1_9 * By
+                  + a0_10 * Avx + a0_11 * Avy + a1_10 * Bvx + a1_11 * Bvy)
+            dS1x = (a1_0 * Ax + a1_1 * Ay + a2_0 * Bx + a2_1 * By
+                  + a1_4 * Avx + a1_5 * Avy + a2_4 * Bvx + a2_5 * Bvy)
+            dS1y = (a1_2 * Ax + a1_3 * Ay + a2_2 * Bx + a2_3 * By
+                  + a1_6 * Avx + a1_7 * Avy + a2_6 * Bvx + a2_7 * Bvy)
+            dQz = (a1_8 * Ax + a1_9 * Ay + a2_8 * Bx + a2_9 * By
+                  + a1_10 * Avx + a1_11 * Avy + a2_10 * Bvx + a2_11 * Bvy)
+            dS2x, dS2y = row * dS0x + dS1x, row * dS0y + dS1y
+            # traction
+            drho = (pcx_ * ddx + pcy_ * ddy) * irho
+            decx, decy = (ddx - ecx * drho) * irho, (ddy - ecy * drho) * irho
+            dtx, dty = -decy, decx
+            drrx, drry = -drho * ecx + rl * decx, -drho * ecy + rl * decy
+            drbx, drby = drcx + R * decx, drcy + R * decy
+            dVrx, dVry = dvr0 - dvr2 * rry - vr2 * drry, dvr1 + dvr2 * rrx + vr2 * drrx
+            dVbx, dVby = dvb0 - dvb2 * rby - vb2 * drby, dvb1 + dvb2 * rbx + vb2 * drbx
+            dur = dVrx * tx + Vrx * dtx + dVry * ty + Vry * dty
+            dub = dVbx * tx + Vbx * dtx + dVby * ty + Vby * dty
+            dwt = dwvx * tx + wvx * dtx + dwvy * ty + wvy * dty
+            dvP = dVcx * tx + Vcx * dtx + dVcy * ty + Vcy * dty + R * (dwt - wt * drho * irho) * irho
+            du = 0.5 * (dur + dub) - dvP
+            dmu = mu_s * (dur - dub) + mu_u * du + mu_Q * dQ
+            dFt = -(dmu * Q + mu * dQ)
+            dFtx, dFty = dFt * tx + Ft * dtx, dFt * ty + Ft * dty
+            dzbar = (dQz - zbar * dQ) * iQ
+            dT1x = dS1x + dzbar * Ftx + zbar * dFtx
+            dT1y = dS1y + dzbar * Fty + zbar * dFty
+            dT2x = dS2x + dzbar * Ftx + (zbar + row) * dFtx
+            dT2y = dS2y + dzbar * Fty + (zbar + row) * dFty
+            ds1e = dex * T1x + ex * dT1x + dey * T1y + ey * dT1y
+            dGx = (dta * (T1x - s1e * ex) + tau * (dT1x - ds1e * ex - s1e * dex) - Gx * drho_p) * irp
+            dGy = (dta * (T1y - s1e * ey) + tau * (dT1y - ds1e * ey - s1e * dey) - Gy * drho_p) * irp
+            f0 = dS0x + dGx + dFtx
+            f1 = dS0y + dGy + dFty
+            f2 = drrx * Fty + rrx * dFty - drry * Ftx - rry * dFtx
+            f4, f5 = -dS0x - dFtx, -dS0y - dFty
+            f6 = (-(drcx * S0y + rcx * dS0y - drcy * S0x - rcy * dS0x)
+                  - (drbx * Fty + rbx * dFty - drby * Ftx - rby * dFtx)
+                  + dT2x * k0x + T2x * dk0x + dT2y * k0y + T2y * dk0y)
+            dpin = -(drpx * Gy + rpx * dGy - drpy * Gx - rpy * dGx)
+            if j < nl:
+                _race_col(Jq, i, j, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
+            else:
+                _race_col(Jv, i, j - nl, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
+
+
+# ------------------------------------------------------------------------------------------------ SlicedGearMesh
+# P: the GearMesh layout (mbd.compiled.mesh, without eccentricity or the tooth-pair law), then 4 columns:
+# face width b [m], slices n_m, gear 1 has slopes (1/0), gear 2 has slopes (1/0);  G: the GearMesh layout.
+MESH_EXTRA = 4
+
+
+def pack_sliced_gear_mesh(elem):
+    if type(elem) is not SlicedGearMesh:
+        raise NotImplementedError(f"{elem.name}: the compiled SlicedGearMesh kernel does not cover "
+                                  f"{type(elem).__name__}")
+    if elem.has_offset or elem.pairs is not None:
+        raise NotImplementedError(f"SlicedGearMesh {elem.name!r}: the compiled path has no face-sliced mesh with "
+                                  "eccentricity or the tooth-pair law (use the numpy path)")
+    P, G = mesh.pack_gear_mesh(elem)
+    n = elem.n
+    extra = np.column_stack([elem.face_width, np.full(n, float(elem.n_m)), np.full(n, float(elem.has1)),
+                             np.full(n, float(elem.has2))])
+    return np.ascontiguousarray(np.hstack([P, extra])), G
+
+
+@njit(cache=True)
+def evaluate_sliced_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    """The face-sliced lumped mesh law (SlicedGearMesh.kernel, docs/model.md §6.6) and its exact Jacobian: the slice
+    loop once per flank, its derivative blocks summed against the powers of ζ_k, then every direction of the local
+    coordinates at the mesh level (the differential of every line of the reference)."""
+    shape = int(G[mesh.G_SHAPE])
+    nl = ql.shape[1]
+    e0 = P.shape[1] - MESH_EXTRA
+    mom = np.zeros((2, 9))          # per flank: Σ ζ^m A_k, Σ ζ^m B_k, Σ ζ^m d_k (m = 0, 1, 2)
+    Ff, Mf = np.zeros(2), np.zeros(2)
+    dq, dv = np.zeros(nl), np.zeros(nl)
+    for i in range(ql.shape[0]):
+        sig, rb1, rb2 = P[i, mesh.P_SIGMA], P[i, mesh.P_RB1], P[i, mesh.P_RB2]
+        sa, kappa0, pb, z1 = P[i, mesh.P_SIN_ALPHA], P[i, mesh.P_KAPPA0], P[i, mesh.P_PITCH], P[i, mesh.P_TEETH1]
+        bw, nm, has1, has2 = P[i, e0], int(P[i, e0 + 1]), P[i, e0 + 2] != 0.0, P[i, e0 + 3] != 0.0
+        x1, y1, th1, x2, y2, th2 = ql[i, 0], ql[i, 1], ql[i, 2], ql[i, 3], ql[i, 4], ql[i, 5]
+        vx1, vy1, w1, vx2, vy2, w2 = vl[i, 0], vl[i, 1], vl[i, 2], vl[i, 3], vl[i, 4], vl[i, 5]
+        j1 = 6
+        s1x, s1y, u1x, u1y, s2x, s2y, u2x, u2y = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        if has1:
+            s1x, s1y, u1x, u1y = ql[i, 6], ql[i, 7], vl[i, 6], vl[i, 7]
+            j1 = 8
+        if has2:
+            s2x, s2y, u2x, u2y = ql[i, j1], ql[i, j1 + 1], vl[i, j1], vl[i, j1 + 1]
+        dsx, dsy, dvx, dvy = s2x - s1x, s2y - s1y, u2x - u1x, u2y - u1y
+        # the mesh geometry (GearMesh._geometry, mbd.compiled.mesh._meshes)
+        dx, dy, ddx, ddy = sig * (x2 - x1), sig * (y2 - y1), sig * (vx2 - vx1), sig * (vy2 - vy1)
+        r2 = dx * dx + dy * dy
+        a = np.sqrt(r2)
+        inv_a = 1.0 / a
+        ex, ey = dx * inv_a, dy * inv_a
+        tx, ty = -ey, ex
+        phi_ref = P[i, mesh.P_PHI_REF]
+        phi_e = phi_ref + mesh._wrap(np.arctan2(dy, dx) - phi_ref)
+        raw = sig * rb1 * (th1 - phi_e) + rb2 * (th2 - phi_e) - P[i, mesh.P_U0]
+        roll = sig * rb1 * w1 + rb2 * w2
+        s = mesh._wrap(raw * (_TWO_PI / pb)) * (pb / _TWO_PI)
+        kappa = kappa0 * inv_a
+        radial = sig * sa * (a - P[i, mesh.P_A0])
+        half_b = 0.5 * P[i, mesh.P_BACKLASH]
+        t_dd = tx * ddx + ty * ddy
+        e_dd = ex * ddx + ey * ddy
+        s_dot = roll - kappa * t_dd
+        radial_dot = sig * sa * e_dd
+        fac, dfac = mesh._factor(shape, z1 * (th1 - phi_e) * (1.0 / _TWO_PI) + P[i, mesh.P_P0], P, i, G)
+        k_mean, c_m, ramp = P[i, mesh.P_K_MEAN], P[i, mesh.P_C_MESH], P[i, mesh.P_RAMP]
+        kp = k_mean * fac
+        kk, cc = kp / nm, c_m / nm
+        t_s, e_s = tx * dsx + ty * dsy, ex * dsx + ey * dsy
+        hx, hy, qsx, qsy = 0.0, 0.0, 0.0, 0.0
+        if jac:
+            mom[:, :] = 0.0
+        for fi in range(2):
+            f = 1.0 if fi == 0 else -1.0
+            d_f = f * s - radial - half_b
+            r_f = f * s_dot - radial_dot
+            gx = -sig * f * kappa * tx - sa * ex
+            gy = -sig * f * kappa * ty - sa * ey
+            gs = gx * dsx + gy * dsy
+            gs_dot = (sig * f * kappa * (e_dd * t_s + t_dd * e_s) - sa * t_dd * t_s) / a + gx * dvx + gy * dvy
+            FF, MM = 0.0, 0.0
+            for k in range(nm):
+                zeta = bw / nm * (k + 1 - 0.5 * (nm + 1))
+                d_k = d_f + zeta * gs
+                if not d_k > 0.0:
+                    continue
+                r_k = r_f + zeta * gs_dot
+                S, dS = tooth_pairs.damping_share(d_k, ramp)
+                F_k = kk * d_k + cc * S * r_k
+                if not F_k > 0.0:
+                    continue
+                FF += F_k
+                MM += zeta * F_k
+                if jac:
+                    A_k, B_k = kk + cc * dS * r_k, cc * S
+                    zm = 1.0
+                    for m in range(3):
+                        mom[fi, m] += zm * A_k
+                        mom[fi, 3 + m] += zm * B_k
+                        mom[fi, 6 + m] += zm * d_k
+                        zm *= zeta
+            Ff[fi], Mf[fi] = FF, MM
+            cx = (sig * f * kappa * t_s) / a
+            ct = (sig * f * kappa * e_s - sa * t_s) / a
+            hx = hx - MM * (cx * ex + ct * tx)
+            hy = hy - MM * (cx * ey + ct * ty)
+            qsx += MM * gx
+            qsy += MM * gy
+        F_net, F_sum = Ff[0] - Ff[1], Ff[0] + Ff[1]
+        Fhx = F_net * kappa * tx + sig * sa * F_sum * ex + hx
+        Fhy = F_net * kappa * ty + sig * sa * F_sum * ey + hy
+        F[i, 0], F[i, 1], F[i, 2] = -sig * Fhx, -sig * Fhy, -sig * rb1 * F_net
+        F[i, 3], F[i, 4], F[i, 5] = sig * Fhx, sig * Fhy, -1.0 * rb2 * F_net
+        if has1:
+            F[i, 6], F[i, 7] = qsx, qsy
+        if has2:
+            F[i, j1], F[i, j1 + 1] = -qsx, -qsy
+        if not jac:
+            continue
+        for j in range(2 * nl):
+            dq[:] = 0.0
+            dv[:] = 0.0
+            if j < nl:
+                dq[j] = 1.0
+            else:
+                dv[j - nl] = 1.0
+            # direction → (δd, θ1, θ2, δḋ, ω1, ω2, Δs, Δṡ)
+            pdx, pdy, pth1, pth2 = sig * (dq[3] - dq[0]), sig * (dq[4] - dq[1]), dq[2], dq[5]
+            vdx, vdy, pw1, pw2 = sig * (dv[3] - dv[0]), sig * (dv[4] - dv[1]), dv[2], dv[5]
+            pdsx, pdsy, pdvx, pdvy = 0.0, 0.0, 0.0, 0.0
+            if has1:
+                pdsx, pdsy, pdvx, pdvy = -dq[6], -dq[7], -dv[6], -dv[7]
+            if has2:
+                pdsx, pdsy = pdsx + dq[j1], pdsy + dq[j1 + 1]
+                pdvx, pdvy = pdvx + dv[j1], pdvy + dv[j1 + 1]
+            tdd_ = tx * pdx + ty * pdy                          # t·δd
+            da = ex * pdx + ey * pdy
+            dex, dey = tx * tdd_ * inv_a, ty * tdd_ * inv_a
+            dtx, dty = -ex * tdd_ * inv_a, -ey * tdd_ * inv_a
+            dkappa = -kappa * da * inv_a
+            dphi = (-dy * pdx + dx * pdy) / r2
+            ds = sig * rb1 * (pth1 - dphi) + rb2 * (pth2 - dphi)
+            droll = sig * rb1 * pw1 + rb2 * pw2
+            dradial = sig * sa * da
+            dt_dd = dtx * ddx + dty * ddy + tx * vdx + ty * vdy
+            de_dd = dex * ddx + dey * ddy + ex * vdx + ey * vdy
+            ds_dot = droll - dkappa * t_dd - kappa * dt_dd
+            dradial_dot = sig * sa * de_dd
+            dkp = k_mean * dfac * z1 * (pth1 - dphi) * (1.0 / _TWO_PI)
+            dt_s = dtx * dsx + dty * dsy + tx * pdsx + ty * pdsy
+            de_s = dex * dsx + dey * dsy + ex * pdsx + ey * pdsy
+            dFnet, dFsum, dhx, dhy, dqsx, dqsy = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            for fi in range(2):
+                f = 1.0 if fi == 0 else -1.0
+                dd_f = f * ds - dradial
+                dr_f = f * ds_dot - dradial_dot
+                gx = -sig * f * kappa * tx - sa * ex
+                gy = -sig * f * kappa * ty - sa * ey
+                dgx = -sig * f * (dkappa * tx + kappa * dtx) - sa * dex
+                dgy = -sig * f * (dkappa * ty + kappa * dty) - sa * dey
+                dgs = dgx * dsx + dgy * dsy + gx * pdsx + gy * pdsy
+                Nn = sig * f * kappa * (e_dd * t_s + t_dd * e_s) - sa * t_dd * t_s
+                dN = (sig * f * (dkappa * (e_dd * t_s + t_dd * e_s)
+                                 + kappa * (de_dd * t_s + e_dd * dt_s + dt_dd * e_s + t_dd * de_s))
+                      - sa * (dt_dd * t_s + t_dd * dt_s))
+                dgs_dot = dN / a - Nn * da / (a * a) + dgx * dvx + dgy * dvy + gx * pdvx + gy * pdvy
+                mo = mom[fi]
+                dF = mo[0] * dd_f + mo[1] * dgs + mo[3] * dr_f + mo[4] * dgs_dot + dkp * mo[6] / nm
+                dM = mo[1] * dd_f + mo[2] * dgs + mo[4] * dr_f + mo[5] * dgs_dot + dkp * mo[7] / nm
+                MM = Mf[fi]
+                dFnet += f * dF
+                dFsum += dF
+                cx = (sig * f * kappa * t_s) / a
+                ct = (sig * f * kappa * e_s - sa * t_s) / a
+                dcx = sig * f * (dkappa * t_s + kappa * dt_s) / a - cx * da / a
+                dct = (sig * f * (dkappa * e_s + kappa * de_s) - sa * dt_s) / a - ct * da / a
+                dhx -= dM * (cx * ex + ct * tx) + MM * (dcx * ex + cx * dex + dct * tx + ct * dtx)
+                dhy -= dM * (cx * ey + ct * ty) + MM * (dcx * ey + cx * dey + dct * ty + ct * dty)
+                dqsx += dM * gx + MM * dgx
+                dqsy += dM * gy + MM * dgy
+            dFhx = (dFnet * kappa * tx + F_net * (dkappa * tx + kappa * dtx)
+                    + sig * sa * (dFsum * ex + F_sum * dex) + dhx)
+            dFhy = (dFnet * kappa * ty + F_net * (dkappa * ty + kappa * dty)
+                    + sig * sa * (dFsum * ey + F_sum * dey) + dhy)
+            J = Jq if j < nl else Jv
+            c = j if j < nl else j - nl
+            J[i, 0, c], J[i, 1, c], J[i, 2, c] = -sig * dFhx, -sig * dFhy, -sig * rb1 * dFnet
+            J[i, 3, c], J[i, 4, c], J[i, 5, c] = sig * dFhx, sig * dFhy, -1.0 * rb2 * dFnet
+            if has1:
+                J[i, 6, c], J[i, 7, c] = dqsx, dqsy
+            if has2:
+                J[i, j1, c], J[i, j1 + 1, c] = -dqsx, -dqsy

@@ -1,0 +1,175 @@
+"""The compiled sliced race contact (mbd.compiled.sliced) equals the reference kernel (mbd.element.evaluate over
+mbd.elements.sliced.SlicedRaceContact, whose Jacobians are mbd.ad's dual numbers) to round-off: forces, J_q and J_v
+to 1e-10 of each instance's block (tests.support.contact.assert_matches_reference), inner and outer raceways, the
+three traction laws, with damping, profile drops, row offsets, a pin slope, tilts and slopes drawn at random, and
+contacts fully open (skipped by the bound), partly open (an edge load) and fully closed in one family."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+from mbd.compiled.registry import kind_of
+from mbd.elements import StiffnessShape
+from mbd.elements.gear_mesh import SlicedGearMesh, mesh_u0
+from mbd.elements.sliced import SlicedRaceContact, slice_stations
+
+from tests.support.contact import DR, EHL, FILM, FS, K_HZ, LR, M_ROLLER, TANH, assert_matches_reference, compiled
+from tests.support.strategies import frame_states
+
+SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+TRACTIONS = {"tanh": TANH, "slide_roll": EHL, "film": FILM}
+R_IN, R_OUT = 15.75e-3, 23.26e-3
+PIN = np.array([0.004, -0.002])          # the pin centre in the pin body's axes
+N = 6                                    # rollers
+# full-vector layout: pin body 0..2, planet 3..5, the planet's slopes 6, 7, roller b at 8 + 3b, its tilt 8 + 3N + b
+ROLLER = lambda b: 8 + 3 * b             # noqa: E731
+TILT = lambda b: 8 + 3 * N + b           # noqa: E731
+
+
+def _family(kind, n_s, traction, *, zeta, drop, row, pin_slope):
+    z, _ = slice_stations(LR, n_s)
+    law = dict(D=DR, K=K_HZ, exponent=10.0 / 9.0, zeta=zeta, m_roller=M_ROLLER, traction=traction, z=z, drop=drop,
+               row_offset=row)
+    rows = []
+    for b in range(N):
+        r = [ROLLER(b), ROLLER(b) + 1, ROLLER(b) + 2, TILT(b)]
+        rows.append(r + ([0, 1, 2] if kind == "inner" else [3, 4, 5, 6, 7, 0, 1, 2]))
+    if kind == "inner":
+        return SlicedRaceContact("in", rows, kind="inner", race_marker=PIN, pin_marker=PIN, R_race=R_IN,
+                                 race_slope=pin_slope, **law)
+    return SlicedRaceContact("out", rows, kind="outer", race_marker=(0.0, 0.0), pin_marker=PIN, R_race=R_OUT,
+                             race_slope=pin_slope, **law)
+
+
+def _state(kind, rng, press, tilt, slope):
+    """Rollers around the pin, each pressed by press[b] into the ``kind`` raceway (negative: a gap), tilted by tilt[b];
+    the planet's slope ``slope``; small random offsets; random velocities."""
+    nf = 8 + 4 * N
+    q = np.zeros(nf)
+    q[:3] = (0.01, 0.02, 0.1)
+    pin_c = q[:2] + np.array([[np.cos(0.1), -np.sin(0.1)], [np.sin(0.1), np.cos(0.1)]]) @ PIN
+    q[3:5] = pin_c + rng.uniform(-2e-6, 2e-6, 2)
+    q[6:8] = slope
+    for b in range(N):
+        e = np.array([np.cos(2 * np.pi * b / N + 0.3), np.sin(2 * np.pi * b / N + 0.3)])
+        radius = R_IN + DR / 2 - press[b] if kind == "inner" else R_OUT - DR / 2 + press[b]
+        q[ROLLER(b):ROLLER(b) + 2] = pin_c + e * radius
+        q[ROLLER(b) + 2] = rng.uniform(-3, 3)
+        q[TILT(b)] = tilt[b]
+    q[3:6] += rng.standard_normal(3) * (1e-7, 1e-7, 1e-3)
+    v = rng.standard_normal(nf) * np.r_[[1e-2, 1e-2, 50.0] * 2, [0.5] * 2, [1e-2, 1e-2, 300.0] * N, [0.5] * N]
+    return q, v
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+@pytest.mark.parametrize("law", ["tanh", "slide_roll", "film"])
+@SETTINGS
+@given(data=st.data(), fs=frame_states(), n_s=st.sampled_from([1, 5, 21]), zeta=st.sampled_from([0.0, 0.05, 0.3]),
+       row=st.sampled_from([0.0, 3e-3, -6e-3]), seed=st.integers(0, 2 ** 31))
+def test_sliced_race_matches_reference(kind, law, data, fs, n_s, zeta, row, seed):
+    rng = np.random.default_rng(seed)
+    press = data.draw(st.lists(st.sampled_from([-20e-6, -1e-6, 0.3e-6, 2e-6, 8e-6]), min_size=N, max_size=N))
+    tilt = rng.uniform(-1e-3, 1e-3, N)
+    slope = rng.uniform(-5e-4, 5e-4, 2)
+    pin_slope = rng.uniform(-3e-4, 3e-4, 2) if data.draw(st.booleans()) else (0.0, 0.0)
+    drop = rng.uniform(0.0, 1e-6, (N, n_s)) if data.draw(st.booleans()) else np.zeros(n_s)
+    elem = _family(kind, n_s, TRACTIONS[law], zeta=zeta, drop=drop, row=row, pin_slope=pin_slope)
+    qf, vf = _state(kind, rng, press, tilt, slope)
+    Fr = assert_matches_reference(elem, fs, qf, vf)
+    assert np.any(Fr != 0.0) or min(press) < 0.0
+
+
+def test_loaded_open_and_edge_contacts_in_one_family():
+    """The equality holds where it matters: a contact with every slice closed, one with an edge load (tilt beyond
+    the compression) and one skipped as open are all in the family, and the open one is exactly zero."""
+    rng = np.random.default_rng(7)
+    press = [6e-6, 1e-6, -30e-6, 4e-6, 0.5e-6, 2e-6]
+    tilt = [0.0, 8e-4, 0.0, -3e-4, 2e-4, 0.0]
+    for kind in ("inner", "outer"):
+        elem = _family(kind, 21, TANH, zeta=0.05, drop=np.zeros(21), row=0.0, pin_slope=(0.0, 0.0))
+        qf, vf = _state(kind, rng, press, tilt, (2e-4, -1e-4))
+        loads = elem.slice_loads(qf, vf)
+        assert np.all(loads[0] > 0.0) and np.any(loads[1] == 0.0) and np.any(loads[1] > 0.0)
+        assert np.all(loads[2] == 0.0)
+        assert_matches_reference(elem, FS, qf, vf)
+        F, Jq, Jv = compiled(elem, FS, qf, vf, None, True)
+        assert np.all(F[2] == 0.0) and np.all(Jq[2] == 0.0) and np.all(Jv[2] == 0.0)
+
+
+def test_family_declares_its_twin():
+    assert kind_of(SlicedRaceContact).evaluate.__name__ == "evaluate_sliced_race"
+
+
+# ------------------------------------------------------------------------------------------------ SlicedGearMesh
+RB1, RB2, ALPHA, Z1 = 0.03, 0.045, np.radians(20.0), 20
+RBR = 0.12                               # a ring's base radius (internal meshes: gear 1 the planet, gear 2 the ring)
+K_MESH, BW = 4.0e8, 0.02
+SHAPES = {"constant": StiffnessShape.constant(), "rectangular": StiffnessShape.rectangular(1.6, 1.5, 0.1),
+          "fourier": StiffnessShape.fourier(a=(0.1, 0.03), b=(0.05,))}
+
+
+def _mesh_family(internal, shape, n_m, c, backlash, has1, has2):
+    """Three meshes of one kind (gear bodies 0..5, slopes from 18), their slope pairs as asked."""
+    rb2 = RBR if internal else RB2
+    a0 = ((rb2 - RB1) if internal else (RB1 + rb2)) / np.cos(ALPHA)
+    g1, g2 = np.arange(0, 3), np.arange(3, 6)
+    s1 = np.array([[18 + 2 * m, 19 + 2 * m] for m in range(3)]) if has1 else None
+    s2 = np.array([[24 + 2 * m, 25 + 2 * m] for m in range(3)]) if has2 else None
+    poses1, poses2 = _nominal(a0, internal)
+    return SlicedGearMesh("mesh", g1, g2, slopes1=s1, slopes2=s2, face_width=BW, slices=n_m, internal=internal,
+                          rb1=RB1, rb2=rb2, alpha=ALPHA, a0=a0, teeth1=Z1, k_mean=K_MESH, c_mesh=c,
+                          damping_ramp=1e-6 if c else 0.0, backlash=backlash, stiffness=shape,
+                          u0=mesh_u0(internal, RB1, rb2, poses1, poses2), phi_ref=LINE), a0
+
+
+# the meshes' lines of centres [rad], and gear 1 near the origin: the transmission error is the small difference of
+# terms r_b (θ − φ_e) that grow with φ_e, whose round-off (an ulp of arctan2 apart between numpy and numba) the
+# damping share's slope 60/δ_c² carries into J to ≈ 2e-10 of the block at φ_e ≈ 4.4 rad; at |φ_e| ≤ 1.1 it stays
+# at the contact tests' 1e-10
+LINE = np.array([0.4, 1.1, -0.7])
+
+
+def _nominal(a0, internal):
+    """(3, 3) nominal poses of gears 1 and 2: gear 2 at a0 along LINE (internal: the planet, gear 1, at a0 from the
+    ring along LINE)."""
+    p1 = np.column_stack([0.01 * np.arange(3), -0.01 * np.arange(3), np.zeros(3)])
+    e = np.column_stack([np.cos(LINE), np.sin(LINE), np.zeros(3)])
+    return p1, p1 + (-1.0 if internal else 1.0) * a0 * e
+
+
+def _mesh_state(rng, a0, internal, turn, slope):
+    """Gear 2 of mesh m at a0 from gear 1 (internal: the planet, gear 1, inside at a0 from the ring), turned by turn[m]
+    (flank + compressed by ≈ r_b2 θ_2); slopes of ≈ ``slope``; random offsets and velocities."""
+    q, v = np.zeros(30), np.zeros(30)
+    p1, p2 = _nominal(a0, internal)
+    q[:9], q[9:18] = p1.ravel(), p2.ravel()
+    q[11:18:3] = turn
+    q[:18] += rng.standard_normal(18) * np.tile([1e-7, 1e-7, 1e-6], 6)
+    q[18:] = rng.standard_normal(12) * slope
+    v[:18] = rng.standard_normal(18) * np.tile([1e-2, 1e-2, 10.0], 6)
+    v[18:] = rng.standard_normal(12) * 0.1
+    return q, v
+
+
+@pytest.mark.parametrize("internal", [False, True])
+@pytest.mark.parametrize("shape", sorted(SHAPES))
+@SETTINGS
+@given(fs=frame_states(), n_m=st.sampled_from([1, 4, 11]), c=st.sampled_from([0.0, 2e3]),
+       backlash=st.sampled_from([0.0, 1e-5]), has=st.sampled_from([(True, True), (True, False), (False, True)]),
+       turn=st.lists(st.sampled_from([-3e-4, -2e-5, 2e-5, 3e-4]), min_size=3, max_size=3),
+       slope=st.sampled_from([1e-5, 1e-4, 1e-3]), seed=st.integers(0, 2 ** 31))
+def test_sliced_mesh_matches_reference(internal, shape, fs, n_m, c, backlash, has, turn, slope, seed):
+    """Flanks open, in the damping ramp (r_b2 · 2e-5 ≈ 0.9 δ_c) and beyond it, slices partly open. Not a flank at
+    ≈ 1e-8 m in the ramp: its compression is the difference of terms ≈ 0.05 m, so its round-off is ≈ 1e-9 of itself
+    and the share S ∝ δ³ carries that into J_v (seen 3e-10 of the block, structured, in both kernels alike)."""
+    elem, a0 = _mesh_family(internal, SHAPES[shape], n_m, c, backlash, *has)
+    qf, vf = _mesh_state(np.random.default_rng(seed), a0, internal, turn, slope)
+    assert_matches_reference(elem, fs, qf, vf)
+
+
+def test_sliced_mesh_with_teeth_or_runout_is_refused_by_the_compiled_path():
+    elem, _ = _mesh_family(False, SHAPES["rectangular"], 5, 0.0, 0.0, True, True)
+    elem.has_offset = True
+    with pytest.raises(NotImplementedError, match="eccentricity or the tooth-pair law"):
+        kind_of(SlicedGearMesh).pack(elem)
