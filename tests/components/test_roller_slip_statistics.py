@@ -176,3 +176,35 @@ def test_entries_end_with_each_bearings_window_and_survive_a_checkpoint():
                  pocket_force="pocket_force", entry_keys=(Q.ROLLER_LOADED, Q.ROLLER_SLIP, Q.ROLLER_PV_PIN))
     again.add_steps(t[k:], {n: v[k:] for n, v in rows.items()}, np.zeros((t.size - k, 0)))
     np.testing.assert_allclose(again.entry, whole.entry, rtol=1e-12)
+
+
+@pytest.fixture(scope="module")
+def condition_3_summary(tmp_path_factory):
+    import json
+    import warnings
+
+    from scenarios import api
+
+    out = tmp_path_factory.mktemp("entries") / "run"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        api.run(condition=3, out=out, settle=0.01, progress=False, sample_rate=2000.0)
+    return json.loads((out / "summary.json").read_text())
+
+
+def test_a_run_counts_one_entry_per_roller_and_cage_revolution(condition_3_summary):
+    """Over its window of whole cage revolutions relative to the carrier each roller passes the load zone once a
+    revolution: Z rollers × N planets × n revolutions entries, one more per roller at most (a roller at the zone's
+    edge at the window's start enters again at its end); the roller's slip there is a percentage, the SRR its
+    s/(1 − s/2), the p·Δv at entry not above the window's largest."""
+    s = condition_3_summary
+    for kind in ("inner", "outer"):
+        d = s[kind]
+        assert d["whole_revolutions"]
+        n = round(d["cage_revolutions"])
+        expect = s["rollers"] * s["planets"] * n
+        assert expect <= d["roller_entries"] <= expect + s["rollers"] * s["planets"]
+        assert -100.0 < d["roller_slip_entry_pct"] < 100.0
+        assert d["roller_entry_slide_roll"] == pytest.approx(entry_slide_roll(d["roller_slip_entry_pct"]), rel=1e-12)
+        assert 0.0 < d["smearing_pv_entry_W_m2"] <= d["smearing_pv_max_W_m2"]
+        assert 0.0 < d["roller_loaded_share"] < 1.0
