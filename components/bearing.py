@@ -123,6 +123,15 @@ def roller_slip_pct(b: BearingSI, roller_speed_rel, planet_speed_rel):
     return 100.0 * (1.0 - np.asarray(roller_speed_rel, float) / np.where(w_r != 0.0, w_r, np.nan))
 
 
+def entry_slide_roll(slip_pct):
+    """Slide-to-roll ratio on the pin of a roller that meets the load zone at the roller slip ``slip_pct`` [%] (the one
+    definition; :func:`roller_slip_pct`): with the roller's centre at the cage's rolling speed ω_m and its spin short of
+    the rolling spin by s = slip/100, the sliding speed on the pin is s ω_m r and the entraining speed (1 − s/2) ω_m r
+    (r the roller centre's radius about the pin), so SRR = s/(1 − s/2): 0 rolling, 2 for a roller that does not turn."""
+    s = np.asarray(slip_pct, float) / 100.0
+    return s / (1.0 - 0.5 * s)
+
+
 def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, outer_body: str, bearing: BearingSI,
                        lubricant: LubricantSI | None, pin_xy, pin_vel, omega_pin: float, omega_outer: float,
                        damage: dict, bore_tilt_inertia: float | None = None, bore_spin_inertia: float | None = None,

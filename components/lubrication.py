@@ -28,11 +28,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from mbd.elements.ehl import film_central, film_min, thermal_factor, thermal_loading
+from mbd.elements.ehl import film_central, film_min, hertz_peak_pressure, thermal_factor, thermal_loading
 
 __all__ = ["walther_viscosity", "walther_slope", "oil_density", "dynamic_viscosity", "temperature_viscosity",
            "reduced_modulus", "roller_contact_radius", "line_contact_film", "dowson_higginson_film",
-           "bearing_film", "regime", "FULL_FILM_LAMBDA", "BOUNDARY_LAMBDA"]
+           "bearing_film", "contact_pressure", "regime", "FULL_FILM_LAMBDA", "BOUNDARY_LAMBDA"]
 
 FULL_FILM_LAMBDA, BOUNDARY_LAMBDA = 3.0, 1.0     # Λ bounds of full film and of boundary-dominated contact
 
@@ -125,6 +125,18 @@ def bearing_film(load, rolling_speed, bearing, lubricant, inner: bool) -> dict[s
     out = {"film_min": phi * h_min, "film_central": phi * h_c, "film_min_isothermal": h_min,
            "film_thermal_loading": L, "film_thermal_factor": phi, "film_load_parameter": w / (E_red * R)}
     return {k: np.where(loaded, v, np.nan) for k, v in out.items()}
+
+
+def contact_pressure(load, bearing, inner: bool):
+    """Hertz peak pressure p_max = √(w'E'/(2πR)) [Pa] of each roller's line contact on one raceway (Johnson, *Contact
+    Mechanics*, 1985, eq. 4.45; :func:`mbd.elements.ehl.hertz_peak_pressure`), the roller's ``load`` [N, per
+    physical roller] spread evenly over its effective length l (w' = Q/l), the reduced radius R and modulus E' as
+    :func:`bearing_film` takes them; 0 where a roller carries no load."""
+    b = bearing
+    R_race = b.inner_raceway_radius if inner else b.outer_raceway_radius
+    R = roller_contact_radius(b.roller_diameter, R_race, inner)
+    E_red = reduced_modulus(b.elastic_modulus, b.poisson_ratio, b.elastic_modulus, b.poisson_ratio)
+    return hertz_peak_pressure(np.maximum(np.asarray(load, float), 0.0) / b.roller_length, R, E_red)
 
 
 def regime(lam: float) -> str:

@@ -1,8 +1,10 @@
-"""The rollers' slip of the planet bearings from a run's recording (results.nc): each roller's spin against its
-pure-rolling spin (:func:`components.bearing.roller_slip_pct`) at every recorded sample, by its angle about the pin
-in the carrier frame measured from the planet's radial direction (the line from the carrier's centre through the
-pin, outward: 0° is where the planet's centrifugal load points, the same place on every planet), in the load zone (the roller carries load on the pin: the bore carries every roller's
-centrifugal load all round) and out of it.
+"""The rollers' slip of the planet bearings by their angle about the pin, from a run's recording (results.nc): each
+roller's spin against its pure-rolling spin (:func:`components.bearing.roller_slip_pct`) at every recorded sample, by
+its angle about the pin in the carrier frame measured from the planet's radial direction (the line from the carrier's
+centre through the pin, outward: 0° is where the planet's centrifugal load points, the same place on every planet),
+with the share of the samples loaded on the pin (the load zone; the bore carries every roller's centrifugal load all
+round). The slip in the load zone, out of it and at its entry are every run's statistics, taken on every step
+(summary.json: :func:`components.statistics.summaries.roller_slip_summary`); this is the figure's view of them.
 
 The recording samples the window uniformly in time (``--sample-rate``), so every sample weighs the same, as the
 statistics weigh equal steps (:mod:`components.statistics`); the means here are of the recorded samples, not of
@@ -24,15 +26,10 @@ ANGLE_BINS = 24          # angle bins of the roller slip about the pin (15° eac
 
 def roller_slip_zones(ds, b, bins: int = ANGLE_BINS) -> dict:
     """Per bearing type (``"inner"``, ``"outer"``: every planet's bearing of the type pooled) from the dataset ``ds``
-    of a run's results.nc and the bearing ``b`` (its BearingSI): ``load_zone_pct`` and ``unloaded_pct`` the mean
-    roller slip [%] over the samples where a roller carries load on the pin and where it does not,
-    ``loaded_share`` the share of the samples in the load zone, and by angle about the pin from the planet's radial
-    direction on the carrier, positive in the carrier's sense of rotation (``angle_deg``, the bins' centres): ``slip_by_angle_pct`` and ``loaded_by_angle`` (the share loaded). At the load zone's entry — a roller unloaded at one
-    sample and loaded at the next — ``entry_pct``, its slip at the last unloaded sample (mean over the ``entries``),
-    and ``entry_slide_roll``, the slide-to-roll ratio on the pin it meets there: with the roller's centre at the cage's
-    rolling speed ω_m (cage slip is below 1 % here) and its spin short of the rolling spin by the slip s, the sliding
-    speed on the pin is s ω_m r and the entraining speed (1 − s/2) ω_m r (r the roller centre's radius about the pin),
-    so SRR = s/(1 − s/2) — 2 for a roller that does not turn."""
+    of a run's results.nc and the bearing ``b`` (its BearingSI), by angle about the pin from the planet's radial
+    direction on the carrier, positive in the carrier's sense of rotation (``angle_deg``, the bins' centres): the mean
+    roller slip [%] over the samples in each bin (``slip_by_angle_pct``) and the share of them loaded on the pin
+    (``loaded_by_angle``)."""
     w = np.asarray(ds["motion.angular_velocity"].values, float)
     body = {str(n): i for i, n in enumerate(ds["motion.body"].values)}
     w_c = w[:, body["carrier"]]
@@ -52,24 +49,14 @@ def roller_slip_zones(ds, b, bins: int = ANGLE_BINS) -> dict:
         # the pin's direction from the carrier's centre, in the carrier's axes (race_inner.angle's axes)
         r = pos[:, body[bm["planet"]]] - pos[:, body["carrier"]]
         phi = np.arctan2(r[:, 1], r[:, 0]) - theta_c
-        enter = np.zeros_like(loaded)
-        enter[:-1] = ~loaded[:-1] & loaded[1:]           # unloaded now, loaded at the next sample
-        pooled.setdefault(bm["kind"], []).append((slip, loaded, np.mod(angle[:, lo:hi] - phi[:, None], 2.0 * np.pi),
-                                                  enter))
+        pooled.setdefault(bm["kind"], []).append((slip, loaded, np.mod(angle[:, lo:hi] - phi[:, None], 2.0 * np.pi)))
     out = {}
     for kind, parts in pooled.items():
-        slip, loaded, ang, enter = (np.concatenate([p[k].ravel() for p in parts]) for k in range(4))
-        s_e = float(slip[enter].mean()) if enter.any() else None
+        slip, loaded, ang = (np.concatenate([p[k].ravel() for p in parts]) for k in range(3))
         which = np.clip(np.digitize(ang, edges) - 1, 0, bins - 1)
         count = np.bincount(which, minlength=bins)
         with np.errstate(invalid="ignore", divide="ignore"):
             out[kind] = {
-                "load_zone_pct": float(slip[loaded].mean()) if loaded.any() else None,
-                "unloaded_pct": float(slip[~loaded].mean()) if (~loaded).any() else None,
-                "loaded_share": float(loaded.mean()),
-                "entries": int(enter.sum()),
-                "entry_pct": s_e,
-                "entry_slide_roll": None if s_e is None else (s_e / 100.0) / (1.0 - s_e / 200.0),
                 "angle_deg": list(np.degrees(0.5 * (edges[:-1] + edges[1:]))),
                 "slip_by_angle_pct": list(np.bincount(which, slip, bins) / count),
                 "loaded_by_angle": list(np.bincount(which, loaded.astype(float), bins) / count)}

@@ -14,9 +14,9 @@ or anything else of the machine (clearance, cage guidance, oil).
 
 Writes ``summary.csv`` / ``summary.md`` (a row per run and bearing type: the mean bearing load and the catalogue
 minimum load 0.02 C_r with the load over it, cage slip of the reference bearing and of all bearings of the type,
-the rollers' slip in the load zone, out of it and at its entry with the slide-to-roll ratio there
-(:func:`components.skid.roller_slip_zones`, every bearing of the type pooled), traction coefficient, film parameter,
-heat of traction and land), ``slip_against_load.png`` (cage slip, roller slip out of the load zone and at its entry,
+the rollers' slip in the load zone, out of it and at its entry with the slide-to-roll ratio there and the
+frictional power density p·Δv at entry and its largest (every bearing of the type pooled: summary.json's, docs/model.md
+§13.5), traction coefficient, film parameter, heat of traction and land), ``slip_against_load.png`` (cage slip, roller slip out of the load zone and at its entry,
 and the film parameter against the load over the catalogue minimum, a marker per oil temperature),
 ``roller_slip_by_angle.png`` (the rollers' slip and the share loaded against their angle about the pin from the
 planet's radial direction, at the coldest oil, a marker per power) and the answer in words
@@ -51,11 +51,9 @@ __all__ = ["main", "run", "LAWS", "COLUMNS", "SKID_PCT", "make_cases", "rows_of"
 LAWS = {"bearing.traction_law": "ehl", "bearing.rolling_resistance": "houpert", "bearing.drag_law": "viscous"}
 COLUMNS = ["power_kW", "oil_temperature_C", "direction", "bearing", "bearing_load_mean_N", "minimum_load_N",
            "load_over_minimum", "cage_slip_pct", "cage_slip_all_pct", "roller_slip_load_zone_pct",
-           "roller_slip_unloaded_pct", "roller_slip_entry_pct", "slide_roll_entry", "traction_coefficient_max",
-           "lambda_min", "heat_traction_W", "heat_land_W"]
-_ROLLERS = {"roller_slip_load_zone_pct": "load_zone_pct", "roller_slip_unloaded_pct": "unloaded_pct",
-            "roller_slip_entry_pct": "entry_pct", "slide_roll_entry": "entry_slide_roll"}
-_NUMBERS = [c for c in COLUMNS[4:] if c not in _ROLLERS]
+           "roller_slip_unloaded_pct", "roller_slip_entry_pct", "roller_entry_slide_roll", "smearing_pv_entry_W_m2",
+           "smearing_pv_max_W_m2", "traction_coefficient_max", "lambda_min", "heat_traction_W", "heat_land_W"]
+_NUMBERS = COLUMNS[4:]
 
 EXAMPLES = ["{prog} --out results/skidding", '{prog} --speed "1500 rpm" --powers 0,5,50 --oil-temperatures 30,60,90',
             "{prog} --set bearing.clearance=40um --directions forward --workers 2"]
@@ -115,8 +113,8 @@ def _power_and_oil(case: Case) -> tuple[float, float]:
 
 
 def rows_of(cases: list[Case], results: dict) -> list[dict]:
-    """A row per finished run and bearing type (:data:`COLUMNS`): its summary's numbers and its rollers' slip from its
-    recording (:func:`components.skid.roller_slip_zones`)."""
+    """A row per finished run and bearing type (:data:`COLUMNS`): its summary's numbers, and for the figure its
+    rollers' slip by angle about the pin from its recording (:func:`components.skid.roller_slip_zones`)."""
     rows = []
     for case in cases:
         s = results.get(case.label)
@@ -128,7 +126,6 @@ def rows_of(cases: list[Case], results: dict) -> list[dict]:
             d = s[kind]
             row = {"power_kW": P, "oil_temperature_C": T, "direction": case.direction, "bearing": kind}
             row.update({c: d.get(c) for c in _NUMBERS})
-            row.update({c: zones.get(kind, {}).get(k) for c, k in _ROLLERS.items()})
             if kind in zones:        # by angle about the pin, for the figure (not a column)
                 row["by_angle"] = {k: zones[kind][k] for k in ("angle_deg", "slip_by_angle_pct", "loaded_by_angle")}
             rows.append(row)

@@ -24,7 +24,7 @@ BEARING_KINDS = ("inner", "outer")     # a summary's per-bearing-kind sections (
 # Every key of :meth:`WindowStatistics.summary` is here. A key with a unit ends in its suffix (UNIT_SUFFIXES);
 # a key without one is dimensionless ("1": a count, a ratio, a factor) and is listed in DIMENSIONLESS_KEYS.
 UNIT_SUFFIXES = {"_N": "N", "_m": "m", "_m_s": "m/s", "_m_s2": "m/s^2", "_s": "s", "_h": "h", "_W": "W", "_pct": "%",
-                 "_Mrev": "10^6 rev", "_hz": "Hz", "_rpm": "r/min", "_rad": "rad",
+                 "_Mrev": "10^6 rev", "_hz": "Hz", "_rpm": "r/min", "_rad": "rad", "_W_m2": "W/m^2",
                  "_MB": "MiB"}
 
 
@@ -55,6 +55,14 @@ SUMMARY_WORDS = {
     "minimum_load_N": ("catalogue minimum load of the bearing, 0.02 C_r (SKF's rule for roller bearings)", "N"),
     "load_over_minimum": ("planet bearing load, mean, over the catalogue minimum load", "1"),
     "load_over_minimum_per_planet": ("planet bearing load, mean, over the catalogue minimum load, per planet", "1"),
+    "roller_slip_load_zone_pct": ("roller slip in the load zone, mean of the type's rollers", "%"),
+    "roller_slip_unloaded_pct": ("roller slip out of the load zone, mean of the type's rollers", "%"),
+    "roller_loaded_share": ("share of the time a roller is loaded on the pin", "1"),
+    "roller_entries": ("load-zone entries of the type's rollers in the window", "1"),
+    "roller_slip_entry_pct": ("roller slip at load-zone entry, mean", "%"),
+    "roller_entry_slide_roll": ("slide-to-roll ratio on the pin at load-zone entry", "1"),
+    "smearing_pv_entry_W_m2": ("frictional power density p·Δv on the pin at load-zone entry, mean", "W/m^2"),
+    "smearing_pv_max_W_m2": ("frictional power density p·Δv of a roller contact, largest", "W/m^2"),
     "life_L10_relative": ("L10 life relative to forward", "1"),
     "life_iso281_Mrev": ("L10 life, ISO 281 from the bearing load", "10^6 rev"),
     "life_iso281_h": ("L10 life, ISO 281 from the bearing load", "h"),

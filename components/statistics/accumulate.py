@@ -310,9 +310,11 @@ class Accumulators:
 
     ``n_bearings``; ``t0``, ``t1`` the nominal window [s]; ``target`` (n_b,) the whole cage revolutions that end
     each bearing's window, or None (the nominal window); ``pocket_bearing`` (n_p,) each pocket's bearing and
-    ``v_floor`` (n_p,) the impact law's approach-speed floor (slower onsets are touches)."""
+    ``v_floor`` (n_p,) the impact law's approach-speed floor (slower onsets are touches); ``entry_dwell`` (n_b,) the
+    time [s] a roller of each bearing must have spent out of the load zone for its loading to count as an entry
+    (:meth:`_entries`; None: 0, every loading)."""
 
-    def __init__(self, n_bearings: int, t0: float, t1: float, target, pocket_bearing, v_floor):
+    def __init__(self, n_bearings: int, t0: float, t1: float, target, pocket_bearing, v_floor, entry_dwell=None):
         self.t0, self.t1 = float(t0), float(t1)
         self.has_target = target is not None
         self.target = np.asarray(target if target is not None else np.zeros(n_bearings), float)
@@ -325,12 +327,17 @@ class Accumulators:
         self.t_close = np.full(n_bearings, np.nan)
         self.imp = np.zeros((len(IMPACT_ROWS), self.pocket_bearing.size))
         self.impact = dict(zip(IMPACT_ROWS, self.imp)) if self.imp.size else None    # row views
+        self.entry = None          # (3, n_rollers): load-zone entries, Σ slip and Σ p·Δv at them (:meth:`_entries`)
+        self.exit_time = None      # (n_rollers,): when each roller last left the load zone [s] (−inf: not yet)
+        self.entry_dwell = np.zeros(n_bearings) if entry_dwell is None else np.asarray(entry_dwell, float)
+        self._entry_keys = None
 
-    def layout(self, sizes: dict, owners: dict, cage_speed: str, pocket_force: str) -> None:
+    def layout(self, sizes: dict, owners: dict, cage_speed: str, pocket_force: str, entry_keys=None) -> None:
         """Lay the flat accumulator out (zeros; ±inf extrema) for the quantities ``sizes`` {key: instances}, in that
         order, each instance tagged with its bearing (``owners`` {key: (n,) or None: the global window}); if it
         holds sums already (a checkpoint), only its views. ``cage_speed``, ``pocket_force``: the keys whose
-        columns the kernel reads for the cages' angles and the impact peaks."""
+        columns the kernel reads for the cages' angles and the impact peaks; ``entry_keys`` (loaded, slip, p·Δv): the
+        per-roller quantities whose load-zone entries are counted (:meth:`_entries`), None: none."""
         keys = list(sizes)
         edges = np.concatenate([[0], np.cumsum([sizes[k] for k in keys])]).astype(int)
         self.keys, self.owners = keys, dict(owners)
@@ -343,6 +350,11 @@ class Accumulators:
         col = dict(zip(keys, edges[:-1]))
         self._cage_cols = (col[cage_speed] + np.arange(self.angle.size)).astype(np.int64) \
             if cage_speed in col else np.zeros(0, np.int64)
+        if entry_keys is not None and entry_keys[0] in sizes:
+            self._entry_keys, self._entry_owner = tuple(entry_keys), np.asarray(owners[entry_keys[0]], np.int64)
+            if self.entry is None:
+                self.entry = np.zeros((3, sizes[entry_keys[0]]))
+                self.exit_time = np.full(sizes[entry_keys[0]], -np.inf)
         npk = self.imp.shape[1]
         self._pocket_cols = (col[pocket_force] + np.arange(npk)).astype(np.int64) if npk else np.zeros(0, np.int64)
 
@@ -361,6 +373,33 @@ class Accumulators:
         accumulate_steps(t, V, self._own_flat, self.flat, self.T, self.angle, self.open, self.t_close, self.target,
                          self.has_target, self.t0, self.t1, self._cage_cols, self._pocket_cols, self.pocket_bearing,
                          Zf, self.v_floor, self.imp)
+        if self._entry_keys is not None:
+            self._entries(t, rows)
+
+    def _entries(self, t, rows) -> None:
+        """The load-zone entries of K steps: a roller unloaded at a step's start and loaded at its end (the first
+        of the ``entry_keys`` quantities) that had been out of the load zone for at least its bearing's
+        ``entry_dwell`` (since the first unloaded state after it last left; a roller flickering at the zone's edge
+        does not enter it again), in its bearing's window (the step ending after t0 and by the window's end),
+        counted with its slip at the step's start (the last state out of the load zone) and its pin contact's p·Δv at
+        the step's end (the first state in it): ``entry`` rows count, Σ slip [%], Σ p·Δv [W/m²]."""
+        loaded, slip, pv = (np.asarray(rows[k], float).reshape(t.size, -1) for k in self._entry_keys)
+        t = np.asarray(t, float)
+        was, now = loaded[:-1] > 0.0, loaded[1:] > 0.0
+        enter, leave = ~was & now, was & ~now
+        # when each roller last left the zone, as of each step (a step leaves or enters, never both)
+        left = np.maximum.accumulate(np.where(leave, t[1:, None], -np.inf), axis=0)
+        left = np.maximum(left, self.exit_time[None, :])
+        self.exit_time = left[-1].copy()
+        if not enter.any():
+            return
+        end = np.where(self.open, np.inf, self.t_close) if self.has_target else np.full(self.open.size, self.t1)
+        t_b = t[1:, None]
+        own = self._entry_owner
+        enter &= (t_b > self.t0) & (t_b <= end[own][None, :]) & (t[:-1, None] - left >= self.entry_dwell[own][None, :])
+        self.entry[0] += enter.sum(axis=0)
+        self.entry[1] += np.where(enter, slip[:-1], 0.0).sum(axis=0)
+        self.entry[2] += np.where(enter, pv[1:], 0.0).sum(axis=0)
 
     def add_samples(self, rows) -> None:
         """K equally weighted states (``rows`` as for :meth:`add_steps`): each counts one unit of time in every
@@ -385,6 +424,15 @@ class Accumulators:
         im["peak_now"][act] = 0.0
 
     # reading back ---------------------------------------------------------------------------------
+    def integral(self, key: str) -> np.ndarray:
+        """Σx dt of a quantity over its window (per instance; equally weighted samples: Σx)."""
+        return self.acc[key][0]
+
+    def time(self, key: str) -> np.ndarray:
+        """The time each instance of a quantity's window covers [s] (samples: their count)."""
+        own = self.owners[key]
+        return self.T[:-1][own] if own is not None else np.full(self.acc[key].shape[1], self.T[-1])
+
     def stats(self, key: str) -> dict[str, np.ndarray]:
         """mean, rms, max, min of a quantity over its window (arrays per instance)."""
         acc = self.acc[key]
@@ -419,6 +467,8 @@ class Accumulators:
         d.update({f"imp__{k}": v for k, v in (self.impact or {}).items()})
         d.update({"T_global": np.array(self.T[-1]), "T_bearing": self.T[:-1], "angle": self.angle,
                   "open": self.open, "t_close": self.t_close})
+        if self.entry is not None:
+            d["entry"], d["entry_exit"] = self.entry, self.exit_time
         return d
 
     def load_state_dict(self, d: dict) -> None:
@@ -430,6 +480,8 @@ class Accumulators:
         if "T_global" in d:
             self.T[:-1], self.T[-1] = d["T_bearing"], float(d["T_global"])
             self.angle[:], self.open[:], self.t_close[:] = d["angle"], d["open"].astype(bool), d["t_close"]
+        self.entry = d["entry"].copy() if "entry" in d else None
+        self.exit_time = d["entry_exit"].copy() if "entry_exit" in d else None
 
 
 def accumulators_cached() -> bool:

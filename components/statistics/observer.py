@@ -75,6 +75,14 @@ class WindowStatistics(mbd.Observer):
         self.t_end = self.t1 + (self.MARGIN * (self.t1 - self.t0) if self.target is not None else 0.0)
         # the planet's speed relative to its pin, per bearing kind: the revolutions a life counts
         self._w_rel = {k: float(sp.planet(k)) - self.omega_c for k in ("inner", "outer")}
+        # a load-zone entry follows at least one roller pitch of the cage's orbit out of the zone (in pure rolling):
+        # a shorter gap is a roller flickering at the zone's edge (Accumulators._entries)
+        self.entry_dwell = None
+        if rollers:
+            pitch = {k: cage_period(scene.bearing, self.omega_c, sp.planet(k)) / scene.bearing.rollers
+                     for k in ("inner", "outer")}
+            self.entry_dwell = np.array([pitch[x["kind"]] if np.isfinite(pitch[x["kind"]]) else 0.0
+                                         for x in self.bmap])
 
     # setup -------------------------------------------------------------------------------------
     def bind(self, model, system, state) -> None:
@@ -95,7 +103,7 @@ class WindowStatistics(mbd.Observer):
         # approach-speed floor of the impact law: slower onsets are touches
         pockets = p.pocket_bearing if p.pocket_bearing is not None else np.zeros(0, np.int64)
         floor = self.model.element(FAMILY["pocket"]).v_min * (1.0 + 1e-9) if pockets.size else np.zeros(0)
-        self.sums = Accumulators(p.planet.size, self.t0, self.t1, self.target, pockets, floor)
+        self.sums = Accumulators(p.planet.size, self.t0, self.t1, self.target, pockets, floor, self.entry_dwell)
         self.flank = self._flank_peaks()
         self._prev = None            # the quantities at the last step's end: the next step's start
         self.ref_roller = None       # (inner, outer) race_inner instance of the reference rollers
@@ -188,7 +196,8 @@ class WindowStatistics(mbd.Observer):
             return
         keys = [k for k in rows if not k.startswith("_")]
         self.sums.layout({k: int(np.size(rows[k][-1])) for k in keys}, {k: Q.owner(self.plan, k) for k in keys},
-                         cage_speed=Q.CAGE_SPEED, pocket_force=Q.POCKET_FORCE)
+                         cage_speed=Q.CAGE_SPEED, pocket_force=Q.POCKET_FORCE,
+                         entry_keys=(Q.ROLLER_LOADED, Q.ROLLER_SLIP, Q.ROLLER_PV_PIN))
 
     # checkpoints ---------------------------------------------------------------------------------
     def state_dict(self) -> dict:

@@ -16,18 +16,22 @@ import numpy as np
 import mbd
 from mbd.ad import wrap_angle
 
-from ..bearing import bearing_kinematics
+from ..bearing import bearing_kinematics, roller_slip_pct
 from ..families import FAMILY, MESH_FAMILY
 from ..life import LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, raceway_ratings, sliced_raceway_ratings
-from ..lubrication import bearing_film
+from ..lubrication import bearing_film, contact_pressure
 
 __all__ = ["bearing_map", "Plan", "plan_of", "owner", "quantities", "carrier_frame_motion", "to_carrier",
            "radial_tangential", "pin_reactions", "contact_film", "traction_heat", "film_extremes",
-           "reference_rollers", "slice_quantities", "CAGE_SPEED", "POCKET_FORCE"]
+           "reference_rollers", "slice_quantities", "roller_slip_quantities", "CAGE_SPEED", "POCKET_FORCE",
+           "ROLLER_LOADED", "ROLLER_SLIP", "ROLLER_PV_PIN"]
 
 # the quantities the accumulators read beyond their sums: the cage speed (its window's revolutions) and the
 # pocket force (impact peaks)
 CAGE_SPEED, POCKET_FORCE = "cage_speed_rel", "pocket_force"
+# the quantities the load-zone entries read (:meth:`.accumulate.Accumulators.add_steps`): a roller loaded on the pin
+# (1/0), its slip [%] and its pin contact's p·Δv [W/m²] (the last two not accumulated themselves)
+ROLLER_LOADED, ROLLER_SLIP, ROLLER_PV_PIN = "roller_loaded", "_roller_slip", "_roller_pv_pin"
 
 
 # ----------------------------------------------------------------------------------------------
@@ -137,6 +141,8 @@ def quantities(p: Plan, model, evaluator, t, q, v, a, z, roller_angles: bool) ->
     out = evaluator.outputs_batch(t, q, v, z, families=p.families, full=full)
     X, V, A = carrier_frame_motion(model, t, q, v, a, p.omega_c, full=full)
     snap: dict[str, np.ndarray] = roller_quantities(p, out) if p.rollers else {}
+    if p.rollers:
+        snap.update(roller_slip_quantities(p, out, V))
     snap.update(load_quantities(p, model, t, out, X))
     if p.omega_c != 0.0:      # the carrier's speed against its reference: has the drive settled?
         snap["carrier_speed_error"] = (V[:, p.carrier, 2] / p.omega_c)[:, None]
@@ -165,6 +171,24 @@ def roller_quantities(p: Plan, out) -> dict[str, np.ndarray]:
     if "max_slice_load" in ri:            # the sliced contact (bearing.model = "sliced", docs/model.md §8.8)
         snap.update(slice_quantities(p, ri, ro))
     return snap
+
+
+def roller_slip_quantities(p: Plan, out, V) -> dict[str, np.ndarray]:
+    """Per roller: loaded on the pin or not (``roller_loaded``, 1/0: the load zone; the bore carries every roller's
+    centrifugal load all round), its slip (:func:`components.bearing.roller_slip_pct`, speeds relative to the
+    carrier from the carrier-frame speeds ``V``) split into the load zone and out of it (``roller_slip_loaded``,
+    ``roller_slip_unloaded``: slip × 1/0, whose time integrals over the loaded time are the zones' means), and the
+    frictional power density p·Δv [W/m²] of its contacts — the Hertz peak pressure of the contact
+    (:func:`components.lubrication.contact_pressure`) times its sliding speed — the larger of pin and bore
+    (``roller_pv``); the slip itself and the pin's p·Δv for the load-zone entries (not accumulated)."""
+    ri, ro = out[FAMILY["race_inner"]], out[FAMILY["race_outer"]]
+    w_c = V[:, p.carrier, 2][:, None]
+    slip = roller_slip_pct(p.bearing, V[:, p.roller_body, 2] - w_c, V[:, p.planet[p.roller_bearing], 2] - w_c)
+    loaded = (np.asarray(ri["load"], float) > 0.0).astype(float)
+    pv = {inner: contact_pressure(r["load"], p.bearing, inner) * np.abs(np.asarray(r["slip_velocity"], float))
+          for inner, r in ((True, ri), (False, ro))}
+    return {ROLLER_LOADED: loaded, "roller_slip_loaded": slip * loaded, "roller_slip_unloaded": slip * (1.0 - loaded),
+            "roller_pv": np.maximum(pv[True], pv[False]), ROLLER_SLIP: slip, ROLLER_PV_PIN: pv[True]}
 
 
 def slice_quantities(p: Plan, ri, ro) -> dict[str, np.ndarray]:

@@ -14,13 +14,13 @@ import numpy as np
 
 from mbd.elements.ehl import thermal_factor
 
-from ..bearing import cage_slip_pct
+from ..bearing import cage_slip_pct, entry_slide_roll
 from ..sliced_bearing import pressure_scales
 from ..life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
                     iso281_rating, lundberg_palmgren_life, minimum_load, sliced_life, sliced_raceway_ratings)
 
 __all__ = ["run_summary", "bearing_summary", "load_summary", "roller_summary", "impact_summary", "life_summary",
-           "heat_summary", "film_summary", "cage_summary", "mesh_summary"]
+           "heat_summary", "film_summary", "cage_summary", "mesh_summary", "roller_slip_summary"]
 
 
 def run_summary(sums, p, ref_roller, w_rel: dict, loaded: bool, flank=None) -> dict:
@@ -51,6 +51,8 @@ def bearing_summary(sums, p, kind: str, ref_roller, w_rel: float) -> dict:
     load_summary(d, sums, ref, sel)
     if p.rollers:
         roller_summary(d, sums, p, ref_roller[0 if kind == "inner" else 1], sel)
+        if "roller_loaded" in sums.acc:
+            roller_slip_summary(d, sums, p, sel)
         if "roller_inner_slice_max" in sums.acc:
             slice_summary(d, sums, p, ref, sel)
         heat_summary(d, sums, ref, sel)
@@ -105,6 +107,36 @@ def roller_summary(d, sums, p, r: int, sel) -> None:
         if sums.impact is not None:
             impact_summary(d, sums, pk, sel)
     d["all_rollers"] = al
+
+
+def _finite(x) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def roller_slip_summary(d, sums, p, sel) -> None:
+    """The rollers' slip (:func:`components.bearing.roller_slip_pct`) over every roller of the bearings ``sel``
+    pooled, time-weighted over their windows: in the load zone (loaded on the pin) and out of it, the share of the
+    time in it; at the load zone's entry (a roller unloaded at a step's start and loaded at its end) its slip at the
+    last state out of it, the slide-to-roll ratio on the pin that means (:func:`components.bearing.entry_slide_roll`)
+    and the frictional power density p·Δv of its pin contact at the first state in it, and the largest p·Δv of any
+    roller contact in the windows (the smearing indicator: no published threshold is applied). None where there is
+    nothing to average (no loaded time, no entry, no rolling speed)."""
+    mine = np.isin(p.roller_bearing, sel)
+    T = sums.time("roller_loaded")[mine].sum()
+    L = sums.integral("roller_loaded")[mine].sum()
+    zone = sums.integral("roller_slip_loaded")[mine].sum()
+    free = sums.integral("roller_slip_unloaded")[mine].sum()
+    d["roller_slip_load_zone_pct"] = _finite(zone / L) if L > 0 else None
+    d["roller_slip_unloaded_pct"] = _finite(free / (T - L)) if T - L > 0 else None
+    d["roller_loaded_share"] = float(L / T) if T > 0 else None
+    n = int(sums.entry[0][mine].sum()) if sums.entry is not None else 0
+    d["roller_entries"] = n
+    s_e = _finite(sums.entry[1][mine].sum() / n) if n else None
+    d["roller_slip_entry_pct"] = s_e
+    d["roller_entry_slide_roll"] = float(entry_slide_roll(s_e)) if s_e is not None else None
+    d["smearing_pv_entry_W_m2"] = _finite(sums.entry[2][mine].sum() / n) if n else None
+    d["smearing_pv_max_W_m2"] = _finite(sums.stats("roller_pv")["max"][mine].max())
 
 
 def slice_summary(d, sums, p, ref, sel) -> None:

@@ -54,15 +54,9 @@ def recording(carrier_speed: float, n: int = 720, slip_out: float = 25.0):
 
 @pytest.mark.parametrize("carrier_speed", [0.0, 104.7])
 def test_zones_entry_and_angles_of_a_synthetic_recording(carrier_speed):
-    """Load zone 0 %, unloaded 25 %, a quarter of the samples loaded, every entry from 25 % (SRR 0.25/0.875), the
-    slip by angle 0 in the bins of 0°–90° from the planet's radial direction and 25 % elsewhere — the same whether
-    the recording's frame turns with the carrier or not."""
+    """The slip by angle 0 in the bins of 0°–90° from the planet's radial direction (the load zone) and 25 %
+    elsewhere, loaded there only — the same whether the recording's frame turns with the carrier or not."""
     z = roller_slip_zones(recording(carrier_speed), B, bins=8)["inner"]
-    assert z["load_zone_pct"] == pytest.approx(0.0, abs=1e-9)
-    assert z["unloaded_pct"] == pytest.approx(25.0, abs=1e-9)
-    assert z["loaded_share"] == pytest.approx(0.25, abs=2e-3)
-    assert z["entries"] == 5 and z["entry_pct"] == pytest.approx(25.0, abs=1e-9)   # 3 orbits × 2 rollers, the last cut
-    assert z["entry_slide_roll"] == pytest.approx(0.25 / 0.875, rel=1e-12)
     np.testing.assert_allclose(z["angle_deg"], 22.5 + 45.0 * np.arange(8))
     np.testing.assert_allclose(z["slip_by_angle_pct"], [0, 0, 25, 25, 25, 25, 25, 25], atol=1e-9)
     np.testing.assert_allclose(z["loaded_by_angle"], [1, 1, 0, 0, 0, 0, 0, 0], atol=1e-12)
