@@ -30,6 +30,7 @@ import numpy as np
 import mbd
 from components.iso6336 import machine_dynamic_factors
 from components.results.io import atomic_write_text
+from components.results import percent_change
 
 from .core import args
 from .core.command import command
@@ -172,8 +173,7 @@ def by_grade(rows: list[dict]) -> list[dict]:
         f = index.get((r["condition"], "forward", r["grade"], r["bearing"]))
         rev = index.get((r["condition"], "reverse", r["grade"], r["bearing"]))
         for col in ("bearing_load_mean_N", "life_iso16281_h"):
-            ok = f and rev and f[col] and rev[col] is not None
-            r[f"{col}_reverse_change_pct"] = 100.0 * (rev[col] / f[col] - 1.0) if ok else None
+            r[f"{col}_reverse_change_pct"] = percent_change(f[col], rev[col]) if f and rev else None
     return out
 
 
@@ -185,7 +185,7 @@ def findings(groups: list[dict]) -> str:
     grades = sorted({g["grade"] for g in groups if g["grade"] is not None})
     lines = ["What real teeth do (ISO 1328-1:2013 flank tolerance class, every gear its own teeth; mean of the "
              "seeds, their range in brackets; against perfect teeth at the same operating point).", ""]
-    pct = lambda x, y: 100.0 * (x / y - 1.0)
+    pct = lambda x, y: percent_change(y, x)      # loads and lives: positive, so always a percentage
     for c in sorted({g["condition"] for g in groups}, key=point_order):
         lines.append(f"{point_words(c)}:")
         for d in ("forward", "reverse"):
