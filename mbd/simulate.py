@@ -469,16 +469,28 @@ class _Progress:
                     self._last_post = now
                     left = (self.t_end - t) / max(t - self.t0, 1e-300) * (now - self._start)
                     print(f"simulating: t = {t:.4g} of {self.t_end:.4g} s, {self._steps / (now - self._start):.0f} "
-                          f"steps/s, about {left:.0f} s left", file=sys.stderr, flush=True)
+                          f"steps/s, " + (f"about {left:.0f} s left" if self._settled(t) else "time left: estimating"),
+                          file=sys.stderr, flush=True)
                 return
             from tqdm.auto import tqdm  # deferred: ≈ 45 ms (probes Jupyter), only for a bar on a terminal
             self.bar = tqdm(total=self.total, unit="s", unit_scale=True, desc="simulating",
-                            bar_format="{desc}: {percentage:3.0f}%|{bar}| t={n:.4g}/{total:.4g} s [{elapsed}<{remaining}{postfix}]")
+                            bar_format=self.EARLY_FORMAT)
+        if self.bar.bar_format == self.EARLY_FORMAT and self._settled(t):
+            self.bar.bar_format = self.FORMAT
         self.bar.update(t - self.t_last)
         self.t_last = t
         if now - self._last_post > 0.5:
             self.bar.set_postfix_str(f"{self._steps / (now - self._start):.0f} steps/s, rej {counters.rejected}")
             self._last_post = now
+
+    # the run's start (the kinematic start's short steps) would extrapolate to many times the real time left: the
+    # estimate is shown once this share of the simulated time is done
+    SETTLED_SHARE = 0.1
+    FORMAT = "{desc}: {percentage:3.0f}%|{bar}| t={n:.4g}/{total:.4g} s [{elapsed}<{remaining}{postfix}]"
+    EARLY_FORMAT = "{desc}: {percentage:3.0f}%|{bar}| t={n:.4g}/{total:.4g} s [{elapsed}, time left: estimating{postfix}]"
+
+    def _settled(self, t) -> bool:
+        return t - self.t0 >= self.SETTLED_SHARE * (self.t_end - self.t0)
 
     def close(self):
         if self.bar is not None:
