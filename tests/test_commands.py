@@ -633,3 +633,13 @@ def test_a_design_warning_names_the_parameter_value_that_removes_it(key, words):
         above = [str(f) for f in design_findings(with_overrides(reference_dpgt(3), {key: limit + 0.01}))
                  if words in str(f)]
     assert at == [] and len(above) == 1
+
+
+def test_a_reader_that_stops_reading_ends_the_command_quietly():
+    """`dpgt params | head`: the pipe closed before the command writes is not an error (no message, exit 0)."""
+    import subprocess
+    import sys as _sys
+    p = subprocess.Popen([_sys.executable, "-m", "scenarios.params"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p.stdout.close()                                    # the reader is gone before anything is written
+    err = p.stderr.read().decode()
+    assert p.wait(timeout=120) == 0 and err == "", err

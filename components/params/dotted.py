@@ -53,7 +53,11 @@ def parameter_names(params: Params) -> list[str]:
 def _unknown(params: Params, key: str, path: str) -> ParameterError:
     names = [f"{path}{n}" for n in parameter_names(params)]
     hint = did_you_mean(f"{path}{key}", names)
-    return ParameterError.at(f"{path}{key}", f"unknown parameter{hint}; valid keys: {', '.join(names)}")
+    where = (f"the keys of {path.rstrip('.')}: `dpgt params --grep {path.rstrip('.')}`" if path else
+             "every key: `dpgt params`")
+    if not hint and len(names) <= 12:          # a short list helps more than a command
+        where = f"valid keys: {', '.join(names)}"
+    return ParameterError.at(f"{path}{key}", f"unknown parameter{hint}; {where}")
 
 
 def _override(params: _P, overrides: Mapping[str, Any], path: str) -> _P:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import errno
 import functools
+import os
 import sys
 
 from components.units import ParameterError
@@ -57,6 +58,9 @@ def command(main):
         except FolderLocked as exc:
             print(f"error: {exc}", file=sys.stderr)
             return FAILED
+        except BrokenPipeError:              # the reader stopped reading (`| head`): nothing went wrong
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # so the exit's flush is quiet too
+            return 0
         except OSError as exc:               # disk full, unwritable folder: earlier results are intact
             if debug:
                 raise
