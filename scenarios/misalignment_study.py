@@ -50,7 +50,7 @@ SLOPES = {"radial": 0.0, "tangential": 90.0}      # the slope's direction from t
 WINDUP = ("off", "on")
 EDGE_AT = 4.0                                     # arcmin: the slope at which the answer gives the edge pressure ratio
 SHOWN_AT = (2.0, 4.0, 6.0, 10.0)                  # arcmin: the slopes the answer gives the life at
-SNAPSHOTS = 4       # instants per case: the relative life compares the same instants, aligned and sloped (see --help)
+SNAPSHOTS = 2       # instants per case: the relative life compares the same instants, aligned and sloped (see --help)
 COLUMNS = ["condition", "direction", "profile", "windup", "slope", "gamma_arcmin", "bearing", "load_N",
            "seen_slope_arcmin", "seen_share", "life_sliced_h", "life_aligned_h", "life_relative", "edge_pressure_ratio",
            "contact_pressure_max_Pa", "slice_load_max_pin_N", "life_unsliced_h"]
