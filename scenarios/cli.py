@@ -26,6 +26,8 @@ SCENARIOS = {
     "tolerance_study": "load sharing K_γ, bearing loads and lives of machines drawn from their tolerances (static + dynamic)",
     "duty_cycle": "bearing lives over a duty cycle (speed–torque bins or a time series), Palmgren–Miner per bearing and planet",
     "bearing_misalignment": "a planet bearing's sliced life and edge pressure against the pin's slope, per roller profile",
+    "misalignment_study": "the planet bearings' sliced life and edge pressure against the pins' slope in the full "
+                          "machine (quasi-static, planets free to tilt), per profile, forward and reverse",
     "sensitivity": "which assumed parameters move each headline output: Morris screening, then Sobol indices (static)",
     "spectrum": "fixed-frame carrier-housing acceleration spectrum (the source's test rig)",
     "bearing_rig": "one planet bearing on a rig: roller load distribution, load zone, Q_max",

@@ -202,6 +202,8 @@ OTHERS = {"spectrum": "results/spectrum", "bearing_rig": "results/bearing_rig", 
           "work_precision": "results/numerics", "stability": "results/numerics", "benchmark": "results/numerics",
           "bench_engine": None, "params": None, "animate": None, "duty_cycle": "results/duty_cycle",
           "bearing_misalignment": "results/bearing_misalignment",
+          # static only, at the preset conditions (no --operating)
+          "misalignment_study": "results/misalignment",
           # its own axes (carrier speed, powers, oil temperatures) in place of --conditions/--operating
           "skidding_study": "results/skidding"}
 SHARED_OPTIONS = ("--params", "--set", "--out", "--overwrite", "--force", "--no-progress", "--workers",
@@ -465,8 +467,8 @@ def test_a_command_whose_default_conditions_differ_says_why():
     p = argparse.ArgumentParser(prog="x")
     with pytest.raises(ValueError, match="say why"):
         args.add_shared(p, "conditions", conditions="1,2")
-    from scenarios import bearing_misalignment, fault_study, gear_quality, paper_study, sensitivity
-    for mod in (paper_study, fault_study, gear_quality, sensitivity, bearing_misalignment):
+    from scenarios import bearing_misalignment, fault_study, gear_quality, misalignment_study, paper_study, sensitivity
+    for mod in (paper_study, fault_study, gear_quality, sensitivity, bearing_misalignment, misalignment_study):
         text = _help_text(mod)
         block = text[text.index("--conditions C"):].split("\n  --")[0]
         assert ":" in block.split("default", 1)[1], f"{mod.__name__}: {block}"

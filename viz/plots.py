@@ -29,7 +29,7 @@ __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_di
            "mode_shapes", "fault_spectra", "fault_loads", "FAULT_QUANTITIES", "gear_quality", "forward_reverse_headline",
            "time_history_group", "cage_orbit_picture", "display_unit", "format_pct", "HEADLINE_QUANTITIES", "FWD", "REV",
            "STYLE", "tolerance_distributions", "tolerance_against_torque", "tolerance_life_cdf", "damage_shares",
-           "binned_series", "morris_heatmap", "sobol_heatmap"]
+           "binned_series", "morris_heatmap", "sobol_heatmap", "life_against_misalignment"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
 STYLE = {
@@ -1190,4 +1190,57 @@ def sobol_heatmap(sobol: Mapping[str, Mapping[str, Mapping[str, Mapping]]], para
         fig.colorbar(img, ax=list(axes.flat), label="S1 [–]", shrink=0.6)
         if title:
             fig.suptitle(_wrap(title, max(40, int(11 * fig.get_figwidth()))))
+        return _save(fig, path)
+
+
+_PROFILE_MARKERS = {"straight": "o", "iso_16281": "s", "logarithmic": "^", "crowned": "D", "table": "v"}
+
+
+def life_against_misalignment(rows: Sequence[Mapping], path, *, title: str | None = None) -> Path:
+    """The bearing life relative to the aligned machine against the pins' slope γ: a row of panels per operating
+    point and slope direction (radial, tangential), a column per bearing type (inner, outer); a line per roller
+    profile (its marker) and direction (forward solid blue, reverse dashed orange), the wind-up's lines lighter.
+
+    rows: mappings with ``condition``, ``direction``, ``bearing``, ``profile``, ``windup`` ("off"/"on"), ``slope``
+    ("aligned", "radial", "tangential"), ``gamma_arcmin`` and ``life_relative`` (None: not drawn); an aligned row
+    (γ = 0) starts every slope direction's lines."""
+    conds = sorted({r["condition"] for r in rows}, key=_point_key)
+    slopes = [s for s in ("radial", "tangential") if any(r["slope"] == s for r in rows)]
+    bearings = [b for b in ("inner", "outer") if any(r["bearing"] == b for r in rows)]
+    panels = [(c, s) for c in conds for s in slopes]
+    profiles = list(dict.fromkeys(r["profile"] for r in rows))
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(3.4 * len(bearings) + 0.6, 2.4 * max(len(panels), 1) + 0.9), layout="constrained")
+        axes = fig.subplots(max(len(panels), 1), len(bearings), squeeze=False, sharex=True)
+        for i, (c, s) in enumerate(panels):
+            for j, b in enumerate(bearings):
+                ax = axes[i, j]
+                for prof in profiles:
+                    for w in ("off", "on"):
+                        for d, style in (("forward", FWD), ("reverse", REV)):
+                            mine = [r for r in rows if r["condition"] == c and r["bearing"] == b and r["profile"] == prof
+                                    and r["windup"] == w and r["direction"] == d and r["slope"] in ("aligned", s)
+                                    and r["life_relative"] is not None]
+                            if len(mine) < 2:
+                                continue
+                            mine.sort(key=lambda r: r["gamma_arcmin"])
+                            ax.plot([r["gamma_arcmin"] for r in mine], [r["life_relative"] for r in mine],
+                                    marker=_PROFILE_MARKERS.get(prof, "x"), ms=4.5, alpha=1.0 if w == "off" else 0.45,
+                                    color=style["color"], linestyle=style["linestyle"])
+                ax.axhline(1.0, color="0.5", lw=0.6)
+                _from_zero(ax)          # a 1 % loss is not stretched over the panel
+                if i == 0:
+                    ax.set_title(f"{b} planet bearings")
+                ax.set_ylabel(_axis_label(_wrap(f"L/L0, {_point_words(c)}, {s} slope", 26), None))
+                if i == len(panels) - 1:
+                    ax.set_xlabel(_axis_label("pin slope γ", "arcmin"))
+        handles = [Line2D([], [], color=st["color"], ls=st["linestyle"], label=d) for d, st in
+                   (("forward", FWD), ("reverse", REV)) if any(r["direction"] == d for r in rows)]
+        handles += [Line2D([], [], color="0.3", ls="none", marker=_PROFILE_MARKERS.get(p, "x"), label=p)
+                    for p in profiles]
+        if any(r["windup"] == "on" for r in rows):
+            handles.append(Line2D([], [], color="0.3", alpha=0.45, label="with carrier wind-up"))
+        fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 6), frameon=False)
+        if title:
+            _suptitle(fig, title)
         return _save(fig, path)
