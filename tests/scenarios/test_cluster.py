@@ -288,7 +288,10 @@ def test_ctrl_c_of_a_study_on_a_local_cluster_says_interrupted_and_nothing_else(
     p = subprocess.Popen([sys.executable, "-m", "scenarios.paper_study", "--conditions", "4", "--directions",
                           "forward,reverse", "--settle", "0.002", "--window", "0.05", "--workers", "2", "--no-progress",
                           "--out", str(out)], cwd=ROOT, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                         text=True, start_new_session=True)
+                         text=True, start_new_session=True,
+                         # a terminal's command takes Ctrl-C; a pytest-xdist worker ignores SIGINT, and a child
+                         # would inherit that
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         deadline = time.monotonic() + STUDY_S
         if when == "cluster starting":      # the sweep says how many runs it has, then starts its cluster

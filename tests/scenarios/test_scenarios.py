@@ -21,7 +21,8 @@ BEARING_KEYS = {"roller_cage_rms_N", "roller_cage_max_N", "cage_guide_rms_N", "c
                 "pocket_impact_peak_max_N", "cage_slip_pct", "life_iso281_h", "life_iso16281_h",
                 "roller_equivalent_load_pin_N", "roller_equivalent_load_bore_N", "dynamic_load_rating_N"}
 
-SIGNED = {"bearing_load_radial_mean_N", "bearing_load_tangential_mean_N", "cage_slip_pct", "cage_slip_all_pct"}
+SIGNED = {"bearing_load_radial_mean_N", "bearing_load_tangential_mean_N", "cage_slip_pct", "cage_slip_all_pct",
+          "roller_slip_load_zone_pct", "roller_slip_unloaded_pct", "roller_slip_entry_pct", "roller_entry_slide_roll"}
 
 REDUCED = ["--settle", "0.002", "--window", "0.001", "--set", "bearing.rollers=8", "--no-progress",
            "--workers", "1"]
