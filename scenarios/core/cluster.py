@@ -32,7 +32,7 @@ from components.results.reader import SUMMARY_NAME
 
 from .runner import code_digest
 
-__all__ = ["worker_state", "check_workers", "other_code", "scratch_folder", "folder_files", "land", "params_texts",
+__all__ = ["worker_state", "check_workers", "warm_here", "other_code", "scratch_folder", "folder_files", "land", "params_texts",
            "relocated", "done_on_worker", "WORKER_WAIT_S", "SCRATCH"]
 
 SCRATCH = "dpgt-scratch"       # the folder of the workers' scratch folders, in their temporary directory
@@ -77,9 +77,22 @@ def check_workers(client, scheduler: str, wait_s: float = WORKER_WAIT_S) -> dict
     for w, s in sorted(states.items()):
         if not s["warm"] and (scheduler, w) not in _NAMED_COLD:
             _NAMED_COLD.add((scheduler, w))
-            print(f"worker {w} ({s['host']}): the engine's kernels of this code are not compiled there yet; its first "
-                  f"run compiles them (about a minute; `python -m scenarios.warm` on it does it beforehand)", flush=True)
+            print(f"worker {w} ({s['host']}): the engine's kernels of this code are not compiled there yet", flush=True)
+    # the cluster warms up before the runs: one worker per machine compiles (a machine's workers share numba's cache)
+    cold = {s["host"]: w for w, s in sorted(states.items()) if not s["warm"]}
+    if cold:
+        print(f"warming the cluster: compiling the kernels on {len(cold)} machine(s) before any run (about a minute "
+              f"each, in parallel; `python -m scenarios.warm` on a worker does it beforehand)", flush=True)
+        for w, line in sorted(client.run(warm_here, workers=sorted(cold.values())).items()):
+            print(f"worker {w}: {line}", flush=True)
     return states
+
+
+def warm_here() -> str:
+    """Compile (or load) the engine's kernels on this worker (run by ``client.run``); the line saying which."""
+    from components.warm import warm    # deferred: the engine is built on the worker, not on the client
+
+    return warm()
 
 
 def scratch_folder(what: str, label: str) -> Path:

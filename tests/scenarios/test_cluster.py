@@ -247,13 +247,34 @@ def test_a_task_on_a_worker_of_other_code_fails_naming_both_fingerprints(tmp_pat
 class _Client:
     def __init__(self, states):
         self.states = states
+        self.warmed = []
 
     def wait_for_workers(self, n, timeout):
         if not self.states:
             raise TimeoutError
 
-    def run(self, fn):
+    def run(self, fn, workers=None):
+        if fn is clusterlib.warm_here:
+            self.warmed.append(list(workers))
+            return {w: "engine kernels: compiled in 1 s" for w in workers}
         return self.states
+
+
+def test_the_cluster_warms_up_before_the_runs_one_worker_per_machine(capsys):
+    mine = code_digest()
+    states = {"tcp://a:1": {"code": mine, "warm": False, "host": "a"},
+              "tcp://a:2": {"code": mine, "warm": False, "host": "a"},     # shares machine a's numba cache
+              "tcp://b:1": {"code": mine, "warm": True, "host": "b"},
+              "tcp://c:1": {"code": mine, "warm": False, "host": "c"}}
+    client = _Client(states)
+    clusterlib.check_workers(client, "tcp://s:2")
+    assert client.warmed == [["tcp://a:2", "tcp://c:1"]]               # one cold worker per machine, once, together
+    out = capsys.readouterr().out
+    assert "warming the cluster: compiling the kernels on 2 machine(s) before any run" in out
+    assert "worker tcp://c:1: engine kernels: compiled in 1 s" in out
+    warm = _Client({w: {**s, "warm": True} for w, s in states.items()})
+    clusterlib.check_workers(warm, "tcp://s:2")
+    assert warm.warmed == [] and "warming" not in capsys.readouterr().out
 
 
 def test_a_cold_worker_is_named_once_and_no_worker_is_a_one_line_error(capsys):
