@@ -81,7 +81,7 @@ class Cluster:
             p.wait(timeout=30)
 
     def wait_for(self, n_workers: int) -> None:
-        with Client(self.address, timeout=START_S) as c:
+        with Client(self.address, timeout=START_S, set_as_default=False) as c:
             c.wait_for_workers(n_workers, timeout=START_S)
 
 
@@ -186,7 +186,9 @@ def test_a_worker_killed_during_a_run_loses_no_finished_run_and_the_run_complete
     landed = Path(short.out_dir) / "summary.json"
     deadline = time.monotonic() + STUDY_S
     victim = None
-    with Client(cluster.address, timeout=30) as watch:
+    # not the default client: the sweep in the thread holds that, and closing out of order would leave dask
+    # configured for a scheduler no client serves (xarray then fails to write netCDF in later tests)
+    with Client(cluster.address, timeout=30, set_as_default=False) as watch:
         while victim is None and time.monotonic() < deadline and t.is_alive():
             running_long = [w for w, keys in watch.processing().items() if any(k.startswith(long.label) for k in keys)]
             if landed.exists() and running_long:
