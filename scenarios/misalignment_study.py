@@ -289,13 +289,7 @@ class MisalignmentStudy(Study):
         return make_cases(self.a, self.out)
 
     def report(self, run: StudyRun) -> dict:
-        rows = rows_of(run.cases, run.results)
-        text = answer(rows) if rows else ""
-        print(text)
-        if rows:
-            run.step("tables", write_tables, rows, self.out, self.machine_identity()["label"])
-            run.step("figures", plot, rows, self.out, self.machine_identity()["label"])
-        return {"rows": rows, "answer": text}
+        return self.table_report(run, rows_of(run.cases, run.results), answer, write_tables, plot)
 
 
 @holds_out_folder

@@ -146,6 +146,18 @@ class Study(abc.ABC):
     def prepare(self, cfg: RunConfig, cases: list[Case]) -> None:
         """A study's own work after every check and before its sweep (the tolerance study's static solutions)."""
 
+    def table_report(self, run: StudyRun, rows: list[dict], answer: Callable, tables: Callable,
+                     figures: Callable) -> dict:
+        """The report of a study that is one table of rows: ``answer(rows)`` in words first, then ``tables`` and
+        ``figures`` (each called with the rows, the out folder and the machine's label)."""
+        text = answer(rows) if rows else ""
+        print(text)                          # the headline first
+        if rows:
+            label = self.machine_identity()["label"]
+            run.step("tables", tables, rows, self.out, label)
+            run.step("figures", figures, rows, self.out, label)
+        return {"rows": rows, "answer": text}
+
     def beside(self, cfg: RunConfig) -> Beside | None:
         """Work done group by group while the other runs go on (:class:`~scenarios.core.sweep.Beside`: a point's
         figures as soon as its runs are in); its results reach :meth:`report` as ``run.beside``. None by default."""
