@@ -133,3 +133,30 @@ def test_pocket_centring_stiffness_against_a_hand_calculation():
     np.testing.assert_allclose(k, K_P * (8 + 2 * np.sqrt(3)), rtol=1e-3)
     # within both plays the cage floats free
     assert np.all(_cage_among_rollers(r_m, 0.09e-3, phi) == 0)
+
+
+@SETTINGS
+@given(state=retention_states(), z=stored_speeds())
+def test_retention_multiplicity_scales_forces_not_outputs(state, z):
+    qf, vf, one, _ = retention_scene(*state)
+    _, _, two, _ = retention_scene(*state, multiplicity=2)
+    F1, o1, J1, V1 = evaluate(one, 0.0, FS, qf, vf, z, True)
+    F2, o2, J2, V2 = evaluate(two, 0.0, FS, qf, vf, z, True)
+    np.testing.assert_array_equal(F2, 2 * F1)
+    np.testing.assert_array_equal(J2, 2 * J1)
+    np.testing.assert_array_equal(V2, 2 * V1)
+    for key in o1:
+        np.testing.assert_array_equal(o2[key], o1[key])
+
+
+def test_retention_parameter_errors_name_the_parameter():
+    from mbd.errors import ModelError
+    ok = dict(pitch_radius=DM / 2, clearance=C_R, K_r=K_P, restitution=E_SET, impact_law=ExactRestitution(),
+              v_min=V_MIN, mu=0.1, v_mu=0.05, D=DR)
+    PocketRetention("r", [1], 0, **ok)
+    for key, bad in (("clearance", -1e-5), ("K_r", 0.0), ("pitch_radius", 0.0), ("restitution", 0.0),
+                     ("mu", -0.1), ("D", 0.0)):
+        with pytest.raises(ModelError, match=key):
+            PocketRetention("r", [1], 0, **{**ok, key: bad})
+    with pytest.raises(TypeError):
+        PocketRetention("r", [1], 0, **{k: v for k, v in ok.items() if k != "K_r"})
