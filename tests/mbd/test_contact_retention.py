@@ -160,3 +160,28 @@ def test_retention_parameter_errors_name_the_parameter():
             PocketRetention("r", [1], 0, **{**ok, key: bad})
     with pytest.raises(TypeError):
         PocketRetention("r", [1], 0, **{k: v for k, v in ok.items() if k != "K_r"})
+
+
+def test_without_retention_the_pockets_leave_a_displaced_cage_free():
+    """The circumferential pocket contact alone cannot centre a cage: displace it by Δ and put each roller where its
+    pocket's centre line from the displaced cage centre crosses the rollers' orbit (the rollers re-spaced along their
+    orbits, those in line with Δ moved radially in their pockets) — every pocket is centred and no force acts; the
+    radial retention then pushes the cage back."""
+    Z, r_m, delta, phi = 12, DM / 2, 0.4e-3, 0.3
+    c = delta * np.array([np.cos(phi), np.sin(phi)])
+    psi = 2 * np.pi * np.arange(Z) / Z
+    qf, vf = np.zeros(3 * (Z + 1)), np.zeros(3 * (Z + 1))
+    qf[:2] = c
+    for j in range(Z):
+        e = np.array([np.cos(psi[j]), np.sin(psi[j])])
+        s = -c @ e + np.sqrt((c @ e) ** 2 - c @ c + r_m ** 2)   # |c + s e| = r_m: on the orbit about the origin
+        qf[3 * (j + 1):3 * (j + 1) + 2] = c + s * e
+    law = dict(restitution=E_SET, impact_law=ExactRestitution(), v_min=V_MIN, mu=0.1, v_mu=0.05, D=DR)
+    rollers = np.arange(1, Z + 1)
+    pocket = PocketContact("pocket", rollers, 0, pocket_angle=psi, pitch_radius=r_m, clearance=C_P, K_p=K_P, **law)
+    F, out, _, _ = evaluate(pocket, 0.0, FS, qf, vf, None, False)
+    assert np.all(F == 0) and np.abs(out["offset"]).max() <= 1e-15
+    retain = PocketRetention("retention", rollers, 0, pitch_radius=r_m, clearance=C_R, K_r=K_P, **law)
+    F, out, _, _ = evaluate(retain, 0.0, FS, qf, vf, None, False)
+    np.testing.assert_allclose(out["offset"], -delta * np.cos(psi - phi), rtol=0, atol=delta ** 2 / r_m)
+    assert F[:, 3:5].sum(axis=0) @ c < 0                       # back towards the centre
