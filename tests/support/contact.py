@@ -264,7 +264,7 @@ def pocket_states(draw):
 
 
 # retention (a roller-centred cage's pocket, radially): body 0 cage, bodies 1..n rollers
-C_R = 0.15e-3                      # [m] radial pocket play (an odd value beside C_P)
+C_R = 0.15e-3                      # [m] radial pocket play of a roller-centred cage (the reference bearing's)
 
 
 def retention_scene(pose, vel, pockets, offsets, radial, v_circ, v_rad, spins, mu=0.1, restitution=E_SET,
