@@ -21,11 +21,12 @@
 * :func:`limiting_shear_slope` — the pressure slope γ_L of the limiting shear stress τ_L = τ_L0 + γ_L p at the
   oil's temperature (docs/model.md §9.3). ``"constant"``: γ_L as given, at every temperature. ``"dyson"``: the
   temperature form of Dyson's limiting shear stress of a mineral oil, τ_L = G_∞/4 with
-  G_∞ = 1.2 p/(2.52 + 0.024 t) − 10⁸ Pa (t in °C; Dyson 1970, Phil. Trans. R. Soc. A 266: 1–33, from Crook's
-  disc-machine tractions, as Zhou & Hoeprich 1991, J. Tribol. 113: 590–597, eqs. 36–37 quote it), whose pressure
-  slope 0.3/(2.52 + 0.024 t) = 12.5/(t + 105 °C) falls as 1/(T − T₀) with the pole T₀ = −105 °C: the given γ_L
-  holds at the reference temperature T_ref and γ_L(T) = γ_L (T_ref − T₀)/(T − T₀). Dyson's offset −25 MPa is not
-  taken (it would make τ_L negative below ≈ 0.3 GPa, lighter than his data); τ_L0 keeps its value.
+  G_∞ = 1.2 p/(2.52 + 0.024 t) − 10⁸ (Dyson 1970, Phil. Trans. R. Soc. A 266: 1–33, as Zhou & Hoeprich 1991,
+  J. Tribol. 113: 590–597, eqs. 36–37 quote it; t the temperature, taken in °C: the quoting paper prints no unit
+  with it and gives its temperatures in °C), whose pressure slope 0.3/(2.52 + 0.024 t) = 12.5/(t + 105 °C) falls as
+  1/(T − T₀) with the pole T₀ = −105 °C: the given γ_L holds at the reference temperature T_ref and
+  γ_L(T) = γ_L (T_ref − T₀)/(T − T₀). Dyson's offset −10⁸/4 is not taken (in Pa it would make τ_L negative below
+  ≈ 0.3 GPa, where light rollers run); τ_L0 keeps its value.
 * The film parameter Λ = h_min / σ, σ the composite roughness of the two surfaces, and its regime as the
   literature names it (:func:`regime`): Λ ≥ 3 full film; 1 ≤ Λ < 3 partial EHL (mixed: asperities carry part
   of the load); Λ < 1 boundary-dominated.

@@ -341,7 +341,8 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
                                                                     "keeps gamma_L = 0.07 there"),
             limiting_shear_pole_temperature=assumed("-105 degC", "Dyson (1970) via Zhou & Hoeprich (1991, J. Tribol. "
                                                                  "113, eqs. 36-37): tau_L = G/4, G = 1.2 p/(2.52 + "
-                                                                 "0.024 t) - 1e8 Pa, a mineral oil: t = -2.52/0.024"),
+                                                                 "0.024 t) - 1e8, a mineral oil, t taken in degC: "
+                                                                 "t = -2.52/0.024"),
         ),
         support=SupportParams(
             sun_stiffness=assumed("1e8 N/m", span=Span("1e6 N/m", "1e10 N/m", "a floating sun (held by its coupling only) to a rigid seat", log=True)),
