@@ -13,8 +13,8 @@ Regularisations (all smooth, documented where they are made):
 - friction laws are tanh-regularised Coulomb laws (no stick state in a stateless element);
 - the slide-to-roll traction curve uses a regularised slide-to-roll ratio (see :class:`SlideRollTraction`).
 
-The pocket and guide-land impacts carry internal state (the approach speed of the current impact, for
-Hunt–Crossley damping that gives the set restitution at any speed), so those families are never fused.
+The pocket, pocket-retention and guide-land impacts carry internal state (the approach speed of the current impact,
+for Hunt–Crossley damping that gives the set restitution at any speed), so those families are never fused.
 """
 from __future__ import annotations
 

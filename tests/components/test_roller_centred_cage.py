@@ -1,6 +1,6 @@
 """A roller-centred cage (bearing.cage.guidance = "rollers", docs/model.md §8.5–8.6): the scene builds no guide land
 and the pockets' radial retention instead; by symmetry a centred cage among uniformly spaced rollers stays centred on
-both engines, which agree to round-off; a radially loaded rig's cage is held by its rollers."""
+both engines, which agree to round-off."""
 from __future__ import annotations
 
 import numpy as np
