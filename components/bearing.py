@@ -13,11 +13,12 @@ import numpy as np
 from mbd.elements import BodySpring, SlopeGyroscopic
 from mbd.elements.sliced import SlicedRaceContact, iso_16281_stiffness, slice_stations
 from mbd.elements.contact import (IMPACT_LAWS, ROLLING_LAWS, TRACTION_LAWS, DryLand, EHLTraction, GuideContact,
-                                  HoupertRolling, HydrodynamicLand, LubricantDrag, PocketContact, RaceContact,
+                                  HoupertRolling, HydrodynamicLand, LubricantDrag, PocketContact, PocketRetention,
+                                  RaceContact,
                                   RollingResistance, SlideRollTraction, TanhTraction, Traction)
 
 from .families import FAMILY
-from .lubrication import oil_density, reduced_modulus
+from .lubrication import limiting_shear_slope, oil_density, reduced_modulus
 from .params import BearingSI, LubricantSI
 from .profiles import roller_drop
 from .scene import Scene
@@ -36,6 +37,7 @@ class BearingHandles:
     race_outer: slice | None = None
     drag: slice | None = None
     pocket: slice | None = None
+    retention: slice | None = None            # a roller-centred cage's radial pocket retention
     guide: slice | None = None
     cage: str | None = None
     spring: slice | None = None               # the linear bearing's spring
@@ -49,8 +51,10 @@ def _ehl(b, lub):
         raise ParameterError.at("bearing.traction_law", "'ehl' needs a lubricant (its viscosity and limiting "
                                                         "shear); this scene has none")
     E_red = reduced_modulus(b.elastic_modulus, b.poisson_ratio, b.elastic_modulus, b.poisson_ratio)
+    gamma_L = limiting_shear_slope(lub.limiting_shear_law, lub.limiting_shear_slope, lub.temperature,
+                                   lub.limiting_shear_reference_temperature, lub.limiting_shear_pole_temperature)
     return EHLTraction(eta0=lub.oil_viscosity, alpha_p=lub.pressure_viscosity, E_red=E_red, length=b.roller_length,
-                       tau_L0=lub.limiting_shear_stress, gamma_L=lub.limiting_shear_slope,
+                       tau_L0=lub.limiting_shear_stress, gamma_L=gamma_L,
                        G_e=lub.film_shear_modulus, u_reg=lub.film_speed_reg, beta=lub.temperature_viscosity,
                        k_oil=lub.thermal_conductivity)
 
@@ -308,8 +312,9 @@ def _land(c, lubricant):
 
 def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel, wm, outer_body, held,
               lubricant) -> dict:
-    """The cage body, its pockets and (a free cage) its guide land on the outer raceway: the
-    BearingHandles fields they fill."""
+    """The cage body, its pockets and (a free cage) what centres it — its guide land on the outer raceway
+    (``bearing.cage.guidance = "outer_land"``) or its pockets' radial retention of the rollers (``"rollers"``,
+    docs/model.md §8.5): the BearingHandles fields they fill."""
     c, Z, D = b.cage, len(names), b.roller_diameter
     cage = f"{tag}.cage"
     scene.body(cage, c.mass, c.inertia, pose=(*pin_xy, 0.0), vel=(*pin_vel, wm), fixed=held)
@@ -319,12 +324,18 @@ def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel,
                          clearance=c.pocket_clearance, K_p=c.pocket_stiffness, restitution=c.restitution,
                          v_min=c.impact_speed_floor, mu=c.pocket_friction, v_mu=c.friction_speed, D=D,
                          multiplicity=b.rows)
-    guides = None                 # a held cage has no guide land
-    if not held:
+    guides = retention = None     # a held cage has no guide land
+    if not held and c.guidance == "rollers":     # roller-centred: the pockets hold the rollers radially, no land
+        fam = scene.family(FAMILY["retention"], PocketRetention, ("roller", "cage"), impact_law=law)
+        retention = fam.add(Z, roller=names, cage=[cage] * Z, pitch_radius=0.5 * b.pitch_diameter,
+                            clearance=c.pocket_radial_clearance, K_r=c.pocket_stiffness, restitution=c.restitution,
+                            v_min=c.impact_speed_floor, mu=c.pocket_friction, v_mu=c.friction_speed, D=D,
+                            multiplicity=b.rows)
+    elif not held:
         guide = scene.family(FAMILY["guide"], GuideContact, ("cage", "planet"), impact_law=law,
                              land=_land(c, lubricant))
         guides = guide.add(1, cage=[cage], planet=[outer_body], clearance=c.guide_clearance,
                            K_g=c.guide_stiffness, restitution=c.restitution, v_min=c.impact_speed_floor,
                            mu=c.guide_friction, v_mu=c.friction_speed,
                            land_radius=0.5 * (b.pitch_diameter + D))
-    return {"pocket": pockets, "guide": guides, "cage": cage}
+    return {"pocket": pockets, "retention": retention, "guide": guides, "cage": cage}

@@ -6,6 +6,6 @@ from types import MappingProxyType
 __all__ = ["FAMILY", "MESH_FAMILY"]
 
 FAMILY = MappingProxyType({"race_inner": "race_inner", "race_outer": "race_outer", "pocket": "pocket",
-                           "guide": "guide", "drag": "drag", "linear": "bearing_linear", "support": "support",
+                           "retention": "pocket_retention", "guide": "guide", "drag": "drag", "linear": "bearing_linear", "support": "support",
                            "gyroscopic": "planet_gyroscopic"})
 MESH_FAMILY = MappingProxyType({"sun_inner": "mesh_sa", "inner_outer": "mesh_ab", "outer_ring": "mesh_br"})

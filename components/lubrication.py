@@ -18,6 +18,15 @@
       h_min / R = 1.714 W'^(−0.128) U^0.694 G^0.568,    h_c / R = 2.922 W'^(−0.166) U^0.692 G^0.470.
   Dowson & Higginson's classic h_min/R = 2.65 U^0.70 G^0.54 W'^(−0.13) is :func:`dowson_higginson_film`
   (a cross-check: the two agree within ≈ 15 % over bearing conditions).
+* :func:`limiting_shear_slope` — the pressure slope γ_L of the limiting shear stress τ_L = τ_L0 + γ_L p at the
+  oil's temperature (docs/model.md §9.3). ``"constant"``: γ_L as given, at every temperature. ``"dyson"``: the
+  temperature form of Dyson's limiting shear stress of a mineral oil, τ_L = G_∞/4 with
+  G_∞ = 1.2 p/(2.52 + 0.024 t) − 10⁸ (Dyson 1970, Phil. Trans. R. Soc. A 266: 1–33, as Zhou & Hoeprich 1991,
+  J. Tribol. 113: 590–597, eqs. 36–37 quote it; t the temperature, taken in °C: the quoting paper prints no unit
+  with it and gives its temperatures in °C), whose pressure slope 0.3/(2.52 + 0.024 t) = 12.5/(t + 105 °C) falls as
+  1/(T − T₀) with the pole T₀ = −105 °C: the given γ_L holds at the reference temperature T_ref and
+  γ_L(T) = γ_L (T_ref − T₀)/(T − T₀). Dyson's offset −10⁸/4 is not taken (in Pa it would make τ_L negative below
+  ≈ 0.3 GPa, where light rollers run); τ_L0 keeps its value.
 * The film parameter Λ = h_min / σ, σ the composite roughness of the two surfaces, and its regime as the
   literature names it (:func:`regime`): Λ ≥ 3 full film; 1 ≤ Λ < 3 partial EHL (mixed: asperities carry part
   of the load); Λ < 1 boundary-dominated.
@@ -32,7 +41,8 @@ from mbd.elements.ehl import film_central, film_min, hertz_peak_pressure, therma
 
 __all__ = ["walther_viscosity", "walther_slope", "oil_density", "dynamic_viscosity", "temperature_viscosity",
            "reduced_modulus", "roller_contact_radius", "line_contact_film", "dowson_higginson_film",
-           "bearing_film", "contact_pressure", "regime", "FULL_FILM_LAMBDA", "BOUNDARY_LAMBDA"]
+           "bearing_film", "contact_pressure", "regime", "limiting_shear_slope", "LIMITING_SHEAR_LAWS",
+           "FULL_FILM_LAMBDA", "BOUNDARY_LAMBDA"]
 
 FULL_FILM_LAMBDA, BOUNDARY_LAMBDA = 3.0, 1.0     # Λ bounds of full film and of boundary-dominated contact
 
@@ -75,6 +85,20 @@ def dynamic_viscosity(nu40: float, nu100: float, rho15: float, expansion: float,
 def temperature_viscosity(nu40: float, nu100: float, expansion: float, temperature: float) -> float:
     """β = −(1/η) dη/dT [1/K] of η = ρ(T) ν(T): Walther's slope plus the density's −(1/ρ) dρ/dT."""
     return walther_slope(nu40, nu100, temperature) + expansion / (1.0 - expansion * (temperature - T_DENSITY))
+
+
+LIMITING_SHEAR_LAWS = ("constant", "dyson")     # lubricant.limiting_shear_law: γ_L's temperature dependence
+
+
+def limiting_shear_slope(law: str, gamma_ref: float, temperature: float, reference_temperature: float,
+                         pole_temperature: float) -> float:
+    """γ_L at ``temperature`` [K] (module docstring): ``gamma_ref`` itself for ``"constant"``; for ``"dyson"``
+    γ_L(T) = γ_ref (T_ref − T₀)/(T − T₀), T₀ = ``pole_temperature`` below both temperatures [K]."""
+    if law == "constant":
+        return gamma_ref
+    if law != "dyson":
+        raise ValueError(f"limiting_shear_slope: law must be one of {LIMITING_SHEAR_LAWS}, got {law!r}")
+    return gamma_ref * (reference_temperature - pole_temperature) / (temperature - pole_temperature)
 
 
 def reduced_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:

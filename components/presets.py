@@ -127,6 +127,11 @@ def reference_bearing() -> BearingParams:
         land_law=assumed("dry", "the source's model; 'hydrodynamic' runs the land in the oil film"),
         land_width=assumed("4 mm", "two side rails of about 2 mm"),
         land_min_film=assumed("1 um", "a few composite roughnesses"),
+        guidance=assumed("outer_land", "the source's model: a cage guided on the planet bore; rollers: a "
+                                       "roller-centred cage (catalogue cages of cylindrical roller bearings come "
+                                       "both ways, e.g. SKF's MA outer-ring and M roller centred)"),
+        pocket_radial_clearance=assumed("0.15 mm", "radial play of a roller in a roller-centred cage's pocket, "
+                                                   "the order of its circumferential play", span=Span("0.05 mm", "0.3 mm", "pocket shapes of roller-centred machined cages")),
         impact_law=derived("exact", "lambda(e) from ln((1+lambda)/(1-lambda e)) = lambda (1+e): the set e holds "
                                     "at any approach speed (docs/model.md §8.4)"),
     )
@@ -330,6 +335,14 @@ def reference_dpgt(condition: int = 3, direction: str = "forward") -> DPGTParams
             film_speed_reg=assumed("0.1 m/s", "far below the entraining speeds of m/s: matters only near rest"),
             film_shear_modulus=assumed("1 GPa", "Johnson and Tevaarwerk (1977): 0.5-2 GPa for mineral oils in EHL "
                                                 "contacts"),
+            limiting_shear_law=assumed("constant", "gamma_L is not referred to a temperature; dyson: its "
+                                                   "temperature form (docs/model.md §9.3)"),
+            limiting_shear_reference_temperature=assumed("60 degC", "the reference oil temperature: the dyson law "
+                                                                    "keeps gamma_L = 0.07 there"),
+            limiting_shear_pole_temperature=assumed("-105 degC", "Dyson (1970) via Zhou & Hoeprich (1991, J. Tribol. "
+                                                                 "113, eqs. 36-37): tau_L = G/4, G = 1.2 p/(2.52 + "
+                                                                 "0.024 t) - 1e8, a mineral oil, t taken in degC: "
+                                                                 "t = -2.52/0.024"),
         ),
         support=SupportParams(
             sun_stiffness=assumed("1e8 N/m", span=Span("1e6 N/m", "1e10 N/m", "a floating sun (held by its coupling only) to a rigid seat", log=True)),

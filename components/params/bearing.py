@@ -17,7 +17,8 @@ __all__ = ["CageParams", "CageSI", "SlideRollTractionParams", "SlideRollTraction
 
 @dataclass(frozen=True, kw_only=True)
 class CageParams(Params["CageSI"]):
-    """Cage of a planet bearing: outer-raceway (planet bore) guided, with Z pockets.
+    """Cage of a planet bearing with Z pockets, centred by the planet bore's land (outer-raceway guided) or by its
+    rollers (roller-centred: the pockets hold the rollers radially too), ``guidance``.
 
     :class:`CageSI` ``inertia`` stays None when the rule applies: the rule needs the bearing's pitch
     diameter, and ``BearingParams.si().cage`` has it resolved."""
@@ -44,6 +45,11 @@ class CageParams(Params["CageSI"]):
                                     "film, short journal bearing)", choices=("dry", "hydrodynamic"))
     land_width: Quantity = positive("length", "axial width of the guide lands (both sides together), for the film")
     land_min_film: Quantity = positive("length", "thinnest film the hydrodynamic land keeps before the solid contact")
+    guidance: str = param("choice", "what centres the cage: outer_land (the planet bore's land, GuideContact) or "
+                                    "rollers (a roller-centred cage: its pockets on the rollers, no land contact)",
+                          choices=("outer_land", "rollers"))
+    pocket_radial_clearance: Quantity = nonneg("length", "radial play C_r of a roller in its pocket before the "
+                                                         "bars' converging faces hold it (guidance rollers)")
 
 
 @si_of(CageParams)
@@ -63,6 +69,8 @@ class CageSI(SI):
     land_law: str
     land_width: float
     land_min_film: float
+    guidance: str
+    pocket_radial_clearance: float
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -302,6 +310,13 @@ class LubricantParams(Params["LubricantSI"]):
                                                     "regularised")
     film_shear_modulus: Quantity = positive("pressure", "elastic shear modulus G_e of the film in the contact (EHL "
                                                         "traction's linear region, Johnson-Tevaarwerk)")
+    limiting_shear_law: str = param("choice", "temperature dependence of gamma_L: constant (gamma_L at every "
+                                              "temperature) or dyson (gamma_L (T_ref - T_0)/(T - T_0), Dyson's "
+                                              "mineral-oil form)", choices=("constant", "dyson"))
+    limiting_shear_reference_temperature: Quantity = positive("temperature", "temperature T_ref at which "
+                                                                             "limiting_shear_slope holds (law dyson)")
+    limiting_shear_pole_temperature: Quantity = positive("temperature", "pole T_0 of the dyson law, below every "
+                                                                        "oil temperature")
 
     oil_viscosity: Quantity | None = rule("dynamic_viscosity", "derived", "Walther (ASTM D341) at the temperature, "
                                                                          "times the oil density there")
@@ -330,6 +345,12 @@ class LubricantParams(Params["LubricantSI"]):
             X = v["density"] / oil_density(v["oil_density"], v["thermal_expansion"], v["temperature"])
         if not 0.0 < X <= 1.0:
             raise ParameterError.at("lubricant.oil_fraction", f"must lie in (0, 1] (a volume fraction), got {X!r}")
+        if v["limiting_shear_law"] == "dyson":
+            T0 = v["limiting_shear_pole_temperature"]
+            if not (T0 < v["temperature"] and T0 < v["limiting_shear_reference_temperature"]):
+                raise ParameterError.at("lubricant.limiting_shear_pole_temperature",
+                                        f"must lie below lubricant.temperature and "
+                                        f"lubricant.limiting_shear_reference_temperature (K), got {T0!r} K")
         return dict(
             oil_fraction=X,
             oil_viscosity=eta if eta is not None else dynamic_viscosity(*line, v["oil_density"],
@@ -354,6 +375,9 @@ class LubricantSI(SI):
     limiting_shear_slope: float
     film_speed_reg: float
     film_shear_modulus: float
+    limiting_shear_law: str
+    limiting_shear_reference_temperature: float
+    limiting_shear_pole_temperature: float
     oil_viscosity: float = computed("dynamic viscosity at the operating temperature [Pa s] (given, or Walther)")
     temperature_viscosity: float = computed("temperature-viscosity coefficient beta at the operating "
                                             "temperature [1/K] (given, or Walther)")

@@ -61,6 +61,10 @@ OUTPUTS = {
     FAMILY["pocket"]: {
         "force": ("N", "roller–cage pocket force (> 0: the roller pushes the cage forward)"),
         "offset": ("m", "roller circumferential offset in its cage pocket")},
+    FAMILY["retention"]: {
+        "force": ("N", "roller–cage pocket radial retention force of a roller-centred cage (> 0: the roller presses "
+                       "the cage outwards)"),
+        "offset": ("m", "roller radial offset from the cage's pitch circle")},
     FAMILY["guide"]: {
         "force": ("N", "cage–guide land normal force"),
         "fx": ("N", "cage–guide land force on the cage, x in R"),
@@ -105,7 +109,7 @@ def instance_coords(scene) -> dict[str, dict[str, tuple[str, list]]]:
     for b in bearing_map(scene):
         base = {c: b[field] for c, (_, field) in _BEARING_COORDS.items()}
         if b["type"] == "rollers":
-            for fam in ("race_inner", "race_outer", "pocket"):
+            for fam in ("race_inner", "race_outer", "pocket", "retention"):
                 if fam in b:
                     start, stop = b[fam]
                     for j, i in enumerate(range(start, stop)):

@@ -50,6 +50,8 @@ def bearing_map(scene) -> list[dict]:
                             "race_outer": [h.race_outer.start, h.race_outer.stop]})
                 if h.pocket is not None:
                     rec["pocket"] = [h.pocket.start, h.pocket.stop]
+                if h.retention is not None:
+                    rec["retention"] = [h.retention.start, h.retention.stop]
                 if h.guide is not None:
                     rec["guide"] = h.guide.start
                 if h.cage is not None:

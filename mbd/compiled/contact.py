@@ -15,6 +15,7 @@ Layouts (P: one row per instance, columns in this order; G: family-wide values):
                   decides from G's size, a family without it pays nothing)
 ``PocketContact`` P (n, 10): pocket_angle ψ, pitch_radius, clearance, K_p, λ (impact law damping), v_min, mu,
                   v_mu, D, multiplicity;  G (0,)
+``PocketRetention`` P (n, 9): pitch_radius, clearance C_r, K_r, λ, v_min, mu, v_mu, D, multiplicity;  G (0,)
 ``GuideContact``  P (n, 7): clearance, K_g, λ, v_min, mu, v_mu, land_radius;  G (4,): land law (0 dry,
                   1 hydrodynamic), then for the film: eta, width, min_film
 ``LubricantDrag`` P (n, 4): race_marker x, y [m], coef = C_d ρ D l d_m²/8, multiplicity; with viscous churning
@@ -47,11 +48,11 @@ from numba import njit
 
 from ..elements import ehl
 from ..elements.contact import (DryLand, EHLTraction, GuideContact, HoupertRolling, HydrodynamicLand, LubricantDrag,
-                                PocketContact, RaceContact, SlideRollTraction, TanhTraction)
+                                PocketContact, PocketRetention, RaceContact, SlideRollTraction, TanhTraction)
 
 __all__ = ["traction_g", "pack_race", "evaluate_race", "outputs_race", "pack_pocket", "evaluate_pocket", "outputs_pocket",
-           "update_pocket", "pack_guide", "evaluate_guide", "outputs_guide", "update_guide", "pack_drag",
-           "evaluate_drag", "TRACTION_IDS", "RACE_OUTPUTS", "POCKET_OUTPUTS", "GUIDE_OUTPUTS"]
+           "update_pocket", "pack_retention", "evaluate_retention", "outputs_retention", "update_retention",
+           "pack_guide", "evaluate_guide", "outputs_guide", "update_guide", "pack_drag", "evaluate_drag", "TRACTION_IDS", "RACE_OUTPUTS", "POCKET_OUTPUTS", "RETENTION_OUTPUTS", "GUIDE_OUTPUTS"]
 
 _ETA2 = 1e-24          # the reference's η² (mbd.elements.contact._ETA2)
 _TWO_PI = 2.0 * np.pi
@@ -111,6 +112,13 @@ def pack_pocket(elem):
     _require(elem, PocketContact)
     P = _rows(elem.pocket_angle, elem.pitch_radius, elem.clearance, elem.K_p, elem.lam, elem.v_min, elem.mu,
               elem.v_mu, elem.D, elem.multiplicity)
+    return P, np.zeros(0)
+
+
+def pack_retention(elem):
+    _require(elem, PocketRetention)
+    P = _rows(elem.pitch_radius, elem.clearance, elem.K_r, elem.lam, elem.v_min, elem.mu, elem.v_mu, elem.D,
+              elem.multiplicity)
     return P, np.zeros(0)
 
 
@@ -660,6 +668,115 @@ def update_pocket(z, t0, t1, ql0, vl0, ql1, vl1, P, G):
         if not z[i, 3] > 0:                      # first step: the start state is not cached
             g0 = _pocket_gap(ql0[i, 0], ql0[i, 1], ql0[i, 3], ql0[i, 4], ql0[i, 5], vl0[i, 0], vl0[i, 1],
                              vl0[i, 3], vl0[i, 4], vl0[i, 5], psi, rm, clr)
+            x0, xd0 = g0[6], g0[7]
+        z1[i, 0] = _impact_state(z[i, 0], x0, xd0, x1, xd1, v_min)
+        z1[i, 1], z1[i, 2], z1[i, 3] = x1, xd1, 1.0
+    return z1
+
+
+# ----------------------------------------------------------------------------------- pocket retention
+@njit(cache=True)
+def _retention_gap(xr, yr, xg, yg, vr0, vr1, vg0, vg1, rm, clearance):
+    """Retention geometry (PocketRetention._geometry): dx, dy, ρ, u, wx, wy, penetration x, rate ẋ."""
+    dx, dy = xr - xg, yr - yg
+    rho = np.sqrt(dx * dx + dy * dy + _ETA2)
+    u = rho - rm
+    wx, wy = vr0 - vg0, vr1 - vg1
+    rho_dot = (dx * wx + dy * wy) / rho
+    return dx, dy, rho, u, wx, wy, abs(u) - clearance, _sign(u) * rho_dot
+
+
+# the outputs of PocketRetention the compiled kernel gives (rows of O in outputs_retention), as the reference names them
+RETENTION_OUTPUTS = ("force", "offset", "penetration", "penetration_rate", "approach_speed", "friction")
+
+
+@njit(cache=True)
+def evaluate_retention(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    _retention(ql, vl, z, P, F, Jq, Jv, jac, np.empty((0, 0)))
+
+
+@njit(cache=True)
+def outputs_retention(t, phi, omega, domega, ql, vl, z, P, G, O):
+    """The outputs :data:`RETENTION_OUTPUTS` into the rows of O (6, n), by the law of :func:`evaluate_retention`."""
+    n = ql.shape[0]
+    _retention(ql, vl, z, P, np.empty((n, 6)), np.empty((0, 6, 6)), np.empty((0, 6, 6)), False, O)
+
+
+@njit(cache=True)
+def _retention(ql, vl, z, P, F, Jq, Jv, jac, O):
+    """The retention law: forces into F (and Jacobians); with O of 6 rows, the outputs too (else O is (0, 0))."""
+    out = O.shape[0] > 0
+    for i in range(ql.shape[0]):
+        rm, clr, Kr, lam, v_min = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4]
+        mu, v_mu, D, mult = P[i, 5], P[i, 6], P[i, 7], P[i, 8]
+        vr0, vr1, vr2 = vl[i, 0], vl[i, 1], vl[i, 2]
+        vg0, vg1, vg2 = vl[i, 3], vl[i, 4], vl[i, 5]
+        dx, dy, rho, u, wx, wy, pen, pen_dot = _retention_gap(ql[i, 0], ql[i, 1], ql[i, 3], ql[i, 4], vr0, vr1,
+                                                              vg0, vg1, rm, clr)
+        Fi, F_x, F_xd = _impact(Kr, lam, v_min, pen, pen_dot, z[i, 0])
+        sg = _sign(u)
+        Fu = Fi * sg
+        ex, ey = dx / rho, dy / rho
+        half = 0.5 * D * sg
+        rwx, rwy = half * ex, half * ey
+        rgx, rgy = dx + rwx, dy + rwy
+        tx, ty = -ey, ex
+        Vrx, Vry = vr0 - vr2 * rwy, vr1 + vr2 * rwx
+        Vgx, Vgy = vg0 - vg2 * rgy, vg1 + vg2 * rgx
+        v_t = (Vrx - Vgx) * tx + (Vry - Vgy) * ty
+        th = np.tanh(v_t / v_mu)
+        f = -mu * th * Fi
+        if out:            # (the reference's v₀ in use is 0 where the pocket is open)
+            touch = pen > 0.0
+            O[0, i], O[1, i], O[2, i], O[3, i] = Fu, u, pen if touch else 0.0, pen_dot
+            O[4, i] = _approach(v_min, pen_dot, z[i, 0])[0] if touch else 0.0
+            O[5, i] = f
+        if Fi == 0.0:
+            _zero(F, Jq, Jv, i, jac)
+            continue
+        fnx, fny = -Fu * ex, -Fu * ey
+        fx, fy = f * tx, f * ty
+        _write(F, Jq, Jv, i, -1, mult, fnx + fx, fny + fy, rwx * fy - rwy * fx, -fnx - fx, -fny - fy,
+               rgx * (-fy) - rgy * (-fx))
+        if not jac:
+            continue
+        rho_dot = sg * pen_dot
+        f_v = -mu * (1.0 - th * th) / v_mu * Fi  # ∂f/∂v_t
+        for j in range(12):
+            dxr, dyr, _, dxg, dyg, _, dvr0, dvr1, dvr2, dvg0, dvg1, dvg2 = _unit(j)
+            ddx, ddy = dxr - dxg, dyr - dyg
+            drho = (dx * ddx + dy * ddy) / rho
+            dwx, dwy = dvr0 - dvg0, dvr1 - dvg1
+            drho_dot = (ddx * wx + dx * dwx + ddy * wy + dy * dwy - rho_dot * drho) / rho
+            dFi = F_x * sg * drho + F_xd * sg * drho_dot          # x = |u| − C, ẋ = sign(u)·ρ̇
+            dFu = dFi * sg
+            dex, dey = (ddx - ex * drho) / rho, (ddy - ey * drho) / rho
+            dfnx, dfny = -(dFu * ex + Fu * dex), -(dFu * ey + Fu * dey)
+            drwx, drwy = half * dex, half * dey
+            drgx, drgy = ddx + drwx, ddy + drwy
+            dtx, dty = -dey, dex
+            dVrx, dVry = dvr0 - dvr2 * rwy - vr2 * drwy, dvr1 + dvr2 * rwx + vr2 * drwx
+            dVgx, dVgy = dvg0 - dvg2 * rgy - vg2 * drgy, dvg1 + dvg2 * rgx + vg2 * drgx
+            dv_t = (dVrx - dVgx) * tx + (Vrx - Vgx) * dtx + (dVry - dVgy) * ty + (Vry - Vgy) * dty
+            df = f_v * dv_t - mu * th * dFi
+            dfx, dfy = df * tx + f * dtx, df * ty + f * dty
+            _write(F, Jq, Jv, i, j, mult, dfnx + dfx, dfny + dfy, _d_cross(rwx, rwy, drwx, drwy, fx, fy, dfx, dfy),
+                   -dfnx - dfx, -dfny - dfy, -_d_cross(rgx, rgy, drgx, drgy, fx, fy, dfx, dfy))
+
+
+@njit(cache=True)
+def update_retention(z, t0, t1, ql0, vl0, ql1, vl1, P, G):
+    n = z.shape[0]
+    z1 = np.empty((n, 4))
+    for i in range(n):
+        rm, clr, v_min = P[i, 0], P[i, 1], P[i, 4]
+        g1 = _retention_gap(ql1[i, 0], ql1[i, 1], ql1[i, 3], ql1[i, 4], vl1[i, 0], vl1[i, 1], vl1[i, 3],
+                            vl1[i, 4], rm, clr)
+        x1, xd1 = g1[6], g1[7]
+        x0, xd0 = z[i, 1], z[i, 2]
+        if not z[i, 3] > 0:                      # first step: the start state is not cached
+            g0 = _retention_gap(ql0[i, 0], ql0[i, 1], ql0[i, 3], ql0[i, 4], vl0[i, 0], vl0[i, 1], vl0[i, 3],
+                                vl0[i, 4], rm, clr)
             x0, xd0 = g0[6], g0[7]
         z1[i, 0] = _impact_state(z[i, 0], x0, xd0, x1, xd1, v_min)
         z1[i, 1], z1[i, 2], z1[i, 3] = x1, xd1, 1.0

@@ -46,11 +46,12 @@ class Kind:
 
 
 (_RACE, _POCKET, _GUIDE, _DRAG, _MESH, _SUPPORT, _BODY_SPRING, _TORSION, _TORQUE, _FORCE, _SPEED, _GYRO,
- _COORD_SPRING, _SLICED_RACE, _SLICED_MESH) = range(15)
+ _COORD_SPRING, _SLICED_RACE, _SLICED_MESH, _RETENTION) = range(16)
 
 # compiled twin (as the families declare it) -> its id in the dispatch below
 KIND_IDS = {
     "contact.race": _RACE, "contact.pocket": _POCKET, "contact.guide": _GUIDE, "contact.drag": _DRAG,
+    "contact.retention": _RETENTION,
     "mesh.gear_mesh": _MESH,
     "generic.ground_support": _SUPPORT, "generic.body_spring": _BODY_SPRING, "generic.torsional_spring": _TORSION,
     "generic.torque_source": _TORQUE, "generic.force_source": _FORCE, "generic.speed_drive": _SPEED,
@@ -63,7 +64,7 @@ GROUPS = {"contact": 1, "generic": 2, "mesh": 4, "sliced": 8}
 # twins that give their outputs (outputs_kind) -> the reference's names of the rows they write
 # (the meshes' are not among them: numpy's batched mesh kernel takes as long over a block as the compiled one)
 OUTPUT_NAMES = {"contact.race": contact.RACE_OUTPUTS, "contact.pocket": contact.POCKET_OUTPUTS,
-                "contact.guide": contact.GUIDE_OUTPUTS}
+                "contact.guide": contact.GUIDE_OUTPUTS, "contact.retention": contact.RETENTION_OUTPUTS}
 
 
 def kind_of(cls) -> Kind | None:
@@ -231,6 +232,8 @@ def evaluate_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, J
         sliced.evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     elif kind == _SLICED_MESH:
         sliced.evaluate_sliced_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _RETENTION:
+        contact.evaluate_retention(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
 
 
 def update_kind(groups, kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):
@@ -239,6 +242,8 @@ def update_kind(groups, kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):
         return contact.update_pocket(z, t0, t1, ql0, vl0, ql1, vl1, P, G)
     if kind == _GUIDE:
         return contact.update_guide(z, t0, t1, ql0, vl0, ql1, vl1, P, G)
+    if kind == _RETENTION:
+        return contact.update_retention(z, t0, t1, ql0, vl0, ql1, vl1, P, G)
     if kind == _SPEED:
         return generic.update_speed_drive(z, t0, t1, ql0, vl0, ql1, vl1, P, G, phi0, phi1)
     return np.copy(z)
@@ -252,4 +257,6 @@ def outputs_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, O):
         contact.outputs_pocket(t, phi, omega, domega, ql, vl, z, P, G, O)
     elif kind == _GUIDE:
         contact.outputs_guide(t, phi, omega, domega, ql, vl, z, P, G, O)
+    elif kind == _RETENTION:
+        contact.outputs_retention(t, phi, omega, domega, ql, vl, z, P, G, O)
 

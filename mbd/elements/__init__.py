@@ -5,7 +5,7 @@ Law variants are small classes registered by name (a parameter chooses one): :da
 hydrodynamic guide land),
 :data:`STIFFNESS_SHAPES` (mesh stiffness over a mesh cycle)."""
 from .contact import (IMPACT_LAWS, LAND_LAWS, TRACTION_LAWS, DryLand, EHLTraction, HydrodynamicLand, LandLaw, ExactRestitution, Flores, GuideContact, HuntCrossley, ImpactLaw,
-                      LankaraniNikravesh, LubricantDrag, PocketContact, RaceContact, SlideRollTraction, TanhTraction,
+                      LankaraniNikravesh, LubricantDrag, PocketContact, PocketRetention, RaceContact, SlideRollTraction, TanhTraction,
                       Traction)
 from .drives import Ramp, SpeedDrive, TorqueSource
 from .gear_mesh import (STIFFNESS_SHAPES, ConstantStiffness, FourierStiffness, GearMesh, RectangularStiffness,
@@ -16,7 +16,7 @@ from .tilt import CoordinateSpring, SlopeGyroscopic
 
 __all__ = [
     "BodySpring", "ForceSource", "GearMesh", "GroundSupport", "GuideContact", "LubricantDrag", "PocketContact",
-    "CoordinateSpring", "RaceContact", "Ramp", "SlopeGyroscopic", "SpeedDrive", "TorqueSource", "TorsionalSpring",
+    "PocketRetention", "CoordinateSpring", "RaceContact", "Ramp", "SlopeGyroscopic", "SpeedDrive", "TorqueSource", "TorsionalSpring",
     "Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS",
     "LandLaw", "DryLand", "HydrodynamicLand", "LAND_LAWS",
     "ImpactLaw", "ExactRestitution", "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS",

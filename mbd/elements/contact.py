@@ -1,5 +1,6 @@
 """Planet-bearing contacts (docs/model.md §8): roller–raceway Hertz line contact with traction,
-roller–cage pocket impact, cage–guide-land impact and lubricant drag on the rollers.
+roller–cage pocket impact (and the pocket's radial retention of a roller-centred cage), cage–guide-land impact and
+lubricant drag on the rollers.
 
 Every family covers all rollers (or cages) of all bearings at once; each instance couples two bodies
 (k = 6: first body x, y, θ, then second body x, y, θ). Forces that act at a contact point are applied
@@ -12,8 +13,8 @@ Regularisations (all smooth, documented where they are made):
 - friction laws are tanh-regularised Coulomb laws (no stick state in a stateless element);
 - the slide-to-roll traction curve uses a regularised slide-to-roll ratio (see :class:`SlideRollTraction`).
 
-The pocket and guide-land impacts carry internal state (the approach speed of the current impact, for
-Hunt–Crossley damping that gives the set restitution at any speed), so those families are never fused.
+The pocket, pocket-retention and guide-land impacts carry internal state (the approach speed of the current impact,
+for Hunt–Crossley damping that gives the set restitution at any speed), so those families are never fused.
 """
 from __future__ import annotations
 
@@ -30,7 +31,7 @@ from ..element import Element, body_dofs, marker, marker_velocity, point_force
 from ..errors import ModelError
 
 __all__ = ["Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS", "ImpactLaw", "ExactRestitution",
-           "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS", "RaceContact", "PocketContact",
+           "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS", "RaceContact", "PocketContact", "PocketRetention",
            "GuideContact", "LubricantDrag", "restitution_lambda", "LandLaw", "DryLand", "HydrodynamicLand",
            "LAND_LAWS", "spall_profile", "RollingResistance", "HoupertRolling", "ROLLING_LAWS"]
 
@@ -663,6 +664,83 @@ class PocketContact(_Impact):
         forces = _scaled(forces, self.multiplicity, self._multi)
         return forces, {"force": Fs, "offset": s, "penetration": ad.pos(pen), "penetration_rate": pen_dot,
                         "approach_speed": v_app}
+
+
+# --------------------------------------------------------------------------------------------
+class PocketRetention(_Impact):
+    """Radial retention of a roller in its pocket, for a roller-centred cage (docs/model.md §8.5).
+
+    Instances couple a roller (first 3 coordinates) with its cage (last 3). The roller's radial offset from the
+    cage's pitch circle u = ρ − d_m/2, ρ = |p − c_g| (safe norm), and the penetration beyond the radial pocket
+    play C_r, x = |u| − C_r, ẋ = sign(u)·ρ̇: the pocket's bars converge below and above the pitch circle, so a
+    roller displaced radially in its pocket by more than C_r meets them (a roller-centred cage rides on its
+    rollers). For x > 0 the force is the impact law of :class:`_Impact` (K_r, restitution, approach speed),
+    F = K_r x (1 + λ(e) ẋ/v₀) ≥ 0, applied in potential form −F ∂x/∂q: the roller is pushed back towards the
+    pitch circle along e_r = (p − c_g)/ρ, the cage the opposite, both at the roller centre (the converging
+    faces' normal forces meet there: no moment on the cage). Friction of the faces on the turning roller,
+    −μ tanh(v_t/v_mu)·F along t = k × e_r, at the roller's surface point P = p + sign(u)(D/2) e_r on both
+    bodies (v_t the sliding speed of roller on cage there; the two faces' friction lumped at one point).
+    ``multiplicity`` as :class:`PocketContact`'s.
+
+    Internal state ``z`` (n, 4): as :class:`PocketContact`'s, with x the radial penetration.
+
+    Outputs, per physical contact: "force" F·sign(u) [N] (+ when the roller presses the cage outwards);
+    "offset" u [m]; "penetration" max(x, 0) [m]; "penetration_rate" ẋ [m/s]; "approach_speed" v₀ in use [m/s];
+    "friction" the friction force on the roller along t [N].
+    """
+    batched = True
+    n_local = 6
+    compiled_twin = "contact.retention"
+
+    def __init__(self, name, roller, cage, *, pitch_radius, clearance, K_r, restitution, impact_law, v_min, mu,
+                 v_mu, D, multiplicity=1):
+        self.name = name
+        self.dofs = body_dofs(roller, cage)
+        self.pitch_radius = self._per_instance("pitch_radius", pitch_radius, positive=True)
+        self.clearance = self._per_instance("clearance", clearance, nonneg=True)
+        self.K_r = self._per_instance("K_r", K_r, positive=True)
+        self._impact_params(restitution, v_min, impact_law)
+        self.mu = self._per_instance("mu", mu, nonneg=True)
+        self.v_mu = self._per_instance("v_mu", v_mu, positive=True)
+        self.D = self._per_instance("D", D, positive=True)
+        self.multiplicity = _multiplicity(self, multiplicity)
+        self._multi = bool(np.any(self.multiplicity != 1.0))
+
+    def _geometry(self, q, v):
+        qr, qg, vr, vg = q[:3], q[3:], v[:3], v[3:]
+        dx, dy = qr[0] - qg[0], qr[1] - qg[1]
+        rho = _norm(dx, dy)
+        u = rho - self.pitch_radius
+        sg = ad.sign(u)
+        wx, wy = vr[0] - vg[0], vr[1] - vg[1]
+        rho_dot = (dx * wx + dy * wy) / rho
+        return dx, dy, rho, u, sg, ad.abs_(u) - self.clearance, sg * rho_dot
+
+    def _gap(self, q, v):
+        g = self._geometry(q, v)
+        return g[5], g[6]
+
+    def kernel(self, t, fs, q, v, z):
+        vr, vg = v[:3], v[3:]
+        dx, dy, rho, u, sg, pen, pen_dot = self._geometry(q, v)
+        F, v_app = self._impact_force(self.K_r, pen, pen_dot, z)
+        Fu = F * sg
+        ex, ey = dx / rho, dy / rho
+        fnx, fny = -1.0 * Fu * ex, -1.0 * Fu * ey            # −F ∂x/∂p on the roller (the cage: the opposite)
+        half = 0.5 * self.D * sg
+        r_w = (half * ex, half * ey)                          # the roller's surface point on the faces it presses
+        r_wg = (dx + r_w[0], dy + r_w[1])                     # the same point from the cage centre
+        tx, ty = -1.0 * ey, ex
+        Vr = marker_velocity(vr, r_w)
+        Vg = marker_velocity(vg, r_wg)
+        v_t = (Vr[0] - Vg[0]) * tx + (Vr[1] - Vg[1]) * ty
+        f = -1.0 * self.mu * ad.tanh(v_t / self.v_mu) * F
+        fr = point_force(r_w, (f * tx, f * ty))
+        fg = point_force(r_wg, (-1.0 * f * tx, -1.0 * f * ty))
+        forces = [fnx + fr[0], fny + fr[1], fr[2], -1.0 * fnx + fg[0], -1.0 * fny + fg[1], fg[2]]
+        forces = _scaled(forces, self.multiplicity, self._multi)
+        return forces, {"force": Fu, "offset": u, "penetration": ad.pos(pen), "penetration_rate": pen_dot,
+                        "approach_speed": v_app, "friction": f}
 
 
 # --------------------------------------------------------------------------------------------

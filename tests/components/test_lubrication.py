@@ -383,3 +383,57 @@ def test_pan_hamrock_crosses_its_own_films_at_heavy_load():
     w = validity_warnings(si, {"inner": bad, "outer": {**bad, "film_central_ratio_min": 0.99}})
     assert len(w) == 1 and "Pan & Hamrock" in w[0] and "inner planet bearings" in w[0] and "outer" in w[0]
     assert "0.995" in w[0] and "0.0012" in w[0]
+
+
+# ------------------------------------------------------------------------------- limiting shear with temperature
+def _dyson_slope(t_c):
+    """Dyson's pressure slope of τ_L = G∞/4, G∞ = 1.2 p/(2.52 + 0.024 t) − 1e8 Pa (t in °C; Zhou & Hoeprich 1991,
+    eqs. 36–37): 0.25 × 1.2/(2.52 + 0.024 t), by hand."""
+    return 0.3 / (2.52 + 0.024 * t_c)
+
+
+def _ehl_law(**lubricant):
+    from components.bearing import traction
+    p = with_overrides(reference_dpgt(), {"bearing.traction_law": "ehl",
+                                          **{f"lubricant.{k}": v for k, v in lubricant.items()}}).si()
+    return traction(p.bearing, p.lubricant)
+
+
+def test_dyson_limiting_shear_slope_against_dysons_formula():
+    """With γ_L set to Dyson's value at the reference temperature (60 °C: 0.3/3.96), the law gives Dyson's slope at
+    other temperatures: 0.3/3.48 = 0.08621 at 40 °C, 0.3/4.44 = 0.06757 at 80 °C (a value from the source's formula
+    by hand), and the traction law the scene builds carries it; τ_L0 keeps its value."""
+    assert _dyson_slope(40.0) == pytest.approx(0.086207, rel=1e-5)
+    assert _dyson_slope(80.0) == pytest.approx(0.067568, rel=1e-5)
+    ref = _dyson_slope(60.0)
+    for t_c in (40.0, 80.0, 110.0):
+        law = _ehl_law(limiting_shear_law="dyson", limiting_shear_slope=ref, temperature=f"{t_c} degC",
+                       limiting_shear_reference_temperature="60 degC")
+        assert law.gamma_L == pytest.approx(_dyson_slope(t_c), rel=1e-12)
+        assert law.tau_L0 == 2e6
+    # τ_L(p) = τ_L0 + γ_L p: Dyson's rise of the limiting shear between 1 and 2 GPa at 40 °C, 86.2 MPa
+    law = _ehl_law(limiting_shear_law="dyson", limiting_shear_slope=ref, temperature="40 degC")
+    assert law.gamma_L * 1e9 == pytest.approx(0.25 * (1.2 * 2e9 - 1.2 * 1e9) / 3.48, rel=1e-12)
+
+
+def test_constant_limiting_shear_is_the_given_slope_at_every_temperature():
+    """The default law leaves γ_L exactly as given (the reference machine unchanged); the dyson law at its reference
+    temperature gives it back exactly, falls as the oil warms and rises as it cools."""
+    for t in ("20 degC", "60 degC", "95 degC"):
+        assert _ehl_law(temperature=t).gamma_L == 0.07
+    assert _ehl_law(limiting_shear_law="dyson").gamma_L == 0.07
+    warm, cold = (_ehl_law(limiting_shear_law="dyson", temperature=t).gamma_L for t in ("80 degC", "40 degC"))
+    assert warm < 0.07 < cold
+    # the relative slope at the reference temperature: −1/(T − T₀) = −1/165 K
+    h = 1e-3
+    slope = (_ehl_law(limiting_shear_law="dyson", temperature=f"{60 + h} degC").gamma_L
+             - _ehl_law(limiting_shear_law="dyson", temperature=f"{60 - h} degC").gamma_L) / (2 * h)
+    assert slope / 0.07 == pytest.approx(-1.0 / 165.0, rel=1e-6)
+
+
+def test_dyson_pole_above_the_oil_temperature_is_refused():
+    with pytest.raises(ParameterError, match="lubricant.limiting_shear_pole_temperature"):
+        with_overrides(reference_dpgt(), {"lubricant.limiting_shear_law": "dyson",
+                                          "lubricant.limiting_shear_pole_temperature": "70 degC"}).si()
+    # the constant law never reads the pole
+    with_overrides(reference_dpgt(), {"lubricant.limiting_shear_pole_temperature": "70 degC"}).si()

@@ -17,11 +17,13 @@ from mbd.compiled.registry import kind_of
 from mbd.element import evaluate
 from mbd.model import FrameState
 from mbd.elements.contact import (IMPACT_LAWS, GuideContact, HoupertRolling, HydrodynamicLand, LubricantDrag,
-                                  PocketContact, RaceContact, SlideRollTraction, TanhTraction, Traction)
+                                  PocketContact, PocketRetention, RaceContact, SlideRollTraction, TanhTraction,
+                                  Traction)
 
 from tests.support.contact import (C_G, DM, DR, EHL, FILM, K_G, K_HZ, M_ROLLER, N, TANH, assert_matches_reference,
                                    compiled, drag_scene, drag_states, guide_scene, guide_states, pocket_scene,
-                                   pocket_states, race_scene, race_states, stored_speeds)
+                                   pocket_states, race_scene, race_states, retention_scene, retention_states,
+                                   stored_speeds)
 from tests.support.strategies import frame_states
 
 SETTINGS = settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -269,6 +271,36 @@ def test_drag_zero_relative_orbit_has_zero_jacobian():
 def test_every_family_has_kernels():
     kinds = {c: kind_of(c) for c in vars(mbd.elements).values()
              if isinstance(c, type) and str(getattr(c, "compiled_twin", None)).startswith("contact.")}
-    assert set(kinds) == {RaceContact, PocketContact, GuideContact, LubricantDrag}
+    assert set(kinds) == {RaceContact, PocketContact, PocketRetention, GuideContact, LubricantDrag}
     assert kinds[RaceContact].update is None and kinds[LubricantDrag].update is None
-    assert kinds[PocketContact].update is not None and kinds[GuideContact].update is not None
+    assert all(kinds[c].update is not None for c in (PocketContact, PocketRetention, GuideContact))
+
+
+# ------------------------------------------------------------------------------------------ retention
+@SETTINGS
+@given(state=retention_states(), z=impact_z(), fs=frame_states(), law=LAWS, mult=MULTS,
+       fast=st.one_of(st.none(), st.lists(st.floats(-5.0, 5.0), min_size=N, max_size=N)),
+       mu=st.sampled_from([0.0, 0.1]))
+def test_retention_matches_reference(state, z, fs, law, mult, fast, mu):
+    state = list(state)
+    if fast is not None:          # fast radial motion: separation clips the force to zero
+        state[6] = fast
+    qf, vf, elem, _ = retention_scene(*state, mu=mu, multiplicity=mult)
+    assert_matches_reference(_with_law(elem, law), fs, qf, vf, z)
+
+
+@SETTINGS
+@given(data=st.data(), z=cached_states())
+def test_retention_update_matches_update_internal(data, z):
+    s0, s1 = data.draw(retention_states()), data.draw(retention_states())
+    q0, v0, elem, _ = retention_scene(*s0)
+    q1, v1, _, _ = retention_scene(*s1[:2], s0[2], *s1[3:])      # the same pockets
+    twin = kind_of(type(elem))
+    P, G = twin.pack(elem)
+    loc = lambda a: np.ascontiguousarray(a[elem.dofs])    # noqa: E731
+    cols = lambda a: list(a[elem.dofs].T)                  # noqa: E731
+    fs0, fs1 = data.draw(frame_states()), data.draw(frame_states())
+    for zz in (np.zeros((N, 4)), z):
+        ref = elem.update_internal(zz.copy(), 0.1, 0.1 + 1e-6, fs0, fs1, cols(q0), cols(v0), cols(q1), cols(v1))
+        got = twin.update(zz.copy(), 0.1, 0.1 + 1e-6, loc(q0), loc(v0), loc(q1), loc(v1), P, G)
+        np.testing.assert_array_equal(got, ref)          # the radial gap is bitwise the reference's

@@ -91,14 +91,17 @@ def test_compiled_outputs_equal_the_reference_on_a_faulty_machine(frame):
     ({"bearing.traction_law": "tanh"}, {}),
     ({"bearing.traction_law": "slide_roll"}, {"cage": "none"}),
     ({}, {"bearings": "linear"}),                                             # no compiled family
-], ids=["double_row_oil_land", "tanh", "slide_roll_no_cage", "linear_bearings"])
+    ({"bearing.cage.guidance": "rollers"}, {}),                               # the pockets' retention, no land
+], ids=["double_row_oil_land", "tanh", "slide_roll_no_cage", "linear_bearings", "roller_centred_cage"])
 def test_compiled_outputs_equal_the_reference_for_each_law_variant(overrides, options):
     """The law variants the kernels branch on: both rows of a double-row bearing (the outputs are per physical
     roller, the forces times two), the hydrodynamic cage land (its shear in the friction), the tanh and
-    slide-to-roll traction laws, no cage, and linear bearings (every output from the numpy kernels)."""
+    slide-to-roll traction laws, no cage, linear bearings (every output from the numpy kernels) and a roller-centred
+    cage (the pockets' radial retention instead of the land)."""
     bs = build(with_overrides(reference_dpgt(3, "forward"), overrides), **options)
     compiled, n = _compare(bs)
-    want = {"race_inner", "race_outer"} | ({"pocket", "guide"} if options.get("cage") != "none" else set())
+    centring = "pocket_retention" if overrides.get("bearing.cage.guidance") == "rollers" else "guide"
+    want = {"race_inner", "race_outer"} | ({"pocket", centring} if options.get("cage") != "none" else set())
     assert compiled == (set() if options.get("bearings") == "linear" else want)
     assert n >= (0 if options.get("bearings") == "linear" else 10)
 

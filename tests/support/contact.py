@@ -16,7 +16,7 @@ from hypothesis import HealthCheck, settings, strategies as st
 from mbd.compiled.registry import kind_of
 from mbd.element import evaluate
 from mbd.elements.contact import (DryLand, EHLTraction, ExactRestitution, GuideContact, LubricantDrag, PocketContact,
-                                  RaceContact, SlideRollTraction, TanhTraction, restitution_lambda)
+                                  PocketRetention, RaceContact, SlideRollTraction, TanhTraction, restitution_lambda)
 from mbd.model import FrameState
 
 # the reference bearing (docs/parameters.md)
@@ -260,6 +260,36 @@ def pocket_states(draw):
     v_circ = lst(floats(-0.05, 0.05))
     v_rad = lst(floats(-0.5, 0.5))
     spins = lst(floats(-3000, 3000))
+    return pose, vel, pockets, offsets, radial, v_circ, v_rad, spins
+
+
+# retention (a roller-centred cage's pocket, radially): body 0 cage, bodies 1..n rollers
+C_R = 0.15e-3                      # [m] radial pocket play of a roller-centred cage (the reference bearing's)
+
+
+def retention_scene(pose, vel, pockets, offsets, radial, v_circ, v_rad, spins, mu=0.1, restitution=E_SET,
+                    multiplicity=1):
+    """Rollers at their pockets' angles (+ offsets along the pitch circle) and radial offsets ``radial`` from the
+    pitch circle, with circumferential and radial speeds relative to the cage and spins."""
+    qf, vf, _, psi = pocket_scene(pose, vel, pockets, offsets, radial, v_circ, v_rad, spins, mu=mu,
+                                  restitution=restitution, multiplicity=multiplicity)
+    n = len(pockets)
+    elem = PocketRetention("retention", np.arange(1, n + 1), 0, pitch_radius=DM / 2, clearance=C_R, K_r=K_P,
+                           restitution=restitution, impact_law=ExactRestitution(), v_min=V_MIN, mu=mu, v_mu=0.05,
+                           D=DR, multiplicity=multiplicity)
+    return qf, vf, elem, psi
+
+
+@st.composite
+def retention_states(draw):
+    """As :func:`pocket_states`, the radial offsets inside or beyond the radial play C_R, either side."""
+    pose, vel, pockets, offsets, _, v_circ, v_rad, spins = draw(pocket_states())
+    lst = lambda s: draw(st.lists(s, min_size=N, max_size=N))  # noqa: E731
+    inside = lst(st.booleans())
+    sgn = lst(st.sampled_from([-1.0, 1.0]))
+    a_in = lst(floats(0.0, C_R - 1e-6))
+    a_out = lst(floats(C_R + 1e-6, C_R + 5e-5))
+    radial = [s * (i_ if c else o) for s, c, i_, o in zip(sgn, inside, a_in, a_out)]
     return pose, vel, pockets, offsets, radial, v_circ, v_rad, spins
 
 
