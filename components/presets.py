@@ -127,6 +127,8 @@ def reference_bearing() -> BearingParams:
         land_law=assumed("dry", "the source's model; 'hydrodynamic' runs the land in the oil film"),
         land_width=assumed("4 mm", "two side rails of about 2 mm"),
         land_min_film=assumed("1 um", "a few composite roughnesses"),
+        pocket_law=assumed("dry", "the source's model; 'hydrodynamic' runs the rollers in oiled pockets"),
+        pocket_min_film=assumed("1 um", "a few composite roughnesses, as the land's"),
         impact_law=derived("exact", "lambda(e) from ln((1+lambda)/(1-lambda e)) = lambda (1+e): the set e holds "
                                     "at any approach speed (docs/model.md §8.4)"),
     )

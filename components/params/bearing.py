@@ -44,6 +44,12 @@ class CageParams(Params["CageSI"]):
                                     "film, short journal bearing)", choices=("dry", "hydrodynamic"))
     land_width: Quantity = positive("length", "axial width of the guide lands (both sides together), for the film")
     land_min_film: Quantity = positive("length", "thinnest film the hydrodynamic land keeps before the solid contact")
+    pocket_law: str = param("choice", "cage pocket: dry (solid contact with wall friction only) or hydrodynamic (an "
+                                      "oil film on both pocket walls: wedge, squeeze film and shear of a rigid "
+                                      "cylinder near a plane; the solid contact below its thinnest film)",
+                            choices=("dry", "hydrodynamic"))
+    pocket_min_film: Quantity = positive("length", "thinnest film the hydrodynamic pocket keeps (below it the film "
+                                                   "is taken at this gap and the solid contact carries)")
 
 
 @si_of(CageParams)
@@ -63,6 +69,8 @@ class CageSI(SI):
     land_law: str
     land_width: float
     land_min_film: float
+    pocket_law: str
+    pocket_min_film: float
 
 
 @dataclass(frozen=True, kw_only=True)
