@@ -47,7 +47,8 @@ def film_states(draw):
     # moving with its pocket (V = 0 up to round-off) is the deterministic test below
     v_circ = lst(st.one_of(floats(-0.05, -1e-4), floats(1e-4, 0.05)))
     v_rad = lst(floats(-0.5, 0.5))
-    spins = lst(floats(-3000, 3000))
+    # the wedge load's |ũ| has its kink at ũ = 0 (the same): the roller turns relative to its cage
+    spins = [vel[2] + r for r in lst(st.one_of(floats(-3000, -1.0), floats(1.0, 3000)))]
     return pose, vel, pockets, offsets, radial, v_circ, v_rad, spins
 
 
@@ -267,3 +268,33 @@ def test_cage_drag_jacobian_and_compiled():
     assert_balanced(elem, qf, vf)
     for fs in (FS,):
         assert_matches_reference(elem, fs, qf, vf)
+
+
+# ------------------------------------------------------------------------------ a roller in an oiled pocket
+@pytest.mark.parametrize("engine", ["numpy", "compiled"])
+def test_a_spinning_roller_pushed_at_its_wall_settles_at_martins_gap(engine):
+    """A roller held at Δω = 600 rad/s (a speed drive) in a fixed cage's pocket, its centre held radially (a
+    support along x), pushed by a constant 1 N along the pitch circle: it settles where the two walls' wedge loads
+    carry the push, F = 4.896 η (RΔω/2) R l [1/h − 1/(2C_p − h)] (Martin's published constant, solved for h
+    here), the squeeze film damping the approach."""
+    import mbd
+    from mbd.elements import ForceSource, GroundSupport, SpeedDrive
+    F, dw, rm = 1.0, 600.0, DM / 2
+    h = brentq(lambda h: 4.896 * ETA * (0.5 * R * dw) * R * LR * (1 / h - 1 / (2 * C_P - h)) - F, 1e-7, C_P)
+    mb = mbd.ModelBuilder()
+    cage = mb.add_body("cage", 0.04, 1.5e-5, fixed=True)
+    m_r = 7800 * np.pi * R ** 2 * LR
+    roller = mb.add_body("roller", m_r, m_r * R ** 2 / 2, pose=(rm, 0.0, 0.0))
+    mb.add(PocketFilm("pocket_film", [roller.index], cage.index, pocket_angle=0.0, pitch_radius=rm, clearance=C_P,
+                      D=DR, length=LR, eta=ETA, min_film=H_MIN))
+    mb.add(GroundSupport("radial", [roller.index], kx=1e7, cx=50.0, ky=0.0, cy=0.0, anchor=(rm, 0.0)))
+    mb.add(ForceSource("push", [roller.index], (0.0, F)))
+    mb.add(SpeedDrive("spin", roller.index, dw, k=50.0, c=1.0))
+    model = mb.build()
+    assert model.ndof == 3                       # the roller's x, y, θ
+    res = mbd.simulate(model, np.array([rm, 0.0, 0.0]), np.array([0.0, 0.0, dw]), 0.01, stepper=mbd.PRODUCTION.stepper(),
+                       controller=mbd.PRODUCTION.controller(), progress=False, engine=engine)
+    assert res.engine == engine
+    out = mbd.System(model).outputs(res.state.t, res.state.q, res.state.v, res.state.z)["pocket_film"]
+    assert out["gap"][0] == pytest.approx(h, rel=1e-3)
+    assert out["force"][0] == pytest.approx(F, rel=1e-3)
