@@ -910,14 +910,14 @@ def _film_wall(w, C, hmin, R, el, s, s_dot, v_c, dw):
     h = C - w * s
     act = h > hmin
     hb = h if act else hmin
-    root = np.sqrt(2.0 * R / hb)
+    rr = R * (1.0 / hb)                         # the reference's reciprocal products, in its order
+    root = np.sqrt(2.0 * rr)
     ue = -0.5 * v_c - (0.5 * w) * R * dw
     du = v_c - w * R * dw
     V = w * s_dot
-    rr = R / hb
     srr = np.sqrt(rr)
     Vp = V if V > 0.0 else 0.0
-    W = (_PF_W * el * R) * abs(ue) / hb + (_PF_S * el) * rr * srr * Vp
+    W = (_PF_W * el) * abs(ue) * rr + (_PF_S * el) * rr * srr * Vp
     poi = (_PF_P * el) * ue * root
     T = -1.0 * (_PF_C * el) * du * root + poi
     return W, T, poi, act, hb, root, ue, du, V, rr, srr, Vp
@@ -932,7 +932,7 @@ def _dfilm_wall(w, R, el, ds, ds_dot, dv_c, ddw, act, hb, root, ue, du, V, rr, s
     ddu = dv_c - w * R * ddw
     drr = -rr * dhb / hb
     dVp = w * ds_dot if V > 0.0 else (0.5 * w * ds_dot if V == 0.0 else 0.0)
-    dW = (_PF_W * el * R) * (_sign(ue) * due / hb - abs(ue) * dhb / (hb * hb)) \
+    dW = (_PF_W * el) * (_sign(ue) * due * rr + abs(ue) * drr) \
         + (_PF_S * el) * (1.5 * srr * drr * Vp + rr * srr * dVp)
     dpoi = (_PF_P * el) * (due * root + ue * droot)
     dT = -1.0 * (_PF_C * el) * (ddu * root + du * droot) + dpoi
@@ -951,12 +951,14 @@ def evaluate_pocket_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         vg0, vg1, vg2 = vl[i, 3], vl[i, 4], vl[i, 5]
         dx, dy = xr - xg, yr - yg
         rho2 = dx * dx + dy * dy + _ETA2
+        inv_r2 = 1.0 / rho2
+        inv_r = 1.0 / np.sqrt(rho2)
         rho = np.sqrt(rho2)
-        ex, ey = dx / rho, dy / rho
+        ex, ey = dx * inv_r, dy * inv_r
         s = rm * _wrap(np.arctan2(dy, dx) - thg - psi)
         wx, wy = vr0 - vg0, vr1 - vg1
         num = dx * wy - dy * wx
-        s_dot = rm * (num / rho2 - vg2)
+        s_dot = rm * (num * inv_r2 - vg2)
         v_c = wx * ex + wy * ey
         dw = vr2 - vg2
         a = _film_wall(1.0, C, hmin, R, el, s, s_dot, v_c, dw)
@@ -972,7 +974,7 @@ def evaluate_pocket_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             cpl = (w * 2.0) * R * poi
             f0, f1, f2 = f0 + Tx, f1 + Ty, f2 + (rwx * Ty - rwy * Tx) + cpl
             f3, f4, f5 = f3 - Tx, f4 - Ty, f5 + (rgx * (-Ty) - rgy * (-Tx)) - cpl
-        fnx, fny = N * rm * dy / rho2, -N * rm * dx / rho2
+        fnx, fny = N * rm * dy * inv_r2, -1.0 * N * rm * dx * inv_r2
         _write(F, Jq, Jv, i, -1, mult, f0 + fnx, f1 + fny, f2, f3 - fnx, f4 - fny, f5 + N * rm)
         if not jac:
             continue
