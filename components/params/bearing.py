@@ -207,7 +207,8 @@ class BearingParams(Params["BearingSI"]):
                               choices=("tanh", "slide_roll", "ehl"))
     drag_law: str = param("choice", "lubricant drag on the rollers: inertial (quadratic drag on the orbit, C_d "
                                     "constant) or viscous (C_d(Re) of a cylinder and a viscous moment on the "
-                                    "roller spin, with the oil-air mixture's viscosity)",
+                                    "roller spin, with the oil-air mixture's viscosity, and the mixture's moment "
+                                    "on the cage's faces)",
                           choices=("inertial", "viscous"))
     rolling_resistance: str = param("choice", "hydrodynamic rolling resistance of the loaded roller-raceway "
                                               "contacts: none, or houpert (Biboulet-Houpert's fully flooded "
