@@ -173,3 +173,24 @@ def test_the_scenes_build_the_oiled_pocket_and_the_cage_drag_when_asked():
     with pytest.raises(ParameterError, match=r"^bearing\.cage\.pocket_law"):
         build_bearing_rig(b, radial_load=2000.0, outer_speed=300.0, lubricant=None,
                           options=SceneOptions(cage="free", drag=False))
+
+
+def test_the_pocket_brake_of_a_centred_spinning_roller_is_both_walls_shear():
+    """components.pocket_brake at the oiled rig's start (rollers centred in their pockets, orbiting with the cage, spinning
+    at Δω in it): each roller is braked by −M of both walls, M = 2R²ηl|Δω|√(2R/C_p)(π/2 + γ_e + c_P/2)
+    (docs/model.md §8.5), the solid contact open; the dry pockets brake nothing there."""
+    from components.pocket_brake import pocket_brake
+    ref = reference_bearing()
+    lub = reference_dpgt().lubricant.replace(temperature="40 degC").si()
+    for law in ("hydrodynamic", "dry"):
+        b = ref.replace(cage=ref.cage.replace(pocket_law=law)).si()
+        built = build_bearing_rig(b, radial_load=2000.0, outer_speed=300.0, lubricant=lub,
+                                  options=SceneOptions(cage="free", drag=True))
+        m = built.model
+        qf, vf = m.full(0.0, built.q0, built.v0)
+        brake, touch = pocket_brake(m, 0.0, qf, vf)
+        assert not touch.any()
+        R, dw = b.roller_diameter / 2, abs(built.bearing_handles.omega_roller - built.bearing_handles.omega_cage)
+        M = 2 * R ** 2 * lub.oil_viscosity * b.roller_length * dw * np.sqrt(2 * R / b.cage.pocket_clearance) \
+            * (np.pi / 2 + 0.443554 + 3.25345 / 2)
+        np.testing.assert_allclose(brake, M if law == "hydrodynamic" else 0.0, rtol=1e-5, atol=1e-15)
