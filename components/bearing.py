@@ -12,6 +12,7 @@ import numpy as np
 
 from mbd.elements import BodySpring, SlopeGyroscopic
 from mbd.elements.sliced import SlicedRaceContact, iso_16281_stiffness, slice_stations
+from mbd.elements.pocket_film import CageDrag, PocketFilm
 from mbd.elements.contact import (IMPACT_LAWS, ROLLING_LAWS, TRACTION_LAWS, DryLand, EHLTraction, GuideContact,
                                   HoupertRolling, HydrodynamicLand, LubricantDrag, PocketContact, PocketRetention,
                                   RaceContact,
@@ -39,6 +40,8 @@ class BearingHandles:
     pocket: slice | None = None
     retention: slice | None = None            # a roller-centred cage's radial pocket retention
     guide: slice | None = None
+    pocket_film: slice | None = None          # the pockets' oil film (bearing.cage.pocket_law = "hydrodynamic")
+    cage_drag: slice | None = None            # the mixture's drag on the cage (bearing.drag_law = "viscous")
     cage: str | None = None
     spring: slice | None = None               # the linear bearing's spring
     omega_cage: float | None = None           # pure-rolling start speeds [rad/s]
@@ -218,7 +221,23 @@ def _add_drag_and_cage(scene, tag, b, names, psi, wm, pin_body, marker, outer_bo
     if opt.cage != "none":
         handles = replace(handles, **_add_cage(scene, tag, b, names, psi, pin_xy, pin_vel, wm, outer_body,
                                                opt.cage == "held", lubricant))
+        if opt.drag and b.drag_law == "viscous" and opt.cage != "held":
+            handles = replace(handles, cage_drag=_add_cage_drag(scene, b, handles.cage, pin_body, lubricant))
     return handles
+
+
+def cage_faces(b: BearingSI) -> tuple[float, float]:
+    """(inner, outer) radius [m] of the cage's side faces in the mixture: annuli from the pin's raceway to the bore,
+    (d_m − D)/2 … (d_m + D)/2 — the most a bore-guided cage's side rings can span (an upper bound on their area)."""
+    return 0.5 * (b.pitch_diameter - b.roller_diameter), 0.5 * (b.pitch_diameter + b.roller_diameter)
+
+
+def _add_cage_drag(scene, b, cage, pin_body, lubricant):
+    """The mixture's moment on the cage's faces, against its rotation relative to the pin's body (docs/model.md
+    §8.7): Cochran's free disk with the mixture's density and viscosity."""
+    rho_e, eta_e = mixture(lubricant)
+    fam = scene.family(FAMILY["cage_drag"], CageDrag, ("cage", "carrier"))
+    return fam.add(1, cage=[cage], carrier=[pin_body], coef=CageDrag.coefficient(rho_e, eta_e, *cage_faces(b)))
 
 
 def sliced_law(b: BearingSI) -> dict:
@@ -324,6 +343,14 @@ def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel,
                          clearance=c.pocket_clearance, K_p=c.pocket_stiffness, restitution=c.restitution,
                          v_min=c.impact_speed_floor, mu=c.pocket_friction, v_mu=c.friction_speed, D=D,
                          multiplicity=b.rows)
+    films = None
+    if c.pocket_law == "hydrodynamic":      # the oil film on the pocket walls (docs/model.md §8.5)
+        if lubricant is None:
+            raise ParameterError.at("bearing.cage.pocket_law", "'hydrodynamic' needs a lubricant; this scene has none")
+        film = scene.family(FAMILY["pocket_film"], PocketFilm, ("roller", "cage"))
+        films = film.add(Z, roller=names, cage=[cage] * Z, pocket_angle=psi, pitch_radius=0.5 * b.pitch_diameter,
+                         clearance=c.pocket_clearance, D=D, length=b.roller_length, eta=lubricant.oil_viscosity,
+                         min_film=c.pocket_min_film, multiplicity=b.rows)
     guides = retention = None     # a held cage has no guide land
     if not held and c.guidance == "rollers":     # roller-centred: the pockets hold the rollers radially, no land
         fam = scene.family(FAMILY["retention"], PocketRetention, ("roller", "cage"), impact_law=law)
@@ -338,4 +365,4 @@ def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel,
                            K_g=c.guide_stiffness, restitution=c.restitution, v_min=c.impact_speed_floor,
                            mu=c.guide_friction, v_mu=c.friction_speed,
                            land_radius=0.5 * (b.pitch_diameter + D))
-    return {"pocket": pockets, "retention": retention, "guide": guides, "cage": cage}
+    return {"pocket": pockets, "retention": retention, "guide": guides, "cage": cage, "pocket_film": films}

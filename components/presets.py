@@ -132,6 +132,8 @@ def reference_bearing() -> BearingParams:
                                        "both ways, e.g. SKF's MA outer-ring and M roller centred)"),
         pocket_radial_clearance=assumed("0.15 mm", "radial play of a roller in a roller-centred cage's pocket, "
                                                    "the order of its circumferential play", span=Span("0.05 mm", "0.3 mm", "pocket shapes of roller-centred machined cages")),
+        pocket_law=assumed("dry", "the source's model; 'hydrodynamic' runs the rollers in oiled pockets"),
+        pocket_min_film=assumed("1 um", "a few composite roughnesses, as the land's"),
         impact_law=derived("exact", "lambda(e) from ln((1+lambda)/(1-lambda e)) = lambda (1+e): the set e holds "
                                     "at any approach speed (docs/model.md §8.4)"),
     )

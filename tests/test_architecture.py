@@ -585,7 +585,8 @@ def _shipped_scenes():
         yield f"gear quality: grade {grade}", lambda ov=ov: dpgt(ov)
     for key, cls, field in (("bearing.traction_law", BearingParams, "traction_law"),
                             ("bearing.cage.impact_law", CageParams, "impact_law"),
-                            ("bearing.cage.land_law", CageParams, "land_law")):
+                            ("bearing.cage.land_law", CageParams, "land_law"),
+                            ("bearing.cage.pocket_law", CageParams, "pocket_law")):
         for law in cls._spec(field).choices:
             yield f"{key} = {law}", lambda ov={key: law}: dpgt(ov)
     for name in CASES:

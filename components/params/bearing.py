@@ -50,6 +50,12 @@ class CageParams(Params["CageSI"]):
                           choices=("outer_land", "rollers"))
     pocket_radial_clearance: Quantity = nonneg("length", "radial play C_r of a roller in its pocket before the "
                                                          "bars' converging faces hold it (guidance rollers)")
+    pocket_law: str = param("choice", "cage pocket: dry (solid contact with wall friction only) or hydrodynamic (an "
+                                      "oil film on both pocket walls: wedge, squeeze film and shear of a rigid "
+                                      "cylinder near a plane; the solid contact below its thinnest film)",
+                            choices=("dry", "hydrodynamic"))
+    pocket_min_film: Quantity = positive("length", "thinnest film the hydrodynamic pocket keeps (below it the film "
+                                                   "is taken at this gap and the solid contact carries)")
 
 
 @si_of(CageParams)
@@ -71,6 +77,8 @@ class CageSI(SI):
     land_min_film: float
     guidance: str
     pocket_radial_clearance: float
+    pocket_law: str
+    pocket_min_film: float
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -207,7 +215,8 @@ class BearingParams(Params["BearingSI"]):
                               choices=("tanh", "slide_roll", "ehl"))
     drag_law: str = param("choice", "lubricant drag on the rollers: inertial (quadratic drag on the orbit, C_d "
                                     "constant) or viscous (C_d(Re) of a cylinder and a viscous moment on the "
-                                    "roller spin, with the oil-air mixture's viscosity)",
+                                    "roller spin, with the oil-air mixture's viscosity, and the mixture's moment "
+                                    "on the cage's faces)",
                           choices=("inertial", "viscous"))
     rolling_resistance: str = param("choice", "hydrodynamic rolling resistance of the loaded roller-raceway "
                                               "contacts: none, or houpert (Biboulet-Houpert's fully flooded "

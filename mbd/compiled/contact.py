@@ -46,13 +46,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..elements import ehl
+from ..elements import ehl, pocket_film
 from ..elements.contact import (DryLand, EHLTraction, GuideContact, HoupertRolling, HydrodynamicLand, LubricantDrag,
                                 PocketContact, PocketRetention, RaceContact, SlideRollTraction, TanhTraction)
 
 __all__ = ["traction_g", "pack_race", "evaluate_race", "outputs_race", "pack_pocket", "evaluate_pocket", "outputs_pocket",
            "update_pocket", "pack_retention", "evaluate_retention", "outputs_retention", "update_retention",
-           "pack_guide", "evaluate_guide", "outputs_guide", "update_guide", "pack_drag", "evaluate_drag", "TRACTION_IDS", "RACE_OUTPUTS", "POCKET_OUTPUTS", "RETENTION_OUTPUTS", "GUIDE_OUTPUTS"]
+           "pack_guide", "evaluate_guide", "outputs_guide", "update_guide", "pack_drag", "evaluate_drag", "pack_pocket_film", "evaluate_pocket_film",
+           "pack_cage_drag", "evaluate_cage_drag", "TRACTION_IDS", "RACE_OUTPUTS", "POCKET_OUTPUTS", "RETENTION_OUTPUTS", "GUIDE_OUTPUTS"]
 
 _ETA2 = 1e-24          # the reference's η² (mbd.elements.contact._ETA2)
 _TWO_PI = 2.0 * np.pi
@@ -997,3 +998,155 @@ def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
             else:
                 _write(F, Jq, Jv, i, j, mult, dFx, dFy, 0.0, -dFx, -dFy, dMb)
 
+
+
+# ----------------------------------------------------------------------------------- pocket film, cage drag
+# ``PocketFilm`` P (n, 8): pocket_angle ψ, pitch_radius, clearance C_p, D, η·l, min_film, multiplicity, 0;  G (0,)
+# ``CageDrag``   P (n, 1): coef (of sign(Δω)|Δω|^(3/2));  G (0,)
+# (mbd.elements.pocket_film; stateless, no compiled outputs: theirs come from the numpy kernels)
+_PF_W, _PF_S = pocket_film.WEDGE_LOAD, pocket_film.SQUEEZE_LOAD
+_PF_C, _PF_P = pocket_film.COUETTE_EXTENT, pocket_film.POISEUILLE_SHEAR
+
+
+def pack_pocket_film(elem):
+    _require(elem, pocket_film.PocketFilm)
+    P = _rows(elem.pocket_angle, elem.pitch_radius, elem.clearance, elem.D, elem.eta * elem.length, elem.min_film,
+              elem.multiplicity, np.zeros(elem.n))
+    return P, np.zeros(0)
+
+
+def pack_cage_drag(elem):
+    _require(elem, pocket_film.CageDrag)
+    return _rows(elem.coef), np.zeros(0)
+
+
+@njit(cache=True)
+def _film_wall(w, C, hmin, R, el, s, s_dot, v_c, dw):
+    """One wall's film (PocketFilm.kernel): W (its normal load), T (the roller's force along e_r), poi (the
+    Poiseuille shear), and what the differentials need."""
+    h = C - w * s
+    act = h > hmin
+    hb = h if act else hmin
+    rr = R * (1.0 / hb)                         # the reference's reciprocal products, in its order
+    root = np.sqrt(2.0 * rr)
+    ue = -0.5 * v_c - (0.5 * w) * R * dw
+    du = v_c - w * R * dw
+    V = w * s_dot
+    srr = np.sqrt(rr)
+    Vp = V if V > 0.0 else 0.0
+    W = (_PF_W * el) * abs(ue) * rr + (_PF_S * el) * rr * srr * Vp
+    poi = (_PF_P * el) * ue * root
+    T = -1.0 * (_PF_C * el) * du * root + poi
+    return W, T, poi, act, hb, root, ue, du, V, rr, srr, Vp
+
+
+@njit(cache=True)
+def _dfilm_wall(w, R, el, ds, ds_dot, dv_c, ddw, act, hb, root, ue, du, V, rr, srr, Vp):
+    """Differentials (dW, dT, dpoi) of :func:`_film_wall` along one direction."""
+    dhb = -w * ds if act else 0.0
+    droot = -0.5 * root * dhb / hb
+    due = -0.5 * dv_c - (0.5 * w) * R * ddw
+    ddu = dv_c - w * R * ddw
+    drr = -rr * dhb / hb
+    dVp = w * ds_dot if V > 0.0 else (0.5 * w * ds_dot if V == 0.0 else 0.0)
+    dW = (_PF_W * el) * (_sign(ue) * due * rr + abs(ue) * drr) \
+        + (_PF_S * el) * (1.5 * srr * drr * Vp + rr * srr * dVp)
+    dpoi = (_PF_P * el) * (due * root + ue * droot)
+    dT = -1.0 * (_PF_C * el) * (ddu * root + du * droot) + dpoi
+    return dW, dT, dpoi
+
+
+@njit(cache=True)
+def evaluate_pocket_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    """The pocket's oil film (docs/model.md §8.5): both walls' wedge and squeeze loads in the pocket's potential
+    form, their shear at the wall points with the Poiseuille couple."""
+    for i in range(ql.shape[0]):
+        psi, rm, C, D, el, hmin, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
+        R = 0.5 * D
+        xr, yr, xg, yg, thg = ql[i, 0], ql[i, 1], ql[i, 3], ql[i, 4], ql[i, 5]
+        vr0, vr1, vr2 = vl[i, 0], vl[i, 1], vl[i, 2]
+        vg0, vg1, vg2 = vl[i, 3], vl[i, 4], vl[i, 5]
+        dx, dy = xr - xg, yr - yg
+        rho2 = dx * dx + dy * dy + _ETA2
+        inv_r2 = 1.0 / rho2
+        inv_r = 1.0 / np.sqrt(rho2)
+        rho = np.sqrt(rho2)
+        ex, ey = dx * inv_r, dy * inv_r
+        s = rm * _wrap(np.arctan2(dy, dx) - thg - psi)
+        wx, wy = vr0 - vg0, vr1 - vg1
+        num = dx * wy - dy * wx
+        s_dot = rm * (num * inv_r2 - vg2)
+        v_c = wx * ex + wy * ey
+        dw = vr2 - vg2
+        a = _film_wall(1.0, C, hmin, R, el, s, s_dot, v_c, dw)
+        b = _film_wall(-1.0, C, hmin, R, el, s, s_dot, v_c, dw)
+        N = a[0] - b[0]
+        f0, f1, f2, f3, f4, f5 = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        for k in range(2):
+            w = 1.0 if k == 0 else -1.0
+            T, poi = (a[1], a[2]) if k == 0 else (b[1], b[2])
+            rwx, rwy = -w * R * ey, w * R * ex
+            rgx, rgy = dx + rwx, dy + rwy
+            Tx, Ty = T * ex, T * ey
+            cpl = (w * 2.0) * R * poi
+            f0, f1, f2 = f0 + Tx, f1 + Ty, f2 + (rwx * Ty - rwy * Tx) + cpl
+            f3, f4, f5 = f3 - Tx, f4 - Ty, f5 + (rgx * (-Ty) - rgy * (-Tx)) - cpl
+        fnx, fny = N * rm * dy * inv_r2, -1.0 * N * rm * dx * inv_r2
+        _write(F, Jq, Jv, i, -1, mult, f0 + fnx, f1 + fny, f2, f3 - fnx, f4 - fny, f5 + N * rm)
+        if not jac:
+            continue
+        r2 = dx * dx + dy * dy                   # ad.arctan2's derivative: no η
+        for j in range(12):
+            dxr, dyr, _, dxg, dyg, dthg, dvr0, dvr1, dvr2, dvg0, dvg1, dvg2 = _unit(j)
+            ddx, ddy = dxr - dxg, dyr - dyg
+            ds = rm * (ddy * (dx / r2) - ddx * (dy / r2) - dthg)
+            drho2 = 2.0 * (dx * ddx + dy * ddy)
+            drho = 0.5 * drho2 / rho
+            dex, dey = (ddx - ex * drho) / rho, (ddy - ey * drho) / rho
+            dwx, dwy = dvr0 - dvg0, dvr1 - dvg1
+            dnum = ddx * wy + dx * dwy - ddy * wx - dy * dwx
+            ds_dot = rm * ((dnum - num * drho2 / rho2) / rho2 - dvg2)
+            dv_c = dwx * ex + wx * dex + dwy * ey + wy * dey
+            ddw = dvr2 - dvg2
+            da = _dfilm_wall(1.0, R, el, ds, ds_dot, dv_c, ddw, a[3], a[4], a[5], a[6], a[7], a[8], a[9], a[10],
+                             a[11])
+            db = _dfilm_wall(-1.0, R, el, ds, ds_dot, dv_c, ddw, b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10],
+                             b[11])
+            dN = da[0] - db[0]
+            g0, g1, g2, g3, g4, g5 = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            for k in range(2):
+                w = 1.0 if k == 0 else -1.0
+                T, dT, dpoi = (a[1], da[1], da[2]) if k == 0 else (b[1], db[1], db[2])
+                rwx, rwy = -w * R * ey, w * R * ex
+                drwx, drwy = -w * R * dey, w * R * dex
+                rgx, rgy = dx + rwx, dy + rwy
+                drgx, drgy = ddx + drwx, ddy + drwy
+                Tx, Ty = T * ex, T * ey
+                dTx, dTy = dT * ex + T * dex, dT * ey + T * dey
+                dcpl = (w * 2.0) * R * dpoi
+                g0, g1 = g0 + dTx, g1 + dTy
+                g2 = g2 + _d_cross(rwx, rwy, drwx, drwy, Tx, Ty, dTx, dTy) + dcpl
+                g3, g4 = g3 - dTx, g4 - dTy
+                g5 = g5 - _d_cross(rgx, rgy, drgx, drgy, Tx, Ty, dTx, dTy) - dcpl
+            dfnx = rm * (dN * dy + N * ddy) / rho2 - fnx * drho2 / rho2
+            dfny = -rm * (dN * dx + N * ddx) / rho2 - fny * drho2 / rho2
+            _write(F, Jq, Jv, i, j, mult, g0 + dfnx, g1 + dfny, g2, g3 - dfnx, g4 - dfny, g5 + dN * rm)
+
+
+@njit(cache=True)
+def evaluate_cage_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    """The mixture's moment on the cage's faces (docs/model.md §8.7): −coef·sign(Δω)|Δω|^(3/2), Δω = ω_cage −
+    ω_carrier, on the cage; the opposite on the carrier."""
+    for i in range(ql.shape[0]):
+        coef = P[i, 0]
+        dw = vl[i, 2] - vl[i, 5]
+        M = -coef * _sign(dw) * abs(dw) ** 1.5
+        _write(F, Jq, Jv, i, -1, 1.0, 0.0, 0.0, M, 0.0, 0.0, -M)
+        if not jac:
+            continue
+        dM = -1.5 * coef * abs(dw) ** 0.5
+        for a in range(6):
+            for b in range(6):
+                Jq[i, a, b] = 0.0
+                Jv[i, a, b] = 0.0
+        Jv[i, 2, 2], Jv[i, 2, 5], Jv[i, 5, 2], Jv[i, 5, 5] = dM, -dM, -dM, dM

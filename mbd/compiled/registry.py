@@ -46,7 +46,7 @@ class Kind:
 
 
 (_RACE, _POCKET, _GUIDE, _DRAG, _MESH, _SUPPORT, _BODY_SPRING, _TORSION, _TORQUE, _FORCE, _SPEED, _GYRO,
- _COORD_SPRING, _SLICED_RACE, _SLICED_MESH, _RETENTION) = range(16)
+ _COORD_SPRING, _SLICED_RACE, _SLICED_MESH, _RETENTION, _POCKET_FILM, _CAGE_DRAG) = range(18)
 
 # compiled twin (as the families declare it) -> its id in the dispatch below
 KIND_IDS = {
@@ -57,6 +57,7 @@ KIND_IDS = {
     "generic.torque_source": _TORQUE, "generic.force_source": _FORCE, "generic.speed_drive": _SPEED,
     "generic.slope_gyroscopic": _GYRO, "generic.coordinate_spring": _COORD_SPRING,
     "sliced.sliced_race": _SLICED_RACE, "sliced.sliced_gear_mesh": _SLICED_MESH,
+    "contact.pocket_film": _POCKET_FILM, "contact.cage_drag": _CAGE_DRAG,
 }
 _MODULES = {"contact": contact, "generic": generic, "mesh": mesh, "sliced": sliced}
 # kernel module -> its bit in a system's ``groups`` (the unit of the lazy compile)
@@ -234,6 +235,10 @@ def evaluate_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, J
         sliced.evaluate_sliced_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     elif kind == _RETENTION:
         contact.evaluate_retention(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _POCKET_FILM:
+        contact.evaluate_pocket_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _CAGE_DRAG:
+        contact.evaluate_cage_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
 
 
 def update_kind(groups, kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):

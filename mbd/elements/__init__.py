@@ -7,6 +7,7 @@ hydrodynamic guide land),
 from .contact import (IMPACT_LAWS, LAND_LAWS, TRACTION_LAWS, DryLand, EHLTraction, HydrodynamicLand, LandLaw, ExactRestitution, Flores, GuideContact, HuntCrossley, ImpactLaw,
                       LankaraniNikravesh, LubricantDrag, PocketContact, PocketRetention, RaceContact, SlideRollTraction, TanhTraction,
                       Traction)
+from .pocket_film import CageDrag, PocketFilm
 from .drives import Ramp, SpeedDrive, TorqueSource
 from .gear_mesh import (STIFFNESS_SHAPES, ConstantStiffness, FourierStiffness, GearMesh, RectangularStiffness,
                         StiffnessShape, mesh_offset, mesh_u0)
@@ -15,7 +16,7 @@ from .springs import BodySpring, GroundSupport, TorsionalSpring
 from .tilt import CoordinateSpring, SlopeGyroscopic
 
 __all__ = [
-    "BodySpring", "ForceSource", "GearMesh", "GroundSupport", "GuideContact", "LubricantDrag", "PocketContact",
+    "BodySpring", "CageDrag", "PocketFilm", "ForceSource", "GearMesh", "GroundSupport", "GuideContact", "LubricantDrag", "PocketContact",
     "PocketRetention", "CoordinateSpring", "RaceContact", "Ramp", "SlopeGyroscopic", "SpeedDrive", "TorqueSource", "TorsionalSpring",
     "Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS",
     "LandLaw", "DryLand", "HydrodynamicLand", "LAND_LAWS",

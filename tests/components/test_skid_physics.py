@@ -121,12 +121,16 @@ def test_rolling_resistance_adds_its_moment_to_the_brake():
     assert abs(vs) > abs(plain.v[5] * p_lever - plain.v[2] * R_RING)   # more slip than the brake alone gives
 
 
-def test_the_engines_run_the_skid_physics_alike():
-    """A loaded, turning rig with both opt-in laws, 1000 fixed steps: the compiled and numpy engines reach the same
+@pytest.mark.parametrize("pocket", ["dry", "hydrodynamic"])
+def test_the_engines_run_the_skid_physics_alike(pocket):
+    """A loaded, turning rig with the opt-in laws (the viscous drag with the cage's, the rolling resistance; dry or
+    oiled pockets), 1000 fixed steps: the compiled and numpy engines reach the same
     state to round-off. (With adaptive steps an accept/reject decision at the edge of the error bound can go either
     way on an ulp, after which the runs differ by the controller's tolerance, not by round-off: fixed steps compare
     the laws, not the controller's coin flips.)"""
-    b = reference_bearing().replace(drag_law="viscous", rolling_resistance="houpert").si()
+    ref = reference_bearing()
+    b = ref.replace(drag_law="viscous", rolling_resistance="houpert",
+                    cage=ref.cage.replace(pocket_law=pocket)).si()
     lub = reference_dpgt().lubricant.replace(temperature="40 degC").si()
     built = build_bearing_rig(b, radial_load=2000.0, outer_speed=300.0, lubricant=lub,
                               options=SceneOptions(cage="free", drag=True))
@@ -138,3 +142,55 @@ def test_the_engines_run_the_skid_physics_alike():
     tol = SETTINGS.stepper().tol.scale(built.model, None, None)
     assert np.all(np.abs(c.state.q - r.state.q) <= 1e-6 * tol)          # seen: 1e-13 of it
     np.testing.assert_allclose(c.state.v, r.state.v, rtol=0, atol=1e-12 * np.abs(r.state.v).max())
+
+
+def test_the_scenes_build_the_oiled_pocket_and_the_cage_drag_when_asked():
+    """The default machine has neither family; bearing.drag_law = "viscous" adds the mixture's moment on each free
+    cage (Cochran's disk over the faces from the pin's raceway to the bore, with the mixture's ρ_e, η_e), and
+    bearing.cage.pocket_law = "hydrodynamic" a film per pocket in the oil's own viscosity; without oil it is refused."""
+    from components.bearing import cage_faces
+    from components.dpgt import build_dpgt
+    from components.families import FAMILY
+    from components.units import ParameterError
+    from mbd.elements.pocket_film import CageDrag
+    from components.params import with_overrides
+    names = lambda sc: {e.name for e in sc.model.elements}  # noqa: E731
+    base = reference_dpgt(3)
+    assert not {FAMILY["pocket_film"], FAMILY["cage_drag"]} & names(build_dpgt(base))
+    p = with_overrides(base, {"bearing.drag_law": "viscous", "bearing.cage.pocket_law": "hydrodynamic"})
+    sc = build_dpgt(p)
+    si = p.si()
+    film, drag = sc.model.element(FAMILY["pocket_film"]), sc.model.element(FAMILY["cage_drag"])
+    assert film.n == sc.model.element(FAMILY["pocket"]).n
+    assert np.all(film.eta == si.lubricant.oil_viscosity) and np.all(film.clearance == si.bearing.cage.pocket_clearance)
+    rho_e, eta_e = mixture(si.lubricant)
+    ri, ro = cage_faces(si.bearing)
+    assert (ri, ro) == ((si.bearing.pitch_diameter - si.bearing.roller_diameter) / 2,
+                        (si.bearing.pitch_diameter + si.bearing.roller_diameter) / 2)
+    np.testing.assert_allclose(drag.coef, 0.616 * np.pi * np.sqrt(rho_e * eta_e) * (ro ** 4 - ri ** 4), rtol=1e-12)
+    assert isinstance(drag, CageDrag) and drag.n == sc.model.element(FAMILY["guide"]).n      # one per free cage
+    b = reference_bearing().replace(cage=reference_bearing().cage.replace(pocket_law="hydrodynamic")).si()
+    with pytest.raises(ParameterError, match=r"^bearing\.cage\.pocket_law"):
+        build_bearing_rig(b, radial_load=2000.0, outer_speed=300.0, lubricant=None,
+                          options=SceneOptions(cage="free", drag=False))
+
+
+def test_the_pocket_brake_of_a_centred_spinning_roller_is_both_walls_shear():
+    """components.pocket_brake at the oiled rig's start (rollers centred in their pockets, orbiting with the cage, spinning
+    at Δω in it): each roller is braked by −M of both walls, M = 2R²ηl|Δω|√(2R/C_p)(π/2 + γ_e + c_P/2)
+    (docs/model.md §8.5), the solid contact open; the dry pockets brake nothing there."""
+    from components.pocket_brake import pocket_brake
+    ref = reference_bearing()
+    lub = reference_dpgt().lubricant.replace(temperature="40 degC").si()
+    for law in ("hydrodynamic", "dry"):
+        b = ref.replace(cage=ref.cage.replace(pocket_law=law)).si()
+        built = build_bearing_rig(b, radial_load=2000.0, outer_speed=300.0, lubricant=lub,
+                                  options=SceneOptions(cage="free", drag=True))
+        m = built.model
+        qf, vf = m.full(0.0, built.q0, built.v0)
+        brake, touch = pocket_brake(m, 0.0, qf, vf)
+        assert not touch.any()
+        R, dw = b.roller_diameter / 2, abs(built.bearing_handles.omega_roller - built.bearing_handles.omega_cage)
+        M = 2 * R ** 2 * lub.oil_viscosity * b.roller_length * dw * np.sqrt(2 * R / b.cage.pocket_clearance) \
+            * (np.pi / 2 + 0.443554 + 3.25345 / 2)
+        np.testing.assert_allclose(brake, M if law == "hydrodynamic" else 0.0, rtol=1e-5, atol=1e-15)

@@ -189,7 +189,8 @@ def test_direct_construction_checks_values():
         CageParams(mass=None, pocket_clearance="0.1 mm", guide_clearance="0.1 mm", pocket_stiffness="1e7 N/m",
                    guide_stiffness="1e7 N/m", restitution=0.8, pocket_friction=0.1, guide_friction=0.1,
                    friction_speed="0.01 m/s", impact_speed_floor="0.01 m/s", impact_law="exact", land_law="dry",
-                   land_width="4 mm", land_min_film="1 um", guidance="outer_land", pocket_radial_clearance="0.15 mm")
+                   land_width="4 mm", land_min_film="1 um", guidance="outer_land", pocket_radial_clearance="0.15 mm",
+                   pocket_law="dry", pocket_min_film="1 um")
     with pytest.raises(TypeError):  # a forgotten field is a programming error, caught by the dataclass
         BearingParams(pitch_diameter="39 mm")
 
