@@ -371,6 +371,8 @@ def reference_bearing_rig() -> BearingRigParams:
         ring_mass=assumed("0.557 kg", "a planet-like outer ring: the reference planet's mass"),
         ring_radius=assumed("0.036 m", "the reference planet's pitch radius (36 mm)"),
         drive_bandwidth=assumed("100 Hz", "holds the ring's spin; far above the rig's slow settling"),
+        tilt_support_stiffness=assumed("1e7 N*m/rad", "a stiff housing: ~1000x a loaded planet bearing's tilt "
+                                                      "stiffness (~1e4 N m/rad), the ring keeps its given tilt"),
         drive_damping_ratio=assumed(0.7),
         settle_damping_ratio=assumed(0.2, "of the ring's radial mode: settles in a few periods"),
         load_ramp_periods=assumed(20.0, "of the ring's radial mode: no impulse at the start"),

@@ -201,6 +201,13 @@ def life_summary(d, sums, p, w_rel, ref, sel) -> None:
         q_bore = p.qc[1] * float(equivalent_load(sums.stats("roller_outer_fatigue")["mean"][mine].mean(),
                                                  ROTATING_EXPONENT))
         out["roller_equivalent_load_pin_N"], out["roller_equivalent_load_bore_N"] = q_pin, q_bore
+        if p.explicit_rows > 1:    # every row its raceways' equivalent loads, the rows combined (life.py)
+            q_pin, q_bore = (c * equivalent_load(np.array([sums.stats(key)["mean"][mine & (p.roller_row == r)].mean()
+                                                           for r in range(p.explicit_rows)]), e)
+                             for key, c, e in (("roller_inner_fatigue", p.qc[0], STATIONARY_EXPONENT),
+                                               ("roller_outer_fatigue", p.qc[1], ROTATING_EXPONENT)))
+            out["roller_equivalent_load_pin_per_row_N"] = q_pin.tolist()
+            out["roller_equivalent_load_bore_per_row_N"] = q_bore.tolist()
         out["life_iso16281_Mrev"] = lundberg_palmgren_life(q_pin, q_bore, b)
         out["life_iso16281_h"] = hours(out["life_iso16281_Mrev"], w_rel)
         if "slice_inner_fatigue" in sums.acc:
@@ -218,11 +225,16 @@ def _sliced_life(sums, p, bearings) -> float | None:
     per slice, the equivalent loads of the pin and the bore over the window and over the bearings' rollers, as the
     roller loads' life takes them, q_e,k = q_c,k (mean (q_k/q_c,k)^e)^(1/e)."""
     b = p.bearing
-    mine = np.isin(np.repeat(p.roller_bearing, p.slices), bearings)
     qc = sliced_raceway_ratings(b, p.slices)
+    keys = (("slice_inner_fatigue", qc[0], STATIONARY_EXPONENT), ("slice_outer_fatigue", qc[1], ROTATING_EXPONENT))
+    if p.explicit_rows > 1:       # per row (rows, n_s): the rows' raceways combined as the standard's (life.py)
+        mine = np.isin(p.roller_bearing, bearings)
+        q = [c * equivalent_load(np.stack([sums.stats(key)["mean"].reshape(-1, p.slices)[mine & (p.roller_row == r)]
+                                           .mean(axis=0) for r in range(p.explicit_rows)]), e) for key, c, e in keys]
+        return sliced_life(q[0], q[1], b)
+    mine = np.isin(np.repeat(p.roller_bearing, p.slices), bearings)
     q = [c * equivalent_load(sums.stats(key)["mean"][mine].reshape(-1, p.slices).mean(axis=0), e)
-         for key, c, e in (("slice_inner_fatigue", qc[0], STATIONARY_EXPONENT),
-                           ("slice_outer_fatigue", qc[1], ROTATING_EXPONENT))]
+         for key, c, e in keys]
     return sliced_life(q[0], q[1], b)
 
 
