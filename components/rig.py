@@ -368,13 +368,15 @@ def rig_loads(built: BearingRigScene, system: mbd.System, s: mbd.State) -> dict:
     return rec
 
 
-def rig_quasi_static(built: BearingRigScene, times=None, engine: str = "auto", system: mbd.System | None = None):
+def rig_quasi_static(built: BearingRigScene, times=None, engine: str = "auto", system: mbd.System | None = None,
+                     hold_tilt: bool = True):
     """The rig's quasi-static states (:func:`mbd.static.solve_static`, docs/model.md §10.5, §16) at ``times`` [s]
     (default: the end of the load ramp, the load at its full value), each started from the last: every roller keeps
     its pocket's centre (it moves along its radius only, as ISO/TS 16281's rollers do), its radius, tilt and spin
     rate solved; a free cage's rate with its rollers' orbits; the ring's translation. Held: the ring's angle (its speed
     drive supplies the torque) and, in the sliced model, the ring's slope at its given zero (the tilting moment is the
-    housing's reaction). Returns the :class:`mbd.static.StaticSolution` list; :func:`rig_loads` reads each."""
+    housing's reaction; ``hold_tilt=False`` solves it against the housing's support instead, as a dynamic run sees
+    it). Returns the :class:`mbd.static.StaticSolution` list; :func:`rig_loads` reads each."""
     from components.static import check_static
     from mbd.static import SteadyMotion, carry, solve_static
     check_static(built.bearing.traction_law)
@@ -396,13 +398,20 @@ def rig_quasi_static(built: BearingRigScene, times=None, engine: str = "auto", s
             circles[i] = (0.0, 0.0)            # the pin's centre: the rollers rest on their radial lines
     motion = SteadyMotion.from_state(m, built.q0, built.v0, orbit, host, circles=circles)
     full = [3 * m.body(built.ring).index + 2]
-    if built.bearing.model == "sliced":
+    if built.bearing.model == "sliced" and hold_tilt:
         full += [int(i) for i in _slope_indices(built)]
     hold = m.full_to_free[full]
     rates = ([(cage, idx if h.omega_cage != 0.0 else [])] if cage_free else []) + [(i, []) for i in idx]
+    # the first start: the ring displaced by the classical deflection (the contacts near the zone's centre closed;
+    # from the kinematic pose a profiled roller touches nowhere and nothing resists the load)
+    q_first = np.asarray(built.q0, float).copy()
+    if built.reference is not None:
+        k = 3 * m.body(built.ring).index
+        q_first[m.full_to_free[[k, k + 1]]] += built.reference.deflection * np.array([np.cos(built.load_angle),
+                                                                                      np.sin(built.load_angle)])
     out = []
     for t in times:
-        start = carry(m, motion, out[-1], t, rates) if out else (None, None)
+        start = carry(m, motion, out[-1], t, rates) if out else (q_first, None)
         out.append(solve_static(m, motion, t, hold=hold[hold >= 0], rates=rates, q_start=start[0],
                                 rates_start=start[1], system=system, engine=engine))
     return out
