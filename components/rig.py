@@ -65,8 +65,8 @@ class DiscreteDistribution:
 
     @property
     def stribeck(self) -> float:
-        """Q_max·Z/F_r."""
-        return self.q_max * self.loads.size / self.radial_load
+        """Q_max·Z/F_r of one row (its share F_r/rows; ≈ 4.08 at zero clearance, as :class:`RigSolution`'s)."""
+        return self.q_max * self.loads.size * self.rows / self.radial_load
 
     @property
     def zone_angle(self) -> float:

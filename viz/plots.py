@@ -29,7 +29,8 @@ __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_di
            "mode_shapes", "fault_spectra", "fault_loads", "FAULT_QUANTITIES", "gear_quality", "forward_reverse_headline",
            "time_history_group", "cage_orbit_picture", "display_unit", "format_pct", "HEADLINE_QUANTITIES", "FWD", "REV",
            "STYLE", "tolerance_distributions", "tolerance_against_torque", "tolerance_life_cdf", "damage_shares",
-           "binned_series", "morris_heatmap", "sobol_heatmap", "life_against_misalignment"]
+           "binned_series", "morris_heatmap", "sobol_heatmap", "life_against_misalignment",
+           "slice_pressure_profiles"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
 STYLE = {
@@ -1241,6 +1242,34 @@ def life_against_misalignment(rows: Sequence[Mapping], path, *, title: str | Non
         if any(r["windup"] == "on" for r in rows):
             handles.append(Line2D([], [], color="0.3", alpha=0.45, label="with carrier wind-up"))
         fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 6), frameon=False)
+        if title:
+            _suptitle(fig, title)
+        return _save(fig, path)
+
+
+def slice_pressure_profiles(z_m, panels: Sequence[tuple], path, *, title: str | None = None) -> Path:
+    """The contact pressure along the most loaded roller, as a bearing engineer reads it: one panel per bearing (or
+    per row), the axial position along the roller [mm] against the pin's slice pressure [MPa] (the convex raceway,
+    the higher one), a line per case (e.g. aligned solid, tilted dashed); the roller's length shaded.
+
+    z_m: (n_s,) slice centres from the roller centre [m]. panels: (panel title, {label: (n_s,) pressures [Pa]})."""
+    z = np.asarray(z_m, float) * 1e3
+    half = 0.5 * (z[-1] - z[0]) + (0.5 * (z[1] - z[0]) if z.size > 1 else 0.5)
+    styles = [{"color": "#1f5fa8", "linestyle": "-"}, {"color": "#b2182b", "linestyle": "--"},
+              {"color": "#e07b00", "linestyle": ":"}, {"color": "0.3", "linestyle": "-."}]
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(3.6 * len(panels) + 0.6, 3.4), layout="constrained")
+        axes = fig.subplots(1, max(len(panels), 1), squeeze=False, sharey=True)[0]
+        for ax, (name, curves) in zip(axes, panels):
+            ax.axvspan(-half, half, color="0.93", zorder=0)
+            for i, (label, p) in enumerate(curves.items()):
+                ax.plot(z, np.asarray(p, float) * 1e-6, marker="o", ms=2.5, label=label, **styles[i % len(styles)])
+            ax.set_title(name)
+            ax.set_xlim(-1.08 * half, 1.08 * half)
+            ax.set_xlabel(_axis_label("axial position along the roller", "mm"))
+            _from_zero(ax)
+        axes[0].set_ylabel(_axis_label("contact pressure on the pin", "MPa"))
+        axes[0].legend(loc="lower center")
         if title:
             _suptitle(fig, title)
         return _save(fig, path)

@@ -143,7 +143,9 @@ def slice_summary(d, sums, p, ref, sel) -> None:
     """The sliced contact's statistics (docs/model.md §8.8): the largest slice load of any roller of these bearings
     on the pin and on the bore, and the largest contact pressure (the pin's, the convex raceway); the edge ratio of
     the reference bearing, its largest end-slice pin pressure over its largest middle-slice one in the window
-    (√ of the loads' ratio); the misalignment each bearing sees, its time mean (reference, per planet) and maximum."""
+    (√ of the loads' ratio); the misalignment each bearing sees, its time mean (reference, per planet) and maximum;
+    with explicit rows (bearing.rows > 1), each row's share of the reference bearing's mean pin load, row by row from
+    the axial station −e_r/2 (``row_load_share``)."""
     mine = np.isin(p.roller_bearing, sel)
     own = p.roller_bearing == ref
     q_in, q_out = (float(sums.stats(k)["max"][mine].max()) for k in ("roller_inner_slice_max", "roller_outer_slice_max"))
@@ -152,6 +154,11 @@ def slice_summary(d, sums, p, ref, sel) -> None:
     d["contact_pressure_max_Pa"] = float(max(c_pin * np.sqrt(q_in), c_bore * np.sqrt(q_out)))
     edge, mid = (float(sums.stats(k)["max"][own].max()) for k in ("roller_inner_edge_load", "roller_inner_mid_load"))
     d["edge_pressure_ratio"] = float(np.sqrt(edge / mid)) if mid > 0 else None
+    if p.explicit_rows > 1:     # the reference bearing's rows: each row's share of its rollers' mean pin load
+        m = sums.stats("roller_inner_load")["mean"]
+        total = float(m[own].sum())
+        d["row_load_share"] = [float(m[own & (p.roller_row == r)].sum() / total) if total > 0 else None
+                               for r in range(p.explicit_rows)]
     mis = sums.stats("planet_misalignment")
     d["misalignment_mean_rad"] = float(mis["mean"][ref])
     d["misalignment_max_rad"] = float(mis["max"][ref])
