@@ -214,6 +214,7 @@ def slice_quantities(p: Plan, ri, ro) -> dict[str, np.ndarray]:
     for race, out, e, c in (("inner", ri, STATIONARY_EXPONENT, qc[0]), ("outer", ro, ROTATING_EXPONENT, qc[1])):
         q = np.stack([np.asarray(out[f"slice_load_{k}"], float) for k in range(p.slices)], axis=-1)
         snap[f"slice_{race}_fatigue"] = ((q / c) ** e).reshape(q.shape[:-2] + (-1,))
+        snap[f"_slice_{race}"] = q.reshape(q.shape[:-2] + (-1,))     # the loads: the peak profile (not accumulated)
     return snap
 
 

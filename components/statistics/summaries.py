@@ -245,6 +245,19 @@ def _sliced_life(sums, p, bearings) -> float | None:
     return sliced_life(q[0], q[1], b)
 
 
+def equivalent_slice_loads(sums, p) -> tuple[np.ndarray, np.ndarray]:
+    """(pin, bore) (n_bearings, rows, n_s): each bearing's equivalent slice loads per row over its window and the row's
+    rollers, as its sliced life takes them (:func:`_sliced_life`), q_e,k = q_c,k (mean (q_k/q_c,k)^e)^(1/e), e 4.5 on the
+    pin, 4 on the bore [N]."""
+    qc = sliced_raceway_ratings(p.bearing, p.slices)
+    nb, rows = p.planet.size, p.explicit_rows
+    out = []
+    for key, c, e in (("slice_inner_fatigue", qc[0], STATIONARY_EXPONENT), ("slice_outer_fatigue", qc[1], ROTATING_EXPONENT)):
+        m = sums.stats(key)["mean"].reshape(nb, rows, -1, p.slices)            # rollers bearing by bearing, row by row
+        out.append(c * equivalent_load(m.mean(axis=2), e))
+    return out[0], out[1]
+
+
 def heat_summary(d, sums, ref, sel) -> None:
     """Heat from traction and land friction (time means, W): the reference bearing's and the mean of its
     kind; the largest traction coefficient of a loaded contact."""
