@@ -28,6 +28,7 @@ from mbd.ad import wrap_angle
 from mbd.compile_time import compile_seconds
 from mbd.elements import ForceSource, GroundSupport, Ramp, SpeedDrive
 from mbd.elements.tilt import CoordinateSpring
+from mbd.static import SteadyMotion, carry, solve_static
 
 from .bearing import BearingHandles, add_planet_bearing
 from .families import FAMILY
@@ -35,6 +36,7 @@ from .outputs import pin_reactions
 from .params import BearingParams, BearingRigParams, BearingRigSI, BearingSI, LubricantParams, LubricantSI
 from .presets import reference_bearing_rig
 from .scene import BuiltScene, Scene, SceneOptions
+from .static import check_static
 from .units import ParameterError
 
 __all__ = ["build_bearing_rig", "BearingRigScene", "rig_options", "run_sampled", "rig_loads", "rig_quasi_static",
@@ -377,8 +379,6 @@ def rig_quasi_static(built: BearingRigScene, times=None, engine: str = "auto", s
     drive supplies the torque) and, in the sliced model, the ring's slope at its given zero (the tilting moment is the
     housing's reaction; ``hold_tilt=False`` solves it against the housing's support instead, as a dynamic run sees
     it). Returns the :class:`mbd.static.StaticSolution` list; :func:`rig_loads` reads each."""
-    from components.static import check_static
-    from mbd.static import SteadyMotion, carry, solve_static
     check_static(built.bearing.traction_law)
     m, h = built.model, built.bearing_handles
     system = system if system is not None else mbd.System(m)

@@ -115,8 +115,9 @@ class BearingRigParams(Params["BearingRigSI"]):
     ring_inertia: Quantity | None = rule("inertia", "assumed", "solid disc of the ring radius, m r^2/2")
     ring_tilt_inertia: Quantity | None = rule("inertia", "assumed", "thin disc: half the polar inertia",
                                               "the ring's diametral moment of inertia (its slopes: the sliced model)")
-    tilt_support_stiffness: Quantity = positive("torsional_stiffness", "the housing's support of the ring's slope "
-                                                                       "about the given ring tilt (the sliced model)")
+    tilt_support_stiffness: Quantity = positive("torsional_stiffness", "the housing's support holding the ring's "
+                                                                       "slope at zero, the pin carrying the given tilt "
+                                                                       "(the sliced model)")
     drive_bandwidth: Quantity = positive("frequency", "bandwidth of the ring's speed drive")
     drive_damping_ratio: Quantity = nonneg("dimensionless", "damping ratio of the ring's speed drive")
     settle_damping_ratio: Quantity = nonneg("dimensionless", "ring-to-ground dashpot as a fraction of the critical "

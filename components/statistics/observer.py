@@ -12,6 +12,7 @@ from mbd.simulate import ENGINES
 
 from ..bearing import bearing_kinematics
 from ..families import FAMILY
+from ..sliced_bearing import pressure_scales
 from . import quantities as Q
 from .accumulate import PeakProfiles, Accumulators, FlankPeaks, compile_accumulators
 from .summaries import equivalent_slice_loads, run_summary
@@ -254,7 +255,6 @@ class WindowStatistics(mbd.Observer):
         (:func:`.quantities.bearing_map`'s order), slice, row."""
         if self.peak is None:
             return None
-        from ..sliced_bearing import pressure_scales
         p, pk = self.plan, self.peak
         c_pin, c_bore = pressure_scales(p.bearing, p.slices)
         z = p.roller_bearing.size // p.planet.size // p.explicit_rows        # rollers per row
