@@ -138,12 +138,12 @@ def run(a) -> dict:
     if sliced is not None:
         prof = sliced["pressure_profile_pin_Pa"]
         rows = len(prof["tilted"])
-        panels = [(f"row {r + 1} of {rows}" if rows > 1 else "the most loaded roller",
-                   {"aligned": prof["aligned"][r], f"tilted {a.misalignment} {a.misalignment_direction}":
-                    prof["tilted"][r]}) for r in range(rows)]
-        pfig = vp.slice_pressure_profiles(sliced["slice_z_m"], panels, out / "pressure_profile.png",
-                                          title=f"Pin pressure along the most loaded roller, F_r = {F / 1e3:.3g} kN, "
-                                                f"{b.profile.shape} rollers (quasi-static)")
+        pfig = vp.slice_pressure_profiles(sliced["slice_z_m"], sliced["row_stations_m"],
+                                          {"aligned": prof["aligned"],
+                                           f"tilted {a.misalignment} {a.misalignment_direction}": prof["tilted"]},
+                                          out / "pressure_profile.png",
+                                          title=f"Most loaded roller{' of each row' if rows > 1 else ''}: "
+                                                f"F_r = {F / 1e3:.3g} kN, {b.profile.shape} rollers, quasi-static")
         print(f"sliced ({rows} row{'s' if rows > 1 else ''}, {b.profile.shape}): row shares of the pin load "
               f"{', '.join(f'{x:.3f}' for x in sliced['row_load_share']['tilted'])} tilted (quasi-static; dynamic "
               f"{', '.join(f'{x:.3f}' for x in sliced['row_load_share_dynamic'])}), life relative to aligned "

@@ -1247,29 +1247,36 @@ def life_against_misalignment(rows: Sequence[Mapping], path, *, title: str | Non
         return _save(fig, path)
 
 
-def slice_pressure_profiles(z_m, panels: Sequence[tuple], path, *, title: str | None = None) -> Path:
-    """The contact pressure along the most loaded roller, as a bearing engineer reads it: one panel per bearing (or
-    per row), the axial position along the roller [mm] against the pin's slice pressure [MPa] (the convex raceway,
-    the higher one), a line per case (e.g. aligned solid, tilted dashed); the roller's length shaded.
+def slice_pressure_profiles(z_m, stations_m, curves: Mapping[str, Sequence], path, *, title: str | None = None) -> Path:
+    """The contact pressure along the most loaded roller of each row, as a bearing engineer reads it: the axial position
+    across the bearing [mm] (each row's roller drawn at its station, its length shaded) against the pin's slice
+    pressure [MPa] (the convex raceway, the higher one), a line per case (e.g. aligned solid blue, tilted dashed red).
 
-    z_m: (n_s,) slice centres from the roller centre [m]. panels: (panel title, {label: (n_s,) pressures [Pa]})."""
+    z_m: (n_s,) slice centres from the roller centre [m]; stations_m: (rows,) the rows' axial stations [m];
+    curves: label -> (rows, n_s) pressures [Pa]."""
     z = np.asarray(z_m, float) * 1e3
+    st = np.atleast_1d(np.asarray(stations_m, float)) * 1e3
     half = 0.5 * (z[-1] - z[0]) + (0.5 * (z[1] - z[0]) if z.size > 1 else 0.5)
     styles = [{"color": "#1f5fa8", "linestyle": "-"}, {"color": "#b2182b", "linestyle": "--"},
               {"color": "#e07b00", "linestyle": ":"}, {"color": "0.3", "linestyle": "-."}]
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(3.6 * len(panels) + 0.6, 3.4), layout="constrained")
-        axes = fig.subplots(1, max(len(panels), 1), squeeze=False, sharey=True)[0]
-        for ax, (name, curves) in zip(axes, panels):
-            ax.axvspan(-half, half, color="0.93", zorder=0)
-            for i, (label, p) in enumerate(curves.items()):
-                ax.plot(z, np.asarray(p, float) * 1e-6, marker="o", ms=2.5, label=label, **styles[i % len(styles)])
-            ax.set_title(name)
-            ax.set_xlim(-1.08 * half, 1.08 * half)
-            ax.set_xlabel(_axis_label("axial position along the roller", "mm"))
-            _from_zero(ax)
-        axes[0].set_ylabel(_axis_label("contact pressure on the pin", "MPa"))
-        axes[0].legend(loc="lower center")
+        fig = Figure(figsize=(4.2 + 2.2 * st.size, 3.6), layout="constrained")
+        ax = fig.add_subplot()
+        for r, c in enumerate(st):
+            ax.axvspan(c - half, c + half, color="0.93" if r % 2 == 0 else "0.88", zorder=0)
+            if st.size > 1:
+                ax.text(c, 1.0, f"row {r + 1}", transform=ax.get_xaxis_transform(), ha="center", va="bottom",
+                        fontsize="small")
+        for i, (label, p) in enumerate(curves.items()):
+            p = np.atleast_2d(np.asarray(p, float))
+            for r, c in enumerate(st):
+                ax.plot(c + z, p[r] * 1e-6, marker="o", ms=2.5, label=label if r == 0 else None,
+                        **styles[i % len(styles)])
+        ax.set_xlim(st.min() - 1.08 * half, st.max() + 1.08 * half)
+        ax.set_xlabel(_axis_label("axial position from the bearing's centre", "mm"))
+        ax.set_ylabel(_axis_label("contact pressure on the pin", "MPa"))
+        _from_zero(ax)
+        ax.legend(loc="best")
         if title:
             _suptitle(fig, title)
         return _save(fig, path)
