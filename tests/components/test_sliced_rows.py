@@ -199,7 +199,8 @@ def test_the_double_row_rig_jacobians_are_its_forces_derivatives(tilted):
 
 
 def test_the_double_row_rig_runs_compiled_as_on_the_numpy_path(tilted):
-    """Forces and Jacobians of the compiled assembly equal the reference's to round-off at the tilted state."""
+    """Forces and Jacobians of the compiled assembly equal the reference's to round-off at the tilted state, and twenty
+    steps from it give the same states on both engines."""
     from mbd.compiled.system import CompiledSystem
     r, system, t, q, v, z = tilted
     ref = system.evaluate(t, q, v, z, jac=True)
@@ -207,6 +208,15 @@ def test_the_double_row_rig_runs_compiled_as_on_the_numpy_path(tilted):
     for name in ("F", "Jq", "Jv"):
         a, b = getattr(got, name), getattr(ref, name)
         assert np.abs(a - b).max() <= 1e-10 * np.abs(b).max(), name
+    # twenty steps from the tilted state: the same step counts and states on both engines
+    h = 2e-6
+    st = mbd.PRODUCTION.stepper().initial_state(system, t, q, v)
+    run = lambda eng: mbd.simulate(r.model, t_end=t + 20 * h, state=st.copy(), stepper=mbd.PRODUCTION.stepper(),  # noqa: E731
+                                   controller=mbd.FixedStep(h), progress=False, engine=eng)
+    rc, rn = run("compiled"), run("numpy")
+    assert (rc.engine, rn.engine) == ("compiled", "numpy") and rc.counters == rn.counters
+    np.testing.assert_allclose(rc.state.q, rn.state.q, rtol=0, atol=1e-12)
+    assert np.abs(rn.state.q - q).max() > 1e-9                     # it moved
 
 
 # ------------------------------------------------------------------------------------- dynamic rig and life
