@@ -378,7 +378,8 @@ def rig_quasi_static(built: BearingRigScene, times=None, engine: str = "auto", s
     rate solved; a free cage's rate with its rollers' orbits; the ring's translation. Held: the ring's angle (its speed
     drive supplies the torque) and, in the sliced model, the ring's slope at its given zero (the tilting moment is the
     housing's reaction; ``hold_tilt=False`` solves it against the housing's support instead, as a dynamic run sees
-    it). Returns the :class:`mbd.static.StaticSolution` list; :func:`rig_loads` reads each."""
+    it). Returns the :class:`mbd.static.StaticSolution` list; :func:`rig_loads` reads each. A turning ring's unloaded
+    rollers have no traction and so no static spin rate: the ring at rest (the standard's case) always has a state."""
     check_static(built.bearing.traction_law)
     m, h = built.model, built.bearing_handles
     system = system if system is not None else mbd.System(m)

@@ -171,7 +171,9 @@ def sliced_rig_report(bearing, a, F: float, w: float, gamma: float, sol, positio
     rollers): per row its share of the pin load and the most loaded roller's slice loads and pin pressures (at the
     first position: the rollers symmetric about the load line), the edge pressure ratio, and the ISO/TS 16281 life
     with slices of the rows combined (:func:`components.life.sliced_life`) relative to aligned; the dynamic run's
-    (``sol``) row shares beside them."""
+    (``sol``, at the given speed and cage) row shares beside them. The quasi-static rig is the standard's case: the
+    ring at rest, the cage held, no drag (no centrifugal load, no traction; an unloaded roller of a turning ring has no
+    static spin)."""
     b = bearing.si() if hasattr(bearing, "si") else bearing
     c_pin, c_bore = pressure_scales(b, b.slicing.slices)
     out = {"slice_z_m": slice_stations(b.roller_length, b.slicing.slices)[0].tolist(), "rows": b.rows,
@@ -182,8 +184,8 @@ def sliced_rig_report(bearing, a, F: float, w: float, gamma: float, sol, positio
         recs = []
         for k in range(positions):
             load_angle = -0.5 * np.pi + 2 * np.pi * k / (positions * b.rollers)
-            built = build_bearing_rig(b, radial_load=F, load_angle=load_angle, outer_speed=w,
-                                      options=SceneOptions(cage=a.cage, drag=False, gravity=False), misalignment=g,
+            built = build_bearing_rig(b, radial_load=F, load_angle=load_angle, outer_speed=0.0,
+                                      options=SceneOptions(cage="held", drag=False, gravity=False), misalignment=g,
                                       misalignment_direction=a.misalignment_direction)
             system = mbd.System(built.model)
             recs.append(rig_loads(built, system, rig_quasi_static(built, system=system)[0]))
@@ -207,7 +209,8 @@ def sliced_rig_report(bearing, a, F: float, w: float, gamma: float, sol, positio
                 "most_loaded_roller_slice_load_pin_N": loads, "pressure_profile_pin_Pa": profile,
                 "edge_pressure_ratio": edge, "life_iso16281_sliced_Mrev": lives,
                 "life_relative": lives["tilted"] / lives["aligned"] if lives["aligned"] and lives["tilted"] else None,
-                "note": "quasi-static (the ring's slope held, rollers at their pockets' centres), the life over "
+                "note": "quasi-static: ISO/TS 16281's case (the ring at rest, its slope held, the rollers at their held "
+                        "pockets' centres, no centrifugal load or traction), the life over "
                         f"{positions} cage positions of one roller pitch; the row shares also from the dynamic run"})
     return out
 
