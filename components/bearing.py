@@ -46,6 +46,8 @@ class BearingHandles:
     spring: slice | None = None               # the linear bearing's spring
     omega_cage: float | None = None           # pure-rolling start speeds [rad/s]
     omega_roller: float | None = None
+    rows: int = 1                             # roller rows built one by one (the sliced model; the planar model
+                                              # folds its rows into one roller body: 1); rollers listed row by row
 
 
 # each traction law from the bearing's SI parameters (a parameter, bearing.traction_law, names one)
@@ -172,12 +174,16 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
     rho = 0.5 * d_m + 0.25 * b.clearance          # centred in the radial gap
     pin_xy = np.asarray(pin_xy, float)
     pin_vel = np.asarray(pin_vel, float)
-    for j in range(Z):
-        off = rho * np.array([np.cos(psi[j]), np.sin(psi[j])])
-        vel = pin_vel + wm * np.array([-off[1], off[0]])
-        scene.body(f"{tag}.roller{j}", b.rows * b.roller_mass, b.rows * b.roller_inertia,
-                   pose=(*(pin_xy + off), 0.0), vel=(*vel, wr))
-    names = [f"{tag}.roller{j}" for j in range(Z)]
+    # the planar model folds identical rows into one roller body of rows × the mass (its contacts count each
+    # physical roller b.rows times); the sliced model builds every row's rollers at their axial station
+    rows, fold = (b.rows, 1) if b.model == "sliced" else (1, b.rows)
+    names = [roller_name(tag, r, j) for r in range(rows) for j in range(Z)]
+    for r in range(rows):
+        for j in range(Z):
+            off = rho * np.array([np.cos(psi[j]), np.sin(psi[j])])
+            vel = pin_vel + wm * np.array([-off[1], off[0]])
+            scene.body(roller_name(tag, r, j), fold * b.roller_mass, fold * b.roller_inertia,
+                       pose=(*(pin_xy + off), 0.0), vel=(*vel, wr))
     marker = np.tile(pin_local, (Z, 1))
     common = dict(D=damage.get("D", D), K=b.contact_stiffness, zeta=b.contact_damping_ratio, m_roller=b.roller_mass,
                   multiplicity=b.rows)
@@ -201,9 +207,12 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
 
 
 def _add_drag_and_cage(scene, tag, b, names, psi, wm, pin_body, marker, outer_body, lubricant, pin_xy, pin_vel,
-                       handles):
-    """The rollers' lubricant drag and the cage (as the scene's options ask), for either contact model."""
+                       handles, fold=None):
+    """The rollers' lubricant drag and the cage (as the scene's options ask), for either contact model: ``names``
+    every roller body, row by row (``psi`` their pocket angles), ``fold`` the physical rollers one body stands for
+    (default ``b.rows``: the planar model's folded rows; 1 for the sliced model's explicit rows)."""
     opt, Z, D, d_m = scene.options, len(names), b.roller_diameter, b.pitch_diameter
+    fold = b.rows if fold is None else fold
     if opt.drag:
         if lubricant is None:
             raise ParameterError.at("lubricant", "the scene has lubricant drag on (option drag) but no lubricant "
@@ -216,11 +225,11 @@ def _add_drag_and_cage(scene, tag, b, names, psi, wm, pin_body, marker, outer_bo
             visc = dict(rho=lubricant.density)
         drag_slice = drag.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker,
                               C_d=lubricant.drag_coefficient, D=D, l=b.roller_length, d_m=d_m,
-                              multiplicity=b.rows, **visc)
+                              multiplicity=fold, **visc)
         handles = replace(handles, drag=drag_slice)
     if opt.cage != "none":
         handles = replace(handles, **_add_cage(scene, tag, b, names, psi, pin_xy, pin_vel, wm, outer_body,
-                                               opt.cage == "held", lubricant))
+                                               opt.cage == "held", lubricant, fold))
         if opt.drag and b.drag_law == "viscous" and opt.cage != "held":
             handles = replace(handles, cage_drag=_add_cage_drag(scene, b, handles.cage, pin_body, lubricant))
     return handles
@@ -238,6 +247,18 @@ def _add_cage_drag(scene, b, cage, pin_body, lubricant):
     rho_e, eta_e = mixture(lubricant)
     fam = scene.family(FAMILY["cage_drag"], CageDrag, ("cage", "carrier"))
     return fam.add(1, cage=[cage], carrier=[pin_body], coef=CageDrag.coefficient(rho_e, eta_e, *cage_faces(b)))
+
+
+def roller_name(tag: str, row: int, j: int) -> str:
+    """The body name of roller ``j`` of row ``row`` of the bearing ``tag`` (row 0: ``tag.roller<j>``, a one-row
+    bearing's names; row r > 0: ``tag.row<r>.roller<j>``)."""
+    return f"{tag}.roller{j}" if row == 0 else f"{tag}.row{row}.roller{j}"
+
+
+def row_stations(b: BearingSI) -> np.ndarray:
+    """(rows,) axial station ζ_row [m] of each row's roller centres on pin and bore, from the bearing's centre:
+    ζ_i = (i − (rows − 1)/2) e_r, e_r = ``bearing.row_spacing`` (two rows at ±e_r/2; docs/model.md §8.8)."""
+    return (np.arange(b.rows) - 0.5 * (b.rows - 1)) * b.row_spacing
 
 
 def sliced_law(b: BearingSI) -> dict:
@@ -280,9 +301,6 @@ def _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local,
                          pin_vel, damage, law, bore_tilt_inertia, bore_spin_inertia, pin_slope):
     """The sliced raceway contacts of one bearing (:class:`mbd.elements.sliced.SlicedRaceContact`), the bore's slope
     pair and the rollers' tilts; then drag and cage as the planar model's."""
-    if b.rows != 1:
-        raise ParameterError.at("bearing.rows", f"the sliced model takes one row (two rows at their axial stations "
-                                                f"are not built), got {b.rows}")
     if "inner" in damage or "outer" in damage or "rolling" in law:
         raise ParameterError.at("bearing.model", "'sliced' has no raceway spall and no rolling resistance; use "
                                                  "'planar' for those")
@@ -290,7 +308,9 @@ def _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local,
         if J is None or not J > 0.0:
             raise ParameterError.at("bearing.model", f"'sliced' needs the bore body's {what} inertia > 0 kg m^2 "
                                                      f"(this scene gives {J!r})")
-    Z = len(names)
+    Z = len(names)                          # every roller body: b.rows rows of b.rollers
+    pin_local = np.asarray(pin_local, float)
+    marker = np.tile(pin_local, (Z, 1))
     if outer_body not in scene._slopes:
         scene.slopes(outer_body, bore_tilt_inertia)
         scene.family(FAMILY["gyroscopic"], SlopeGyroscopic, (), resolve=_gyro_dofs).add(
@@ -299,25 +319,25 @@ def _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local,
     for nm in names:
         scene.tilt(nm, J_r)
     sl = sliced_law(b)
-    pin_local = np.asarray(pin_local, float)
-    marker = np.tile(pin_local, (Z, 1))
-    common = dict(D=damage.get("D", b.roller_diameter), K=sl["K"], zeta=b.contact_damping_ratio, m_roller=b.roller_mass)
+    D = np.tile(np.broadcast_to(np.asarray(damage.get("D", b.roller_diameter), float), (b.rollers,)), b.rows)
+    common = dict(D=D, K=sl["K"], zeta=b.contact_damping_ratio, m_roller=b.roller_mass)
     fam_law = dict(traction=law["traction"], exponent=law["exponent"], z=sl["z"], drop=sl["drop"])
     slope = np.tile(np.asarray(pin_slope, float), (Z, 1))
+    row_offset = np.repeat(row_stations(b), b.rollers)      # ζ_row of every roller, row by row
     inner = scene.family(FAMILY["race_inner"], SlicedRaceContact, (), resolve=_sliced_dofs("inner"), kind="inner",
                          **fam_law)
     s_in = inner.add(Z, roller=names, roller_name=names, race_body=[pin_body] * Z, pin_body=[pin_body] * Z,
                      slope_body=[outer_body] * Z, race_marker=marker, pin_marker=marker, race_slope=slope,
-                     R_race=b.inner_raceway_radius, **common)
+                     R_race=b.inner_raceway_radius, row_offset=row_offset, **common)
     outer = scene.family(FAMILY["race_outer"], SlicedRaceContact, (), resolve=_sliced_dofs("outer"), kind="outer",
                          **fam_law)
     s_out = outer.add(Z, roller=names, roller_name=names, race_body=[outer_body] * Z, pin_body=[pin_body] * Z,
                       slope_body=[outer_body] * Z, race_marker=np.zeros((Z, 2)), pin_marker=marker,
-                      race_slope=np.zeros((Z, 2)), R_race=b.outer_raceway_radius, **common)
+                      race_slope=np.zeros((Z, 2)), R_race=b.outer_raceway_radius, row_offset=row_offset, **common)
     handles = BearingHandles("rollers", rollers=tuple(names), race_inner=s_in, race_outer=s_out, omega_cage=wm,
-                             omega_roller=wr)
-    return _add_drag_and_cage(scene, tag, b, names, psi, wm, pin_body, marker, outer_body, lubricant, pin_xy,
-                              pin_vel, handles)
+                             omega_roller=wr, rows=b.rows)
+    return _add_drag_and_cage(scene, tag, b, names, np.tile(psi, b.rows), wm, pin_body, marker, outer_body,
+                              lubricant, pin_xy, pin_vel, handles, fold=1)
 
 
 def _land(c, lubricant):
@@ -330,8 +350,9 @@ def _land(c, lubricant):
 
 
 def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel, wm, outer_body, held,
-              lubricant) -> dict:
-    """The cage body, its pockets and (a free cage) what centres it — its guide land on the outer raceway
+              lubricant, fold) -> dict:
+    """The cage body, its pockets (one per roller body: a pocket of a double-row cage holds a roller of each row,
+    each its own pocket contact) and (a free cage) what centres it — its guide land on the outer raceway
     (``bearing.cage.guidance = "outer_land"``) or its pockets' radial retention of the rollers (``"rollers"``,
     docs/model.md §8.5): the BearingHandles fields they fill."""
     c, Z, D = b.cage, len(names), b.roller_diameter
@@ -342,7 +363,7 @@ def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel,
     pockets = pocket.add(Z, roller=names, cage=[cage] * Z, pocket_angle=psi, pitch_radius=0.5 * b.pitch_diameter,
                          clearance=c.pocket_clearance, K_p=c.pocket_stiffness, restitution=c.restitution,
                          v_min=c.impact_speed_floor, mu=c.pocket_friction, v_mu=c.friction_speed, D=D,
-                         multiplicity=b.rows)
+                         multiplicity=fold)
     films = None
     if c.pocket_law == "hydrodynamic":      # the oil film on the pocket walls (docs/model.md §8.5)
         if lubricant is None:
@@ -350,14 +371,14 @@ def _add_cage(scene: Scene, tag: str, b: BearingSI, names, psi, pin_xy, pin_vel,
         film = scene.family(FAMILY["pocket_film"], PocketFilm, ("roller", "cage"))
         films = film.add(Z, roller=names, cage=[cage] * Z, pocket_angle=psi, pitch_radius=0.5 * b.pitch_diameter,
                          clearance=c.pocket_clearance, D=D, length=b.roller_length, eta=lubricant.oil_viscosity,
-                         min_film=c.pocket_min_film, multiplicity=b.rows)
+                         min_film=c.pocket_min_film, multiplicity=fold)
     guides = retention = None     # a held cage has no guide land
     if not held and c.guidance == "rollers":     # roller-centred: the pockets hold the rollers radially, no land
         fam = scene.family(FAMILY["retention"], PocketRetention, ("roller", "cage"), impact_law=law)
         retention = fam.add(Z, roller=names, cage=[cage] * Z, pitch_radius=0.5 * b.pitch_diameter,
                             clearance=c.pocket_radial_clearance, K_r=c.pocket_stiffness, restitution=c.restitution,
                             v_min=c.impact_speed_floor, mu=c.pocket_friction, v_mu=c.friction_speed, D=D,
-                            multiplicity=b.rows)
+                            multiplicity=fold)
     elif not held:
         guide = scene.family(FAMILY["guide"], GuideContact, ("cage", "planet"), impact_law=law,
                              land=_land(c, lubricant))

@@ -54,6 +54,15 @@ planet relative to its pin and in hours at that relative speed:
   window (exponents 4.5 and 4 as above) and the slice rating q_c = Q_c n_s^(−7/9); the bearing's
   L = [Σ_rows Σ_k ((q_e,k,pin/q_c,pin)^(9/2) + (q_e,k,bore/q_c,bore)^(9/2))]^(−8/9) (:func:`sliced_life`).
   Equal slices q_e,k = Q_e/n_s give exactly the roller sum above: n_s (n_s^(−2/9))^(9/2) = 1.
+
+* **Rows.** ISO/TS 16281:2008 §5.3 gives a bearing's life from its raceways' lives as a series system of Weibull
+  members, L = (Σ L_k^(−e))^(−1/e), e = 9/8; its scope (clause 1) extends the calculation to multi-row bearings
+  through the same equations. Each row's raceways are members of that system: each row has its own equivalent loads
+  (over its own rollers, with the exponents above) and its own raceway lives, and the bearing's life is the sum over
+  rows and raceways. Identical rows (the planar model's folded rows) count ``b.rows`` times one row's terms; rows
+  loaded differently (the sliced model's explicit rows under a tilt) are passed row by row. Pooling the rows'
+  rollers into one equivalent load would be wrong for the rotating raceway, whose (mean Q^4)^(9/8) is not linear in
+  the rows' means.
 """
 from __future__ import annotations
 
@@ -140,16 +149,20 @@ def equivalent_load(power_mean, exponent: float):
     return np.asarray(power_mean, float) ** (1.0 / exponent)
 
 
-def lundberg_palmgren_life(q_pin: float, q_bore: float, b) -> float | None:
+def lundberg_palmgren_life(q_pin, q_bore, b) -> float | None:
     """Basic reference rating life [10^6 revolutions of the bore relative to the pin] from the raceways'
-    equivalent roller loads ``q_pin``, ``q_bore`` [N] (per physical roller, one row's share; the caller
-    has taken each with its raceway's exponent): L_k = (Q_c,k/Q_e,k)^4 per raceway and row, the bearing
-    L = (Σ_rows Σ_k L_k^(−e))^(−1/e). None when no roller is loaded."""
+    equivalent roller loads ``q_pin``, ``q_bore`` [N] (per physical roller; the caller has taken each with its
+    raceway's exponent): numbers, one row's share of ``b.rows`` identical rows, or arrays (rows,), each row's own
+    (rows loaded differently: the sliced model's explicit rows). L_k = (Q_c,k/Q_e,k)^4 per raceway and row, the
+    bearing L = (Σ_rows Σ_k L_k^(−e))^(−1/e) (module docstring). None when no roller is loaded."""
     qc_pin, qc_bore = raceway_ratings(b)
-    if not (q_pin >= 0.0 and q_bore >= 0.0):
-        raise ValueError(f"equivalent roller loads must be >= 0 N, got pin {q_pin!r}, bore {q_bore!r}")
+    per_row = np.ndim(q_pin) > 0
+    q_pin, q_bore = np.asarray(q_pin, float), np.asarray(q_bore, float)
+    if not (np.all(q_pin >= 0.0) and np.all(q_bore >= 0.0)) or q_pin.shape != q_bore.shape:
+        raise ValueError(f"equivalent roller loads must be >= 0 N of equal shapes, got pin {q_pin!r}, bore {q_bore!r}")
     e = WEIBULL_SLOPE
-    damage = b.rows * ((q_pin / qc_pin) ** (LINE_EXPONENT * e) + (q_bore / qc_bore) ** (LINE_EXPONENT * e))
+    damage = float(np.sum((q_pin / qc_pin) ** (LINE_EXPONENT * e) + (q_bore / qc_bore) ** (LINE_EXPONENT * e)))
+    damage *= 1.0 if per_row else b.rows
     return float(damage ** (-1.0 / e)) if damage > 0 else None
 
 

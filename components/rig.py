@@ -27,6 +27,8 @@ import mbd
 from mbd.ad import wrap_angle
 from mbd.compile_time import compile_seconds
 from mbd.elements import ForceSource, GroundSupport, Ramp, SpeedDrive
+from mbd.elements.tilt import CoordinateSpring
+from mbd.static import SteadyMotion, carry, solve_static
 
 from .bearing import BearingHandles, add_planet_bearing
 from .families import FAMILY
@@ -34,9 +36,11 @@ from .outputs import pin_reactions
 from .params import BearingParams, BearingRigParams, BearingRigSI, BearingSI, LubricantParams, LubricantSI
 from .presets import reference_bearing_rig
 from .scene import BuiltScene, Scene, SceneOptions
+from .static import check_static
 from .units import ParameterError
 
-__all__ = ["build_bearing_rig", "BearingRigScene", "rig_options", "run_sampled", "rig_loads", "RigSolution",
+__all__ = ["build_bearing_rig", "BearingRigScene", "rig_options", "run_sampled", "rig_loads", "rig_quasi_static",
+           "RigSolution",
            "rig_static_solution", "discrete_load_distribution", "DiscreteDistribution"]
 
 
@@ -63,8 +67,8 @@ class DiscreteDistribution:
 
     @property
     def stribeck(self) -> float:
-        """Q_max·Z/F_r."""
-        return self.q_max * self.loads.size / self.radial_load
+        """Q_max·Z/F_r of one row (its share F_r/rows; ≈ 4.08 at zero clearance, as :class:`RigSolution`'s)."""
+        return self.q_max * self.loads.size * self.rows / self.radial_load
 
     @property
     def zone_angle(self) -> float:
@@ -136,11 +140,20 @@ class BearingRigScene(BuiltScene):
     t_settle: float                       # a suggested start of the averaging window [s]
     radial_stiffness: float               # dF/dδ_r of the classical solution [N/m] (0 unloaded)
     reference: DiscreteDistribution | None    # the classical load distribution (None unloaded)
+    pin_slope: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(2))   # the pin's slope [rad], fixed
+                                                                                     # frame (the sliced model)
+
+    @property
+    def fold(self) -> int:
+        """Physical rollers one roller body stands for: ``bearing.rows`` in the planar model (its rows folded into
+        one), 1 in the sliced model (every row built)."""
+        return self.bearing.rows // self.bearing_handles.rows
 
 
 def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 * np.pi, outer_speed: float = 0.0,
                       options: SceneOptions | None = None, lubricant=None,
-                      rig: BearingRigParams | None = None) -> BearingRigScene:
+                      rig: BearingRigParams | None = None, misalignment: float = 0.0,
+                      misalignment_direction="radial") -> BearingRigScene:
     """A bearing between a fixed pin and a loaded outer ring (SI arguments).
 
     ``bearing``: :class:`~components.params.BearingParams` or its SI object (``.si()``); ``lubricant`` a
@@ -157,6 +170,14 @@ def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 *
     from the ring to ground with ``rig.settle_damping_ratio`` of that mode's critical damping lets it
     settle (the Hertz contacts alone damp the ring very little).
 
+    With ``bearing.model = "sliced"`` (docs/model.md §8.8, §10.5) the ring gets a slope pair (diametral inertia
+    ``rig.ring_tilt_inertia``, gyroscopic terms with its spin) held at zero by the housing's support
+    (``rig.tilt_support_stiffness``, its dashpot ``rig.settle_damping_ratio`` of the tilt mode's critical damping),
+    and the pin's axis is sloped by ``misalignment`` γ [rad] against it, in ``misalignment_direction``: "radial"
+    (along the load on the ring, the load plane), "tangential" (90° ahead of it) or an angle [rad] in the fixed
+    frame — the tilted bearing under a radial load that ISO/TS 16281 covers. The planar model refuses a
+    misalignment.
+
     Returns a :class:`BearingRigScene`.
     """
     b, lub, rs = _rig_inputs(bearing, lubricant, rig)
@@ -164,13 +185,31 @@ def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 *
     F = _finite("radial_load", radial_load, nonneg=True)
     a = _finite("load_angle", load_angle)
     w = _finite("outer_speed", outer_speed)
+    gamma = _finite("misalignment", misalignment)
+    if gamma != 0.0 and b.model != "sliced":
+        raise ParameterError.at("misalignment", "a tilted rig bearing needs bearing.model = 'sliced' (the planar "
+                                                "model has no slopes)")
+    if isinstance(misalignment_direction, str):
+        if misalignment_direction not in ("radial", "tangential"):
+            raise ParameterError.at("misalignment_direction", f"expected 'radial', 'tangential' or an angle [rad], "
+                                                              f"got {misalignment_direction!r}")
+        beta = a + (0.0 if misalignment_direction == "radial" else 0.5 * np.pi)
+    else:
+        beta = _finite("misalignment_direction", misalignment_direction)
+    pin_slope = gamma * np.array([np.cos(beta), np.sin(beta)])
     opt = rig_options(options, has_lubricant=lub is not None)
     scene = Scene(frame_omega=0.0, gravity=rs.gravity if opt.gravity else 0.0, options=opt)
     scene.body("pin", 1.0, 1.0, fixed=True)
     scene.body("ring", rs.ring_mass, rs.ring_inertia, vel=(0.0, 0.0, w))
     h = add_planet_bearing(scene, "pb", pin_body="pin", pin_local=(0.0, 0.0), outer_body="ring", bearing=b,
                            lubricant=lub, pin_xy=(0.0, 0.0), pin_vel=(0.0, 0.0), omega_pin=0.0, omega_outer=w,
-                           damage={})   # the rig's bearing is perfect
+                           damage={}, bore_tilt_inertia=rs.ring_tilt_inertia, bore_spin_inertia=rs.ring_inertia,
+                           pin_slope=pin_slope)   # the rig's bearing is perfect
+    if b.model == "sliced":         # the housing holds the ring's slope at zero: the pin's slope is the tilt
+        k_t = rs.tilt_support_stiffness
+        c_t = 2.0 * rs.settle_damping_ratio * np.sqrt(k_t * rs.ring_tilt_inertia)
+        scene.add_late_element(lambda sc: CoordinateSpring("ring_tilt_support", list(sc.slope_index["ring"]),
+                                                           k=k_t, c=c_t))
     # radial mode of the ring on the loaded bearing (stiffness dF/dδ_r of the classical solution)
     if F > 0:
         ref = discrete_load_distribution(b, F, _roller_angles_from_zone(b.rollers, a))
@@ -189,7 +228,8 @@ def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 *
         scene.add_element(GroundSupport("ring_damper", [scene.index["ring"]], kx=0.0, cx=c_settle))
     return scene.build(BearingRigScene, bearing_handles=h, ring="ring", pin="pin", bearing=b, options=opt,
                        radial_load=F, load_angle=a, zone_angle=a + np.pi, outer_speed=w, ramp=ramp, period=period,
-                       t_settle=ramp + 10.0 * period, radial_stiffness=k_r, reference=ref)
+                       t_settle=ramp + 10.0 * period, radial_stiffness=k_r, reference=ref,
+                       pin_slope=pin_slope)
 
 
 def rig_options(options: SceneOptions | None, has_lubricant: bool) -> SceneOptions:
@@ -299,7 +339,9 @@ def rig_loads(built: BearingRigScene, system: mbd.System, s: mbd.State) -> dict:
     roller angles from the load-zone centre (Z,) [rad], the ring centre (2,) [m], and the vector sums
     (2,) [N, fixed frame] of the inner normal loads pressing the pin, Σ Q_j·(−e_j), and of the whole
     contact forces (normal + traction) the rollers exert on the pin and on the ring. Loads are per physical
-    roller; the sums count every row."""
+    roller; the sums count every row. The sliced model (docs/model.md §8.8) adds, its rollers row by row,
+    ``slices_inner`` and ``slices_outer`` (rows, Z, n_s) the slice loads [N], ``tilt`` (rows, Z) the rollers' tilts
+    [rad] and ``ring_slope`` (2,) the ring's slope [rad, fixed frame]."""
     m = built.model
     out = system.outputs(s.t, s.q, s.v, s.z)
     h = built.bearing_handles
@@ -310,14 +352,76 @@ def rig_loads(built: BearingRigScene, system: mbd.System, s: mbd.State) -> dict:
     qf, _ = m.full(s.t, s.q, s.v)
     ring = qf[3 * m.body(built.ring).index: 3 * m.body(built.ring).index + 2]
     Qi, Qo = inner["load"][si], outer["load"][so]
-    rows = built.bearing.rows
-    return {
+    rows = built.fold
+    rec = {
         "t": s.t, "angle": wrap_angle(ang - built.zone_angle), "load_inner": Qi, "load_outer": Qo,
         "ring": ring.copy(),
         "load_sum": -rows * (Qi[:, None] * e).sum(axis=0),
         "pin_force": pin_reactions(inner, si, np.zeros(si.stop - si.start, int), 1, rows)[0],
         "ring_force": rows * np.array([outer["fx"][so].sum(), outer["fy"][so].sum()]),   # −(force on ring)
     }
+    if "max_slice_load" in inner:
+        shape = (h.rows, built.bearing.rollers, -1)
+        for key, o, sl in (("slices_inner", inner, si), ("slices_outer", outer, so)):
+            n_s = sum(1 for k in o if k.startswith("slice_load_"))
+            rec[key] = np.stack([np.asarray(o[f"slice_load_{k}"])[sl] for k in range(n_s)], axis=-1).reshape(shape)
+        rec["tilt"] = np.asarray(inner["tilt"])[si].reshape(shape[:2])
+        rec["ring_slope"] = qf[_slope_indices(built)]
+    return rec
+
+
+def rig_quasi_static(built: BearingRigScene, times=None, engine: str = "auto", system: mbd.System | None = None,
+                     hold_tilt: bool = True):
+    """The rig's quasi-static states (:func:`mbd.static.solve_static`, docs/model.md §10.5, §16) at ``times`` [s]
+    (default: the end of the load ramp, the load at its full value), each started from the last: every roller keeps
+    its pocket's centre (it moves along its radius only, as ISO/TS 16281's rollers do), its radius, tilt and spin
+    rate solved; a free cage's rate with its rollers' orbits; the ring's translation. Held: the ring's angle (its speed
+    drive supplies the torque) and, in the sliced model, the ring's slope at its given zero (the tilting moment is the
+    housing's reaction; ``hold_tilt=False`` solves it against the housing's support instead, as a dynamic run sees
+    it). Returns the :class:`mbd.static.StaticSolution` list; :func:`rig_loads` reads each. A turning ring's unloaded
+    rollers have no traction and so no static spin rate: the ring at rest (the standard's case) always has a state."""
+    check_static(built.bearing.traction_law)
+    m, h = built.model, built.bearing_handles
+    system = system if system is not None else mbd.System(m)
+    times = [built.ramp] if times is None else [float(t) for t in times]
+    orbit = np.zeros(m.n_bodies)
+    host = np.full(m.n_bodies, -1)
+    circles = {}
+    idx = [m.body(r).index for r in h.rollers]
+    cage = m.body(h.cage).index if h.cage is not None else -1
+    cage_free = cage >= 0 and not m.fixed[cage]
+    for i in idx:
+        if h.omega_cage != 0.0:
+            orbit[i] = h.omega_cage
+            if cage_free:
+                host[i] = cage
+        else:
+            circles[i] = (0.0, 0.0)            # the pin's centre: the rollers rest on their radial lines
+    motion = SteadyMotion.from_state(m, built.q0, built.v0, orbit, host, circles=circles)
+    full = [3 * m.body(built.ring).index + 2]
+    if built.bearing.model == "sliced" and hold_tilt:
+        full += [int(i) for i in _slope_indices(built)]
+    hold = m.full_to_free[full]
+    rates = ([(cage, idx if h.omega_cage != 0.0 else [])] if cage_free else []) + [(i, []) for i in idx]
+    # the first start: the ring displaced by the classical deflection (the contacts near the zone's centre closed;
+    # from the kinematic pose a profiled roller touches nowhere and nothing resists the load)
+    q_first = np.asarray(built.q0, float).copy()
+    if built.reference is not None:
+        k = 3 * m.body(built.ring).index
+        q_first[m.full_to_free[[k, k + 1]]] += built.reference.deflection * np.array([np.cos(built.load_angle),
+                                                                                      np.sin(built.load_angle)])
+    out = []
+    for t in times:
+        start = carry(m, motion, out[-1], t, rates) if out else (q_first, None)
+        out.append(solve_static(m, motion, t, hold=hold[hold >= 0], rates=rates, q_start=start[0],
+                                rates_start=start[1], system=system, engine=engine))
+    return out
+
+
+def _slope_indices(built: BearingRigScene) -> np.ndarray:
+    """Full indices of the ring's slope pair (its support's coordinates)."""
+    sup = [e for e in built.model.elements if e.name == "ring_tilt_support"][0]
+    return np.asarray(sup.dofs).ravel()
 
 
 @dataclass(frozen=True)
@@ -358,6 +462,7 @@ class RigSolution:
     error_max: float = float("nan")
     runs: tuple = ()                  # the mbd.SimResult of each piece (which engine ran, its counters)
     compile_s: float = 0.0            # compiling or loading the kernels [s], left out of wall_s
+    loads_rows: np.ndarray | None = None   # (rows, Z) mean pin loads per row and bin [N] (the sliced model's rows)
 
     def summary(self) -> dict:
         return {"radial_load_N": self.radial_load, "q_max_N": self.q_max, "stribeck": self.stribeck,
@@ -394,16 +499,18 @@ def rig_static_solution(built: BearingRigScene, *, t_settle: float | None = None
     k = np.mod(np.round(ang * Z / (2 * np.pi)).astype(int), Z)
     Qi = np.array([r["load_inner"] for r in recs])
     Qo = np.array([r["load_outer"] for r in recs])
-    n = len(recs)
-    loads = np.bincount(k.ravel(), weights=Qi.ravel(), minlength=Z) / n
-    loads_o = np.bincount(k.ravel(), weights=Qo.ravel(), minlength=Z) / n
+    n, rows = len(recs), built.bearing_handles.rows        # explicit rows (sliced model): a bin's mean over them
+    loads = np.bincount(k.ravel(), weights=Qi.ravel(), minlength=Z) / (n * rows)
+    loads_o = np.bincount(k.ravel(), weights=Qo.ravel(), minlength=Z) / (n * rows)
+    row = np.broadcast_to(np.repeat(np.arange(rows), Z), k.shape)
+    loads_rows = np.bincount((row * Z + k).ravel(), weights=Qi.ravel(), minlength=rows * Z).reshape(rows, Z) / n
     # mean angle of each bin's occupants, relative to the bin centre (no wrap problems)
     centre = 2 * np.pi * np.arange(Z) / Z
     rel = wrap_angle(ang - centre[k])
     cnt = np.bincount(k.ravel(), minlength=Z)
     angles = wrap_angle(centre + np.bincount(k.ravel(), weights=rel.ravel(), minlength=Z) / np.maximum(cnt, 1))
     order = np.argsort(angles)
-    angles, loads, loads_o = angles[order], loads[order], loads_o[order]
+    angles, loads, loads_o, loads_rows = angles[order], loads[order], loads_o[order], loads_rows[:, order]
     q_max = float(loads.max())
     loaded = angles[loads > zone_tol * q_max] if q_max > 0 else np.array([])
     zone = float(loaded.max() - loaded.min()) if loaded.size else 0.0
@@ -413,6 +520,7 @@ def rig_static_solution(built: BearingRigScene, *, t_settle: float | None = None
     side = float(ring @ np.array([-u[1], u[0]]))
     mean = lambda key: np.array([r[key] for r in recs]).mean(axis=0)
     return RigSolution(t0=float(times[0]), t1=float(times[-1]), samples=n, angles=angles, loads=loads,
+                       loads_rows=loads_rows,
                        loads_outer=loads_o, q_max=q_max,
                        stribeck=q_max * Z * built.bearing.rows / F if F > 0 else float("nan"),
                        zone_angle=zone, zone_angle_continuous=_zone_angle(defl, built.bearing.clearance),

@@ -17,7 +17,8 @@ there: a roller's tangential forces are the cage's), its radius r_j and its tilt
 raceways being of one material and the line contact's constant independent of the curvature, a free roller takes
 half the misalignment and both its contacts the same slice loads, so that the two contacts act as one lamina of
 the series constant K 2^(−10/9), ISO/TS 16281's form; the exact-norm geometry keeps the second-order terms the
-standard's linear kinematics leaves out. Rows sit side by side at ζ_row = (i − (rows − 1)/2) l.
+standard's linear kinematics leaves out. Rows sit at ζ_row = (i − (rows − 1)/2) e_r, e_r = ``bearing.row_spacing``
+(:func:`components.bearing.row_stations`).
 
 Solution. For a bore displacement u every roller's (r_j, τ_j) is solved by Newton's method on its own 2×2 system
 (exact Jacobian of the slice law, vectorised over rollers, steps halved until the roller's residual falls); the
@@ -41,6 +42,7 @@ from scipy.optimize import root
 from mbd.elements.sliced import SlicedContact, iso_16281_stiffness, slice_stations
 
 from . import life
+from .bearing import row_stations
 from .profiles import reduced_modulus, roller_drop
 
 __all__ = ["ARCMIN", "MISALIGNMENT_DIRECTIONS", "SlicedBearing", "SlicedBearingState", "sliced_bearing_life",
@@ -121,7 +123,7 @@ class SlicedBearing:
         self._load_scale = K * b.roller_diameter ** b.contact_exponent * 1e-3   # N: a roller load's scale (δ = D/1000)
         Z, rows = b.rollers, b.rows
         self.Z, self.rows = Z, rows
-        zeta_row = np.repeat((np.arange(rows) - 0.5 * (rows - 1)) * b.roller_length, Z)
+        zeta_row = np.repeat(row_stations(b), Z)
         drop = roller_drop(b, self.z)
         common = dict(D=b.roller_diameter, K=K, exponent=b.contact_exponent, z=self.z, drop=drop,
                       row_offset=zeta_row)

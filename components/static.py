@@ -195,7 +195,7 @@ def static_statistics(scene, n_snapshots: int = DEFAULT_SNAPSHOTS, engine: str =
     z = {k: np.stack([np.asarray(s.z[k]) for s in sols]) for k in sols[0].z}
     rows = stats.snapshots(ts, np.stack([s.q for s in sols]),
                            np.stack([s.v for s in sols]), np.stack([s.a for s in sols]), z)
-    stats.add_samples(rows)
+    stats.add_samples(rows, ts)
     return stats, sols
 
 

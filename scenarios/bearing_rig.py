@@ -24,7 +24,12 @@ import mbd
 from components.params import overrides_from_toml, with_overrides
 from components.presets import reference_dpgt
 from components.results.io import atomic_write_text
-from components.rig import build_bearing_rig, discrete_load_distribution, rig_static_solution
+from components import life
+from components.bearing import row_stations
+from components.rig import (build_bearing_rig, discrete_load_distribution, rig_loads, rig_quasi_static,
+                            rig_static_solution)
+from components.sliced_bearing import pressure_scales
+from mbd.elements.sliced import slice_stations
 from components.scene import SceneOptions
 from components.units import ParameterError, quantity, to_si
 
@@ -53,6 +58,13 @@ def parse_args(argv):
     p.add_argument("--speed", default="0 rpm", type=args.quantity_of("angular_velocity"), help='outer ring speed (default "0 rpm": static)')
     p.add_argument("--cage", default="held", choices=["held", "free", "none"], help="cage held (default), free or absent")
     p.add_argument("--no-drag", action="store_true", help="switch lubricant drag off")
+    p.add_argument("--model", default=None, choices=["planar", "sliced"],
+                   help="roller contact model (default: the parameters', planar); sliced: slices, tilts, rows")
+    p.add_argument("--rows", type=args.count(1), default=None, help="roller rows (default 1; the sliced model builds each)")
+    p.add_argument("--misalignment", default="0 arcmin", type=args.quantity_of("angle"),
+                   help='the pin\'s tilt against the ring, e.g. "4 arcmin" (sliced model; default "0 arcmin")')
+    p.add_argument("--misalignment-direction", default="radial", choices=["radial", "tangential"],
+                   help="the tilt in the load plane (radial, default) or across it (tangential)")
     # the bearing's parameters (bearing.*) from a file or --set; the options above win over them
     args.add_shared(p, "params", "set", "out", "overwrite", "no-progress", out="results/bearing_rig")
     return p.parse_args(argv)
@@ -70,20 +82,25 @@ def run(a) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     ov = {k: v for k, v in {"bearing.clearance": a.clearance, "bearing.rollers": a.rollers,
                             "bearing.roller_diameter": a.roller_diameter, "bearing.roller_length": a.roller_length,
-                            "bearing.pitch_diameter": a.pitch_diameter}.items() if v is not None}
+                            "bearing.pitch_diameter": a.pitch_diameter, "bearing.model": a.model,
+                            "bearing.rows": a.rows}.items() if v is not None}
     try:
         params = with_overrides(reference_dpgt(), {**_file_overrides(a.params), **args.parse_sets(a.set), **ov})
         F = to_si(quantity("radial_load", a.radial_load, "force"))
         w = to_si(quantity("speed", a.speed, "angular_velocity"))
+        gamma = to_si(quantity("misalignment", a.misalignment, "angle"))
         if F <= 0:
             raise ParameterError.at("radial_load", f"must be > 0 N, got {a.radial_load!r}")
+        if gamma != 0.0 and params.bearing.model != "sliced":
+            raise ParameterError.at("misalignment", "a tilted rig bearing needs --model sliced (bearing.model)")
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
     identity = claim_for_inputs(out, command_inputs(a), a.overwrite)     # other inputs' results: --overwrite
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         built = build_bearing_rig(params.bearing, lubricant=None if a.no_drag else params.lubricant, radial_load=F,
-                                  outer_speed=w, options=SceneOptions(cage=a.cage, drag=not a.no_drag, gravity=False))
+                                  outer_speed=w, options=SceneOptions(cage=a.cage, drag=not a.no_drag, gravity=False),
+                                  misalignment=gamma, misalignment_direction=a.misalignment_direction)
     sol = rig_static_solution(built)
     b = built.bearing
     theory = discrete_load_distribution(b, F)
@@ -109,8 +126,29 @@ def run(a) -> dict:
                             "note": "rigid rings, discrete rollers, no centrifugal force or traction"},
         **identity,
     }
+    sliced = None
+    if built.bearing.model == "sliced":
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sliced = sliced_rig_report(params.bearing, a, F, w, gamma, sol)
+        summary["sliced"] = sliced
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2, default=float))
     from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
+
+    if sliced is not None:
+        prof = sliced["pressure_profile_pin_Pa"]
+        rows = len(prof["tilted"])
+        pfig = vp.slice_pressure_profiles(sliced["slice_z_m"], sliced["row_stations_m"],
+                                          {"aligned": prof["aligned"],
+                                           f"tilted {a.misalignment} {a.misalignment_direction}": prof["tilted"]},
+                                          out / "pressure_profile.png",
+                                          title=f"Most loaded roller{' of each row' if rows > 1 else ''}: "
+                                                f"F_r = {F / 1e3:.3g} kN, {b.profile.shape} rollers, quasi-static")
+        print(f"sliced ({rows} row{'s' if rows > 1 else ''}, {b.profile.shape}): row shares of the pin load "
+              f"{', '.join(f'{x:.3f}' for x in sliced['row_load_share']['tilted'])} tilted (quasi-static; dynamic "
+              f"{', '.join(f'{x:.3f}' for x in sliced['row_load_share_dynamic'])}), life relative to aligned "
+              f"{sliced['life_relative']:.3f}, edge pressure ratio {sliced['edge_pressure_ratio']['tilted']:.3f}; "
+              f"written: {pfig}")
 
     fig = vp.load_distribution(sol.angles[order], {"simulated (time mean)": sol.loads[order]},
                                out / "load_distribution.png", zero="the load-zone centre",
@@ -125,6 +163,56 @@ def run(a) -> dict:
                                                          sol.compile_s))
     print(f"written: {out / 'summary.json'}, {fig}")
     return summary
+
+
+def sliced_rig_report(bearing, a, F: float, w: float, gamma: float, sol, positions: int = 4) -> dict:
+    """The sliced rig bearing's quasi-static answer (:func:`components.rig.rig_quasi_static`, the ring's slope held),
+    aligned and tilted by ``gamma``, at ``positions`` cage positions over one roller pitch (the load turned against the
+    rollers): per row its share of the pin load and the most loaded roller's slice loads and pin pressures (at the
+    first position: the rollers symmetric about the load line), the edge pressure ratio, and the ISO/TS 16281 life
+    with slices of the rows combined (:func:`components.life.sliced_life`) relative to aligned; the dynamic run's
+    (``sol``, at the given speed and cage) row shares beside them. The quasi-static rig is the standard's case: the
+    ring at rest, the cage held, no drag (no centrifugal load, no traction; an unloaded roller of a turning ring has no
+    static spin)."""
+    b = bearing.si() if hasattr(bearing, "si") else bearing
+    c_pin, c_bore = pressure_scales(b, b.slicing.slices)
+    out = {"slice_z_m": slice_stations(b.roller_length, b.slicing.slices)[0].tolist(), "rows": b.rows,
+           "row_stations_m": row_stations(b).tolist()}
+    cases = {"aligned": 0.0, "tilted": gamma}
+    lives, share, profile, loads, edge = {}, {}, {}, {}, {}
+    for name, g in cases.items():
+        recs = []
+        for k in range(positions):
+            load_angle = -0.5 * np.pi + 2 * np.pi * k / (positions * b.rollers)
+            built = build_bearing_rig(b, radial_load=F, load_angle=load_angle, outer_speed=0.0,
+                                      options=SceneOptions(cage="held", drag=False, gravity=False), misalignment=g,
+                                      misalignment_direction=a.misalignment_direction)
+            system = mbd.System(built.model)
+            recs.append(rig_loads(built, system, rig_quasi_static(built, system=system)[0]))
+        q_pin = np.stack([r["slices_inner"] for r in recs])            # (positions, rows, Z, n_s)
+        q_bore = np.stack([r["slices_outer"] for r in recs])
+        pe = life.equivalent_load(np.mean(q_pin ** life.STATIONARY_EXPONENT, axis=(0, 2)), life.STATIONARY_EXPONENT)
+        be = life.equivalent_load(np.mean(q_bore ** life.ROTATING_EXPONENT, axis=(0, 2)), life.ROTATING_EXPONENT)
+        lives[name] = life.sliced_life(pe, be, b)
+        first = q_pin[0]
+        row_sum = first.sum(axis=(1, 2))
+        share[name] = (row_sum / row_sum.sum()).tolist()
+        top = first.sum(-1).argmax(axis=1)                             # each row's most loaded roller
+        loads[name] = [first[r, top[r]].tolist() for r in range(b.rows)]
+        profile[name] = [(c_pin * np.sqrt(first[r, top[r]])).tolist() for r in range(b.rows)]
+        p = np.array(profile[name])
+        mid = p[:, p.shape[1] // 2]
+        edge[name] = float(np.max(np.maximum(p[:, 0], p[:, -1])) / np.max(mid)) if np.max(mid) > 0 else None
+    dyn = sol.loads_rows.sum(axis=1)
+    out.update({"misalignment_rad": gamma, "misalignment_direction": a.misalignment_direction,
+                "row_load_share": share, "row_load_share_dynamic": (dyn / dyn.sum()).tolist(),
+                "most_loaded_roller_slice_load_pin_N": loads, "pressure_profile_pin_Pa": profile,
+                "edge_pressure_ratio": edge, "life_iso16281_sliced_Mrev": lives,
+                "life_relative": lives["tilted"] / lives["aligned"] if lives["aligned"] and lives["tilted"] else None,
+                "note": "quasi-static: ISO/TS 16281's case (the ring at rest, its slope held, the rollers at their held "
+                        "pockets' centres, no centrifugal load or traction), the life over "
+                        f"{positions} cage positions of one roller pitch; the row shares also from the dynamic run"})
+    return out
 
 
 @command

@@ -197,11 +197,14 @@ class BearingParams(Params["BearingSI"]):
     roller_diameter: Quantity = positive("length", "roller diameter D")
     roller_length: Quantity = positive("length", "effective roller length l")
     rollers: int = param("count", "rollers Z per bearing", lo=3, bound_text=">= 3")
-    rows: int = param("count", "roller rows (identical rows move as one in the planar model)", lo=1,
-                      bound_text=">= 1")
+    rows: int = param("count", "roller rows (identical rows move as one in the planar model; the sliced model "
+                               "builds each row's rollers at its axial station)", lo=1, bound_text=">= 1")
+    row_spacing: Quantity | None = rule("length", "derived", "rows side by side: the roller length l (no rib "
+                                                             "between them)",
+                                        "axial distance between the centres of neighbouring roller rows (>= l)")
     model: str = param("choice", "roller-raceway contact model: planar (one line contact per roller) or sliced "
                                  "(bearing.slicing slices per roller, the planets' slopes and the rollers' tilts "
-                                 "as degrees of freedom; one row)", choices=("planar", "sliced"))
+                                 "as degrees of freedom; every row its own rollers)", choices=("planar", "sliced"))
     clearance: Quantity = nonneg("length", "diametral clearance P_d")
     roller_density: Quantity = positive("density", "roller material density")
     roller_mass: Quantity | None = rule("mass", "derived", "solid cylinder: density x pi D^2 l / 4")
@@ -242,7 +245,11 @@ class BearingParams(Params["BearingSI"]):
         cage = v["cage"]
         if cage.inertia is None:
             cage = cage.replace(inertia=cage.mass * (dm / 2.0) ** 2)
-        return dict(roller_mass=m,
+        spacing = v["row_spacing"] if v["row_spacing"] is not None else ln
+        if spacing < ln:
+            raise ParameterError.at("bearing.row_spacing", f"expected >= the roller length {ln * 1e3:g} mm (rows "
+                                                           f"cannot overlap), got {spacing * 1e3:g} mm")
+        return dict(roller_mass=m, row_spacing=spacing,
                     roller_inertia=v["roller_inertia"] if v["roller_inertia"] is not None else m * dr ** 2 / 8.0,
                     contact_stiffness=(v["contact_stiffness"] if v["contact_stiffness"] is not None
                                        else geo.palmgren_stiffness(ln)),
@@ -257,6 +264,7 @@ class BearingSI(SI):
     roller_length: float
     rollers: int
     rows: int
+    row_spacing: float = computed("axial distance between neighbouring rows' centres [m] (given, or the rule)")
     model: str
     clearance: float
     roller_density: float

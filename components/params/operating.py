@@ -113,6 +113,11 @@ class BearingRigParams(Params["BearingRigSI"]):
     ring_mass: Quantity = positive("mass", "outer ring mass")
     ring_radius: Quantity = positive("length", "outer ring radius for its inertia rule")
     ring_inertia: Quantity | None = rule("inertia", "assumed", "solid disc of the ring radius, m r^2/2")
+    ring_tilt_inertia: Quantity | None = rule("inertia", "assumed", "thin disc: half the polar inertia",
+                                              "the ring's diametral moment of inertia (its slopes: the sliced model)")
+    tilt_support_stiffness: Quantity = positive("torsional_stiffness", "the housing's support holding the ring's "
+                                                                       "slope at zero, the pin carrying the given tilt "
+                                                                       "(the sliced model)")
     drive_bandwidth: Quantity = positive("frequency", "bandwidth of the ring's speed drive")
     drive_damping_ratio: Quantity = nonneg("dimensionless", "damping ratio of the ring's speed drive")
     settle_damping_ratio: Quantity = nonneg("dimensionless", "ring-to-ground dashpot as a fraction of the critical "
@@ -121,9 +126,9 @@ class BearingRigParams(Params["BearingRigSI"]):
     gravity: Quantity = nonneg("acceleration", "gravitational acceleration along -y (scene option gravity)")
 
     def _si_values(self, v):
-        if v["ring_inertia"] is not None:
-            return {}
-        return dict(ring_inertia=0.5 * v["ring_mass"] * v["ring_radius"] ** 2)
+        J = v["ring_inertia"] if v["ring_inertia"] is not None else 0.5 * v["ring_mass"] * v["ring_radius"] ** 2
+        return dict(ring_inertia=J,
+                    ring_tilt_inertia=v["ring_tilt_inertia"] if v["ring_tilt_inertia"] is not None else 0.5 * J)
 
 
 @si_of(BearingRigParams)
@@ -131,6 +136,8 @@ class BearingRigSI(SI):
     ring_mass: float
     ring_radius: float
     ring_inertia: float = computed("outer ring polar moment of inertia [kg m^2] (given, or the rule)")
+    ring_tilt_inertia: float = computed("outer ring diametral moment of inertia [kg m^2] (given, or the rule)")
+    tilt_support_stiffness: float
     drive_bandwidth: float
     drive_damping_ratio: float
     settle_damping_ratio: float

@@ -30,7 +30,7 @@ except ImportError:      # pragma: no cover - numba is a dependency; this keeps 
         return fn
 
 __all__ = ["Accumulators", "accumulate_steps", "compile_accumulators", "IMPACT_ROWS", "FlankPeaks", "accumulate_flank",
-           "FLANK_RANGE", "FLANK_BINS", "DYNAMIC_PERCENTILE"]
+           "FLANK_RANGE", "FLANK_BINS", "DYNAMIC_PERCENTILE", "PeakProfiles"]
 
 # the drive-flank force's distribution: x/F_nom in FLANK_BINS equal bins over [0, FLANK_RANGE), one more above
 FLANK_RANGE = 8.0
@@ -503,3 +503,47 @@ def compile_accumulators() -> None:
                          np.zeros((2, 1)), np.array([[0.0], [0.0], [-np.inf], [-1.0]]))
     _compiled.compile_announced(toy, cold=not accumulators_cached(), what="the statistics' accumulator kernels",
                                 done="accumulator kernels", about="a few seconds")
+
+
+class PeakProfiles:
+    """Per bearing, the slice loads of its most loaded roller at that roller's peak instant (docs/model.md §13.2: a
+    maximum over the states of the window — the step ends, or the samples of a static solution): the roller with the
+    largest pin load Σ_k q_k over its bearing's window, its pin and bore slice loads [N] at that state, the time [s]
+    and the roller (instance index within its bearing, row by row). ``n_bearings``, ``n_slices``; the rollers of the
+    quantities are grouped bearing by bearing, equally many each (:func:`.quantities.plan_of`)."""
+
+    def __init__(self, n_bearings: int, n_slices: int):
+        self.load = np.full(n_bearings, -np.inf)
+        self.time = np.full(n_bearings, np.nan)
+        self.roller = np.full(n_bearings, -1, np.int64)
+        self.pin = np.zeros((n_bearings, n_slices))
+        self.bore = np.zeros((n_bearings, n_slices))
+
+    def add(self, t, Q, pin, bore, owner, lo: float, end) -> None:
+        """K states at times ``t`` (K,): roller pin loads ``Q`` (K, n_r), slice loads ``pin``, ``bore`` (K, n_r·n_s);
+        ``owner`` (n_r,) each roller's bearing; a state counts for a bearing when lo ≤ t ≤ ``end`` [bearing] (its
+        window's end, inf while open)."""
+        t, Q = np.asarray(t, float), np.asarray(Q, float)
+        K, n_r = Q.shape
+        nb, n_s = self.pin.shape
+        z = n_r // nb
+        ok = ~((t[:, None] < lo) | (t[:, None] > np.asarray(end, float)[owner][None, :]))     # NaN times: samples
+        flat = np.where(ok, Q, -np.inf).reshape(K, nb, z).transpose(1, 0, 2).reshape(nb, K * z)
+        i = flat.argmax(axis=1)
+        best = flat[np.arange(nb), i]
+        better = best > self.load
+        if not better.any():
+            return
+        k, j = np.divmod(i, z)
+        b = np.flatnonzero(better)
+        r = b * z + j[b]
+        self.load[b], self.time[b], self.roller[b] = best[b], t[k[b]], j[b]
+        self.pin[b] = np.asarray(pin, float).reshape(K, n_r, n_s)[k[b], r]
+        self.bore[b] = np.asarray(bore, float).reshape(K, n_r, n_s)[k[b], r]
+
+    def state_dict(self) -> dict:
+        return {"load": self.load, "time": self.time, "roller": self.roller, "pin": self.pin, "bore": self.bore}
+
+    def load_state_dict(self, d: dict) -> None:
+        for k in ("load", "time", "roller", "pin", "bore"):
+            getattr(self, k)[...] = d[k]

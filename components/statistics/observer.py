@@ -12,9 +12,10 @@ from mbd.simulate import ENGINES
 
 from ..bearing import bearing_kinematics
 from ..families import FAMILY
+from ..sliced_bearing import pressure_scales
 from . import quantities as Q
-from .accumulate import Accumulators, FlankPeaks, compile_accumulators
-from .summaries import run_summary
+from .accumulate import PeakProfiles, Accumulators, FlankPeaks, compile_accumulators
+from .summaries import equivalent_slice_loads, run_summary
 
 __all__ = ["WindowStatistics", "default_window", "cage_period"]
 
@@ -105,6 +106,7 @@ class WindowStatistics(mbd.Observer):
         floor = self.model.element(FAMILY["pocket"]).v_min * (1.0 + 1e-9) if pockets.size else np.zeros(0)
         self.sums = Accumulators(p.planet.size, self.t0, self.t1, self.target, pockets, floor, self.entry_dwell)
         self.flank = self._flank_peaks()
+        self.peak = PeakProfiles(p.planet.size, p.slices) if p.slices else None    # the sliced model's profiles
         self._prev = None            # the quantities at the last step's end: the next step's start
         self.ref_roller = None       # (inner, outer) race_inner instance of the reference rollers
 
@@ -177,17 +179,27 @@ class WindowStatistics(mbd.Observer):
         self.sums.add_steps(t, rows, Z)
         if self.flank is not None:
             self.flank.add_steps(t, rows)
+        if self.peak is not None:      # the bearing windows as the sums just closed them
+            s = self.sums
+            end = np.where(s.open, np.inf, s.t_close) if s.has_target else np.full(s.open.size, self.t1)
+            self.peak.add(t, rows["roller_inner_load"], rows["_slice_inner"], rows["_slice_outer"],
+                          self.plan.roller_bearing, self.t0, end)
         self._prev = {k: x[-1].copy() for k, x in rows.items()}
 
-    def add_samples(self, rows) -> None:
+    def add_samples(self, rows, t=None) -> None:
         """Equally weighted states instead of integrator steps (a static solution's snapshots,
         :mod:`components.static`): ``rows`` as :meth:`snapshots` returns them; each state counts one unit of
-        time in every window, so means are plain averages and max/min the extremes over the states."""
+        time in every window, so means are plain averages and max/min the extremes over the states; ``t`` their
+        times [s] (the peak profiles' instants; NaN when not given)."""
         if self.ref_roller is None and self.plan.rollers:
             first = _at(rows, 0)
             self.ref_roller = Q.reference_rollers(self.plan, first, first, 0.0)
         self._layout(rows)
         self.sums.add_samples(rows)
+        if self.peak is not None:      # every sample counts
+            K = len(rows["roller_inner_load"])
+            self.peak.add(np.full(K, np.nan) if t is None else np.asarray(t, float), rows["roller_inner_load"], rows["_slice_inner"], rows["_slice_outer"],
+                          self.plan.roller_bearing, -np.inf, np.full(self.plan.planet.size, np.inf))
 
     def _layout(self, rows) -> None:
         """Lay the accumulators out for the quantities of ``rows`` once (the leading-underscore ones are not
@@ -205,6 +217,7 @@ class WindowStatistics(mbd.Observer):
         d.update({f"flank__{k}": v for k, v in (self.flank.state_dict() if self.flank is not None else {}).items()})
         d.update({f"prev__{k}": v for k, v in (self._prev or {}).items()})
         d["ref"] = np.array(self.ref_roller if self.ref_roller is not None else (-1, -1))
+        d.update({f"peak__{k}": v for k, v in (self.peak.state_dict() if self.peak is not None else {}).items()})
         return d
 
     def load_state_dict(self, d: dict) -> None:
@@ -214,6 +227,8 @@ class WindowStatistics(mbd.Observer):
         self._prev = {k[6:]: v.copy() for k, v in d.items() if k.startswith("prev__")} or None
         if self.sums.flat is not None and self._prev is not None:
             self._layout({k: x[None] for k, x in self._prev.items()})
+        if self.peak is not None and "peak__load" in d:
+            self.peak.load_state_dict({k[6:]: v for k, v in d.items() if k.startswith("peak__")})
         ref = tuple(int(x) for x in d.get("ref", (-1, -1)))
         self.ref_roller = None if ref[0] < 0 else ref
 
@@ -230,6 +245,24 @@ class WindowStatistics(mbd.Observer):
     def duration(self) -> float:
         """Length of the global (mesh) window covered so far [s]."""
         return self.sums.duration
+
+    def slice_profiles(self) -> dict | None:
+        """The sliced model's profiles per bearing (None for the planar model): along the most loaded roller at its
+        peak instant (:class:`.accumulate.PeakProfiles`) its pin and bore slice loads [N] and Hertz pressures
+        p = c √q [Pa] (:func:`components.sliced_bearing.pressure_scales`), the instant [s], the roller (within its
+        bearing, row by row) and its row; and each bearing's equivalent slice loads per row over its window and its
+        rollers, the ISO/TS 16281 life's q_e,k (pin exponent 4.5, bore 4; :mod:`.summaries`) [N]. Arrays by bearing
+        (:func:`.quantities.bearing_map`'s order), slice, row."""
+        if self.peak is None:
+            return None
+        p, pk = self.plan, self.peak
+        c_pin, c_bore = pressure_scales(p.bearing, p.slices)
+        z = p.roller_bearing.size // p.planet.size // p.explicit_rows        # rollers per row
+        qe = equivalent_slice_loads(self.sums, p)
+        return {"names": [x["name"] for x in self.bmap], "load_pin": pk.pin.copy(), "load_bore": pk.bore.copy(),
+                "pressure_pin": c_pin * np.sqrt(pk.pin), "pressure_bore": c_bore * np.sqrt(pk.bore),
+                "time": pk.time.copy(), "roller": pk.roller.copy(), "row": pk.roller // z,
+                "equivalent_pin": qe[0], "equivalent_bore": qe[1]}
 
     def summary(self) -> dict:
         """The statistics users read, per bearing kind (see README: summary.json; :mod:`.summaries`)."""

@@ -76,7 +76,7 @@ class Plan:
     pocket_bearing: np.ndarray | None
     guide: np.ndarray | None     # guide instance per bearing
     spring: np.ndarray | None    # bearing_linear instance per bearing
-    rows: int
+    rows: int                    # physical rollers one roller body stands for (the planar model's folded rows)
     omega_c: float               # nominal carrier speed [rad/s]: the carrier frame's
     meshes: dict                 # mesh type -> its family, those the model has
     flanks: dict                 # mesh type -> its loaded flank (+1/−1)
@@ -85,6 +85,8 @@ class Plan:
     qc: tuple                    # (pin, bore) roller contact ratings [N]
     families: frozenset          # the element families whose outputs the quantities read
     slices: int = 0              # slices per roller of the sliced contact (0: the planar contact)
+    roller_row: np.ndarray | None = None   # row of every race_inner instance (the sliced model's explicit rows)
+    explicit_rows: int = 1       # rows built roller by roller (the sliced model: bearing.rows; the planar: 1)
 
 
 def plan_of(scene, model) -> Plan:
@@ -102,6 +104,9 @@ def plan_of(scene, model) -> Plan:
             raise mbd.ModelError(f"statistics: every planet bearing needs the same number of rollers, listed "
                                  f"bearing by bearing; got {counts.tolist()} in the order {rb.tolist()}")
     meshes = {k: f for k, f in MESH_FAMILY.items() if f in fams}
+    sliced = rollers and getattr(b, "model", "planar") == "sliced"
+    explicit = int(b.rows) if sliced else 1          # the sliced model builds every row; the planar folds them
+    roller_row = (np.tile(np.repeat(np.arange(explicit), counts[0] // explicit), len(bm)) if rollers else None)
     return Plan(
         kinds=np.array([x["kind"] for x in bm]), rollers=rollers, planet=np.array([idx(x["planet"]) for x in bm]),
         cage=np.array([idx(x["cage"]) for x in bm]) if rollers and "cage" in bm[0] else None,
@@ -111,11 +116,11 @@ def plan_of(scene, model) -> Plan:
         if rollers and FAMILY["pocket"] in fams else None,
         guide=np.array([x["guide"] for x in bm]) if rollers and "guide" in bm[0] else None,
         spring=np.array([x["spring"] for x in bm]) if not rollers else None,
-        rows=int(getattr(b, "rows", 1)), omega_c=float(scene.speeds.carrier),
+        rows=1 if sliced else int(getattr(b, "rows", 1)), omega_c=float(scene.speeds.carrier),
         meshes=meshes, flanks=dict(scene.flanks), bearing=b, lubricant=scene.lubricant, qc=raceway_ratings(b),
         families=frozenset({FAMILY[k] for k in ("race_inner", "race_outer", "pocket", "guide", "linear")}
                            | set(meshes.values())),
-        slices=int(b.slicing.slices) if rollers and getattr(b, "model", "planar") == "sliced" else 0)
+        slices=int(b.slicing.slices) if sliced else 0, roller_row=roller_row, explicit_rows=explicit)
 
 
 def owner(p: Plan, key: str):
@@ -211,6 +216,7 @@ def slice_quantities(p: Plan, ri, ro) -> dict[str, np.ndarray]:
     for race, out, e, c in (("inner", ri, STATIONARY_EXPONENT, qc[0]), ("outer", ro, ROTATING_EXPONENT, qc[1])):
         q = np.stack([np.asarray(out[f"slice_load_{k}"], float) for k in range(p.slices)], axis=-1)
         snap[f"slice_{race}_fatigue"] = ((q / c) ** e).reshape(q.shape[:-2] + (-1,))
+        snap[f"_slice_{race}"] = q.reshape(q.shape[:-2] + (-1,))     # the loads: the peak profile (not accumulated)
     return snap
 
 

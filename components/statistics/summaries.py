@@ -143,7 +143,9 @@ def slice_summary(d, sums, p, ref, sel) -> None:
     """The sliced contact's statistics (docs/model.md §8.8): the largest slice load of any roller of these bearings
     on the pin and on the bore, and the largest contact pressure (the pin's, the convex raceway); the edge ratio of
     the reference bearing, its largest end-slice pin pressure over its largest middle-slice one in the window
-    (√ of the loads' ratio); the misalignment each bearing sees, its time mean (reference, per planet) and maximum."""
+    (√ of the loads' ratio); the misalignment each bearing sees, its time mean (reference, per planet) and maximum;
+    with explicit rows (bearing.rows > 1), each row's share of the reference bearing's mean pin load, row by row from
+    the axial station −e_r/2 (``row_load_share``)."""
     mine = np.isin(p.roller_bearing, sel)
     own = p.roller_bearing == ref
     q_in, q_out = (float(sums.stats(k)["max"][mine].max()) for k in ("roller_inner_slice_max", "roller_outer_slice_max"))
@@ -152,6 +154,11 @@ def slice_summary(d, sums, p, ref, sel) -> None:
     d["contact_pressure_max_Pa"] = float(max(c_pin * np.sqrt(q_in), c_bore * np.sqrt(q_out)))
     edge, mid = (float(sums.stats(k)["max"][own].max()) for k in ("roller_inner_edge_load", "roller_inner_mid_load"))
     d["edge_pressure_ratio"] = float(np.sqrt(edge / mid)) if mid > 0 else None
+    if p.explicit_rows > 1:     # the reference bearing's rows: each row's share of its rollers' mean pin load
+        m = sums.stats("roller_inner_load")["mean"]
+        total = float(m[own].sum())
+        d["row_load_share"] = [float(m[own & (p.roller_row == r)].sum() / total) if total > 0 else None
+                               for r in range(p.explicit_rows)]
     mis = sums.stats("planet_misalignment")
     d["misalignment_mean_rad"] = float(mis["mean"][ref])
     d["misalignment_max_rad"] = float(mis["max"][ref])
@@ -201,6 +208,13 @@ def life_summary(d, sums, p, w_rel, ref, sel) -> None:
         q_bore = p.qc[1] * float(equivalent_load(sums.stats("roller_outer_fatigue")["mean"][mine].mean(),
                                                  ROTATING_EXPONENT))
         out["roller_equivalent_load_pin_N"], out["roller_equivalent_load_bore_N"] = q_pin, q_bore
+        if p.explicit_rows > 1:    # every row its raceways' equivalent loads, the rows combined (life.py)
+            q_pin, q_bore = (c * equivalent_load(np.array([sums.stats(key)["mean"][mine & (p.roller_row == r)].mean()
+                                                           for r in range(p.explicit_rows)]), e)
+                             for key, c, e in (("roller_inner_fatigue", p.qc[0], STATIONARY_EXPONENT),
+                                               ("roller_outer_fatigue", p.qc[1], ROTATING_EXPONENT)))
+            out["roller_equivalent_load_pin_per_row_N"] = q_pin.tolist()
+            out["roller_equivalent_load_bore_per_row_N"] = q_bore.tolist()
         out["life_iso16281_Mrev"] = lundberg_palmgren_life(q_pin, q_bore, b)
         out["life_iso16281_h"] = hours(out["life_iso16281_Mrev"], w_rel)
         if "slice_inner_fatigue" in sums.acc:
@@ -218,12 +232,30 @@ def _sliced_life(sums, p, bearings) -> float | None:
     per slice, the equivalent loads of the pin and the bore over the window and over the bearings' rollers, as the
     roller loads' life takes them, q_e,k = q_c,k (mean (q_k/q_c,k)^e)^(1/e)."""
     b = p.bearing
-    mine = np.isin(np.repeat(p.roller_bearing, p.slices), bearings)
     qc = sliced_raceway_ratings(b, p.slices)
+    keys = (("slice_inner_fatigue", qc[0], STATIONARY_EXPONENT), ("slice_outer_fatigue", qc[1], ROTATING_EXPONENT))
+    if p.explicit_rows > 1:       # per row (rows, n_s): the rows' raceways combined as the standard's (life.py)
+        mine = np.isin(p.roller_bearing, bearings)
+        q = [c * equivalent_load(np.stack([sums.stats(key)["mean"].reshape(-1, p.slices)[mine & (p.roller_row == r)]
+                                           .mean(axis=0) for r in range(p.explicit_rows)]), e) for key, c, e in keys]
+        return sliced_life(q[0], q[1], b)
+    mine = np.isin(np.repeat(p.roller_bearing, p.slices), bearings)
     q = [c * equivalent_load(sums.stats(key)["mean"][mine].reshape(-1, p.slices).mean(axis=0), e)
-         for key, c, e in (("slice_inner_fatigue", qc[0], STATIONARY_EXPONENT),
-                           ("slice_outer_fatigue", qc[1], ROTATING_EXPONENT))]
+         for key, c, e in keys]
     return sliced_life(q[0], q[1], b)
+
+
+def equivalent_slice_loads(sums, p) -> tuple[np.ndarray, np.ndarray]:
+    """(pin, bore) (n_bearings, rows, n_s): each bearing's equivalent slice loads per row over its window and the row's
+    rollers, as its sliced life takes them (:func:`_sliced_life`), q_e,k = q_c,k (mean (q_k/q_c,k)^e)^(1/e), e 4.5 on the
+    pin, 4 on the bore [N]."""
+    qc = sliced_raceway_ratings(p.bearing, p.slices)
+    nb, rows = p.planet.size, p.explicit_rows
+    out = []
+    for key, c, e in (("slice_inner_fatigue", qc[0], STATIONARY_EXPONENT), ("slice_outer_fatigue", qc[1], ROTATING_EXPONENT)):
+        m = sums.stats(key)["mean"].reshape(nb, rows, -1, p.slices)            # rollers bearing by bearing, row by row
+        out.append(c * equivalent_load(m.mean(axis=2), e))
+    return out[0], out[1]
 
 
 def heat_summary(d, sums, ref, sel) -> None:

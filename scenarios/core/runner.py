@@ -40,7 +40,8 @@ from mbd.recorder import BodyMotion, Recorder
 from components.outputs import BearingSeries, WindowStatistics, bearing_map, cage_period, default_window
 from components.sensor import HousingLoads
 from components.results import Summary
-from components.results.io import atomic_write_text, write_summary
+from components.bearing import row_stations, sliced_law
+from components.results.io import append_slice_profiles, atomic_write_text, write_summary
 from components.results.schema import drawing_geometry, element_probes
 
 from .integrity import checkpoint_usable, claim_folder, read_summary, results_intact
@@ -284,6 +285,10 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     t_stats = time.perf_counter()
     summary = _run_info(params, scene, stats)
     summary.update(stats.summary())
+    profiles = stats.slice_profiles()          # the sliced model's: along the most loaded rollers, into results.nc
+    if profiles is not None and res.results_path is not None:
+        b = scene.bearing
+        append_slice_profiles(res.results_path, profiles, sliced_law(b)["z"], row_stations(b))
     stats_summary_s = time.perf_counter() - t_stats
     summary["samples"] = int(rec.next_index)      # recorded (for plots); the statistics use every step
     summary.update(label or {})

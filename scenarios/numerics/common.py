@@ -330,7 +330,8 @@ def observables(prob: Problem, grid, q, v, z) -> dict[str, np.ndarray]:
     ic = m.body(prob.cage).index if prob.cage else None
     ip = m.body(prob.planet).index
     sl = prob.race_inner
-    rows = prob.built.bearing.rows
+    b = prob.built.bearing
+    rows = 1 if b.model == "sliced" else b.rows          # physical rollers per roller body (the planar model folds rows)
     out = {k: [] for k in ("pin_load", "inner_load", "guide_force", "cage_acc_x", "cage_acc_y")}
     for t, qi, vi, zi in zip(grid, q, v, z):
         o = system.outputs(t, qi, vi, zi)

@@ -17,6 +17,7 @@ from components.params import overrides_from_toml, with_overrides
 from components.presets import reference_bearing
 from components.profiles import reduced_modulus, roller_drop
 from components.sliced_bearing import ARCMIN, SlicedBearing, sliced_bearing_life
+from tests.support.iso16281 import iso_laminae, iso_solve
 
 P = 10.0 / 9.0
 LOAD = np.array([12000.0, 0.0])          # N on the planet: the outer planet bearing's mean load at condition 3
@@ -27,35 +28,7 @@ def _bearing(**over):
 
 
 # ------------------------------------------------------------------------------------- ISO/TS 16281 transcription
-def _iso_laminae(b, u, slope, cage_angle):
-    """ISO/TS 16281:2008's laminae of a radial cylindrical roller bearing, written from the standard: for roller j
-    at ψ_j and lamina k at x_k the approach of the rings δ_jk = (ζ_k s − u)·e_j − P_d/2 − 2 p(x_k) (the pin's slope s
-    against the bore, the bore displaced u, the roller's profile p on both its contacts), and the lamina load
-    q_jk = c ⟨δ_jk⟩^(10/9) with c the constant of a lamina's two contacts in series: Palmgren's K (each contact at
-    half the approach, K (δ/2)^(10/9)) or the standard's own c_L = 35948 L^(8/9) N/mm^(10/9) per roller, over n_s."""
-    n = b.slicing.slices
-    width = b.roller_length / n
-    x = -0.5 * b.roller_length + width * (np.arange(n) + 0.5)
-    psi = cage_angle + 2 * np.pi * np.arange(b.rollers) / b.rollers
-    e = np.stack([np.cos(psi), np.sin(psi)], 1)
-    if b.slicing.stiffness == "palmgren":
-        K = 8.06e4 * (b.roller_length * 1e3) ** (8 / 9) * 1e3 ** P           # N/m^(10/9), one contact
-        lam = lambda d: K / n * (0.5 * d) ** P                             # noqa: E731
-    else:
-        cL = 35948.0 * (b.roller_length * 1e3) ** (8 / 9)                 # N/mm^(10/9), two contacts in series
-        lam = lambda d: cL / n * (1e3 * d) ** P                            # noqa: E731
-    drop = roller_drop(b, x)
-    d = (e @ -np.asarray(u))[:, None] + x[None, :] * (e @ np.asarray(slope))[:, None] - 0.5 * b.clearance - 2 * drop
-    return lam(np.clip(d, 0.0, None)), e
-
-
-def _iso_solve(b, load, slope, cage_angle):
-    """The standard's bore displacement under ``load``: F + Σ_jk q_jk e_j = 0 (its own small solver)."""
-    def res(u):
-        q, e = _iso_laminae(b, u, slope, cage_angle)
-        return (load + q.sum(1) @ e) / np.hypot(*load)
-    u0 = 3e-5 * np.asarray(load) / np.hypot(*load)
-    return fsolve(res, u0, xtol=1e-13)
+_iso_laminae, _iso_solve = iso_laminae, iso_solve       # the transcription: tests/support/iso16281.py
 
 
 @pytest.mark.parametrize("shape,stiffness", [("straight", "palmgren"), ("iso_16281", "palmgren"),

@@ -81,8 +81,6 @@ def test_the_sliced_model_refuses_what_it_does_not_build():
     p = reference_dpgt(3, "forward")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        with pytest.raises(ParameterError, match="bearing.rows"):
-            build_dpgt(p.replace(bearing=p.bearing.replace(model="sliced", rows=2)))
         with pytest.raises(ParameterError, match="bearing.model"):
             build_dpgt(p.replace(bearing=p.bearing.replace(model="sliced", rolling_resistance="houpert")))
 
