@@ -403,6 +403,7 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
     pe = 0.5 * (p - 1.0)                        # exponent of the damping's δ factor
     spall = P.shape[1] > RACE_COLS              # decided at pack time (see the module docstring)
     out = O.shape[0] > 0
+    th_last, cth, sth = np.nan, 0.0, 0.0
     for i in range(ql.shape[0]):
         kap, mx, my, R, D, K, c0, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6], P[i, 7]
         xr, yr = ql[i, 0], ql[i, 1]
@@ -410,7 +411,8 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
         vr0, vr1, vr2 = vl[i, 0], vl[i, 1], vl[i, 2]
         vb0, vb1, vb2 = vl[i, 3], vl[i, 4], vl[i, 5]
         # raceway centre c = c_b + rc, roller centre relative to it, normal e and tangent t = k × e
-        cth, sth = np.cos(thb), np.sin(thb)
+        if thb != th_last:                       # a bearing's contacts follow each other: one race body's angle
+            th_last, cth, sth = thb, np.cos(thb), np.sin(thb)
         rcx, rcy = cth * mx - sth * my, sth * mx + cth * my
         dx, dy = xr - (xb + rcx), yr - (yb + rcy)
         rho = np.sqrt(dx * dx + dy * dy + _ETA2)
@@ -830,13 +832,15 @@ def update_guide(z, t0, t1, ql0, vl0, ql1, vl1, P, G):
 @njit(cache=True)
 def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     visc = P.shape[1] > 4                       # viscous churning (decided at pack time)
+    th_last, cth, sth = np.nan, 0.0, 0.0
     for i in range(ql.shape[0]):
         mx, my, coef, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3]
         xr, yr = ql[i, 0], ql[i, 1]
         xb, yb, thb = ql[i, 3], ql[i, 4], ql[i, 5]
         vr0, vr1 = vl[i, 0], vl[i, 1]
         vb0, vb1, vb2 = vl[i, 3], vl[i, 4], vl[i, 5]
-        cth, sth = np.cos(thb), np.sin(thb)
+        if thb != th_last:                       # the race body's angle repeats along a bearing's rollers
+            th_last, cth, sth = thb, np.cos(thb), np.sin(thb)
         rcx, rcy = cth * mx - sth * my, sth * mx + cth * my
         dx, dy = xr - (xb + rcx), yr - (yb + rcy)
         rho2 = dx * dx + dy * dy + _ETA2
