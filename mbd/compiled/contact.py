@@ -190,6 +190,17 @@ def _write(F, Jq, Jv, i, j, m, f0, f1, f2, f3, f4, f5):
 
 
 @njit(cache=True)
+def _mirror_cols(Jq, Jv, i):
+    """The columns a two-body law that sees the bodies' centres only through their difference need not compute: the
+    second body's translations (position and velocity) are the first's negated, exactly (every line of the
+    differential is odd in the direction), and the first body's angle (column 2 of J_q) moves no force."""
+    for a in range(6):
+        Jq[i, a, 2] = 0.0
+        Jq[i, a, 3], Jq[i, a, 4] = -Jq[i, a, 0], -Jq[i, a, 1]
+        Jv[i, a, 3], Jv[i, a, 4] = -Jv[i, a, 0], -Jv[i, a, 1]
+
+
+@njit(cache=True)
 def _zero(F, Jq, Jv, i, jac):
     """An inactive instance: no force, and (ad.where) no derivative."""
     for a in range(6):
@@ -625,6 +636,8 @@ def _pocket(ql, vl, z, P, F, Jq, Jv, jac, O):
         num = dx * wy - dy * wx
         f_v = -mu * (1.0 - th * th) / v_mu * Fi  # ∂f/∂v_rad
         for j in range(12):
+            if j == 2 or j == 3 or j == 4 or j == 9 or j == 10:     # _mirror_cols: the roller's angle, the cage's
+                continue                                              # translations
             dxr, dyr, _, dxg, dyg, dthg, dvr0, dvr1, dvr2, dvg0, dvg1, dvg2 = _unit(j)
             ddx, ddy = dxr - dxg, dyr - dyg
             ds = rm * (ddy * (dx / r2) - ddx * (dy / r2) - dthg)
@@ -647,6 +660,7 @@ def _pocket(ql, vl, z, P, F, Jq, Jv, jac, O):
             dfx, dfy = df * ex + f * dex, df * ey + f * dey
             _write(F, Jq, Jv, i, j, mult, dfnx + dfx, dfny + dfy, _d_cross(rwx, rwy, drwx, drwy, fx, fy, dfx, dfy),
                    -dfnx - dfx, -dfny - dfy, dFs * rm - _d_cross(rgx, rgy, drgx, drgy, fx, fy, dfx, dfy))
+        _mirror_cols(Jq, Jv, i)
 
 
 @njit(cache=True)
@@ -866,6 +880,8 @@ def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         if not jac:
             continue
         for j in range(12):
+            if j == 2 or j == 3 or j == 4 or j == 9 or j == 10 or (j == 8 and not visc):    # _mirror_cols
+                continue
             dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, dvr2, dvb0, dvb1, dvb2 = _unit(j)
             drcx, drcy = -dthb * rcy, dthb * rcx
             ddx, ddy = dxr - dxb - drcx, dyr - dyb - drcy
@@ -883,4 +899,8 @@ def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
                 _write(F, Jq, Jv, i, j, mult, dFx, dFy, dMs, -dFx, -dFy, dMb - dMs)
             else:
                 _write(F, Jq, Jv, i, j, mult, dFx, dFy, 0.0, -dFx, -dFy, dMb)
+        _mirror_cols(Jq, Jv, i)
+        if not visc:                             # the roller's spin moves no force without the viscous moment
+            for a in range(6):
+                Jv[i, a, 2] = 0.0
 
