@@ -199,6 +199,17 @@ def _write(F, Jq, Jv, i, j, m, f0, f1, f2, f3, f4, f5):
 
 
 @njit(cache=True)
+def _mirror_cols(Jq, Jv, i):
+    """The columns a two-body law that sees the bodies' centres only through their difference need not compute: the
+    second body's translations (position and velocity) are the first's negated, exactly (every line of the
+    differential is odd in the direction), and the first body's angle (column 2 of J_q) moves no force."""
+    for a in range(6):
+        Jq[i, a, 2] = 0.0
+        Jq[i, a, 3], Jq[i, a, 4] = -Jq[i, a, 0], -Jq[i, a, 1]
+        Jv[i, a, 3], Jv[i, a, 4] = -Jv[i, a, 0], -Jv[i, a, 1]
+
+
+@njit(cache=True)
 def _zero(F, Jq, Jv, i, jac):
     """An inactive instance: no force, and (ad.where) no derivative."""
     for a in range(6):
@@ -412,6 +423,7 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
     pe = 0.5 * (p - 1.0)                        # exponent of the damping's δ factor
     spall = P.shape[1] > RACE_COLS              # decided at pack time (see the module docstring)
     out = O.shape[0] > 0
+    th_last, cth, sth = np.nan, 0.0, 0.0
     for i in range(ql.shape[0]):
         kap, mx, my, R, D, K, c0, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6], P[i, 7]
         xr, yr = ql[i, 0], ql[i, 1]
@@ -419,7 +431,8 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
         vr0, vr1, vr2 = vl[i, 0], vl[i, 1], vl[i, 2]
         vb0, vb1, vb2 = vl[i, 3], vl[i, 4], vl[i, 5]
         # raceway centre c = c_b + rc, roller centre relative to it, normal e and tangent t = k × e
-        cth, sth = np.cos(thb), np.sin(thb)
+        if thb != th_last:                       # a bearing's contacts follow each other: one race body's angle
+            th_last, cth, sth = thb, np.cos(thb), np.sin(thb)
         rcx, rcy = cth * mx - sth * my, sth * mx + cth * my
         dx, dy = xr - (xb + rcx), yr - (yb + rcy)
         rho = np.sqrt(dx * dx + dy * dy + _ETA2)
@@ -632,6 +645,8 @@ def _pocket(ql, vl, z, P, F, Jq, Jv, jac, O):
         num = dx * wy - dy * wx
         f_v = -mu * (1.0 - th * th) / v_mu * Fi  # ∂f/∂v_rad
         for j in range(12):
+            if j == 2 or j == 3 or j == 4 or j == 9 or j == 10:     # _mirror_cols: the roller's angle, the cage's
+                continue                                              # translations
             dxr, dyr, _, dxg, dyg, dthg, dvr0, dvr1, dvr2, dvg0, dvg1, dvg2 = _unit(j)
             ddx, ddy = dxr - dxg, dyr - dyg
             ds = rm * (ddy * (dx / r2) - ddx * (dy / r2) - dthg)
@@ -654,6 +669,7 @@ def _pocket(ql, vl, z, P, F, Jq, Jv, jac, O):
             dfx, dfy = df * ex + f * dex, df * ey + f * dey
             _write(F, Jq, Jv, i, j, mult, dfnx + dfx, dfny + dfy, _d_cross(rwx, rwy, drwx, drwy, fx, fy, dfx, dfy),
                    -dfnx - dfx, -dfny - dfy, dFs * rm - _d_cross(rgx, rgy, drgx, drgy, fx, fy, dfx, dfy))
+        _mirror_cols(Jq, Jv, i)
 
 
 @njit(cache=True)
@@ -948,13 +964,15 @@ def update_guide(z, t0, t1, ql0, vl0, ql1, vl1, P, G):
 @njit(cache=True)
 def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     visc = P.shape[1] > 4                       # viscous churning (decided at pack time)
+    th_last, cth, sth = np.nan, 0.0, 0.0
     for i in range(ql.shape[0]):
         mx, my, coef, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3]
         xr, yr = ql[i, 0], ql[i, 1]
         xb, yb, thb = ql[i, 3], ql[i, 4], ql[i, 5]
         vr0, vr1 = vl[i, 0], vl[i, 1]
         vb0, vb1, vb2 = vl[i, 3], vl[i, 4], vl[i, 5]
-        cth, sth = np.cos(thb), np.sin(thb)
+        if thb != th_last:                       # the race body's angle repeats along a bearing's rollers
+            th_last, cth, sth = thb, np.cos(thb), np.sin(thb)
         rcx, rcy = cth * mx - sth * my, sth * mx + cth * my
         dx, dy = xr - (xb + rcx), yr - (yb + rcy)
         rho2 = dx * dx + dy * dy + _ETA2
@@ -980,6 +998,8 @@ def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         if not jac:
             continue
         for j in range(12):
+            if j == 2 or j == 3 or j == 4 or j == 9 or j == 10 or (j == 8 and not visc):    # _mirror_cols
+                continue
             dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, dvr2, dvb0, dvb1, dvb2 = _unit(j)
             drcx, drcy = -dthb * rcy, dthb * rcx
             ddx, ddy = dxr - dxb - drcx, dyr - dyb - drcy
@@ -997,6 +1017,10 @@ def evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
                 _write(F, Jq, Jv, i, j, mult, dFx, dFy, dMs, -dFx, -dFy, dMb - dMs)
             else:
                 _write(F, Jq, Jv, i, j, mult, dFx, dFy, 0.0, -dFx, -dFy, dMb)
+        _mirror_cols(Jq, Jv, i)
+        if not visc:                             # the roller's spin moves no force without the viscous moment
+            for a in range(6):
+                Jv[i, a, 2] = 0.0
 
 
 

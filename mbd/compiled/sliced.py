@@ -22,7 +22,13 @@ so d Σ z_k^m F_k = Σ z_k^m M_k A + Σ z_k^(m+1) M_k B + (the same with N_k and
 M_k, N_k and of the load gradients carry every slice into the contact's 2 n_local directions, which are then
 contact-level scalars (the geometry of e, σ_r, σ_c, the traction law, the generalised forces; the differential of
 every line of the reference evaluated along each unit direction, as :mod:`mbd.compiled.contact`). Exact, no
-differencing; the values are the reference's in its operation order up to the order of the slice sums.
+differencing; the values are the reference's in its operation order up to the order of the slice sums. The directions
+use the law's structure, as the planar race contact's: the velocity directions leave the geometry unchanged and carry
+only the rate terms (a pass of their own); the roller's angle enters no force (its column is zero); and a common
+translation (or velocity) of roller, race body and pin changes no force, so the roller's translation columns are the
+negated sum of the race body's and the pin's (outer raceway; the inner raceway's pin is its race body, whose columns
+are then the roller's negated) — 9 of 12 position and 10 of 12 velocity directions computed for an outer contact, 4 of
+7 and 5 of 7 for an inner one.
 
 Contacts whose every slice is open by the reference's bound (δ_0 + max_k |z_k σ_r − ζ_k σ_c| ≤ 0) are skipped before
 the slice loop; a contact without load has no force and (ad.where) no derivative.
@@ -74,14 +80,42 @@ def _zero(F, Jq, Jv, i, jac):
 
 
 @njit(cache=True)
-def _accumulate(acc, zk, *vals):
-    """acc[m, :] += z_k^m · vals, m = 0, 1, 2."""
-    z2 = zk * zk
-    for c in range(12):
-        x = vals[c]
-        acc[0, c] += x
-        acc[1, c] += zk * x
-        acc[2, c] += z2 * x
+def _moments(acc, blocks, loaded, n_loaded, zs):
+    """acc[m, :] = Σ z_k^m · blocks[r, :] over the loaded slices r (k = loaded[r], ascending), m = 0, 1, 2 (a loop over
+    the 12 columns inside: SIMD)."""
+    acc[:, :] = 0.0
+    for r in range(n_loaded):
+        zk = zs[loaded[r]]
+        z2 = zk * zk
+        for c in range(12):
+            x = blocks[r, c]
+            acc[0, c] += x
+            acc[1, c] += zk * x
+            acc[2, c] += z2 * x
+
+
+@njit(cache=True)
+def _u(j, m):
+    return 1.0 if j == m else 0.0
+
+
+@njit(cache=True)
+def _derived_cols(Jq, Jv, i, outer):
+    """The columns the direction passes leave out: the roller's angle (no force depends on it) and the translations
+    a common one of roller, race body and pin gives (outer: the roller's = −(race body's + pin's); inner, whose pin
+    is the race body: the race body's = −the roller's)."""
+    for a in range(Jq.shape[1]):
+        Jq[i, a, 2] = 0.0
+        if outer:
+            Jq[i, a, 0] = -(Jq[i, a, 4] + Jq[i, a, 9])
+            Jq[i, a, 1] = -(Jq[i, a, 5] + Jq[i, a, 10])
+            Jv[i, a, 0] = -(Jv[i, a, 4] + Jv[i, a, 9])
+            Jv[i, a, 1] = -(Jv[i, a, 5] + Jv[i, a, 10])
+        else:
+            Jq[i, a, 4] = -Jq[i, a, 0]
+            Jq[i, a, 5] = -Jq[i, a, 1]
+            Jv[i, a, 4] = -Jv[i, a, 0]
+            Jv[i, a, 5] = -Jv[i, a, 1]
 
 
 @njit(cache=True)
@@ -108,8 +142,11 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         zmax = max(zmax, abs(zs[k]))
     nl = ql.shape[1]
     outer = nl == 12
+    jd0, jd1 = (0, 1) if outer else (4, 5)      # translation columns derived from the others (_derived_cols)
     acc = np.zeros((3, 12))          # moments m = 0, 1, 2 of M_k (4), N_k (4), g_k (2), ∂q_k/∂ẇ_k (2)
-    dq, dv = np.zeros(12), np.zeros(12)
+    w_x, w_y, w_d, w_delta = np.empty(ns), np.empty(ns), np.empty(ns), np.empty(ns)     # a contact's slices
+    blocks, loaded = np.empty((ns if jac else 0, 12)), np.empty(ns, np.int64)    # its loaded slices' blocks
+    thb_last, cb, sb, thp_last, cp, sp = np.nan, 0.0, 0.0, np.nan, 0.0, 0.0
     for i in range(ql.shape[0]):
         kap, mx, my, pmx, pmy, s0x, s0y = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
         R, D, K, c0, row, Rr = P[i, 7], P[i, 8], P[i, 9], P[i, 10], P[i, 11], P[i, 12]
@@ -124,11 +161,13 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             sx, sy, vsx, vsy = 0.0, 0.0, 0.0, 0.0
             xp, yp, thp, vp0, vp1, vp2 = xb, yb, thb, vb0, vb1, vb2
         # the raceway's centre and its velocity; the pin's centre and its velocity (SlicedRaceContact._geometry)
-        cb, sb = np.cos(thb), np.sin(thb)
+        if thb != thb_last:              # a bearing's contacts follow each other: one race body's, one pin's angle
+            thb_last, cb, sb = thb, np.cos(thb), np.sin(thb)
         rcx, rcy = cb * mx - sb * my, sb * mx + cb * my
         cx, cy = xb + rcx, yb + rcy
         Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
-        cp, sp = np.cos(thp), np.sin(thp)
+        if thp != thp_last:
+            thp_last, cp, sp = thp, np.cos(thp), np.sin(thp)
         rpx, rpy = cp * pmx - sp * pmy, sp * pmx + cp * pmy
         pcx, pcy = xp + rpx, yp + rpy
         Vpx, Vpy = vp0 - vp2 * rpy, vp1 + vp2 * rpx
@@ -156,21 +195,26 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             continue
         # the slice loop
         S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        if jac:
-            acc[:, :] = 0.0
+        n_loaded = 0
         Ks, c0s = K / ns, c0 / ns
-        for k in range(ns):
+        for k in range(ns):          # every slice's offset and compression first: a loop without branches (SIMD)
             zk = zs[k]
             zeta = row + zk
             wx = pcx_ + zk * srx - zeta * scx
             wy = pcy_ + zk * sry - zeta * scy
+            d = np.sqrt(wx * wx + wy * wy + _ETA2)
+            w_x[k], w_y[k], w_d[k] = wx, wy, d
+            w_delta[k] = 0.5 * D - kap * (d - R) - P[i, SLICED_COLS + k]
+        for k in range(ns):
+            delta = w_delta[k]
+            if not delta > 0.0:                     # an open slice: nothing more of it
+                continue
+            zk = zs[k]
+            zeta = row + zk
+            wx, wy, d = w_x[k], w_y[k], w_d[k]
+            nx, ny = wx / d, wy / d
             vwx = wvx + zk * dsrx - zeta * dscx
             vwy = wvy + zk * dsry - zeta * dscy
-            d = np.sqrt(wx * wx + wy * wy + _ETA2)
-            nx, ny = wx / d, wy / d
-            delta = 0.5 * D - kap * (d - R) - P[i, SLICED_COLS + k]
-            if not delta > 0.0:
-                continue
             nv = nx * vwx + ny * vwy
             delta_dot = -kap * nv
             dpe = delta ** pe                       # δ^((p−1)/2); δ^p = δ (δ^((p−1)/2))², one power a slice
@@ -191,19 +235,26 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
                 continue
             q_d = Ks * p * dp1 + c0s * pe * (dpe / delta) * delta_dot                         # ∂q/∂δ
             q_r = c0s * dpe                                                                   # ∂q/∂δ̇
-            hx, hy = (vwx - nx * nv) / d, (vwy - ny * nv) / d
+            i_d = 1.0 / d
+            hx, hy = (vwx - nx * nv) * i_d, (vwy - ny * nv) * i_d
             gqx, gqy = -kap * (q_d * nx + q_r * hx), -kap * (q_d * ny + q_r * hy)
             gvx, gvy = -kap * q_r * nx, -kap * q_r * ny
-            qd = kap * q / d
-            m00 = kap * nx * gqx + qd * (1.0 - nx * nx)
-            m01 = kap * nx * gqy - qd * nx * ny
-            m10 = kap * ny * gqx - qd * nx * ny
-            m11 = kap * ny * gqy + qd * (1.0 - ny * ny)
-            _accumulate(acc, zk, m00, m01, m10, m11, kap * nx * gvx, kap * nx * gvy, kap * ny * gvx,
-                        kap * ny * gvy, gqx, gqy, gvx, gvy)
+            qd = kap * q * i_d
+            r = n_loaded             # the slice's blocks; their moments after the loop (_moments)
+            blocks[r, 0] = kap * nx * gqx + qd * (1.0 - nx * nx)
+            blocks[r, 1] = kap * nx * gqy - qd * nx * ny
+            blocks[r, 2] = kap * ny * gqx - qd * nx * ny
+            blocks[r, 3] = kap * ny * gqy + qd * (1.0 - ny * ny)
+            blocks[r, 4], blocks[r, 5] = kap * nx * gvx, kap * nx * gvy
+            blocks[r, 6], blocks[r, 7] = kap * ny * gvx, kap * ny * gvy
+            blocks[r, 8], blocks[r, 9], blocks[r, 10], blocks[r, 11] = gqx, gqy, gvx, gvy
+            loaded[n_loaded] = k
+            n_loaded += 1
         if not Q > 0.0:
             _zero(F, Jq, Jv, i, jac)
             continue
+        if jac:
+            _moments(acc, blocks, loaded, n_loaded, zs)
         # traction as the planar contact's on Q, applied at the load centroid z̄
         rho = np.sqrt(pcx_ * pcx_ + pcy_ * pcy_ + _ETA2)
         ecx, ecy = pcx_ / rho, pcy_ / rho
@@ -256,46 +307,39 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             acc[2, 0], acc[2, 1], acc[2, 2], acc[2, 3], acc[2, 4], acc[2, 5],
             acc[2, 6], acc[2, 7], acc[2, 8], acc[2, 9], acc[2, 10], acc[2, 11])
         irp, irho, iQ = 1.0 / rho_p, 1.0 / rho, 1.0 / Q
-        # every direction: position (j < nl) and velocity (j ≥ nl) unit vectors of the local coordinates
-        for j in range(2 * nl):
-            dq[:] = 0.0
-            dv[:] = 0.0
-            if j < nl:
-                dq[j] = 1.0
-            else:
-                dv[j - nl] = 1.0
-            dxr, dyr, dta, dxb, dyb, dthb = dq[0], dq[1], dq[3], dq[4], dq[5], dq[6]
-            dvr0, dvr1, dvr2, ddta, dvb0, dvb1, dvb2 = dv[0], dv[1], dv[2], dv[3], dv[4], dv[5], dv[6]
+        # Positions (no velocity moves along them). The roller's angle (column 2) enters no force. The forces see the
+        # roller, the race body and the pin only through their relative positions: a common translation changes
+        # nothing, so the roller's translation columns are the race body's and the pin's negated and summed (outer:
+        # computed from them; inner, whose pin is the race body: the race body's are the roller's negated, exactly).
+        for j in range(nl):
+            if j == 2 or j == jd0 or j == jd1:
+                continue
+            dxr, dyr, dta, dxb, dyb, dthb = _u(j, 0), _u(j, 1), _u(j, 3), _u(j, 4), _u(j, 5), _u(j, 6)
             if outer:
-                dsx, dsy, dvsx, dvsy = dq[7], dq[8], dv[7], dv[8]
-                dxp, dyp, dthp, dvp0, dvp1, dvp2 = dq[9], dq[10], dq[11], dv[9], dv[10], dv[11]
+                dsx, dsy, dxp, dyp, dthp = _u(j, 7), _u(j, 8), _u(j, 9), _u(j, 10), _u(j, 11)
             else:
-                dsx, dsy, dvsx, dvsy = 0.0, 0.0, 0.0, 0.0
-                dxp, dyp, dthp, dvp0, dvp1, dvp2 = dxb, dyb, dthb, dvb0, dvb1, dvb2
+                dsx, dsy, dxp, dyp, dthp = 0.0, 0.0, dxb, dyb, dthb
             drcx, drcy = -dthb * rcy, dthb * rcx
-            dVcx = dvb0 - dvb2 * rcy - vb2 * drcy
-            dVcy = dvb1 + dvb2 * rcx + vb2 * drcx
+            dVcx, dVcy = -vb2 * drcy, vb2 * drcx
             drpx, drpy = -dthp * rpy, dthp * rpx
-            dVpx = dvp0 - dvp2 * rpy - vp2 * drpy
-            dVpy = dvp1 + dvp2 * rpx + vp2 * drpx
+            dVpx, dVpy = -vp2 * drpy, vp2 * drpx
             dux, duy = dxr - (dxp + drpx), dyr - (dyp + drpy)
             drho_p = (ux * dux + uy * duy) * irp
             dex, dey = (dux - ex * drho_p) * irp, (duy - ey * drho_p) * irp
-            dgx, dgy = dvr0 - dVpx, dvr1 - dVpy
+            dgx, dgy = -dVpx, -dVpy
             dge = dex * gx + ex * dgx + dey * gy + ey * dgy
             dedx = (dgx - dge * ex - ge * dex - edx * drho_p) * irp
             dedy = (dgy - dge * ey - ge * dey - edy * drho_p) * irp
             ds0cx, ds0cy = -dthb * s0cy, dthb * s0cx
             dscx_ = ds0cx + dsx
             dscy_ = ds0cy + dsy
-            ddscx = -dvb2 * s0cy - vb2 * ds0cy + dvsx
-            ddscy = dvb2 * s0cx + vb2 * ds0cx + dvsy
+            ddscx, ddscy = -vb2 * ds0cy, vb2 * ds0cx
             dk0x, dk0y = ds0cy, -ds0cx
             dsrx_, dsry_ = dta * ex + tau * dex, dta * ey + tau * dey
-            ddsrx = ddta * ex + dtau * dex + dta * edx + tau * dedx
-            ddsry = ddta * ey + dtau * dey + dta * edy + tau * dedy
+            ddsrx = dtau * dex + dta * edx + tau * dedx
+            ddsry = dtau * dey + dta * edy + tau * dedy
             ddx, ddy = dxr - (dxb + drcx), dyr - (dyb + drcy)          # d(p − c)
-            dwvx, dwvy = dvr0 - dVcx, dvr1 - dVcy                      # d(ṗ − ċ)
+            dwvx, dwvy = -dVcx, -dVcy                                  # d(ṗ − ċ)
             Ax, Ay = ddx - row * dscx_, ddy - row * dscy_
             Bx, By = dsrx_ - dscx_, dsry_ - dscy_
             Avx, Avy = dwvx - row * ddscx, dwvy - row * ddscy
@@ -320,8 +364,8 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             dtx, dty = -decy, decx
             drrx, drry = -drho * ecx + rl * decx, -drho * ecy + rl * decy
             drbx, drby = drcx + R * decx, drcy + R * decy
-            dVrx, dVry = dvr0 - dvr2 * rry - vr2 * drry, dvr1 + dvr2 * rrx + vr2 * drrx
-            dVbx, dVby = dvb0 - dvb2 * rby - vb2 * drby, dvb1 + dvb2 * rbx + vb2 * drbx
+            dVrx, dVry = -vr2 * drry, vr2 * drrx
+            dVbx, dVby = -vb2 * drby, vb2 * drbx
             dur = dVrx * tx + Vrx * dtx + dVry * ty + Vry * dty
             dub = dVbx * tx + Vbx * dtx + dVby * ty + Vby * dty
             dwt = dwvx * tx + wvx * dtx + dwvy * ty + wvy * dty
@@ -346,10 +390,60 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
                   - (drbx * Fty + rbx * dFty - drby * Ftx - rby * dFtx)
                   + dT2x * k0x + T2x * dk0x + dT2y * k0y + T2y * dk0y)
             dpin = -(drpx * Gy + rpx * dGy - drpy * Gx - rpy * dGx)
-            if j < nl:
-                _race_col(Jq, i, j, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
+            _race_col(Jq, i, j, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
+        # Velocities: they leave the geometry (e, σ_c's turn, the contact point, the levers) and move only the rates.
+        # A common velocity of the roller, the race body and the pin changes no force (as for the positions).
+        for j in range(nl):
+            if j == jd0 or j == jd1:
+                continue
+            dvr0, dvr1, dvr2, ddta, dvb0, dvb1, dvb2 = _u(j, 0), _u(j, 1), _u(j, 2), _u(j, 3), _u(j, 4), _u(j, 5), _u(j, 6)
+            if outer:
+                dvsx, dvsy, dvp0, dvp1, dvp2 = _u(j, 7), _u(j, 8), _u(j, 9), _u(j, 10), _u(j, 11)
             else:
-                _race_col(Jv, i, j - nl, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
+                dvsx, dvsy, dvp0, dvp1, dvp2 = 0.0, 0.0, dvb0, dvb1, dvb2
+            dVcx, dVcy = dvb0 - dvb2 * rcy, dvb1 + dvb2 * rcx
+            dVpx, dVpy = dvp0 - dvp2 * rpy, dvp1 + dvp2 * rpx
+            dgx, dgy = dvr0 - dVpx, dvr1 - dVpy
+            dge = ex * dgx + ey * dgy
+            dedx, dedy = (dgx - dge * ex) * irp, (dgy - dge * ey) * irp
+            ddscx, ddscy = -dvb2 * s0cy + dvsx, dvb2 * s0cx + dvsy
+            ddsrx, ddsry = ddta * ex + tau * dedx, ddta * ey + tau * dedy
+            dwvx, dwvy = dvr0 - dVcx, dvr1 - dVcy                      # d(ṗ − ċ)
+            Avx, Avy = dwvx - row * ddscx, dwvy - row * ddscy
+            Bvx, Bvy = ddsrx - ddscx, ddsry - ddscy
+            dS0x = a0_4 * Avx + a0_5 * Avy + a1_4 * Bvx + a1_5 * Bvy
+            dS0y = a0_6 * Avx + a0_7 * Avy + a1_6 * Bvx + a1_7 * Bvy
+            dQ = a0_10 * Avx + a0_11 * Avy + a1_10 * Bvx + a1_11 * Bvy
+            dS1x = a1_4 * Avx + a1_5 * Avy + a2_4 * Bvx + a2_5 * Bvy
+            dS1y = a1_6 * Avx + a1_7 * Avy + a2_6 * Bvx + a2_7 * Bvy
+            dQz = a1_10 * Avx + a1_11 * Avy + a2_10 * Bvx + a2_11 * Bvy
+            dS2x, dS2y = row * dS0x + dS1x, row * dS0y + dS1y
+            dVrx, dVry = dvr0 - dvr2 * rry, dvr1 + dvr2 * rrx
+            dVbx, dVby = dvb0 - dvb2 * rby, dvb1 + dvb2 * rbx
+            dur = dVrx * tx + dVry * ty
+            dub = dVbx * tx + dVby * ty
+            dwt = dwvx * tx + dwvy * ty
+            dvP = dVcx * tx + dVcy * ty + R * dwt * irho
+            du = 0.5 * (dur + dub) - dvP
+            dmu = mu_s * (dur - dub) + mu_u * du + mu_Q * dQ
+            dFt = -(dmu * Q + mu * dQ)
+            dFtx, dFty = dFt * tx, dFt * ty
+            dzbar = (dQz - zbar * dQ) * iQ
+            dT1x = dS1x + dzbar * Ftx + zbar * dFtx
+            dT1y = dS1y + dzbar * Fty + zbar * dFty
+            dT2x = dS2x + dzbar * Ftx + (zbar + row) * dFtx
+            dT2y = dS2y + dzbar * Fty + (zbar + row) * dFty
+            ds1e = ex * dT1x + ey * dT1y
+            dGx = tau * (dT1x - ds1e * ex) * irp
+            dGy = tau * (dT1y - ds1e * ey) * irp
+            f0 = dS0x + dGx + dFtx
+            f1 = dS0y + dGy + dFty
+            f2 = rrx * dFty - rry * dFtx
+            f4, f5 = -dS0x - dFtx, -dS0y - dFty
+            f6 = -(rcx * dS0y - rcy * dS0x) - (rbx * dFty - rby * dFtx) + dT2x * k0x + dT2y * k0y
+            dpin = -(rpx * dGy - rpy * dGx)
+            _race_col(Jv, i, j, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
+        _derived_cols(Jq, Jv, i, outer)
 
 
 # ------------------------------------------------------------------------------------------------ SlicedGearMesh

@@ -3,6 +3,7 @@ split into its parts — each element family's kernel, the assembly around them,
 internal-state update and the rest of the step loop — in µs per accepted step against the loop's measured time.
 
     python -m scenarios.bench_breakdown [--window 0.01] [--samples 24] [--rounds 3] [--reps 20] [--target 3] [--json]
+                                        [--slices N]
 
 The engine runs the window from the settled state (the benchmark's, cached in OUT/dpgt_settled.npz) and counts its
 work: residual-only assemblies, residual + Jacobian assemblies, LUs, Newton iterations (one solve each), accepted
@@ -17,6 +18,9 @@ steps, with the update after each): what that costs beyond their sum measured on
 interaction (caches: alone, a part finds its data where it left it); the loop's time per step less the replay is
 the rest of the step (predictor, norms and convergence tests, the log row, a compiled call per block). ``--target``
 [s per 0.1 s] gives the µs per step a target needs (the target: 3 s per 0.1 s of condition 3) and how much must go.
+``--slices N`` splits the sliced machine's step instead (bearing.model = "sliced", N slices per roller, docs/model.md
+§8.8), from the planar machine's settled state with every slope and tilt at zero (the straight profile's exact
+planar reduction: the state is settled for the sliced machine too).
 """
 from __future__ import annotations
 
@@ -45,7 +49,7 @@ WRITES = ("breakdown.json (and the settled state dpgt_settled.npz, shared with t
 
 # a family's compiled twin -> its row of the table (the other twins: supports, springs, drives)
 FAMILY_ROWS = {"contact.race": "race", "contact.pocket": "pocket", "contact.guide": "guide", "contact.drag": "drag",
-               "mesh.gear_mesh": "meshes"}
+               "mesh.gear_mesh": "meshes", "sliced.sliced_race": "race", "sliced.sliced_gear_mesh": "meshes"}
 OTHER = "other families"
 BLOCK = 256     # accepted steps per compiled call, as mbd.simulate runs them
 
@@ -163,9 +167,14 @@ def _engine_wall(runner: CompiledRunner, s0: mbd.State, h: float, t_end: float) 
 
 
 def breakdown(out: Path, window: float = 0.01, samples: int = 24, rounds: int = 3, reps: int = 20, h: float = 5e-6,
-              alpha: float = -0.3, settle: float = 0.03, target_s_per_100ms: float = 3.0, log=print) -> dict:
+              alpha: float = -0.3, settle: float = 0.03, target_s_per_100ms: float = 3.0, log=print,
+              slices: int = 0) -> dict:
     prob = dpgt_problem(settle=settle)
     s0, _ = settled_state(prob, out / "dpgt_settled.npz")
+    if slices:              # the sliced machine from the planar one's settled state, every slope and tilt zero
+        prob = dpgt_problem(settle=settle, overrides={"bearing.model": "sliced", "bearing.slicing.slices": slices})
+        ext = lambda x: np.concatenate([x, np.zeros(prob.model.ndof - x.size)])           # noqa: E731
+        s0 = mbd.State(s0.t, ext(s0.q), ext(s0.v), ext(s0.a), ext(s0.f), dict(s0.z))
     warm_up(prob, s0)
     system = mbd.System(prob.model)
     stepper = mbd.HHT(alpha=alpha)
@@ -249,7 +258,7 @@ def breakdown(out: Path, window: float = 0.01, samples: int = 24, rounds: int = 
         (cpu_step - t_replay) * 1e6)
     steps_per_100ms = steps * 0.1 / window
     target_us = target_s_per_100ms / steps_per_100ms * 1e6
-    res = {"window_s": window, "h_s": h, "alpha": alpha, "steps": steps, "counters": counters,
+    res = {"slices": slices, "dofs": int(prob.model.ndof), "window_s": window, "h_s": h, "alpha": alpha, "steps": steps, "counters": counters,
            "calls_per_step": calls, "samples": int(pick.size), "rounds": rounds, "reps": reps,
            "cpu_s": cpu, "cpus_s": cpus, "cpu_per_step_us": cpu_step * 1e6, "wall_s": statistics.median(walls),
            "walls_s": walls,
@@ -264,7 +273,8 @@ def breakdown(out: Path, window: float = 0.01, samples: int = 24, rounds: int = 
 
 def table(res: dict) -> str:
     c = res["calls_per_step"]
-    lines = [f"settled window {res['window_s']:g} s, h = {res['h_s']:.0e} s, α = {res['alpha']:g}: {res['steps']} steps; "
+    what = f"sliced machine, {res['slices']} slices" if res.get("slices") else "planar machine"
+    lines = [f"{what} ({res.get('dofs')} DOF), settled window {res['window_s']:g} s, h = {res['h_s']:.0e} s, α = {res['alpha']:g}: {res['steps']} steps; "
              f"per step {c['residual']:.2f} residuals, {c['jacobian']:.3f} residual+Jacobians, {c['lu']:.3f} LUs, "
              f"{c['solve']:.2f} solves",
              f"engine {res['cpu_s']:.3f} s CPU (median of {res['rounds']}; wall {res['wall_s']:.3f} s) = "
@@ -294,14 +304,16 @@ def main(argv=None) -> int:
     ap.add_argument("--alpha", type=args.alpha, default=-0.3, help="HHT alpha in [-1/3, 0]")
     ap.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="settling time before the window [s]")
     ap.add_argument("--target", type=args.positive("s"), default=3.0, help="target wall per 0.1 s simulated [s]")
+    ap.add_argument("--slices", type=args.count(0), default=0,
+                    help="split the sliced machine's step (N slices per roller; 0: the planar machine)")
     args.add_shared(ap, "out", out="results/numerics")
     a = ap.parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     log = progress_log(a.json)
     log(machine_note())
-    res = breakdown(out, a.window, a.samples, a.rounds, a.reps, a.h, a.alpha, a.settle, a.target, log)
-    (out / "breakdown.json").write_text(json.dumps(res, indent=2, default=str))
+    res = breakdown(out, a.window, a.samples, a.rounds, a.reps, a.h, a.alpha, a.settle, a.target, log, a.slices)
+    (out / (f"breakdown_sliced{a.slices}.json" if a.slices else "breakdown.json")).write_text(json.dumps(res, indent=2, default=str))
     log(table(res))
     if a.json:
         print(json.dumps(res, default=str))

@@ -10,7 +10,7 @@ import pytest
 
 import mbd
 
-from scenarios.numerics import bench_breakdown, benchmark, stability, work_precision
+from scenarios.numerics import bench_breakdown, bench_sliced, benchmark, stability, work_precision
 from scenarios.numerics.common import StateSampler, dpgt_problem, settled_state
 
 
@@ -124,6 +124,53 @@ def test_bench_breakdown_counts_the_engines_work_and_splits_its_time(tmp_path, c
     assert sum(r["us_per_step"] for r in d["rows"]) == pytest.approx(d["cpu_per_step_us"])
     assert d["target_us_per_step"] == pytest.approx(3.0 / (res.steps * 0.1 / window) * 1e6)
     assert (tmp_path / "breakdown.json").exists()
+
+
+def test_bench_breakdown_splits_the_sliced_machines_step(tmp_path, capsys):
+    """--slices: the sliced machine (more DOFs than the planar one) from the planar settled state, its calls per step
+    the engine's own counters over the same window, the sliced race contacts in the race row."""
+    window, h = 1e-4, 1e-5
+    assert bench_breakdown.main(["--json", "--settle", "2e-4", "--window", str(window), "--h", str(h), "--samples", "2",
+                                 "--rounds", "1", "--reps", "1", "--slices", "5", "--out", str(tmp_path)]) == 0
+    d = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    planar = dpgt_problem(settle=2e-4)
+    s0, _ = settled_state(planar, tmp_path / "dpgt_settled.npz")
+    prob = dpgt_problem(settle=2e-4, overrides={"bearing.model": "sliced", "bearing.slicing.slices": 5})
+    ext = lambda x: np.concatenate([x, np.zeros(prob.model.ndof - x.size)])           # noqa: E731
+    s1 = mbd.State(s0.t, ext(s0.q), ext(s0.v), ext(s0.a), ext(s0.f), dict(s0.z))
+    res = mbd.simulate(prob.model, t_end=s1.t + window, state=s1, stepper=mbd.HHT(alpha=-0.3),
+                       controller=mbd.FixedStep(h), progress=False)
+    c = res.counters
+    assert d["slices"] == 5 and d["dofs"] == prob.model.ndof > planar.model.ndof
+    assert d["steps"] == res.steps
+    assert d["calls_per_step"]["residual"] == pytest.approx(c["residual"] / res.steps)
+    assert d["calls_per_step"]["jacobian"] == pytest.approx(c["jacobian"] / res.steps)
+    race = next(r for r in d["rows"] if r["part"] == "race")
+    assert race["residual_us"] > 0 and race["jacobian_us"] > race["residual_us"]
+    assert (tmp_path / "breakdown_sliced5.json").exists()
+
+
+def test_bench_sliced_counts_the_step_loops_work_as_the_engine_does():
+    """The step loop timed alone does the work mbd.simulate counts over the same fixed steps from the same state (both
+    start without a Jacobian), on both machines; the ratio is of the two CPU medians."""
+    out = bench_sliced.measure(3, 5, 2, 1, 2e-4, numpy=False, loop_steps=3, budget=1.0)
+    assert out["repeats"] == 1 and out["loop_steps"] == 3
+    assert out["sliced_over_planar_loop_cpu"] == pytest.approx(out["sliced_compiled_loop_cpu_us_per_step"]
+                                                               / out["planar_compiled_loop_cpu_us_per_step"])
+    import warnings
+    from components.dpgt import build_dpgt
+    from components.presets import reference_dpgt
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")          # the reference machine's known design warnings (tip overlaps)
+        planar = build_dpgt(reference_dpgt(3, "forward"))
+    s = mbd.simulate(planar.model, planar.q0, planar.v0, 2e-4, stepper=mbd.PRODUCTION.stepper(),
+                     controller=mbd.PRODUCTION.controller(), progress=False, engine="compiled").state
+    res = mbd.simulate(planar.model, t_end=s.t + 3 * bench_sliced.H, state=s, stepper=mbd.PRODUCTION.stepper(),
+                       controller=mbd.FixedStep(bench_sliced.H), progress=False, engine="compiled")
+    calls = out["planar_compiled_calls_per_step"]
+    assert calls["residual"] == pytest.approx(res.counters["residual"] / res.steps)
+    assert calls["jacobian"] == pytest.approx(res.counters["jacobian"] / res.steps)
+    assert calls["newton"] == pytest.approx(res.counters["newton"] / res.steps)
 
 
 def test_warm_says_loaded_only_when_every_group_was_loaded():
