@@ -7,7 +7,7 @@ hydrodynamic guide land),
 from .contact import (IMPACT_LAWS, LAND_LAWS, TRACTION_LAWS, DryLand, EHLTraction, HydrodynamicLand, LandLaw, ExactRestitution, Flores, GuideContact, HuntCrossley, ImpactLaw,
                       LankaraniNikravesh, LubricantDrag, PocketContact, RaceContact, SlideRollTraction, TanhTraction,
                       Traction)
-from .drives import Ramp, SpeedDrive, TorqueSource
+from .drives import Ramp, Schedule, SpeedDrive, TorqueSource
 from .gear_mesh import (STIFFNESS_SHAPES, ConstantStiffness, FourierStiffness, GearMesh, RectangularStiffness,
                         StiffnessShape, mesh_offset, mesh_u0)
 from .loads import ForceSource
@@ -16,7 +16,7 @@ from .tilt import CoordinateSpring, SlopeGyroscopic
 
 __all__ = [
     "BodySpring", "ForceSource", "GearMesh", "GroundSupport", "GuideContact", "LubricantDrag", "PocketContact",
-    "CoordinateSpring", "RaceContact", "Ramp", "SlopeGyroscopic", "SpeedDrive", "TorqueSource", "TorsionalSpring",
+    "CoordinateSpring", "RaceContact", "Ramp", "Schedule", "SlopeGyroscopic", "SpeedDrive", "TorqueSource", "TorsionalSpring",
     "Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS",
     "LandLaw", "DryLand", "HydrodynamicLand", "LAND_LAWS",
     "ImpactLaw", "ExactRestitution", "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS",
