@@ -26,8 +26,9 @@ beside it (the grid's run of that point: the same folder, reused when it is ther
 
 Each is recorded from ``--before`` ahead of the change to ``--after`` past its end. Writes ``transients.csv`` /
 ``transients.md`` (per transient, oil, direction, bearing type and series — cage, rollers out of the load zone, at
-its entry: the slip before the change, its peak and when, its final and the steady run's value, the time to settle
-within ``--within`` % of the steady value (at least one slip point) and the times to go 50, 63 and 90 % of the way),
+its entry: the slip before the change, its peak and when, its final and the steady run's value (the mean of its
+recording's series, the same estimator; its summary's, taken on every step, beside), the time to settle within
+``--within`` % of the steady value (at least one slip point) and the times to go 50, 63 and 90 % of the way),
 ``slip_transients.png`` (the slips against time in bins of ``--bin``, the speed and torque schedule on a second
 axis) and ``transients_answer.md`` (printed).
 
@@ -49,6 +50,8 @@ import csv
 import io
 import sys
 from pathlib import Path
+
+import numpy as np
 
 import mbd
 from components.results import RESULTS_NAME, open_dataset
@@ -330,7 +333,8 @@ def _by_angle(rows: list[dict], out: Path, machine: str) -> list[Path]:
 
 
 TRANSIENT_COLUMNS = ["transient", "oil_temperature_C", "direction", "bearing", "series", "before_pct", "peak_pct",
-                     "peak_after_s", "final_pct", "steady_pct", "settle_s", "t50_s", "t63_s", "t90_s"]
+                     "peak_after_s", "final_pct", "steady_pct", "steady_every_step_pct", "settle_s", "t50_s", "t63_s",
+                     "t90_s"]
 _STEADY_KEY = {"cage": "cage_slip_all_pct", "unloaded": "roller_slip_unloaded_pct", "entry": "roller_slip_entry_pct"}
 _SERIES_WORDS = {"cage": "cage", "unloaded": "rollers out of the load zone", "entry": "rollers at load-zone entry"}
 
@@ -338,10 +342,10 @@ _SERIES_WORDS = {"cage": "cage", "unloaded": "rollers out of the load zone", "en
 def transient_rows(cases: list[Case], results: dict, a) -> tuple[list[dict], list[dict]]:
     """A row per transient run, bearing type and series (:data:`TRANSIENT_COLUMNS`, times from the change), from its
     recording (:func:`components.skid.slip_series`, :func:`~components.skid.transient_numbers`) and the steady run
-    at its final point; and per transient run its binned series and schedule for the figure."""
+    at its final point (the mean of its recording's series, the same estimator; the summary's value on every step
+beside it); and per transient run its binned series and schedule for the figure."""
     rows, series = [], []
-    steady = {(_power_and_oil(c)[0], _power_and_oil(c)[1], c.direction): results.get(c.label)
-              for c in cases if not c.tag}
+    steady = {(_power_and_oil(c)[0], _power_and_oil(c)[1], c.direction): c for c in cases if not c.tag}
     hi, lo = max(a.powers), min(a.powers)
     for case in cases:
         s = results.get(case.label)
@@ -352,7 +356,9 @@ def transient_rows(cases: list[Case], results: dict, a) -> tuple[list[dict], lis
             continue
         _, T = _power_and_oil(case)
         knots, t0, length = transient_schedule(case.tag, a)
-        ref = steady.get((hi if case.tag == "startup" else lo, T, case.direction))
+        ref_case = steady.get((hi if case.tag == "startup" else lo, T, case.direction))
+        ref = None if ref_case is None else results.get(ref_case.label)
+        ref_binned = _steady_series(ref_case, a.bin) if ref is not None and not ref.failed else {}
         with open_dataset(path) as ds:
             binned = slip_series(ds, a.bin)
         series.append({"transient": case.tag, "oil_temperature_C": T, "direction": case.direction, "change_s": t0,
@@ -362,13 +368,26 @@ def transient_rows(cases: list[Case], results: dict, a) -> tuple[list[dict], lis
                 continue
             b = binned[kind]
             for name in SERIES:
-                st = None if ref is None or ref.failed else ref[kind].get(_STEADY_KEY[name])
+                every = None if ref is None or ref.failed else ref[kind].get(_STEADY_KEY[name])
+                rb = ref_binned.get(kind, {}).get(name)
+                st = float(np.nanmean(rb)) if rb is not None and np.isfinite(rb).any() else None
                 n = transient_numbers(b["time_s"], b[name], t0, st, a.within, SETTLE_FLOOR_PCT)
                 rows.append({"transient": case.tag, "oil_temperature_C": T, "direction": case.direction,
                              "bearing": kind, "series": name, "before_pct": n["before"], "peak_pct": n["peak"],
                              "peak_after_s": n["peak_after_s"], "final_pct": n["final"], "steady_pct": n["steady"],
+                             "steady_every_step_pct": every,
                              "settle_s": n["settle_s"], "t50_s": n["t50_s"], "t63_s": n["t63_s"], "t90_s": n["t90_s"]})
     return rows, series
+
+
+def _steady_series(case: Case | None, bin_s: float) -> dict:
+    """The steady run's slip series from its recording (the transient's own estimator: its mean is the value a settled
+    transient is held to; the summary's, taken on every step, is beside it in the table)."""
+    path = None if case is None else Path(case.out_dir) / RESULTS_NAME
+    if path is None or not path.is_file():
+        return {}
+    with open_dataset(path) as ds:
+        return slip_series(ds, bin_s)
 
 
 def _v(x, fmt=".1f", unit="") -> str:
@@ -383,7 +402,8 @@ def transient_answer(rows: list[dict]) -> str:
     for r in rows:
         lines.append(f"{r['transient']}, oil {r['oil_temperature_C']:g} °C, {r['direction']}, {r['bearing']} planets, "
                      f"{_SERIES_WORDS[r['series']]}: {_v(r['before_pct'])} → {_v(r['peak_pct'])} "
-                     f"({_v(r['peak_after_s'], '.3f', ' s')}) → {_v(r['final_pct'])} (steady {_v(r['steady_pct'])}); "
+                     f"({_v(r['peak_after_s'], '.3f', ' s')}) → {_v(r['final_pct'])} (steady {_v(r['steady_pct'])}, on every "
+                     f"step {_v(r['steady_every_step_pct'])}); "
                      f"settled after {_v(r['settle_s'], '.3f', ' s') if r['settle_s'] is not None else 'not within the run'}"
                      f", t63 {_v(r['t63_s'], '.3f', ' s')}")
     return "\n".join(lines)
