@@ -18,10 +18,10 @@ or anything else of the machine (clearance, cage guidance, oil).
 operating point's schedule (``operating.schedule``, docs/model.md §10.3), with the steady run at its final point
 beside it (the grid's run of that point: the same folder, reused when it is there):
 
-* ``startup``: the carrier held at ``--start-speed`` × ``--speed`` for the settling time, then ramped linearly to
-  ``--speed`` in ``--ramp-time``, the sun torque following the square of the speed up to the largest of ``--powers``
-  (the load a wind turbine's generator takes below rated speed, k ω², and the fan-and-pump law of an industrial
-  drive; the torque at the start is ``--start-speed``² of it);
+* ``startup``: the carrier held at ``--start-speed`` × ``--speed`` for ``--settle`` + ``--before``, then ramped
+  linearly to ``--speed`` in ``--ramp-time``, the sun torque following the square of the speed up to the largest of
+  ``--powers`` (the load a wind turbine's generator takes below rated speed, k ω², and the fan-and-pump law of an
+  industrial drive; the torque at the start is ``--start-speed``² of it);
 * ``torque_drop``: running at the largest of ``--powers``, the torque falls to the smallest in ``--drop-time``.
 
 Each is recorded from ``--before`` ahead of the change to ``--after`` past its end. Writes ``transients.csv`` /
@@ -83,7 +83,9 @@ EXAMPLES = ["{prog} --out results/skidding",
             "{prog} --set bearing.clearance=40um --directions forward --workers 2"]
 WRITES = ("p{power}kW_oil{T}C_{direction}/{results.nc, summary.json} per run; summary.csv and summary.md (a row per "
           "run and bearing type: load and catalogue minimum load, cage slip, traction, film, heat); answer.md (the "
-          "answer in words, also printed); slip_against_load.png, roller_slip_by_angle.png; study.json")
+          "answer in words, also printed); slip_against_load.png, roller_slip_by_angle.png; study.json; with "
+          "--transients: p{power}kW_oil{T}C_{direction}_{transient}/ per transient run, transients.csv, transients.md, "
+          "transients_answer.md, slip_transients.png")
 
 
 def _numbers(unit: str):
