@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mbd.elements import GroundSupport, Ramp, SpeedDrive, TorqueSource
+from mbd.elements import GroundSupport, Ramp, Schedule, SpeedDrive, TorqueSource
 
 from . import faults, teeth
 from .bearing import BearingHandles, add_planet_bearing
@@ -23,7 +23,7 @@ from .params import BearingSI, CarrierRippleParams, DPGTParams, LubricantSI
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError
 
-__all__ = ["build_dpgt", "DPGTScene", "PlanetBearingScene", "Speeds", "PairHandles", "carrier_ripple"]
+__all__ = ["build_dpgt", "DPGTScene", "PlanetBearingScene", "Speeds", "PairHandles", "carrier_ripple", "schedules"]
 
 
 @dataclass(frozen=True)
@@ -121,6 +121,15 @@ def carrier_ripple(ripple, wc: float) -> list[tuple[float, float, float]] | None
     return [(k * wc, getattr(ripple, f"amplitude_{k}"), getattr(ripple, f"phase_{k}")) for k in orders] or None
 
 
+def schedules(op) -> tuple[Schedule | None, Schedule | None]:
+    """The operating point's schedule (``operating.schedule``, an OperatingSI's) as the carrier speed's and the sun
+    torque's factors of time, (None, None) without one (docs/model.md §10.3)."""
+    if not op.schedule:
+        return None, None
+    t = [k.time for k in op.schedule]
+    return Schedule(t, [k.speed for k in op.schedule]), Schedule(t, [k.torque for k in op.schedule])
+
+
 def planet_tilt_inertia(gear) -> float:
     """A planet's diametral moment of inertia [kg·m²] about its centre, from its polar one as a hollow cylinder of
     its face width b: J_d = J_p/2 + m b²/12 (J_p = m (r_o² + r_i²)/2)."""
@@ -198,8 +207,16 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     f_m = op.mesh_frequency
     rig = si.rig
     ramp_t = min(rig.load_ramp_mesh_periods / f_m, rig.load_ramp_max) if f_m > 0 else 0.0
+    speed_f, torque_f = schedules(op)
+    if speed_f is not None and wc == 0.0 and len(set(speed_f.values)) > 1:
+        raise ParameterError.at("operating.schedule", "a speed schedule needs operating.carrier_speed > 0 rpm "
+                                                      "(its speeds are fractions of it)")
+    if speed_f is not None and carrier_ripple(rig.carrier_ripple, wc):
+        raise ParameterError.at("operating.schedule", "a schedule cannot be combined with rig.carrier_ripple "
+                                                      "(its orders are of the constant carrier speed)")
     if T_s != 0:
-        scene.add_element(TorqueSource("sun_torque", [scene.index["sun"]], T_s, ramp=Ramp(0.0, ramp_t)))
+        scene.add_element(TorqueSource("sun_torque", [scene.index["sun"]], T_s, ramp=Ramp(0.0, ramp_t),
+                                       schedule=torque_f))
     # inertia the drive sees: every speed of the kinematic state scales with ω_c (ring fixed), so
     # J_eff = 2T/ω_c² over all bodies (carrier, sun reflected, planets orbiting and spinning, rollers, cages);
     # a carrier at rest has no kinematic scaling: then the carrier plus the planets' orbital inertia
@@ -210,7 +227,9 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     wd = 2 * np.pi * rig.carrier_drive_bandwidth
     scene.add_element(SpeedDrive("carrier_drive", scene.index["carrier"], wc, k=J_eff * wd**2,
                                  c=2 * rig.carrier_drive_damping_ratio * J_eff * wd, k_i=J_eff * wd**3 / 5,
-                                 ripple=carrier_ripple(rig.carrier_ripple, wc)))
+                                 ripple=carrier_ripple(rig.carrier_ripple, wc), schedule=speed_f))
+    if speed_f is not None:      # the run starts on the kinematic state at the schedule's first speed
+        scene.scale_velocities(speed_f(0.0))
     return scene.build(DPGTScene, pairs=tuple(pairs), flanks=flanks, lubricant=si.lubricant, bearing=b, options=opt,
                        speeds=Speeds(sun=speed["sun"], inner_planet=speed["a"], outer_planet=speed["b"], carrier=wc),
                        f_c=abs(op.carrier_frequency), f_m=f_m, sun_torque=T_s, carrier_torque=op.carrier_torque,

@@ -28,7 +28,7 @@ import numpy as np
 
 import mbd
 
-from .bearing import cage_slip_pct
+from .bearing import cage_slip_pct, roller_slip_pct
 from .families import FAMILY, MESH_FAMILY
 from .life import LIFE_EXPONENT, relative_life
 # the words and units of summary keys: owned by the results module, re-exported here
@@ -42,14 +42,17 @@ __all__ = ["FAMILY", "MESH_FAMILY", "BearingSeries", "LIFE_EXPONENT", "bearing_m
 
 
 class BearingSeries:
-    """Each planet bearing's load (the pin reaction) and its cage's slip at every recorded sample, for results.nc
-    (the statistics take every step; these are the histories to plot). The load is split as the statistics split
-    it — radial from the carrier axis through the planet, tangential 90° ahead — and the slip is the cage's speed
-    below its epicyclic speed, both relative to the carrier, as ``cage_slip_pct``."""
+    """Each planet bearing's load (the pin reaction), its cage's slip and each roller's slip at every recorded
+    sample, for results.nc (the statistics take every step; these are the histories to plot). The load is split as
+    the statistics split it — radial from the carrier axis through the planet, tangential 90° ahead — the cage's slip
+    is its speed below its epicyclic speed, both relative to the carrier, as ``cage_slip_pct``, and a roller's its
+    spin below its pure-rolling spin, as ``roller_slip_pct`` (with ``race_inner.load`` > 0 it is in the load zone)."""
 
     def __init__(self, scene):
         self.plan = plan_of(scene, scene.model)        # the bodies and families, as the statistics index them
-        self.names = tuple(b["name"] for b in bearing_map(scene))
+        bm = bearing_map(scene)
+        self.names = tuple(b["name"] for b in bm)
+        self.rollers = tuple(r for b in bm for r in b.get("rollers", ()))
 
     def load(self, t, X, V, A, outputs) -> np.ndarray:
         """(radial, tangential) pin reaction per bearing [N], (2, nb)."""
@@ -66,6 +69,12 @@ class BearingSeries:
         p = self.plan
         return cage_slip_pct(p.bearing, V[p.cage, 2] - V[p.carrier, 2], V[p.planet, 2] - V[p.carrier, 2])
 
+    def roller_slip(self, t, X, V, A, outputs) -> np.ndarray:
+        """Roller slip per roller [%] (:func:`components.bearing.roller_slip_pct`) from the body speeds ``V``."""
+        p = self.plan
+        return roller_slip_pct(p.bearing, V[p.roller_body, 2] - V[p.carrier, 2],
+                               V[p.planet[p.roller_bearing], 2] - V[p.carrier, 2])
+
     def probes(self) -> list:
         where = "radial: from the carrier axis through the planet; tangential 90 deg ahead"
         out = [mbd.DerivedOutput("bearing.load_radial", lambda *a: self.load(*a)[0], "N",
@@ -77,4 +86,8 @@ class BearingSeries:
             out.append(mbd.DerivedOutput("bearing.cage_slip", self.slip, "percent",
                                          "cage speed below its epicyclic speed, relative to the carrier",
                                          instances=self.names))
+        if self.plan.rollers:
+            out.append(mbd.DerivedOutput("bearing.roller_slip", self.roller_slip, "percent",
+                                         "roller spin below its pure-rolling spin, relative to the carrier",
+                                         instances=self.rollers))
         return out

@@ -46,7 +46,8 @@ def operating_point(condition: int = 3, direction: str = "forward") -> Operating
     speed, power = CONDITIONS[condition]
     return OperatingPoint(carrier_speed=paper(speed, f"condition {condition}"),
                           output_power=paper(power, f"condition {condition}"),
-                          direction=paper(direction, "the study runs both senses"))
+                          direction=paper(direction, "the study runs both senses"),
+                          schedule=paper((), "the source's operating points are steady"))
 
 
 def _gear(teeth, face_width, mass, internal=False) -> GearParams:

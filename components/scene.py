@@ -166,6 +166,11 @@ class Scene:
         u = np.array(self._vel) / speed
         return float(np.sum(m * (u[:, 0] ** 2 + u[:, 1] ** 2) + J * u[:, 2] ** 2))
 
+    def scale_velocities(self, factor: float) -> None:
+        """Every initial velocity times ``factor``: a kinematic state whose speeds all scale with one member's
+        (a ring-fixed train started at a fraction of its speed)."""
+        self._vel = [v * factor for v in self._vel]
+
     def family(self, key: str, cls, body_args: tuple[str, ...], resolve=None, **common) -> FamilyCollector:
         """The collector for family ``key`` (created on first use). ``resolve(columns, scene)``: the family's arguments
         from its collected columns, for families that index tilt coordinates (known only at build)."""

@@ -3,6 +3,8 @@ bearing's catalogue minimum load.
 
     python -m scenarios.skidding_study [--speed "1000 rpm"] [--powers 2,20,200] [--oil-temperatures 40,80]
         [--directions forward,reverse] [--settle S] [--window S]
+        [--transients startup,torque_drop [--ramp-time S] [--start-speed F] [--drop-time S] [--before S]
+         [--after S] [--bin S] [--within PCT]]
         [--set KEY=VALUE ...] [--params FILE] [--workers N | --scheduler ADDR] [--out DIR]
 
 Every output power × oil temperature × direction at one carrier speed runs through the one runner (resumable, on
@@ -11,6 +13,24 @@ the EHL traction with its limiting shear (``bearing.traction_law = "ehl"``, docs
 resistance (``bearing.rolling_resistance = "houpert"``, §9.5) and the viscous churning of the oil–air mixture
 (``bearing.drag_law = "viscous"``, §8.7); ``--set`` changes any of them (e.g. ``--set bearing.traction_law=tanh``)
 or anything else of the machine (clearance, cage guidance, oil).
+
+``--transients`` runs transients instead of the grid, each at every oil temperature × direction, through the
+operating point's schedule (``operating.schedule``, docs/model.md §10.3), with the steady run at its final point
+beside it (the grid's run of that point: the same folder, reused when it is there):
+
+* ``startup``: the carrier held at ``--start-speed`` × ``--speed`` for ``--settle`` + ``--before``, then ramped
+  linearly to ``--speed`` in ``--ramp-time``, the sun torque following the square of the speed up to the largest of
+  ``--powers`` (the load a wind turbine's generator takes below rated speed, k ω², and the fan-and-pump law of an
+  industrial drive; the torque at the start is ``--start-speed``² of it);
+* ``torque_drop``: running at the largest of ``--powers``, the torque falls to the smallest in ``--drop-time``.
+
+Each is recorded from ``--before`` ahead of the change to ``--after`` past its end. Writes ``transients.csv`` /
+``transients.md`` (per transient, oil, direction, bearing type and series — cage, rollers out of the load zone, at
+its entry: the slip before the change, its peak and when, its final and the steady run's value (the mean of its
+recording's series, the same estimator; its summary's, taken on every step, beside), the time to settle within
+``--within`` % of the steady value (at least one slip point) and the times to go 50, 63 and 90 % of the way),
+``slip_transients.png`` (the slips against time in bins of ``--bin``, the speed and torque schedule on a second
+axis) and ``transients_answer.md`` (printed).
 
 Writes ``summary.csv`` / ``summary.md`` (a row per run and bearing type: the mean bearing load and the catalogue
 minimum load 0.02 C_r with the load over it, cage slip of the reference bearing and of all bearings of the type,
@@ -31,10 +51,12 @@ import io
 import sys
 from pathlib import Path
 
+import numpy as np
+
 import mbd
 from components.results import RESULTS_NAME, open_dataset
 from components.results.io import atomic_write_text
-from components.skid import SKID_PCT, roller_slip_zones
+from components.skid import SERIES, SKID_PCT, roller_slip_zones, slip_series, transient_numbers
 
 from .core import args
 from .core.command import command
@@ -44,7 +66,8 @@ from .core.runner import RunConfig
 from .core.study import Study, StudyRun
 from .core.sweep import Case, build_params, user_overrides
 
-__all__ = ["main", "run", "LAWS", "COLUMNS", "SKID_PCT", "make_cases", "rows_of", "answer"]
+__all__ = ["main", "run", "LAWS", "COLUMNS", "SKID_PCT", "make_cases", "rows_of", "answer", "TRANSIENTS",
+           "transient_schedule", "make_transient_cases", "transient_rows", "TRANSIENT_COLUMNS"]
 
 # the laws this study runs with unless --set says otherwise: traction with a limiting shear, the film's rolling
 # resistance and viscous churning (docs/model.md §9.3, §9.5, §8.7)
@@ -55,11 +78,14 @@ COLUMNS = ["power_kW", "oil_temperature_C", "direction", "bearing", "bearing_loa
            "smearing_pv_max_W_m2", "traction_coefficient_max", "lambda_min", "heat_traction_W", "heat_land_W"]
 _NUMBERS = COLUMNS[4:]
 
-EXAMPLES = ["{prog} --out results/skidding", '{prog} --speed "1500 rpm" --powers 0,5,50 --oil-temperatures 30,60,90',
+EXAMPLES = ["{prog} --out results/skidding",
+            "{prog} --transients startup,torque_drop --oil-temperatures 40 --directions forward", '{prog} --speed "1500 rpm" --powers 0,5,50 --oil-temperatures 30,60,90',
             "{prog} --set bearing.clearance=40um --directions forward --workers 2"]
 WRITES = ("p{power}kW_oil{T}C_{direction}/{results.nc, summary.json} per run; summary.csv and summary.md (a row per "
           "run and bearing type: load and catalogue minimum load, cage slip, traction, film, heat); answer.md (the "
-          "answer in words, also printed); slip_against_load.png, roller_slip_by_angle.png; study.json")
+          "answer in words, also printed); slip_against_load.png, roller_slip_by_angle.png; study.json; with "
+          "--transients: p{power}kW_oil{T}C_{direction}_{transient}/ per transient run, transients.csv, transients.md, "
+          "transients_answer.md, slip_transients.png")
 
 
 def _numbers(unit: str):
@@ -83,9 +109,77 @@ def parse_args(argv):
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded after the start (default 0.03)")
     p.add_argument("--window", type=args.positive("s"), default=None, help="statistics window [s] (default: the study's rule)")
     p.add_argument("--sample-rate", type=args.positive("Hz"), default=2000.0, help="recording rate [Hz] (statistics use every step)")
+    p.add_argument("--transients", default=None, type=args.choice_list(TRANSIENTS, "transients"),
+                   help="comma list of startup, torque_drop: run these transients instead of the grid")
+    p.add_argument("--ramp-time", type=args.positive("s"), default=0.2, help="startup: the speed ramp's length (default 0.2)")
+    p.add_argument("--start-speed", type=args.positive("", upper=1.0), default=0.1,
+                   help="startup: the speed it starts from, a fraction of --speed (default 0.1)")
+    p.add_argument("--drop-time", type=args.positive("s"), default=0.002, help="torque_drop: the fall's length (default 0.002)")
+    p.add_argument("--before", type=args.nonnegative("s"), default=0.02,
+                   help="transients: recorded before the change, after --settle (default 0.02)")
+    p.add_argument("--after", type=args.positive("s"), default=0.4, help="transients: simulated after the change (default 0.4)")
+    p.add_argument("--bin", type=args.positive("s"), default=0.01, help="transients: the slip series' bins (default 0.01)")
+    p.add_argument("--within", type=args.positive("%"), default=10.0,
+                   help="transients: settled within this %% of the steady slip, at least 1 slip point (default 10)")
     args.add_shared(p, "params", "set", "out", "overwrite", "force", "no-progress", "workers", "scheduler",
                     out="results/skidding")
     return p.parse_args(argv)
+
+
+TRANSIENTS = ("startup", "torque_drop")
+SETTLE_FLOOR_PCT = 1.0     # a bin's mean slip scatters by about a slip point (the settling band's floor)
+_START_KNOTS = 4           # the start-up's torque ∝ speed² in this many linear pieces (0.3 % of the torque off at most
+                           # with the default 0.1 start: (Δs)²/4 of a piece Δs = 0.225)
+
+
+def transient_schedule(kind: str, a) -> tuple[list[dict], float, float]:
+    """The operating point's schedule (``operating.schedule`` knots) of a transient, the time of its change [s] and
+    the change's length [s] (see the module's text)."""
+    t0 = a.settle + a.before
+    if kind == "startup":
+        s0 = a.start_speed
+        knots = []
+        for k in range(_START_KNOTS + 1):
+            sp = s0 + (1.0 - s0) * k / _START_KNOTS
+            knots.append({"time": f"{t0 + a.ramp_time * k / _START_KNOTS!r} s", "speed": sp, "torque": sp * sp})
+        return knots, t0, a.ramp_time
+    if kind == "torque_drop":
+        lo, hi = min(a.powers), max(a.powers)
+        if not hi > 0:
+            raise SystemExit("skidding_study: --transients torque_drop needs a power > 0 in --powers")
+        return ([{"time": f"{t0!r} s", "speed": 1.0, "torque": 1.0},
+                 {"time": f"{t0 + a.drop_time!r} s", "speed": 1.0, "torque": lo / hi}], t0, a.drop_time)
+    raise ValueError(f"unknown transient {kind!r}")
+
+
+def _point_case(a, out: Path, P: float, T: float, d: str, extra: dict | None = None, **kw) -> Case:
+    sets = args.parse_sets(a.set)
+    owned = {"operating.carrier_speed": "--speed", "operating.output_power": "--powers",
+             "lubricant.temperature": "--oil-temperatures", "operating.schedule": "--transients"}
+    point = checked_point(parse_point(f"p{P:g}kW_oil{T:g}C: {a.speed}, {P:g} kW, oil {T:g} degC",
+                                      where="--powers"), "--powers")
+    user = {**LAWS, **machine_overrides(user_overrides(sets, a.params, owned), [point]), **(extra or {})}
+    label = point_label(point, d) + (f"_{kw['tag']}" if kw.get("tag") else "")
+    return Case.at(point, d, str(out / label), user, a.params, **kw)
+
+
+def make_transient_cases(a, out: Path) -> list[Case]:
+    """Per transient (``--transients``) × oil temperature × direction: the transient's case (tag: its name, its
+    window from ``--before`` to ``--after`` past the change) and the steady case at its final point (the grid's)."""
+    kinds = [k for k in str(a.transients).split(",") if k]
+    dirs = [d.strip() for d in str(a.directions).split(",") if d.strip()]
+    hi, lo = max(a.powers), min(a.powers)
+    cases, steady = [], {}
+    for kind in kinds:
+        knots, t0, length = transient_schedule(kind, a)
+        for T in a.oil_temperatures:
+            for d in dirs:
+                cases.append(_point_case(a, out, hi, T, d, {"operating.schedule": knots}, tag=kind,
+                                         window=a.before + length + a.after))
+                final = hi if kind == "startup" else lo
+                c = _point_case(a, out, final, T, d)
+                steady.setdefault(c.label, c)
+    return cases + list(steady.values())
 
 
 def make_cases(a, out: Path) -> list[Case]:
@@ -240,6 +334,118 @@ def _by_angle(rows: list[dict], out: Path, machine: str) -> list[Path]:
                               xaxis=("roller angle from the planet's radial line", "°", 1.0, False))]
 
 
+TRANSIENT_COLUMNS = ["transient", "oil_temperature_C", "direction", "bearing", "series", "before_pct", "peak_pct",
+                     "peak_after_s", "final_pct", "steady_pct", "steady_every_step_pct", "settle_s", "t50_s", "t63_s",
+                     "t90_s"]
+_STEADY_KEY = {"cage": "cage_slip_all_pct", "unloaded": "roller_slip_unloaded_pct", "entry": "roller_slip_entry_pct"}
+_SERIES_WORDS = {"cage": "cage", "unloaded": "rollers out of the load zone", "entry": "rollers at load-zone entry"}
+
+
+def transient_rows(cases: list[Case], results: dict, a) -> tuple[list[dict], list[dict]]:
+    """A row per transient run, bearing type and series (:data:`TRANSIENT_COLUMNS`, times from the change), from its
+    recording (:func:`components.skid.slip_series`, :func:`~components.skid.transient_numbers`) and the steady run
+    at its final point (the mean of its recording's series, the same estimator; the summary's value on every step
+beside it); and per transient run its binned series and schedule for the figure."""
+    rows, series = [], []
+    steady = {(_power_and_oil(c)[0], _power_and_oil(c)[1], c.direction): c for c in cases if not c.tag}
+    hi, lo = max(a.powers), min(a.powers)
+    for case in cases:
+        s = results.get(case.label)
+        if not case.tag or s is None or s.failed:
+            continue
+        path = Path(case.out_dir) / RESULTS_NAME
+        if not path.is_file():
+            continue
+        _, T = _power_and_oil(case)
+        knots, t0, length = transient_schedule(case.tag, a)
+        ref_case = steady.get((hi if case.tag == "startup" else lo, T, case.direction))
+        ref = None if ref_case is None else results.get(ref_case.label)
+        ref_binned = _steady_series(ref_case, a.bin) if ref is not None and not ref.failed else {}
+        with open_dataset(path) as ds:
+            binned = slip_series(ds, a.bin)
+        series.append({"transient": case.tag, "oil_temperature_C": T, "direction": case.direction, "change_s": t0,
+                       "length_s": length, "knots": knots, "binned": binned})
+        for kind in ("inner", "outer"):
+            if kind not in binned:
+                continue
+            b = binned[kind]
+            for name in SERIES:
+                every = None if ref is None or ref.failed else ref[kind].get(_STEADY_KEY[name])
+                rb = ref_binned.get(kind, {}).get(name)
+                st = float(np.nanmean(rb)) if rb is not None and np.isfinite(rb).any() else None
+                n = transient_numbers(b["time_s"], b[name], t0, st, a.within, SETTLE_FLOOR_PCT)
+                rows.append({"transient": case.tag, "oil_temperature_C": T, "direction": case.direction,
+                             "bearing": kind, "series": name, "before_pct": n["before"], "peak_pct": n["peak"],
+                             "peak_after_s": n["peak_after_s"], "final_pct": n["final"], "steady_pct": n["steady"],
+                             "steady_every_step_pct": every,
+                             "settle_s": n["settle_s"], "t50_s": n["t50_s"], "t63_s": n["t63_s"], "t90_s": n["t90_s"]})
+    return rows, series
+
+
+def _steady_series(case: Case | None, bin_s: float) -> dict:
+    """The steady run's slip series from its recording (the transient's own estimator: its mean is the value a settled
+    transient is held to; the summary's, taken on every step, is beside it in the table)."""
+    path = None if case is None else Path(case.out_dir) / RESULTS_NAME
+    if path is None or not path.is_file():
+        return {}
+    with open_dataset(path) as ds:
+        return slip_series(ds, bin_s)
+
+
+def _v(x, fmt=".1f", unit="") -> str:
+    return "–" if x is None else f"{x:{fmt}}{unit}"
+
+
+def transient_answer(rows: list[dict]) -> str:
+    """Per transient, oil, direction and bearing type, in words: each slip series before the change, its peak, its
+    final and steady values and when it settles."""
+    lines = ["Slip [%] in transients (times from the start of the change): before → peak (when) → final, against the "
+             "steady run's; settled: within the band of the steady value from then on; t63: 63 % of the way.", ""]
+    for r in rows:
+        lines.append(f"{r['transient']}, oil {r['oil_temperature_C']:g} °C, {r['direction']}, {r['bearing']} planets, "
+                     f"{_SERIES_WORDS[r['series']]}: {_v(r['before_pct'])} → {_v(r['peak_pct'])} "
+                     f"({_v(r['peak_after_s'], '.3f', ' s')}) → {_v(r['final_pct'])} (steady {_v(r['steady_pct'])}, on every "
+                     f"step {_v(r['steady_every_step_pct'])}); "
+                     f"settled after {_v(r['settle_s'], '.3f', ' s') if r['settle_s'] is not None else 'not within the run'}"
+                     f", t63 {_v(r['t63_s'], '.3f', ' s')}")
+    return "\n".join(lines)
+
+
+def write_transient_tables(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
+    """transients.csv, transients.md and transients_answer.md."""
+    head = [f"Machine: {machine}", ""] if machine else []
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=TRANSIENT_COLUMNS, extrasaction="ignore")
+    w.writeheader()
+    w.writerows(rows)
+    atomic_write_text(out / "transients.csv", buf.getvalue())
+    md = ["| " + " | ".join(TRANSIENT_COLUMNS) + " |", "|" + "---|" * len(TRANSIENT_COLUMNS)]
+    md += ["| " + " | ".join("–" if r[c] is None else f"{r[c]:.4g}" if isinstance(r[c], float) else str(r[c])
+                             for c in TRANSIENT_COLUMNS) + " |" for r in rows]
+    atomic_write_text(out / "transients.md", "\n".join(head + md) + "\n")
+    atomic_write_text(out / "transients_answer.md", "\n".join(head + [transient_answer(rows)]) + "\n")
+    return [out / "transients.csv", out / "transients.md", out / "transients_answer.md"]
+
+
+def plot_transients(series: list[dict], out: Path, machine: str = "") -> list[Path]:
+    """slip_transients.png (:func:`viz.plots.slip_transients`): per transient run and bearing type, the slips against
+    time with the schedule on a second axis."""
+    from viz.plots import slip_transients  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
+
+    if not series:
+        return []
+    panels = []
+    for s in series:
+        k = s["knots"]
+        sched = ([float(x["time"].split()[0]) for x in k], [x["speed"] for x in k], [x["torque"] for x in k])
+        for kind in ("inner", "outer"):
+            if kind in s["binned"]:
+                panels.append((f"{s['transient'].replace('_', ' ')}, {kind} planets, oil {s['oil_temperature_C']:g} °C, "
+                               f"{s['direction']}", s["binned"][kind], sched, s["change_s"]))
+    return [slip_transients(panels, out / "slip_transients.png",
+                            title="Slip in transients" + (f" — {machine}" if machine else ""))]
+
+
 class SkiddingStudy(Study):
     """Every power × oil temperature × direction (:class:`scenarios.core.study.Study`): the answer first, then the
     tables and the figure."""
@@ -250,9 +456,16 @@ class SkiddingStudy(Study):
                          progress=not a.no_progress)
 
     def cases(self) -> list[Case]:
+        if self.a.transients:
+            return make_transient_cases(self.a, self.out)
         return make_cases(self.a, self.out)
 
     def report(self, run: StudyRun) -> dict:
+        if self.a.transients:
+            a = self.a
+            rows, series = transient_rows(run.cases, run.results, a)
+            return self.table_report(run, rows, transient_answer, write_transient_tables,
+                                     lambda r, out, machine: plot_transients(series, out, machine))
         return self.table_report(run, rows_of(run.cases, run.results), answer, write_tables, plot)
 
 

@@ -30,7 +30,7 @@ __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_di
            "time_history_group", "cage_orbit_picture", "display_unit", "format_pct", "HEADLINE_QUANTITIES", "FWD", "REV",
            "STYLE", "tolerance_distributions", "tolerance_against_torque", "tolerance_life_cdf", "damage_shares",
            "binned_series", "morris_heatmap", "sobol_heatmap", "life_against_misalignment",
-           "slice_pressure_profiles"]
+           "slice_pressure_profiles", "slip_transients"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
 STYLE = {
@@ -1277,6 +1277,52 @@ def slice_pressure_profiles(z_m, stations_m, curves: Mapping[str, Sequence], pat
         ax.set_ylabel(_axis_label("contact pressure on the pin", "MPa"))
         _from_zero(ax)
         ax.legend(loc="best")
+        if title:
+            _suptitle(fig, title)
+        return _save(fig, path)
+
+
+def slip_transients(panels: Sequence[tuple], path, *, title: str | None = None) -> Path:
+    """Slip against time in transients, a panel per (run, bearing type), two columns: ``panels`` of
+    (heading, binned, (times, speed, torque), change_s) with ``binned`` a :func:`components.skid.slip_series` entry
+    (``time_s``, ``cage``, ``unloaded``, ``entry`` [%] and the single ``entries``) and the schedule's knots (times [s],
+    speed and torque as fractions of the operating point), drawn on a second axis in % of the operating point and
+    held outside the knots; a vertical line where the change starts."""
+    n = len(panels)
+    if n == 0:
+        raise ValueError("panels is empty")
+    cols = 2 if n > 1 else 1
+    rows = (n + cols - 1) // cols
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(5.2 * cols, 0.8 + 2.9 * rows), layout="constrained")
+        axes = fig.subplots(rows, cols, squeeze=False).ravel()
+        twins = []
+        for ax, (heading, b, (kt, ks, kq), change) in zip(axes, panels):
+            t = np.asarray(b["time_s"], float)
+            te, se = b["entries"]
+            ax.scatter(te, se, s=4, color="#c0392b", alpha=0.25, linewidths=0, label="a roller entering")
+            ax.plot(t, b["entry"], color="#c0392b", marker=".", label="rollers at load-zone entry")
+            ax.plot(t, b["unloaded"], color="#1f5fa8", marker=".", label="rollers out of the load zone")
+            ax.plot(t, b["cage"], color="black", label="cage")
+            ax.axvline(change, color=_MARK_COLOR, linewidth=0.8, linestyle=":")
+            ax.set_title(heading)
+            ax.set_xlabel(_axis_label("time", "s"))
+            ax.set_ylabel(_axis_label("slip", "%"))
+            tw = ax.twinx()
+            twins.append(tw)
+            tt = np.concatenate([[min(t[0], kt[0])], kt, [max(t[-1], kt[-1])]])
+            for values, style, label in ((ks, "--", "carrier speed (schedule)"), (kq, ":", "torque (schedule)")):
+                v = 100.0 * np.asarray(values, float)
+                tw.plot(tt, np.concatenate([[v[0]], v, [v[-1]]]), color="grey", linestyle=style, label=label)
+            tw.set_ylabel(_axis_label("schedule", "% of the operating point"))
+            tw.set_ylim(0.0, 105.0)
+            tw.grid(False)
+            ax.set_xlim(t[0] - 0.5 * (t[1] - t[0]) if t.size > 1 else t[0], t[-1])
+        for ax in axes[n:]:
+            ax.set_visible(False)
+        h1, l1 = axes[0].get_legend_handles_labels()
+        h2, l2 = twins[0].get_legend_handles_labels()
+        fig.legend(h1 + h2, l1 + l2, loc="outside lower center", ncol=3)
         if title:
             _suptitle(fig, title)
         return _save(fig, path)

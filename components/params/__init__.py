@@ -62,18 +62,18 @@ from .errors import (ErrorsParams, ErrorsSI, FlankClassParams, FlankClassSI, Pin
 from .gears import GearParams, GearSetParams, GearSetSI, GearSI, MeshParams, MeshSI
 from .machine import DPGTOperatingSI, DPGTParams, DPGTSI, DPGTSupportSI, SupportParams, SupportSI
 from .operating import (BearingRigParams, BearingRigSI, CarrierRippleParams, CarrierRippleSI, OperatingPoint,
-                        OperatingSI, RigParams, RigSI)
+                        OperatingSI, RigParams, RigSI, SchedulePointParams, SchedulePointSI)
 from .sensor import HousingParams, HousingSI, SensorParams, SensorSI
 
 __all__ = [
     "Source", "Sourced", "Span", "paper", "derived", "assumed", "SI", "Derived", "Params",
     "GearParams", "GearSetParams", "CageParams", "SlideRollTractionParams", "LifeParams", "BearingParams", "LubricantParams",
     "SupportParams", "MeshParams", "OperatingPoint", "HousingParams", "SensorParams", "CarrierRippleParams", "RigParams",
-    "DPGTParams", "BearingRigParams",
+    "SchedulePointParams", "DPGTParams", "BearingRigParams",
     "ErrorsParams", "PinholeErrorParams", "RunoutParams", "RollerDiameterErrorParams", "SpallParams", "ToothFaultParams",
     "ToothDeviationParams", "FlankClassParams",
     "GearSI", "GearSetSI", "CageSI", "SlideRollTractionSI", "LifeSI", "BearingSI", "LubricantSI", "SupportSI", "MeshSI",
-    "OperatingSI", "HousingSI", "SensorSI", "CarrierRippleSI", "RigSI", "DPGTSI", "DPGTOperatingSI", "DPGTSupportSI",
+    "OperatingSI", "HousingSI", "SensorSI", "CarrierRippleSI", "RigSI", "SchedulePointSI", "DPGTSI", "DPGTOperatingSI", "DPGTSupportSI",
     "BearingRigSI", "ErrorsSI", "PinholeErrorSI", "RunoutSI", "RollerDiameterErrorSI", "SpallSI", "ToothFaultSI",
     "ToothDeviationSI", "FlankClassSI",
     "with_overrides", "parameter_names", "flatten", "describe", "parameter_rows", "to_toml", "overrides_from_toml",

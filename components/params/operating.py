@@ -6,11 +6,30 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from ..units import Quantity
-from ._machinery import SI, Params, computed, nested, nonneg, param, positive, rule, si_of
+from ..units import ParameterError
+from ._machinery import SI, Params, computed, entries, nested, nonneg, param, positive, rule, si_of
 from .sensor import SensorParams, SensorSI
 
-__all__ = ["OperatingPoint", "OperatingSI", "CarrierRippleParams", "CarrierRippleSI", "RigParams", "RigSI",
+__all__ = ["OperatingPoint", "OperatingSI", "SchedulePointParams", "SchedulePointSI", "CarrierRippleParams", "CarrierRippleSI", "RigParams", "RigSI",
            "BearingRigParams", "BearingRigSI"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class SchedulePointParams(Params["SchedulePointSI"]):
+    """One knot of the operating point's schedule in time (docs/model.md §10.3): the carrier speed and the torques
+    as fractions of the operating point's, linearly interpolated between knots."""
+    _prefix: ClassVar[str] = "operating.schedule"
+    time: Quantity = nonneg("time", "time of the knot from the run's start")
+    speed: Quantity = nonneg("dimensionless", "carrier speed reference there, a fraction of operating.carrier_speed")
+    torque: Quantity = param("dimensionless", "sun torque there, a fraction of the operating point's "
+                                              "(output_power at carrier_speed)")
+
+
+@si_of(SchedulePointParams)
+class SchedulePointSI(SI):
+    time: float
+    speed: float
+    torque: float
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -18,6 +37,11 @@ class OperatingPoint(Params["OperatingSI"]):
     """Ring fixed, sun driven, carrier loaded. ``carrier_speed`` is a magnitude; ``direction`` gives
     its sense (forward = counter-clockwise seen from the input side = positive); ``output_power`` < 0 brakes (the
     carrier drives the sun: the torques turn over, the speeds stay).
+
+    ``schedule`` (empty: a steady operating point): knots (time, speed, torque) of a piecewise-linear schedule —
+    the carrier drive's speed reference is ``speed`` × carrier_speed and the sun torque ``torque`` × its steady
+    value, linear between knots and held before the first and after the last (a start-up, a load drop; docs/model.md
+    §10.3). Times must increase strictly.
 
     si(): carrier_speed signed [rad/s], output_power [W], direction (str) and sign (±1);
     ``DPGTParams.si().operating`` adds the nominal speeds and torques (:class:`geometry.Kinematics`).
@@ -29,6 +53,16 @@ class OperatingPoint(Params["OperatingSI"]):
     output_power: Quantity = param("power", "output power P (> 0 driving: the sun drives the carrier; < 0 braking: "
                                             "the carrier drives the sun)")
     direction: str = param("choice", "sense of rotation", choices=("forward", "reverse"), default="forward")
+    schedule: tuple[SchedulePointParams, ...] = entries(SchedulePointParams, "a schedule in time of the carrier "
+                                                        "speed and the torque, fractions of the point's (empty: steady)")
+
+    def __post_init__(self):
+        super().__post_init__()
+        times = [k.time for k in self.schedule]
+        for i in range(1, len(times)):
+            if not times[i] > times[i - 1]:
+                raise ParameterError.at(f"operating.schedule[{i}].time", f"must be later than the knot before "
+                                                                          f"({times[i - 1]}), got {times[i]}")
 
     def _si_values(self, v):
         sign = 1 if v["direction"] == "forward" else -1
@@ -40,6 +74,7 @@ class OperatingSI(SI):
     carrier_speed: float = computed("signed carrier speed [rad/s] (+: forward)")
     output_power: float
     direction: str
+    schedule: tuple[SchedulePointSI, ...]
     sign: int = computed("+1 forward, -1 reverse")
 
 

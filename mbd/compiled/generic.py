@@ -6,15 +6,17 @@ by hand; (φ, Ω) are the reference frame's angle and speed. Layouts (one row of
 GroundSupport    P = [kx, ky, cx, cy, anchor_x, anchor_y, k_θ, c_θ, θ0]      G = [isotropic (1/0)]
 BodySpring       P = [k, c, marker_a x, marker_a y, marker_b x, marker_b y]   G = []
 TorsionalSpring  P = [k, c, θ0]                                               G = []
-TorqueSource     P = [torque]                                                 G = RAMP
+TorqueSource     P = [torque] (+ SCHEDULE)                                    G = RAMP
 ForceSource      P = [F_X, F_Y] (fixed frame)                                 G = RAMP
-SpeedDrive       P = [k, c, k_i, θ0, ω_ref]                                   G = [Ω_j, A_j, φ_j per ripple harmonic]
+SpeedDrive       P = [k, c, k_i, θ0, ω_ref] (+ SCHEDULE)                      G = [Ω_j, A_j, φ_j per ripple harmonic]
 SlopeGyroscopic  P = [J_p]                                                    G = []
 CoordinateSpring P = [k, c, q0]                                               G = []
 
 RAMP = [has_ramp (1/0), t0, t1]: a :class:`~mbd.elements.drives.Ramp` (or none). A load or speed
 profile given as an arbitrary Python callable of t cannot be compiled: ``pack`` raises
-NotImplementedError. SpeedDrive's internal state z is (n, 1) (the integral of the angle error) when
+NotImplementedError. SCHEDULE = :attr:`~mbd.elements.drives.Schedule.packed` appended to every row of P when the
+element has a schedule (a row without one is the plain layout: the kernels then run the plain arithmetic).
+SpeedDrive's internal state z is (n, 1) (the integral of the angle error) when
 any k_i > 0, else (n, 0), as ``init_internal`` gives (n,) or None.
 
 SpeedDrive's update needs the frame angle at both ends of the step (its error is measured in the
@@ -66,6 +68,39 @@ def _ramp(t, G):
         return 0.0
     s = (t - t0) / (t1 - t0)
     return s * s * (3.0 - 2.0 * s)
+
+
+def _with_schedule(P, schedule):
+    """P with the packed schedule appended to every row (P itself without a schedule)."""
+    if schedule is None:
+        return P
+    S = schedule.packed
+    return np.ascontiguousarray(np.column_stack([P, np.broadcast_to(S, (P.shape[0], S.size))]))
+
+
+@njit(cache=True)
+def _excess_from_start(P, i, o, t):
+    """mbd.elements.drives._excess_from_start of the schedule packed in row i of P from column o."""
+    m = int(P[i, o])
+    if t <= P[i, o + 1]:
+        f = P[i, o + 1 + m]
+        return f, (f - 1.0) * (t - P[i, o + 1])
+    if t >= P[i, o + m]:
+        f = P[i, o + 2 * m]
+        return f, P[i, o + 3 * m] + (f - 1.0) * (t - P[i, o + m])
+    k = 0
+    while P[i, o + 2 + k] <= t:
+        k += 1
+    tk, fk = P[i, o + 1 + k], P[i, o + 1 + m + k]
+    f = fk + (P[i, o + 2 + m + k] - fk) * (t - tk) / (P[i, o + 2 + k] - tk)
+    return f, P[i, o + 1 + 2 * m + k] + (t - tk) * ((fk - 1.0) + 0.5 * (f - fk))
+
+
+@njit(cache=True)
+def _schedule_at(P, i, o, t):
+    """(f(t), ∫_0^t (f − 1) dτ): mbd.elements.drives.schedule_at, operation for operation."""
+    f, e = _excess_from_start(P, i, o, t)
+    return f, e - _excess_from_start(P, i, o, 0.0)[1]
 
 
 @njit(cache=True)
@@ -219,14 +254,18 @@ def pack_torque_source(elem: TorqueSource):
     if elem.fn is not None:
         raise NotImplementedError(f"TorqueSource {elem.name!r}: torque given as a Python callable of time "
                                   f"({elem.fn!r}) cannot be compiled (use a constant with a Ramp, or the numpy path)")
-    return _columns(elem.n, elem.torque), _ramp_g("TorqueSource", elem, elem.ramp)
+    return _with_schedule(_columns(elem.n, elem.torque), elem.schedule), _ramp_g("TorqueSource", elem, elem.ramp)
 
 
 @njit(cache=True)
 def evaluate_torque_source(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     r = _ramp(t, G)
+    scheduled = P.shape[1] > 1
     for i in range(ql.shape[0]):
-        F[i, 0], F[i, 1], F[i, 2] = 0.0, 0.0, P[i, 0] * r
+        T = P[i, 0] * r
+        if scheduled:
+            T = T * _schedule_at(P, i, 1, t)[0]
+        F[i, 0], F[i, 1], F[i, 2] = 0.0, 0.0, T
         if jac:
             _zero_jacobians(Jq, Jv, i)
 
@@ -257,7 +296,7 @@ def pack_speed_drive(elem: SpeedDrive):
                                   "of time, which the compiled path cannot evaluate (use a constant omega_ref, or "
                                   "the numpy path)")
     P = _columns(elem.n, elem.stiffness, elem.damping, elem.k_i, elem.theta0, elem.omega_ref)
-    return P, np.ascontiguousarray(elem.ripple.ravel())
+    return _with_schedule(P, elem.schedule), np.ascontiguousarray(elem.ripple.ravel())
 
 
 @njit(cache=True)
@@ -273,6 +312,8 @@ def _ripple(t, G):
 
 @njit(cache=True)
 def _angle_error(t, phi, P, G, i, theta):
+    if P.shape[1] > 5:                        # a speed schedule (never with ripple): θ0 + ω t + ω ∫(f − 1)
+        return ((P[i, 3] + P[i, 4] * t) + P[i, 4] * _schedule_at(P, i, 5, t)[1]) - (theta + phi)
     if G.shape[0] == 0:                       # no ripple: the constant-speed reference, term for term
         return (P[i, 3] + P[i, 4] * t) - (theta + phi)
     return ((P[i, 3] + P[i, 4] * t) + _ripple(t, G)[0]) - (theta + phi)
@@ -282,9 +323,13 @@ def _angle_error(t, phi, P, G, i, theta):
 def evaluate_speed_drive(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     has_z = z.shape[1] > 0
     dw = _ripple(t, G)[1]
+    scheduled = P.shape[1] > 5
     for i in range(ql.shape[0]):
         e = _angle_error(t, phi, P, G, i, ql[i, 2])
-        de = (P[i, 4] + dw if G.shape[0] else P[i, 4]) - (vl[i, 2] + omega)
+        if scheduled:
+            de = P[i, 4] * _schedule_at(P, i, 5, t)[0] - (vl[i, 2] + omega)
+        else:
+            de = (P[i, 4] + dw if G.shape[0] else P[i, 4]) - (vl[i, 2] + omega)
         T = P[i, 0] * e + P[i, 1] * de
         if has_z:
             T = T + P[i, 2] * z[i, 0]

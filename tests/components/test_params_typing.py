@@ -36,8 +36,9 @@ OLD_NAMES = {
     "parameter_rows", "to_toml", "with_overrides"}
 
 
-# names the package gained since: the range an assumed value carries and the list of them
-ADDED = {"Span", "spans"}
+# names the package gained since: the range an assumed value carries and the list of them; a knot of the operating
+# point's schedule
+ADDED = {"Span", "spans", "SchedulePointParams", "SchedulePointSI"}
 
 
 def test_the_package_offers_every_name_of_the_old_module():

@@ -60,3 +60,30 @@ def test_cage_slip_series_against_pure_rolling():
                                rtol=0, atol=1e-11)
     V[series.plan.planet, 2] = w_c                                     # a planet at rest on its pin: nothing to slip from
     assert np.all(np.isnan(series.slip(0.0, np.zeros_like(V), V, np.zeros_like(V), {})))
+
+
+def test_roller_slip_series_against_pure_rolling():
+    """results.nc's roller slip series at a state whose rollers spin at known speeds: a roller rolling on a pin at
+    rest has its contact point there at rest, so its spin relative to the carrier is its centre's speed over D/2;
+    the centre moves at half the bore's surface speed (ω_p − ω_c)(d_m + D)/2, so the rolling spin is
+    (ω_p − ω_c)(d_m + D)/(2 D); a roller spinning at (1 − s) times that slips 100 s %. The instances are the rollers,
+    bearing by bearing."""
+    from components.outputs import BearingSeries
+    from tests.support.dpgt_runs import build
+
+    scene = build(reference_dpgt(3))
+    series = BearingSeries(scene)
+    b, m, p = scene.bearing, scene.model, series.plan
+    assert len(series.rollers) == p.roller_body.size == 6 * int(b.rollers)
+    assert series.rollers[0].startswith("a1.pb") and series.rollers[-1].startswith("b3.pb")
+    w_c = -310.0
+    w_p = np.array([-1500.0, 900.0, -1400.0, 950.0, -1300.0, 1000.0])
+    s = np.linspace(-0.1, 0.8, p.roller_body.size)
+    rolling = (w_p[p.roller_bearing] - w_c) * (b.pitch_diameter + b.roller_diameter) / (2.0 * b.roller_diameter)
+    V = np.zeros((m.n_bodies, 3))
+    V[p.carrier, 2] = w_c
+    V[p.planet, 2] = w_p
+    V[p.roller_body, 2] = w_c + (1.0 - s) * rolling
+    got = series.roller_slip(0.0, np.zeros_like(V), V, np.zeros_like(V), {})
+    np.testing.assert_allclose(got, 100.0 * s, rtol=0, atol=1e-10)
+    assert "bearing.roller_slip" in [o.name for o in series.probes()]
