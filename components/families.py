@@ -7,5 +7,6 @@ __all__ = ["FAMILY", "MESH_FAMILY"]
 
 FAMILY = MappingProxyType({"race_inner": "race_inner", "race_outer": "race_outer", "pocket": "pocket",
                            "guide": "guide", "drag": "drag", "linear": "bearing_linear", "support": "support",
-                           "gyroscopic": "planet_gyroscopic"})
+                           "gyroscopic": "planet_gyroscopic", "pin_beam": "pin_beam",
+                           "pin_gyroscopic": "pin_gyroscopic"})
 MESH_FAMILY = MappingProxyType({"sun_inner": "mesh_sa", "inner_outer": "mesh_ab", "outer_ring": "mesh_br"})

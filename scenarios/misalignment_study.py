@@ -59,7 +59,9 @@ OWNED = {"bearing.model": "this study (sliced)", "bearing.profile.shape": "--pro
 
 EXAMPLES = ["{prog} --conditions 1,3 --workers 2 --out results/misalignment",
             "{prog} --conditions 3 --gammas 4 --slopes radial --profiles straight --windup off --directions forward",
-            "{prog} --gammas=-4,4 --slopes tangential --windup on --set bearing.slicing.slices=21"]
+            "{prog} --gammas=-4,4 --slopes tangential --windup on --set bearing.slicing.slices=21",
+            "{prog} --mode dynamic --window 0.0071 --conditions 3 --directions forward --gammas 4 --slopes tangential "
+            "--out results/misalignment_dynamic"]
 WRITES = ("{label}/summary.json per case (c{condition}_{direction}_{profile}_w{off|on}_{aligned | slope γ}); "
           "misalignment.csv and misalignment.md (a row per case and bearing type: the slope the bearing sees, the "
           "sliced life and its ratio to the aligned machine's, the edge pressure ratio, the peak pressure); "
@@ -95,6 +97,16 @@ def parse_args(argv):
                    help=f"static solutions per case over a carrier revolution and the mesh cycle (default {SNAPSHOTS}: "
                         "the relative life compares the same instants aligned and sloped; the machine's own default "
                         f"is {DEFAULT_SNAPSHOTS})")
+    p.add_argument("--mode", default="static", choices=("static", "dynamic"),
+                   help="static: each case the machine's quasi-static solution (default); dynamic: each case a "
+                        "dynamic run (HHT, the statistics over --window after --settle; the life from the window's "
+                        "equivalent slice loads, the edge ratio the window's largest, docs/model.md §13)")
+    p.add_argument("--settle", type=args.nonnegative("s"), default=0.03,
+                   help="dynamic mode: seconds discarded after the start (default 0.03: load ramp and transients)")
+    p.add_argument("--window", type=args.positive("s"), default=None,
+                   help="dynamic mode: seconds analysed (default: the runner's, at least 0.02 s and a carrier "
+                        "revolution in whole cage revolutions; the statistics rules ask for one cage revolution "
+                        "relative to the carrier at least, 7.0 ms at condition 3)")
     args.add_shared(p, "conditions", "params", "set", "out", "overwrite", "force", "no-progress", "workers",
                     "scheduler", out="results/misalignment", conditions="1,3",
                     conditions_why="1 and 3: the highest torque (the largest wind-up) and the fastest loaded "
@@ -283,6 +295,8 @@ class MisalignmentStudy(Study):
     machine's quasi-static solution: the answer first, then the tables and the figure."""
 
     def config(self) -> RunConfig:
+        if self.a.mode == "dynamic":
+            return RunConfig(settle=self.a.settle, window=self.a.window, progress=not self.a.no_progress)
         return RunConfig(mode="static", snapshots=self.a.snapshots, progress=not self.a.no_progress)
 
     def cases(self) -> list[Case]:
