@@ -187,6 +187,24 @@ def test_the_beam_support_is_newtons_third_law_and_its_damper_only_dissipates():
     np.testing.assert_allclose(power, expect, rtol=1e-9)
 
 
+def test_a_rigid_turn_of_carrier_pin_and_slope_makes_no_damping_force():
+    """Every point turning at w about the origin, both bodies at θ̇ = w, the slope turning with them (ṡ = w k × s):
+    the rates seen from the carrier vanish, so the damped family's forces are the undamped one's."""
+    rng = np.random.default_rng(9)
+    q, _ = _state(rng)
+    w = 37.0
+    v = np.zeros_like(q)
+    for b in (0, 1, 2):
+        v[3 * b:3 * b + 2] = w * np.array([-q[3 * b + 1], q[3 * b]])
+        v[3 * b + 2] = w
+    for k in (9, 11):
+        v[k:k + 2] = w * np.array([-q[k + 1], q[k]])
+    damped, undamped = _element((2e3, 5.0, 1.0)), _element()
+    Fd = evaluate(damped, 0.0, FSTATE, q, v, None, False)[0]
+    Fu = evaluate(undamped, 0.0, FSTATE, q, v, None, False)[0]
+    np.testing.assert_allclose(Fd, Fu, rtol=0, atol=1e-12 * np.abs(Fu).max())
+
+
 @pytest.mark.parametrize("seed", [4, 5])
 def test_the_compiled_beam_support_equals_the_reference(seed):
     el = _element((2e3, 5.0, 1.0))
