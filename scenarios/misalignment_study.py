@@ -116,6 +116,10 @@ def parse_args(argv):
                         "equivalent slice loads, the edge ratio the window's largest, docs/model.md §13)")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03,
                    help="dynamic mode: seconds discarded after the start (default 0.03: load ramp and transients)")
+    p.add_argument("--start", default="kinematic", choices=("kinematic", "static"),
+                   help="dynamic mode: start from the kinematic state with the torque ramped in (default), or from "
+                        "the static solution at the ramp's end (the sloped machine at rest in its frame: no tilt "
+                        "transient from the start)")
     p.add_argument("--window", type=args.positive("s"), default=None,
                    help="dynamic mode: seconds analysed (default: the runner's, at least 0.02 s and a carrier "
                         "revolution in whole cage revolutions; the statistics rules ask for one cage revolution "
@@ -331,7 +335,8 @@ class MisalignmentStudy(Study):
 
     def config(self) -> RunConfig:
         if self.a.mode == "dynamic":
-            return RunConfig(settle=self.a.settle, window=self.a.window, progress=not self.a.no_progress)
+            return RunConfig(settle=self.a.settle, window=self.a.window, start=self.a.start,
+                             progress=not self.a.no_progress)
         return RunConfig(mode="static", snapshots=self.a.snapshots, progress=not self.a.no_progress)
 
     def cases(self) -> list[Case]:

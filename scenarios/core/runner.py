@@ -79,6 +79,8 @@ def _settings(cfg: "RunConfig") -> dict:
     settings = asdict(replace(cfg, progress=False))
     if cfg.mode == "dynamic":
         del settings["mode"], settings["snapshots"]
+    if cfg.start == "kinematic":     # the default start: runs made before the choice existed stay theirs
+        del settings["start"]
     return settings
 
 
@@ -119,10 +121,14 @@ class RunConfig:
     sensor: bool = False          # record what the housing accelerometer needs (rig.sensor, docs/model.md §12)
     mode: str = "dynamic"         # "static": the quasi-static solution of the same model (components.static)
     snapshots: int = DEFAULT_SNAPSHOTS    # static mode: instants over a carrier revolution and the mesh cycle
+    start: str = "kinematic"      # dynamic mode: from the kinematic state with the torque ramped in (docs/model.md
+    #                               §10.4), or "static": from the static solution at the ramp's end (components.static)
 
     def __post_init__(self):
         if self.mode not in ("dynamic", "static"):
             raise mbd.ModelError(f"mode must be 'dynamic' or 'static', got {self.mode!r}")
+        if self.start not in ("kinematic", "static"):
+            raise mbd.ModelError(f"start must be 'kinematic' or 'static', got {self.start!r}")
         if not (isinstance(self.snapshots, (int, np.integer)) and self.snapshots >= 1):
             raise mbd.ModelError(f"snapshots must be an integer >= 1, got {self.snapshots!r}")
         for k in ("settle", "window"):
@@ -274,7 +280,13 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
         atomic_write_text(out_dir / "progress.json", json.dumps(
             {"t": t, "t_end": t_end, "wall_s": wall, "compile_s": comp, "steps": counters.accepted}))
 
-    res = mbd.simulate(scene.model, scene.q0, scene.v0, t_end, stepper=integ.stepper(), controller=integ.controller(),
+    q0, v0, t0 = scene.q0, scene.v0, 0.0
+    if cfg.start == "static":       # the machine at rest in its frame under its full load, at the ramp's end
+        from components.static import solve_snapshots      # deferred, as the static mode's
+        t0 = min(scene.ramp, cfg.settle)
+        first = solve_snapshots(scene, [t0])[0]
+        q0, v0, t0 = first.q, first.v, first.t
+    res = mbd.simulate(scene.model, q0, v0, t_end, t0=t0, stepper=integ.stepper(), controller=integ.controller(),
                        engine=integ.engine,
                        recorder=rec, checkpoint=mbd.Checkpoint(out_dir / "checkpoint.npz", cfg.checkpoint_every),
                        resume=True, progress=cfg.progress, failed_state_path=out_dir / "failed_state.npz",

@@ -175,7 +175,18 @@ def test_elastic_pins_are_an_axis_and_their_lives_are_relative_to_the_rigid_alig
 
 
 def test_the_dynamic_mode_runs_each_case_over_the_window_asked():
-    a = ms.parse_args(["--mode", "dynamic", "--window", "0.0071", "--settle", "0.05"])
+    a = ms.parse_args(["--mode", "dynamic", "--window", "0.0071", "--settle", "0.05", "--start", "static"])
     cfg = ms.MisalignmentStudy(a).config()
-    assert (cfg.mode, cfg.window, cfg.settle) == ("dynamic", 0.0071, 0.05)
+    assert (cfg.mode, cfg.window, cfg.settle, cfg.start) == ("dynamic", 0.0071, 0.05, "static")
     assert ms.MisalignmentStudy(ms.parse_args([])).config().mode == "static"
+
+
+def test_a_static_start_is_a_run_setting_and_the_default_start_leaves_every_fingerprint_as_it_was():
+    """The start from the static solution identifies a run (its settings say so); the kinematic start, the default,
+    is not among the settings at all, so runs made before the choice existed keep their fingerprints."""
+    from mbd import ModelError
+    from scenarios.core.runner import RunConfig, _settings
+    assert "start" not in _settings(RunConfig()) and "start" not in _settings(RunConfig(window=0.01))
+    assert _settings(RunConfig(start="static"))["start"] == "static"
+    with pytest.raises(ModelError, match="start must be"):
+        RunConfig(start="warm")
