@@ -241,6 +241,22 @@ def time_record(wall_s: float, compile_s: float) -> dict:
     return {"wall_s": wall_s, "compile_s": compile_s, "time_note": TIME_NOTE}
 
 
+def _static_start(scene, settle: float):
+    """(q, v, t) of the static solution at the load ramp's end, or the first of the instants a third of a mesh period
+    apart after it (up to the settling time) that has one (components.static.solve_snapshots: an instant resting on a
+    force's jump has none)."""
+    from components.static import solve_snapshots      # deferred, as the static mode's
+    step = 1.0 / (3.0 * scene.f_m) if scene.f_m > 0 else settle
+    first = None
+    for t in [min(scene.ramp + k * step, settle) for k in range(6)]:
+        try:
+            s = solve_snapshots(scene, [t])[0]
+            return s.q, s.v, s.t
+        except mbd.ModelError as exc:
+            first = first or exc
+    raise first
+
+
 def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> Summary:
     start, compile0, peak = time.perf_counter(), compile_seconds(), RunPeak()
 
@@ -282,10 +298,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
 
     q0, v0, t0 = scene.q0, scene.v0, 0.0
     if cfg.start == "static":       # the machine at rest in its frame under its full load, at the ramp's end
-        from components.static import solve_snapshots      # deferred, as the static mode's
-        t0 = min(scene.ramp, cfg.settle)
-        first = solve_snapshots(scene, [t0])[0]
-        q0, v0, t0 = first.q, first.v, first.t
+        q0, v0, t0 = _static_start(scene, cfg.settle)
     res = mbd.simulate(scene.model, q0, v0, t_end, t0=t0, stepper=integ.stepper(), controller=integ.controller(),
                        engine=integ.engine,
                        recorder=rec, checkpoint=mbd.Checkpoint(out_dir / "checkpoint.npz", cfg.checkpoint_every),
