@@ -33,7 +33,7 @@ from components.dpgt import build_dpgt
 from components.lubrication import BOUNDARY_LAMBDA
 from components.params import DPGTParams, flatten
 from components.scene import SceneOptions
-from components.static import DEFAULT_SNAPSHOTS, static_summary
+from components.static import DEFAULT_SNAPSHOTS, solve_snapshots, static_summary
 from mbd.compile_time import compile_seconds
 from mbd.recorder import BodyMotion, Recorder
 
@@ -245,7 +245,6 @@ def _static_start(scene, settle: float):
     """(q, v, t) of the static solution at the load ramp's end, or the first of the instants a third of a mesh period
     apart after it (up to the settling time) that has one (components.static.solve_snapshots: an instant resting on a
     force's jump has none)."""
-    from components.static import solve_snapshots      # deferred, as the static mode's
     step = 1.0 / (3.0 * scene.f_m) if scene.f_m > 0 else settle
     first = None
     for t in [min(scene.ramp + k * step, settle) for k in range(6)]:
