@@ -315,3 +315,104 @@ def test_a_cantilever_pin_slopes_as_roark_under_its_bearings_static_load_and_a_t
     for planet in ("a1", "b1"):
         i = [m2.body_names[j // 3] for j in beam2.dofs[:, 3]].index(f"{planet}.pin")
         assert np.linalg.norm(qf2[beam2.dofs[i, 6:8]]) < 1e-3 * np.linalg.norm(slopes[planet])
+
+
+def _perturbed(sc, seed):
+    """The scene's kinematic state with every tilt coordinate (slopes, tilts) and the pins' centres and turns moved a
+    little, and rates on them."""
+    m = sc.model
+    rng = np.random.default_rng(seed)
+    q, v = sc.q0.copy(), sc.v0.copy()
+    tilt = m.free >= m.n_body_coords
+    q[tilt] += rng.uniform(-1e-4, 1e-4, tilt.sum())
+    v[tilt] += rng.uniform(-0.05, 0.05, tilt.sum())
+    for name in m.body_names:
+        if name.endswith(".pin"):
+            i = m.full_to_free[3 * m.body(name).index + np.arange(3)]
+            q[i] += rng.uniform(-2e-6, 2e-6, 3) * (1, 1, 10)
+            v[i] += rng.uniform(-1e-3, 1e-3, 3)
+    return q, v
+
+
+def test_the_elastic_machines_jacobian_in_its_pins_coordinates_matches_central_differences():
+    """Every column of a pin (its centre, turn and slope pair): the assembled J_q and J_v — the beam, the pin's
+    gyroscopic terms and the sliced inner raceway on the pin body twice (race body and pin body) — against central
+    differences of the assembled forces."""
+    sc = _machine("one_plate")
+    m = sc.model
+    q, v = _perturbed(sc, 8)
+    system = mbd.System(m)
+    z = system.init_internal()
+    ev = system.evaluate(0.01, q, v, z, jac=True)
+    _, C, K = system.matrices(ev)
+    K, C = K.toarray(), C.toarray()
+    pin = m.body("a1.pin").index
+    beam = m.element("pin_beam")
+    row = [m.body_names[j // 3] for j in beam.dofs[:, 3]].index("a1.pin")
+    cols = m.full_to_free[np.r_[3 * pin + np.arange(3), beam.dofs[row, 6:8]]]
+    for j in cols:
+        for x, h, J in ((q, 1e-9, K), (v, 1e-6, C)):
+            xp, xm = x.copy(), x.copy()
+            xp[j] += h
+            xm[j] -= h
+            Fp = system.forces(0.01, *((xp, v) if x is q else (q, xp)), z)
+            Fm = system.forces(0.01, *((xm, v) if x is q else (q, xm)), z)
+            fd = (Fp - Fm) / (2 * h)
+            np.testing.assert_allclose(-J[:, j], fd, rtol=0, atol=2e-6 * np.abs(fd).max() + 1e-6)
+
+
+def test_the_elastic_machine_accelerates_alike_in_the_rotating_and_the_fixed_frame():
+    """A state with deflected and sloped cantilever pins, tilted planets and rollers, seen from R and from I: every
+    acceleration maps from R to I to round-off (the beam's damping on rates seen from the carrier, the pins' slopes
+    and gyroscopic terms)."""
+    from components.scene import SceneOptions
+    ov = {"bearing.model": "sliced", "bearing.pin.model": "elastic", "bearing.pin.mounting": "one_plate"}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        p = with_overrides(reference_dpgt(3, "forward"), ov)
+        rot, fix = build_dpgt(p), build_dpgt(p, SceneOptions(frame="fixed"))
+    mR, mI = rot.model, fix.model
+    q, v = _perturbed(rot, 21)
+    t = 0.004
+    sysR = mbd.System(mR)
+    F = sysR.evaluate(t, q, v, sysR.init_internal()).F
+    qf, vf = mR.full(t, q, v)
+    af = np.zeros_like(qf)
+    af[mR.free] = F / mR.mdiag
+    fs = mR.frame.at(t)
+    X, V, A = (mR.poses(x) for x in (qf, vf, af))
+    XI, VI, AI = mbd.to_fixed(X, V, fs, A)
+    out = [np.array(x, float) for x in (qf, vf, af)]
+    for o, arr in zip(out, (XI, VI, AI)):
+        o[: mR.n_body_coords] = arr.ravel()
+    for ix, iy in mR.slope_pairs:
+        P3 = [np.array([[x[ix], x[iy], 0.0]]) for x in (qf, vf, af)]
+        pI, vI, aI = mbd.to_fixed(*P3[:2], fs, P3[2])
+        for o, arr in zip(out, (pI, vI, aI)):
+            o[ix], o[iy] = arr[0, 0], arr[0, 1]
+    qI, vI, a_expect = out
+    sysI = mbd.System(mI)
+    a_I = sysI.evaluate(t, qI[mI.free], vI[mI.free], sysI.init_internal()).F / mI.mdiag
+    got = a_expect[mI.free]
+    tilt = mI.free >= mI.n_body_coords
+    for part in (~tilt, tilt):
+        np.testing.assert_allclose(a_I[part], got[part], rtol=0, atol=1e-9 * np.abs(got[part]).max())
+
+
+def test_the_elastic_machine_steps_alike_on_both_engines():
+    """Ten fixed steps from a state with the pins deflected and sloped: the same step counts and states on the compiled
+    and the numpy engine."""
+    sc = _machine("one_plate")
+    q, v = sc.q0.copy(), sc.v0.copy()
+    for name in sc.model.body_names:            # the pins a µm off their pinholes, turning a little
+        if name.endswith(".pin"):
+            i = sc.model.full_to_free[3 * sc.model.body(name).index + np.arange(3)]
+            q[i] += (1e-6, -5e-7, 0.0)
+            v[i] += (1e-3, 0.0, 0.01)
+    h = 5e-6
+    run = lambda eng: mbd.simulate(sc.model, q, v, 0.001 + 10 * h, t0=0.001, stepper=mbd.PRODUCTION.stepper(),   # noqa: E731
+                                   controller=mbd.FixedStep(h), progress=False, engine=eng)
+    rc, rn = run("compiled"), run("numpy")
+    assert (rc.engine, rn.engine) == ("compiled", "numpy") and rc.counters == rn.counters
+    np.testing.assert_allclose(rc.state.q, rn.state.q, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(rc.state.v, rn.state.v, rtol=0, atol=1e-10 / h)
