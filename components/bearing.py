@@ -274,16 +274,19 @@ def roller_tilt_inertia(b: BearingSI) -> float:
     return b.roller_mass * (b.roller_diameter ** 2 / 16.0 + b.roller_length ** 2 / 12.0)
 
 
-def _sliced_dofs(kind: str):
+def _sliced_dofs(kind: str, race_slopes: bool | None = None):
     """resolve(columns, scene) of a sliced family: its (n, n_local) dofs from the body names and the scene's tilt
-    coordinates (known at build), the other columns as they are."""
+    coordinates (known at build), the other columns as they are. ``race_slopes``: the race body's slope pair among
+    them (the bore's always; an elastic pin's, whose race body is the pin body itself)."""
+    with_slopes = kind == "outer" if race_slopes is None else race_slopes
+
     def resolve(cat, scene):
         idx = lambda names: np.array([scene.index[nm] for nm in names], np.int64)     # noqa: E731
         r, rb, pb = idx(cat.pop("roller")), idx(cat.pop("race_body")), idx(cat.pop("pin_body"))
         tilt = np.array([scene.tilt_index[nm] for nm in cat.pop("roller_name")], np.int64)
         cols = [3 * r, 3 * r + 1, 3 * r + 2, tilt, 3 * rb, 3 * rb + 1, 3 * rb + 2]
         slope_of = cat.pop("slope_body")
-        if kind == "outer":
+        if with_slopes:
             s = np.array([scene.slope_index[nm] for nm in slope_of], np.int64)
             cols += [s[:, 0], s[:, 1], 3 * pb, 3 * pb + 1, 3 * pb + 2]
         return dict(dofs=np.column_stack(cols), **cat)
@@ -324,11 +327,13 @@ def _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local,
     fam_law = dict(traction=law["traction"], exponent=law["exponent"], z=sl["z"], drop=sl["drop"])
     slope = np.tile(np.asarray(pin_slope, float), (Z, 1))
     row_offset = np.repeat(row_stations(b), b.rollers)      # ζ_row of every roller, row by row
-    inner = scene.family(FAMILY["race_inner"], SlicedRaceContact, (), resolve=_sliced_dofs("inner"), kind="inner",
-                         **fam_law)
+    elastic = pin_body in scene._slopes          # an elastic pin (components.dpgt.add_elastic_pin): its slope pair
+    extra = dict(race_slopes=True) if elastic else {}
+    inner = scene.family(FAMILY["race_inner"], SlicedRaceContact, (), resolve=_sliced_dofs("inner", elastic),
+                         kind="inner", **fam_law, **extra)
     s_in = inner.add(Z, roller=names, roller_name=names, race_body=[pin_body] * Z, pin_body=[pin_body] * Z,
-                     slope_body=[outer_body] * Z, race_marker=marker, pin_marker=marker, race_slope=slope,
-                     R_race=b.inner_raceway_radius, row_offset=row_offset, **common)
+                     slope_body=[pin_body if elastic else outer_body] * Z, race_marker=marker, pin_marker=marker,
+                     race_slope=slope, R_race=b.inner_raceway_radius, row_offset=row_offset, **common)
     outer = scene.family(FAMILY["race_outer"], SlicedRaceContact, (), resolve=_sliced_dofs("outer"), kind="outer",
                          **fam_law)
     s_out = outer.add(Z, roller=names, roller_name=names, race_body=[outer_body] * Z, pin_body=[pin_body] * Z,

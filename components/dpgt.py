@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mbd.elements import GroundSupport, Ramp, Schedule, SpeedDrive, TorqueSource
+from mbd.elements import BeamSupport, GroundSupport, Ramp, Schedule, SlopeGyroscopic, SpeedDrive, TorqueSource
 
-from . import faults, teeth
+from . import faults, pins, teeth
 from .bearing import BearingHandles, add_planet_bearing
 from .gears import add_mesh_family
 from .geometry import check_design, loaded_flanks
@@ -136,6 +136,41 @@ def planet_tilt_inertia(gear) -> float:
     return 0.5 * gear.inertia + gear.mass * gear.face_width ** 2 / 12.0
 
 
+def _beam_dofs(cat, scene):
+    """The pin beams' arguments: carrier and pin bodies, and each pin's slope pair (known at build)."""
+    idx = lambda names: np.array([scene.index[str(nm)] for nm in names], np.int64)     # noqa: E731
+    pins_ = [str(x) for x in cat.pop("pin")]
+    return dict(body_a=idx(cat.pop("carrier")), body_b=idx(pins_),
+                slopes=np.array([scene.slope_index[nm] for nm in pins_], np.int64), **cat)
+
+
+def _pin_gyro_dofs(cat, scene):
+    names = [str(x) for x in cat.pop("body")]
+    return dict(spin=np.array([3 * scene.index[nm] + 2 for nm in names], np.int64),
+                slopes=np.array([scene.slope_index[nm] for nm in names], np.int64), **cat)
+
+
+def add_elastic_pin(scene: Scene, planet: str, pin_xy, pin_vel, wc: float, b: BearingSI, span: float):
+    """``planet``'s pin as an elastic beam (``bearing.pin.model = "elastic"``, docs/model.md §8.8): a body
+    ``<planet>.pin`` at the pin's centre turning with the carrier, with a slope pair and its gyroscopic terms, held by
+    the carrier at its pinhole on the beam's condensed stiffness (:func:`components.pins.pin_stiffness`,
+    :class:`mbd.elements.tilt.BeamSupport`), damped at ``bearing.pin.damping_ratio`` of each coordinate's critical.
+    Returns (the pin body, the raceway centre in its axes)."""
+    name = f"{planet}.pin"
+    inert = pins.pin_inertias(b, span)
+    k = pins.pin_stiffness(b, span)
+    z = b.pin.damping_ratio
+    scene.body(name, inert["mass"], inert["polar"], pose=(*pin_xy, 0.0), vel=(*pin_vel, wc))
+    scene.slopes(name, inert["diametral"])
+    scene.family(FAMILY["pin_gyroscopic"], SlopeGyroscopic, (), resolve=_pin_gyro_dofs).add(
+        1, body=[name], polar_inertia=inert["polar"])
+    scene.family(FAMILY["pin_beam"], BeamSupport, (), resolve=_beam_dofs).add(
+        1, carrier=["carrier"], pin=[name], marker_a=np.asarray(pin_xy, float)[None, :], **k,
+        c_u=2 * z * np.sqrt(k["k_uu"] * inert["mass"]), c_s=2 * z * np.sqrt(k["k_ss"] * inert["diametral"]),
+        c_theta=2 * z * np.sqrt(k["k_theta"] * inert["polar"]))
+    return name, (0.0, 0.0)
+
+
 def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: bool = True) -> DPGTScene:
     """Build the DPGT scene. Design errors raise ParameterError; design warnings are issued."""
     opt = (options or SceneOptions()).resolved()
@@ -158,7 +193,20 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     ph = lay.phasing
     scene.body("sun", G.sun.mass, G.sun.inertia, vel=(0, 0, speed["sun"]))
     scene.body("ring", G.ring.mass, G.ring.inertia, pose=(0, 0, ph.gamma_ring))
-    scene.body("carrier", G.carrier_mass, G.carrier_inertia, vel=(0, 0, wc))
+    elastic_pins = b.model == "sliced" and b.pin.model == "elastic"
+    if si.bearing.pin.model == "elastic" and b.model == "planar":
+        raise ParameterError.at("bearing.pin.model", "an elastic pin is seen only by the sliced bearing model: set "
+                                                     "bearing.model = 'sliced'")
+    m_c, J_c = G.carrier_mass, G.carrier_inertia
+    if elastic_pins:        # the pins become bodies of their own: their mass and inertia leave the carrier's
+        pin_in = pins.pin_inertias(b, G.carrier_plate_span)
+        r2 = np.sum(np.asarray(lay.centres_a) ** 2) + np.sum(np.asarray(lay.centres_b) ** 2)
+        m_c = m_c - 2 * lay.planets * pin_in["mass"]
+        J_c = J_c - 2 * lay.planets * pin_in["polar"] - pin_in["mass"] * r2
+        if not (m_c > 0.0 and J_c > 0.0):
+            raise ParameterError.at("bearing.pin.density", f"the elastic pins' mass and inertia exceed the carrier's "
+                                                           f"(gears.carrier_mass {G.carrier_mass:g} kg)")
+    scene.body("carrier", m_c, J_c, vel=(0, 0, wc))
     sup_f = scene.family(FAMILY["support"], GroundSupport, ("bodies",))
     for name, k, m, J in (("sun", sup.sun_stiffness, G.sun.mass, G.sun.inertia),
                           ("ring", sup.ring_stiffness, G.ring.mass, G.ring.inertia),
@@ -181,9 +229,13 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
                          pin_slope=faults.pin_slope(si, planet, c))
             for planet, gear, c in ((a_names[n], G.inner_planet, lay.centres_a[n]),
                                     (b_names[n], G.outer_planet, lay.centres_b[n]))}
-        bearings = [add_planet_bearing(scene, f"{planet}.pb", pin_body="carrier", pin_local=p, outer_body=planet,
-                                       bearing=b, lubricant=si.lubricant, pin_xy=p, pin_vel=v, omega_pin=wc,
-                                       omega_outer=w, damage=_bearing_damage(si, planet, psi), **tilt.get(planet, {}))
+        held = {planet: (add_elastic_pin(scene, planet, p, v, wc, b, G.carrier_plate_span) if elastic_pins
+                         else ("carrier", p))
+                for planet, p, v in ((a_names[n], pa, va), (b_names[n], pb, vb))}
+        bearings = [add_planet_bearing(scene, f"{planet}.pb", pin_body=held[planet][0], pin_local=held[planet][1],
+                                       outer_body=planet, bearing=b, lubricant=si.lubricant, pin_xy=p, pin_vel=v,
+                                       omega_pin=wc, omega_outer=w, damage=_bearing_damage(si, planet, psi),
+                                       **tilt.get(planet, {}))
                     for planet, p, v, w, psi in ((a_names[n], pa, va, speed["a"], lay.psi_a[n]),
                                                  (b_names[n], pb, vb, speed["b"], lay.psi_b[n]))]
         pairs.append(PairHandles(a_names[n], b_names[n], float(lay.psi_a[n]), float(lay.psi_b[n]), *bearings))

@@ -15,7 +15,7 @@ import numpy as np
 
 from .params import (BearingParams, BearingRigParams, CageParams, CarrierRippleParams, DPGTParams, ErrorsParams,
                      FlankClassParams, GearParams, GearSetParams, HousingParams, LifeParams, LubricantParams, MeshParams,
-                     OperatingPoint, PinholeErrorParams, ProfileParams, RigParams, RunoutParams, SensorParams,
+                     OperatingPoint, PinParams, PinholeErrorParams, ProfileParams, RigParams, RunoutParams, SensorParams,
                      SlicingParams, SlideRollTractionParams, Span, SupportParams, assumed, derived,
                      overrides_from_toml, paper, with_overrides)
 from .tolerances import radial_runout
@@ -180,6 +180,15 @@ def reference_bearing() -> BearingParams:
                                "(docs/model.md §8.8)"),
             stiffness=assumed("palmgren", "the planar law's constant: a straight, aligned roller is the planar "
                                           "contact")),
+        pin=PinParams(
+            model=assumed("rigid", "the source's pins are part of a rigid carrier; elastic: the pin bends under its "
+                                   "bearing's load (docs/model.md §8.8)"),
+            mounting=assumed("both_plates", "the two-plate carrier the wind-up presumes (gears.carrier_plate_span)"),
+            overhang=assumed("20 mm", "one_plate: half the 40 mm plate span, the planet's 16 mm half face width and "
+                                      "a 4 mm washer"),
+            bore_diameter=assumed("0 mm", "a solid pin; the source gives none"),
+            density=assumed("7850 kg/m^3", "steel"),
+            damping_ratio=assumed(0.02, "a steel part pressed in its bores: a few percent of critical")),
     )
 
 

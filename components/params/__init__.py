@@ -52,8 +52,8 @@ values fit together (rollers fit, gears assemble, tip circles clear) is checked 
 """
 from ._machinery import SI, Derived, Params, Source, Sourced, Span, assumed, derived, paper
 from .bearing import (BearingParams, BearingSI, CageParams, CageSI, LifeParams, LifeSI, LubricantParams, LubricantSI,
-                      ProfileParams, ProfilePointParams, ProfilePointSI, ProfileSI, SlicingParams, SlicingSI,
-                      SlideRollTractionParams, SlideRollTractionSI)
+                      PinParams, PinSI, ProfileParams, ProfilePointParams, ProfilePointSI, ProfileSI, SlicingParams,
+                      SlicingSI, SlideRollTractionParams, SlideRollTractionSI)
 from .dotted import (describe, flatten, overrides_from_toml, parameter_names, parameter_rows, spans, to_toml,
                      with_overrides)
 from .errors import (ErrorsParams, ErrorsSI, FlankClassParams, FlankClassSI, PinholeErrorParams, PinholeErrorSI,
@@ -68,6 +68,7 @@ from .sensor import HousingParams, HousingSI, SensorParams, SensorSI
 __all__ = [
     "Source", "Sourced", "Span", "paper", "derived", "assumed", "SI", "Derived", "Params",
     "GearParams", "GearSetParams", "CageParams", "SlideRollTractionParams", "LifeParams", "BearingParams", "LubricantParams",
+    "PinParams", "PinSI",
     "SupportParams", "MeshParams", "OperatingPoint", "HousingParams", "SensorParams", "CarrierRippleParams", "RigParams",
     "SchedulePointParams", "DPGTParams", "BearingRigParams",
     "ErrorsParams", "PinholeErrorParams", "RunoutParams", "RollerDiameterErrorParams", "SpallParams", "ToothFaultParams",

@@ -12,6 +12,7 @@ from ._machinery import SI, Params, computed, entries, nested, nonneg, param, po
 
 __all__ = ["CageParams", "CageSI", "SlideRollTractionParams", "SlideRollTractionSI", "LifeParams", "LifeSI",
            "ProfilePointParams", "ProfilePointSI", "ProfileParams", "ProfileSI", "SlicingParams", "SlicingSI",
+           "PinParams", "PinSI",
            "BearingParams", "BearingSI", "LubricantParams", "LubricantSI"]
 
 
@@ -184,6 +185,35 @@ class SlicingSI(SI):
 
 
 @dataclass(frozen=True, kw_only=True)
+class PinParams(Params["PinSI"]):
+    """The planet pin, the bearing's inner raceway (diameter d_m − D, Young's modulus bearing.elastic_modulus): rigid,
+    or an elastic beam clamped in the carrier's plates whose bending slope and deflection at the bearing's centre are
+    degrees of freedom (:mod:`components.pins`, docs/model.md §8.8). Read only by the sliced bearing model."""
+    _prefix: ClassVar[str] = "bearing.pin"
+    model: str = param("choice", "rigid (part of the carrier) or elastic (a beam in the carrier's plates: its "
+                                 "slope and deflection at the bearing under the bearing's load; the sliced model)",
+                       choices=("rigid", "elastic"))
+    mounting: str = param("choice", "elastic pin: both_plates (clamped in both carrier plates, gears.carrier_plate_span "
+                                    "apart, the bearing mid-span) or one_plate (a cantilever from the shaft-side "
+                                    "plate, bearing.pin.overhang)", choices=("both_plates", "one_plate"))
+    overhang: Quantity = positive("length", "one_plate: the clamp's face to the bearing's centre a")
+    bore_diameter: Quantity = nonneg("length", "the pin's bore d_i (0: a solid pin)")
+    density: Quantity = positive("density", "the pin's material density (its mass and inertias)")
+    damping_ratio: Quantity = nonneg("dimensionless", "elastic pin: damping ratio of its deflection, slope and turn "
+                                                      "(each against its own stiffness and inertia)")
+
+
+@si_of(PinParams)
+class PinSI(SI):
+    model: str
+    mounting: str
+    overhang: float
+    bore_diameter: float
+    density: float
+    damping_ratio: float
+
+
+@dataclass(frozen=True, kw_only=True)
 class BearingParams(Params["BearingSI"]):
     """Cylindrical roller planet bearing (same for inner and outer planets), with its cage.
 
@@ -238,6 +268,7 @@ class BearingParams(Params["BearingSI"]):
     life: LifeParams = nested(LifeParams, "fatigue life rating factors")
     profile: ProfileParams = nested(ProfileParams, "roller profile (sliced contact)")
     slicing: SlicingParams = nested(SlicingParams, "sliced contact: slices and slice law")
+    pin: PinParams = nested(PinParams, "the planet pin: rigid or an elastic beam (sliced contact)")
 
     def _si_values(self, v):
         dm, dr, ln = v["pitch_diameter"], v["roller_diameter"], v["roller_length"]
@@ -287,6 +318,7 @@ class BearingSI(SI):
     life: LifeSI
     profile: ProfileSI
     slicing: SlicingSI
+    pin: PinSI
     inner_raceway_radius: float = computed("R_i = (d_m - D)/2, the pin [m]")
     outer_raceway_radius: float = computed("R_o = (d_m + D + P_d)/2, the planet bore [m]")
 

@@ -11,6 +11,7 @@ ForceSource      P = [F_X, F_Y] (fixed frame)                                 G 
 SpeedDrive       P = [k, c, k_i, θ0, ω_ref] (+ SCHEDULE)                      G = [Ω_j, A_j, φ_j per ripple harmonic]
 SlopeGyroscopic  P = [J_p]                                                    G = []
 CoordinateSpring P = [k, c, q0]                                               G = []
+BeamSupport      P = [marker_a x, y, k_uu, k_us, k_ss, k_θ, c_u, c_s, c_θ]     G = []
 
 RAMP = [has_ramp (1/0), t0, t1]: a :class:`~mbd.elements.drives.Ramp` (or none). A load or speed
 profile given as an arbitrary Python callable of t cannot be compiled: ``pack`` raises
@@ -31,13 +32,13 @@ from numba import njit
 from ..elements.drives import Ramp, SpeedDrive, TorqueSource
 from ..elements.loads import ForceSource
 from ..elements.springs import BodySpring, GroundSupport, TorsionalSpring
-from ..elements.tilt import CoordinateSpring, SlopeGyroscopic
+from ..elements.tilt import BeamSupport, CoordinateSpring, SlopeGyroscopic
 
 __all__ = ["pack_ground_support", "evaluate_ground_support", "pack_body_spring", "evaluate_body_spring",
            "pack_torsional_spring", "evaluate_torsional_spring", "pack_torque_source", "evaluate_torque_source",
            "pack_force_source", "evaluate_force_source", "pack_speed_drive", "evaluate_speed_drive",
            "update_speed_drive", "pack_slope_gyroscopic", "evaluate_slope_gyroscopic", "pack_coordinate_spring",
-           "evaluate_coordinate_spring"]
+           "evaluate_coordinate_spring", "pack_beam_support", "evaluate_beam_support"]
 
 _NO_G = np.zeros(0)
 
@@ -389,3 +390,67 @@ def evaluate_coordinate_spring(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv
         F[i, 0] = -P[i, 0] * (ql[i, 0] - P[i, 2]) - P[i, 1] * vl[i, 0]
         if jac:
             Jq[i, 0, 0], Jv[i, 0, 0] = -P[i, 0], -P[i, 1]
+
+
+# ------------------------------------------------------------------------------------------------ BeamSupport
+def pack_beam_support(elem: BeamSupport):
+    return _columns(elem.n, elem.marker_a[:, 0], elem.marker_a[:, 1], elem.k_uu, elem.k_us, elem.k_ss, elem.k_theta,
+                    elem.c_u, elem.c_s, elem.c_theta), _NO_G
+
+
+@njit(cache=True)
+def evaluate_beam_support(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    """BeamSupport's forces; its Jacobian column by column, the differential of every line along each of the 16
+    unit directions of (q, v) (as mbd.compiled.sliced)."""
+    dq, dv = np.zeros(8), np.zeros(8)
+    for i in range(ql.shape[0]):
+        mx, my, kuu, kus, kss, kth, cu, cs, cth = (P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6],
+                                                   P[i, 7], P[i, 8])
+        xa, ya, tha, xb, yb, thb, sx, sy = (ql[i, 0], ql[i, 1], ql[i, 2], ql[i, 3], ql[i, 4], ql[i, 5], ql[i, 6],
+                                            ql[i, 7])
+        va0, va1, va2, vb0, vb1, vb2, vsx, vsy = (vl[i, 0], vl[i, 1], vl[i, 2], vl[i, 3], vl[i, 4], vl[i, 5],
+                                                  vl[i, 6], vl[i, 7])
+        ca, sa = np.cos(tha), np.sin(tha)
+        rax, ray = ca * mx - sa * my, sa * mx + ca * my
+        Vax, Vay = va0 - va2 * ray, va1 + va2 * rax
+        dx, dy = xb - (xa + rax), yb - (ya + ray)
+        udx, udy = vb0 - Vax + va2 * dy, vb1 - Vay - va2 * dx
+        usx, usy = vsx + va2 * sy, vsy - va2 * sx
+        Kx, Ky = -kuu * dx - kus * sx, -kuu * dy - kus * sy
+        Cx, Cy = -cu * udx, -cu * udy
+        Dx, Dy = -cs * usx, -cs * usy
+        Mx, My = -kus * dx - kss * sx + Dx, -kus * dy - kss * sy + Dy
+        T = -kth * (thb - tha) - cth * (vb2 - va2)
+        ex, ey = rax + dx, ray + dy
+        tA = -(rax * Ky - ray * Kx) - (ex * Cy - ey * Cx) + (Dx * sy - Dy * sx) - T
+        F[i, 0], F[i, 1], F[i, 2], F[i, 3] = -(Kx + Cx), -(Ky + Cy), tA, Kx + Cx
+        F[i, 4], F[i, 5], F[i, 6], F[i, 7] = Ky + Cy, T, Mx, My
+        if not jac:
+            continue
+        for j in range(16):
+            dq[:] = 0.0
+            dv[:] = 0.0
+            if j < 8:
+                dq[j] = 1.0
+            else:
+                dv[j - 8] = 1.0
+            drax, dray = -ray * dq[2], rax * dq[2]
+            ddx, ddy = dq[3] - dq[0] - drax, dq[4] - dq[1] - dray
+            dVax = dv[0] - dv[2] * ray - va2 * dray
+            dVay = dv[1] + dv[2] * rax + va2 * drax
+            dudx = dv[3] - dVax + dv[2] * dy + va2 * ddy
+            dudy = dv[4] - dVay - dv[2] * dx - va2 * ddx
+            dusx = dv[6] + dv[2] * sy + va2 * dq[7]
+            dusy = dv[7] - dv[2] * sx - va2 * dq[6]
+            dKx, dKy = -kuu * ddx - kus * dq[6], -kuu * ddy - kus * dq[7]
+            dCx, dCy = -cu * dudx, -cu * dudy
+            dDx, dDy = -cs * dusx, -cs * dusy
+            dMx, dMy = -kus * ddx - kss * dq[6] + dDx, -kus * ddy - kss * dq[7] + dDy
+            dT = -kth * (dq[5] - dq[2]) - cth * (dv[5] - dv[2])
+            dex, dey = drax + ddx, dray + ddy
+            dtA = (-(drax * Ky + rax * dKy - dray * Kx - ray * dKx) - (dex * Cy + ex * dCy - dey * Cx - ey * dCx)
+                   + (dDx * sy + Dx * dq[7] - dDy * sx - Dy * dq[6]) - dT)
+            J = Jq if j < 8 else Jv
+            c = j if j < 8 else j - 8
+            J[i, 0, c], J[i, 1, c], J[i, 2, c], J[i, 3, c] = -(dKx + dCx), -(dKy + dCy), dtA, dKx + dCx
+            J[i, 4, c], J[i, 5, c], J[i, 6, c], J[i, 7, c] = dKy + dCy, dT, dMx, dMy

@@ -46,7 +46,7 @@ class Kind:
 
 
 (_RACE, _POCKET, _GUIDE, _DRAG, _MESH, _SUPPORT, _BODY_SPRING, _TORSION, _TORQUE, _FORCE, _SPEED, _GYRO,
- _COORD_SPRING, _SLICED_RACE, _SLICED_MESH, _RETENTION, _POCKET_FILM, _CAGE_DRAG) = range(18)
+ _COORD_SPRING, _SLICED_RACE, _SLICED_MESH, _RETENTION, _POCKET_FILM, _CAGE_DRAG, _BEAM_SUPPORT) = range(19)
 
 # compiled twin (as the families declare it) -> its id in the dispatch below
 KIND_IDS = {
@@ -56,6 +56,7 @@ KIND_IDS = {
     "generic.ground_support": _SUPPORT, "generic.body_spring": _BODY_SPRING, "generic.torsional_spring": _TORSION,
     "generic.torque_source": _TORQUE, "generic.force_source": _FORCE, "generic.speed_drive": _SPEED,
     "generic.slope_gyroscopic": _GYRO, "generic.coordinate_spring": _COORD_SPRING,
+    "generic.beam_support": _BEAM_SUPPORT,
     "sliced.sliced_race": _SLICED_RACE, "sliced.sliced_gear_mesh": _SLICED_MESH,
     "contact.pocket_film": _POCKET_FILM, "contact.cage_drag": _CAGE_DRAG,
 }
@@ -229,6 +230,8 @@ def evaluate_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, J
         generic.evaluate_slope_gyroscopic(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     elif kind == _COORD_SPRING:
         generic.evaluate_coordinate_spring(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _BEAM_SUPPORT:
+        generic.evaluate_beam_support(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     elif kind == _SLICED_RACE:
         sliced.evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     elif kind == _SLICED_MESH:

@@ -7,7 +7,8 @@ Layout (one row of P per instance; G family-wide):
                        R_race [m], D [m], K, c₀ = 2ζ·sqrt(m_roller·p·K), ζ_row [m], R_red [m], then the n_s profile
                        drops P_k [m];  G (11 + n_s,): exponent p, traction law id and coefficients (the race
                        contact's layout, :func:`mbd.compiled.contact.traction_g`), then the n_s slice stations z_k [m].
-                       The local coordinates' count tells the kind: 7 inner, 12 outer.
+                       The local coordinates' count tells the layout: 7 an inner raceway on a rigid pin, 12
+                       a raceway with its body's slope pair (the bore; an elastic pin's raceway, κ = +1).
 
 How the Jacobian is made. The slice loop runs once per contact: it gives the slice loads and the sums the forces
 need (Σ F_k, Σ z_k F_k, Σ ζ_k F_k, Q = Σ q_k, Σ z_k q_k) and, with ``jac``, the slices' derivative blocks summed

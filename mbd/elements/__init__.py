@@ -13,11 +13,11 @@ from .gear_mesh import (STIFFNESS_SHAPES, ConstantStiffness, FourierStiffness, G
                         StiffnessShape, mesh_offset, mesh_u0)
 from .loads import ForceSource
 from .springs import BodySpring, GroundSupport, TorsionalSpring
-from .tilt import CoordinateSpring, SlopeGyroscopic
+from .tilt import BeamSupport, CoordinateSpring, SlopeGyroscopic
 
 __all__ = [
     "BodySpring", "CageDrag", "PocketFilm", "ForceSource", "GearMesh", "GroundSupport", "GuideContact", "LubricantDrag", "PocketContact",
-    "PocketRetention", "CoordinateSpring", "RaceContact", "Ramp", "Schedule", "SlopeGyroscopic", "SpeedDrive", "TorqueSource", "TorsionalSpring",
+    "PocketRetention", "BeamSupport", "CoordinateSpring", "RaceContact", "Ramp", "Schedule", "SlopeGyroscopic", "SpeedDrive", "TorqueSource", "TorsionalSpring",
     "Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS",
     "LandLaw", "DryLand", "HydrodynamicLand", "LAND_LAWS",
     "ImpactLaw", "ExactRestitution", "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS",

@@ -173,6 +173,9 @@ class SlicedRaceContact(Element):
     The roller's slope is σ_r = τ e, e the unit vector from the pin centre to the roller centre (the roller tilts in
     its radial–axial plane); the raceway's slope is σ_c = Rot(θ_b) s_0 (inner: the pin's prescribed slope s_0 in the
     race body's axes) or s + Rot(θ_b) s_0 (outer: the planet's slope coordinates plus a bore error s_0, default 0).
+    An inner raceway on a pin that bends (``race_slopes=True``; the pin a body of its own with a slope pair,
+    :class:`mbd.elements.tilt.BeamSupport`) takes the outer raceway's layout with the pin body in both places: its
+    slope s + Rot(θ_b) s_0 is the pin's bending slope plus its prescribed one.
 
     Per slice k, w_k = p + z_k σ_r − c − ζ_k σ_c, δ_k = D/2 − κ(|w_k| − R) − P_k as :class:`SlicedContact`, and
 
@@ -204,16 +207,20 @@ class SlicedRaceContact(Element):
     compiled_twin = "sliced.sliced_race"
 
     def __init__(self, name, dofs, *, kind, race_marker, pin_marker, R_race, D, K, exponent, zeta, m_roller,
-                 traction, z, drop, row_offset=0.0, race_slope=(0.0, 0.0)):
+                 traction, z, drop, row_offset=0.0, race_slope=(0.0, 0.0), race_slopes=None):
         self.name = name
         if kind not in ("inner", "outer"):
             raise ModelError(f"{name}: kind must be 'inner' or 'outer', got {kind!r}")
         self.kind = kind
-        self.n_local = 7 if kind == "inner" else 12
+        # the race body's slope pair among the coordinates: always for the bore, for the pin when it bends
+        self.race_slopes = kind == "outer" if race_slopes is None else bool(race_slopes)
+        if kind == "outer" and not self.race_slopes:
+            raise ModelError(f"{name}: an outer raceway (the bore) takes its planet's slope pair (race_slopes)")
+        self.n_local = 12 if self.race_slopes else 7
         d = np.asarray(dofs, dtype=np.int64)
         if d.ndim != 2 or d.shape[1] != self.n_local:
             raise ModelError(f"{name}: dofs must be (n, {self.n_local}) full indices for a {kind} contact "
-                             f"(roller x y θ, tilt, race body x y θ{', slope x y, pin body x y θ' if kind == 'outer' else ''}), "
+                             f"(roller x y θ, tilt, race body x y θ{', slope x y, pin body x y θ' if self.race_slopes else ''}), "
                              f"got shape {d.shape}")
         self.dofs = d
         if not isinstance(traction, Traction):
@@ -250,7 +257,7 @@ class SlicedRaceContact(Element):
         """In-plane geometry and the slopes (Duals or arrays, one per instance)."""
         qr, tau, qb = q[:3], q[3], q[4:7]
         vr, dtau, vb = v[:3], v[3], v[4:7]
-        if self.kind == "outer":
+        if self.race_slopes:
             s, ds, qp, vp = q[7:9], v[7:9], q[9:12], v[9:12]
         else:
             s, ds, qp, vp = None, None, qb, vb
@@ -374,7 +381,7 @@ class SlicedRaceContact(Element):
         f_race = [-1.0 * S0x + tr_race[0], -1.0 * S0y + tr_race[1],
                   -1.0 * (rc[0] * S0y - rc[1] * S0x) + tr_race[2] + (S2x * k0x + S2y * k0y)]
         f_pin = [-1.0 * Gx, -1.0 * Gy, -1.0 * (rp[0] * Gy - rp[1] * Gx)]
-        if self.kind == "inner":         # the pin body is the race body
+        if not self.race_slopes:         # the pin body is the race body
             forces = f_roller + [a + b for a, b in zip(f_race, f_pin)]
         else:
             forces = f_roller + f_race + [-1.0 * S2x, -1.0 * S2y] + f_pin

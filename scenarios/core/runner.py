@@ -33,7 +33,7 @@ from components.dpgt import build_dpgt
 from components.lubrication import BOUNDARY_LAMBDA
 from components.params import DPGTParams, flatten
 from components.scene import SceneOptions
-from components.static import DEFAULT_SNAPSHOTS, static_summary
+from components.static import DEFAULT_SNAPSHOTS, solve_snapshots, static_summary
 from mbd.compile_time import compile_seconds
 from mbd.recorder import BodyMotion, Recorder
 
@@ -80,6 +80,8 @@ def _settings(cfg: "RunConfig") -> dict:
     settings = asdict(replace(cfg, progress=False))
     if cfg.mode == "dynamic":
         del settings["mode"], settings["snapshots"]
+    if cfg.start == "kinematic":     # the default start: runs made before the choice existed stay theirs
+        del settings["start"]
     return settings
 
 
@@ -120,10 +122,14 @@ class RunConfig:
     sensor: bool = False          # record what the housing accelerometer needs (rig.sensor, docs/model.md §12)
     mode: str = "dynamic"         # "static": the quasi-static solution of the same model (components.static)
     snapshots: int = DEFAULT_SNAPSHOTS    # static mode: instants over a carrier revolution and the mesh cycle
+    start: str = "kinematic"      # dynamic mode: from the kinematic state with the torque ramped in (docs/model.md
+    #                               §10.4), or "static": from the static solution at the ramp's end (components.static)
 
     def __post_init__(self):
         if self.mode not in ("dynamic", "static"):
             raise mbd.ModelError(f"mode must be 'dynamic' or 'static', got {self.mode!r}")
+        if self.start not in ("kinematic", "static"):
+            raise mbd.ModelError(f"start must be 'kinematic' or 'static', got {self.start!r}")
         if not (isinstance(self.snapshots, (int, np.integer)) and self.snapshots >= 1):
             raise mbd.ModelError(f"snapshots must be an integer >= 1, got {self.snapshots!r}")
         for k in ("settle", "window"):
@@ -236,6 +242,21 @@ def time_record(wall_s: float, compile_s: float) -> dict:
     return {"wall_s": wall_s, "compile_s": compile_s, "time_note": TIME_NOTE}
 
 
+def _static_start(scene, settle: float):
+    """(q, v, t) of the static solution at the load ramp's end, or the first of the instants a third of a mesh period
+    apart after it (up to the settling time) that has one (components.static.solve_snapshots: an instant resting on a
+    force's jump has none)."""
+    step = 1.0 / (3.0 * scene.f_m) if scene.f_m > 0 else settle
+    first = None
+    for t in [min(scene.ramp + k * step, settle) for k in range(6)]:
+        try:
+            s = solve_snapshots(scene, [t])[0]
+            return s.q, s.v, s.t
+        except mbd.ModelError as exc:
+            first = first or exc
+    raise first
+
+
 def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | None) -> Summary:
     start, compile0, peak = time.perf_counter(), compile_seconds(), RunPeak()
 
@@ -275,7 +296,10 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
         atomic_write_text(out_dir / "progress.json", json.dumps(
             {"t": t, "t_end": t_end, "wall_s": wall, "compile_s": comp, "steps": counters.accepted}))
 
-    res = mbd.simulate(scene.model, scene.q0, scene.v0, t_end, stepper=integ.stepper(), controller=integ.controller(),
+    q0, v0, t0 = scene.q0, scene.v0, 0.0
+    if cfg.start == "static":       # the machine at rest in its frame under its full load, at the ramp's end
+        q0, v0, t0 = _static_start(scene, cfg.settle)
+    res = mbd.simulate(scene.model, q0, v0, t_end, t0=t0, stepper=integ.stepper(), controller=integ.controller(),
                        engine=integ.engine,
                        recorder=rec, checkpoint=mbd.Checkpoint(out_dir / "checkpoint.npz", cfg.checkpoint_every),
                        resume=True, progress=cfg.progress, failed_state_path=out_dir / "failed_state.npz",

@@ -141,3 +141,52 @@ def test_bad_gammas_are_refused_in_one_line():
             ms.parse_args(["--gammas", bad])
         msg = str(info.value.code)
         assert "--gammas" in msg and "arcmin" in msg and "\n" not in msg
+
+
+def test_elastic_pins_are_an_axis_and_their_lives_are_relative_to_the_rigid_aligned_machine(tmp_path):
+    a = ms.parse_args(["--conditions", "3", "--directions", "forward", "--profiles", "straight", "--gammas=-4,4",
+                       "--slopes", "tangential", "--windup", "off,on", "--pins", "rigid,one_plate",
+                       "--out", str(tmp_path / "x")])
+    cases = ms.make_cases(a, tmp_path / "x")
+    # per pin model and wind-up state: aligned, −4′ and +4′
+    assert len(cases) == 2 * 2 * 3
+    one = next(c for c in cases if c.tag == "straight_one_plate_woff_aligned")
+    assert one.overrides["bearing.pin.model"] == "elastic" and one.overrides["bearing.pin.mounting"] == "one_plate"
+    assert all("bearing.pin.model" not in c.overrides for c in cases if "one_plate" not in c.tag)
+    axes = [ms._case_axes(c) for c in cases]
+    assert {x["pins"] for x in axes} == {"rigid", "one_plate"}
+
+    class S(dict):
+        failed = False
+    results = {}
+    for c, x in zip(cases, axes):
+        life = 100.0 * (0.8 if x["pins"] == "one_plate" else 1.0) * (1.0 - 0.01 * abs(x["gamma_arcmin"]))
+        results[c.label] = S({k: {"life_iso16281_sliced_h": life, "misalignment_mean_rad": 0.0,
+                                  "edge_pressure_ratio": 1.0, "bearing_load_mean_N": 1e4} for k in ("inner", "outer")})
+    rows = ms.rows_of(cases, results)
+    r = next(r for r in rows if r["pins"] == "one_plate" and r["gamma_arcmin"] == 0.0 and r["windup"] == "off")
+    assert r["life_relative"] == pytest.approx(0.8, rel=1e-12)      # against the rigid aligned machine
+    assert "one plate elastic pins alone" in ms.answer(rows)
+    # only the rigid aligned machine is run besides the asked elastic pins when rigid is not asked
+    b = ms.parse_args(["--conditions", "3", "--directions", "forward", "--profiles", "straight", "--gammas", "4",
+                       "--slopes", "tangential", "--pins", "both_plates", "--out", str(tmp_path / "y")])
+    tags = [c.tag for c in ms.make_cases(b, tmp_path / "y")]
+    assert tags == ["straight_woff_aligned", "straight_both_plates_woff_aligned", "straight_both_plates_woff_tangential4am"]
+
+
+def test_the_dynamic_mode_runs_each_case_over_the_window_asked():
+    a = ms.parse_args(["--mode", "dynamic", "--window", "0.0071", "--settle", "0.05", "--start", "static"])
+    cfg = ms.MisalignmentStudy(a).config()
+    assert (cfg.mode, cfg.window, cfg.settle, cfg.start) == ("dynamic", 0.0071, 0.05, "static")
+    assert ms.MisalignmentStudy(ms.parse_args([])).config().mode == "static"
+
+
+def test_a_static_start_is_a_run_setting_and_the_default_start_leaves_every_fingerprint_as_it_was():
+    """The start from the static solution identifies a run (its settings say so); the kinematic start, the default,
+    is not among the settings at all, so runs made before the choice existed keep their fingerprints."""
+    from mbd import ModelError
+    from scenarios.core.runner import RunConfig, _settings
+    assert "start" not in _settings(RunConfig()) and "start" not in _settings(RunConfig(window=0.01))
+    assert _settings(RunConfig(start="static"))["start"] == "static"
+    with pytest.raises(ModelError, match="start must be"):
+        RunConfig(start="warm")
