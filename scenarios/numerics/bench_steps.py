@@ -20,7 +20,13 @@ from collections import defaultdict
 
 import numpy as np
 
+import mbd.compiled.runner as runner_module
+
+from components.params import with_overrides
+from components.presets import reference_dpgt
+
 from ..core import args
+from ..core.runner import RunConfig, run_case
 from ..core.command import command
 
 EXAMPLES = ["{prog} --conditions 1,3", "{prog} --conditions 1 --set operating.output_power=\"2 kW\""]
@@ -104,8 +110,6 @@ class _Tally:
 
 
 def measure(condition: int, settle: float, window: float, sets: dict) -> dict:
-    import mbd.compiled.runner as runner_module
-    import scenarios
     tally, original = _Tally(), runner_module.CompiledRunner.advance
 
     def advance(self, state, h, t_end, max_steps):
@@ -117,8 +121,8 @@ def measure(condition: int, settle: float, window: float, sets: dict) -> dict:
     try:
         with warnings.catch_warnings(), tempfile.TemporaryDirectory() as d:
             warnings.simplefilter("ignore")
-            p = scenarios.parameters(condition=condition, direction="forward", set=sets)
-            scenarios.run(p, d, settle=settle, window=window, progress=False)
+            p = with_overrides(reference_dpgt(condition, "forward"), sets)
+            run_case(p, RunConfig(settle=settle, window=window, progress=False), d)
     finally:
         runner_module.CompiledRunner.advance = original
     return {"condition": condition, "set": sets, **tally.report(settle + window)}
