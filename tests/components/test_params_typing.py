@@ -38,7 +38,7 @@ OLD_NAMES = {
 
 # names the package gained since: the range an assumed value carries and the list of them; a knot of the operating
 # point's schedule
-ADDED = {"Span", "spans", "SchedulePointParams", "SchedulePointSI"}
+ADDED = {"Span", "spans", "SchedulePointParams", "SchedulePointSI", "PinParams", "PinSI"}
 
 
 def test_the_package_offers_every_name_of_the_old_module():

@@ -20,7 +20,7 @@ import mbd.elements
 from mbd.compiled import generic, mesh
 from mbd.compiled.registry import kind_of
 from mbd.element import evaluate
-from mbd.elements import (BodySpring, CoordinateSpring, ForceSource, GearMesh, GroundSupport, Ramp, SlopeGyroscopic,
+from mbd.elements import (BeamSupport, BodySpring, CoordinateSpring, ForceSource, GearMesh, GroundSupport, Ramp, SlopeGyroscopic,
                           SpeedDrive, StiffnessShape, TorqueSource, TorsionalSpring)
 from mbd.elements.gear_mesh import RectangularStiffness
 from mbd.model import FrameState
@@ -269,7 +269,7 @@ def test_kernel_tables():
     tables = families("mesh."), families("generic.")
     assert set(tables[0]) == {GearMesh}
     assert set(tables[1]) == {GroundSupport, BodySpring, TorsionalSpring, TorqueSource, ForceSource, SpeedDrive,
-                              SlopeGyroscopic, CoordinateSpring}
+                              SlopeGyroscopic, CoordinateSpring, BeamSupport}
     for table in tables:
         for cls, twin in table.items():
             assert callable(twin.pack) and callable(twin.evaluate)

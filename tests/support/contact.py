@@ -438,8 +438,10 @@ def assert_blocks_close(name, A, B, atol, rtol=RTOL):
         assert err <= rtol * scale + atol[i], f"{name} instance {i}: max error {err:.3e}, scale {scale:.3e}\n{A[i]}\n{B[i]}"
 
 
-def assert_matches_reference(elem, fs, qf, vf, z=None):
-    """Compiled and reference kernels agree; an impact family's all-zero z is the reference's z = None."""
+def assert_matches_reference(elem, fs, qf, vf, z=None, jq_floor=0.0, jv_floor=0.0):
+    """Compiled and reference kernels agree; an impact family's all-zero z is the reference's z = None.
+    ``jq_floor``/``jv_floor``: per-instance round-off floors of the Jacobians the caller measured (added to the
+    bounds below)."""
     t = 0.25
     zr = None if z is not None and not np.any(z) else z
     Fr, _, Jqr, Jvr = evaluate(elem, t, fs, qf, vf, zr, True)
@@ -458,9 +460,9 @@ def assert_matches_reference(elem, fs, qf, vf, z=None):
     for A, B, what in ((F, Fr, "F"), (F0, F0r, "F (no jac)")):
         for i in range(B.shape[0]):
             assert_blocks_close(f"{elem.name} {what} [{i}]", A[i:i + 1], B[i:i + 1], floor[i])
-    assert_blocks_close(f"{elem.name} J_q", Jq, Jqr, ATOL, rj)
+    assert_blocks_close(f"{elem.name} J_q", Jq, Jqr, ATOL + np.asarray(jq_floor), rj)
     # J_v's floor: its round-off is a force over a speed (above, at JV_FLOOR), so it scales with the force
     floor_v = (JV_FLOOR_FILM if film else JV_FLOOR) * np.abs(Fr).max(axis=1)
-    assert_blocks_close(f"{elem.name} J_v", Jv, Jvr, floor_v, rj)
+    assert_blocks_close(f"{elem.name} J_v", Jv, Jvr, floor_v + np.asarray(jv_floor), rj)
     np.testing.assert_array_equal(F0, F)     # the value path does not depend on jac
     return Fr
