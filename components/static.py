@@ -34,9 +34,9 @@ STATIC_LIVES_NOTE = ("lives from the quasi-static solution's mean loads: they le
                      "dynamic factor, impacts, cage motion), so they are longer than a dynamic run's of the same mean "
                      "load where the load fluctuates")
 # The rollers' slip and what follows from it (their share of time in the load zone, the entry, the smearing indicator)
-# are a dynamic run's: out of the load zone a roller's spin keeps the memory of its inertia and slows by 2–20 % under
-# EHL traction, where a static roller spins at the balance of its place (≈ 0.1–0.2 %), and in the load zone, where the
-# speeds agree within 1.7 %, the slip is their small difference (docs/model.md §16)
+# are a dynamic run's: out of the load zone a roller's spin keeps the memory of its inertia and slows by 1.4–28 % under
+# EHL traction, where a static roller spins at the balance of its place (within 0.3 %), and in the load zone, where the
+# speeds agree within 2.4 %, the slip is their small difference (docs/model.md §16)
 DYNAMIC_ONLY = ("cage_", "pocket_", "guide_", "heat_land", "whole_revolutions", "carrier_speed_error",
                 "te_peak_to_peak", "dynamic_factor", "drive_flank_peak", "roller_cage_", "roller_slip_",
                 "roller_entr", "roller_loaded_share", "smearing_")
