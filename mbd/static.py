@@ -418,7 +418,11 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
     g0 = np.abs(prob.residual(x)[0][:nB])
     prob.force_floor = np.concatenate([force_rtol * float(g0.max(initial=0.0)) * scale,
                                        np.zeros(len(rates))])
-    x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization)
+    x_start = x.copy()
+    x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization, bisect=True)
+    if not ok:      # again without the rates' bisection: a machine without load (rates flip as the loads come in)
+        x, more, ok = _ptc(prob, x_start, local, tol, cap, max_steps, regularization, bisect=False)
+        steps += more
     if not ok:
         worst = int(np.argmax(np.abs(prob.residual(x)[0]) / np.maximum(prob.floor, 1e-300)))
         raise ModelError(f"solve_static: no static state at t = {t:.6g} s after {steps} steps (worst unknown: "
@@ -535,7 +539,7 @@ def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarr
 
 
 def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap: np.ndarray, max_steps: int,
-         regularization: float):
+         regularization: float, bisect: bool = True):
     """Pseudo-transient continuation on the outer unknowns, the local ones solved after every step
     (:func:`_local_solve`): implicit Euler steps of the overdamped flow M x' = g, (K_c + μM) Δ = g_c with K_c the
     Schur complement of the local blocks and μ = 1/Δτ. μ starts where no unknown moves more than its ``cap``
@@ -544,10 +548,11 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
     |g| is retried with a tenfold μ, and so is any growth once |g| is a hundredth of its start or μ at its
     floor (Newton's steps can cycle across a kink of the forces); steps are clipped to their caps. A rate unknown
     (a cage's, with its rollers' orbits) whose step reached its bound and flipped the sign of its residual jumped
-    across its root: its bound is quartered, and regrows by half while no jump recurs (bisection-like). A saturating
+    across its root: with ``bisect``, its bound is quartered, and regrows by half while no jump recurs. A saturating
     traction makes the cage's moment a step of ≈ ±20 N·m within ≈ 1 rad/s with flat shoulders, where the stiffness
     is nil and Newton's steps from one shoulder land on the other; the shrinking bound brings the rate into the
-    step, where Newton converges. Converged
+    step, where Newton converges (:func:`_solve` runs the continuation again without it where it fails: at no load the
+    rates' residuals flip as the loads come in, not by jumping). Converged
     when every unknown's residual would move it less than its tolerance under its own stiffness,
     |g_i| ≤ (|K_ii| + μ_min M_i)·tol_i. Stops, unconverged, when μ has grown 10⁴-fold over its start (no step
     lowers |g|). Returns (x, steps, converged)."""
@@ -606,8 +611,8 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
         g, K = prob.residual(x, jac=True)
         jumped = np.zeros(M.size, bool)
         jumped[outer] = clipped
-        jumped[rt] &= sign[rt] * np.sign(g[rt]) < 0
+        jumped[rt] &= (sign[rt] * np.sign(g[rt]) < 0) & bisect
         reach[rt] = np.where(jumped[rt], 0.25 * reach[rt], np.minimum(cap[rt], 1.5 * reach[rt]))
         sign = np.sign(g)
         mu = max(mu * (0.5 * ratio if ratio <= 1.0 else ratio), mu_min)
-    return x, max_steps, False
+    return x, k, False              # the steps taken (fewer than max_steps where μ ran away)
