@@ -418,7 +418,11 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
     g0 = np.abs(prob.residual(x)[0][:nB])
     prob.force_floor = np.concatenate([force_rtol * float(g0.max(initial=0.0)) * scale,
                                        np.zeros(len(rates))])
-    x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization)
+    x_start = x.copy()
+    x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization, bisect=True)
+    if not ok:      # again without the rates' bisection: a machine without load (rates flip as the loads come in)
+        x, more, ok = _ptc(prob, x_start, local, tol, cap, max_steps, regularization, bisect=False)
+        steps += more
     if not ok:
         worst = int(np.argmax(np.abs(prob.residual(x)[0]) / np.maximum(prob.floor, 1e-300)))
         raise ModelError(f"solve_static: no static state at t = {t:.6g} s after {steps} steps (worst unknown: "
@@ -475,7 +479,9 @@ def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarr
     perturbation of every group's first unknown gives each group's first Jacobian column, and so on: a 3×3
     Newton system per group (an unknown whose own stiffness is not positive steps by its cap along its
     residual). Steps are clipped to their caps and damped per group: a group whose scaled residual grew has
-    its next step halved (a contact that opened or closed too far), one whose residual fell regains full steps.
+    its next step halved (a contact that opened or closed too far), one whose residual fell regains full steps —
+    grown measured against both the new and the last floor, so that a floor drifting with its stiffness (a roller's
+    spin on a flat EHL traction curve) does not read as growth and halve the steps to nothing.
     Returns (x, g, converged)."""
     x = x.copy()
     L = local.shape[0]
@@ -483,6 +489,7 @@ def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarr
     present = local >= 0
     damp = np.ones(L)
     size = np.full(L, np.inf)
+    last_floor = np.ones((L, 3))
     reach = cap[idx].copy()                 # each unknown's own step bound: quartered when its residual flips sign
     sign = np.zeros((L, 3))
     g = prob.residual(x)[0]
@@ -508,9 +515,13 @@ def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarr
         scaled = np.where(present & (reach > prob.tol[idx]), np.abs(gl) / floor, 0.0)
         if np.all(scaled <= 1.0):
             return x, g, True
+        # grown: the scaled residual grew, and so did the residual itself over the last floor — a residual creeping
+        # down a flat traction curve (EHL) while its stiffness, and so its floor, drifts is not growth
         new_size = scaled.max(axis=1)
-        damp = np.where(new_size > size, 0.5 * damp, np.minimum(1.0, 2.0 * damp))
-        size = new_size
+        same_floor = np.where(present & (reach > prob.tol[idx]), np.abs(gl) / last_floor, 0.0).max(axis=1)
+        grown = (new_size > size) & (same_floor > size)
+        damp = np.where(grown, 0.5 * damp, np.minimum(1.0, 2.0 * damp))
+        size, last_floor = new_size, floor
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             fin = np.all(np.isfinite(Kl), axis=(1, 2))
             det = np.where(fin, np.linalg.det(np.where(fin[:, None, None], Kl, np.eye(3))), 0.0)
@@ -528,14 +539,20 @@ def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarr
 
 
 def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap: np.ndarray, max_steps: int,
-         regularization: float):
+         regularization: float, bisect: bool = True):
     """Pseudo-transient continuation on the outer unknowns, the local ones solved after every step
     (:func:`_local_solve`): implicit Euler steps of the overdamped flow M x' = g, (K_c + μM) Δ = g_c with K_c the
     Schur complement of the local blocks and μ = 1/Δτ. μ starts where no unknown moves more than its ``cap``
     and follows the residual, μ ← μ·|g_new|/|g| (halved again while it falls; |g|² = Σ g²/M over the outer
     unknowns), down to ``regularization``·max K/M: the last steps are Newton's. A step that more than doubles
     |g| is retried with a tenfold μ, and so is any growth once |g| is a hundredth of its start or μ at its
-    floor (Newton's steps can cycle across a kink of the forces); steps are clipped to their caps. Converged
+    floor (Newton's steps can cycle across a kink of the forces); steps are clipped to their caps. A rate unknown
+    (a cage's, with its rollers' orbits) whose step reached its bound and flipped the sign of its residual jumped
+    across its root: with ``bisect``, its bound is quartered, and regrows by half while no jump recurs. A saturating
+    traction makes the cage's moment a step of ≈ ±20 N·m within ≈ 1 rad/s with flat shoulders, where the stiffness
+    is nil and Newton's steps from one shoulder land on the other; the shrinking bound brings the rate into the
+    step, where Newton converges (:func:`_solve` runs the continuation again without it where it fails: at no load the
+    rates' residuals flip as the loads come in, not by jumping). Converged
     when every unknown's residual would move it less than its tolerance under its own stiffness,
     |g_i| ≤ (|K_ii| + μ_min M_i)·tol_i. Stops, unconverged, when μ has grown 10⁴-fold over its start (no step
     lowers |g|). Returns (x, steps, converged)."""
@@ -553,6 +570,10 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
     g, K = prob.residual(x, jac=True)
     mu = max(float(np.max(np.abs(g[outer]) / (Mo * cap[outer]))), mu_min)
     g_start, mu_start = norm(g), mu
+    # the outer rates (a cage's with its rollers'): a step that reached its bound and flipped the rate's residual
+    # jumped across its root — the bound is quartered (it regrows by half a step while no such jump recurs)
+    rt = outer[outer >= prob.nB]
+    reach, sign = cap.copy(), np.sign(g)
     for k in range(max_steps + 1):
         prob.floor = np.maximum((np.abs(np.diagonal(K)) + mu_min * M) * tol, prob.force_floor)
         if np.all(np.abs(g[outer]) <= prob.floor[outer]) and local_ok:
@@ -569,7 +590,8 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
             return x, k, False
         if not np.all(np.isfinite(d)):
             return x, k, False
-        d = np.clip(d, -cap[outer], cap[outer])
+        clipped = np.abs(d) >= reach[outer]
+        d = np.clip(d, -reach[outer], reach[outer])
         x_new = x.copy()
         x_new[outer] += d
         x_new[loc] += np.clip(-X @ d, -cap[loc], cap[loc])        # the locals' linear prediction
@@ -587,5 +609,10 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
             continue
         x, local_ok = x_new, ok_new
         g, K = prob.residual(x, jac=True)
+        jumped = np.zeros(M.size, bool)
+        jumped[outer] = clipped
+        jumped[rt] &= (sign[rt] * np.sign(g[rt]) < 0) & bisect
+        reach[rt] = np.where(jumped[rt], 0.25 * reach[rt], np.minimum(cap[rt], 1.5 * reach[rt]))
+        sign = np.sign(g)
         mu = max(mu * (0.5 * ratio if ratio <= 1.0 else ratio), mu_min)
-    return x, max_steps, False
+    return x, k, False              # the steps taken (fewer than max_steps where μ ran away)

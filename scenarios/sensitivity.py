@@ -89,6 +89,8 @@ OUTPUTS = {
 DYNAMIC_ONLY_OUTPUTS = {
     "cage slip": "the static solution balances each cage's rate, but its summary leaves the slip to dynamic runs "
                  "(components.static.DYNAMIC_ONLY)",
+    "roller slip, load-zone entry, smearing indicator": "a roller's spin out of the load zone keeps the memory of its "
+                                                         "inertia (components.static.DYNAMIC_ONLY)",
     "pocket impacts, cage guide forces, cage accelerations": "collisions and the cage's whirl are motion",
     "dynamic factor K_v, dynamic largest loads": "the meshes' and bearings' dynamic response",
 }
@@ -585,7 +587,7 @@ class SensitivityStudy(Study):
 
     def prepare(self, cfg: RunConfig, cases: list[Case]) -> None:
         a = self.a
-        validate_cases([Case(c, d, "", self.base, a.params) for c, d in self.points], mode="static")
+        validate_cases([Case(c, d, "", self.base, a.params) for c, d in self.points])
         self._refuse_other_settings()
         fs = self.factors
         X = morris_design(fs, a.trajectories, a.levels, a.seed)

@@ -757,7 +757,7 @@ class ToleranceStudy(Study):
             firsts.setdefault((t.key()[:4], t.sample is None), t.case)
         # the design warnings were said once already if the sweep has cases (the same machine)
         with contextlib.redirect_stdout(io.StringIO()) if cases else contextlib.nullcontext():
-            validate_cases(list(firsts.values()), mode="static")
+            validate_cases(list(firsts.values()))
         done, todo = _earlier(self.tasks, self.a.overwrite)
         failed = sum(r.failed for r in done.values())
         print(f"static: {len(todo)} solutions to solve, {len(done)} reused (same parameters and code"

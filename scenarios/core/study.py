@@ -178,7 +178,7 @@ class Study(abc.ABC):
         t0 = time.perf_counter()
         cfg = self.config()
         cases = self.cases()
-        validate_cases(cases, lambda c: self.check(c, cfg), cfg.mode)      # every parameter checked before any run starts
+        validate_cases(cases, lambda c: self.check(c, cfg))      # every parameter checked before any run starts
         machine = self.machine_identity()
         print(f"machine: {machine['label']}", flush=True)
         self.out.mkdir(parents=True, exist_ok=True)

@@ -42,7 +42,6 @@ from components.params import overrides_from_toml, with_overrides
 from components.presets import reference_dpgt
 from components.results import Summary
 from components.results.io import atomic_write_text
-from components.static import check_static
 from components.units import ParameterError
 
 from .points import Point, file_overrides, point_overrides
@@ -155,12 +154,11 @@ def user_overrides(sets: dict, params_file: str | None, owned: dict[str, str], m
     return {**from_file, **sets} if merge_file else dict(sets)
 
 
-def validate_cases(cases: list[Case], check=None, mode: str | None = None) -> None:
+def validate_cases(cases: list[Case], check=None) -> None:
     """Before any run starts: every case's parameters convert, its errors name what the machine has and its design
-    is checked (``check(case)``, optional, adds a study's own checks); a case solved statically (its own ``mode``,
-    else ``mode``) has a traction law the static solution takes (:func:`components.static.check_static`). A
-    ParameterError ends the study with its one line; each distinct design warning (the reference machine's known
-    tip-circle overlaps) is said once for the whole study, not once per run."""
+    is checked (``check(case)``, optional, adds a study's own checks). A ParameterError ends the study with its one
+    line; each distinct design warning (the reference machine's known tip-circle overlaps) is said once for the
+    whole study, not once per run."""
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -168,8 +166,6 @@ def validate_cases(cases: list[Case], check=None, mode: str | None = None) -> No
                 params = build_params(c)
                 check_design(params)
                 faults.check_errors(params.si())
-                if (c.mode or mode) == "static":
-                    check_static(params.bearing.traction_law)
                 if check is not None:
                     check(c)
     except ParameterError as exc:

@@ -2,6 +2,7 @@
 The DPGT's static solution against the dynamic runs' means is in tests/components/test_load_path.py (same runs)."""
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -88,6 +89,71 @@ def test_a_cage_and_its_roller_turn_where_the_torque_meets_the_drag():
     np.testing.assert_allclose(sol.v[2], w, rtol=1e-9)
     np.testing.assert_allclose(sol.q[3], r, rtol=1e-9)
     np.testing.assert_allclose(sol.v[4], w * sol.q[3], rtol=1e-12)
+
+
+@pytest.mark.parametrize("law", ["tanh", "ehl"])
+def test_a_roller_between_two_races_settles_at_the_slip_its_traction_curve_gives_for_its_drag_moment(law):
+    """One roller pressed between a pin turning at ω_i and a ring at rest (4 µm interference on each race), orbiting
+    the pin's centre at a rate W and spinning at ω_R — both solved, W as a group's rate (the bracketed continuation
+    of a cage's rate), ω_R as the roller's own — against a drag moment M on its spin and nothing on its orbit. By
+    hand: the orbit carries no tangential force, so the two tractions are equal and opposite, and the spin's balance
+    gives each |F_t| = M/(r_i + r_o), r_i, r_o the contact points' distances from the roller's centre. Each contact
+    then slips at the v_s where the traction curve gives that force: μ(v_s, u_e, Q)·Q = M/(r_i + r_o) — for tanh the
+    closed form v_s = v₀ artanh(F_t/(μ_max Q)), for EHL the root of the law's curve (scipy's brentq, the law's
+    coefficient at the contact's load and entraining speed). M puts the tractions at 85 % of what the curve gives at
+    5 m/s of slip, on its shoulder, where the slip is most sensitive to M (measured: tanh 0.38 m/s, EHL 1.3–1.6 mm/s:
+    the film's traction saturates within millimetres per second); the solve starts 30 rad/s off the kinematic orbit
+    rate and 100 rad/s off the rolling spin."""
+    from scipy.optimize import brentq
+    from components.bearing import traction
+    from components.presets import reference_dpgt
+    from mbd.elements import RaceContact
+    si = reference_dpgt(2, "forward").si()
+    b = si.bearing
+    tr = traction(dataclasses.replace(b, traction_law=law), si.lubricant)
+    D, rho, m_r, dz = b.roller_diameter, 0.5 * b.pitch_diameter, b.roller_mass, 4e-6
+    Ri, Ro = rho - 0.5 * D + dz, rho + 0.5 * D - dz
+    Kc, w_i = 5e8, 400.0                       # N/m (a linear contact: Q ≈ 2 kN per race), rad/s
+    mb = mbd.ModelBuilder()
+    pin = mb.add_body("pin", 1.0, 1e-4)
+    ring = mb.add_body("ring", 1.0, 1e-4, fixed=True)
+    roller = mb.add_body("roller", m_r, m_r * D * D / 8, pose=(rho, 0.0, 0.0))
+    common = dict(D=D, K=Kc, exponent=1.0, zeta=0.0, m_roller=m_r, traction=tr)
+    mb.add(RaceContact("ri", [roller.index], [pin.index], kind="inner", race_marker=(0.0, 0.0), R_race=Ri, **common))
+    mb.add(RaceContact("ro", [roller.index], [ring.index], kind="outer", race_marker=(0.0, 0.0), R_race=Ro, **common))
+    # the largest traction the curve gives at the nominal load and entraining speed, and 85 % of it as the drag
+    W_m = w_i * Ri / (Ri + Ro)                  # rolling: the orbit's rate, the roller's spin
+    w_R = -(w_i - W_m) * Ri / (0.5 * D)
+    u_e, Q0 = 0.5 * (w_i - W_m) * Ri, Kc * dz
+    R_red = 1.0 / (2.0 / D + 1.0 / Ri)
+    mu = (lambda v: tr.coefficient(v, u_e, Q0, R_red)) if law == "ehl" else (
+        lambda v: tr.coefficient(v, u_e) if tr.needs_rolling_speed else tr.coefficient(v))
+    M = 0.85 * float(mu(5.0)) * Q0 * D
+    mb.add(TorqueSource("drag", [roller.index], M))     # against the roller's (negative) spin
+    model = mb.build()
+    q0 = model.pose0.ravel()[model.free]
+    W0, s0 = W_m + 30.0, w_R + 100.0
+    v0 = np.array([0.0, 0.0, w_i, 0.0, 0.0, 0.0, 0.0, W0 * rho, s0])[model.free]
+    orbit = np.array([0.0, 0.0, W0])
+    motion = SteadyMotion.from_state(model, q0, v0, orbit)
+    sol = solve_static(model, motion, 0.0, hold=[0, 1, 2], rates=[(-1, [roller.index]), (roller.index, [])],
+                       max_rate_step=10.0)
+    out = mbd.System(model).outputs(sol.t, sol.q, sol.v, sol.z)
+    ri, ro = out["ri"], out["ro"]
+    r = np.hypot(sol.q[3], sol.q[4])
+    arms = (r - Ri, Ro - r)
+    F_t = M / sum(arms)
+    np.testing.assert_allclose(ri["traction"][0], -ro["traction"][0], rtol=1e-6)      # nothing on the orbit
+    np.testing.assert_allclose(abs(ri["traction"][0]), F_t, rtol=1e-6)                # the spin's balance
+    for o, Rr in ((ri, R_red), (ro, 1.0 / (2.0 / D - 1.0 / Ro))):
+        Q, u, vs = float(o["load"][0]), float(o["rolling_speed"][0]), float(o["slip_velocity"][0])
+        if law == "tanh":
+            v_hand = tr.v0 * np.arctanh(F_t / (tr.mu_max * Q))
+        else:
+            v_hand = brentq(lambda v: tr.coefficient(v, u, Q, Rr) * Q - F_t, 0.0, 5.0, xtol=1e-14)
+        np.testing.assert_allclose(abs(vs), v_hand, rtol=1e-4)
+        assert np.sign(vs) == -np.sign(o["traction"][0])               # the traction opposes the slip
+    assert F_t > 0.8 * float(mu(5.0)) * float(ri["load"][0])           # on the curve's shoulder
 
 
 def test_the_static_jacobian_is_the_derivative_of_the_residual():

@@ -2,6 +2,7 @@
 conversions (a sun speed, a torque) checked by the kinematics they feed, and what is refused."""
 from __future__ import annotations
 
+import json
 import math
 
 import pytest
@@ -164,30 +165,26 @@ def test_the_tolerance_study_scales_a_points_torque(tmp_path):
         tolerance_study.ToleranceStudy(a)
 
 
+def _static_solves(out):
+    """(steps, snapshots) of every static solution a study wrote under ``out``."""
+    recs = [json.loads(f.read_text()) for f in out.rglob("*.json")]
+    return [(r["static_solver"]["steps"], r["snapshots"]) for r in recs if "static_solver" in r]
+
+
 @pytest.mark.parametrize("study, argv", [
-    (paper_study, ["--mode", "static", "--conditions", "2"]),
-    (tolerance_study, ["--samples", "2", "--conditions", "2", "--gear-class", "7", "--dynamic", "0"]),
+    (paper_study, ["--mode", "static", "--conditions", "2", "--snapshots", "8"]),
+    pytest.param(tolerance_study, ["--samples", "1", "--conditions", "2", "--gear-class", "7", "--dynamic", "0"],
+                 marks=pytest.mark.slow),
 ])
-def test_a_traction_law_the_static_solution_cannot_take_is_refused_before_any_run(study, argv, tmp_path, capsys):
-    """The EHL traction law has no static solve of the cage rate (components.static.STATIC_TRACTION_LAWS): a static
-    run of it is refused in one line naming the parameter, and nothing is written."""
+def test_the_static_solution_takes_the_ehl_traction_law(study, argv, tmp_path):
+    """The EHL traction law's steady cage and roller speeds are part of the static state (docs/model.md §16): a static
+    study of it runs (nothing refused) and its snapshots solve in a few continuation steps each — on average fewer
+    than 40 (measured at condition 2: the reference machine ≈ 10, 28 from the kinematic pose and 6–9 carried over;
+    a class-7 tolerance sample 18–24, where some carried-over starts fail and the kinematic pose solves), where a
+    cage rate whose Newton steps jump across its traction's narrow step ends at the 200-step limit."""
     out = tmp_path / "out"
-    assert study.main([*argv, "--set", "bearing.traction_law=ehl", "--out", str(out), "--no-progress"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()[-1]
-    assert err.startswith("error: bearing.traction_law: the quasi-static solution takes tanh or slide_roll, not 'ehl'"), err
-    assert not out.exists() or not any(out.rglob("*.json"))
-
-
-def test_the_static_solution_refuses_the_ehl_law_before_solving():
-    """components.static's own gate (a script calling it directly): the scene of the EHL law is refused at once."""
-    import warnings
-    from components.dpgt import build_dpgt
-    from components.params import with_overrides
-    from components.static import check_static, static_statistics
-    for law in ("tanh", "slide_roll"):
-        check_static(law)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        scene = build_dpgt(with_overrides(reference_dpgt(2, "forward"), {"bearing.traction_law": "ehl"}))
-    with pytest.raises(ParameterError, match="bearing.traction_law"):
-        static_statistics(scene, 2)
+    assert study.main([*argv, "--set", "bearing.traction_law=ehl", "--out", str(out), "--no-progress"]) == 0
+    solved = _static_solves(out)
+    assert solved, sorted(str(f.relative_to(out)) for f in out.rglob("*.json"))
+    for steps, snapshots in solved:
+        assert steps < 40 * snapshots, (steps, snapshots)
