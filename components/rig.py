@@ -36,7 +36,6 @@ from .outputs import pin_reactions
 from .params import BearingParams, BearingRigParams, BearingRigSI, BearingSI, LubricantParams, LubricantSI
 from .presets import reference_bearing_rig
 from .scene import BuiltScene, Scene, SceneOptions
-from .static import check_static
 from .units import ParameterError
 
 __all__ = ["build_bearing_rig", "BearingRigScene", "rig_options", "run_sampled", "rig_loads", "rig_quasi_static",
@@ -380,7 +379,6 @@ def rig_quasi_static(built: BearingRigScene, times=None, engine: str = "auto", s
     housing's reaction; ``hold_tilt=False`` solves it against the housing's support instead, as a dynamic run sees
     it). Returns the :class:`mbd.static.StaticSolution` list; :func:`rig_loads` reads each. A turning ring's unloaded
     rollers have no traction and so no static spin rate: the ring at rest (the standard's case) always has a state."""
-    check_static(built.bearing.traction_law)
     m, h = built.model, built.bearing_handles
     system = system if system is not None else mbd.System(m)
     times = [built.ramp] if times is None else [float(t) for t in times]

@@ -24,6 +24,7 @@ import mbd
 from mbd.static import SteadyMotion, _evaluator, carry, solve_static
 
 from .outputs import WindowStatistics, cage_period
+from .units import ParameterError
 
 __all__ = ["STATIC_LIVES_NOTE", "steady_motion", "held_dofs", "snapshot_times", "solve_snapshots", "static_statistics", "static_summary",
            "rate_groups", "DYNAMIC_ONLY", "DEFAULT_SNAPSHOTS", "MOVES", "RATE_STEP"]
@@ -181,6 +182,14 @@ def static_statistics(scene, n_snapshots: int = DEFAULT_SNAPSHOTS, engine: str =
                            np.stack([s.v for s in sols]), np.stack([s.a for s in sols]), z)
     stats.add_samples(rows, ts)
     return stats, sols
+
+
+def check_steady(params) -> None:
+    """Refuse an operating point with a schedule in time (``operating.schedule``): a static solution is the steady
+    state of one operating point, so a start-up or a torque drop has none."""
+    if params.si().operating.schedule:
+        raise ParameterError.at("operating.schedule", "a static solution is of a steady operating point; a schedule "
+                                                      "in time needs a dynamic run (--mode dynamic)")
 
 
 def static_summary(scene, n_snapshots: int = DEFAULT_SNAPSHOTS, engine: str = "auto") -> dict:

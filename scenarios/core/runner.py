@@ -33,7 +33,7 @@ from components.dpgt import build_dpgt
 from components.lubrication import BOUNDARY_LAMBDA
 from components.params import DPGTParams, flatten
 from components.scene import SceneOptions
-from components.static import DEFAULT_SNAPSHOTS, solve_snapshots, static_summary
+from components.static import DEFAULT_SNAPSHOTS, check_steady, solve_snapshots, static_summary
 from mbd.compile_time import compile_seconds
 from mbd.recorder import BodyMotion, Recorder
 
@@ -205,6 +205,7 @@ def _run_static(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict |
     """The quasi-static solution (:mod:`components.static`) of one operating point: summary.json in the dynamic
     run's keys, those only a dynamic run gives left out (listed in ``omitted``); no results.nc."""
     t0, peak = time.perf_counter(), RunPeak()
+    check_steady(params)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # design warnings were shown once by the caller
         scene = build_dpgt(params, cfg.options)

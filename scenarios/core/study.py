@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Callable, ClassVar
 
 from components.results import Summary
+from components.static import check_steady
 from components.results.io import atomic_write_text, write_summary
 
 from .args import parse_sets
@@ -125,6 +126,12 @@ class Study(abc.ABC):
     def cases(self) -> list[Case]:
         """Every run of the study."""
 
+    def _check(self, case: Case, cfg: RunConfig) -> None:
+        """The checks every study makes of a case (a static solution needs a steady operating point), then its own."""
+        if _case_cfg(case, cfg).mode == "static":
+            check_steady(build_params(case))
+        self.check(case, cfg)
+
     def check(self, case: Case, cfg: RunConfig) -> None:
         """A study's own check of a case before anything runs (raise ParameterError to refuse it)."""
 
@@ -178,7 +185,7 @@ class Study(abc.ABC):
         t0 = time.perf_counter()
         cfg = self.config()
         cases = self.cases()
-        validate_cases(cases, lambda c: self.check(c, cfg))      # every parameter checked before any run starts
+        validate_cases(cases, lambda c: self._check(c, cfg))     # every parameter checked before any run starts
         machine = self.machine_identity()
         print(f"machine: {machine['label']}", flush=True)
         self.out.mkdir(parents=True, exist_ok=True)
@@ -197,7 +204,7 @@ class Study(abc.ABC):
         run = StudyRun(self.out, cases, outcomes, beside=beside.done if beside is not None else {})
         more = self.second_phase(run)
         if more:                          # the same checks, then a second sweep; its outcomes join the first's
-            validate_cases(more, lambda c: self.check(c, cfg))
+            validate_cases(more, lambda c: self._check(c, cfg))
             advice = []
             for w in check_runs([(c.label, build_params(c), _case_cfg(c, cfg)) for c in more], self.out, a.force,
                                 advice):

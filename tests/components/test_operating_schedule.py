@@ -11,6 +11,7 @@ from components.dpgt import schedules
 from components.params import with_overrides
 from components.presets import reference_dpgt
 from components.units import ParameterError
+from scenarios.core.runner import RunConfig, run_case
 
 from tests.support.dpgt_runs import CONTROLLER, FAST_DRIVE, build
 
@@ -95,3 +96,11 @@ def test_the_carrier_follows_a_speed_ramp():
         speed.append(res.state.v[i] + fs.omega)
     assert angle[1] - angle[0] == pytest.approx(w * 0.0075, rel=1e-2)
     assert speed[1] == pytest.approx(w, rel=1e-2)
+
+
+def test_a_static_solution_of_a_schedule_is_refused_before_it_solves(tmp_path):
+    """A start-up has no steady state: the static mode refuses the schedule by name, in a study before any run."""
+    p = with_overrides(reference_dpgt(3, "forward"), {"operating.schedule": _knots((0.0, 0.5, 1), (0.1, 1, 1))})
+    with pytest.raises(ParameterError, match=r"^operating.schedule: a static solution is of a steady operating point"):
+        run_case(p, RunConfig(mode="static", progress=False), tmp_path / "run")
+    assert not (tmp_path / "run" / "summary.json").exists()
