@@ -22,7 +22,7 @@ import sys
 import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor
-from multiprocessing import get_context
+from multiprocessing import current_process, get_context
 
 import numpy as np
 from numba import typeof
@@ -109,11 +109,13 @@ def _timed(name: str, fn, cold: bool, say, announce: bool = True) -> None:
 
 def warm(jobs: int | None = None, say=_say) -> str:
     """Load or compile the three kernel groups (in two processes when ``jobs`` — by default the usable cores — is
-    2 or more and the step loop must compile); returns the line that says which (:func:`warm_line`), with the CPU
+    2 or more, the step loop must compile and this process may start others); returns the line that says which (:func:`warm_line`), with the CPU
     seconds of every process taking part."""
     t0, c0 = time.perf_counter(), time.process_time()
     children0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     jobs = usable_cores() if jobs is None else int(jobs)
+    if current_process().daemon:      # a cluster's worker (a daemon process) may not start processes of its own
+        jobs = 1
     scene, system = _scene()
     cs = CompiledSystem(system)
     cold = not _compiled.kernels_cached(groups=cs.groups)

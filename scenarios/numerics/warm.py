@@ -2,14 +2,14 @@
 
     python -m scenarios.warm [--jobs N]
 
-numba caches the compiled step loop on disk; the first run of the code on a machine compiles it (about a minute on
-2 cores), every later run loads it in about a second. Doing it here, once, says so in one line and keeps it out of
-the runs that follow (and out of parallel test workers, which would each compile it). With two usable cores or
-more (``--jobs``: by default the usable cores; 1 compiles in this process only) the assembly and its family kernels
-compile in a second process while this one compiles the rest (:mod:`components.warm`); each part is announced with
-its estimate and reported with its CPU and wall seconds. The line says "loaded from
-the cache" only when numba loaded all three kernel groups (:mod:`components.warm`); it names those it had to compile
-otherwise (numba's own count of cache hits and misses, read after the call).
+numba caches the compiled kernels on disk; the first run of the code on a machine compiles them (about 40 s of
+CPU, docs/numerics.md "The compile"), every later run loads them in about a second. Doing it here, once, says so
+and keeps it out of the runs that follow (and out of parallel test workers, which would each compile it). With two
+usable cores or more (``--jobs``: by default the usable cores; 1 compiles in this process only) the assembly and its
+family kernels compile in a second process while this one compiles the rest (:mod:`components.warm`); each part is
+announced with its estimate and reported with its CPU and wall seconds. The last line says "loaded from the cache"
+only when numba loaded all three kernel groups; it names those it had to compile otherwise (numba's own count of
+cache hits and misses, read after the call).
 """
 from __future__ import annotations
 
