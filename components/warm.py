@@ -8,11 +8,12 @@ the statistics read (mbd.compiled.outputs.family_outputs) and the statistics' ac
 group the scenes compile (contact, generic, mesh), so after a warm every scene of those groups loads instead of
 compiling (:func:`mbd.compiled.registry.groups_to_compile`).
 
-With two cores or more the compile runs in two processes sharing numba's cache: a second process compiles the
-assembly with the family kernels (the largest part, :func:`_compile_assembly`); this one meanwhile compiles the
-outputs, the accumulators, the internal-state update and the family kernels in the reverse of the dispatch's order
-(the second process then loads those it reaches after them), then the step loop, which loads the assembly the
-second process cached. Each part is announced with its estimate (:data:`ESTIMATES`) and reported with its time.
+With two idle cores or more (:func:`idle_cores`) the compile runs in two processes sharing numba's cache: a second
+process compiles the assembly with the family kernels (the largest part, :func:`_compile_assembly`); this one
+meanwhile compiles the outputs, the accumulators, the internal-state update and the family kernels in the reverse of
+the dispatch's order (the second process then loads those it reaches after them), then the step loop, which loads
+the assembly the second process cached. Each part is announced with its estimate (:data:`ESTIMATES`) and reported
+with its time.
 """
 from __future__ import annotations
 
@@ -40,12 +41,13 @@ from .dpgt import build_dpgt
 from .presets import reference_dpgt
 from .statistics.accumulate import accumulate_steps, accumulators_cached, compile_accumulators
 
-__all__ = ["warm", "warm_line", "ESTIMATES", "usable_cores"]
+__all__ = ["warm", "warm_line", "ESTIMATES", "usable_cores", "idle_cores"]
 
-# CPU seconds of each part's first compile, measured on the reference machine (2 cores, numba 0.68, condition 3's
-# scene; docs/numerics.md "The first compile"): what warm announces before it starts a part. The wall on a busy machine
-# is longer (CPU time is shared), the CPU time about the same.
-ESTIMATES = {"assembly": 20.0, "outputs": 4.0, "accumulators": 2.5, "update": 2.0, "step loop": 12.0}
+# CPU seconds of each part's first compile, measured on the reference machine (2 cores shared with other work, load
+# 25-28, numba 0.68, condition 3's scene; docs/numerics.md "The compile"): what warm announces before it starts a
+# part. "assembly" counts the second process's start; "step loop" the step loop alone (one process: with the assembly).
+# On an idle machine the CPU seconds are somewhat fewer (less contention), the wall about the CPU seconds.
+ESTIMATES = {"assembly": 21.0, "outputs": 6.0, "accumulators": 2.0, "update": 3.0, "step loop": 13.0}
 
 
 def usable_cores() -> int:
@@ -54,6 +56,17 @@ def usable_cores() -> int:
         return len(os.sched_getaffinity(0))
     except AttributeError:          # pragma: no cover - not Linux
         return os.cpu_count() or 1
+
+
+def idle_cores() -> int:
+    """The usable cores less the 1-minute load average (at least 1): a second compiling process only helps on a core
+    nobody else uses — on a busy machine it costs CPU (its own start, kernels both processes reach) and saves no
+    wall."""
+    try:
+        load = os.getloadavg()[0]
+    except OSError:                 # pragma: no cover - no load average
+        load = 0.0
+    return max(1, usable_cores() - int(round(load)))
 
 
 def _scene():
@@ -108,12 +121,12 @@ def _timed(name: str, fn, cold: bool, say, announce: bool = True) -> None:
 
 
 def warm(jobs: int | None = None, say=_say) -> str:
-    """Load or compile the three kernel groups (in two processes when ``jobs`` — by default the usable cores — is
-    2 or more, the step loop must compile and this process may start others); returns the line that says which (:func:`warm_line`), with the CPU
-    seconds of every process taking part."""
+    """Load or compile the three kernel groups (in two processes when ``jobs`` — by default the idle cores — is
+    2 or more, the step loop must compile and this process may start others); returns the line that says which
+    (:func:`warm_line`), with the CPU seconds of every process taking part."""
     t0, c0 = time.perf_counter(), time.process_time()
     children0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    jobs = usable_cores() if jobs is None else int(jobs)
+    jobs = idle_cores() if jobs is None else int(jobs)
     if current_process().daemon:      # a cluster's worker (a daemon process) may not start processes of its own
         jobs = 1
     scene, system = _scene()
@@ -122,11 +135,12 @@ def warm(jobs: int | None = None, say=_say) -> str:
     pool = future = None
     if cold:
         total = sum(ESTIMATES.values())
-        wall = ESTIMATES["assembly"] + 2 + ESTIMATES["step loop"] if jobs > 1 else total
+        wall = ESTIMATES["assembly"] + ESTIMATES["step loop"] if jobs > 1 else total
         say(f"the engine's kernels of this code are not compiled on this machine yet: compiling them once, about "
             f"{total:.0f} s of CPU, {'two processes, ' if jobs > 1 else ''}about {wall:.0f} s wall on free cores")
     if cold and jobs > 1:
-        say(f"compiling the assembly and the family kernels in a second process (about {ESTIMATES['assembly']:.0f} s of CPU)")
+        say(f"compiling the assembly and the family kernels in a second process "
+            f"(about {ESTIMATES['assembly']:.0f} s of CPU)")
         pool = ProcessPoolExecutor(1, mp_context=get_context("spawn"))
         future = pool.submit(_compile_assembly)
     try:
@@ -136,7 +150,7 @@ def warm(jobs: int | None = None, say=_say) -> str:
         if cold:
             z = np.zeros(cs.ndof)
             _timed("update", lambda: entry(update_internal, cs.groups, 0.0, 0.0, z, z, z, z, cs.fams, cs.zs, cs.sysd),
-                   True, say)
+                   not _compiled.kernels_cached(update_internal), say)
         if future is not None:
             _compile_kernels_reversed(cs)
             c_other = future.result()
