@@ -7,6 +7,13 @@ A call advances until ``t_end``, until ``max_steps`` steps were accepted (the ca
 observes, checkpoints) or until the step size falls below the controller's floor (a failure the caller
 reports with the last good state). A zero diagonal pivot falls back to a dense LU with partial pivoting
 (the numpy path falls back to SuperLU with partial pivoting).
+
+Compiled as one function, for a short first compile: numba links a callee's code into its caller and optimises it
+again there, once per level, so the loop's helpers (:func:`_step`, :func:`_newton`, :func:`_refresh_at`,
+:func:`_refresh`, :func:`_lu_solve`, :func:`_scale`) are inlined into :func:`advance` at numba's IR level
+(``inline="always"``), and the assembly gets ``jac`` as a run-time bool (``bool(True)``: a constant would be typed
+as a literal and compile the assembly and every family kernel twice; the kernels branch on it per contact).
+docs/numerics.md §5 "The compile" has the measurements.
 """
 from __future__ import annotations
 
