@@ -9,11 +9,11 @@ group the scenes compile (contact, generic, mesh), so after a warm every scene o
 compiling (:func:`mbd.compiled.registry.groups_to_compile`).
 
 With two idle cores or more (:func:`idle_cores`) the compile runs in two processes sharing numba's cache: a second
-process compiles the assembly with the family kernels (the largest part, :func:`_compile_assembly`); this one
-meanwhile compiles the outputs, the accumulators, the internal-state update and the family kernels in the reverse of
-the dispatch's order (the second process then loads those it reaches after them), then the step loop, which loads
-the assembly the second process cached. Each part is announced with its estimate (:data:`ESTIMATES`) and reported
-with its time.
+process compiles the assembly with the family kernels (the largest part, :func:`_compile_assembly`), first branch of
+the dispatch first; this one meanwhile compiles the family kernels last branch first (the second process loads those
+it reaches after they are cached), the internal-state update, the accumulators and the outputs (whose contact laws
+the second process has cached by then), then the step loop, which loads the assembly the second process cached. Each
+part is announced with its estimate (:data:`ESTIMATES`) and reported with its time.
 """
 from __future__ import annotations
 
@@ -43,11 +43,13 @@ from .statistics.accumulate import accumulate_steps, accumulators_cached, compil
 
 __all__ = ["warm", "warm_line", "ESTIMATES", "usable_cores", "idle_cores"]
 
-# CPU seconds of each part's first compile, measured on the reference machine (2 cores shared with other work, load
-# 25-28, numba 0.68, condition 3's scene; docs/numerics.md "The compile"): what warm announces before it starts a
-# part. "assembly" counts the second process's start; "step loop" the step loop alone (one process: with the assembly).
-# On an idle machine the CPU seconds are somewhat fewer (less contention), the wall about the CPU seconds.
-ESTIMATES = {"assembly": 21.0, "outputs": 6.0, "accumulators": 2.0, "update": 3.0, "step loop": 13.0}
+# CPU seconds of the first compile, measured on the reference machine (2 cores, load 7-10 from other work, numba
+# 0.68, condition 3's scene; docs/numerics.md "The compile"): what warm announces. In one process or two (the second
+# costs its own start and kernels both reach); "wall, two processes": estimated from the parts for two free cores
+# (the second process's start, then the longer of its assembly and this one's kernels, update, accumulators and
+# outputs, then the step loop); the parts: "assembly" in the second process, with its start; "update" the
+# internal-state update.
+ESTIMATES = {"one process": 35.0, "two processes": 41.0, "wall, two processes": 30.0, "assembly": 14.0, "update": 2.0}
 
 
 def usable_cores() -> int:
@@ -134,8 +136,8 @@ def warm(jobs: int | None = None, say=_say) -> str:
     cold = not _compiled.kernels_cached(groups=cs.groups)
     pool = future = None
     if cold:
-        total = sum(ESTIMATES.values())
-        wall = ESTIMATES["assembly"] + ESTIMATES["step loop"] if jobs > 1 else total
+        total = ESTIMATES["two processes" if jobs > 1 else "one process"]
+        wall = ESTIMATES["wall, two processes"] if jobs > 1 else total
         say(f"the engine's kernels of this code are not compiled on this machine yet: compiling them once, about "
             f"{total:.0f} s of CPU, {'two processes, ' if jobs > 1 else ''}about {wall:.0f} s wall on free cores")
     if cold and jobs > 1:
@@ -144,15 +146,17 @@ def warm(jobs: int | None = None, say=_say) -> str:
         pool = ProcessPoolExecutor(1, mp_context=get_context("spawn"))
         future = pool.submit(_compile_assembly)
     try:
-        _timed("outputs", lambda: _warm_outputs(system, scene), not _compiled.kernels_cached("outputs.family_outputs"),
-               say, announce=False)
-        _timed("accumulators", compile_accumulators, not accumulators_cached(), say, announce=False)
+        if future is not None:       # the kernels first, last branch first: cached before the other process gets there
+            _timed("family kernels", lambda: _compile_kernels_reversed(cs), True, say, announce=False)
         if cold:
             z = np.zeros(cs.ndof)
             _timed("update", lambda: entry(update_internal, cs.groups, 0.0, 0.0, z, z, z, z, cs.fams, cs.zs, cs.sysd),
                    not _compiled.kernels_cached(update_internal), say)
+        _timed("accumulators", compile_accumulators, not accumulators_cached(), say, announce=False)
+        # last: the contacts' force laws it shares with the engine are then cached by the other process
+        _timed("outputs", lambda: _warm_outputs(system, scene), not _compiled.kernels_cached("outputs.family_outputs"),
+               say, announce=False)
         if future is not None:
-            _compile_kernels_reversed(cs)
             c_other = future.result()
             say(f"assembly (second process): {c_other:.0f} s CPU")
     finally:

@@ -78,7 +78,7 @@ class CompiledOutputs:
             lambda: self.outputs_batch(np.zeros(0), empty, empty, {},
                                        families={name for rec in self._compiled for name, _ in rec[0]}),
             cold=not _compiled.kernels_cached("outputs.family_outputs", self.groups), what="the element output kernels",
-            done="output kernels", about="about 4 s of CPU")
+            done="output kernels", about="a few seconds of CPU")
 
     def outputs_batch(self, t, q, v, z, families=None, full=None) -> dict[str, dict[str, np.ndarray]]:
         """Every family's outputs at K states (those named in ``families``, when given), as
