@@ -391,7 +391,7 @@ def outputs_race(t, phi, omega, domega, ql, vl, z, P, G, O):
     """The outputs :data:`RACE_OUTPUTS` of every instance into the rows of O (7, n): the force law of
     :func:`evaluate_race`, evaluated once (the reference's outputs; per physical contact)."""
     n = ql.shape[0]
-    _race(ql, vl, P, G, np.empty((n, 6)), np.empty((0, 6, 6)), np.empty((0, 6, 6)), bool(False), O)
+    _race(ql, vl, P, G, np.empty((n, 6)), np.empty((0, 6, 6)), np.empty((0, 6, 6)), False, O)
 
 
 @njit(cache=True)
@@ -575,7 +575,7 @@ def evaluate_pocket(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
 def outputs_pocket(t, phi, omega, domega, ql, vl, z, P, G, O):
     """The outputs :data:`POCKET_OUTPUTS` into the rows of O (5, n), by the law of :func:`evaluate_pocket`."""
     n = ql.shape[0]
-    _pocket(ql, vl, z, P, np.empty((n, 6)), np.empty((0, 6, 6)), np.empty((0, 6, 6)), bool(False), O)
+    _pocket(ql, vl, z, P, np.empty((n, 6)), np.empty((0, 6, 6)), np.empty((0, 6, 6)), False, O)
 
 
 @njit(cache=True)
@@ -739,7 +739,7 @@ def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
 def outputs_guide(t, phi, omega, domega, ql, vl, z, P, G, O):
     """The outputs :data:`GUIDE_OUTPUTS` into the rows of O (8, n), by the law of :func:`evaluate_guide`."""
     n = ql.shape[0]
-    _guide(ql, vl, z, P, G, np.empty((n, 6)), np.empty((0, 6, 6)), np.empty((0, 6, 6)), bool(False), O)
+    _guide(ql, vl, z, P, G, np.empty((n, 6)), np.empty((0, 6, 6)), np.empty((0, 6, 6)), False, O)
 
 
 @njit(cache=True)
