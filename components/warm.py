@@ -11,9 +11,9 @@ compiling (:func:`mbd.compiled.registry.groups_to_compile`).
 With two idle cores or more (:func:`idle_cores`) the compile runs in two processes sharing numba's cache: a second
 process compiles the assembly with the family kernels (the largest part, :func:`_compile_assembly`), first branch of
 the dispatch first; this one meanwhile compiles the family kernels last branch first (the second process loads those
-it reaches after they are cached), the internal-state update, the accumulators and the outputs (whose contact laws
-the second process has cached by then), then the step loop, which loads the assembly the second process cached. Each
-part is announced with its estimate (:data:`ESTIMATES`) and reported with its time.
+it reaches after they are cached), the internal-state update, the accumulators and the outputs, then the step loop,
+which loads the assembly the second process cached. Each part is announced with its estimate (:data:`ESTIMATES`) and
+reported with its time.
 """
 from __future__ import annotations
 
@@ -49,7 +49,7 @@ __all__ = ["warm", "warm_line", "ESTIMATES", "usable_cores", "idle_cores"]
 # (the second process's start, then the longer of its assembly and this one's kernels, update, accumulators and
 # outputs, then the step loop); the parts: "assembly" in the second process, with its start; "update" the
 # internal-state update.
-ESTIMATES = {"one process": 35.0, "two processes": 41.0, "wall, two processes": 30.0, "assembly": 14.0, "update": 2.0}
+ESTIMATES = {"one process": 40.0, "two processes": 47.0, "wall, two processes": 30.0, "assembly": 16.0, "update": 2.0}
 
 
 def usable_cores() -> int:
@@ -153,7 +153,6 @@ def warm(jobs: int | None = None, say=_say) -> str:
             _timed("update", lambda: entry(update_internal, cs.groups, 0.0, 0.0, z, z, z, z, cs.fams, cs.zs, cs.sysd),
                    not _compiled.kernels_cached(update_internal), say)
         _timed("accumulators", compile_accumulators, not accumulators_cached(), say, announce=False)
-        # last: the contacts' force laws it shares with the engine are then cached by the other process
         _timed("outputs", lambda: _warm_outputs(system, scene), not _compiled.kernels_cached("outputs.family_outputs"),
                say, announce=False)
         if future is not None:
