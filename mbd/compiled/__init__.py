@@ -26,8 +26,10 @@ see :mod:`.registry`):
     where it computes each value (:mod:`.outputs` evaluates them for K states at once).
 """
 
+import ast as _ast
 import hashlib as _hashlib
 import importlib as _importlib
+import json as _json
 import os as _os
 import sys as _sys
 import time as _time
@@ -39,31 +41,83 @@ from numba.core import types as _nbtypes
 from ..compile_time import compiling
 
 
-def _drop_stale_kernels() -> None:
-    """numba's disk cache keys a function on its own source file only: a kernel compiled into the
-    dispatch (registry), the assembly or the step loop keeps a changed kernel's old code. So the cache of
-    the whole compiled path is dropped whenever any source it compiles from changes (a hash of those
-    files, kept beside the cache)."""
+def _sources() -> list:
+    """The files the compiled path compiles from: this package's modules, the step rules and the EHL film law."""
     here = _Path(__file__).resolve().parent
-    sources = sorted(here.glob("*.py")) + [here.parent / "rules.py", here.parent / "elements" / "ehl.py"]
-    digest = _hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()
+    return sorted(here.glob("*.py")) + [here.parent / "rules.py", here.parent / "elements" / "ehl.py"]
+
+
+def _imports(path: _Path, sources: set) -> set:
+    """The files of ``sources`` that the module at ``path`` imports (its relative imports, read from its source)."""
+    found = set()
+    for node in _ast.walk(_ast.parse(path.read_bytes())):
+        if not isinstance(node, _ast.ImportFrom) or node.level == 0:
+            continue
+        base = path.parent
+        for _ in range(node.level - 1):
+            base = base.parent
+        target = base.joinpath(*node.module.split(".")) if node.module else base
+        names = [target.with_suffix(".py"), target / "__init__.py"] if node.module else []
+        names += [p for a in node.names for p in (target / f"{a.name}.py", target / a.name / "__init__.py")]
+        found.update(p for p in names if p in sources)
+    return found - {path}
+
+
+def source_keys(sources=None) -> dict:
+    """Each compiled module's key (module stem -> sha256 of its own source and of every source it imports,
+    directly or through others, in :func:`_sources`): a cached kernel of that module is current while its key is."""
+    sources = [_Path(p) for p in (sources or _sources())]
+    within = set(sources)
+    direct = {p: _imports(p, within) for p in sources}
+    keys = {}
+    for p in sources:
+        seen, todo = {p}, [p]
+        while todo:
+            for d in direct[todo.pop()] - seen:
+                seen.add(d)
+                todo.append(d)
+        digest = _hashlib.sha256()
+        for d in sorted(seen):
+            digest.update(d.name.encode() + b"\0" + d.read_bytes())
+        keys[p.stem] = digest.hexdigest()
+    return keys
+
+
+def stale_modules(stored: dict, keys: dict) -> set:
+    """The module stems whose cached kernels are stale: their key changed (or was never stored)."""
+    return {stem for stem, key in keys.items() if stored.get(stem) != key}
+
+
+def _drop_stale_kernels() -> None:
+    """numba keys a cached function on its own source file only (the file's time stamp and size, and the
+    function's bytecode): a kernel compiled into a caller in another file — the dispatch (registry), the assembly,
+    the step loop — would keep a changed kernel's old code. So each module's cached kernels are dropped when its
+    key changes (:func:`source_keys`: its source and every source it imports, kept beside the cache): an edit
+    to the step loop recompiles the step loop and loads the family kernels; an edit to a kernel module recompiles
+    it and the modules importing it, not the other kernel modules."""
+    here = _Path(__file__).resolve().parent
     roots = [_Path(_numba_config.CACHE_DIR)] if _numba_config.CACHE_DIR else [here / "__pycache__", here.parent / "__pycache__"]
-    stamp = roots[0] / "compiled_sources.sha256"
+    stamp = roots[0] / "compiled_sources.json"
     try:
-        if stamp.is_file() and stamp.read_text().strip() == digest:
+        keys = source_keys()
+        try:
+            stored = _json.loads(stamp.read_text()) if stamp.is_file() else {}
+        except ValueError:
+            stored = {}
+        stale = stale_modules(stored, keys)
+        if not stale:
             return
-        names = tuple(p.stem + "." for p in sources)
+        names = tuple(stem + "." for stem in stale)
         for root in roots:
             for f in root.rglob("*.nb[ic]") if root.is_dir() else ():
                 if f.name.startswith(names):
                     f.unlink(missing_ok=True)
         stamp.parent.mkdir(parents=True, exist_ok=True)
         tmp = stamp.with_suffix(f".{_os.getpid()}.tmp")
-        tmp.write_text(digest)
+        tmp.write_text(_json.dumps(keys, indent=0, sort_keys=True))
         _os.replace(tmp, stamp)
     except OSError:          # a read-only install: numba then compiles in memory (it cannot cache either)
         pass
-
 
 
 def kernels_cached(function="stepper.advance", groups: int | None = None) -> bool:

@@ -32,7 +32,9 @@ def family_outputs(groups, kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O
                 ql[i, j] = qf[s, dofs[i, j]]
                 vl[i, j] = vf[s, dofs[i, j]]
         outputs_for(groups, kind, t[s], phi[s], omega[s], domega[s], ql, vl, Z[s], P, G, Os)
-        O[:, :, s] = Os
+        for r in range(O.shape[0]):       # element-wise: a slice assignment from an array compiles numba's
+            for i in range(n):            # shape-mismatch message (seconds of the first compile)
+                O[r, i, s] = Os[r, i]
 
 
 class CompiledOutputs:
@@ -76,7 +78,7 @@ class CompiledOutputs:
             lambda: self.outputs_batch(np.zeros(0), empty, empty, {},
                                        families={name for rec in self._compiled for name, _ in rec[0]}),
             cold=not _compiled.kernels_cached("outputs.family_outputs", self.groups), what="the element output kernels",
-            done="output kernels", about="about 10 s")
+            done="output kernels", about="a few seconds of CPU")
 
     def outputs_batch(self, t, q, v, z, families=None, full=None) -> dict[str, dict[str, np.ndarray]]:
         """Every family's outputs at K states (those named in ``families``, when given), as

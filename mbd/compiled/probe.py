@@ -65,7 +65,7 @@ def replay(groups, steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c
         aj += cj
         if aj >= 1.0:
             aj -= 1.0
-            assemble(groups, t, q, v, fams, zs, True, sysd, F, Jq, Jv)
+            assemble(groups, t, q, v, fams, zs, bool(True), sysd, F, Jq, Jv)    # run-time flags, as the step loop
             for e in range(A.size):
                 A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
             _factor(n, indptr, indices, A, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, xw)
@@ -74,7 +74,7 @@ def replay(groups, steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c
         while ar >= 1.0 or asol >= 1.0:
             if ar >= 1.0:
                 ar -= 1.0
-                assemble(groups, t, q, v, fams, zs, False, sysd, F, Jq, Jv)
+                assemble(groups, t, q, v, fams, zs, bool(False), sysd, F, Jq, Jv)
             if asol >= 1.0:
                 asol -= 1.0
                 _solve(n, perm, Lp, Li, Lx, Up, Ui, Ux, b, yw)

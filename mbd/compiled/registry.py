@@ -173,8 +173,8 @@ def _variant(template, groups):
 
 
 # What the compiled code calls, with groups a literal: the template compiled for that set. Explicit arguments, not
-# *args: a literal jac (True / False) must reach the kernels, whose residual-only copy (jac False) then drops the
-# derivative work (through a *args tuple it arrived as a plain bool and the engine ran ≈ 40 % slower).
+# *args (through a *args tuple the engine once ran ≈ 40 % slower). jac arrives as a run-time bool: one compiled copy
+# of every kernel serves residuals and Jacobians (mbd.compiled.stepper's docstring; the step costs the same).
 def evaluate_for(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     raise NotImplementedError("compiled code only")
 

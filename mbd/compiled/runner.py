@@ -127,7 +127,7 @@ class CompiledRunner:
                          self.lu, self.cache, self.work, np.zeros(6, np.int64), self.out,
                          np.empty((1, 3 + 4 * n + self.n_z))),
             cold=not _compiled.kernels_cached(groups=self.cs.groups), what="the engine's kernels", done="kernels",
-            about="about a minute")
+            about="about half a minute of CPU")
 
     def drop_lu(self) -> None:
         """Forget the LU (the numpy path drops it at checkpoints: both refactorise at the same step)."""

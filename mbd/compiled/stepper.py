@@ -7,6 +7,13 @@ A call advances until ``t_end``, until ``max_steps`` steps were accepted (the ca
 observes, checkpoints) or until the step size falls below the controller's floor (a failure the caller
 reports with the last good state). A zero diagonal pivot falls back to a dense LU with partial pivoting
 (the numpy path falls back to SuperLU with partial pivoting).
+
+Compiled as one function, for a short first compile: numba links a callee's code into its caller and optimises it
+again there, once per level, so the loop's helpers (:func:`_step`, :func:`_newton`, :func:`_refresh_at`,
+:func:`_refresh`, :func:`_lu_solve`, :func:`_scale`) are inlined into :func:`advance` at numba's IR level
+(``inline="always"``), and the assembly gets ``jac`` as a run-time bool (``bool(True)``: a constant would be typed
+as a literal and compile the assembly and every family kernel twice; the kernels branch on it per contact).
+docs/numerics.md §5 "The compile" has the measurements.
 """
 from __future__ import annotations
 
@@ -64,14 +71,14 @@ def _dense_solve(A, piv, b):
     return y
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _refresh(groups, t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F, Jq, Jv, A):
     """New Jacobian + LU at (q1, v1): the forces there in F; 0 = sparse LU, 1 = dense fallback,
     -1 = unusable Newton matrix."""
     indptr, indices, Mdata, mdiag = pat
     n = mdiag.size
     perm, iperm, Lp, Li, Lx, Up, Ui, Ux, xw, yw, D, dpiv = lu
-    assemble(groups, t1, q1, v1, fams, zs, True, sysd, F, Jq, Jv)
+    assemble(groups, t1, q1, v1, fams, zs, bool(True), sysd, F, Jq, Jv)       # a run-time flag (module docstring)
     for e in range(A.size):
         A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
         if not np.isfinite(A[e]):
@@ -85,11 +92,12 @@ def _refresh(groups, t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F, Jq, Jv, A
         for p in range(indptr[c], indptr[c + 1]):
             D[indices[p], c] = A[p]
     ok, pv = _dense_lu(D)
-    dpiv[:] = pv
+    for i in range(n):
+        dpiv[i] = pv[i]
     return 1 if ok else -1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _refresh_at(groups, t1, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
     """Jacobian + LU at the current iterate a₁ (its forces left in work's F1); False when unusable."""
     qp, vp, a1, q1, v1, F1, r, sc, x, xp, Jq, Jv, A = work
@@ -106,7 +114,7 @@ def _refresh_at(groups, t1, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _lu_solve(kind, lu, r, n):
     perm, iperm, Lp, Li, Lx, Up, Ui, Ux, xw, yw, D, dpiv = lu
     if kind == 0:
@@ -114,13 +122,13 @@ def _lu_solve(kind, lu, r, n):
     return _dense_solve(D, dpiv, r)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _scale(atol, rtol, q0, q1, out):
     for i in range(atol.size):
         out[i] = atol[i] if rtol == 0.0 else atol[i] + rtol * max(abs(q0[i]), abs(q1[i]))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _newton(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, work, cnt):
     """Newton on a₁ (returns it in work's a1); (converged, iterations, rate, reason). ``cache``:
     [LU valid (1/0), h of the LU, LU kind (0 sparse, 1 dense)]; ``cnt``: this step's residuals, Jacobians."""
@@ -146,7 +154,7 @@ def _newton(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, 
             q1[i] = qp[i] + bh2 * a1[i]
             v1[i] = vp[i] + gh * a1[i]
         if not have_F:
-            assemble(groups, t + h, q1, v1, fams, zs, False, sysd, F1, Jq, Jv)
+            assemble(groups, t + h, q1, v1, fams, zs, bool(False), sysd, F1, Jq, Jv)   # run-time flag
             cnt[0] += 1
         have_F = False
         for i in range(n):
@@ -193,7 +201,7 @@ def _newton(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, 
     return False, max_iter, rate, _MAX_ITER
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _step(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, cache, work, cnt, out):
     """One HHT step of size h from (t, q, v, a, f) into ``out`` = (q1, v1, a1, f1) without touching the
     start; (converged, iterations, rate, reason, error)."""
@@ -271,14 +279,16 @@ def advance(groups, t, q, v, a, f, h, t_end, max_steps, prm, ctrl, atol, rtol, f
             q[i], v[i], a[i], f[i] = q1[i], v1[i], a1[i], f1[i]
         row = log[acc]
         row[0], row[1], row[2] = t, h_try, error
-        row[3:3 + n] = q
-        row[3 + n:3 + 2 * n] = v
-        row[3 + 2 * n:3 + 3 * n] = a
-        row[3 + 3 * n:3 + 4 * n] = f
+        for i in range(n):                    # element-wise copies: a slice assignment from an array compiles
+            row[3 + i] = q[i]                 # numba's shape-mismatch message (≈ 3 s of the first compile)
+            row[3 + n + i] = v[i]
+            row[3 + 2 * n + i] = a[i]
+            row[3 + 3 * n + i] = f[i]
         off = 3 + 4 * n
         for zi in range(1, len(zs)):          # the element internal states, flattened in slot order
             flat = zs[zi].ravel()
-            row[off:off + flat.size] = flat
+            for i in range(flat.size):
+                row[off + i] = flat[i]
             off += flat.size
         acc += 1
         h = h_next

@@ -117,7 +117,11 @@ def update_internal(groups, t0, t1, q0, v0, q1, v1, fams, zs, sysd):
             for j in range(k):
                 ql0[i, j], vl0[i, j] = q0f[dofs[i, j]], v0f[dofs[i, j]]
                 ql[i, j], vl[i, j] = q1f[dofs[i, j]], v1f[dofs[i, j]]
-        zs[zi][:, :] = update_for(groups, kind, zs[zi], t0, t1, omega * t0, omega * t1, ql0, vl0, ql, vl, P, G)
+        z1 = update_for(groups, kind, zs[zi], t0, t1, omega * t0, omega * t1, ql0, vl0, ql, vl, P, G)
+        z = zs[zi]
+        for i in range(n):                    # element-wise: a slice assignment from an array compiles numba's
+            for j in range(z.shape[1]):       # shape-mismatch message (seconds of the first compile)
+                z[i, j] = z1[i, j]
 
 
 class CompiledSystem:

@@ -139,11 +139,12 @@ def test_a_family_without_a_compiled_twin_falls_back_and_says_so(capsys):
         mbd.simulate(model, np.zeros(3), np.zeros(3), 0.01, engine="compiled", **kw)
 
 
-def test_the_kernel_cache_is_dropped_when_any_compiled_source_changes(tmp_path, monkeypatch):
-    """numba caches a function against its own file only: the compiled package keeps a hash of all its
-    sources beside the cache and drops every cached kernel when it changes (a stale dispatch once kept
-    an old race kernel)."""
+def test_a_module_s_cached_kernels_are_dropped_when_its_key_changes(tmp_path, monkeypatch):
+    """numba caches a function against its own file only: the compiled package keeps each module's key beside the
+    cache and drops the cached kernels of the modules whose key changed (a stale dispatch once kept an old race
+    kernel); a cache without keys counts as changed throughout, files of other packages are left alone."""
     import importlib
+    import json
 
     import mbd.compiled as mc
     from numba import config
@@ -152,12 +153,53 @@ def test_the_kernel_cache_is_dropped_when_any_compiled_source_changes(tmp_path, 
     stale.write_text("old")
     keep = tmp_path / "other_module.f-1.py311.nbi"
     keep.write_text("not ours")
-    importlib.reload(mc)                       # the hash in tmp_path is missing: a change
+    importlib.reload(mc)                       # no keys in tmp_path: every module counts as changed
     assert not stale.exists() and keep.exists()
-    stamp = (tmp_path / "compiled_sources.sha256").read_text()
+    stamp = tmp_path / "compiled_sources.json"
+    keys = json.loads(stamp.read_text())
     stale.write_text("fresh")                  # same sources: nothing is dropped
     importlib.reload(mc)
-    assert stale.exists() and (tmp_path / "compiled_sources.sha256").read_text() == stamp
+    assert stale.exists() and json.loads(stamp.read_text()) == keys
+    kernel = tmp_path / "contact._race-398.py311.nbi"
+    kernel.write_text("current")
+    stamp.write_text(json.dumps({**keys, "registry": "an older key"}))     # the dispatch's key changed, not contact's
+    importlib.reload(mc)
+    assert not stale.exists() and kernel.exists() and json.loads(stamp.read_text()) == keys
+
+
+def _package_copy(tmp_path):
+    """The compiled path's sources copied with their layout (mbd/compiled, mbd/rules.py, mbd/elements/ehl.py)."""
+    import shutil
+
+    import mbd.compiled as mc
+    copies = []
+    for src in mc._sources():
+        rel = src.relative_to(src.parents[2] if src.parent.name in ("compiled", "elements") else src.parents[1])
+        dst = tmp_path / rel
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(src, dst)
+        copies.append(dst)
+    return copies
+
+
+@pytest.mark.parametrize("edited, stale", [
+    ("mesh.py", {"mesh", "sliced", "registry", "system", "stepper", "outputs", "probe", "runner"}),
+    ("stepper.py", {"stepper", "runner"}),
+    ("ehl.py", {"ehl", "contact", "sliced", "registry", "system", "stepper", "outputs", "probe", "runner"}),
+    ("sparse_lu.py", {"sparse_lu", "stepper", "probe", "runner"}),
+], ids=["a kernel module", "the step loop", "the film law", "the sparse LU"])
+def test_an_edit_makes_stale_the_module_and_those_compiled_from_it_only(tmp_path, edited, stale):
+    """The keys (mbd.compiled.source_keys) follow the imports: an edit of a module changes its key and the keys of
+    every module importing it, directly or through others (the sets written out from the package's imports), and no
+    other; the cache of the family kernels outside that set survives an edit of the step loop."""
+    import mbd.compiled as mc
+    copies = _package_copy(tmp_path)
+    before = mc.source_keys(copies)
+    assert set(before) == {p.stem for p in copies}
+    target = next(p for p in copies if p.name == edited)
+    target.write_text(target.read_text() + "\n# an edit\n")
+    assert mc.stale_modules(before, mc.source_keys(copies)) == stale
+    assert mc.stale_modules(before, before) == set()
 
 
 def test_the_cache_of_a_kernel_outside_the_package_is_read_from_its_own_index(tmp_path, monkeypatch):
@@ -241,3 +283,19 @@ def test_a_set_of_family_groups_compiles_only_those_groups_kernels():
     assert "update_speed_drive" in generic_only and "update_speed_drive" in with_contacts
     assert "update_pocket" not in generic_only and "update_guide" not in generic_only
     assert "update_pocket" in with_contacts and "update_guide" in with_contacts
+
+
+def test_one_compiled_assembly_serves_residuals_and_jacobians():
+    """The step loop passes ``jac`` to the assembly as a run-time flag, not a literal True / False: numba compiles the
+    assembly and every family kernel once, not twice (read from numba's cache index of the assembly after a compiled
+    run: every entry types jac as a plain bool)."""
+    from numba.core import types
+
+    from mbd.compiled.runner import CompiledRunner
+    from mbd.compiled.system import assemble
+
+    built = build_single_planetary()
+    CompiledRunner(mbd.System(built.model), mbd.PRODUCTION.stepper(), mbd.FixedStep(1e-4))
+    entries = assemble._cache._cache_file._load_index()
+    jacs = {key[0][6] for key in entries}
+    assert jacs == {types.boolean}, jacs

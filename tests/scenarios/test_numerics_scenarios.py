@@ -210,3 +210,56 @@ def test_warm_reads_numba_s_own_count_of_compiles(tmp_path):
     said = [subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True,
                            timeout=300).stdout.strip() for _ in range(2)]
     assert said == ["True", "False"]
+
+
+_AFTER_WARM = """
+import warnings
+import numpy as np
+import mbd
+from components.dpgt import build_dpgt
+from components.planetary import build_single_planetary
+from components.presets import reference_dpgt
+from components.statistics.accumulate import accumulate_steps, compile_accumulators
+from mbd.compiled.outputs import family_outputs
+from mbd.compiled.runner import CompiledRunner
+from mbd.compiled.stepper import advance
+from scenarios.numerics.common import rig_problem
+
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    scenes = [build_dpgt(reference_dpgt(c)) for c in (1, 3)] + [rig_problem().built, build_single_planetary()]
+s = mbd.PRODUCTION
+for scene in scenes:
+    system = mbd.System(scene.model)
+    CompiledRunner(system, s.stepper(), s.controller())
+    z = {k: np.asarray(x)[None] for k, x in system.init_internal().items()}
+    mbd.output_evaluator(system, "compiled").outputs_batch(np.zeros(1), scene.q0[None], scene.v0[None], z)
+compile_accumulators()
+for kernel in (advance, family_outputs, accumulate_steps):
+    print(sum(kernel.stats.cache_misses.values()), sum(kernel.stats.cache_hits.values()) > 0)
+"""
+
+
+@pytest.mark.slow
+def test_after_warm_the_default_scenes_compile_nothing():
+    """`python -m scenarios.warm` compiles every kernel group the default scenes need: after it, a fresh process
+    building the DPGT at conditions 1 and 3, the bearing rig and a single planetary stage (each its compiled step loop
+    and outputs) and the statistics' accumulators loads every one from numba's cache — numba's own count: no miss,
+    hits (the scenes' family groups are subsets of the warmed one, registry.groups_to_compile). Run in this
+    checkout's cache: after `make warm` the warm step itself only loads; on a cold cache it compiles first."""
+    import os
+    import subprocess
+    import sys
+
+    from tests.support import ROOT
+
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    warm = subprocess.run([sys.executable, "-m", "scenarios.warm"], cwd=ROOT, env=env, capture_output=True, text=True,
+                          timeout=3000)
+    assert warm.returncode == 0, warm.stderr
+    assert warm.stdout.startswith("engine kernels: ")
+    after = subprocess.run([sys.executable, "-c", _AFTER_WARM], cwd=ROOT, env=env, capture_output=True, text=True,
+                           timeout=600)
+    assert after.returncode == 0, after.stderr
+    assert after.stdout.split("\n")[:3] == ["0 True"] * 3, after.stdout + after.stderr
+    assert "mbd: compiling" not in after.stderr
