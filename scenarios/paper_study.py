@@ -468,9 +468,11 @@ class PaperStudy(Study):
         return make_cases(self.a, self.out)
 
     def beside(self, cfg: RunConfig) -> Beside | None:
-        """A dynamic study draws each point's figures (and animation) as soon as both its runs are in, on a worker
-        while the other points run; the tables and the figures across points wait for every run."""
-        if cfg.mode == "static":
+        """A dynamic study of several points draws each point's figures (and animation) as soon as both its runs are
+        in, on a worker while the other points run; the tables and the figures across points wait for every run. One
+        point (the demo) has nothing to draw beside: its figures wait for its runs either way, and the report draws
+        them in this process without handing the results to a worker."""
+        if cfg.mode == "static" or len({c.condition for c in self.cases()}) < 2:
             return None
         out, animation = self.out, bool(self.a.animate)
 

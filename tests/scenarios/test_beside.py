@@ -42,7 +42,7 @@ def test_cases_outside_every_group_wait_for_nothing_and_a_failing_task_is_kept_a
 
 def test_the_paper_study_draws_a_point_beside_only_when_both_its_runs_finished(tmp_path):
     from scenarios import paper_study
-    a = paper_study.parse_args(["--conditions", "3", "--out", str(tmp_path)])
+    a = paper_study.parse_args(["--conditions", "2,3", "--out", str(tmp_path)])
     study = paper_study.PaperStudy(a)
     b = study.beside(study.config())
     f, r = _case(3, "forward"), _case(3, "reverse")
@@ -52,3 +52,5 @@ def test_the_paper_study_draws_a_point_beside_only_when_both_its_runs_finished(t
     static = paper_study.PaperStudy(paper_study.parse_args(["--conditions", "3", "--mode", "static",
                                                             "--out", str(tmp_path)]))
     assert static.beside(static.config()) is None
+    one = paper_study.PaperStudy(paper_study.parse_args(["--conditions", "3", "--out", str(tmp_path)]))
+    assert one.beside(one.config()) is None     # one point (the demo): nothing runs beside its figures
