@@ -38,7 +38,7 @@ from .presets import reference_bearing_rig
 from .scene import BuiltScene, Scene, SceneOptions
 from .units import ParameterError
 
-__all__ = ["build_bearing_rig", "BearingRigScene", "rig_options", "run_sampled", "rig_loads", "rig_quasi_static",
+__all__ = ["build_bearing_rig", "check_rig_pin", "BearingRigScene", "rig_options", "run_sampled", "rig_loads", "rig_quasi_static",
            "RigSolution",
            "rig_static_solution", "discrete_load_distribution", "DiscreteDistribution"]
 
@@ -181,6 +181,7 @@ def build_bearing_rig(bearing, *, radial_load: float, load_angle: float = -0.5 *
     """
     b, lub, rs = _rig_inputs(bearing, lubricant, rig)
     _check_bearing(b)
+    check_rig_pin(b)
     F = _finite("radial_load", radial_load, nonneg=True)
     a = _finite("load_angle", load_angle)
     w = _finite("outer_speed", outer_speed)
@@ -261,6 +262,14 @@ def _rig_inputs(bearing, lubricant, rig) -> tuple[BearingSI, LubricantSI | None,
     if not isinstance(rig, BearingRigParams):
         raise ParameterError.at("rig", f"expected BearingRigParams, got {type(rig).__name__}")
     return bearing, lubricant, rig.si()
+
+
+def check_rig_pin(b) -> None:
+    """Refuse an elastic pin (``bearing.pin.model = "elastic"``, ``b`` the bearing's parameters or SI object): the
+    rig's pin is a fixed body, so a bending pin would be silently rigid here."""
+    if b.pin.model != "rigid":
+        raise ParameterError.at("bearing.pin.model", f"the bearing rig's pin is fixed (rigid): expected 'rigid', got "
+                                                     f"{b.pin.model!r}")
 
 
 def _check_bearing(b: BearingSI) -> None:

@@ -26,7 +26,7 @@ from components.presets import reference_dpgt
 from components.results.io import atomic_write_text
 from components import life
 from components.bearing import row_stations
-from components.rig import (build_bearing_rig, discrete_load_distribution, rig_loads, rig_quasi_static,
+from components.rig import (build_bearing_rig, check_rig_pin, discrete_load_distribution, rig_loads, rig_quasi_static,
                             rig_static_solution)
 from components.sliced_bearing import pressure_scales
 from mbd.elements.sliced import slice_stations
@@ -93,6 +93,7 @@ def run(a) -> dict:
             raise ParameterError.at("radial_load", f"must be > 0 N, got {a.radial_load!r}")
         if gamma != 0.0 and params.bearing.model != "sliced":
             raise ParameterError.at("misalignment", "a tilted rig bearing needs --model sliced (bearing.model)")
+        check_rig_pin(params.bearing)
     except ParameterError as exc:
         raise SystemExit(f"error: {exc}") from None
     identity = claim_for_inputs(out, command_inputs(a), a.overwrite)     # other inputs' results: --overwrite

@@ -105,6 +105,16 @@ def test_every_numeric_key_has_a_unit_suffix_or_is_declared_dimensionless(summar
                                            "atol_rot_rad", "engine"}
 
 
+def test_a_rigid_pin_run_has_no_pin_bending_keys_nor_variables(run_dir, summary):
+    """The elastic pins' statistics and histories exist only where the pins are elastic (tests/components/test_pins.py
+    holds their values): this run's rigid pins give neither ``pin_*`` keys nor ``pin_beam.*`` variables."""
+    import xarray as xr
+
+    assert not [k for kind in ("inner", "outer") for k in summary[kind] if k.startswith("pin_")]
+    with xr.open_dataset(run_dir / "results.nc", engine="h5netcdf") as ds:
+        assert "race_inner.load" in ds.variables and not [v for v in ds.variables if str(v).startswith("pin_beam")]
+
+
 def test_each_runs_bearing_load_is_held_against_the_catalogue_minimum(summary):
     """summary.json's minimum load is 0.02 C_r (SKF's rule for roller bearings) and the load against it the mean
     bearing load over it, per planet too."""

@@ -3,6 +3,8 @@
 * :data:`OUTPUTS` — per element family, the output keys the runner records with their CF units and
   long names (from the element docstrings in ``mbd/elements``: contact.py, gear_mesh.py, drives.py,
   springs.py). Forces are per physical roller (one row), vectors are in the reference frame R.
+* :data:`PIN_OUTPUTS` — the elastic pins' bending slope magnitude and deflection, recorded along the pin beam
+  family when the pins are elastic (computed by :func:`components.statistics.quantities.pin_bending`).
 * :data:`FILM_OUTPUTS` — the EHL film of every roller–raceway contact, recorded along the raceway
   families when the scene has a lubricant (computed by :func:`components.outputs.contact_film`).
 * :func:`instance_coords` — per family, which bearing / roller / planet / mesh each instance is
@@ -25,8 +27,9 @@ from mbd import ElementOutput
 
 from ..families import FAMILY, MESH_FAMILY
 from ..outputs import bearing_map, contact_film
+from ..statistics.quantities import pin_bending
 
-__all__ = ["OUTPUTS", "FILM_OUTPUTS", "MESH_WORDS", "instance_coords", "element_probes", "drawing_geometry",
+__all__ = ["OUTPUTS", "FILM_OUTPUTS", "PIN_OUTPUTS", "MESH_WORDS", "instance_coords", "element_probes", "drawing_geometry",
            "loaded_transmission_error"]
 
 MESH_WORDS = {MESH_FAMILY["sun_inner"]: "sun–inner planet mesh",
@@ -75,7 +78,17 @@ OUTPUTS = {
         "fy": ("N", "linear planet bearing force on the planet, y in R")},
     **{f: _mesh(w) for f, w in MESH_WORDS.items()},
     "carrier_drive": {"torque": ("N m", "carrier speed-drive torque on the carrier")},
+    FAMILY["pin_beam"]: {
+        "slope_x": ("rad", "elastic pin's bending slope against its pinhole at the bearing's centre, x in R"),
+        "slope_y": ("rad", "elastic pin's bending slope against its pinhole at the bearing's centre, y in R"),
+        "fx": ("N", "carrier's force on the elastic pin at the bearing's centre, x in R"),
+        "fy": ("N", "carrier's force on the elastic pin at the bearing's centre, y in R")},
 }
+
+# the elastic pins' bending (components.statistics.quantities.pin_bending, the statistics' definition), recorded along
+# the pin beam family: key -> (units, long_name)
+PIN_OUTPUTS = {"slope": ("rad", "elastic pin's bending slope magnitude against its pinhole at the bearing's centre"),
+               "deflection": ("m", "elastic pin's deflection from its pinhole at the bearing's centre")}
 
 
 def _film(race: str) -> dict:
@@ -118,6 +131,8 @@ def instance_coords(scene) -> dict[str, dict[str, tuple[str, list]]]:
                 put(FAMILY["guide"], b["guide"], instance=f"{b['name']}.cage", **base)
         else:
             put(FAMILY["linear"], b["spring"], instance=b["name"], **base)
+        if "pin_beam" in b:
+            put(FAMILY["pin_beam"], b["pin_beam"], instance=f"{b['planet']}.pin", **base)
     for n, pair in enumerate(scene.pairs):
         gears = {"sun_inner": ("sun", pair.inner), "inner_outer": (pair.inner, pair.outer),
                  "outer_ring": (pair.outer, "ring")}
@@ -138,6 +153,7 @@ def instance_coords(scene) -> dict[str, dict[str, tuple[str, list]]]:
             words_f = dict(words, instance=f"{MESH_WORDS[fam]} name (first gear-second gear)")
         else:
             words_f = dict(words, instance={FAMILY["guide"]: "cage name", FAMILY["linear"]: "planet bearing name",
+                                            FAMILY["pin_beam"]: "elastic pin name",
                                             "carrier_drive": "driven body"}.get(fam, "roller name"))
         out[fam] = {k: (words_f[k], [r[k] for r in recs]) for k in names}
     return out
@@ -168,6 +184,9 @@ def element_probes(scene) -> list[ElementOutput]:
             inner, film = FILM_OUTPUTS[f]
             meta = {**meta, **film}
             derived = partial(contact_film, bearing=scene.bearing, lubricant=lub, inner=inner)
+        if f == FAMILY["pin_beam"]:
+            meta = {**meta, **PIN_OUTPUTS}
+            derived = pin_bending
         if f in flanks:
             meta = {**meta, "transmission_error": (
                 "m", f"{MESH_WORDS[f]} loaded transmission error: compression of the drive flank (flank "

@@ -25,7 +25,7 @@ BEARING_KINDS = ("inner", "outer")     # a summary's per-bearing-kind sections (
 # a key without one is dimensionless ("1": a count, a ratio, a factor) and is listed in DIMENSIONLESS_KEYS.
 UNIT_SUFFIXES = {"_N": "N", "_m": "m", "_m_s": "m/s", "_m_s2": "m/s^2", "_s": "s", "_h": "h", "_W": "W", "_pct": "%",
                  "_Mrev": "10^6 rev", "_hz": "Hz", "_rpm": "r/min", "_rad": "rad", "_W_m2": "W/m^2",
-                 "_MB": "MiB"}
+                 "_MB": "MiB", "_arcmin": "arcmin"}
 
 
 def _cage_acc_words() -> dict:
@@ -63,6 +63,17 @@ SUMMARY_WORDS = {
     "roller_entry_slide_roll": ("slide-to-roll ratio on the pin at load-zone entry", "1"),
     "smearing_pv_entry_W_m2": ("frictional power density p·Δv on the pin at load-zone entry, mean", "W/m^2"),
     "smearing_pv_max_W_m2": ("frictional power density p·Δv of a roller contact, largest", "W/m^2"),
+    "misalignment_mean_rad": ("slope the bearing sees (pin against planet bore), time mean", "rad"),
+    "misalignment_max_rad": ("slope the bearing sees (pin against planet bore), max", "rad"),
+    "misalignment_mean_per_planet_rad": ("slope the bearing sees (pin against planet bore), time mean, per planet",
+                                         "rad"),
+    "pin_slope_mean_arcmin": ("elastic pin's bending slope against its pinhole, time mean", "arcmin"),
+    "pin_slope_max_arcmin": ("elastic pin's bending slope against its pinhole, max", "arcmin"),
+    "pin_slope_mean_per_planet_arcmin": ("elastic pin's bending slope against its pinhole, time mean, per planet",
+                                         "arcmin"),
+    "pin_slope_max_per_planet_arcmin": ("elastic pin's bending slope against its pinhole, max, per planet", "arcmin"),
+    "pin_deflection_mean_m": ("elastic pin's deflection at its bearing's centre, time mean", "m"),
+    "pin_deflection_max_m": ("elastic pin's deflection at its bearing's centre, max", "m"),
     "life_L10_relative": ("L10 life relative to forward", "1"),
     "life_iso281_Mrev": ("L10 life, ISO 281 from the bearing load", "10^6 rev"),
     "life_iso281_h": ("L10 life, ISO 281 from the bearing load", "h"),

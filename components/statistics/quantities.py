@@ -23,7 +23,7 @@ from ..lubrication import bearing_film, contact_pressure
 
 __all__ = ["bearing_map", "Plan", "plan_of", "owner", "quantities", "carrier_frame_motion", "to_carrier",
            "radial_tangential", "pin_reactions", "contact_film", "traction_heat", "film_extremes",
-           "reference_rollers", "slice_quantities", "roller_slip_quantities", "CAGE_SPEED", "POCKET_FORCE",
+           "reference_rollers", "slice_quantities", "pin_beam_instances", "pin_bending", "roller_slip_quantities", "CAGE_SPEED", "POCKET_FORCE",
            "ROLLER_LOADED", "ROLLER_SLIP", "ROLLER_PV_PIN"]
 
 # the quantities the accumulators read beyond their sums: the cage speed (its window's revolutions) and the
@@ -41,6 +41,8 @@ def bearing_map(scene) -> list[dict]:
     """Per bearing: name, kind (inner/outer), pair index, planet, cage, and the instance ranges of the
     roller families (all rollers of all bearings share one family each, in bearing order)."""
     out = []
+    model = getattr(scene, "model", None)
+    n_pin = pin_beam_instances(model) if model is not None else None
     for n, pair in enumerate(scene.pairs):
         for kind in ("inner", "outer"):
             h, planet = pair.bearing(kind), pair.planet(kind)
@@ -58,8 +60,28 @@ def bearing_map(scene) -> list[dict]:
                     rec["cage"] = h.cage
             else:
                 rec["spring"] = h.spring.start
+            if n_pin is not None:
+                rec["pin_beam"] = n_pin[planet]
             out.append(rec)
     return out
+
+
+def pin_beam_instances(model) -> dict[str, int] | None:
+    """{planet: the instance of the pin beam family (:class:`mbd.elements.tilt.BeamSupport`) holding its pin}, or None:
+    rigid pins (no such family). A pin body is named ``<planet>.pin`` (:func:`components.dpgt.add_elastic_pin`)."""
+    fam = [e for e in model.elements if e.name == FAMILY["pin_beam"]]
+    if not fam:
+        return None
+    names = [model.body_names[j // 3] for j in fam[0].dofs[:, 3]]
+    return {nm[:-len(".pin")]: i for i, nm in enumerate(names)}
+
+
+def pin_bending(beam) -> dict[str, np.ndarray]:
+    """The elastic pin's bending at its bearing's centre from the pin beam's outputs ``beam``: its slope against the
+    carrier's pinhole |s| [rad] (the magnitude of the slope pair, frame-independent) and its deflection |d| [m]
+    (the beam's own output). The one definition of both, for the statistics and results.nc."""
+    return {"slope": np.hypot(np.asarray(beam["slope_x"], float), np.asarray(beam["slope_y"], float)),
+            "deflection": np.asarray(beam["deflection"], float)}
 
 
 @dataclass(frozen=True)
@@ -87,6 +109,7 @@ class Plan:
     slices: int = 0              # slices per roller of the sliced contact (0: the planar contact)
     roller_row: np.ndarray | None = None   # row of every race_inner instance (the sliced model's explicit rows)
     explicit_rows: int = 1       # rows built roller by roller (the sliced model: bearing.rows; the planar: 1)
+    pin_beam: np.ndarray | None = None     # pin beam instance per bearing (elastic pins; None: rigid pins)
 
 
 def plan_of(scene, model) -> Plan:
@@ -118,9 +141,10 @@ def plan_of(scene, model) -> Plan:
         spring=np.array([x["spring"] for x in bm]) if not rollers else None,
         rows=1 if sliced else int(getattr(b, "rows", 1)), omega_c=float(scene.speeds.carrier),
         meshes=meshes, flanks=dict(scene.flanks), bearing=b, lubricant=scene.lubricant, qc=raceway_ratings(b),
-        families=frozenset({FAMILY[k] for k in ("race_inner", "race_outer", "pocket", "guide", "linear")}
+        families=frozenset({FAMILY[k] for k in ("race_inner", "race_outer", "pocket", "guide", "linear", "pin_beam")}
                            | set(meshes.values())),
-        slices=int(b.slicing.slices) if sliced else 0, roller_row=roller_row, explicit_rows=explicit)
+        slices=int(b.slicing.slices) if sliced else 0, roller_row=roller_row, explicit_rows=explicit,
+        pin_beam=np.array([x["pin_beam"] for x in bm]) if "pin_beam" in bm[0] else None)
 
 
 def owner(p: Plan, key: str):
@@ -131,7 +155,7 @@ def owner(p: Plan, key: str):
         return np.repeat(p.roller_bearing, p.slices)
     if key == POCKET_FORCE:
         return p.pocket_bearing
-    if key.startswith(("load_", "cage_", "guide_", "planet_", "film_", "heat_", "traction_")):
+    if key.startswith(("load_", "cage_", "guide_", "planet_", "film_", "heat_", "traction_", "pin_")):
         return np.arange(p.planet.size)
     return None
 
@@ -156,6 +180,9 @@ def quantities(p: Plan, model, evaluator, t, q, v, a, z, roller_angles: bool) ->
     if p.cage is not None:
         snap.update(cage_quantities(p, out, X, V, A))
     snap.update(mesh_quantities(p, out))
+    if p.pin_beam is not None:      # elastic pins (bearing.pin.model = "elastic", docs/model.md §8.8)
+        bend = pin_bending(out[FAMILY["pin_beam"]])
+        snap["pin_slope"], snap["pin_deflection"] = bend["slope"][:, p.pin_beam], bend["deflection"][:, p.pin_beam]
     if p.rollers and roller_angles:
         d = X[:, p.roller_body, :2] - X[:, p.planet[p.roller_bearing], :2]
         snap["_roller_angle"] = np.arctan2(d[..., 1], d[..., 0])

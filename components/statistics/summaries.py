@@ -15,12 +15,12 @@ import numpy as np
 from mbd.elements.ehl import thermal_factor
 
 from ..bearing import cage_slip_pct, entry_slide_roll
-from ..sliced_bearing import pressure_scales
+from ..sliced_bearing import ARCMIN, pressure_scales
 from ..life import (LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, equivalent_load, hours, iso281_life,
                     iso281_rating, lundberg_palmgren_life, minimum_load, sliced_life, sliced_raceway_ratings)
 
 __all__ = ["run_summary", "bearing_summary", "load_summary", "roller_summary", "impact_summary", "life_summary",
-           "heat_summary", "film_summary", "cage_summary", "mesh_summary", "roller_slip_summary"]
+           "heat_summary", "film_summary", "cage_summary", "mesh_summary", "roller_slip_summary", "pin_summary"]
 
 
 def run_summary(sums, p, ref_roller, w_rel: dict, loaded: bool, flank=None) -> dict:
@@ -58,6 +58,8 @@ def bearing_summary(sums, p, kind: str, ref_roller, w_rel: float) -> dict:
         heat_summary(d, sums, ref, sel)
         if p.lubricant is not None:
             film_summary(d, sums, sel)
+    if "pin_slope" in sums.acc:
+        pin_summary(d, sums, ref, sel)
     life_summary(d, sums, p, w_rel, ref, sel)
     if p.cage is not None:
         cage_summary(d, sums, p, ref, sel)
@@ -163,6 +165,20 @@ def slice_summary(d, sums, p, ref, sel) -> None:
     d["misalignment_mean_rad"] = float(mis["mean"][ref])
     d["misalignment_max_rad"] = float(mis["max"][ref])
     d["misalignment_mean_per_planet_rad"] = [float(x) for x in mis["mean"][sel]]
+
+
+def pin_summary(d, sums, ref, sel) -> None:
+    """The elastic pins' bending (``bearing.pin.model = "elastic"``, docs/model.md §8.8; :func:`.quantities.pin_bending`):
+    the slope magnitude of the pin against its pinhole — the reference bearing's time mean and maximum, each planet's
+    — in arcmin, and the reference pin's deflection at its bearing's centre, time mean and maximum. The slope the
+    bearing itself sees (the pin's against its planet's) is ``misalignment_*_rad`` (:func:`slice_summary`)."""
+    sl, de = sums.stats("pin_slope"), sums.stats("pin_deflection")
+    d["pin_slope_mean_arcmin"] = float(sl["mean"][ref] / ARCMIN)
+    d["pin_slope_max_arcmin"] = float(sl["max"][ref] / ARCMIN)
+    d["pin_slope_mean_per_planet_arcmin"] = [float(x / ARCMIN) for x in sl["mean"][sel]]
+    d["pin_slope_max_per_planet_arcmin"] = [float(x / ARCMIN) for x in sl["max"][sel]]
+    d["pin_deflection_mean_m"] = float(de["mean"][ref])
+    d["pin_deflection_max_m"] = float(de["max"][ref])
 
 
 def impact_summary(d, sums, pk, sel) -> None:

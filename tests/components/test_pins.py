@@ -272,8 +272,8 @@ def static_pins():
     out = {}
     for pin in ("one_plate", "both_plates"):
         sc = _machine(pin)
-        _, sols = static_statistics(sc, 1)
-        out[pin] = (sc, sols[0])
+        stats, sols = static_statistics(sc, 1)
+        out[pin] = (sc, sols[0], stats.summary())
     return out
 
 
@@ -281,8 +281,11 @@ def test_a_cantilever_pin_slopes_as_roark_under_its_bearings_static_load_and_a_t
     """In the static solution at condition 3: the cantilever pin's slope is Roark's W a²/(2EI) + M a/(EI) (1a + 3a)
     under the force W the beam carries and the moment M on the pin's slope from the contacts, its direction that of
     the load falling away from the shaft-side plate; a pin clamped in both plates under its centred bearing slopes
-    by M L/(16 EI) alone (3d), the load's share none (1d at mid-span) — under a thousandth of the cantilever's."""
-    sc, sol = static_pins["one_plate"]
+    by M L/(16 EI) alone (3d), the load's share none (1d at mid-span) — under a thousandth of the cantilever's.
+    summary.json says the same: the pin slope keys are Roark's slope's magnitude in arcmin (1′ = π/10800 rad), the
+    deflection keys Roark's deflection's, per planet too; the slope the bearing sees is the pin's slope against its
+    planet's, |s_pin − s_planet|."""
+    sc, sol, summary = static_pins["one_plate"]
     m = sc.model
     si = with_overrides(reference_dpgt(3, "forward"), {"bearing.model": "sliced"}).si()
     EIp = si.bearing.elastic_modulus * math.pi * (2 * si.bearing.inner_raceway_radius) ** 4 / 64
@@ -308,13 +311,31 @@ def test_a_cantilever_pin_slopes_as_roark_under_its_bearings_static_load_and_a_t
         # the bearing's load dominates: the slope lies along the load (the moment's share is small)
         assert np.linalg.norm(W) > 5e3 and abs(np.dot(s, W)) > 0.99 * np.linalg.norm(s) * np.linalg.norm(W)
         assert np.linalg.norm(s) > np.radians(0.5 / 60)
-    sc2, sol2 = static_pins["both_plates"]
+        # summary.json (one static solution: mean = max = the solution's): Roark's slope and deflection
+        d = summary["inner" if planet.startswith("a") else "outer"]
+        arcmin = math.pi / 10800.0
+        roark_slope = np.linalg.norm(expect) / arcmin
+        roark_deflection = np.linalg.norm(W * a ** 3 / (3 * EIp) - M * a ** 2 / (2 * EIp))
+        for key in ("pin_slope_mean_arcmin", "pin_slope_max_arcmin"):
+            assert d[key] == pytest.approx(roark_slope, rel=1e-9), key
+        assert d["pin_slope_mean_per_planet_arcmin"][0] == pytest.approx(roark_slope, rel=1e-9)
+        assert d["pin_slope_max_per_planet_arcmin"][0] == pytest.approx(roark_slope, rel=1e-9)
+        for key in ("pin_deflection_mean_m", "pin_deflection_max_m"):
+            assert d[key] == pytest.approx(roark_deflection, rel=1e-9), key
+        # the bearing sees its pin's slope against its planet's (the planet's slope pair from the solution)
+        pairs = {m.body_names[m.extra_owner[i - m.n_body_coords]]: (i, j) for i, j in m.slope_pairs}
+        planet_slope = qf[list(pairs[planet])]
+        assert d["misalignment_mean_rad"] == pytest.approx(np.linalg.norm(s - planet_slope), rel=1e-9)
+    sc2, sol2, summary2 = static_pins["both_plates"]
     m2 = sc2.model
     beam2 = m2.element("pin_beam")
     qf2, _ = m2.full(sol2.t, sol2.q, sol2.v)
     for planet in ("a1", "b1"):
         i = [m2.body_names[j // 3] for j in beam2.dofs[:, 3]].index(f"{planet}.pin")
         assert np.linalg.norm(qf2[beam2.dofs[i, 6:8]]) < 1e-3 * np.linalg.norm(slopes[planet])
+        d2 = summary2["inner" if planet.startswith("a") else "outer"]
+        assert d2["pin_slope_max_arcmin"] == pytest.approx(np.linalg.norm(qf2[beam2.dofs[i, 6:8]]) / (math.pi / 10800),
+                                                           rel=1e-9)
 
 
 def _perturbed(sc, seed):
@@ -416,3 +437,51 @@ def test_the_elastic_machine_steps_alike_on_both_engines():
     assert (rc.engine, rn.engine) == ("compiled", "numpy") and rc.counters == rn.counters
     np.testing.assert_allclose(rc.state.q, rn.state.q, rtol=0, atol=1e-10)
     np.testing.assert_allclose(rc.state.v, rn.state.v, rtol=0, atol=1e-10 / h)
+
+
+def test_an_elastic_pin_run_records_its_bending_in_results_nc_and_summary(tmp_path):
+    """A short dynamic run (from the static solution) of cantilever pins: results.nc holds each pin's bending slope
+    (x, y in R and its magnitude, rad) and deflection (m) along ``pin_beam.instance`` (a1.pin …, with its bearing);
+    the deflection is the pin's centre from its pinhole as the recorded body motion places them (the carrier's pose
+    and the pinhole's place on it); the statistics take every step, so the summary's maximum slope is at least every
+    recorded sample's in the window (and the mean, of a pin bent by its bearing's load, over half an arcminute as in the
+    static solution)."""
+    import xarray as xr
+
+    from scenarios.core.runner import RunConfig, run_case
+
+    p = with_overrides(reference_dpgt(3, "forward"), {"bearing.model": "sliced", "bearing.pin.model": "elastic",
+                                                      "bearing.pin.mounting": "one_plate", "bearing.rollers": 8})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        s = run_case(p, RunConfig(settle=0.0005, window=0.0005, progress=False, start="static"), tmp_path / "run")
+        sc = build_dpgt(p)
+    ds = xr.open_dataset(tmp_path / "run" / "results.nc", engine="h5netcdf")
+    assert list(ds["pin_beam.instance"].values) == ["a1.pin", "b1.pin", "a2.pin", "b2.pin", "a3.pin", "b3.pin"]
+    assert list(ds["pin_beam.bearing"].values[:2]) == ["a1.pb", "b1.pb"]
+    for key, unit in (("slope", "rad"), ("slope_x", "rad"), ("slope_y", "rad"), ("deflection", "m")):
+        assert ds[f"pin_beam.{key}"].attrs["units"] == unit, key
+    np.testing.assert_allclose(ds["pin_beam.slope"], np.hypot(ds["pin_beam.slope_x"], ds["pin_beam.slope_y"]),
+                               rtol=1e-12)
+    # the deflection from the recorded motion: pin centre − (carrier centre + Rot(θ_c) pinhole marker)
+    beam = sc.model.element("pin_beam")
+    pos = ds["motion.position"]
+    ang = ds["motion.angle"].sel({"motion.body": "carrier"}).values
+    c = pos.sel({"motion.body": "carrier"}).values
+    for i, name in enumerate(ds["pin_beam.instance"].values):
+        mx, my = beam.marker_a[i]
+        hole = c + np.stack([np.cos(ang) * mx - np.sin(ang) * my, np.sin(ang) * mx + np.cos(ang) * my], axis=-1)
+        d = np.linalg.norm(pos.sel({"motion.body": name}).values - hole, axis=-1)
+        np.testing.assert_allclose(ds["pin_beam.deflection"].values[:, i], d, rtol=1e-6, atol=1e-12)
+        assert d.min() > 1e-6                    # µm: the load bends the pin
+    arcmin = math.pi / 10800.0
+    for kind, i in (("inner", 0), ("outer", 1)):
+        d = s[kind]
+        t0, t1 = d["window_s"]
+        w = ds["pin_beam.slope"].sel(time=slice(t0, t1)).values[:, i] / arcmin
+        assert w.size >= 2
+        assert d["pin_slope_max_arcmin"] >= w.max() * (1 - 1e-12)
+        assert d["pin_slope_max_arcmin"] == d["pin_slope_max_per_planet_arcmin"][0]
+        assert 0.5 < d["pin_slope_mean_arcmin"] <= d["pin_slope_max_arcmin"]
+        dfl = ds["pin_beam.deflection"].sel(time=slice(t0, t1)).values[:, i]
+        assert d["pin_deflection_max_m"] >= dfl.max() * (1 - 1e-12)

@@ -228,6 +228,7 @@ def test_the_summary_reports_the_slices_and_the_misalignment_each_bearing_sees()
         assert d["slice_load_max_pin_N"] * n_s == pytest.approx(d["all_rollers"]["roller_inner_race_max_N"], rel=1e-9)
         assert d["edge_pressure_ratio"] == pytest.approx(1.0, abs=1e-9)
         assert d["misalignment_max_rad"] < 1e-12 * gamma
+        assert not [k for k in d if k.startswith("pin_")]        # rigid pins: no pin bending keys
     d = stats.summary()["inner"]
     m = scene.model
     psi = pg.si().layout.psi_a[0]

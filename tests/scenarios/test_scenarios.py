@@ -286,6 +286,28 @@ def test_bearing_rig_scenario(tmp_path, capsys):
         bearing_rig.parse_args(["--radial-load", "5 m", "--out", str(tmp_path)])
 
 
+def test_the_bearing_rig_refuses_an_elastic_pin_in_one_line(tmp_path):
+    """The rig's pin is a fixed body: ``bearing.pin.model = "elastic"`` is refused (not silently rigid), by the command
+    before it claims a folder and by the builder, in one line naming the parameter."""
+    from components.params import with_overrides
+    from components.presets import reference_dpgt
+    from components.rig import build_bearing_rig
+    from components.units import ParameterError
+    from scenarios import bearing_rig
+
+    out = tmp_path / "rig"
+    with pytest.raises(SystemExit) as e:
+        bearing_rig.run(bearing_rig.parse_args(["--radial-load", "5 kN", "--model", "sliced", "--out", str(out),
+                                                "--set", "bearing.pin.model=elastic"]))
+    msg = str(e.value)
+    assert "bearing.pin.model" in msg and "fixed" in msg and "\n" not in msg
+    assert not (out / "summary.json").exists()
+    b = with_overrides(reference_dpgt(), {"bearing.model": "sliced", "bearing.pin.model": "elastic"}).bearing
+    with pytest.raises(ParameterError, match=r"bearing\.pin\.model.*fixed"):
+        build_bearing_rig(b, radial_load=5e3)
+    build_bearing_rig(with_overrides(reference_dpgt(), {"bearing.model": "sliced"}).bearing, radial_load=5e3)
+
+
 def _slow_first_compile(monkeypatch, delay: float) -> None:
     """Make the first compiled runner built from now on take ``delay`` s longer to compile: a known compile time."""
     from mbd.compiled.runner import CompiledRunner
