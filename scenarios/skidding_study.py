@@ -2,12 +2,13 @@
 bearing's catalogue minimum load.
 
     python -m scenarios.skidding_study [--speed "1000 rpm"] [--powers 2,20,200] [--oil-temperatures 40,80]
-        [--directions forward,reverse] [--settle S] [--window S]
+        [--oil VG32,VG68,VG150] [--directions forward,reverse] [--settle S] [--window S]
         [--transients startup,torque_drop [--ramp-time S] [--start-speed F] [--drop-time S] [--before S]
          [--after S] [--bin S] [--within PCT]]
         [--set KEY=VALUE ...] [--params FILE] [--workers N | --scheduler ADDR] [--out DIR]
 
-Every output power × oil temperature × direction at one carrier speed runs through the one runner (resumable, on
+Every output power × oil temperature (× ISO VG grade with ``--oil``: folders ``…_VG32``) × direction at one carrier
+speed runs through the one runner (resumable, on
 Dask like the other studies) with the laws that decide whether a lightly loaded roller set is driven or slides:
 the EHL traction with its limiting shear (``bearing.traction_law = "ehl"``, docs/model.md §9.3), the film's rolling
 resistance (``bearing.rolling_resistance = "houpert"``, §9.5) and the viscous churning of the oil–air mixture
@@ -54,6 +55,7 @@ from pathlib import Path
 import numpy as np
 
 import mbd
+from components.presets import OIL_GRADES, oil_grade
 from components.results import RESULTS_NAME, open_dataset
 from components.results.io import atomic_write_text
 from components.skid import SERIES, SKID_PCT, roller_slip_zones, slip_series, transient_numbers
@@ -72,15 +74,17 @@ __all__ = ["main", "run", "LAWS", "COLUMNS", "SKID_PCT", "make_cases", "rows_of"
 # the laws this study runs with unless --set says otherwise: traction with a limiting shear, the film's rolling
 # resistance and viscous churning (docs/model.md §9.3, §9.5, §8.7)
 LAWS = {"bearing.traction_law": "ehl", "bearing.rolling_resistance": "houpert", "bearing.drag_law": "viscous"}
-COLUMNS = ["power_kW", "oil_temperature_C", "direction", "bearing", "bearing_load_mean_N", "minimum_load_N",
+COLUMNS = ["power_kW", "oil_temperature_C", "oil_grade", "direction", "bearing", "bearing_load_mean_N", "minimum_load_N",
            "load_over_minimum", "cage_slip_pct", "cage_slip_all_pct", "roller_slip_load_zone_pct",
            "roller_slip_unloaded_pct", "roller_slip_entry_pct", "roller_entry_slide_roll", "smearing_pv_entry_W_m2",
            "smearing_pv_max_W_m2", "traction_coefficient_max", "lambda_min", "heat_traction_W", "heat_land_W"]
-_NUMBERS = COLUMNS[4:]
+_NUMBERS = COLUMNS[5:]
+MACHINE_OIL = "machine"    # the oil_grade of a run with the machine's own oil (no --oil)
 
 EXAMPLES = ["{prog} --out results/skidding",
             "{prog} --transients startup,torque_drop --oil-temperatures 40 --directions forward", '{prog} --speed "1500 rpm" --powers 0,5,50 --oil-temperatures 30,60,90',
-            "{prog} --set bearing.clearance=40um --directions forward --workers 2"]
+            "{prog} --set bearing.clearance=40um --directions forward --workers 2",
+            "{prog} --powers 2 --oil VG32,VG150 --directions forward"]
 WRITES = ("p{power}kW_oil{T}C_{direction}/{results.nc, summary.json} per run; summary.csv and summary.md (a row per "
           "run and bearing type: load and catalogue minimum load, cage slip, traction, film, heat); answer.md (the "
           "answer in words, also printed); slip_against_load.png, roller_slip_by_angle.png; study.json; with "
@@ -105,6 +109,9 @@ def parse_args(argv):
                    help="output powers [kW], comma list >= 0 (default 2,20,200; 0: no load)")
     p.add_argument("--oil-temperatures", default=[40.0, 80.0], type=_numbers("°C"),
                    help="oil temperatures [°C], comma list (default 40,80)")
+    p.add_argument(args.OIL, default=None, type=args.choice_list(tuple(OIL_GRADES), "ISO VG grades"), metavar="VG[,VG...]",
+                   help=f"comma list of ISO VG grades ({', '.join(OIL_GRADES)}), each run at every oil temperature "
+                        "(default: the machine's own oil)")
     p.add_argument("--directions", default="forward,reverse", type=args.directions, help="comma list: forward, reverse")
     p.add_argument("--settle", type=args.nonnegative("s"), default=0.03, help="seconds discarded after the start (default 0.03)")
     p.add_argument("--window", type=args.positive("s"), default=None, help="statistics window [s] (default: the study's rule)")
@@ -167,6 +174,9 @@ def make_transient_cases(a, out: Path) -> list[Case]:
     """Per transient (``--transients``) × oil temperature × direction: the transient's case (tag: its name, its
     window from ``--before`` to ``--after`` past the change) and the steady case at its final point (the grid's)."""
     kinds = [k for k in str(a.transients).split(",") if k]
+    if _grades(a) != [None]:
+        raise SystemExit(f"skidding_study: {args.OIL} spans the grid; a transient runs the machine's oil "
+                         f"(--set lubricant.viscosity_40=… for another)")
     dirs = [d.strip() for d in str(a.directions).split(",") if d.strip()]
     hi, lo = max(a.powers), min(a.powers)
     cases, steady = [], {}
@@ -190,15 +200,33 @@ def make_cases(a, out: Path) -> list[Case]:
     sets = args.parse_sets(a.set)
     owned = {"operating.carrier_speed": "--speed", "operating.output_power": "--powers",
              "lubricant.temperature": "--oil-temperatures"}
+    grades = _grades(a)
+    if grades != [None]:
+        owned.update({"lubricant.viscosity_40": args.OIL, "lubricant.viscosity_100": args.OIL})
     cases = []
     for P in powers:
         for T in temps:
-            point = checked_point(parse_point(f"p{P:g}kW_oil{T:g}C: {a.speed}, {P:g} kW, oil {T:g} degC",
-                                              where="--powers"), "--powers")
-            user = {**LAWS, **machine_overrides(user_overrides(sets, a.params, owned), [point])}
-            for d in dirs:
-                cases.append(Case.at(point, d, str(out / point_label(point, d)), user, a.params))
+            for g in grades:
+                name = f"p{P:g}kW_oil{T:g}C" + (f"_{g}" if g else "")
+                point = checked_point(parse_point(f"{name}: {a.speed}, {P:g} kW, oil {T:g} degC",
+                                                  where="--powers"), "--powers")
+                user = {**LAWS, **machine_overrides(user_overrides(sets, a.params, owned), [point]),
+                        **(oil_grade(g) if g else {})}
+                for d in dirs:
+                    cases.append(Case.at(point, d, str(out / point_label(point, d)), user, a.params))
     return cases
+
+
+def _grades(a) -> list:
+    """The ``--oil`` grades, or [None]: the machine's own oil."""
+    oil = getattr(a, "oil", None)
+    return [g.strip() for g in oil.split(",") if g.strip()] if oil else [None]
+
+
+def grade_of(case: Case) -> str:
+    """The case's ISO VG grade (its point's name ends in it), or :data:`MACHINE_OIL`."""
+    tail = str(case.point["name"]).rsplit("_", 1)[-1]
+    return tail if tail in OIL_GRADES else MACHINE_OIL
 
 
 def _power_and_oil(case: Case) -> tuple[float, float]:
@@ -218,7 +246,8 @@ def rows_of(cases: list[Case], results: dict) -> list[dict]:
         zones = _roller_zones(case)
         for kind in ("inner", "outer"):
             d = s[kind]
-            row = {"power_kW": P, "oil_temperature_C": T, "direction": case.direction, "bearing": kind}
+            row = {"power_kW": P, "oil_temperature_C": T, "oil_grade": grade_of(case), "direction": case.direction,
+                   "bearing": kind}
             row.update({c: d.get(c) for c in _NUMBERS})
             if kind in zones:        # by angle about the pin, for the figure (not a column)
                 row["by_angle"] = {k: zones[kind][k] for k in ("angle_deg", "slip_by_angle_pct", "loaded_by_angle")}
@@ -240,25 +269,26 @@ def answer(rows: list[dict]) -> str:
     the load over the catalogue minimum, whether a cage skids, and the slip's trends with load and oil temperature."""
     lines = [f"Do the planet bearings skid? Cage slip [%] (+: the cage lags its rolling speed) at each load, the mean "
              f"bearing load over the catalogue minimum 0.02 C_r in brackets; skidding: |slip| > {SKID_PCT:g} %.", ""]
-    key = lambda r: (r["oil_temperature_C"], r["direction"], r["bearing"])
-    for k in sorted({key(r) for r in rows}, key=lambda k: (k[0], k[1] != "forward", k[2])):
+    key = lambda r: (r["oil_temperature_C"], r.get("oil_grade", MACHINE_OIL), r["direction"], r["bearing"])
+    for k in sorted({key(r) for r in rows}, key=lambda k: (k[0], _viscosity(k[1]), k[2] != "forward", k[3])):
         rr = sorted((r for r in rows if key(r) == k), key=lambda r: r["power_kW"])
         pts = ", ".join(f"{r['power_kW']:g} kW {r['cage_slip_pct']:+.2f} ({r['load_over_minimum']:.2f})" for r in rr)
         rol = ", ".join(f"{r['power_kW']:g} kW {_pct(r.get('roller_slip_entry_pct'))} / "
                         f"{_pct(r.get('roller_slip_unloaded_pct'))}" for r in rr)
         skid = [r["power_kW"] for r in rr if abs(r["cage_slip_pct"]) > SKID_PCT]
-        lines.append(f"oil {k[0]:g} °C, {k[1]}, {k[2]}: {pts}"
+        lines.append(f"oil {k[0]:g} °C{_grade_words(k[1])}, {k[2]}, {k[3]}: {pts}"
                      + (f" -> skids at {', '.join(f'{p:g}' for p in skid)} kW" if skid else " -> no skid")
                      + (f"; roller slip at load-zone entry / out of the load zone: {rol}"
                         if any(r.get("roller_slip_entry_pct") is not None for r in rr) else ""))
     lines.append("")
     for col, words in (("cage_slip_pct", "cage |slip|"), ("roller_slip_unloaded_pct", "roller slip out of the load zone")):
-        for what, axis in (("load", "power_kW"), ("oil temperature", "oil_temperature_C")):
+        for what, axis in (("load", "power_kW"), ("oil temperature", "oil_temperature_C"), ("oil grade", "grade_viscosity")):
             falls = rises = 0
-            other = [c for c in ("power_kW", "oil_temperature_C") if c != axis][0]
-            for k in {(r[other], r["direction"], r["bearing"]) for r in rows}:
-                rr = sorted((r for r in rows if (r[other], r["direction"], r["bearing"]) == k and r.get(col) is not None),
-                            key=lambda r: r[axis])
+            others = [c for c in ("power_kW", "oil_temperature_C", "grade_viscosity") if c != axis]
+            at = lambda r, c: _viscosity(r.get("oil_grade", MACHINE_OIL)) if c == "grade_viscosity" else r[c]  # noqa: E731
+            group = lambda r: (*(at(r, c) for c in others), r["direction"], r["bearing"])  # noqa: E731
+            for k in {group(r) for r in rows}:
+                rr = sorted((r for r in rows if group(r) == k and r.get(col) is not None), key=lambda r: at(r, axis))
                 if len(rr) > 1:
                     lo, hi = abs(rr[0][col]), abs(rr[-1][col])
                     falls += hi < lo
@@ -266,6 +296,15 @@ def answer(rows: list[dict]) -> str:
             if falls + rises:
                 lines.append(f"{words} falls as the {what} rises in {falls} of {falls + rises} series, rises in {rises}.")
     return "\n".join(lines)
+
+
+def _viscosity(grade: str) -> float:
+    """The grade's viscosity at 40 °C [mm²/s] (its ISO VG number; the machine's own oil: 0, first in a sort)."""
+    return float(grade[2:]) if grade in OIL_GRADES else 0.0
+
+
+def _grade_words(grade: str) -> str:
+    return "" if grade == MACHINE_OIL else f" {grade}"
 
 
 def _pct(v) -> str:
@@ -297,7 +336,8 @@ def plot(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
     series = {}
     for key in ("cage_slip_pct", "roller_slip_unloaded_pct", "roller_slip_entry_pct", "lambda_min"):
         for r in sorted(rows, key=lambda r: r["load_over_minimum"]):
-            k = (key, r["bearing"], r["direction"], f"oil {r['oil_temperature_C']:g} °C")
+            k = (key, r["bearing"], r["direction"],
+                 f"oil {r['oil_temperature_C']:g} °C{_grade_words(r.get('oil_grade', MACHINE_OIL))}")
             x, y = series.setdefault(k, ([], []))
             x.append(r["load_over_minimum"])
             y.append(r[key])

@@ -28,6 +28,35 @@ def test_the_cases_are_every_power_oil_and_direction_at_the_speed_with_the_skid_
     assert seen == {(0, 30.0), (0, 90.0), (50000, 30.0), (50000, 90.0)}
 
 
+def test_oil_grades_are_an_axis_of_the_grid_with_their_iso_viscosities(tmp_path):
+    """--oil VG32,VG150: every power and temperature once per grade, the grade's ISO 3448 viscosity at 40 °C and the
+    folders named for it; a --set of the viscosity the grade owns is refused by name."""
+    a = skidding_study.parse_args(["--powers", "2", "--oil-temperatures", "40", "--oil", "VG32,VG150",
+                                   "--directions", "forward", "--out", str(tmp_path)])
+    cases = skidding_study.make_cases(a, Path(tmp_path))
+    assert [c.label for c in cases] == ["p2kW_oil40C_VG32_forward", "p2kW_oil40C_VG150_forward"]
+    nu40 = [build_params(c).si().lubricant.viscosity_40 for c in cases]
+    assert nu40 == pytest.approx([32e-6, 150e-6])                      # mm²/s in m²/s
+    assert [skidding_study.grade_of(c) for c in cases] == ["VG32", "VG150"]
+    plain = skidding_study.make_cases(skidding_study.parse_args(["--powers", "2", "--oil-temperatures", "40",
+                                                                 "--directions", "forward", "--out", str(tmp_path)]),
+                                      Path(tmp_path))
+    assert skidding_study.grade_of(plain[0]) == skidding_study.MACHINE_OIL
+    with pytest.raises(SystemExit, match="lubricant.viscosity_40"):
+        skidding_study.make_cases(skidding_study.parse_args(["--oil", "VG32", "--set", "lubricant.viscosity_40=40 mm^2/s",
+                                                             "--out", str(tmp_path)]), Path(tmp_path))
+
+
+def test_the_answer_reads_the_trend_with_the_oil_grade():
+    """Slip 60 % with VG32 and 40 % with VG150 at one load and temperature: it falls as the grade rises."""
+    rows = [_row(2, 40, "forward", "outer", 0.7, 1.1), _row(2, 40, "forward", "outer", 0.6, 1.1)]
+    for r, g, unloaded in zip(rows, ("VG32", "VG150"), (60.0, 40.0)):
+        r.update(oil_grade=g, roller_slip_unloaded_pct=unloaded, roller_slip_entry_pct=70.0)
+    text = skidding_study.answer(rows)
+    assert "oil 40 °C VG32, forward, outer: 2 kW +0.70 (1.10)" in text
+    assert "roller slip out of the load zone falls as the oil grade rises in 1 of 1 series, rises in 0." in text
+
+
 def _row(P, T, d, kind, slip, ratio):
     return {"power_kW": P, "oil_temperature_C": T, "direction": d, "bearing": kind, "cage_slip_pct": slip,
             "load_over_minimum": ratio}
