@@ -64,10 +64,14 @@ def _profile(prof: cProfile.Profile, wall_stats: float, steps: int) -> tuple[flo
     """(the observer's time over the engine's in its runs, {part: {"us_per_step", "share"}}) from the profile of
     the observer's runs (``wall_stats`` their summed wall time [s], ``steps`` their accepted steps)."""
     cum = {}
-    for (path, _, name), (_, _, _, ct, _) in pstats.Stats(prof).stats.items():
+    for (path, _, name), (_, _, _, ct, callers) in pstats.Stats(prof).stats.items():
         for label, (suffix, fn) in PARTS.items():
             if name == fn and path.replace("\\", "/").endswith(suffix):
-                cum[label] = cum.get(label, 0.0) + ct
+                # the output evaluator's load-or-compile call on an empty block when an observer binds is set-up,
+                # not a step's work (and lies outside the snapshots the outputs are otherwise part of)
+                setup = sum(c[3] for (cpath, _, cname), c in callers.items()
+                            if cname == "<lambda>" and cpath.replace("\\", "/").endswith("mbd/compiled/outputs.py"))
+                cum[label] = cum.get(label, 0.0) + ct - setup
     total = cum["on_block"]
     parts = {k: {"us_per_step": round(1e6 * cum[k] / steps, 2), "share": round(cum[k] / total, 4)}
              for k in PARTS if k in cum}
