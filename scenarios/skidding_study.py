@@ -311,20 +311,30 @@ def _pct(v) -> str:
     return "–" if v is None else f"{v:.1f} %"
 
 
-def write_tables(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
-    """summary.csv, summary.md and answer.md (the markdown files headed by ``machine``)."""
+def _cell(v) -> str:
+    return "–" if v is None else f"{v:.4g}" if isinstance(v, float) else str(v)
+
+
+def _write_row_tables(rows: list[dict], columns: list[str], out: Path, stem: str, answer_name: str, text: str,
+                      machine: str) -> list[Path]:
+    """``stem``.csv and ``stem``.md (a row per row, :data:`columns`) and the answer ``text`` in ``answer_name``, the
+    markdown files headed by ``machine``."""
     head = [f"Machine: {machine}", ""] if machine else []
     buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=COLUMNS, extrasaction="ignore")
+    w = csv.DictWriter(buf, fieldnames=columns, extrasaction="ignore")
     w.writeheader()
     w.writerows(rows)
-    atomic_write_text(out / "summary.csv", buf.getvalue())
-    md = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
-    md += ["| " + " | ".join(f"{r[c]:.4g}" if isinstance(r[c], float) else str(r[c]) for c in COLUMNS) + " |"
-           for r in rows]
-    atomic_write_text(out / "summary.md", "\n".join(head + md) + "\n")
-    atomic_write_text(out / "answer.md", "\n".join(head + [answer(rows)]) + "\n")
-    return [out / "summary.csv", out / "summary.md", out / "answer.md"]
+    atomic_write_text(out / f"{stem}.csv", buf.getvalue())
+    md = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    md += ["| " + " | ".join(_cell(r[c]) for c in columns) + " |" for r in rows]
+    atomic_write_text(out / f"{stem}.md", "\n".join(head + md) + "\n")
+    atomic_write_text(out / answer_name, "\n".join(head + [text]) + "\n")
+    return [out / f"{stem}.csv", out / f"{stem}.md", out / answer_name]
+
+
+def write_tables(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
+    """summary.csv, summary.md and answer.md (the markdown files headed by ``machine``)."""
+    return _write_row_tables(rows, COLUMNS, out, "summary", "answer.md", answer(rows), machine)
 
 
 def plot(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
@@ -453,18 +463,8 @@ def transient_answer(rows: list[dict]) -> str:
 
 def write_transient_tables(rows: list[dict], out: Path, machine: str = "") -> list[Path]:
     """transients.csv, transients.md and transients_answer.md."""
-    head = [f"Machine: {machine}", ""] if machine else []
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=TRANSIENT_COLUMNS, extrasaction="ignore")
-    w.writeheader()
-    w.writerows(rows)
-    atomic_write_text(out / "transients.csv", buf.getvalue())
-    md = ["| " + " | ".join(TRANSIENT_COLUMNS) + " |", "|" + "---|" * len(TRANSIENT_COLUMNS)]
-    md += ["| " + " | ".join("–" if r[c] is None else f"{r[c]:.4g}" if isinstance(r[c], float) else str(r[c])
-                             for c in TRANSIENT_COLUMNS) + " |" for r in rows]
-    atomic_write_text(out / "transients.md", "\n".join(head + md) + "\n")
-    atomic_write_text(out / "transients_answer.md", "\n".join(head + [transient_answer(rows)]) + "\n")
-    return [out / "transients.csv", out / "transients.md", out / "transients_answer.md"]
+    return _write_row_tables(rows, TRANSIENT_COLUMNS, out, "transients", "transients_answer.md",
+                             transient_answer(rows), machine)
 
 
 def plot_transients(series: list[dict], out: Path, machine: str = "") -> list[Path]:
