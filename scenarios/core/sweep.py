@@ -314,6 +314,7 @@ class Beside:
     key: Callable[[Case], object]
     task: Callable[[object, dict], tuple | None]
     done: dict = field(default_factory=dict)
+    spans: list = field(default_factory=list)   # where and when each piece of work ran (as Outcome.span)
 
     def groups(self, cases: list[Case]) -> dict:
         out: dict = {}
@@ -334,10 +335,24 @@ class Beside:
 
     def here(self, k, work) -> None:
         fn, fargs = work
-        try:
-            self.done[k] = fn(*fargs)
-        except Exception as exc:      # a figure that fails is reported with the study's files, not fatal
-            self.done[k] = exc
+        self.took(k, timed_call(fn, *fargs))
+
+    def took(self, k, got: tuple) -> None:
+        """Keep what :func:`timed_call` gave for group ``k``: its value (or exception) and its span."""
+        self.done[k], span = got
+        self.spans.append(span)
+
+
+def timed_call(fn: Callable, *args) -> tuple:
+    """(fn(*args) or the exception it raised, {"pid", "start_unix_s", "end_unix_s"}): work beside the runs with
+    where and when it ran, so a study's time profile can tell a worker drawing figures from one waiting. A figure
+    that fails is reported with the study's files, not fatal."""
+    start = time.time()
+    try:
+        value = fn(*args)
+    except Exception as exc:
+        value = exc
+    return value, {"pid": os.getpid(), "start_unix_s": start, "end_unix_s": time.time()}
 
 
 class _RunBars:
@@ -394,7 +409,8 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
     sweep's phases (wall seconds: ``reuse_check_s``, on Dask ``cluster_start_s`` — Dask imported, scheduler and
     workers started —, ``runs_s`` from the first submission to the last result, ``cluster_close_s``; the runs'
     phase as wall-clock stamps ``runs_start_unix_s``, ``runs_end_unix_s``; ``workers``, ``dask``); ``beside``: work
-    done group by group as the runs finish (:class:`Beside`), its wall seconds after the last run ``beside_tail_s``."""
+    done group by group as the runs finish (:class:`Beside`), its wall seconds after the last run ``beside_tail_s``
+    and each piece's span ``beside_spans`` (:func:`timed_call`)."""
     timing = {} if timing is None else timing
     groups, started = (beside.groups(cases), set()) if beside is not None else ({}, set())
 
@@ -428,6 +444,7 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
                 beside.here(k, work)
         timing["runs_end_unix_s"] = time.time()
         timing["runs_s"] = timing["runs_end_unix_s"] - timing["runs_start_unix_s"]
+        timing["beside_spans"] = list(beside.spans) if beside is not None else []
         return results
     wcfg = replace(cfg, progress=False)   # per-run bars would interleave; the sweep bar shows progress
     futs, side = {}, {}
@@ -476,7 +493,8 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
                     bar.write(f"run {c.label} failed: {results[c.label].error}")
                 for k, (fn, fargs) in ready(results):
                     if scheduler is None:       # a worker shares this filesystem: there, ahead of the queued runs
-                        side[k] = client.submit(fn, *fargs, pure=False, priority=1, key=f"beside-{time.time_ns()}")
+                        side[k] = client.submit(timed_call, fn, *fargs, pure=False, priority=1,
+                                                key=f"beside-{time.time_ns()}")
                     else:
                         beside.here(k, (fn, fargs))
             runs.close()
@@ -484,14 +502,15 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
             timing["runs_end_unix_s"] = time.time()
             for k, f in side.items():
                 try:
-                    beside.done[k] = f.result()
-                except Exception as exc:
+                    beside.took(k, f.result())
+                except Exception as exc:      # the worker itself was lost
                     beside.done[k] = exc
         except BaseException:       # Ctrl-C or a failure of the client: take its runs off the scheduler
             client.cancel([*futs, *side.values()], force=True)
             raise
         timing["runs_s"] = timing["runs_end_unix_s"] - timing["runs_start_unix_s"]
         timing["beside_tail_s"] = time.time() - timing["runs_end_unix_s"]
+        timing["beside_spans"] = list(beside.spans) if beside is not None else []
         t_close = time.perf_counter()
     timing["cluster_close_s"] = time.perf_counter() - t_close
     return results

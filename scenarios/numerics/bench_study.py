@@ -133,6 +133,8 @@ def profile(job: dict) -> list[tuple[str, str, float]]:
         gaps += sum(b[0] - a[1] for a, b in zip(sp, sp[1:]))
         tail += sw["runs_end_unix_s"] - sp[-1][1]
     tail += (n - len(by_pid)) * R           # a worker that ran nothing waited the whole phase
+    drawn = _beside_in_phase(sw, by_pid)
+    first, gaps, tail = first - drawn["first"], gaps - drawn["gaps"], tail - drawn["tail"]
     parts = dict.fromkeys(RUN_PARTS, 0.0)
     outside = 0.0
     for k, v in spans.items():
@@ -143,6 +145,9 @@ def profile(job: dict) -> list[tuple[str, str, float]]:
     for p, (g, what) in RUN_PARTS.items():
         add(g, what, parts[p] / n)
     add("other", "a run's case outside the runner (parameters, lock, folder checks)", outside / n)
+    add("figures", "figures beside the runs, drawn while runs were on (their share of a worker)",
+        sum(drawn.values()) / n)
+    add("figures", "figures beside the runs, waited for after the last run", sw.get("beside_tail_s", 0.0))
     if sw.get("dask"):
         add("dask", "a worker's first task: the imports, transfer, start", first / n)
         add("dask", "between a worker's tasks: scheduling, transfer", gaps / n)
@@ -153,10 +158,30 @@ def profile(job: dict) -> list[tuple[str, str, float]]:
     for what, s in steps.items():
         add("study I/O", f"report: {what}", s)
     add("study I/O", "report: relative lives into each summary.json, headline tables", T["report_s"] - sum(steps.values()))
-    sweep_rest = T["sweep_s"] - sw.get("reuse_check_s", 0) - sw.get("cluster_start_s", 0) - R - sw.get("cluster_close_s", 0)
+    sweep_rest = (T["sweep_s"] - sw.get("reuse_check_s", 0) - sw.get("cluster_start_s", 0) - R
+                  - sw.get("cluster_close_s", 0) - sw.get("beside_tail_s", 0.0))
     add("other", "the study's rest (sweep bookkeeping, epilogue)", T["total_s"] - T["checks_s"] - T["prepare_s"]
         - T["sweep_s"] - T["report_s"] + sweep_rest)
     return rows
+
+
+def _beside_in_phase(sw: dict, by_pid: dict) -> dict[str, float]:
+    """Wall seconds of the work beside the runs (``sweep.beside_spans``) inside the runs' phase, by where it fell on
+    its process's timeline: before that process's first run, between its runs, or after its last one (a process
+    that ran no run: after). The profile moves them out of the idle rows they would otherwise be counted in."""
+    lo, hi = sw.get("runs_start_unix_s"), sw.get("runs_end_unix_s")
+    out = {"first": 0.0, "gaps": 0.0, "tail": 0.0}
+    if lo is None or hi is None:
+        return out
+    for span in sw.get("beside_spans", []):
+        a, b = max(span["start_unix_s"], lo), min(span["end_unix_s"], hi)
+        if b <= a:
+            continue
+        runs = by_pid.get(span["pid"])
+        mid = 0.5 * (a + b)
+        where = ("tail" if not runs or mid >= runs[-1][1] else "first" if mid <= runs[0][0] else "gaps")
+        out[where] += b - a
+    return out
 
 
 def profile_table(name: str, jobs: list[dict]) -> str:

@@ -117,6 +117,30 @@ def test_a_worker_that_ran_nothing_counts_as_idle():
         pytest.approx((0 + 54) / 2)
 
 
+def test_figures_drawn_on_a_worker_leave_its_idle_rows_and_the_tail_leaves_the_rest():
+    """Worker 2 draws for 4 s between its run's end (1043) and the phase's end (1054), worker 1 for 0.5 s in its
+    1 s gap, and the client waits 3 s after the last run for a third drawing: each moves out of the row it would
+    otherwise swell, and the rows still add up to the wall time."""
+    job = _study()
+    sw = job["study"]["sweep"]
+    sw["beside_spans"] = [{"pid": 2, "start_unix_s": 1045.0, "end_unix_s": 1049.0},
+                          {"pid": 1, "start_unix_s": 1022.25, "end_unix_s": 1022.75},
+                          {"pid": 1, "start_unix_s": 1054.0, "end_unix_s": 1057.0}]
+    sw["beside_tail_s"] = 3.0
+    job["study"]["sweep_s"] += 3.0
+    job["study"]["total_s"] += 3.0
+    job["wall_s"] += 3.0
+    rows = {what: s for _, what, s in profile(job)}
+    assert sum(rows.values()) == pytest.approx(88.0, abs=1e-9)
+    assert rows["figures beside the runs, drawn while runs were on (their share of a worker)"] == \
+        pytest.approx((4 + 0.5) / 2)
+    assert rows["figures beside the runs, waited for after the last run"] == 3.0
+    assert rows["between a worker's tasks: scheduling, transfer"] == pytest.approx((1 - 0.5) / 2)
+    assert rows["idle at the end: waiting for the other worker's last run, the client's 0.5 s poll"] == \
+        pytest.approx((1 + 11 - 4) / 2)
+    assert rows["the study's rest (sweep bookkeeping, epilogue)"] == pytest.approx(76 - 1 - 62.75 - 12 + 0.25)
+
+
 def _touch(mb: int) -> np.ndarray:
     a = np.empty(mb * 2 ** 20 // 8)
     a[:] = 1.0                          # resident, not only reserved
