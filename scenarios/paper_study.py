@@ -368,6 +368,12 @@ def point_figures(results: dict, out: Path, c) -> list[Path]:
     return paths
 
 
+def point_work(results: dict, out: Path, c, with_animation: bool) -> list[Path]:
+    """What a point's finished runs give on their own — its figures and (``with_animation``) its animation — done
+    beside the other points' runs (:meth:`PaperStudy.beside`)."""
+    return point_figures(results, out, c) + (animate(results, out, only=[c]) if with_animation else [])
+
+
 def plots(results: dict, out: Path, machine: str = "", drawn=()) -> list[Path]:
     """Every figure of a dynamic study, the points in ``drawn`` (their figures made beside the runs) left out of the
     per-point ones; ``machine``: the machine's label, in the headline figure's title."""
@@ -462,20 +468,19 @@ class PaperStudy(Study):
         return make_cases(self.a, self.out)
 
     def beside(self, cfg: RunConfig) -> Beside | None:
-        """A dynamic study draws each point's figures, and its animation as a second piece at the same time, as soon
-        as both its runs are in, on the workers while the other points run; the tables and the figures across points
-        wait for every run. One point without an animation has nothing to draw beside anything: the report draws
-        its figures in this process without handing the results to a worker."""
-        animation = bool(self.a.animate)
-        if cfg.mode == "static" or (len({c.condition for c in self.cases()}) < 2 and not animation):
+        """A dynamic study of several points draws each point's figures (and animation) as soon as both its runs are
+        in, on a worker while the other points run; the tables and the figures across points wait for every run. One
+        point (the demo) has nothing to draw beside: its figures wait for its runs either way, and the report draws
+        them in this process without handing the results to a worker."""
+        if cfg.mode == "static" or len({c.condition for c in self.cases()}) < 2:
             return None
-        out = self.out
+        out, animation = self.out, bool(self.a.animate)
 
         def task(c, outcomes):
             if not all(o.ok for o in outcomes.values()):    # a failed run: the report draws what it can
                 return None
             results = {label: Summary.of(o.summary) for label, o in outcomes.items()}
-            return [(point_figures, (results, out, c))] + ([(animate, (results, out, [c]))] if animation else [])
+            return point_work, (results, out, c, animation)
         return Beside(key=lambda case: case.condition, task=task)
 
     def machine_identity(self) -> dict:

@@ -307,16 +307,14 @@ def execute_on_worker(case: Case, cfg, overwrite: bool, code: str, texts: dict) 
 @dataclass
 class Beside:
     """Work to do beside the runs, e.g. one operating point's figures: the cases fall into groups (``key(case)``;
-    None: in none), and once every case of a group has its outcome, ``task(key, {label: outcome})`` gives its work:
-    ``(function, args)``, a list of such pieces that may run at the same time (a point's figures and its
-    animation), or None. On a local cluster each piece runs on a worker, ahead of the runs still queued, while the
-    other runs go on; without Dask, or on a cluster whose workers share no filesystem with this process, the pieces
-    run here at that moment, one after another. ``done``: {key: the pieces' lists of files joined (one piece: its
-    return value), or the first exception one raised}; ``spans``: where and when each piece ran."""
+    None: in none), and once every case of a group has its outcome, ``task(key, {label: outcome})`` gives
+    ``(function, args)`` or None. On a local cluster the function runs on a worker, ahead of the runs still
+    queued, while the other runs go on; without Dask, or on a cluster whose workers share no filesystem with this
+    process, it runs here at that moment. ``done``: {key: its return value, or the exception it raised}."""
     key: Callable[[Case], object]
-    task: Callable[[object, dict], tuple | list | None]
+    task: Callable[[object, dict], tuple | None]
     done: dict = field(default_factory=dict)
-    spans: list = field(default_factory=list)
+    spans: list = field(default_factory=list)   # where and when each piece of work ran (as Outcome.span)
 
     def groups(self, cases: list[Case]) -> dict:
         out: dict = {}
@@ -327,24 +325,22 @@ class Beside:
         return out
 
     def ready(self, groups: dict, results: dict, started: set):
-        """(key, [(function, args), ...]) of every group whose cases all have outcomes now, each once."""
+        """(key, (function, args)) of every group whose cases all have outcomes now, each once."""
         for k, labels in groups.items():
             if k not in started and all(lab in results for lab in labels):
                 started.add(k)
                 work = self.task(k, {lab: results[lab] for lab in labels})
                 if work is not None:
-                    yield k, (work if isinstance(work, list) else [work])
+                    yield k, work
 
-    def here(self, k, pieces: list) -> None:
-        self.took(k, [timed_call(fn, *fargs) for fn, fargs in pieces])
+    def here(self, k, work) -> None:
+        fn, fargs = work
+        self.took(k, timed_call(fn, *fargs))
 
-    def took(self, k, got: list[tuple]) -> None:
-        """Keep what :func:`timed_call` gave for each piece of group ``k``: the values joined, and the spans."""
-        values = [v for v, _ in got]
-        self.spans += [span for _, span in got]
-        failed = [v for v in values if isinstance(v, BaseException)]
-        self.done[k] = (failed[0] if failed else values[0] if len(values) == 1 else
-                        [x for v in values for x in (v if isinstance(v, list) else [v])])
+    def took(self, k, got: tuple) -> None:
+        """Keep what :func:`timed_call` gave for group ``k``: its value (or exception) and its span."""
+        self.done[k], span = got
+        self.spans.append(span)
 
 
 def timed_call(fn: Callable, *args) -> tuple:
@@ -495,22 +491,22 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
                     print(f"runs: {n_done}/{len(futs)} done ({c.label})", file=sys.stderr, flush=True)
                 if not results[c.label].ok:
                     bar.write(f"run {c.label} failed: {results[c.label].error}")
-                for k, pieces in ready(results):
+                for k, (fn, fargs) in ready(results):
                     if scheduler is None:       # a worker shares this filesystem: there, ahead of the queued runs
-                        side[k] = [client.submit(timed_call, fn, *fargs, pure=False, priority=1,
-                                                 key=f"beside-{time.time_ns()}") for fn, fargs in pieces]
+                        side[k] = client.submit(timed_call, fn, *fargs, pure=False, priority=1,
+                                                key=f"beside-{time.time_ns()}")
                     else:
-                        beside.here(k, pieces)
+                        beside.here(k, (fn, fargs))
             runs.close()
             bar.close()
             timing["runs_end_unix_s"] = time.time()
-            for k, fs in side.items():
+            for k, f in side.items():
                 try:
-                    beside.took(k, [f.result() for f in fs])
+                    beside.took(k, f.result())
                 except Exception as exc:      # the worker itself was lost
                     beside.done[k] = exc
         except BaseException:       # Ctrl-C or a failure of the client: take its runs off the scheduler
-            client.cancel([*futs, *(f for fs in side.values() for f in fs)], force=True)
+            client.cancel([*futs, *side.values()], force=True)
             raise
         timing["runs_s"] = timing["runs_end_unix_s"] - timing["runs_start_unix_s"]
         timing["beside_tail_s"] = time.time() - timing["runs_end_unix_s"]

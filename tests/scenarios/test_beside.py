@@ -28,19 +28,6 @@ def test_a_group_starts_once_and_only_when_all_its_cases_are_in():
     for k, work in ready:
         b.here(k, work)
     assert b.done == {1: 2}                                   # len of the group's two outcomes
-    assert len(b.spans) == 1 and b.spans[0]["end_unix_s"] >= b.spans[0]["start_unix_s"]
-
-
-def test_pieces_of_a_group_join_their_files_and_a_failing_piece_is_the_groups_error():
-    b = Beside(key=lambda c: c.condition, task=lambda k, outs: [(list, ("ab",)), (list, ("c",))])
-    case = _case(1, "forward")
-    (k, pieces), = b.ready(b.groups([case]), {case.label: _done(case)}, set())
-    b.here(k, pieces)
-    assert b.done == {1: ["a", "b", "c"]} and len(b.spans) == 2
-    bad = Beside(key=lambda c: c.condition, task=lambda k, outs: [(list, ("ab",)), (int, ("x",))])
-    (k, pieces), = bad.ready(bad.groups([case]), {case.label: _done(case)}, set())
-    bad.here(k, pieces)
-    assert isinstance(bad.done[1], ValueError)
 
 
 def test_cases_outside_every_group_wait_for_nothing_and_a_failing_task_is_kept_as_its_error():
@@ -60,15 +47,10 @@ def test_the_paper_study_draws_a_point_beside_only_when_both_its_runs_finished(t
     b = study.beside(study.config())
     f, r = _case(3, "forward"), _case(3, "reverse")
     assert b.task(3, {f.label: _done(f), r.label: _done(r, ok=False)}) is None
-    (fn, fargs), = b.task(3, {f.label: _done(f), r.label: _done(r)})
-    assert fn is paper_study.point_figures and fargs[2] == 3
+    fn, fargs = b.task(3, {f.label: _done(f), r.label: _done(r)})
+    assert fn is paper_study.point_work and fargs[2] == 3
     static = paper_study.PaperStudy(paper_study.parse_args(["--conditions", "3", "--mode", "static",
                                                             "--out", str(tmp_path)]))
     assert static.beside(static.config()) is None
     one = paper_study.PaperStudy(paper_study.parse_args(["--conditions", "3", "--out", str(tmp_path)]))
-    assert one.beside(one.config()) is None     # one point without an animation: nothing runs beside its figures
-    from scenarios import demo
-    shown = paper_study.PaperStudy(demo.build_parser().parse_args(["--out", str(tmp_path)]))
-    pieces = shown.beside(shown.config()).task(3, {f.label: _done(f), r.label: _done(r)})
-    # the demo's one point: its figures and its animation drawn at the same time, on the two workers
-    assert [fn for fn, _ in pieces] == [paper_study.point_figures, paper_study.animate] and pieces[1][1][2] == [3]
+    assert one.beside(one.config()) is None     # one point (the demo): nothing runs beside its figures
