@@ -88,8 +88,8 @@ def check_errors(si) -> None:
     for i, x in enumerate(e.pinhole_ends):
         planet(f"errors.pinhole_ends[{i}].planet", x.planet)
         if x.planet in both:
-            raise ParameterError.at(f"errors.pinhole_ends[{i}]", f"{x.planet}'s pinhole is given at its two ends and "
-                                                                 "also by errors.pinhole or errors.pin_slope: give one form")
+            raise ParameterError.at(f"errors.pinhole_ends[{i}]", f"{x.planet}'s pinhole is given at its two ends and also "
+                                                                 "by errors.pinhole or errors.pin_slope: give one form")
     ends = [x.planet for x in e.pinhole_ends]
     if len(set(ends)) < len(ends):
         raise ParameterError.at("errors.pinhole_ends", "at most one entry per planet (its pin has two ends)")

@@ -121,6 +121,6 @@ def test_a_sliced_machines_static_state_is_that_of_the_equivalent_position_error
     xa, xb = (solve_snapshots(s, snapshot_times(s, 1))[0] for s in (sa, sb))
     m = sa.model
     tilts = m.free >= m.n_body_coords
-    assert np.abs(xb.q[tilts]).max() > 1e-5                                  # the slope is felt: planets and rollers tilt
+    assert np.abs(xb.q[tilts]).max() > 1e-5                  # the slope is felt: planets and rollers tilt
     np.testing.assert_allclose(xa.q, xb.q, rtol=0, atol=1e-12 * max(1.0, np.abs(xb.q).max()))
     np.testing.assert_allclose(xa.q[tilts], xb.q[tilts], rtol=0, atol=1e-9 * np.abs(xb.q[tilts]).max())

@@ -197,7 +197,8 @@ def _pairs(rng, n, z2, faults):
         f1, f2 = np.ones(Z1), np.ones(z2)
         if faults:
             f1[3 + m], f2[5] = 0.4, 0.0
-        t1, t2 = tooth_table(Z1, rng.normal(0, 4e-6, (Z1, 2, 4)), f1), tooth_table(z2, rng.normal(0, 4e-6, (z2, 2, 4)), f2)
+        t1 = tooth_table(Z1, rng.normal(0, 4e-6, (Z1, 2, 4)), f1)
+        t2 = tooth_table(z2, rng.normal(0, 4e-6, (z2, 2, 4)), f2)
         off = sum(t.size for t in tables)
         s1.append(off)
         s2.append(off + t1.size)
