@@ -179,9 +179,12 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     check_design(params, strict=strict)
     si = params.si()
     faults.check_errors(si)
-    if si.bearing.model == "planar" and (si.errors.pin_slope or si.gears.carrier_windup):
-        raise ParameterError.at("errors.pin_slope" if si.errors.pin_slope else "gears.carrier_windup",
-                                "a pin slope is seen only by the sliced bearing model: set bearing.model = 'sliced'")
+    if si.bearing.model == "planar" and (faults.pin_slopes(si) or si.gears.carrier_windup):
+        what = ("errors.pin_slope" if si.errors.pin_slope else "errors.pinhole_ends" if faults.pin_slopes(si)
+                else "gears.carrier_windup")
+        why = "a pinhole's two ends differ, so its pin slopes: " if what == "errors.pinhole_ends" else ""
+        raise ParameterError.at(what, why + "a pin slope is seen only by the sliced bearing model: set "
+                                            "bearing.model = 'sliced'")
     lay = si.layout
     G, op, sup, ms = si.gears, si.operating, si.support, si.mesh
     wc = op.carrier_speed
@@ -219,7 +222,7 @@ def build_dpgt(params: DPGTParams, options: SceneOptions | None = None, strict: 
     a_names = [f"a{n + 1}" for n in range(N)]
     b_names = [f"b{n + 1}" for n in range(N)]
     for n in range(N):
-        # pins (and the planets on them) where the carrier's pinholes really are (errors.pinhole)
+        # pins (and the planets on them) where the carrier's pinholes really are (errors.pinhole, pinhole_ends)
         pa, pb = faults.pin_position(si, a_names[n], lay.centres_a[n]), faults.pin_position(si, b_names[n], lay.centres_b[n])
         va, vb = wc * np.array([-pa[1], pa[0]]), wc * np.array([-pb[1], pb[0]])
         scene.body(a_names[n], G.inner_planet.mass, G.inner_planet.inertia, pose=(*pa, ph.gamma_inner[n]), vel=(*va, speed["a"]))

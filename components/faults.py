@@ -5,7 +5,9 @@ outer) and gears ("sun", "ring" or a planet). :func:`check_errors` checks those 
 the machine; the other functions resolve the errors into the per-instance parameters of the element
 families that feel them:
 
-* pinhole error → the pin's marker on the carrier (:func:`pin_position`);
+* pinhole error → the pin's marker on the carrier (:func:`pin_position`); a pinhole measured at the pin's two ends
+  → its mean position error and its slope (:func:`pinhole_from_ends`), which :func:`pin_position` and
+  :func:`pin_slope` take with the others;
 * roller diameter deviation → that roller's D in both raceway contacts (:func:`roller_diameters`);
 * spall → the raceway contacts' defect parameters (:func:`spall_args`);
 * runout → the mesh families' geometric-centre offsets (:func:`mesh_error_args`);
@@ -21,9 +23,11 @@ import numpy as np
 
 from . import teeth
 from .geometry import centre_distance_limit
+from .params import PinholeErrorSI, PinSlopeSI
 from .units import ParameterError
 
-__all__ = ["check_errors", "pin_position", "roller_diameters", "spall_args", "mesh_error_args", "GEAR_OF"]
+__all__ = ["check_errors", "pin_position", "pin_slope", "pinhole_from_ends", "pinholes", "pin_slopes",
+           "roller_diameters", "spall_args", "mesh_error_args", "GEAR_OF"]
 
 TWO_PI = 2.0 * np.pi
 GEAR_OF = {"sun": "sun", "ring": "ring", "a": "inner_planet", "b": "outer_planet"}   # name → si.gears field
@@ -35,6 +39,36 @@ def _gear_si(si, name: str):
 
 def _planet_index(name: str) -> int:
     return int(name[1:]) - 1
+
+
+def pinhole_from_ends(x, plate_span: float) -> tuple[PinholeErrorSI, PinSlopeSI]:
+    """A pinhole measured at its pin's two ends (:class:`~components.params.errors.PinholeEndsSI`: radial r and
+    tangential t errors in the shaft-side plate at ζ = +L_c/2 and in the far plate at ζ = −L_c/2, L_c = ``plate_span``
+    [m]) as the pin's position error and slope it stands for: the pin's axis is the straight line through its two
+    ends, so at the bearing's mid-plane (ζ = 0) it is off by the ends' mean, ((r_s + r_f)/2, (t_s + t_f)/2), and it
+    slopes by (r_s − r_f)/L_c radially and (t_s − t_f)/L_c tangentially — the slope γ = |that| in the direction
+    χ = atan2(tangential, radial) from the planet's radial line (errors.pin_slope's form: the axis at station ζ is
+    off by ζ γ (cos χ, sin χ) in the planet's radial and tangential directions)."""
+    L = float(plate_span)
+    if not L > 0.0:
+        raise ParameterError.at("gears.carrier_plate_span", f"must be > 0 m to place a pin's two ends, got {L!r}")
+    rs, ts, rf, tf = x.radial_shaft_plate, x.tangential_shaft_plate, x.radial_far_plate, x.tangential_far_plate
+    sr, st = (rs - rf) / L, (ts - tf) / L
+    return (PinholeErrorSI(planet=x.planet, radial=0.5 * (rs + rf), tangential=0.5 * (ts + tf)),
+            PinSlopeSI(planet=x.planet, slope=float(np.hypot(sr, st)), direction=float(np.arctan2(st, sr))))
+
+
+def pinholes(si) -> tuple:
+    """Every pinhole position error: errors.pinhole and the mean of each errors.pinhole_ends entry."""
+    span = si.gears.carrier_plate_span
+    return tuple(si.errors.pinhole) + tuple(pinhole_from_ends(x, span)[0] for x in si.errors.pinhole_ends)
+
+
+def pin_slopes(si) -> tuple:
+    """Every pin slope error: errors.pin_slope and the slope of each errors.pinhole_ends entry whose ends differ."""
+    span = si.gears.carrier_plate_span
+    ends = (pinhole_from_ends(x, span)[1] for x in si.errors.pinhole_ends)
+    return tuple(si.errors.pin_slope) + tuple(s for s in ends if s.slope != 0.0)
 
 
 def check_errors(si) -> None:
@@ -50,6 +84,15 @@ def check_errors(si) -> None:
         planet(f"errors.pinhole[{i}].planet", x.planet)
     for i, x in enumerate(e.pin_slope):
         planet(f"errors.pin_slope[{i}].planet", x.planet)
+    both = {x.planet for x in e.pinhole} | {x.planet for x in e.pin_slope}
+    for i, x in enumerate(e.pinhole_ends):
+        planet(f"errors.pinhole_ends[{i}].planet", x.planet)
+        if x.planet in both:
+            raise ParameterError.at(f"errors.pinhole_ends[{i}]", f"{x.planet}'s pinhole is given at its two ends and also "
+                                                                 "by errors.pinhole or errors.pin_slope: give one form")
+    ends = [x.planet for x in e.pinhole_ends]
+    if len(set(ends)) < len(ends):
+        raise ParameterError.at("errors.pinhole_ends", "at most one entry per planet (its pin has two ends)")
     for i, x in enumerate(e.runout):
         planet(f"errors.runout[{i}].gear", x.gear)
     for i, x in enumerate(e.roller_diameter):
@@ -100,10 +143,12 @@ def _check_pinholes(si) -> None:
     e, lay = si.errors, si.layout
     play = 0.5 * si.bearing.clearance
     moved: dict[str, float] = {}
-    first: dict[str, int] = {}
-    for i, x in enumerate(e.pinhole):
+    first: dict[str, str] = {}
+    named = [(f"errors.pinhole[{i}]", x) for i, x in enumerate(e.pinhole)]
+    named += [(f"errors.pinhole_ends[{i}]", x) for i, x in enumerate(pinholes(si)[len(e.pinhole):])]
+    for path, x in named:
         moved[x.planet] = moved.get(x.planet, 0.0) + float(np.hypot(x.radial, x.tangential))
-        first.setdefault(x.planet, i)
+        first.setdefault(x.planet, path)
     for planet, d in moved.items():
         n = _planet_index(planet)
         other = moved.get(("b" if planet[0] == "a" else "a") + planet[1:], 0.0)     # the pair's other planet
@@ -112,7 +157,7 @@ def _check_pinholes(si) -> None:
         for key, da in meshes:
             what = centre_distance_limit(lay.meshes[key], lay.gears, da)
             if what:
-                raise ParameterError.at(f"errors.pinhole[{first[planet]}]",
+                raise ParameterError.at(first[planet],
                                         f"moves {planet} by {d * 1e6:.4g} um, its {key.replace('_', '-')} centre distance "
                                         f"(with the bearing's play) by up to {da * 1e3:.3f} mm, at which {what}: the "
                                         f"gears allow less (pair {n + 1})")
@@ -120,12 +165,12 @@ def _check_pinholes(si) -> None:
 
 def pin_position(si, planet: str, nominal) -> np.ndarray:
     """The pin centre of ``planet`` in the carrier's axes: nominal plus its pinhole errors (radial along the
-    planet's angle ψ, tangential along ψ + 90°)."""
+    planet's angle ψ, tangential along ψ + 90°; :func:`pinholes`)."""
     n = _planet_index(planet)
     psi = (si.layout.psi_a if planet[0] == "a" else si.layout.psi_b)[n]
     er, et = np.array([np.cos(psi), np.sin(psi)]), np.array([-np.sin(psi), np.cos(psi)])
     out = np.array(nominal, float)
-    for x in si.errors.pinhole:
+    for x in pinholes(si):
         if x.planet == planet:
             out = out + x.radial * er + x.tangential * et
     return out
@@ -133,14 +178,15 @@ def pin_position(si, planet: str, nominal) -> np.ndarray:
 
 def pin_slope(si, planet: str, nominal) -> np.ndarray:
     """The slope (2,) [rad] of ``planet``'s pin axis in the carrier's axes (docs/model.md §8.8): its errors.pin_slope
-    entries (γ along the direction χ from the planet's radial line) plus, with gears.carrier_windup, the carrier's
+    entries and its errors.pinhole_ends' slope (:func:`pin_slopes`: γ along the direction χ from the planet's radial
+    line) plus, with gears.carrier_windup, the carrier's
     wind-up: the shaft-side plate (at +ζ) turns by Δθ = T_c/k_tc against the far plate (T_c the carrier's torque,
     k_tc gears.carrier_torsional_stiffness), so a pin at radius r_p (``nominal`` its centre) slopes by r_p Δθ/L_c
     along the tangential direction (L_c gears.carrier_plate_span): forward and reverse tilt it opposite ways."""
     n = _planet_index(planet)
     psi = (si.layout.psi_a if planet[0] == "a" else si.layout.psi_b)[n]
     out = np.zeros(2)
-    for x in si.errors.pin_slope:
+    for x in pin_slopes(si):
         if x.planet == planet:
             out = out + x.slope * np.array([np.cos(psi + x.direction), np.sin(psi + x.direction)])
     G = si.gears

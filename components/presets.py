@@ -196,7 +196,7 @@ def perfect_machine() -> ErrorsParams:
     """No manufacturing errors or faults: the machine the source models (docs/model.md §11)."""
     return ErrorsParams(**{f: paper((), "the source models a perfect machine")
                            for f in ("pinhole", "runout", "roller_diameter", "spall", "tooth_fault", "tooth",
-                                     "flank_class", "pin_slope")})
+                                     "flank_class", "pin_slope", "pinhole_ends")})
 
 
 def typical_errors(params: DPGTParams, grade: int) -> ErrorsParams:

@@ -56,9 +56,10 @@ from .bearing import (BearingParams, BearingSI, CageParams, CageSI, LifeParams, 
                       SlicingSI, SlideRollTractionParams, SlideRollTractionSI)
 from .dotted import (describe, flatten, overrides_from_toml, parameter_names, parameter_rows, spans, to_toml,
                      with_overrides)
-from .errors import (ErrorsParams, ErrorsSI, FlankClassParams, FlankClassSI, PinholeErrorParams, PinholeErrorSI,
-                     RollerDiameterErrorParams, RollerDiameterErrorSI, RunoutParams, RunoutSI, SpallParams, SpallSI,
-                     ToothDeviationParams, ToothDeviationSI, ToothFaultParams, ToothFaultSI)
+from .errors import (ErrorsParams, ErrorsSI, FlankClassParams, FlankClassSI, PinholeEndsParams, PinholeEndsSI,
+                     PinholeErrorParams, PinholeErrorSI, PinSlopeParams, PinSlopeSI, RollerDiameterErrorParams,
+                     RollerDiameterErrorSI, RunoutParams, RunoutSI, SpallParams, SpallSI, ToothDeviationParams,
+                     ToothDeviationSI, ToothFaultParams, ToothFaultSI)
 from .gears import GearParams, GearSetParams, GearSetSI, GearSI, MeshParams, MeshSI
 from .machine import DPGTOperatingSI, DPGTParams, DPGTSI, DPGTSupportSI, SupportParams, SupportSI
 from .operating import (BearingRigParams, BearingRigSI, CarrierRippleParams, CarrierRippleSI, OperatingPoint,
@@ -72,11 +73,11 @@ __all__ = [
     "SupportParams", "MeshParams", "OperatingPoint", "HousingParams", "SensorParams", "CarrierRippleParams", "RigParams",
     "SchedulePointParams", "DPGTParams", "BearingRigParams",
     "ErrorsParams", "PinholeErrorParams", "RunoutParams", "RollerDiameterErrorParams", "SpallParams", "ToothFaultParams",
-    "ToothDeviationParams", "FlankClassParams",
+    "ToothDeviationParams", "FlankClassParams", "PinSlopeParams", "PinholeEndsParams",
     "GearSI", "GearSetSI", "CageSI", "SlideRollTractionSI", "LifeSI", "BearingSI", "LubricantSI", "SupportSI", "MeshSI",
     "OperatingSI", "HousingSI", "SensorSI", "CarrierRippleSI", "RigSI", "SchedulePointSI", "DPGTSI", "DPGTOperatingSI", "DPGTSupportSI",
     "BearingRigSI", "ErrorsSI", "PinholeErrorSI", "RunoutSI", "RollerDiameterErrorSI", "SpallSI", "ToothFaultSI",
-    "ToothDeviationSI", "FlankClassSI",
+    "ToothDeviationSI", "FlankClassSI", "PinSlopeSI", "PinholeEndsSI",
     "with_overrides", "parameter_names", "flatten", "describe", "parameter_rows", "to_toml", "overrides_from_toml",
     "spans",
 ]

@@ -11,7 +11,7 @@ from ._machinery import SI, Params, entries, named, nonneg, param, param_fields,
 __all__ = ["PinholeErrorParams", "PinholeErrorSI", "RunoutParams", "RunoutSI", "RollerDiameterErrorParams",
            "RollerDiameterErrorSI", "SpallParams", "SpallSI", "ToothFaultParams", "ToothFaultSI",
            "ToothDeviationParams", "ToothDeviationSI", "FlankClassParams", "FlankClassSI", "PinSlopeParams",
-           "PinSlopeSI", "ErrorsParams", "ErrorsSI"]
+           "PinSlopeSI", "PinholeEndsParams", "PinholeEndsSI", "ErrorsParams", "ErrorsSI"]
 
 
 _PLANET = r"[ab][1-9][0-9]*"
@@ -43,7 +43,8 @@ class PinSlopeParams(Params["PinSlopeSI"]):
     """A planet's pin not parallel to the carrier axis (a pinhole's two ends off by different amounts across the
     face): the pin's axis slopes by ``slope`` in the direction ``direction`` measured in the carrier from the
     planet's radial line (0: radial, outwards at +ζ; 90 deg: tangential, with the planet angle). Seen only by the
-    sliced bearing model (bearing.model = "sliced", docs/model.md §8.8)."""
+    sliced bearing model (bearing.model = "sliced", docs/model.md §8.8). A pinhole measured at its two ends:
+    errors.pinhole_ends."""
     _prefix: ClassVar[str] = "errors.pin_slope"
     planet: str = named(_PLANET, _PLANET_TEXT, "the planet whose pin slopes")
     slope: Quantity = nonneg("angle", "the pin's slope against the carrier axis (e.g. '4 arcmin')")
@@ -55,6 +56,35 @@ class PinSlopeSI(SI):
     planet: str
     slope: float
     direction: float
+
+
+@dataclass(frozen=True, kw_only=True)
+class PinholeEndsParams(Params["PinholeEndsSI"]):
+    """A planet's pinhole as it is measured: the radial and tangential position errors of its pin's two ends, in the
+    carrier's shaft-side plate (at ζ = +L_c/2) and in its far plate (at ζ = −L_c/2), L_c = gears.carrier_plate_span.
+    The model takes their mean as the pin's position error (errors.pinhole) and their difference over L_c as its
+    slope (errors.pin_slope: radial part (r_shaft − r_far)/L_c, tangential (t_shaft − t_far)/L_c;
+    components.faults.pinhole_from_ends, docs/model.md §11.1). A planet's pinhole is given in this form or in the
+    other two, not both. Ends that differ need the sliced bearing model (bearing.model = "sliced")."""
+    _prefix: ClassVar[str] = "errors.pinhole_ends"
+    planet: str = named(_PLANET, _PLANET_TEXT, "the planet whose pinhole is measured")
+    radial_shaft_plate: Quantity = param("length", "radial position error of the pin's end in the shaft-side carrier "
+                                                   "plate, at +L_c/2 (+ outwards)")
+    tangential_shaft_plate: Quantity = param("length", "tangential position error of the pin's end in the shaft-side "
+                                                       "plate (+ with the planet angle)")
+    radial_far_plate: Quantity = param("length", "radial position error of the pin's end in the far carrier plate, at "
+                                                 "-L_c/2 (+ outwards)")
+    tangential_far_plate: Quantity = param("length", "tangential position error of the pin's end in the far plate "
+                                                     "(+ with the planet angle)")
+
+
+@si_of(PinholeEndsParams)
+class PinholeEndsSI(SI):
+    planet: str
+    radial_shaft_plate: float
+    tangential_shaft_plate: float
+    radial_far_plate: float
+    tangential_far_plate: float
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -215,6 +245,8 @@ class ErrorsParams(Params["ErrorsSI"]):
                                                                           "flank tolerance class")
     pin_slope: tuple[PinSlopeParams, ...] = entries(PinSlopeParams, "pin slopes (misalignment; the sliced bearing "
                                                                    "model)")
+    pinhole_ends: tuple[PinholeEndsParams, ...] = entries(PinholeEndsParams, "pinhole errors measured at the pin's two "
+                                                                             "ends (the carrier plates)")
 
     @property
     def perfect(self) -> bool:
@@ -231,3 +263,4 @@ class ErrorsSI(SI):
     tooth: tuple[ToothDeviationSI, ...]
     flank_class: tuple[FlankClassSI, ...]
     pin_slope: tuple[PinSlopeSI, ...]
+    pinhole_ends: tuple[PinholeEndsSI, ...]

@@ -198,17 +198,19 @@ def _to_geometric(ql, vl, P, off, qg, vg, r):
 def _from_geometric(Fg, Jqg, Jvg, r, vl, F, Jq, Jv, jac):
     """Body forces Q = Aᵀ F_g from the forces F_g on the geometric centres (A = ∂q_g/∂q), and
     ∂Q/∂q = Aᵀ(J_q A + J_v B) + (∂Aᵀ/∂θ) F_g, ∂Q/∂v = Aᵀ J_v A with B = ∂v_g/∂q.
-    Per gear A = [[1, 0, −r_y], [0, 1, r_x], [0, 0, 1]] and B's only column, θ's, is −ω (r_x, r_y, 0)."""
+    Per gear A = [[1, 0, −r_y], [0, 1, r_x], [0, 0, 1]] and B's only column, θ's, is −ω (r_x, r_y, 0); local
+    coordinates after the two gears' six (a face-sliced mesh's slopes) are the same in both (A = I there)."""
+    nl = Fg.shape[1]
     for i in range(Fg.shape[0]):
-        for j in range(6):
+        for j in range(nl):
             F[i, j] = Fg[i, j]
         for b in range(2):
             k, rx, ry = 3 * b, r[i, 2 * b], r[i, 2 * b + 1]
             F[i, k + 2] = Fg[i, k + 2] + (rx * Fg[i, k + 1] - ry * Fg[i, k])     # + the moment r × F_g
         if not jac:
             continue
-        for row in range(6):         # columns: J_q A + J_v B and J_v A
-            for col in range(6):
+        for row in range(nl):        # columns: J_q A + J_v B and J_v A
+            for col in range(nl):
                 Jq[i, row, col] = Jqg[i, row, col]
                 Jv[i, row, col] = Jvg[i, row, col]
             for b in range(2):
@@ -218,7 +220,7 @@ def _from_geometric(Fg, Jqg, Jvg, r, vl, F, Jq, Jv, jac):
                 Jv[i, row, k + 2] += -ry * Jvg[i, row, k] + rx * Jvg[i, row, k + 1]
         for b in range(2):           # rows: Aᵀ (the θ rows gain r × the force rows), then (∂Aᵀ/∂θ) F_g
             k, rx, ry = 3 * b, r[i, 2 * b], r[i, 2 * b + 1]
-            for col in range(6):
+            for col in range(nl):
                 Jq[i, k + 2, col] += -ry * Jq[i, k, col] + rx * Jq[i, k + 1, col]
                 Jv[i, k + 2, col] += -ry * Jv[i, k, col] + rx * Jv[i, k + 1, col]
             Jq[i, k + 2, k + 2] -= rx * Fg[i, k] + ry * Fg[i, k + 1]

@@ -448,8 +448,8 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
 
 
 # ------------------------------------------------------------------------------------------------ SlicedGearMesh
-# P: the GearMesh layout (mbd.compiled.mesh, without eccentricity or the tooth-pair law), then 4 columns:
-# face width b [m], slices n_m, gear 1 has slopes (1/0), gear 2 has slopes (1/0);  G: the GearMesh layout.
+# P: the GearMesh layout (mbd.compiled.mesh: its eccentricity and tooth-pair blocks when the family has them), then 4
+# columns: face width b [m], slices n_m, gear 1 has slopes (1/0), gear 2 has slopes (1/0);  G: the GearMesh layout.
 MESH_EXTRA = 4
 
 
@@ -457,9 +457,6 @@ def pack_sliced_gear_mesh(elem):
     if type(elem) is not SlicedGearMesh:
         raise NotImplementedError(f"{elem.name}: the compiled SlicedGearMesh kernel does not cover "
                                   f"{type(elem).__name__}")
-    if elem.has_offset or elem.pairs is not None:
-        raise NotImplementedError(f"SlicedGearMesh {elem.name!r}: the compiled path has no face-sliced mesh with "
-                                  "eccentricity or the tooth-pair law (use the numpy path)")
     P, G = mesh.pack_gear_mesh(elem)
     n = elem.n
     extra = np.column_stack([elem.face_width, np.full(n, float(elem.n_m)), np.full(n, float(elem.has1)),
@@ -469,15 +466,41 @@ def pack_sliced_gear_mesh(elem):
 
 @njit(cache=True)
 def evaluate_sliced_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
-    """The face-sliced lumped mesh law (SlicedGearMesh.kernel, docs/model.md §6.6) and its exact Jacobian: the slice
-    loop once per flank, its derivative blocks summed against the powers of ζ_k, then every direction of the local
-    coordinates at the mesh level (the differential of every line of the reference)."""
-    shape = int(G[mesh.G_SHAPE])
+    """The face-sliced mesh law (SlicedGearMesh.kernel, docs/model.md §6.6) and its exact Jacobian. Without
+    eccentricity the law on the body centres (:func:`_sliced_meshes`); with it (G[G_OFFSET] ≥ 0) on the geometric
+    centres c + R(θ)·o, the forces and Jacobians mapped back to the body coordinates by the chain rule as the
+    unsliced mesh's (mbd.compiled.mesh._to_geometric, _from_geometric; the slopes are the same coordinates in both)."""
+    off = int(G[mesh.G_OFFSET])
+    if off < 0:
+        _sliced_meshes(ql, vl, P, G, F, Jq, Jv, jac)
+        return
+    n, nl = ql.shape
+    qg, vg, r, Fg = ql.copy(), vl.copy(), np.empty((n, 4)), np.empty((n, nl))
+    Jqg, Jvg = np.empty((n if jac else 0, nl, nl)), np.empty((n if jac else 0, nl, nl))
+    mesh._to_geometric(ql, vl, P, off, qg, vg, r)
+    _sliced_meshes(qg, vg, P, G, Fg, Jqg, Jvg, jac)
+    mesh._from_geometric(Fg, Jqg, Jvg, r, vl, F, Jq, Jv, jac)
+
+
+@njit(cache=True)
+def _sliced_meshes(ql, vl, P, G, F, Jq, Jv, jac):
+    """The face-sliced law at local coordinates ql, rates vl (body or geometric centres): the slice loop once per
+    flank, its derivative blocks summed against the powers of ζ_k, then every direction of the local coordinates at
+    the mesh level (the differential of every line of the reference). Lumped law: a slice's force is
+    (k(p)/n_m) δ_k + (c_m/n_m) S δ̇_k, its derivative blocks ∂F_k/∂δ_k, ∂F_k/∂δ̇_k and (for k(p)) δ_k. Tooth-pair law
+    (G[G_PAIRS] ≥ 0): the pairs' stiffness, gaps and roll coordinate u are the mesh's (every slice has its mesh's
+    teeth: :func:`.tooth_pairs.pair_setup` once per flank), each slice their sum at its own δ_k, δ̇_k with 1/n_m of
+    the stiffness and damping (:func:`.tooth_pairs.pair_force`), and the blocks gain ∂F_k/∂u and ∂F_k/∂u̇, moved along
+    a direction by du = z_1/2π (dθ_1 − dφ_e) and du̇ = z_1/2π (dω_1 − d(t·ḋ/a))."""
+    shape, pcol, tstart = int(G[mesh.G_SHAPE]), int(G[mesh.G_PAIRS]), int(G[mesh.G_TABLE])
+    pairs = pcol >= 0
     nl = ql.shape[1]
     e0 = P.shape[1] - MESH_EXTRA
-    mom = np.zeros((2, 9))          # per flank: Σ ζ^m A_k, Σ ζ^m B_k, Σ ζ^m d_k (m = 0, 1, 2)
+    # per flank: Σ ζ^m A_k, Σ ζ^m B_k, Σ ζ^m d_k (m = 0, 1, 2), Σ ζ^m U_k, Σ ζ^m V_k (m = 0, 1)
+    mom = np.zeros((2, 13))
     Ff, Mf = np.zeros(2), np.zeros(2)
     dq, dv = np.zeros(nl), np.zeros(nl)
+    kk, dk, gg, dg, d2g = np.empty(2), np.empty(2), np.empty(2), np.empty(2), np.empty(2)
     for i in range(ql.shape[0]):
         sig, rb1, rb2 = P[i, mesh.P_SIGMA], P[i, mesh.P_RB1], P[i, mesh.P_RB2]
         sa, kappa0, pb, z1 = P[i, mesh.P_SIN_ALPHA], P[i, mesh.P_KAPPA0], P[i, mesh.P_PITCH], P[i, mesh.P_TEETH1]
@@ -514,7 +537,7 @@ def evaluate_sliced_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv,
         fac, dfac = mesh._factor(shape, z1 * (th1 - phi_e) * (1.0 / _TWO_PI) + P[i, mesh.P_P0], P, i, G)
         k_mean, c_m, ramp = P[i, mesh.P_K_MEAN], P[i, mesh.P_C_MESH], P[i, mesh.P_RAMP]
         kp = k_mean * fac
-        kk, cc = kp / nm, c_m / nm
+        kk_, cc = kp / nm, c_m / nm
         t_s, e_s = tx * dsx + ty * dsy, ex * dsx + ey * dsy
         hx, hy, qsx, qsy = 0.0, 0.0, 0.0, 0.0
         if jac:
@@ -528,20 +551,62 @@ def evaluate_sliced_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv,
             gs = gx * dsx + gy * dsy
             gs_dot = (sig * f * kappa * (e_dd * t_s + t_dd * e_s) - sa * t_dd * t_s) / a + gx * dvx + gy * dvy
             FF, MM = 0.0, 0.0
+            if pairs:
+                bound = P[i, pcol + tooth_pairs.Q_BOUND]
+                # no slice reaches a pair (δ_k ≤ δ_f + |ζ_k g·Δs| ≤ −bound): the flank carries nothing
+                if d_f + 0.5 * bw * abs(gs) + bound <= 0.0:
+                    Ff[fi], Mf[fi] = 0.0, 0.0
+                    continue
+                z2 = np.rint(rb2 / rb1 * z1)
+                K0, dK0, udot = tooth_pairs.pair_setup(f, P, i, pcol, G, tstart, sig, z1, z2, k_mean / nm,
+                                                       P[i, mesh.P_RECT_H], P[i, mesh.P_RECT_S],
+                                                       P[i, mesh.P_RECT_SINGLE], P[i, mesh.P_RECT_RATIO], th1, th2,
+                                                       phi_e, w1, inv_a, t_dd, kk, dk, gg, dg, d2g)
             for k in range(nm):
                 zeta = bw / nm * (k + 1 - 0.5 * (nm + 1))
                 d_k = d_f + zeta * gs
+                if pairs:
+                    if d_k + bound <= 0.0:
+                        continue
+                    r_k = r_f + zeta * gs_dot
+                    F_k, A_k, B_k, U_k, V_k = 0.0, 0.0, 0.0, 0.0, 0.0
+                    for j in range(2):
+                        Fj, kc, cS, a_u, a_ud = tooth_pairs.pair_force(kk[j], dk[j], gg[j], dg[j], d2g[j], K0, dK0,
+                                                                       udot, cc, ramp, d_k, r_k)
+                        if not Fj > 0.0:
+                            continue
+                        F_k += Fj
+                        A_k += kc
+                        B_k += cS
+                        U_k += a_u
+                        V_k += a_ud
+                    if not F_k > 0.0:
+                        continue
+                    FF += F_k
+                    MM += zeta * F_k
+                    if jac:
+                        mom[fi, 0] += A_k
+                        mom[fi, 1] += zeta * A_k
+                        mom[fi, 2] += zeta * zeta * A_k
+                        mom[fi, 3] += B_k
+                        mom[fi, 4] += zeta * B_k
+                        mom[fi, 5] += zeta * zeta * B_k
+                        mom[fi, 9] += U_k
+                        mom[fi, 10] += zeta * U_k
+                        mom[fi, 11] += V_k
+                        mom[fi, 12] += zeta * V_k
+                    continue
                 if not d_k > 0.0:
                     continue
                 r_k = r_f + zeta * gs_dot
                 S, dS = tooth_pairs.damping_share(d_k, ramp)
-                F_k = kk * d_k + cc * S * r_k
+                F_k = kk_ * d_k + cc * S * r_k
                 if not F_k > 0.0:
                     continue
                 FF += F_k
                 MM += zeta * F_k
                 if jac:
-                    A_k, B_k = kk + cc * dS * r_k, cc * S
+                    A_k, B_k = kk_ + cc * dS * r_k, cc * S
                     zm = 1.0
                     for m in range(3):
                         mom[fi, m] += zm * A_k
@@ -596,6 +661,8 @@ def evaluate_sliced_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv,
             ds_dot = droll - dkappa * t_dd - kappa * dt_dd
             dradial_dot = sig * sa * de_dd
             dkp = k_mean * dfac * z1 * (pth1 - dphi) * (1.0 / _TWO_PI)
+            du = z1 * (1.0 / _TWO_PI) * (pth1 - dphi)                   # the pairs' roll coordinate and its rate
+            dudot = z1 * (1.0 / _TWO_PI) * (pw1 - (dt_dd * inv_a - t_dd * da * inv_a * inv_a))
             dt_s = dtx * dsx + dty * dsy + tx * pdsx + ty * pdsy
             de_s = dex * dsx + dey * dsy + ex * pdsx + ey * pdsy
             dFnet, dFsum, dhx, dhy, dqsx, dqsy = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -616,6 +683,9 @@ def evaluate_sliced_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv,
                 mo = mom[fi]
                 dF = mo[0] * dd_f + mo[1] * dgs + mo[3] * dr_f + mo[4] * dgs_dot + dkp * mo[6] / nm
                 dM = mo[1] * dd_f + mo[2] * dgs + mo[4] * dr_f + mo[5] * dgs_dot + dkp * mo[7] / nm
+                if pairs:
+                    dF += mo[9] * du + mo[11] * dudot
+                    dM += mo[10] * du + mo[12] * dudot
                 MM = Mf[fi]
                 dFnet += f * dF
                 dFsum += dF

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["flank_force", "damping_share", "NCOLS"]
+__all__ = ["flank_force", "pair_setup", "pair_force", "damping_share", "NCOLS", "Q_BOUND"]
 
 _TWO_PI = 2.0 * np.pi
 (Q_ENTRY, Q_PHASE2, Q_RELIEF1, Q_RELIEF2, Q_START1, Q_START2, Q_BOUND) = (0, 2, 4, 7, 10, 11, 12)
@@ -68,14 +68,11 @@ def _cubic(G, base, x):
 
 
 @njit(cache=True)
-def flank_force(f, P, i, col, G, tstart, sig, z1, z2, k_mean, c_m, ramp, h, s, single, ratio, th1, th2, phi_e,
-                w1, delta, rate, ex, ey, tx, ty, inv_a, t_dd, e_dd, ddelta, drate, grad, jac):
-    """F_f of flank f of mesh i by the pair law; with ``jac`` its gradient into ``grad`` (8,), from the
-    flank's ∇δ_f (``ddelta``) and ∇δ̇_f (``drate``)."""
-    if jac:
-        grad[:] = 0.0
-    if delta + P[i, col + Q_BOUND] <= 0.0:
-        return 0.0
+def pair_setup(f, P, i, col, G, tstart, sig, z1, z2, k_mean, h, s, single, ratio, th1, th2, phi_e, w1, inv_a,
+               t_dd, kk, dk, gg, dg, d2g):
+    """The two pairs of flank f of mesh i: per pair j its stiffness k_j (faults included) and k_j', its gap g_j, g_j',
+    g_j'' (derivatives in u) into kk, dk, gg, dg, d2g (2,); returns (K_0, K_0', u̇): the pairs' stiffness without
+    faults, its derivative in u, and the roll coordinate's rate."""
     eps = 2.0 * h + 1.0
     fi = 0 if f > 0 else 1
     c1 = z1 / _TWO_PI
@@ -92,8 +89,6 @@ def flank_force(f, P, i, col, G, tstart, sig, z1, z2, k_mean, c_m, ramp, h, s, s
     kmax = k_mean * single
     r1, r2 = col + Q_RELIEF1, col + Q_RELIEF2
     s1, s2 = tstart + int(P[i, col + Q_START1]), tstart + int(P[i, col + Q_START2])
-    # per pair: k (with faults), k', gap, g', g''; K0 and K0' (without faults) share the damping
-    kk, dk, gg, dg, d2g = np.empty(2), np.empty(2), np.empty(2), np.empty(2), np.empty(2)
     K0, dK0 = 0.0, 0.0
     for j in range(2):
         u = u0 + j
@@ -118,6 +113,42 @@ def flank_force(f, P, i, col, G, tstart, sig, z1, z2, k_mean, c_m, ramp, h, s, s
         kk[j], dk[j] = kmax * sh * fac, kmax * dsh * fac
         K0 += kmax * sh
         dK0 += kmax * dsh
+    return K0, dK0, udot
+
+
+@njit(cache=True)
+def pair_force(k, dkj, g, dgj, d2gj, K0, dK0, udot, c_m, ramp, delta, rate):
+    """(F_j, ∂F_j/∂δ_f, ∂F_j/∂δ̇_f, ∂F_j/∂u, ∂F_j/∂u̇) of one pair at flank compression δ_f and rate δ̇_f (the pair's
+    data from :func:`pair_setup`); all zero while the pair is open or would pull."""
+    comp = delta - g
+    if comp <= 0.0 or k == 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0
+    S, dS = damping_share(comp, ramp)
+    cj = c_m * k / K0
+    rj = rate - dgj * udot
+    Fj = k * comp + cj * S * rj
+    if Fj <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0
+    dcj = c_m * (dkj * K0 - k * dK0) / (K0 * K0)
+    kc = k + cj * rj * dS                                              # ∂F_j/∂comp
+    a_u = dkj * comp - kc * dgj + dcj * S * rj - cj * S * d2gj * udot       # ∂F_j/∂u (comp = δ − g(u))
+    a_ud = -cj * S * dgj                                                    # ∂F_j/∂u̇
+    return Fj, kc, cj * S, a_u, a_ud
+
+
+@njit(cache=True)
+def flank_force(f, P, i, col, G, tstart, sig, z1, z2, k_mean, c_m, ramp, h, s, single, ratio, th1, th2, phi_e,
+                w1, delta, rate, ex, ey, tx, ty, inv_a, t_dd, e_dd, ddelta, drate, grad, jac):
+    """F_f of flank f of mesh i by the pair law; with ``jac`` its gradient into ``grad`` (8,), from the
+    flank's ∇δ_f (``ddelta``) and ∇δ̇_f (``drate``)."""
+    if jac:
+        grad[:] = 0.0
+    if delta + P[i, col + Q_BOUND] <= 0.0:
+        return 0.0
+    kk, dk, gg, dg, d2g = np.empty(2), np.empty(2), np.empty(2), np.empty(2), np.empty(2)
+    K0, dK0, udot = pair_setup(f, P, i, col, G, tstart, sig, z1, z2, k_mean, h, s, single, ratio, th1, th2, phi_e,
+                               w1, inv_a, t_dd, kk, dk, gg, dg, d2g)
+    c1 = z1 / _TWO_PI
     F = 0.0
     # gradients of u and u̇ over (d, θ1, θ2, ḋ, ω1, ω2)
     gu0, gu1, gu2 = -c1 * tx * inv_a, -c1 * ty * inv_a, c1
@@ -126,25 +157,14 @@ def flank_force(f, P, i, col, G, tstart, sig, z1, z2, k_mean, c_m, ramp, h, s, s
     gv1 = c1 * (ty * e_dd + ey * t_dd) * ia2
     gv4, gv5, gv6 = -c1 * tx * inv_a, -c1 * ty * inv_a, c1
     for j in range(2):
-        k = kk[j]
-        comp = delta - gg[j]
-        if comp <= 0.0 or k == 0.0:
-            continue
-        S, dS = damping_share(comp, ramp)
-        cj = c_m * k / K0
-        rj = rate - dg[j] * udot
-        Fj = k * comp + cj * S * rj
-        if Fj <= 0.0:
+        Fj, kc, cS, a_u, a_ud = pair_force(kk[j], dk[j], gg[j], dg[j], d2g[j], K0, dK0, udot, c_m, ramp, delta, rate)
+        if not Fj > 0.0:
             continue
         F += Fj
         if not jac:
             continue
-        dcj = c_m * (dk[j] * K0 - k * dK0) / (K0 * K0)
-        kc = k + cj * rj * dS                                              # ∂F_j/∂comp
-        a_u = dk[j] * comp - kc * dg[j] + dcj * S * rj - cj * S * d2g[j] * udot     # ∂F_j/∂u (comp = δ − g(u))
-        a_ud = -cj * S * dg[j]                                                      # ∂F_j/∂u̇
         for v in range(8):
-            grad[v] += kc * ddelta[v] + cj * S * drate[v]
+            grad[v] += kc * ddelta[v] + cS * drate[v]
         grad[0] += a_u * gu0 + a_ud * gv0
         grad[1] += a_u * gu1 + a_ud * gv1
         grad[2] += a_u * gu2

@@ -37,8 +37,9 @@ OLD_NAMES = {
 
 
 # names the package gained since: the range an assumed value carries and the list of them; a knot of the operating
-# point's schedule
-ADDED = {"Span", "spans", "SchedulePointParams", "SchedulePointSI", "PinParams", "PinSI"}
+# point's schedule; a pin's slope and a pinhole measured at its two ends
+ADDED = {"Span", "spans", "SchedulePointParams", "SchedulePointSI", "PinParams", "PinSI", "PinSlopeParams", "PinSlopeSI",
+         "PinholeEndsParams", "PinholeEndsSI"}
 
 
 def test_the_package_offers_every_name_of_the_old_module():

@@ -188,8 +188,102 @@ def _roundoff_floor(elem, fs, qf, vf, trials=4):
     return 4.0 * dq, 4.0 * dv
 
 
-def test_sliced_mesh_with_teeth_or_runout_is_refused_by_the_compiled_path():
-    elem, _ = _mesh_family(False, SHAPES["rectangular"], 5, 0.0, 0.0, True, True)
-    elem.has_offset = True
-    with pytest.raises(NotImplementedError, match="eccentricity or the tooth-pair law"):
-        kind_of(SlicedGearMesh).pack(elem)
+def _pairs(rng, n, z2, faults):
+    """Tooth-pair data of n meshes of gear 1 (Z1 teeth) with gear 2 (z2 teeth): a cubic excess on every flank face of
+    every tooth (≈ 4 µm), with ``faults`` a cracked tooth on gear 1 and a missing one on gear 2, tip relief on both."""
+    from mbd.elements.tooth_pairs import ToothPairs, tooth_table
+    tables, s1, s2 = [], [], []
+    for m in range(n):
+        f1, f2 = np.ones(Z1), np.ones(z2)
+        if faults:
+            f1[3 + m], f2[5] = 0.4, 0.0
+        t1 = tooth_table(Z1, rng.normal(0, 4e-6, (Z1, 2, 4)), f1)
+        t2 = tooth_table(z2, rng.normal(0, 4e-6, (z2, 2, 4)), f2)
+        off = sum(t.size for t in tables)
+        s1.append(off)
+        s2.append(off + t1.size)
+        tables += [t1, t2]
+    return ToothPairs(entry=rng.uniform(0, 1, (n, 2)), phase2=rng.uniform(-0.5, 0.5, (n, 2)),
+                      relief1=np.array([6e-6, 0.7, 2.0]), relief2=np.array([5e-6, 0.75, 1.0]),
+                      table=np.concatenate(tables), start1=np.array(s1, float), start2=np.array(s2, float))
+
+
+def _error_family(internal, n_m, c, backlash, has1, has2, runout, pairs, rng):
+    """_mesh_family's three meshes (rectangular stiffness) with eccentricity of both gears (``runout``: ≈ 5 µm, one
+    mesh without) and/or the tooth-pair law (``pairs``)."""
+    rb2 = RBR if internal else RB2
+    a0 = ((rb2 - RB1) if internal else (RB1 + rb2)) / np.cos(ALPHA)
+    s1 = np.array([[18 + 2 * m, 19 + 2 * m] for m in range(3)]) if has1 else None
+    s2 = np.array([[24 + 2 * m, 25 + 2 * m] for m in range(3)]) if has2 else None
+    poses1, poses2 = _nominal(a0, internal)
+    o1 = o2 = None
+    if runout:
+        o1, o2 = rng.normal(0, 5e-6, (3, 2)), rng.normal(0, 5e-6, (3, 2))
+        o1[1], o2[1] = 0.0, 0.0
+    pp = _pairs(rng, 3, int(round(rb2 / RB1 * Z1)), faults=True) if pairs else None
+    return SlicedGearMesh("mesh", np.arange(0, 3), np.arange(3, 6), slopes1=s1, slopes2=s2, face_width=BW, slices=n_m,
+                          internal=internal, rb1=RB1, rb2=rb2, alpha=ALPHA, a0=a0, teeth1=Z1, k_mean=K_MESH, c_mesh=c,
+                          damping_ramp=1e-6 if c else 0.0, backlash=backlash, stiffness=SHAPES["rectangular"],
+                          u0=mesh_u0(internal, RB1, rb2, poses1, poses2), phi_ref=LINE, offset1=o1, offset2=o2,
+                          pairs=pp), a0
+
+
+@pytest.mark.parametrize("internal", [False, True])
+@pytest.mark.parametrize("errors", ["runout", "pairs", "both"])
+@SETTINGS
+@given(fs=frame_states(), n_m=st.sampled_from([1, 4, 11]), c=st.sampled_from([0.0, 2e3]),
+       backlash=st.sampled_from([0.0, 1e-5]), has=st.sampled_from([(True, True), (True, False), (False, True)]),
+       turn=st.lists(st.sampled_from([-3e-4, -2e-5, 2e-5, 3e-4]), min_size=3, max_size=3),
+       slope=st.sampled_from([1e-5, 1e-4, 1e-3]), seed=st.integers(0, 2 ** 31))
+def test_sliced_mesh_with_runout_and_teeth_matches_reference(internal, errors, fs, n_m, c, backlash, has, turn, slope,
+                                                             seed):
+    """The face-sliced mesh with eccentric gears (the law on the geometric centres, mapped back by the chain rule)
+    and the tooth-pair law slice by slice (deviations on every tooth, a cracked and a missing tooth, tip relief):
+    the compiled kernel equals the reference (dual numbers through SlicedGearMesh.kernel) to round-off, forces and
+    both Jacobians, every slice situation of the lumped test (flanks open, in the ramp, beyond, slices partly open)."""
+    rng = np.random.default_rng(seed)
+    elem, a0 = _error_family(internal, n_m, c, backlash, *has, runout=errors != "pairs", pairs=errors != "runout",
+                             rng=rng)
+    qf, vf = _mesh_state(rng, a0, internal, turn, slope)
+    floor_q, floor_v = _roundoff_floor(elem, fs, qf, vf)
+    F = assert_matches_reference(elem, fs, qf, vf, jq_floor=floor_q, jv_floor=floor_v)
+    assert np.all(np.isfinite(F))
+
+
+@pytest.mark.parametrize("internal", [False, True])
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_compiled_uniform_slices_are_the_compiled_mesh_with_runout_and_teeth(internal, seed):
+    """No relative slope: every slice of the compiled face-sliced kernel is 1/n_m of the compiled unsliced mesh
+    (GearMesh, mbd.compiled.mesh), eccentricity and tooth-pair law included — forces and the gears' Jacobian blocks
+    to round-off, and no force on the slopes (the slices' moments cancel)."""
+    from mbd.elements.gear_mesh import GearMesh
+    rng = np.random.default_rng(seed)
+    elem, a0 = _error_family(internal, 7, 2e3, 1e-6, True, True, runout=True, pairs=True, rng=rng)
+    kw = {k: getattr(elem, k) for k in ("rb1", "rb2", "alpha", "a0", "teeth1", "k_mean", "c_mesh", "damping_ramp",
+                                        "u0", "backlash", "phi_ref", "offset1", "offset2", "pairs")}
+    lumped = GearMesh("lumped", np.arange(0, 3), np.arange(3, 6), internal=internal, stiffness=elem.stiffness, **kw)
+    loaded = 0
+    for turn in ([3e-4, -3e-4, 3e-4], [-3e-4, 3e-4, -3e-4]):
+        qf, vf = _mesh_state(rng, a0, internal, turn, 0.0)
+        qf[18:], vf[18:] = 0.0, 0.0
+        Fs, Jqs, Jvs = compiled(elem, FS, qf, vf, None, True)
+        Fl, Jql, Jvl = compiled(lumped, FS, qf, vf, None, True)
+        for i in range(3):
+            scale = np.abs(Fl[i]).max()
+            loaded += scale > 1e3
+            np.testing.assert_allclose(Fs[i, :6], Fl[i], rtol=0, atol=1e-11 * scale + 1e-9)
+            np.testing.assert_allclose(Fs[i, 6:], 0.0, atol=1e-11 * scale * BW + 1e-9)
+            for A, B in ((Jqs, Jql), (Jvs, Jvl)):
+                np.testing.assert_allclose(A[i, :6, :6], B[i], rtol=0, atol=1e-11 * np.abs(B[i]).max() + 1e-9)
+    assert loaded >= 4
+
+
+def test_family_with_runout_and_teeth_packs_both_error_blocks():
+    """The packed layout holds the eccentricity and tooth-pair blocks (G's columns of mbd.compiled.mesh) ahead of the
+    face-sliced columns: the kernel finds both."""
+    from mbd.compiled import mesh as cmesh
+    elem, _ = _error_family(False, 5, 0.0, 0.0, True, True, runout=True, pairs=True, rng=np.random.default_rng(0))
+    P, G = kind_of(SlicedGearMesh).pack(elem)
+    assert G[cmesh.G_OFFSET] >= 0 and G[cmesh.G_PAIRS] > G[cmesh.G_OFFSET]
+    np.testing.assert_array_equal(P[:, int(G[cmesh.G_OFFSET]):int(G[cmesh.G_OFFSET]) + 2], elem.offset1)
+    np.testing.assert_array_equal(P[:, -4], elem.face_width)
