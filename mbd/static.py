@@ -428,8 +428,8 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
             own[sb] = nB + j
     local = np.column_stack([groups, own[orbiting]])           # (L, 3): radius, place, own spin rate
     tilt = _tilt_columns(model, B, orbiting)
-    if np.any(tilt >= 0):         # (L, 4): and its tilt, where it has one (a sliced bearing's roller)
-        local = np.column_stack([local, tilt])
+    # (L, 4): with its tilt, where it has one (a sliced bearing's roller): the continuation that stalls on a tilt
+    local_tilt = np.column_stack([local, tilt]) if np.any(tilt >= 0) else None
     nbod = model.n_bodies         # each free DOF's body, and its inertia (an angle's scale: the radius of gyration)
     body = np.concatenate([np.repeat(np.arange(nbod), 3), model.extra_owner])[model.free]
     J = np.concatenate([np.repeat(model.inertia, 3), model.extra_inertia])[model.free]
@@ -444,6 +444,9 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
                                        np.zeros(len(rates))])
     x_start = x.copy()
     x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization, bisect=True)
+    if not ok and local_tilt is not None:   # again with each roller's tilt in its local group (a roller at the load
+        x, more, ok = _ptc(prob, x_start, local_tilt, tol, cap, max_steps, regularization, bisect=True)  # zone's edge)
+        steps += more
     if not ok:      # again without the rates' bisection: a machine without load (rates flip as the loads come in)
         x, more, ok = _ptc(prob, x_start, local, tol, cap, max_steps, regularization, bisect=False)
         steps += more
