@@ -359,7 +359,11 @@ def _directions(model: Model, motion: SteadyMotion, t: float, held: np.ndarray, 
 def _tilt_columns(model: Model, B: sp.csc_matrix, orbiting: np.ndarray) -> np.ndarray:
     """(L,) the column of B that moves each orbiting body's own tilt coordinate (a roller's tilt in its radial–axial
     plane; −1: none, or held). No element joins two orbiting bodies' tilts (each roller's contacts are its own), so a
-    roller's tilt belongs with its radius and spin in its local group (:func:`_local_solve`)."""
+    roller's tilt can join its radius and spin in its local group (:func:`_local_solve`). That is the second pass of
+    :func:`solve_static`, where the continuation with the tilts among the outer unknowns stalls: a roller at the load
+    zone's edge, on the bore under its centrifugal load alone, has a small tilt stiffness and a moment that steps as
+    the pin's slices touch one by one; Newton's steps throw it across those kinks, every step of the others is refused
+    with it, and the continuation crawls. In its local group it has its own halving and its own quartered bound."""
     out = -np.ones(orbiting.size, np.int64)
     if not model.has_tilt:
         return out
@@ -501,9 +505,10 @@ def carry(model: Model, motion: SteadyMotion, sol: StaticSolution, t: float, rat
 
 
 def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarray, max_iter: int = 100):
-    """Solve every local group (a row of ``local``: radius, place and own spin rate of one orbiting body, −1
-    where absent) for fixed outer unknowns, all groups at once. No element joins two groups, so one
-    perturbation of every group's first unknown gives each group's first Jacobian column, and so on: a 3×3
+    """Solve every local group (a row of ``local``: radius, place and own spin rate of one orbiting body, and its
+    tilt in a second pass (:func:`_tilt_columns`), −1 where absent) for fixed outer unknowns, all groups at once. No
+    element joins two groups, so one perturbation of every group's first unknown gives each group's first Jacobian
+    column, and so on: a 3×3 (4×4 with the tilt)
     Newton system per group (an unknown whose own stiffness is not positive steps by its cap along its
     residual). Steps are clipped to their caps and damped per group: a group whose scaled residual grew has
     its next step halved (a contact that opened or closed too far), one whose residual fell regains full steps —

@@ -1,7 +1,7 @@
-"""Static states of the sliced machine at the instants where the continuation used to stall on a roller's tilt
-(mbd.static: each roller's tilt is solved in its own local group, with its radius and spin): the four cases of the
-elastic pins and wind-up study that found none (docs/misalignment.md, condition 1, straight rollers, two snapshots)
-and the double-row bearing at 10′ tangential (condition 3 forward).
+"""Static states of the sliced machine at instants where the continuation with the rollers' tilts among its unknowns
+stalls on a roller's tilt, so that mbd.static solves them again with each roller's tilt in its local group (with its
+radius and spin): the four cases of the elastic pins and wind-up study that had no state (docs/misalignment.md,
+condition 1, straight rollers, two snapshots) and the double-row bearing at 10′ tangential (condition 3 forward).
 
 Truths: the solution is an equilibrium — every solved unknown's residual at the solver's tolerance and, without the
 solver's residual, each planet's balance summed element family by element family: the bearing's load (the roller
