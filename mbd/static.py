@@ -40,7 +40,7 @@ from threadpoolctl import threadpool_limits
 
 from .assembly import System
 from .errors import ModelError
-from .model import Model
+from .model import TILT, Model
 
 __all__ = ["SteadyMotion", "StaticSolution", "carry", "solve_static"]
 
@@ -356,6 +356,31 @@ def _directions(model: Model, motion: SteadyMotion, t: float, held: np.ndarray, 
     return B, orbiting, np.column_stack([rad, tan])
 
 
+def _tilt_columns(model: Model, B: sp.csc_matrix, orbiting: np.ndarray) -> np.ndarray:
+    """(L,) the column of B that moves each orbiting body's own tilt coordinate (a roller's tilt in its radial–axial
+    plane; −1: none, or held). No element joins two orbiting bodies' tilts (each roller's contacts are its own), so a
+    roller's tilt can join its radius and spin in its local group (:func:`_local_solve`). That is the second pass of
+    :func:`solve_static`, where the continuation with the tilts among the outer unknowns stalls: a roller at the load
+    zone's edge, on the bore under its centrifugal load alone, has a small tilt stiffness and a moment that steps as
+    the pin's slices touch one by one; Newton's steps throw it across those kinks, every step of the others is refused
+    with it, and the continuation crawls. In its local group it has its own halving and its own quartered bound."""
+    out = -np.ones(orbiting.size, np.int64)
+    if not model.has_tilt:
+        return out
+    kind, owner = np.asarray(model.extra_kind), np.asarray(model.extra_owner)
+    rows = B.tocsr()
+    where = {int(b): k for k, b in enumerate(orbiting)}
+    for j in np.flatnonzero(kind == TILT):
+        k = where.get(int(owner[j]))
+        f = int(model.full_to_free[model.n_body_coords + j])
+        if k is None or f < 0:
+            continue
+        cols = rows[f].indices
+        if cols.size == 1:
+            out[k] = int(cols[0])
+    return out
+
+
 def solve_static(model: Model, motion: SteadyMotion, t: float, *, hold=(), rates=(), tangential: bool = False,
                  q_start: np.ndarray | None = None, rates_start=None, z: dict | None = None,
                  system: System | None = None, engine: str = "auto", evaluator=None, length_tol: float = 1e-11,
@@ -406,6 +431,9 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
         if sb >= 0 and not ob and motion.orbit[sb] != 0.0:
             own[sb] = nB + j
     local = np.column_stack([groups, own[orbiting]])           # (L, 3): radius, place, own spin rate
+    tilt = _tilt_columns(model, B, orbiting)
+    # (L, 4): with its tilt, where it has one (a sliced bearing's roller): the continuation that stalls on a tilt
+    local_tilt = np.column_stack([local, tilt]) if np.any(tilt >= 0) else None
     nbod = model.n_bodies         # each free DOF's body, and its inertia (an angle's scale: the radius of gyration)
     body = np.concatenate([np.repeat(np.arange(nbod), 3), model.extra_owner])[model.free]
     J = np.concatenate([np.repeat(model.inertia, 3), model.extra_inertia])[model.free]
@@ -420,6 +448,9 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
                                        np.zeros(len(rates))])
     x_start = x.copy()
     x, steps, ok = _ptc(prob, x, local, tol, cap, max_steps, regularization, bisect=True)
+    if not ok and local_tilt is not None:   # again with each roller's tilt in its local group (a roller at the load
+        x, more, ok = _ptc(prob, x_start, local_tilt, tol, cap, max_steps, regularization, bisect=True)  # zone's edge)
+        steps += more
     if not ok:      # again without the rates' bisection: a machine without load (rates flip as the loads come in)
         x, more, ok = _ptc(prob, x_start, local, tol, cap, max_steps, regularization, bisect=False)
         steps += more
@@ -474,9 +505,10 @@ def carry(model: Model, motion: SteadyMotion, sol: StaticSolution, t: float, rat
 
 
 def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarray, max_iter: int = 100):
-    """Solve every local group (a row of ``local``: radius, place and own spin rate of one orbiting body, −1
-    where absent) for fixed outer unknowns, all groups at once. No element joins two groups, so one
-    perturbation of every group's first unknown gives each group's first Jacobian column, and so on: a 3×3
+    """Solve every local group (a row of ``local``: radius, place and own spin rate of one orbiting body, and its
+    tilt in a second pass (:func:`_tilt_columns`), −1 where absent) for fixed outer unknowns, all groups at once. No
+    element joins two groups, so one perturbation of every group's first unknown gives each group's first Jacobian
+    column, and so on: a 3×3 (4×4 with the tilt)
     Newton system per group (an unknown whose own stiffness is not positive steps by its cap along its
     residual). Steps are clipped to their caps and damped per group: a group whose scaled residual grew has
     its next step halved (a contact that opened or closed too far), one whose residual fell regains full steps —
@@ -489,14 +521,15 @@ def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarr
     present = local >= 0
     damp = np.ones(L)
     size = np.full(L, np.inf)
-    last_floor = np.ones((L, 3))
+    nl = local.shape[1]
+    last_floor = np.ones((L, nl))
     reach = cap[idx].copy()                 # each unknown's own step bound: quartered when its residual flips sign
-    sign = np.zeros((L, 3))
+    sign = np.zeros((L, nl))
     g = prob.residual(x)[0]
     for _ in range(max_iter):
         gl = np.where(present, g[idx], 0.0)
-        Kl = np.zeros((L, 3, 3))
-        for j in range(3):
+        Kl = np.zeros((L, nl, nl))
+        for j in range(nl):
             if not present[:, j].any():
                 Kl[:, j, j] = 1.0
                 continue
@@ -524,9 +557,9 @@ def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarr
         size, last_floor = new_size, floor
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             fin = np.all(np.isfinite(Kl), axis=(1, 2))
-            det = np.where(fin, np.linalg.det(np.where(fin[:, None, None], Kl, np.eye(3))), 0.0)
+            det = np.where(fin, np.linalg.det(np.where(fin[:, None, None], Kl, np.eye(nl))), 0.0)
             good = np.all(diag > 0, axis=1) & (det > 0)
-            d = np.linalg.solve(np.where(good[:, None, None], Kl, np.eye(3)), gl[..., None])[..., 0]
+            d = np.linalg.solve(np.where(good[:, None, None], Kl, np.eye(nl)), gl[..., None])[..., 0]
             good &= np.all(np.isfinite(d), axis=1)
             d = np.where(good[:, None], d, np.where(diag > 0, gl / diag, np.sign(gl) * cap[idx]))
         flipped = sign * np.sign(gl) < 0
