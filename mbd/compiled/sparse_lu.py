@@ -41,12 +41,12 @@ def _factor(lu, data):
     factors of ``lu`` (:attr:`FixedPatternLU.arrays`). X: the block column being eliminated, row-major (3 rows ×
     3 columns a block row); L, U blocks and the diagonal blocks (L strict lower with a unit diagonal, U upper)
     row-major. Returns False on a zero or non-finite pivot (X left clean)."""
-    Sp, Sidx, Srow, Scol, dummy, pos, BLp, BLi, Lx, BUp, BUi, Ux, Dx, X, y = lu
+    Sp, Sidx, Sx, dummy, pos, BLp, BLi, Lx, BUp, BUi, Ux, Dx, X, y = lu
     nb = Sp.size - 1
     for K in range(nb):
         k0 = 3 * K
         for p in range(Sp[K], Sp[K + 1]):                       # scatter block column K
-            X[3 * Srow[p] + Scol[p]] = data[Sidx[p]]
+            X[Sx[p]] = data[Sidx[p]]
         for c in range(3):
             if dummy[k0 + c]:
                 X[3 * (k0 + c) + c] = 1.0
@@ -119,7 +119,7 @@ def _factor(lu, data):
 def _solve(lu, b):
     """x with A x = b from the factors in ``lu`` (forward with L by block columns, backward with U by block
     columns; padded entries stay zero)."""
-    Sp, Sidx, Srow, Scol, dummy, pos, BLp, BLi, Lx, BUp, BUi, Ux, Dx, X, y = lu
+    Sp, Sidx, Sx, dummy, pos, BLp, BLi, Lx, BUp, BUi, Ux, Dx, X, y = lu
     nb = Sp.size - 1
     for i in range(y.size):
         y[i] = 0.0
@@ -231,7 +231,7 @@ class FixedPatternLU:
         lo = np.maximum(br, bc), np.minimum(br, bc)
         if not all((int(r), int(c)) in have for r, c in zip(*lo)):
             raise RuntimeError("FixedPatternLU: the block pattern misses an entry of L or U")
-        # A's entries by block column: (its index in data, padded row, column within the block)
+        # A's entries by block column: its index in data, its place in X (padded row, column within the block)
         place = where[iperm]                             # padded place of A's row / column c
         col = np.repeat(np.arange(n), np.diff(self.indptr))
         pr, pc = place[self.indices], place[col]
@@ -240,7 +240,7 @@ class FixedPatternLU:
         i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)          # noqa: E731
         self.blocks = nb
         self.perm = perm                                 # perm[k]: the column of A eliminated k-th
-        self.arrays = (Sp, i64(order), i64(pr[order]), i64(pc[order] % 3), dummy, i64(place),
+        self.arrays = (Sp, i64(order), i64(3 * pr[order] + pc[order] % 3), dummy, i64(place),
                        i64(BL.indptr), i64(BL.indices), np.zeros(9 * BL.indices.size),
                        i64(BU.indptr), i64(BU.indices), np.zeros(9 * BU.indices.size),
                        np.zeros(9 * nb), np.zeros(9 * nb), np.zeros(3 * nb))
