@@ -21,7 +21,7 @@ reports failure; the caller then falls back to partial pivoting. Every entry of 
 updates in the scalar left-looking LU's order on SuperLU's order (from the earlier columns, ascending;
 the solves' from the earlier and the later columns, in their order), and a structurally zero entry of a
 block contributes an exact zero: the factors and the solution are those of the scalar column LU on the
-same order, bit for bit (``tests/mbd/test_compiled_lu.py``).
+same order, bit for bit up to the sign of a zero (``tests/mbd/test_compiled_lu.py``).
 """
 from __future__ import annotations
 
