@@ -29,12 +29,14 @@ def repeat_assemble(groups, reps, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
 
 
 @njit(cache=True)
-def repeat_lu(reps, c_C, c_K, Mdata, Jq, Jv, lu):
+def repeat_lu(reps, c_C, c_K, Mdata, Jq, Jv, A, lu):
     """The Newton matrix M − c_C J_v − c_K J_q formed and factored, as the step loop's refresh does (``lu``: the
     factors' arrays, :attr:`.sparse_lu.FixedPatternLU.arrays`)."""
     ok = True
     for _ in range(reps):
-        ok = _factor(lu, Mdata, Jq, Jv, c_C, c_K)
+        for e in range(A.size):
+            A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
+        ok = _factor(lu, A)
     return ok
 
 
@@ -54,7 +56,7 @@ def repeat_update(groups, reps, t0, t1, q0, v0, q1, v1, fams, zs, sysd):
 
 
 @njit(cache=True)
-def replay(groups, steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c_K, Mdata, lu, b, t0, q0, v0):
+def replay(groups, steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c_K, Mdata, A, lu, b, t0, q0, v0):
     """The parts in a step's mix and order (per step: a Jacobian + LU when their count per step has accrued to one,
     then the residuals and solves accrued, then the internal-state update), without the loop's own arithmetic."""
     literally(groups)
@@ -64,7 +66,9 @@ def replay(groups, steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c
         if aj >= 1.0:
             aj -= 1.0
             assemble(groups, t, q, v, fams, zs, bool(True), sysd, F, Jq, Jv)    # run-time flags, as the step loop
-            _factor(lu, Mdata, Jq, Jv, c_C, c_K)
+            for e in range(A.size):
+                A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
+            _factor(lu, A)
         ar += cr
         asol += cs
         while ar >= 1.0 or asol >= 1.0:

@@ -36,24 +36,17 @@ _B = 3          # block size: a body's x, y, θ (the kernels below are written o
 
 
 @njit(cache=True)
-def _factor(lu, M, Jq, Jv, c_C, c_K):
-    """Left-looking 3×3-block LU of the ordered matrix A = M − c_C J_v − c_K J_q (each in the pattern's CSC order;
-    the Newton matrix, formed entry by entry as it is scattered) into the factors of ``lu``
-    (:attr:`FixedPatternLU.arrays`). X: the block column being eliminated, row-major (3 rows × 3 columns a block
-    row); L, U blocks and the diagonal blocks (L strict lower with a unit diagonal, U upper) row-major. Returns
-    False on a non-finite entry or a zero or non-finite pivot (X left clean)."""
-    Sp, Sidx, Sx, dummy, pos, BLp, BLi, Lx, BUp, BUi, Ux, Dx, X, y, out = lu
+def _factor(lu, data):
+    """Left-looking 3×3-block LU of the ordered matrix with entries ``data`` (the pattern's CSC order) into the
+    factors of ``lu`` (:attr:`FixedPatternLU.arrays`). X: the block column being eliminated, row-major (3 rows ×
+    3 columns a block row); L, U blocks and the diagonal blocks (L strict lower with a unit diagonal, U upper)
+    row-major. Returns False on a zero or non-finite pivot (X left clean)."""
+    Sp, Sidx, Sx, dummy, pos, BLp, BLi, Lx, BUp, BUi, Ux, Dx, X, y = lu
     nb = Sp.size - 1
     for K in range(nb):
         k0 = 3 * K
         for p in range(Sp[K], Sp[K + 1]):                       # scatter block column K
-            e = Sidx[p]
-            a = M[e] - c_C * Jv[e] - c_K * Jq[e]
-            if not np.isfinite(a):
-                for i in range(X.size):
-                    X[i] = 0.0
-                return False
-            X[Sx[p]] = a
+            X[Sx[p]] = data[Sidx[p]]
         for c in range(3):
             if dummy[k0 + c]:
                 X[3 * (k0 + c) + c] = 1.0
@@ -125,11 +118,11 @@ def _factor(lu, M, Jq, Jv, c_C, c_K):
 @njit(cache=True)
 def _solve(lu, b):
     """x with A x = b from the factors in ``lu`` (forward with L by block columns, backward with U by block
-    columns; padded entries zero). x is ``lu``'s own output array, overwritten by the next solve."""
-    Sp, Sidx, Sx, dummy, pos, BLp, BLi, Lx, BUp, BUi, Ux, Dx, X, y, out = lu
+    columns; padded entries stay zero)."""
+    Sp, Sidx, Sx, dummy, pos, BLp, BLi, Lx, BUp, BUi, Ux, Dx, X, y = lu
     nb = Sp.size - 1
-    for i in range(y.size):                                     # a padded entry that a non-finite solve reached
-        y[i] = 0.0                                              # would carry it into the next one
+    for i in range(y.size):
+        y[i] = 0.0
     for c in range(b.size):
         y[pos[c]] = b[c]
     for J in range(nb):                                         # L y = c (unit diagonal)
@@ -158,9 +151,10 @@ def _solve(lu, b):
             y[j0] = ((y[j0] - Ux[m + 2] * y2) - Ux[m + 1] * y1) - Ux[m] * y0
             y[j0 + 1] = ((y[j0 + 1] - Ux[m + 5] * y2) - Ux[m + 4] * y1) - Ux[m + 3] * y0
             y[j0 + 2] = ((y[j0 + 2] - Ux[m + 8] * y2) - Ux[m + 7] * y1) - Ux[m + 6] * y0
+    x = np.empty(b.size)
     for c in range(b.size):
-        out[c] = y[pos[c]]
-    return out
+        x[c] = y[pos[c]]
+    return x
 
 
 def _runs(S: sp.csr_matrix, n: int) -> list[int]:
@@ -249,17 +243,16 @@ class FixedPatternLU:
         self.arrays = (Sp, i64(order), i64(3 * pr[order] + pc[order] % 3), dummy, i64(place),
                        i64(BL.indptr), i64(BL.indices), np.zeros(9 * BL.indices.size),
                        i64(BU.indptr), i64(BU.indices), np.zeros(9 * BU.indices.size),
-                       np.zeros(9 * nb), np.zeros(9 * nb), np.zeros(3 * nb), np.zeros(n))
-        self._zeros = np.zeros(nnz)
+                       np.zeros(9 * nb), np.zeros(9 * nb), np.zeros(3 * nb))
         self.ok = False
 
     def factor(self, data) -> bool:
         """Factor the matrix with values ``data`` on the pattern; False on a zero or non-finite pivot."""
         data = np.ascontiguousarray(data, dtype=float)
-        self.ok = bool(_factor(self.arrays, data, self._zeros, self._zeros, 0.0, 0.0))
+        self.ok = bool(_factor(self.arrays, data))
         return self.ok
 
     def solve(self, b) -> np.ndarray:
         if not self.ok:
             raise RuntimeError("FixedPatternLU.solve before a successful factor")
-        return _solve(self.arrays, np.ascontiguousarray(b, dtype=float)).copy()
+        return _solve(self.arrays, np.ascontiguousarray(b, dtype=float))

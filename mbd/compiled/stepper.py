@@ -79,12 +79,12 @@ def _refresh(groups, t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F, Jq, Jv, A
     n = mdiag.size
     arrs, D, dpiv = lu
     assemble(groups, t1, q1, v1, fams, zs, bool(True), sysd, F, Jq, Jv)       # a run-time flag (module docstring)
-    if _factor(arrs, Mdata, Jq, Jv, c_C, c_K):        # the Newton matrix formed as the LU scatters it
-        return 0
-    for e in range(A.size):                           # a non-finite entry or a zero pivot: which one
+    for e in range(A.size):
         A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
         if not np.isfinite(A[e]):
             return -1
+    if _factor(arrs, A):
+        return 0
     if D.shape[0] != n:                               # no room for the dense fallback (a large model)
         return -1
     D[:, :] = 0.0                                     # a zero diagonal pivot: partial pivoting
