@@ -29,21 +29,22 @@ def repeat_assemble(groups, reps, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
 
 
 @njit(cache=True)
-def repeat_lu(reps, c_C, c_K, Mdata, Jq, Jv, A, n, indptr, indices, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, x):
-    """The Newton matrix M − c_C J_v − c_K J_q formed and factored, as the step loop's refresh does."""
+def repeat_lu(reps, c_C, c_K, Mdata, Jq, Jv, A, lu):
+    """The Newton matrix M − c_C J_v − c_K J_q formed and factored, as the step loop's refresh does (``lu``: the
+    factors' arrays, :attr:`.sparse_lu.FixedPatternLU.arrays`)."""
     ok = True
     for _ in range(reps):
         for e in range(A.size):
             A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
-        ok = _factor(n, indptr, indices, A, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, x)
+        ok = _factor(lu, A)
     return ok
 
 
 @njit(cache=True)
-def repeat_solve(reps, n, perm, Lp, Li, Lx, Up, Ui, Ux, b, y):
+def repeat_solve(reps, lu, b):
     s = 0.0
     for _ in range(reps):
-        s += _solve(n, perm, Lp, Li, Lx, Up, Ui, Ux, b, y)[0]
+        s += _solve(lu, b)[0]
     return s
 
 
@@ -55,8 +56,7 @@ def repeat_update(groups, reps, t0, t1, q0, v0, q1, v1, fams, zs, sysd):
 
 
 @njit(cache=True)
-def replay(groups, steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c_K, Mdata, A, n, indptr, indices, iperm,
-            perm, Lp, Li, Lx, Up, Ui, Ux, xw, b, yw, t0, q0, v0):
+def replay(groups, steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c_K, Mdata, A, lu, b, t0, q0, v0):
     """The parts in a step's mix and order (per step: a Jacobian + LU when their count per step has accrued to one,
     then the residuals and solves accrued, then the internal-state update), without the loop's own arithmetic."""
     literally(groups)
@@ -68,7 +68,7 @@ def replay(groups, steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c
             assemble(groups, t, q, v, fams, zs, bool(True), sysd, F, Jq, Jv)    # run-time flags, as the step loop
             for e in range(A.size):
                 A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
-            _factor(n, indptr, indices, A, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, xw)
+            _factor(lu, A)
         ar += cr
         asol += cs
         while ar >= 1.0 or asol >= 1.0:
@@ -77,5 +77,5 @@ def replay(groups, steps, cr, cj, cs, t, q, v, fams, zs, sysd, F, Jq, Jv, c_C, c
                 assemble(groups, t, q, v, fams, zs, bool(False), sysd, F, Jq, Jv)
             if asol >= 1.0:
                 asol -= 1.0
-                _solve(n, perm, Lp, Li, Lx, Up, Ui, Ux, b, yw)
+                _solve(lu, b)
         update_internal(groups, t0, t, q0, v0, q, v, fams, zs, sysd)

@@ -106,8 +106,7 @@ class CompiledRunner:
         # the zero-pivot fallback (dense partial pivoting) needs n² floats: kept for n ≤ 1000 (8 MB); a larger
         # model whose diagonal pivot vanishes fails that step instead, and the controller shrinks h
         dense = np.zeros((n, n)) if n <= 1000 else np.zeros((0, 0))
-        self.lu = (lu.perm, lu.iperm, lu.Lp, lu.Li, lu.Lx, lu.Up, lu.Ui, lu.Ux, lu._x, lu._y, dense,
-                   np.zeros(n, np.int64))
+        self.lu = (lu.arrays, dense, np.zeros(n, np.int64))
         self.pat = (lu.indptr, lu.indices, np.ascontiguousarray(system._M, float), np.asarray(m.mdiag, float))
         self.cache = np.array([0.0, np.nan, 0.0])        # LU valid, its h, sparse (0) or dense (1)
         self.work = tuple(np.zeros(n) for _ in range(10)) + (np.zeros(nnz), np.zeros(nnz), np.zeros(nnz))

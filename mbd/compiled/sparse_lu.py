@@ -1,11 +1,27 @@
-"""Sparse LU of matrices that share one sparsity pattern (the Newton matrix of a model).
+"""Sparse LU of matrices that share one sparsity pattern (the Newton matrix of a model), in 3×3 blocks.
 
 Symbolic analysis once: SuperLU (scipy) chooses the fill-reducing symmetric order (minimum degree on
 AᵀA + A, as the numpy path asks it) and gives the patterns of L and U from a random matrix on the
-pattern (no cancellation). Numeric refactorisation, compiled: left-looking column LU on that fixed
-pattern with diagonal pivots — the numpy path's choice (``diag_pivot_thresh = 0``): the Newton matrix
-M + (1+α)(γhC + βh²K) is dominated by its diagonal mass, and the LU only drives Newton (the residual is
-exact). A zero or non-finite pivot reports failure; the caller then falls back to partial pivoting.
+pattern (no cancellation). On the DPGT that order is the bordered elimination by itself: every roller's
+DOFs first (each couples only to its cage, its planet and the carrier that holds its pin), then the
+cages, then the planets, the carrier, the sun and the ring — L and U hold 5 319 entries for the planar
+machine's 4 941.
+
+Blocks: the ordered columns are cut into blocks of 3 — a run of columns with one pattern (a body's x, y, θ:
+its element blocks couple all of them) fills blocks of 3, shorter runs share one (the sliced machine's
+rollers' tilt coordinates, eliminated one by one), and a block a column short is padded with a decoupled
+unit column. The block pattern is the block graph's own elimination (it holds the scalar L and U). Each
+block is a dense 3×3, so the factor and the solves run fixed-size code per block instead of a loop per
+column through index arrays.
+
+Numeric refactorisation, compiled: left-looking block LU on that fixed pattern with diagonal pivots — the
+numpy path's choice (``diag_pivot_thresh = 0``): the Newton matrix M + (1+α)(γhC + βh²K) is dominated by
+its diagonal mass, and the LU only drives Newton (the residual is exact). A zero or non-finite pivot
+reports failure; the caller then falls back to partial pivoting. Every entry of L and U takes its
+updates in the scalar left-looking LU's order on SuperLU's order (from the earlier columns, ascending;
+the solves' from the earlier and the later columns, in their order), and a structurally zero entry of a
+block contributes an exact zero: the factors and the solution are those of the scalar column LU on the
+same order, bit for bit up to the sign of a zero (``tests/mbd/test_compiled_lu.py``).
 """
 from __future__ import annotations
 
@@ -16,61 +32,160 @@ from numba import njit
 
 __all__ = ["FixedPatternLU"]
 
+_B = 3          # block size: a body's x, y, θ (the kernels below are written out for it)
+
 
 @njit(cache=True)
-def _factor(n, indptr, indices, data, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, x):
-    """Left-looking LU of B = A[perm][:, perm] on the fixed patterns (Lp, Li), (Up, Ui) (CSC, rows
-    ascending, L without its unit diagonal, U with the diagonal last). Returns False on a zero pivot."""
-    for k in range(n):
-        c = perm[k]
-        for p in range(indptr[c], indptr[c + 1]):       # scatter column k of B
-            x[iperm[indices[p]]] = data[p]
-        for p in range(Up[k], Up[k + 1] - 1):            # U(j, k), j < k ascending: x[j] is final
-            j = Ui[p]
-            ujk = x[j]
-            for q in range(Lp[j], Lp[j + 1]):
-                x[Li[q]] -= Lx[q] * ujk
-        for p in range(Up[k], Up[k + 1]):
-            Ux[p] = x[Ui[p]]
-            x[Ui[p]] = 0.0
-        piv = Ux[Up[k + 1] - 1]
-        if piv == 0.0 or not np.isfinite(piv):
-            for q in range(Lp[k], Lp[k + 1]):
-                x[Li[q]] = 0.0
+def _factor(lu, data):
+    """Left-looking 3×3-block LU of the ordered matrix with entries ``data`` (the pattern's CSC order) into the
+    factors of ``lu`` (:attr:`FixedPatternLU.arrays`). X: the block column being eliminated, row-major (3 rows ×
+    3 columns a block row); L, U blocks and the diagonal blocks (L strict lower with a unit diagonal, U upper)
+    row-major. Returns False on a zero or non-finite pivot (X left clean)."""
+    Sp, Sidx, Sx, dummy, pos, BLp, BLi, Lx, BUp, BUi, Ux, Dx, X, y = lu
+    nb = Sp.size - 1
+    for K in range(nb):
+        k0 = 3 * K
+        for p in range(Sp[K], Sp[K + 1]):                       # scatter block column K
+            X[Sx[p]] = data[Sidx[p]]
+        for c in range(3):
+            if dummy[k0 + c]:
+                X[3 * (k0 + c) + c] = 1.0
+        for q in range(BUp[K], BUp[K + 1]):                     # U(J, K), J < K ascending
+            J = BUi[q]
+            x = 9 * J
+            l10, l20, l21 = Dx[x + 3], Dx[x + 6], Dx[x + 7]     # J's own columns first (its diagonal block's L)
+            u00, u01, u02 = X[x], X[x + 1], X[x + 2]
+            u10 = X[x + 3] - l10 * u00
+            u11 = X[x + 4] - l10 * u01
+            u12 = X[x + 5] - l10 * u02
+            u20 = (X[x + 6] - l20 * u00) - l21 * u10
+            u21 = (X[x + 7] - l20 * u01) - l21 * u11
+            u22 = (X[x + 8] - l20 * u02) - l21 * u12
+            o = 9 * q
+            Ux[o], Ux[o + 1], Ux[o + 2] = u00, u01, u02
+            Ux[o + 3], Ux[o + 4], Ux[o + 5] = u10, u11, u12
+            Ux[o + 6], Ux[o + 7], Ux[o + 8] = u20, u21, u22
+            for e in range(9):
+                X[x + e] = 0.0
+            for b in range(BLp[J], BLp[J + 1]):                 # X(I, :) −= L(I, J) U(J, K), J's columns in order
+                i = 9 * BLi[b]
+                m = 9 * b
+                for r in range(3):
+                    a0, a1, a2 = Lx[m + 3 * r], Lx[m + 3 * r + 1], Lx[m + 3 * r + 2]
+                    t = i + 3 * r
+                    X[t] = ((X[t] - a0 * u00) - a1 * u10) - a2 * u20
+                    X[t + 1] = ((X[t + 1] - a0 * u01) - a1 * u11) - a2 * u21
+                    X[t + 2] = ((X[t + 2] - a0 * u02) - a1 * u12) - a2 * u22
+        x = 9 * K                                               # the diagonal block, column by column
+        ok = True
+        for c in range(3):
+            for j in range(c):                                  # column c's updates from K's earlier columns
+                ujc = X[x + 3 * j + c]
+                for r in range(j + 1, 3):
+                    X[x + 3 * r + c] -= Dx[x + 3 * r + j] * ujc
+                for b in range(BLp[K], BLp[K + 1]):
+                    i = 9 * BLi[b]
+                    m = 9 * b
+                    X[i + c] -= Lx[m + j] * ujc
+                    X[i + 3 + c] -= Lx[m + 3 + j] * ujc
+                    X[i + 6 + c] -= Lx[m + 6 + j] * ujc
+            for r in range(c + 1):
+                Dx[x + 3 * r + c] = X[x + 3 * r + c]
+            piv = X[x + 4 * c]
+            if piv == 0.0 or not np.isfinite(piv):
+                ok = False
+                break
+            inv = 1.0 / piv
+            for r in range(c + 1, 3):
+                Dx[x + 3 * r + c] = X[x + 3 * r + c] * inv
+            for b in range(BLp[K], BLp[K + 1]):
+                i = 9 * BLi[b]
+                m = 9 * b
+                Lx[m + c] = X[i + c] * inv
+                Lx[m + 3 + c] = X[i + 3 + c] * inv
+                Lx[m + 6 + c] = X[i + 6 + c] * inv
+        for e in range(9):
+            X[x + e] = 0.0
+        for b in range(BLp[K], BLp[K + 1]):
+            i = 9 * BLi[b]
+            for e in range(9):
+                X[i + e] = 0.0
+        if not ok:
             return False
-        inv = 1.0 / piv
-        for q in range(Lp[k], Lp[k + 1]):
-            Lx[q] = x[Li[q]] * inv
-            x[Li[q]] = 0.0
     return True
 
 
 @njit(cache=True)
-def _solve(n, perm, Lp, Li, Lx, Up, Ui, Ux, b, y):
-    """x with A x = b from the factors of B = A[perm][:, perm] (y: work array)."""
-    for i in range(n):
-        y[i] = b[perm[i]]
-    for j in range(n):                                   # L y = c (unit diagonal), column-oriented
-        yj = y[j]
-        for q in range(Lp[j], Lp[j + 1]):
-            y[Li[q]] -= Lx[q] * yj
-    for j in range(n - 1, -1, -1):                      # U y = y, column-oriented, diagonal last
-        d = Up[j + 1] - 1
-        y[j] /= Ux[d]
-        yj = y[j]
-        for p in range(Up[j], d):
-            y[Ui[p]] -= Ux[p] * yj
-    x = np.empty(n)
-    for i in range(n):
-        x[perm[i]] = y[i]
+def _solve(lu, b):
+    """x with A x = b from the factors in ``lu`` (forward with L by block columns, backward with U by block
+    columns; padded entries stay zero)."""
+    Sp, Sidx, Sx, dummy, pos, BLp, BLi, Lx, BUp, BUi, Ux, Dx, X, y = lu
+    nb = Sp.size - 1
+    for i in range(y.size):
+        y[i] = 0.0
+    for c in range(b.size):
+        y[pos[c]] = b[c]
+    for J in range(nb):                                         # L y = c (unit diagonal)
+        j0 = 3 * J
+        d = 9 * J
+        y0 = y[j0]
+        y1 = y[j0 + 1] - Dx[d + 3] * y0
+        y2 = (y[j0 + 2] - Dx[d + 6] * y0) - Dx[d + 7] * y1
+        y[j0 + 1], y[j0 + 2] = y1, y2
+        for q in range(BLp[J], BLp[J + 1]):
+            i0 = 3 * BLi[q]
+            m = 9 * q
+            y[i0] = ((y[i0] - Lx[m] * y0) - Lx[m + 1] * y1) - Lx[m + 2] * y2
+            y[i0 + 1] = ((y[i0 + 1] - Lx[m + 3] * y0) - Lx[m + 4] * y1) - Lx[m + 5] * y2
+            y[i0 + 2] = ((y[i0 + 2] - Lx[m + 6] * y0) - Lx[m + 7] * y1) - Lx[m + 8] * y2
+    for K in range(nb - 1, -1, -1):                             # U y = y, the later columns first
+        k0 = 3 * K
+        d = 9 * K
+        y2 = y[k0 + 2] / Dx[d + 8]
+        y1 = (y[k0 + 1] - Dx[d + 5] * y2) / Dx[d + 4]
+        y0 = ((y[k0] - Dx[d + 2] * y2) - Dx[d + 1] * y1) / Dx[d]
+        y[k0], y[k0 + 1], y[k0 + 2] = y0, y1, y2
+        for q in range(BUp[K], BUp[K + 1]):
+            j0 = 3 * BUi[q]
+            m = 9 * q
+            y[j0] = ((y[j0] - Ux[m + 2] * y2) - Ux[m + 1] * y1) - Ux[m] * y0
+            y[j0 + 1] = ((y[j0 + 1] - Ux[m + 5] * y2) - Ux[m + 4] * y1) - Ux[m + 3] * y0
+            y[j0 + 2] = ((y[j0 + 2] - Ux[m + 8] * y2) - Ux[m + 7] * y1) - Ux[m + 6] * y0
+    x = np.empty(b.size)
+    for c in range(b.size):
+        x[c] = y[pos[c]]
     return x
 
 
+def _runs(S: sp.csr_matrix, n: int) -> list[int]:
+    """Block widths over the ordered columns: runs of one pattern (with the column itself) in blocks of 3, the
+    shorter runs sharing a block while they fit."""
+    rows = [frozenset(S.indices[S.indptr[k]:S.indptr[k + 1]].tolist()) | {k} for k in range(n)]
+    runs, k = [], 0
+    while k < n:
+        w = 1
+        while k + w < n and rows[k + w] == rows[k]:
+            w += 1
+        while w > _B:
+            runs.append(_B)
+            w, k = w - _B, k + _B
+        runs.append(w)
+        k += w
+    blocks: list[int] = []
+    for w in runs:
+        if w < _B and blocks and blocks[-1] + w <= _B:
+            blocks[-1] += w
+        else:
+            blocks.append(w)
+    return blocks
+
+
 class FixedPatternLU:
-    """LU of n×n CSC matrices with the pattern (indptr, indices); ``factor(data)`` then ``solve(b)``."""
+    """LU of n×n CSC matrices with the pattern (indptr, indices); ``factor(data)`` then ``solve(b)``.
+    ``arrays``: the factors and their pattern, for :func:`_factor` and :func:`_solve` in compiled code."""
 
     def __init__(self, indptr, indices, n: int):
-        self.n = int(n)
+        self.n = n = int(n)
         self.indptr = np.ascontiguousarray(indptr, dtype=np.int64)
         self.indices = np.ascontiguousarray(indices, dtype=np.int64)
         nnz = self.indices.size
@@ -82,39 +197,62 @@ class FixedPatternLU:
         lu = spla.splu(sample, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0)
         if not np.array_equal(lu.perm_r, lu.perm_c):     # cannot happen with a dominant diagonal
             raise RuntimeError("FixedPatternLU: SuperLU chose off-diagonal pivots on the sample")
-        # SuperLU: A[perm_r⁻¹...]: row i of A goes to row perm_r[i] of L U; our perm maps back
-        self.iperm = np.ascontiguousarray(lu.perm_c, dtype=np.int64)
-        self.perm = np.argsort(self.iperm).astype(np.int64)
-        L = sp.csc_matrix(lu.L)
-        L.sort_indices()
-        U = sp.csc_matrix(lu.U)
-        U.sort_indices()
-        strict = sp.tril(L, k=-1, format="csc")
-        strict.sort_indices()
-        self.Lp, self.Li = strict.indptr.astype(np.int64), strict.indices.astype(np.int64)
-        self.Up, self.Ui = U.indptr.astype(np.int64), U.indices.astype(np.int64)
-        if not np.all(self.Ui[self.Up[1:] - 1] == np.arange(n)):
-            raise RuntimeError("FixedPatternLU: U has a structurally zero diagonal")
-        self.Lx = np.zeros(self.Li.size)
-        self.Ux = np.zeros(self.Ui.size)
-        self._x = np.zeros(n)
-        self._y = np.zeros(n)
+        # SuperLU: column c of A is column perm_c[c] of L U; perm[k]: the column of A eliminated k-th
+        iperm = np.asarray(lu.perm_c, dtype=np.int64)
+        perm = np.argsort(iperm)
+        L = sp.tril(sp.csc_matrix(lu.L), k=-1).tocoo()
+        U = sp.csc_matrix(lu.U).tocoo()
+        self.fill = int(L.nnz + U.nnz)                   # scalar entries of L (no unit diagonal) and U
+        # blocks over the order
+        S = ((sym != 0).tocsr()[perm][:, perm]).tocsr()
+        S.sort_indices()
+        widths = _runs(S, n)
+        nb = len(widths)
+        blk = np.repeat(np.arange(nb), widths)
+        slot = np.concatenate([np.arange(w) for w in widths]) if n else np.zeros(0, np.int64)
+        where = 3 * blk + slot                           # padded place of the k-th eliminated column
+        dummy = np.ones(3 * nb, np.int64)
+        dummy[where] = 0
+        # the block pattern: the block graph of L + U eliminated in the block order (natural, diagonal pivots)
+        br = np.concatenate([blk[L.row], blk[U.row], np.arange(nb)])
+        bc = np.concatenate([blk[L.col], blk[U.col], np.arange(nb)])
+        Q = sp.csc_matrix((np.ones(br.size), (br, bc)), shape=(nb, nb))
+        Q = ((Q + Q.T) != 0).astype(float).tocsc()
+        Q.data = 1.0 + rng.random(Q.nnz)
+        Q = (Q + sp.identity(nb) * (4.0 * nb)).tocsc()
+        qlu = spla.splu(Q, permc_spec="NATURAL", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+        if not (np.array_equal(qlu.perm_c, np.arange(nb)) and np.array_equal(qlu.perm_r, np.arange(nb))):
+            raise RuntimeError("FixedPatternLU: SuperLU reordered the block graph")
+        BL = sp.tril(sp.csc_matrix(qlu.L), k=-1, format="csc")
+        BL.sort_indices()
+        BU = sp.triu(sp.csc_matrix(qlu.U), k=1, format="csc")
+        BU.sort_indices()
+        have = set(zip(*sp.tril(abs(BL) + abs(BU.T) + sp.identity(nb), format="coo").nonzero()))
+        lo = np.maximum(br, bc), np.minimum(br, bc)
+        if not all((int(r), int(c)) in have for r, c in zip(*lo)):
+            raise RuntimeError("FixedPatternLU: the block pattern misses an entry of L or U")
+        # A's entries by block column: its index in data, its place in X (padded row, column within the block)
+        place = where[iperm]                             # padded place of A's row / column c
+        col = np.repeat(np.arange(n), np.diff(self.indptr))
+        pr, pc = place[self.indices], place[col]
+        order = np.lexsort((pr, pc))
+        Sp = np.searchsorted(pc[order] // 3, np.arange(nb + 1)).astype(np.int64)
+        i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)          # noqa: E731
+        self.blocks = nb
+        self.perm = perm                                 # perm[k]: the column of A eliminated k-th
+        self.arrays = (Sp, i64(order), i64(3 * pr[order] + pc[order] % 3), dummy, i64(place),
+                       i64(BL.indptr), i64(BL.indices), np.zeros(9 * BL.indices.size),
+                       i64(BU.indptr), i64(BU.indices), np.zeros(9 * BU.indices.size),
+                       np.zeros(9 * nb), np.zeros(9 * nb), np.zeros(3 * nb))
         self.ok = False
-
-    @property
-    def fill(self) -> int:
-        """Entries of L and U (L's unit diagonal not counted)."""
-        return self.Li.size + self.Ui.size
 
     def factor(self, data) -> bool:
         """Factor the matrix with values ``data`` on the pattern; False on a zero or non-finite pivot."""
         data = np.ascontiguousarray(data, dtype=float)
-        self.ok = bool(_factor(self.n, self.indptr, self.indices, data, self.iperm, self.perm, self.Lp,
-                               self.Li, self.Lx, self.Up, self.Ui, self.Ux, self._x))
+        self.ok = bool(_factor(self.arrays, data))
         return self.ok
 
     def solve(self, b) -> np.ndarray:
         if not self.ok:
             raise RuntimeError("FixedPatternLU.solve before a successful factor")
-        return _solve(self.n, self.perm, self.Lp, self.Li, self.Lx, self.Up, self.Ui, self.Ux,
-                      np.ascontiguousarray(b, dtype=float), self._y)
+        return _solve(self.arrays, np.ascontiguousarray(b, dtype=float))

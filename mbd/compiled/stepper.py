@@ -77,13 +77,13 @@ def _refresh(groups, t1, q1, v1, c_C, c_K, fams, zs, sysd, pat, lu, F, Jq, Jv, A
     -1 = unusable Newton matrix."""
     indptr, indices, Mdata, mdiag = pat
     n = mdiag.size
-    perm, iperm, Lp, Li, Lx, Up, Ui, Ux, xw, yw, D, dpiv = lu
+    arrs, D, dpiv = lu
     assemble(groups, t1, q1, v1, fams, zs, bool(True), sysd, F, Jq, Jv)       # a run-time flag (module docstring)
     for e in range(A.size):
         A[e] = Mdata[e] - c_C * Jv[e] - c_K * Jq[e]
         if not np.isfinite(A[e]):
             return -1
-    if _factor(n, indptr, indices, A, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, xw):
+    if _factor(arrs, A):
         return 0
     if D.shape[0] != n:                               # no room for the dense fallback (a large model)
         return -1
@@ -116,9 +116,9 @@ def _refresh_at(groups, t1, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache
 
 @njit(cache=True, inline="always")
 def _lu_solve(kind, lu, r, n):
-    perm, iperm, Lp, Li, Lx, Up, Ui, Ux, xw, yw, D, dpiv = lu
+    arrs, D, dpiv = lu
     if kind == 0:
-        return _solve(n, perm, Lp, Li, Lx, Up, Ui, Ux, r, yw)
+        return _solve(arrs, r)
     return _dense_solve(D, dpiv, r)
 
 

@@ -117,31 +117,26 @@ class _Parts:
 
     def lu_and_solve(self, t, q, v, z, reps) -> tuple[float, float]:
         ev = self.cs.evaluate(t, q, v, z, jac=True)
-        indptr, indices, Mdata, _ = self.r.pat
-        perm, iperm, Lp, Li, Lx, Up, Ui, Ux, xw, yw = self.r.lu[:10]
+        Mdata = self.r.pat[2]
+        lu = self.r.lu[0]
         A = np.empty(self.cs.nnz)
-        n = self.cs.ndof
-        t_lu = _timed(repeat_lu, reps, self.c_C, self.c_K, Mdata, ev.Jq, ev.Jv, A, n, indptr, indices, iperm, perm,
-                      Lp, Li, Lx, Up, Ui, Ux, xw)
-        if not repeat_lu(1, self.c_C, self.c_K, Mdata, ev.Jq, ev.Jv, A, n, indptr, indices, iperm, perm, Lp, Li,
-                          Lx, Up, Ui, Ux, xw):
+        t_lu = _timed(repeat_lu, reps, self.c_C, self.c_K, Mdata, ev.Jq, ev.Jv, A, lu)
+        if not repeat_lu(1, self.c_C, self.c_K, Mdata, ev.Jq, ev.Jv, A, lu):
             raise mbd.IntegrationError("bench_breakdown: a zero pivot in the sparse LU at a sampled state")
         b = np.ascontiguousarray(ev.F)
-        t_solve = _timed(repeat_solve, reps, n, perm, Lp, Li, Lx, Up, Ui, Ux, b, yw)
+        t_solve = _timed(repeat_solve, reps, lu, b)
         return t_lu, t_solve
 
     def replay(self, s0, s1, calls, steps) -> float:
         """s per step of :func:`mbd.compiled.probe.replay` at s1 (s0: the state before, for the update)."""
         self.cs.set_internal(s1["z"])
         ev = self.cs.evaluate(s1["t"], s1["q"], s1["v"], s1["z"], jac=True)
-        indptr, indices, Mdata, _ = self.r.pat
-        perm, iperm, Lp, Li, Lx, Up, Ui, Ux, xw, yw = self.r.lu[:10]
+        Mdata = self.r.pat[2]
         n = self.cs.ndof
         F, Jq, Jv, A = np.empty(n), np.empty(self.cs.nnz), np.empty(self.cs.nnz), np.empty(self.cs.nnz)
         return _timed_groups(replay, self.cs.groups, steps, calls["residual"], calls["jacobian"], calls["solve"], float(s1["t"]), s1["q"],
-                      s1["v"], self.cs.fams, self.cs.zs, self.cs.sysd, F, Jq, Jv, self.c_C, self.c_K, Mdata, A, n,
-                      indptr, indices, iperm, perm, Lp, Li, Lx, Up, Ui, Ux, xw, np.ascontiguousarray(ev.F), yw,
-                      float(s0["t"]), s0["q"], s0["v"])
+                      s1["v"], self.cs.fams, self.cs.zs, self.cs.sysd, F, Jq, Jv, self.c_C, self.c_K, Mdata, A,
+                      self.r.lu[0], np.ascontiguousarray(ev.F), float(s0["t"]), s0["q"], s0["v"])
 
     def update(self, s0, s1, reps) -> float:
         self.cs.set_internal(s0["z"])
