@@ -113,7 +113,9 @@ class FamilyCollector:
 
 @dataclass(frozen=True, eq=False, kw_only=True)
 class BuiltScene:
-    """A built model with its initial state (free DOFs, in R). A scene builder returns a subclass whose
+    """A built model with its initial state (free DOFs, in R) at t = 0: in R the ground turns at −Ω, so at
+    a later time a body held to the ground (the ring on its torsional support) is wanted elsewhere and ``q0`` is no
+    state of the machine there (docs/model.md §10.4). A scene builder returns a subclass whose
     typed fields carry what its outputs need (:class:`components.dpgt.DPGTScene`,
     :class:`components.rig.BearingRigScene`, :class:`components.planetary.PlanetaryScene`)."""
     model: mbd.Model
