@@ -17,7 +17,11 @@ compiles the loop, the assembly and the dispatch once per set (and caches each o
 templates, each set's dispatch is a copy of them in which an absent group's module is a stand-in that compiles
 to nothing (:func:`evaluate_for`, :func:`update_for`, :func:`outputs_for`). The bearing rig (no gears) then never
 compiles the mesh and tooth-pair kernels; a set already cached that contains a system's is loaded instead of
-compiling the system's own (:func:`groups_to_compile`)."""
+compiling the system's own (:func:`groups_to_compile`).
+
+Threads: the flag :data:`THREADED` beside the modules' bits asks for the threaded assembly (:mod:`.system`), whose
+parallel function dispatches through :func:`evaluate_threaded_for`, a copy of the branches of the families of
+:data:`THREADED_KINDS` only (the other kernels are not compiled into it)."""
 from __future__ import annotations
 
 import types
