@@ -7,7 +7,8 @@ compiled :func:`assemble` loops over the records and dispatches on the family's 
 
 Threads (``threads`` > 1, opt-in): the families of :data:`.registry.THREADED_KINDS` (every bearing's contacts) are
 cut into ``threads`` fixed chunks of instances and evaluated at once on the threads (:func:`_threaded`, the engine's
-one parallel function), for every Jacobian and, on the sliced machine, for every residual (:func:`_partition`); the
+one parallel function), for every Jacobian and, on the sliced machine, for every residual (:func:`_partition`,
+:func:`_families_threaded`); the
 other families, and then the scatter of every family into the forces and the pattern in the family order, stay in the
 calling thread. A kernel's instances are independent of each other, so every force, Jacobian entry and step is
 bit-identical to the serial assembly's, whatever the thread count (docs/numerics.md §5 "Threads"). A set of families
@@ -15,6 +16,7 @@ without the :data:`.registry.THREADED` flag (one thread, the default) compiles n
 """
 from __future__ import annotations
 
+import contextlib
 import os
 
 import numba
@@ -105,43 +107,14 @@ def _threaded(groups, t, phi, omega, qf, vf, fams, zs, jac, par):
                                   Fl[lo:hi], Jql[lo:hi], Jvl[lo:hi], jac)
 
 
-def _on_threads(groups, t, phi, omega, qf, vf, fams, zs, jac, par):
-    """The threaded families evaluated on the threads for a Jacobian, and for a residual when ``par`` says it pays
-    (its ``residual`` flag, :func:`_partition`); True when they were."""
-    if jac or par[3][0]:
+def _families_threaded(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv):
+    """The families of a threaded set: those of the partition (``sysd[13]``, :func:`_partition`) on the threads for a
+    Jacobian, and for a residual when the partition says it pays; the others here; then every family's scatter in the
+    family order, as :func:`_families_serial`."""
+    par = sysd[13]
+    threaded = jac or par[3][0]
+    if threaded:
         _threaded(groups, t, phi, omega, qf, vf, fams, zs, jac, par)
-        return True
-    return False
-
-
-def on_threads(groups, t, phi, omega, qf, vf, fams, zs, jac, par):
-    raise NotImplementedError("compiled code only")
-
-
-@overload(on_threads, prefer_literal=True)
-def _on_threads_for(groups, t, phi, omega, qf, vf, fams, zs, jac, par):
-    """:func:`_on_threads` for a set with the :data:`.registry.THREADED` flag, else a constant False: no parallel code
-    is compiled, and the assembly evaluates every family itself."""
-    if not isinstance(groups, nbtypes.IntegerLiteral):
-        raise TypingError("on_threads: groups must be a literal int (numba.literally at the entry point)")
-    if groups.literal_value & THREADED:
-        return _on_threads
-    return lambda groups, t, phi, omega, qf, vf, fams, zs, jac, par: False
-
-
-@njit(cache=True)
-def assemble(groups, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
-    """Generalized forces F on the free DOFs and, with ``jac``, J_q, J_v on the pattern (in place). ``groups``: the
-    family groups of ``fams`` (:func:`.registry.groups_of`), compiled as a literal (one specialisation per set)."""
-    literally(groups)
-    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full, par) = sysd
-    qf, vf = _full(t, q, v, free, fixed_idx, fixed_q_I, omega, n_full)
-    phi = omega * t
-    Ffull = np.zeros(n_full)
-    if jac:
-        Jq[:] = 0.0
-        Jv[:] = 0.0
-    threaded = on_threads(groups, t, phi, omega, qf, vf, fams, zs, jac, par)     # a set without THREADED: False
     r = 0
     for rec in fams:
         kind, dofs, P, G, zi, keep, mp, ql, vl, Fl, Jql, Jvl = rec
@@ -162,6 +135,55 @@ def assemble(groups, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
                 Jq[mp[e]] += flat_q[keep[e]]
                 Jv[mp[e]] += flat_v[keep[e]]
         r += 1
+
+
+def _families_serial(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv):
+    """The families one after another: each gathered, evaluated and scattered into the forces and the pattern."""
+    for rec in fams:
+        kind, dofs, P, G, zi, keep, mp, ql, vl, Fl, Jql, Jvl = rec
+        n, k = dofs.shape
+        for i in range(n):
+            for j in range(k):
+                ql[i, j] = qf[dofs[i, j]]
+                vl[i, j] = vf[dofs[i, j]]
+        evaluate_for(groups, kind, t, phi, omega, 0.0, ql, vl, zs[zi], P, G, Fl, Jql, Jvl, jac)
+        for i in range(n):
+            for j in range(k):
+                Ffull[dofs[i, j]] += Fl[i, j]
+        if jac:
+            flat_q = Jql.reshape(-1)
+            flat_v = Jvl.reshape(-1)
+            for e in range(keep.size):
+                Jq[mp[e]] += flat_q[keep[e]]
+                Jv[mp[e]] += flat_v[keep[e]]
+
+
+def families_for(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv):
+    raise NotImplementedError("compiled code only")
+
+
+@overload(families_for, prefer_literal=True, inline="always")
+def _families_for(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv):
+    """:func:`_families_threaded` for a set with the :data:`.registry.THREADED` flag, else :func:`_families_serial`
+    (inlined into the assembly: a serial set compiles no parallel code and no test of it)."""
+    if not isinstance(groups, nbtypes.IntegerLiteral):
+        raise TypingError("families_for: groups must be a literal int (numba.literally at the entry point)")
+    return _families_threaded if groups.literal_value & THREADED else _families_serial
+
+
+@njit(cache=True)
+def assemble(groups, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
+    """Generalized forces F on the free DOFs and, with ``jac``, J_q, J_v on the pattern (in place). ``groups``: the
+    family groups of ``fams`` (:func:`.registry.groups_of`), compiled as a literal (one specialisation per set)."""
+    literally(groups)
+    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full) = sysd[:13]
+    qf, vf = _full(t, q, v, free, fixed_idx, fixed_q_I, omega, n_full)
+    phi = omega * t
+    Ffull = np.zeros(n_full)
+    if jac:
+        Jq[:] = 0.0
+        Jv[:] = 0.0
+    families_for(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv)
     for j in range(free.size):
         F[j] = Ffull[free[j]]
     c, s = np.cos(phi), np.sin(phi)
@@ -186,7 +208,7 @@ def assemble(groups, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
 def update_internal(groups, t0, t1, q0, v0, q1, v1, fams, zs, sysd):
     """Every stateful family's internal state after an accepted step (in place in zs)."""
     literally(groups)
-    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full, par) = sysd
+    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full) = sysd[:13]
     q0f, v0f = _full(t0, q0, v0, free, fixed_idx, fixed_q_I, omega, n_full)
     q1f, v1f = _full(t1, q1, v1, free, fixed_idx, fixed_q_I, omega, n_full)
     for rec in fams:
@@ -218,15 +240,7 @@ class _Threads:
         numba.set_num_threads(self.before)
 
 
-class _Serial:
-    def __enter__(self):
-        pass
-
-    def __exit__(self, *exc):
-        pass
-
-
-_NO_THREADS = _Serial()
+_NO_THREADS = contextlib.nullcontext()
 
 
 def _partition(system: System, kinds, threads: int) -> tuple:
