@@ -176,7 +176,7 @@ def assemble(groups, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
     """Generalized forces F on the free DOFs and, with ``jac``, J_q, J_v on the pattern (in place). ``groups``: the
     family groups of ``fams`` (:func:`.registry.groups_of`), compiled as a literal (one specialisation per set)."""
     literally(groups)
-    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full) = sysd[:13]
+    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full, _) = sysd
     qf, vf = _full(t, q, v, free, fixed_idx, fixed_q_I, omega, n_full)
     phi = omega * t
     Ffull = np.zeros(n_full)
@@ -208,7 +208,7 @@ def assemble(groups, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
 def update_internal(groups, t0, t1, q0, v0, q1, v1, fams, zs, sysd):
     """Every stateful family's internal state after an accepted step (in place in zs)."""
     literally(groups)
-    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full) = sysd[:13]
+    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full, _) = sysd
     q0f, v0f = _full(t0, q0, v0, free, fixed_idx, fixed_q_I, omega, n_full)
     q1f, v1f = _full(t1, q1, v1, free, fixed_idx, fixed_q_I, omega, n_full)
     for rec in fams:
