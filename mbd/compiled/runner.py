@@ -87,7 +87,7 @@ def _controller_array(controller) -> np.ndarray:
 class CompiledRunner:
     """HHT-α (settings of ``stepper``) with ``controller`` on the compiled twin of ``system``. Raises
     NotImplementedError naming what the compiled path cannot do (the caller then uses the numpy path).
-    ``threads`` > 1: the bearings' contact families and the Jacobians' scatter on that many threads
+    ``threads`` > 1: the bearings' contact families evaluated on that many threads
     (:class:`.system.CompiledSystem`; the same steps and states to the bit)."""
 
     def __init__(self, system: System, stepper: HHT, controller, threads: int = 1):
