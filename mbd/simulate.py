@@ -155,7 +155,7 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
              stepper: HHT | None = None, controller: Controller | None = None, recorder: Recorder | None = None,
              checkpoint: Checkpoint | None = None, resume: bool = False, progress: bool | None = None,
              failed_state_path=None, state: State | None = None, system: System | None = None,
-             on_progress=None, observers=(), engine: str = "auto") -> SimResult:
+             on_progress=None, observers=(), engine: str = "auto", threads: int = 1) -> SimResult:
     """Integrate from (t0, q0, v0) — or from ``state`` — to t_end.
 
     ``stepper`` defaults to ``mbd.PRODUCTION.stepper()``; ``controller`` is required (FixedStep or Adaptive), since
@@ -166,7 +166,9 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
     counters)`` is called at most twice a second (e.g. to report progress from a worker process).
     ``observers`` (:class:`~mbd.protocols.Observer`) see every accepted step, whatever the recorder's sample rate.
     The controller, the recorder and each observer are checked against their protocols (:mod:`mbd.protocols`)
-    before anything is built: a missing method fails here, naming the argument.
+    before anything is built: a missing method fails here, naming the argument. ``threads`` (compiled engine; 1 to
+    the usable cores, default 1): the bearings' contact families evaluated on that many threads, the same steps and
+    states to the bit (:mod:`mbd.compiled.system`); it pays on idle cores only (docs/numerics.md §5 "Threads").
     """
     if controller is None:
         raise ModelError("simulate: pass controller=FixedStep(h) or Adaptive(h0=..., ...)")
@@ -175,7 +177,7 @@ def simulate(model: Model, q0=None, v0=None, t_end: float = 0.0, *, t0: float = 
         stepper = PRODUCTION.stepper()
     call0 = time.perf_counter()
     system = system or System(model)
-    runner, engine, engine_note = _engine(engine, system, stepper, controller)
+    runner, engine, engine_note = _engine(engine, system, stepper, controller, threads)
     setup_s = time.perf_counter() - call0
     counters = Counters()
     if state is None:
@@ -240,17 +242,20 @@ def _check_arguments(controller, recorder, observers) -> list:
 ENGINES = ("auto", "compiled", "numpy")
 
 
-def _engine(engine: str, system: System, stepper, controller):
+def _engine(engine: str, system: System, stepper, controller, threads: int = 1):
     """(compiled runner or None, the engine that will run, why "auto" falls back to numpy or None). A fallback
     is said on stderr in one line: the numpy path is ≈ 13× slower, never silently."""
     if engine not in ENGINES:
         raise ModelError(f"simulate: engine must be one of {ENGINES}, got {engine!r}")
     if engine == "numpy":
+        if not (threads == 1 and not isinstance(threads, bool)):
+            raise ModelError(f"simulate: threads must be 1 on the numpy engine (threads run the compiled one), "
+                             f"got {threads!r}")
         return None, "numpy", None
     try:
         from .compiled.runner import CompiledRunner  # deferred: numba kernels, optional (numpy falls back)
         with compiling():        # its twin of the system and its step loop compile or load here, before any step
-            return CompiledRunner(system, stepper, controller), "compiled", None
+            return CompiledRunner(system, stepper, controller, threads), "compiled", None
     except (ImportError, NotImplementedError) as exc:
         if engine == "compiled":
             raise ModelError(f"simulate: the compiled engine cannot run this model: {exc}") from None

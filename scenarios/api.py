@@ -70,14 +70,15 @@ def parameters(condition: int = 3, direction: str = "forward", set: dict | None 
 
 def run(params=None, out=None, *, condition: int = 3, direction: str = "forward", set: dict | None = None,
         settle: float = 0.03, window: float | None = None, sample_rate: float = 25000.0, options: dict | None = None,
-        integration=None, sensor: bool = False, progress: bool = True, overwrite: bool = False) -> Run:
+        integration=None, sensor: bool = False, progress: bool = True, overwrite: bool = False, threads: int = 1) -> Run:
     """Run ``params`` (default: :func:`parameters` of ``condition`` and ``direction``; ``set`` overrides either)
     into the folder ``out`` (default: a new temporary folder) and return the :class:`Run`.
 
     ``settle``, ``window`` [s] and ``sample_rate`` [Hz] as the commands' options (``window`` None: whole cage
     revolutions, README "Defaults"); ``options``: scene switches (:class:`components.scene.SceneOptions` fields,
     e.g. ``{"drag": False}``); ``integration``: :class:`mbd.IntegratorSettings` (default ``mbd.PRODUCTION``);
-    ``sensor``: record what the housing accelerometer needs. The design is checked first (its warnings are
+    ``sensor``: record what the housing accelerometer needs; ``threads``: the engine's threads (the same results; on
+    idle cores only, docs/numerics.md §5 "Threads"). The design is checked first (its warnings are
     Python warnings); bad parameters raise :class:`components.units.ParameterError`."""
     label = {}
     if params is None:
@@ -88,7 +89,7 @@ def run(params=None, out=None, *, condition: int = 3, direction: str = "forward"
     check_design(params)
     faults.check_errors(params.si())
     cfg = RunConfig(settle=settle, window=window, sample_rate=sample_rate, integration=integration or mbd.PRODUCTION,
-                    options=SceneOptions.from_dict(options), progress=progress, sensor=sensor)
+                    options=SceneOptions.from_dict(options), progress=progress, sensor=sensor, threads=threads)
     out = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="dpgt-run-"))
     s = finished_run(out, params, cfg)
     if s is not None:

@@ -17,7 +17,11 @@ compiles the loop, the assembly and the dispatch once per set (and caches each o
 templates, each set's dispatch is a copy of them in which an absent group's module is a stand-in that compiles
 to nothing (:func:`evaluate_for`, :func:`update_for`, :func:`outputs_for`). The bearing rig (no gears) then never
 compiles the mesh and tooth-pair kernels; a set already cached that contains a system's is loaded instead of
-compiling the system's own (:func:`groups_to_compile`)."""
+compiling the system's own (:func:`groups_to_compile`).
+
+Threads: the flag :data:`THREADED` beside the modules' bits asks for the threaded assembly (:mod:`.system`), whose
+parallel function dispatches through :func:`evaluate_threaded_for`, a copy of the branches of the families of
+:data:`THREADED_KINDS` only (the other kernels are not compiled into it)."""
 from __future__ import annotations
 
 import types
@@ -32,8 +36,8 @@ from numba.extending import overload
 
 from . import contact, generic, mesh, sliced
 
-__all__ = ["Kind", "KIND_IDS", "GROUPS", "OUTPUT_NAMES", "kind_of", "groups_of", "groups_to_compile", "call",
-           "evaluate_for", "update_for", "outputs_for"]
+__all__ = ["Kind", "KIND_IDS", "GROUPS", "THREADED", "THREADED_KINDS", "OUTPUT_NAMES", "kind_of", "groups_of",
+           "groups_to_compile", "call", "evaluate_for", "evaluate_threaded_for", "update_for", "outputs_for"]
 
 
 @dataclass(frozen=True)
@@ -63,6 +67,13 @@ KIND_IDS = {
 _MODULES = {"contact": contact, "generic": generic, "mesh": mesh, "sliced": sliced}
 # kernel module -> its bit in a system's ``groups`` (the unit of the lazy compile)
 GROUPS = {"contact": 1, "generic": 2, "mesh": 4, "sliced": 8}
+# a flag in ``groups`` beside the modules' bits: the threaded assembly (:mod:`.system`, ``threads`` > 1), whose
+# heaviest families (:data:`THREADED_KINDS`) run in chunks of instances on the threads; a set without it compiles no
+# parallel code at all
+THREADED = 256
+# the twins that run in chunks on the threads (the contacts of every bearing: most of a step's kernel time, measured
+# in docs/numerics.md §5 "Threads"); the others stay in the calling thread
+THREADED_KINDS = ("contact.race", "contact.pocket", "contact.guide", "contact.drag", "sliced.sliced_race")
 # twins that give their outputs (outputs_kind) -> the reference's names of the rows they write
 # (the meshes' are not among them: numpy's batched mesh kernel takes as long over a block as the compiled one)
 OUTPUT_NAMES = {"contact.race": contact.RACE_OUTPUTS, "contact.pocket": contact.POCKET_OUTPUTS,
@@ -94,10 +105,11 @@ def groups_of(kinds) -> int:
 
 def groups_to_compile(needed: int, cached) -> int:
     """The family groups to run with: ``needed`` when cached, else the smallest ``cached`` set that contains it
-    (loading a superset takes a second, compiling the exact set most of a minute), else ``needed`` (compiled)."""
+    (loading a superset takes a second, compiling the exact set most of a minute), else ``needed`` (compiled). The
+    :data:`THREADED` flag is not a group: a serial run never loads the threaded assembly, nor a threaded one the serial."""
     if needed in cached:
         return needed
-    supersets = [g for g in cached if g & needed == needed]
+    supersets = [g for g in cached if g & needed == needed and g & THREADED == needed & THREADED]
     return min(supersets, key=lambda g: (bin(g).count("1"), g)) if supersets else needed
 
 
@@ -184,6 +196,15 @@ def _evaluate_for(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, J
     return _variant(evaluate_kind, groups)
 
 
+def evaluate_threaded_for(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    raise NotImplementedError("compiled code only")
+
+
+@overload(evaluate_threaded_for, prefer_literal=True)
+def _evaluate_threaded_for(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    return _variant(evaluate_threaded_kind, groups)
+
+
 def update_for(groups, kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):
     raise NotImplementedError("compiled code only")
 
@@ -242,6 +263,21 @@ def evaluate_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, J
         contact.evaluate_pocket_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     elif kind == _CAGE_DRAG:
         contact.evaluate_cage_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+
+
+def evaluate_threaded_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    """The branches of :func:`evaluate_kind` for the families of :data:`THREADED_KINDS` only (the template of
+    :func:`evaluate_threaded_for`, called on the threads: the others' kernels are not compiled into it)."""
+    if kind == _RACE:
+        contact.evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _POCKET:
+        contact.evaluate_pocket(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _GUIDE:
+        contact.evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _DRAG:
+        contact.evaluate_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _SLICED_RACE:
+        sliced.evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
 
 
 def update_kind(groups, kind, z, t0, t1, phi0, phi1, ql0, vl0, ql1, vl1, P, G):

@@ -86,13 +86,15 @@ def _controller_array(controller) -> np.ndarray:
 
 class CompiledRunner:
     """HHT-α (settings of ``stepper``) with ``controller`` on the compiled twin of ``system``. Raises
-    NotImplementedError naming what the compiled path cannot do (the caller then uses the numpy path)."""
+    NotImplementedError naming what the compiled path cannot do (the caller then uses the numpy path).
+    ``threads`` > 1: the bearings' contact families evaluated on that many threads
+    (:class:`.system.CompiledSystem`; the same steps and states to the bit)."""
 
-    def __init__(self, system: System, stepper: HHT, controller):
+    def __init__(self, system: System, stepper: HHT, controller, threads: int = 1):
         if type(stepper) is not HHT:
             raise NotImplementedError(f"compiled path: stepper {type(stepper).__name__} is not compiled")
         self.ctrl = _controller_array(controller)
-        self.cs = CompiledSystem(system)
+        self.cs = CompiledSystem(system, threads)
         m, n, nnz = system.model, system.ndof, system.nnz
         self.n = n
         beta, gamma = stepper.beta_gamma
@@ -138,10 +140,11 @@ class CompiledRunner:
         q, v, a, f = (np.array(x, float) for x in (state.q, state.v, state.a, state.f))
         log = np.empty((max(int(max_steps), 1), 3 + 4 * self.n + self.n_z))
         counters = np.zeros(6, np.int64)
-        t, h, acc, status, it, rate, reason = call(
-            advance, self.cs.groups, float(state.t), q, v, a, f, float(h), float(t_end), int(max_steps), self.prm,
-            self.ctrl, self.atol, self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat, self.lu,
-            self.cache, self.work, counters, self.out, log)
+        with self.cs.threads_set():
+            t, h, acc, status, it, rate, reason = call(
+                advance, self.cs.groups, float(state.t), q, v, a, f, float(h), float(t_end), int(max_steps), self.prm,
+                self.ctrl, self.atol, self.rtol, self.freeze, self.cs.fams, self.cs.zs, self.cs.sysd, self.pat,
+                self.lu, self.cache, self.work, counters, self.out, log)
         keys = ("residual", "jacobian", "factor", "newton", "accepted", "rejected")
         failed = StepInfo(False, int(it), float(rate), reason=FAIL_REASONS[reason]) if status == 2 else None
         blk = Block(log[:acc], state, self.z_shapes, dict(zip(keys, (int(c) for c in counters))), state, float(h),

@@ -333,12 +333,17 @@ SHARED = {
     "workers": (("--workers",), dict(type=count(1), default=None, metavar="N",
                                      help="runs at a time on a local Dask cluster (default: one per core, at most "
                                           "one per run)")),
+    "threads": (("--threads",), dict(type=count(1), default=1, metavar="N",
+                                     help="threads of each run's compiled engine (default 1; the same results on any "
+                                          "number; pays only when the runs at a time times N leave cores idle: "
+                                          "docs/numerics.md §5 Threads)")),
     "scheduler": (("--scheduler",), dict(default=None, type=scheduler, metavar="ADDR",
                                          help="address of an existing Dask scheduler, e.g. tcp://host:8786 "
                                               "(default: a local cluster)")),
 }
 SHARED_TITLE = "shared options (the same name, default and meaning in every dpgt command)"
-SWEEP = ("conditions", "operating", "params", "set", "out", "overwrite", "force", "no-progress", "workers", "scheduler")
+SWEEP = ("conditions", "operating", "params", "set", "out", "overwrite", "force", "no-progress", "workers", "threads",
+         "scheduler")
 
 
 # the default --conditions of the commands (the source's fastest loaded condition); a command whose default differs

@@ -151,8 +151,8 @@ def claim_for_inputs(folder, inputs: dict, overwrite: bool) -> dict:
 
 def command_inputs(a, files: tuple[str, ...] = ("params",)) -> dict:
     """A command's parsed options as its inputs, without those that do not change its results (--out, --overwrite,
-    --no-progress); the option ``files`` by their text, so that an edited file is other inputs."""
-    skip = {"out", "overwrite", "no_progress"}
+    --no-progress, --threads); the option ``files`` by their text, so that an edited file is other inputs."""
+    skip = {"out", "overwrite", "no_progress", "threads"}
     d = {k: v for k, v in vars(a).items() if k not in skip}
     for k in files:
         if d.get(k):

@@ -78,6 +78,7 @@ def _settings(cfg: "RunConfig") -> dict:
     """The run settings that identify a run (the progress display is not one; a dynamic run's static-mode
     settings are not either, so the results of runs made before static mode existed stay theirs)."""
     settings = asdict(replace(cfg, progress=False))
+    del settings["threads"]          # the same results to the bit on any thread count (mbd.simulate)
     if cfg.mode == "dynamic":
         del settings["mode"], settings["snapshots"]
     if cfg.start == "kinematic":     # the default start: runs made before the choice existed stay theirs
@@ -124,6 +125,7 @@ class RunConfig:
     snapshots: int = DEFAULT_SNAPSHOTS    # static mode: instants over a carrier revolution and the mesh cycle
     start: str = "kinematic"      # dynamic mode: from the kinematic state with the torque ramped in (docs/model.md
     #                               §10.4), or "static": from the static solution at the ramp's end (components.static)
+    threads: int = 1              # dynamic mode: threads of the run's compiled engine (mbd.simulate; the same results)
 
     def __post_init__(self):
         if self.mode not in ("dynamic", "static"):
@@ -139,6 +141,9 @@ class RunConfig:
             raise mbd.ModelError(f"window must be > 0 s, got {self.window!r}")
         if not self.sample_rate > 0:
             raise mbd.ModelError(f"sample_rate must be > 0 Hz, got {self.sample_rate!r}")
+        if self.threads != 1 or isinstance(self.threads, bool):
+            from mbd.compiled.system import check_threads   # deferred: numba, for a run that asks for threads only
+            check_threads(self.threads)
 
 
 def statistics_window(scene, base: float = 0.02) -> float:
@@ -301,7 +306,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     if cfg.start == "static":       # the machine at rest in its frame under its full load, at the ramp's end
         q0, v0, t0 = _static_start(scene, cfg.settle)
     res = mbd.simulate(scene.model, q0, v0, t_end, t0=t0, stepper=integ.stepper(), controller=integ.controller(),
-                       engine=integ.engine,
+                       engine=integ.engine, threads=cfg.threads,
                        recorder=rec, checkpoint=mbd.Checkpoint(out_dir / "checkpoint.npz", cfg.checkpoint_every),
                        resume=True, progress=cfg.progress, failed_state_path=out_dir / "failed_state.npz",
                        on_progress=report, observers=[stats])

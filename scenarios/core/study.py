@@ -184,6 +184,8 @@ class Study(abc.ABC):
         a = self.a
         t0 = time.perf_counter()
         cfg = self.config()
+        if getattr(a, "threads", 1) != 1:     # a run's engine threads (--threads): the same results, not a setting
+            cfg = dataclasses.replace(cfg, threads=a.threads)
         cases = self.cases()
         validate_cases(cases, lambda c: self._check(c, cfg))     # every parameter checked before any run starts
         machine = self.machine_identity()

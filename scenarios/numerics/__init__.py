@@ -3,7 +3,7 @@
 Error against run time for every integrator (:mod:`.work_precision`), stiff and extreme cases (:mod:`.stability`),
 the speed target of the full DPGT (:mod:`.benchmark`), what single parts cost (``bench_*``: the engine on networks of
 stiff bodies, the compiled mesh kernel, the statistics observer, a static solution, a study end to end, Dask's
-scheduling of many small tasks), and the one-off compile of the engine's kernels (:mod:`.warm`); :mod:`.common`
+scheduling of many small tasks, what threads buy one run), and the one-off compile of the engine's kernels (:mod:`.warm`); :mod:`.common`
 holds what the first three share (the test
 problems, the settled state, the contender runs, the error metrics).
 

@@ -37,7 +37,7 @@ from mbd.compiled.registry import call
 from mbd.compiled.runner import CompiledRunner
 from mbd.compiled.system import _full
 
-from .common import dpgt_problem, load1, machine_note, progress_log, settled_state, warm_up
+from .common import FAMILY_ROWS, dpgt_problem, load1, machine_note, progress_log, settled_state, warm_up
 from ..core import args
 from ..core.command import command
 
@@ -47,9 +47,6 @@ EXAMPLES = ["{prog}", "{prog} --window 0.02 --samples 40 --rounds 5 --json"]
 WRITES = ("breakdown.json (and the settled state dpgt_settled.npz, shared with the benchmark); the table on the "
           "screen, with --json one JSON object as the last line")
 
-# a family's compiled twin -> its row of the table (the other twins: supports, springs, drives)
-FAMILY_ROWS = {"contact.race": "race", "contact.pocket": "pocket", "contact.guide": "guide", "contact.drag": "drag",
-               "mesh.gear_mesh": "meshes", "sliced.sliced_race": "race", "sliced.sliced_gear_mesh": "meshes"}
 OTHER = "other families"
 BLOCK = 256     # accepted steps per compiled call, as mbd.simulate runs them
 

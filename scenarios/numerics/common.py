@@ -46,7 +46,11 @@ from components.rig import build_bearing_rig
 __all__ = ["Problem", "dpgt_problem", "rig_problem", "settled_state", "StateSampler", "RunResult",
            "run_hht", "run_scipy", "observables", "error_metrics", "scipy_atol", "peak_rss_mb",
            "eval_costs", "machine_note", "load1", "warm_up",
-           "design_verdict"]
+           "design_verdict", "FAMILY_ROWS"]
+
+# a family's compiled twin -> its row of bench_breakdown's table (the other twins: supports, springs, drives)
+FAMILY_ROWS = {"contact.race": "race", "contact.pocket": "pocket", "contact.guide": "guide", "contact.drag": "drag",
+               "mesh.gear_mesh": "meshes", "sliced.sliced_race": "race", "sliced.sliced_gear_mesh": "meshes"}
 
 
 @dataclass

@@ -10,7 +10,7 @@ import pytest
 
 import mbd
 
-from scenarios.numerics import bench_breakdown, bench_sliced, benchmark, stability, work_precision
+from scenarios.numerics import bench_breakdown, bench_sliced, bench_threads, benchmark, stability, work_precision
 from scenarios.numerics.common import StateSampler, dpgt_problem, settled_state
 
 
@@ -148,6 +148,23 @@ def test_bench_breakdown_splits_the_sliced_machines_step(tmp_path, capsys):
     race = next(r for r in d["rows"] if r["part"] == "race")
     assert race["residual_us"] > 0 and race["jacobian_us"] > race["residual_us"]
     assert (tmp_path / "breakdown_sliced5.json").exists()
+
+
+def test_bench_threads_model_is_amdahl_s_law_with_the_threaded_share():
+    """The closed forms: no parallel share gives 1 on any thread count, a wholly parallel step n on n threads, half of
+    it 4/3 on 2; an overhead o of the serial step adds to the time. The share is the threaded families' rows: their
+    Jacobian calls on the planar machine (its residuals stay serial), every call on the sliced one."""
+    assert bench_threads.amdahl(0.0, 8) == 1.0 and bench_threads.amdahl(1.0, 8) == pytest.approx(8.0)
+    assert bench_threads.amdahl(0.5, 2) == pytest.approx(4 / 3) and bench_threads.amdahl(0.5, 2, 0.25) == 1.0
+    assert set(bench_threads.THREADED_ROWS) == {"race", "pocket", "guide", "drag"}
+    rows = [{"part": p, "residual_us": r, "jacobian_us": j, "us_per_step": 4 * r + 0.5 * j}
+            for p, r, j in (("race", 6.0, 18.0), ("pocket", 3.0, 10.0), ("guide", 1.0, 2.0), ("drag", 1.0, 6.0),
+                            ("meshes", 2.0, 3.0), ("assembly (gather, scatter, frame terms)", 3.0, 20.0))]
+    bd = {"rows": rows, "cpu_per_step_us": 200.0, "calls_per_step": {"residual": 4.0, "jacobian": 0.5}, "slices": 0}
+    planar = bench_threads.parallel_share(bd)
+    assert planar["threaded_us"] == pytest.approx(0.5 * (18 + 10 + 2 + 6)) and planar["p"] == pytest.approx(18 / 200)
+    sliced = bench_threads.parallel_share(bd | {"slices": 21})
+    assert sliced["threaded_us"] == pytest.approx(4 * 11 + 0.5 * 36) and sliced["p"] == pytest.approx(62 / 200)
 
 
 def test_bench_sliced_counts_the_step_loops_work_as_the_engine_does():
