@@ -81,18 +81,93 @@ def _zero(F, Jq, Jv, i, jac):
 
 
 @njit(cache=True)
-def _moments(acc, blocks, loaded, n_loaded, zs):
-    """acc[m, :] = Σ z_k^m · blocks[r, :] over the loaded slices r (k = loaded[r], ascending), m = 0, 1, 2 (a loop over
+def _moments(acc, blocks, ns, zs):
+    """acc[m, :] = Σ_k z_k^m · blocks[k, :] over the slices k (an open slice's block is zero), m = 0, 1, 2 (a loop over
     the 12 columns inside: SIMD)."""
     acc[:, :] = 0.0
-    for r in range(n_loaded):
-        zk = zs[loaded[r]]
+    for k in range(ns):
+        zk = zs[k]
         z2 = zk * zk
         for c in range(12):
-            x = blocks[r, c]
+            x = blocks[k, c]
             acc[0, c] += x
             acc[1, c] += zk * x
             acc[2, c] += z2 * x
+
+
+# δ^(1/m) by Halley's iteration (the slices' δ^((p−1)/2) when (p − 1)/2 = 1/m, Palmgren's p = 10/9: m = 18)
+_ONE_BITS = 0x3FF0000000000000                  # the bits of 1.0
+_ROOT_LO, _ROOT_HI = 1e-300, 1e300              # the iteration's range of x (y^m neither under- nor overflows)
+_START_SHIFT = int(0.043 * 2.0 ** 52)           # centres the start's error (±0.045 in log2, 3.2 %)
+_ROOT_MAX = 31                                  # the largest m of the iteration (p ≥ 1 + 2/31)
+_LANES = 8                                      # the roots' buffers are padded to a multiple of a SIMD width
+
+
+@njit(cache=True)
+def root_index(pe):
+    """m when pe = 1/m for an integer 1 ≤ m ≤ 31 (to 1e-12), else 0 (the slices then take np.power)."""
+    if not pe > 0.0:
+        return 0
+    m = int(round(1.0 / pe))
+    if m < 1 or m > _ROOT_MAX or abs(m * pe - 1.0) > 1e-12:
+        return 0
+    return m
+
+
+@njit(cache=True, inline="always")
+def _ipow(y, m):
+    """y^m for 1 ≤ m ≤ 31 by squaring, without branches on y (a select per bit of m: SIMD)."""
+    r, b = 1.0, y
+    for bit in range(5):
+        if (m >> bit) & 1:
+            r = r * b
+        b = b * b
+    return r
+
+
+@njit(cache=True, error_model="numpy")
+def _root_start(xb, yb, n, inv_m):
+    """A start for x^(1/m) from the bits of x: a positive double's bits read as an integer are 2^52 (log2 x + 1023)
+    up to [−0.086, 0] in the log2 (the mantissa read linearly); their offset from 1.0's divided by m and read back
+    give x^(1/m) within [−0.005, 0.086] in the log2, which the shift centres (±0.045, 3.2 %)."""
+    for k in range(n):
+        yb[k] = _ONE_BITS - _START_SHIFT + np.int64((xb[k] - _ONE_BITS) * inv_m)
+
+
+@njit(cache=True, error_model="numpy")
+def _root_halley(x, y, n, m):
+    """Three Halley steps on y^m = x from the start, each a correction to y (its relative error ε → about
+    (m² − 1)/12 ε³: 3.2 % → 3e-3 → 2e-6 → round-off for m ≤ 31; tests/mbd/test_compiled_sliced.py checks every m
+    against a long-double root)."""
+    a, b = m - 1.0, m + 1.0
+    for k in range(n):
+        xk, yk = x[k], y[k]
+        for _ in range(3):
+            ym = _ipow(yk, m)
+            yk = yk - (2.0 * (ym - xk)) * (yk / (b * ym + a * xk))
+        y[k] = yk
+
+
+@njit(cache=True, error_model="numpy")
+def _slice_roots(delta, x, y, ns, npad, m, pe):
+    """y[k] = δ_k^pe for the slices' δ (x, y: buffers of npad ≥ ns, a multiple of the SIMD width; an open slice's is
+    anything finite). With m = root_index(pe) > 0 by Halley's iteration, vectorised (x^(1/m) within about an ulp:
+    tests/mbd/test_compiled_sliced.py); else, and for a δ > 0 outside [1e-300, 1e300], np.power."""
+    if m == 0:
+        for k in range(ns):
+            d = delta[k]
+            y[k] = d ** pe if d > 0.0 else 1.0
+        return
+    for k in range(ns):
+        d = delta[k]
+        d = d if d > _ROOT_LO else _ROOT_LO
+        x[k] = d if d < _ROOT_HI else _ROOT_HI
+    _root_start(x.view(np.int64), y.view(np.int64), npad, 1.0 / m)
+    _root_halley(x, y, npad, m)
+    for k in range(ns):
+        d = delta[k]
+        if d > 0.0 and (d < _ROOT_LO or d > _ROOT_HI):
+            y[k] = d ** pe
 
 
 @njit(cache=True)
@@ -132,7 +207,7 @@ def _race_col(J, i, c, outer, f0, f1, f2, f3, f4, f5, f6, dT2x, dT2y, dGx, dGy, 
         J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4 - dGx, f5 - dGy, f6 + dpin
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     p, law = G[0], int(G[1])
     pe = 0.5 * (p - 1.0)
@@ -146,7 +221,11 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     jd0, jd1 = (0, 1) if outer else (4, 5)      # translation columns derived from the others (_derived_cols)
     acc = np.zeros((3, 12))          # moments m = 0, 1, 2 of M_k (4), N_k (4), g_k (2), ∂q_k/∂ẇ_k (2)
     w_x, w_y, w_d, w_delta = np.empty(ns), np.empty(ns), np.empty(ns), np.empty(ns)     # a contact's slices
-    blocks, loaded = np.empty((ns if jac else 0, 12)), np.empty(ns, np.int64)    # its loaded slices' blocks
+    w_q, w_Fx, w_Fy = np.empty(ns), np.empty(ns), np.empty(ns)
+    mroot = root_index(pe)
+    npad = -(-ns // _LANES) * _LANES
+    w_c, w_root = np.ones(npad), np.ones(npad)           # δ_k clipped at the smallest normal, δ_k^((p−1)/2)
+    blocks = np.empty((ns if jac else 0, 12))           # the slices' derivative blocks (zero: open)
     thb_last, cb, sb, thp_last, cp, sp = np.nan, 0.0, 0.0, np.nan, 0.0, 0.0
     for i in range(ql.shape[0]):
         kap, mx, my, pmx, pmy, s0x, s0y = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
@@ -196,7 +275,6 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             continue
         # the slice loop
         S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        n_loaded = 0
         Ks, c0s = K / ns, c0 / ns
         for k in range(ns):          # every slice's offset and compression first: a loop without branches (SIMD)
             zk = zs[k]
@@ -206,10 +284,9 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             d = np.sqrt(wx * wx + wy * wy + _ETA2)
             w_x[k], w_y[k], w_d[k] = wx, wy, d
             w_delta[k] = 0.5 * D - kap * (d - R) - P[i, SLICED_COLS + k]
-        for k in range(ns):
+        _slice_roots(w_delta, w_c, w_root, ns, npad, mroot, pe)
+        for k in range(ns):          # every slice's load, open ones masked (selects, no branches: SIMD)
             delta = w_delta[k]
-            if not delta > 0.0:                     # an open slice: nothing more of it
-                continue
             zk = zs[k]
             zeta = row + zk
             wx, wy, d = w_x[k], w_y[k], w_d[k]
@@ -218,12 +295,44 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             vwy = wvy + zk * dsry - zeta * dscy
             nv = nx * vwx + ny * vwy
             delta_dot = -kap * nv
-            dpe = delta ** pe                       # δ^((p−1)/2); δ^p = δ (δ^((p−1)/2))², one power a slice
+            dpe = w_root[k]                         # δ^((p−1)/2); δ^p = δ (δ^((p−1)/2))²
             dp1 = dpe * dpe
-            q = Ks * (delta * dp1) + c0s * dpe * delta_dot
-            if not q > 0.0:
-                continue
-            Fx, Fy = kap * q * nx, kap * q * ny
+            q_raw = Ks * (delta * dp1) + c0s * dpe * delta_dot
+            q = q_raw if (delta > 0.0) & (q_raw > 0.0) else 0.0
+            w_q[k] = q
+            w_Fx[k], w_Fy[k] = kap * q * nx, kap * q * ny
+        if jac:
+            for k in range(ns):      # the slices' derivative blocks (zero: open), a loop of its own (SIMD)
+                delta, q = w_delta[k], w_q[k]
+                zk = zs[k]
+                zeta = row + zk
+                wx, wy, d = w_x[k], w_y[k], w_d[k]
+                nx, ny = wx / d, wy / d
+                vwx = wvx + zk * dsrx - zeta * dscx
+                vwy = wvy + zk * dsry - zeta * dscy
+                nv = nx * vwx + ny * vwy
+                delta_dot = -kap * nv
+                dpe = w_root[k]
+                dp1 = dpe * dpe
+                on = q > 0.0
+                q_d = Ks * p * dp1 + c0s * pe * (dpe / delta) * delta_dot                     # ∂q/∂δ
+                q_d = q_d if on else 0.0
+                q_r = c0s * dpe if on else 0.0                                                 # ∂q/∂δ̇
+                i_d = 1.0 / d
+                hx, hy = (vwx - nx * nv) * i_d, (vwy - ny * nv) * i_d
+                gqx, gqy = -kap * (q_d * nx + q_r * hx), -kap * (q_d * ny + q_r * hy)
+                gvx, gvy = -kap * q_r * nx, -kap * q_r * ny
+                qd = kap * q * i_d
+                blocks[k, 0] = kap * nx * gqx + qd * (1.0 - nx * nx)
+                blocks[k, 1] = kap * nx * gqy - qd * nx * ny
+                blocks[k, 2] = kap * ny * gqx - qd * nx * ny
+                blocks[k, 3] = kap * ny * gqy + qd * (1.0 - ny * ny)
+                blocks[k, 4], blocks[k, 5] = kap * nx * gvx, kap * nx * gvy
+                blocks[k, 6], blocks[k, 7] = kap * ny * gvx, kap * ny * gvy
+                blocks[k, 8], blocks[k, 9], blocks[k, 10], blocks[k, 11] = gqx, gqy, gvx, gvy
+        for k in range(ns):          # the sums, in the slices' order
+            zk, Fx, Fy, q = zs[k], w_Fx[k], w_Fy[k], w_q[k]
+            zeta = row + zk
             S0x += Fx
             S0y += Fy
             S1x += zk * Fx
@@ -232,30 +341,11 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             S2y += zeta * Fy
             Q += q
             Qz += zk * q
-            if not jac:
-                continue
-            q_d = Ks * p * dp1 + c0s * pe * (dpe / delta) * delta_dot                         # ∂q/∂δ
-            q_r = c0s * dpe                                                                   # ∂q/∂δ̇
-            i_d = 1.0 / d
-            hx, hy = (vwx - nx * nv) * i_d, (vwy - ny * nv) * i_d
-            gqx, gqy = -kap * (q_d * nx + q_r * hx), -kap * (q_d * ny + q_r * hy)
-            gvx, gvy = -kap * q_r * nx, -kap * q_r * ny
-            qd = kap * q * i_d
-            r = n_loaded             # the slice's blocks; their moments after the loop (_moments)
-            blocks[r, 0] = kap * nx * gqx + qd * (1.0 - nx * nx)
-            blocks[r, 1] = kap * nx * gqy - qd * nx * ny
-            blocks[r, 2] = kap * ny * gqx - qd * nx * ny
-            blocks[r, 3] = kap * ny * gqy + qd * (1.0 - ny * ny)
-            blocks[r, 4], blocks[r, 5] = kap * nx * gvx, kap * nx * gvy
-            blocks[r, 6], blocks[r, 7] = kap * ny * gvx, kap * ny * gvy
-            blocks[r, 8], blocks[r, 9], blocks[r, 10], blocks[r, 11] = gqx, gqy, gvx, gvy
-            loaded[n_loaded] = k
-            n_loaded += 1
         if not Q > 0.0:
             _zero(F, Jq, Jv, i, jac)
             continue
         if jac:
-            _moments(acc, blocks, loaded, n_loaded, zs)
+            _moments(acc, blocks, ns, zs)
         # traction as the planar contact's on Q, applied at the load centroid z̄
         rho = np.sqrt(pcx_ * pcx_ + pcy_ * pcy_ + _ETA2)
         ecx, ecy = pcx_ / rho, pcy_ / rho
