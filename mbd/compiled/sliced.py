@@ -52,6 +52,7 @@ _TWO_PI = 2.0 * np.pi
 _ETA2 = 1e-24            # the reference's η² (mbd.elements.sliced._ETA2)
 SLICED_COLS = 13         # P columns before the profile drops
 _GZ = 11                 # G index of the first slice station
+_NGEO = 48               # a contact's geometry the kernel's second pass reads
 
 
 def pack_sliced_race(elem):
@@ -149,25 +150,33 @@ def _root_halley(x, y, n, m):
 
 
 @njit(cache=True, error_model="numpy")
-def _slice_roots(delta, x, y, ns, npad, m, pe):
-    """y[k] = δ_k^pe for the slices' δ (x, y: buffers of npad ≥ ns, a multiple of the SIMD width; an open slice's is
-    anything finite). With m = root_index(pe) > 0 by Halley's iteration, vectorised (x^(1/m) within about an ulp:
-    tests/mbd/test_compiled_sliced.py); else, and for a δ > 0 outside [1e-300, 1e300], np.power."""
+def _slice_roots(delta, x, y, rows, ns, npad, m, pe):
+    """y[r npad + k] = δ[r, k]^pe for the rows r < rows of the slices' δ (x, y: flat buffers of rows of npad ≥ ns, a
+    multiple of the SIMD width; an open slice's is anything finite). With m = root_index(pe) > 0 by Halley's
+    iteration over all rows at once (vectorised: x^(1/m) within about an ulp, tests/mbd/test_compiled_sliced.py);
+    else, and for a δ > 0 outside [1e-300, 1e300], np.power."""
     if m == 0:
-        for k in range(ns):
-            d = delta[k]
-            y[k] = d ** pe if d > 0.0 else 1.0
+        for r in range(rows):
+            for k in range(ns):
+                d = delta[r, k]
+                y[r * npad + k] = d ** pe if d > 0.0 else 1.0
         return
-    for k in range(ns):
-        d = delta[k]
-        d = d if d > _ROOT_LO else _ROOT_LO
-        x[k] = d if d < _ROOT_HI else _ROOT_HI
-    _root_start(x.view(np.int64), y.view(np.int64), npad, 1.0 / m)
-    _root_halley(x, y, npad, m)
-    for k in range(ns):
-        d = delta[k]
-        if d > 0.0 and (d < _ROOT_LO or d > _ROOT_HI):
-            y[k] = d ** pe
+    for r in range(rows):
+        o = r * npad
+        for k in range(ns):
+            d = delta[r, k]
+            d = d if d > _ROOT_LO else _ROOT_LO
+            x[o + k] = d if d < _ROOT_HI else _ROOT_HI
+        for k in range(ns, npad):
+            x[o + k] = 1.0
+    n = rows * npad
+    _root_start(x.view(np.int64), y.view(np.int64), n, 1.0 / m)
+    _root_halley(x, y, n, m)
+    for r in range(rows):
+        for k in range(ns):
+            d = delta[r, k]
+            if d > 0.0 and (d < _ROOT_LO or d > _ROOT_HI):
+                y[r * npad + k] = d ** pe
 
 
 @njit(cache=True)
@@ -220,13 +229,18 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     outer = nl == 12
     jd0, jd1 = (0, 1) if outer else (4, 5)      # translation columns derived from the others (_derived_cols)
     acc = np.zeros((3, 12))          # moments m = 0, 1, 2 of M_k (4), N_k (4), g_k (2), ∂q_k/∂ẇ_k (2)
-    w_x, w_y, w_d, w_delta = np.empty(ns), np.empty(ns), np.empty(ns), np.empty(ns)     # a contact's slices
-    w_q, w_Fx, w_Fy = np.empty(ns), np.empty(ns), np.empty(ns)
+    n = ql.shape[0]
     mroot = root_index(pe)
     npad = -(-ns // _LANES) * _LANES
-    w_c, w_root = np.ones(npad), np.ones(npad)           # δ_k clipped at the smallest normal, δ_k^((p−1)/2)
+    slot = np.empty(n, np.int64)                        # a contact's row in the buffers below (−1: open by the bound)
+    geo = np.empty((n, _NGEO))                          # its geometry (what the second pass reads)
+    w_x, w_y, w_d, w_delta = np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns))
+    w_c, w_root = np.empty(n * npad), np.empty(n * npad)     # δ clipped to the root's range, δ^((p−1)/2)
+    w_q, w_Fx, w_Fy = np.empty(ns), np.empty(ns), np.empty(ns)
     blocks = np.empty((ns if jac else 0, 12))           # the slices' derivative blocks (zero: open)
     thb_last, cb, sb, thp_last, cp, sp = np.nan, 0.0, 0.0, np.nan, 0.0, 0.0
+    # every contact's geometry and slice compressions, then their powers all at once (the SIMD lanes full)
+    rows = 0
     for i in range(ql.shape[0]):
         kap, mx, my, pmx, pmy, s0x, s0y = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
         R, D, K, c0, row, Rr = P[i, 7], P[i, 8], P[i, 9], P[i, 10], P[i, 11], P[i, 12]
@@ -271,31 +285,52 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         delta0 = 0.5 * D - kap * (np.sqrt(pcx_ * pcx_ + pcy_ * pcy_) - R)
         reach = zmax * abs(tau) + (abs(row) + zmax) * np.sqrt(scx * scx + scy * scy)
         if delta0 + reach <= 0.0:
-            _zero(F, Jq, Jv, i, jac)
+            slot[i] = -1
             continue
-        # the slice loop
-        S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        Ks, c0s = K / ns, c0 / ns
-        for k in range(ns):          # every slice's offset and compression first: a loop without branches (SIMD)
+        r = rows
+        slot[i] = r
+        rows += 1
+        gt = (kap, R, D, K, c0, row, Rr, tau, vr0, vr1, vr2, dtau, vb0, vb1, vb2, vp2, rcx, rcy, Vcx, Vcy, rpx, rpy, ux,
+             uy, rho_p, ex, ey, gx, gy, ge, edx, edy, s0cx, s0cy, scx, scy, dscx, dscy, k0x, k0y, srx, sry, dsrx, dsry,
+             pcx_, pcy_, wvx, wvy)                  # what the second pass reads, in its order
+        for j in range(_NGEO):
+            geo[r, j] = gt[j]
+        for k in range(ns):          # every slice's offset and compression: a loop without branches (SIMD)
             zk = zs[k]
             zeta = row + zk
             wx = pcx_ + zk * srx - zeta * scx
             wy = pcy_ + zk * sry - zeta * scy
             d = np.sqrt(wx * wx + wy * wy + _ETA2)
-            w_x[k], w_y[k], w_d[k] = wx, wy, d
-            w_delta[k] = 0.5 * D - kap * (d - R) - P[i, SLICED_COLS + k]
-        _slice_roots(w_delta, w_c, w_root, ns, npad, mroot, pe)
+            w_x[r, k], w_y[r, k], w_d[r, k] = wx, wy, d
+            w_delta[r, k] = 0.5 * D - kap * (d - R) - P[i, SLICED_COLS + k]
+    _slice_roots(w_delta, w_c, w_root, rows, ns, npad, mroot, pe)
+    for i in range(n):
+        r = slot[i]
+        if r < 0:
+            _zero(F, Jq, Jv, i, jac)
+            continue
+        gr = geo[r]
+        (kap, R, D, K, c0, row, Rr, tau, vr0, vr1, vr2, dtau, vb0, vb1, vb2, vp2, rcx, rcy, Vcx, Vcy, rpx, rpy, ux,
+         uy, rho_p, ex, ey, gx, gy, ge, edx, edy, s0cx, s0cy, scx, scy, dscx, dscy, k0x, k0y, srx, sry, dsrx, dsry,
+         pcx_, pcy_, wvx, wvy) = (
+            gr[0], gr[1], gr[2], gr[3], gr[4], gr[5], gr[6], gr[7], gr[8], gr[9], gr[10], gr[11], gr[12], gr[13],
+            gr[14], gr[15], gr[16], gr[17], gr[18], gr[19], gr[20], gr[21], gr[22], gr[23], gr[24], gr[25], gr[26],
+            gr[27], gr[28], gr[29], gr[30], gr[31], gr[32], gr[33], gr[34], gr[35], gr[36], gr[37], gr[38], gr[39],
+            gr[40], gr[41], gr[42], gr[43], gr[44], gr[45], gr[46], gr[47])
+        S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        Ks, c0s = K / ns, c0 / ns
+        o = r * npad
         for k in range(ns):          # every slice's load, open ones masked (selects, no branches: SIMD)
-            delta = w_delta[k]
+            delta = w_delta[r, k]
             zk = zs[k]
             zeta = row + zk
-            wx, wy, d = w_x[k], w_y[k], w_d[k]
+            wx, wy, d = w_x[r, k], w_y[r, k], w_d[r, k]
             nx, ny = wx / d, wy / d
             vwx = wvx + zk * dsrx - zeta * dscx
             vwy = wvy + zk * dsry - zeta * dscy
             nv = nx * vwx + ny * vwy
             delta_dot = -kap * nv
-            dpe = w_root[k]                         # δ^((p−1)/2); δ^p = δ (δ^((p−1)/2))²
+            dpe = w_root[o + k]                         # δ^((p−1)/2); δ^p = δ (δ^((p−1)/2))²
             dp1 = dpe * dpe
             q_raw = Ks * (delta * dp1) + c0s * dpe * delta_dot
             q = q_raw if (delta > 0.0) & (q_raw > 0.0) else 0.0
@@ -303,16 +338,16 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             w_Fx[k], w_Fy[k] = kap * q * nx, kap * q * ny
         if jac:
             for k in range(ns):      # the slices' derivative blocks (zero: open), a loop of its own (SIMD)
-                delta, q = w_delta[k], w_q[k]
+                delta, q = w_delta[r, k], w_q[k]
                 zk = zs[k]
                 zeta = row + zk
-                wx, wy, d = w_x[k], w_y[k], w_d[k]
+                wx, wy, d = w_x[r, k], w_y[r, k], w_d[r, k]
                 nx, ny = wx / d, wy / d
                 vwx = wvx + zk * dsrx - zeta * dscx
                 vwy = wvy + zk * dsry - zeta * dscy
                 nv = nx * vwx + ny * vwy
                 delta_dot = -kap * nv
-                dpe = w_root[k]
+                dpe = w_root[o + k]
                 dp1 = dpe * dpe
                 on = q > 0.0
                 q_d = Ks * p * dp1 + c0s * pe * (dpe / delta) * delta_dot                     # ∂q/∂δ

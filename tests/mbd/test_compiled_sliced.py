@@ -104,8 +104,8 @@ def test_loaded_open_and_edge_contacts_in_one_family():
 def _roots(delta, pe):
     delta = np.asarray(delta, float)
     npad = -(-delta.size // _LANES) * _LANES
-    x, y = np.ones(npad), np.empty(npad)
-    _slice_roots(delta, x, y, delta.size, npad, root_index(pe), pe)
+    x, y = np.empty(npad), np.empty(npad)
+    _slice_roots(delta[None, :], x, y, 1, delta.size, npad, root_index(pe), pe)
     return y[:delta.size]
 
 
