@@ -204,16 +204,22 @@ def _derived_cols(Jq, Jv, i, outer):
 
 
 @njit(cache=True)
-def _race_col(J, i, c, outer, f0, f1, f2, f3, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin):
-    """Column c of instance i's block (J_q or J_v: passed in, not chosen by a branch in the caller, whose every
-    write then cost array bookkeeping: mbd.compiled.contact._col)."""
-    J[i, 0, c], J[i, 1, c], J[i, 2, c], J[i, 3, c] = f0, f1, f2, f3
+def _race_cols(J, i, cols, outer):
+    """Instance i's block (J_q or J_v) from a pass's columns: the roller's, the race body's, the race's slopes' and the
+    pin's rows (inner: the pin is the race body, its rows added to the race body's)."""
+    nl = J.shape[2]
+    for c in range(nl):
+        J[i, 0, c], J[i, 1, c], J[i, 2, c], J[i, 3, c] = cols[0, c], cols[1, c], cols[2, c], cols[3, c]
     if outer:
-        J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4, f5, f6
-        J[i, 7, c], J[i, 8, c] = -dT2x, -dT2y
-        J[i, 9, c], J[i, 10, c], J[i, 11, c] = -dGx, -dGy, dpin
+        for c in range(nl):
+            J[i, 4, c], J[i, 5, c], J[i, 6, c] = cols[4, c], cols[5, c], cols[6, c]
+            J[i, 7, c], J[i, 8, c] = -cols[7, c], -cols[8, c]
+            J[i, 9, c], J[i, 10, c], J[i, 11, c] = -cols[9, c], -cols[10, c], cols[11, c]
     else:
-        J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4 - dGx, f5 - dGy, f6 + dpin
+        for c in range(nl):
+            J[i, 4, c] = cols[4, c] - cols[9, c]
+            J[i, 5, c] = cols[5, c] - cols[10, c]
+            J[i, 6, c] = cols[6, c] + cols[11, c]
 
 
 @njit(cache=True, error_model="numpy")
@@ -227,7 +233,12 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         zmax = max(zmax, abs(zs[k]))
     nl = ql.shape[1]
     outer = nl == 12
-    jd0, jd1 = (0, 1) if outer else (4, 5)      # translation columns derived from the others (_derived_cols)
+    js0, js1 = (7, 8) if outer else (-1, -1)            # the race's slope pair's columns (none: inner, rigid pin)
+    jp0, jp1, jp2 = (9, 10, 11) if outer else (4, 5, 6)  # the pin body's (inner: the race body is the pin)
+    # a pass's columns (f0 … f6, dT2x, dT2y, dGx, dGy, dpin): every direction of a SIMD width's multiple jn ≥ nl, those
+    # past nl zero, the derived ones overwritten (_derived_cols): a loop of a fixed count without branches (SIMD)
+    jn = 16 if outer else 8
+    cols = np.empty((12, 16))
     acc = np.zeros((3, 12))          # moments m = 0, 1, 2 of M_k (4), N_k (4), g_k (2), ∂q_k/∂ẇ_k (2)
     n = ql.shape[0]
     mroot = root_index(pe)
@@ -437,14 +448,9 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         # roller, the race body and the pin only through their relative positions: a common translation changes
         # nothing, so the roller's translation columns are the race body's and the pin's negated and summed (outer:
         # computed from them; inner, whose pin is the race body: the race body's are the roller's negated, exactly).
-        for j in range(nl):
-            if j == 2 or j == jd0 or j == jd1:
-                continue
+        for j in range(jn):
             dxr, dyr, dta, dxb, dyb, dthb = _u(j, 0), _u(j, 1), _u(j, 3), _u(j, 4), _u(j, 5), _u(j, 6)
-            if outer:
-                dsx, dsy, dxp, dyp, dthp = _u(j, 7), _u(j, 8), _u(j, 9), _u(j, 10), _u(j, 11)
-            else:
-                dsx, dsy, dxp, dyp, dthp = 0.0, 0.0, dxb, dyb, dthb
+            dsx, dsy, dxp, dyp, dthp = _u(j, js0), _u(j, js1), _u(j, jp0), _u(j, jp1), _u(j, jp2)
             drcx, drcy = -dthb * rcy, dthb * rcx
             dVcx, dVcy = -vb2 * drcy, vb2 * drcx
             drpx, drpy = -dthp * rpy, dthp * rpx
@@ -516,17 +522,14 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
                   - (drbx * Fty + rbx * dFty - drby * Ftx - rby * dFtx)
                   + dT2x * k0x + T2x * dk0x + dT2y * k0y + T2y * dk0y)
             dpin = -(drpx * Gy + rpx * dGy - drpy * Gx - rpy * dGx)
-            _race_col(Jq, i, j, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
+            cols[0, j], cols[1, j], cols[2, j], cols[3, j], cols[4, j], cols[5, j] = f0, f1, f2, ds1e, f4, f5
+            cols[6, j], cols[7, j], cols[8, j], cols[9, j], cols[10, j], cols[11, j] = f6, dT2x, dT2y, dGx, dGy, dpin
+        _race_cols(Jq, i, cols, outer)
         # Velocities: they leave the geometry (e, σ_c's turn, the contact point, the levers) and move only the rates.
         # A common velocity of the roller, the race body and the pin changes no force (as for the positions).
-        for j in range(nl):
-            if j == jd0 or j == jd1:
-                continue
+        for j in range(jn):
             dvr0, dvr1, dvr2, ddta, dvb0, dvb1, dvb2 = _u(j, 0), _u(j, 1), _u(j, 2), _u(j, 3), _u(j, 4), _u(j, 5), _u(j, 6)
-            if outer:
-                dvsx, dvsy, dvp0, dvp1, dvp2 = _u(j, 7), _u(j, 8), _u(j, 9), _u(j, 10), _u(j, 11)
-            else:
-                dvsx, dvsy, dvp0, dvp1, dvp2 = 0.0, 0.0, dvb0, dvb1, dvb2
+            dvsx, dvsy, dvp0, dvp1, dvp2 = _u(j, js0), _u(j, js1), _u(j, jp0), _u(j, jp1), _u(j, jp2)
             dVcx, dVcy = dvb0 - dvb2 * rcy, dvb1 + dvb2 * rcx
             dVpx, dVpy = dvp0 - dvp2 * rpy, dvp1 + dvp2 * rpx
             dgx, dgy = dvr0 - dVpx, dvr1 - dVpy
@@ -568,7 +571,9 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             f4, f5 = -dS0x - dFtx, -dS0y - dFty
             f6 = -(rcx * dS0y - rcy * dS0x) - (rbx * dFty - rby * dFtx) + dT2x * k0x + dT2y * k0y
             dpin = -(rpx * dGy - rpy * dGx)
-            _race_col(Jv, i, j, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
+            cols[0, j], cols[1, j], cols[2, j], cols[3, j], cols[4, j], cols[5, j] = f0, f1, f2, ds1e, f4, f5
+            cols[6, j], cols[7, j], cols[8, j], cols[9, j], cols[10, j], cols[11, j] = f6, dT2x, dT2y, dGx, dGy, dpin
+        _race_cols(Jv, i, cols, outer)
         _derived_cols(Jq, Jv, i, outer)
 
 
