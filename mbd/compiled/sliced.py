@@ -10,9 +10,21 @@ Layout (one row of P per instance; G family-wide):
                        The local coordinates' count tells the layout: 7 an inner raceway on a rigid pin, 12
                        a raceway with its body's slope pair (the bore; an elastic pin's raceway, κ = +1).
 
-How the Jacobian is made. The slice loop runs once per contact: it gives the slice loads and the sums the forces
-need (Σ F_k, Σ z_k F_k, Σ ζ_k F_k, Q = Σ q_k, Σ z_k q_k) and, with ``jac``, the slices' derivative blocks summed
-against the powers of z_k. Every slice's offset is w_k = (p − c) + z_k σ_r − ζ_k σ_c with ζ_k = ζ_row + z_k, so along
+How the kernel runs. Two passes over the contacts. The first takes each contact's geometry (kept for the second) and,
+unless the reference's bound finds every slice open (δ_0 + max_k |z_k σ_r − ζ_k σ_c| ≤ 0: the contact is skipped),
+every slice's offset and compression δ_k. Between the passes the slices' powers δ_k^((p−1)/2) of all the contacts at
+once (:func:`_slice_roots`). The second pass gives each contact's slice loads (open slices masked, no branches) and
+the sums the forces need (Σ F_k, Σ z_k F_k, Σ ζ_k F_k, Q = Σ q_k, Σ z_k q_k) and, with ``jac``, the slices'
+derivative blocks summed against the powers of z_k; a contact without load has no force and (ad.where) no derivative.
+
+The power. δ^p = δ (δ^((p−1)/2))², one power a slice shared by the load, its damping and their derivatives. When
+(p − 1)/2 = 1/m for an integer m ≤ 31 (Palmgren's p = 10/9: m = 18) it is the m-th root by Halley's iteration on
+y^m = δ from a start read off δ's bits (:func:`_root_start`, :func:`_root_halley`): arithmetic only, so the
+compiler runs it in SIMD lanes over every loaded slice of the family, where np.power is a library call per slice. It
+is the m-th root within 1.5 ulp from 1e-300 to 1e300 (tests/mbd/test_compiled_sliced.py, against a long-double
+root); any other p, and δ outside that range, take np.power.
+
+How the Jacobian is made. Every slice's offset is w_k = (p − c) + z_k σ_r − ζ_k σ_c with ζ_k = ζ_row + z_k, so along
 any direction its change is dw_k = A + z_k B (A = d(p − c) − ζ_row dσ_c, B = dσ_r − dσ_c), the same for its rate; the
 slice force's change is dF_k = M_k dw_k + N_k dẇ_k with
 
@@ -23,16 +35,14 @@ so d Σ z_k^m F_k = Σ z_k^m M_k A + Σ z_k^(m+1) M_k B + (the same with N_k and
 M_k, N_k and of the load gradients carry every slice into the contact's 2 n_local directions, which are then
 contact-level scalars (the geometry of e, σ_r, σ_c, the traction law, the generalised forces; the differential of
 every line of the reference evaluated along each unit direction, as :mod:`mbd.compiled.contact`). Exact, no
-differencing; the values are the reference's in its operation order up to the order of the slice sums. The directions
-use the law's structure, as the planar race contact's: the velocity directions leave the geometry unchanged and carry
-only the rate terms (a pass of their own); the roller's angle enters no force (its column is zero); and a common
-translation (or velocity) of roller, race body and pin changes no force, so the roller's translation columns are the
-negated sum of the race body's and the pin's (outer raceway; the inner raceway's pin is its race body, whose columns
-are then the roller's negated) — 9 of 12 position and 10 of 12 velocity directions computed for an outer contact, 4 of
-7 and 5 of 7 for an inner one.
-
-Contacts whose every slice is open by the reference's bound (δ_0 + max_k |z_k σ_r − ζ_k σ_c| ≤ 0) are skipped before
-the slice loop; a contact without load has no force and (ad.where) no derivative.
+differencing; the values are the reference's up to the order of the slice sums and the power's last bit. The
+directions use the law's structure, as the planar race contact's: the velocity directions leave the geometry
+unchanged and carry only the rate terms (a pass of their own); the roller's angle enters no force (its column is
+zero); and a common translation (or velocity) of roller, race body and pin changes no force, so the roller's
+translation columns are the negated sum of the race body's and the pin's (outer raceway; the inner raceway's pin is
+its race body, whose columns are then the roller's negated). Each pass is a loop of a fixed count (16 directions for
+an outer contact, 8 for an inner one; those past its n_local zero) without branches, which the compiler runs in SIMD
+lanes; the derived columns are then overwritten.
 """
 from __future__ import annotations
 
