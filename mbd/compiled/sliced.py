@@ -311,11 +311,15 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         r = rows
         slot[i] = r
         rows += 1
-        gt = (kap, R, D, K, c0, row, Rr, tau, vr0, vr1, vr2, dtau, vb0, vb1, vb2, vp2, rcx, rcy, Vcx, Vcy, rpx, rpy, ux,
-             uy, rho_p, ex, ey, gx, gy, ge, edx, edy, s0cx, s0cy, scx, scy, dscx, dscy, k0x, k0y, srx, sry, dsrx, dsry,
-             pcx_, pcy_, wvx, wvy)                  # what the second pass reads, in its order
-        for j in range(_NGEO):
-            geo[r, j] = gt[j]
+        # what the second pass reads, in its order (stores one by one: a loop over a tuple costs twice as much)
+        geo[r, 0], geo[r, 1], geo[r, 2], geo[r, 3], geo[r, 4], geo[r, 5] = kap, R, D, K, c0, row
+        geo[r, 6], geo[r, 7], geo[r, 8], geo[r, 9], geo[r, 10], geo[r, 11] = Rr, tau, vr0, vr1, vr2, dtau
+        geo[r, 12], geo[r, 13], geo[r, 14], geo[r, 15], geo[r, 16], geo[r, 17] = vb0, vb1, vb2, vp2, rcx, rcy
+        geo[r, 18], geo[r, 19], geo[r, 20], geo[r, 21], geo[r, 22], geo[r, 23] = Vcx, Vcy, rpx, rpy, ux, uy
+        geo[r, 24], geo[r, 25], geo[r, 26], geo[r, 27], geo[r, 28], geo[r, 29] = rho_p, ex, ey, gx, gy, ge
+        geo[r, 30], geo[r, 31], geo[r, 32], geo[r, 33], geo[r, 34], geo[r, 35] = edx, edy, s0cx, s0cy, scx, scy
+        geo[r, 36], geo[r, 37], geo[r, 38], geo[r, 39], geo[r, 40], geo[r, 41] = dscx, dscy, k0x, k0y, srx, sry
+        geo[r, 42], geo[r, 43], geo[r, 44], geo[r, 45], geo[r, 46], geo[r, 47] = dsrx, dsry, pcx_, pcy_, wvx, wvy
         for k in range(ns):          # every slice's offset and compression: a loop without branches (SIMD)
             zk = zs[k]
             zeta = row + zk
