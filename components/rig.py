@@ -379,14 +379,15 @@ def rig_loads(built: BearingRigScene, system: mbd.System, s: mbd.State) -> dict:
 
 
 def rig_quasi_static(built: BearingRigScene, times=None, engine: str = "auto", system: mbd.System | None = None,
-                     hold_tilt: bool = True):
+                     hold_tilt: bool = True, length_tol: float | None = None):
     """The rig's quasi-static states (:func:`mbd.static.solve_static`, docs/model.md §10.5, §16) at ``times`` [s]
     (default: the end of the load ramp, the load at its full value), each started from the last: every roller keeps
     its pocket's centre (it moves along its radius only, as ISO/TS 16281's rollers do), its radius, tilt and spin
     rate solved; a free cage's rate with its rollers' orbits; the ring's translation. Held: the ring's angle (its speed
     drive supplies the torque) and, in the sliced model, the ring's slope at its given zero (the tilting moment is the
     housing's reaction; ``hold_tilt=False`` solves it against the housing's support instead, as a dynamic run sees
-    it). Returns the :class:`mbd.static.StaticSolution` list; :func:`rig_loads` reads each. A turning ring's unloaded
+    it). ``length_tol`` [m]: the static solver's (:func:`mbd.static.solve_static`; None: its default). Returns the
+    :class:`mbd.static.StaticSolution` list; :func:`rig_loads` reads each. A turning ring's unloaded
     rollers have no traction and so no static spin rate: the ring at rest (the standard's case) always has a state."""
     m, h = built.model, built.bearing_handles
     system = system if system is not None else mbd.System(m)
@@ -420,8 +421,9 @@ def rig_quasi_static(built: BearingRigScene, times=None, engine: str = "auto", s
     out = []
     for t in times:
         start = carry(m, motion, out[-1], t, rates) if out else (q_first, None)
+        tol = {} if length_tol is None else {"length_tol": float(length_tol)}
         out.append(solve_static(m, motion, t, hold=hold[hold >= 0], rates=rates, q_start=start[0],
-                                rates_start=start[1], system=system, engine=engine))
+                                rates_start=start[1], system=system, engine=engine, **tol))
     return out
 
 

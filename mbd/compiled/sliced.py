@@ -10,9 +10,21 @@ Layout (one row of P per instance; G family-wide):
                        The local coordinates' count tells the layout: 7 an inner raceway on a rigid pin, 12
                        a raceway with its body's slope pair (the bore; an elastic pin's raceway, κ = +1).
 
-How the Jacobian is made. The slice loop runs once per contact: it gives the slice loads and the sums the forces
-need (Σ F_k, Σ z_k F_k, Σ ζ_k F_k, Q = Σ q_k, Σ z_k q_k) and, with ``jac``, the slices' derivative blocks summed
-against the powers of z_k. Every slice's offset is w_k = (p − c) + z_k σ_r − ζ_k σ_c with ζ_k = ζ_row + z_k, so along
+How the kernel runs. Two passes over the contacts. The first takes each contact's geometry (kept for the second) and,
+unless the reference's bound finds every slice open (δ_0 + max_k |z_k σ_r − ζ_k σ_c| ≤ 0: the contact is skipped),
+every slice's offset and compression δ_k. Between the passes the slices' powers δ_k^((p−1)/2) of all the contacts at
+once (:func:`_slice_roots`). The second pass gives each contact's slice loads (open slices masked, no branches) and
+the sums the forces need (Σ F_k, Σ z_k F_k, Σ ζ_k F_k, Q = Σ q_k, Σ z_k q_k) and, with ``jac``, the slices'
+derivative blocks summed against the powers of z_k; a contact without load has no force and (ad.where) no derivative.
+
+The power. δ^p = δ (δ^((p−1)/2))², one power a slice shared by the load, its damping and their derivatives. When
+(p − 1)/2 = 1/m for an integer m ≤ 31 (Palmgren's p = 10/9: m = 18) it is the m-th root by Halley's iteration on
+y^m = δ from a start read off δ's bits (:func:`_root_start`, :func:`_root_halley`): arithmetic only, so the
+compiler runs it in SIMD lanes over every loaded slice of the family, where np.power is a library call per slice. It
+is the m-th root within 1.5 ulp from 1e-300 to 1e300 (tests/mbd/test_compiled_sliced.py, against a long-double
+root); any other p, and δ outside that range, take np.power.
+
+How the Jacobian is made. Every slice's offset is w_k = (p − c) + z_k σ_r − ζ_k σ_c with ζ_k = ζ_row + z_k, so along
 any direction its change is dw_k = A + z_k B (A = d(p − c) − ζ_row dσ_c, B = dσ_r − dσ_c), the same for its rate; the
 slice force's change is dF_k = M_k dw_k + N_k dẇ_k with
 
@@ -23,16 +35,14 @@ so d Σ z_k^m F_k = Σ z_k^m M_k A + Σ z_k^(m+1) M_k B + (the same with N_k and
 M_k, N_k and of the load gradients carry every slice into the contact's 2 n_local directions, which are then
 contact-level scalars (the geometry of e, σ_r, σ_c, the traction law, the generalised forces; the differential of
 every line of the reference evaluated along each unit direction, as :mod:`mbd.compiled.contact`). Exact, no
-differencing; the values are the reference's in its operation order up to the order of the slice sums. The directions
-use the law's structure, as the planar race contact's: the velocity directions leave the geometry unchanged and carry
-only the rate terms (a pass of their own); the roller's angle enters no force (its column is zero); and a common
-translation (or velocity) of roller, race body and pin changes no force, so the roller's translation columns are the
-negated sum of the race body's and the pin's (outer raceway; the inner raceway's pin is its race body, whose columns
-are then the roller's negated) — 9 of 12 position and 10 of 12 velocity directions computed for an outer contact, 4 of
-7 and 5 of 7 for an inner one.
-
-Contacts whose every slice is open by the reference's bound (δ_0 + max_k |z_k σ_r − ζ_k σ_c| ≤ 0) are skipped before
-the slice loop; a contact without load has no force and (ad.where) no derivative.
+differencing; the values are the reference's up to the order of the slice sums and the power's last bit. The
+directions use the law's structure, as the planar race contact's: the velocity directions leave the geometry
+unchanged and carry only the rate terms (a pass of their own); the roller's angle enters no force (its column is
+zero); and a common translation (or velocity) of roller, race body and pin changes no force, so the roller's
+translation columns are the negated sum of the race body's and the pin's (outer raceway; the inner raceway's pin is
+its race body, whose columns are then the roller's negated). Each pass is a loop of a fixed count (16 directions for
+an outer contact, 8 for an inner one; those past its n_local zero) without branches, which the compiler runs in SIMD
+lanes; the derived columns are then overwritten.
 """
 from __future__ import annotations
 
@@ -52,6 +62,7 @@ _TWO_PI = 2.0 * np.pi
 _ETA2 = 1e-24            # the reference's η² (mbd.elements.sliced._ETA2)
 SLICED_COLS = 13         # P columns before the profile drops
 _GZ = 11                 # G index of the first slice station
+_NGEO = 48               # a contact's geometry the kernel's second pass reads
 
 
 def pack_sliced_race(elem):
@@ -81,18 +92,101 @@ def _zero(F, Jq, Jv, i, jac):
 
 
 @njit(cache=True)
-def _moments(acc, blocks, loaded, n_loaded, zs):
-    """acc[m, :] = Σ z_k^m · blocks[r, :] over the loaded slices r (k = loaded[r], ascending), m = 0, 1, 2 (a loop over
+def _moments(acc, blocks, ns, zs):
+    """acc[m, :] = Σ_k z_k^m · blocks[k, :] over the slices k (an open slice's block is zero), m = 0, 1, 2 (a loop over
     the 12 columns inside: SIMD)."""
     acc[:, :] = 0.0
-    for r in range(n_loaded):
-        zk = zs[loaded[r]]
+    for k in range(ns):
+        zk = zs[k]
         z2 = zk * zk
         for c in range(12):
-            x = blocks[r, c]
+            x = blocks[k, c]
             acc[0, c] += x
             acc[1, c] += zk * x
             acc[2, c] += z2 * x
+
+
+# δ^(1/m) by Halley's iteration (the slices' δ^((p−1)/2) when (p − 1)/2 = 1/m, Palmgren's p = 10/9: m = 18)
+_ONE_BITS = 0x3FF0000000000000                  # the bits of 1.0
+_ROOT_LO, _ROOT_HI = 1e-300, 1e300              # the iteration's range of x (y^m neither under- nor overflows)
+_START_SHIFT = int(0.043 * 2.0 ** 52)           # centres the start's error (±0.045 in log2, 3.2 %)
+_ROOT_MAX = 31                                  # the largest m of the iteration (p ≥ 1 + 2/31)
+_LANES = 8                                      # the roots' buffers are padded to a multiple of a SIMD width
+
+
+@njit(cache=True)
+def root_index(pe):
+    """m when pe = 1/m for an integer 1 ≤ m ≤ 31 (to 1e-12), else 0 (the slices then take np.power)."""
+    if not pe > 0.0:
+        return 0
+    m = int(round(1.0 / pe))
+    if m < 1 or m > _ROOT_MAX or abs(m * pe - 1.0) > 1e-12:
+        return 0
+    return m
+
+
+@njit(cache=True, inline="always")
+def _ipow(y, m):
+    """y^m for 1 ≤ m ≤ 31 by squaring, without branches on y (a select per bit of m: SIMD)."""
+    r, b = 1.0, y
+    for bit in range(5):
+        if (m >> bit) & 1:
+            r = r * b
+        b = b * b
+    return r
+
+
+@njit(cache=True, error_model="numpy")
+def _root_start(xb, yb, n, inv_m):
+    """A start for x^(1/m) from the bits of x: a positive double's bits read as an integer are 2^52 (log2 x + 1023)
+    up to [−0.086, 0] in the log2 (the mantissa read linearly); their offset from 1.0's divided by m and read back
+    give x^(1/m) within [−0.005, 0.086] in the log2, which the shift centres (±0.045, 3.2 %)."""
+    for k in range(n):
+        yb[k] = _ONE_BITS - _START_SHIFT + np.int64((xb[k] - _ONE_BITS) * inv_m)
+
+
+@njit(cache=True, error_model="numpy")
+def _root_halley(x, y, n, m):
+    """Three Halley steps on y^m = x from the start, each a correction to y (its relative error ε → about
+    (m² − 1)/12 ε³: 3.2 % → 3e-3 → 2e-6 → round-off for m ≤ 31; tests/mbd/test_compiled_sliced.py checks every m
+    against a long-double root)."""
+    a, b = m - 1.0, m + 1.0
+    for k in range(n):
+        xk, yk = x[k], y[k]
+        for _ in range(3):
+            ym = _ipow(yk, m)
+            yk = yk - (2.0 * (ym - xk)) * (yk / (b * ym + a * xk))
+        y[k] = yk
+
+
+@njit(cache=True, error_model="numpy")
+def _slice_roots(delta, x, y, rows, ns, npad, m, pe):
+    """y[r npad + k] = δ[r, k]^pe for the rows r < rows of the slices' δ (x, y: flat buffers of rows of npad ≥ ns, a
+    multiple of the SIMD width; an open slice's is anything finite). With m = root_index(pe) > 0 by Halley's
+    iteration over all rows at once (vectorised: x^(1/m) within about an ulp, tests/mbd/test_compiled_sliced.py);
+    else, and for a δ > 0 outside [1e-300, 1e300], np.power."""
+    if m == 0:
+        for r in range(rows):
+            for k in range(ns):
+                d = delta[r, k]
+                y[r * npad + k] = d ** pe if d > 0.0 else 1.0
+        return
+    for r in range(rows):
+        o = r * npad
+        for k in range(ns):
+            d = delta[r, k]
+            d = d if d > _ROOT_LO else _ROOT_LO
+            x[o + k] = d if d < _ROOT_HI else _ROOT_HI
+        for k in range(ns, npad):
+            x[o + k] = 1.0
+    n = rows * npad
+    _root_start(x.view(np.int64), y.view(np.int64), n, 1.0 / m)
+    _root_halley(x, y, n, m)
+    for r in range(rows):
+        for k in range(ns):
+            d = delta[r, k]
+            if d > 0.0 and (d < _ROOT_LO or d > _ROOT_HI):
+                y[r * npad + k] = d ** pe
 
 
 @njit(cache=True)
@@ -120,19 +214,25 @@ def _derived_cols(Jq, Jv, i, outer):
 
 
 @njit(cache=True)
-def _race_col(J, i, c, outer, f0, f1, f2, f3, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin):
-    """Column c of instance i's block (J_q or J_v: passed in, not chosen by a branch in the caller, whose every
-    write then cost array bookkeeping: mbd.compiled.contact._col)."""
-    J[i, 0, c], J[i, 1, c], J[i, 2, c], J[i, 3, c] = f0, f1, f2, f3
+def _race_cols(J, i, cols, outer):
+    """Instance i's block (J_q or J_v) from a pass's columns: the roller's, the race body's, the race's slopes' and the
+    pin's rows (inner: the pin is the race body, its rows added to the race body's)."""
+    nl = J.shape[2]
+    for c in range(nl):
+        J[i, 0, c], J[i, 1, c], J[i, 2, c], J[i, 3, c] = cols[0, c], cols[1, c], cols[2, c], cols[3, c]
     if outer:
-        J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4, f5, f6
-        J[i, 7, c], J[i, 8, c] = -dT2x, -dT2y
-        J[i, 9, c], J[i, 10, c], J[i, 11, c] = -dGx, -dGy, dpin
+        for c in range(nl):
+            J[i, 4, c], J[i, 5, c], J[i, 6, c] = cols[4, c], cols[5, c], cols[6, c]
+            J[i, 7, c], J[i, 8, c] = -cols[7, c], -cols[8, c]
+            J[i, 9, c], J[i, 10, c], J[i, 11, c] = -cols[9, c], -cols[10, c], cols[11, c]
     else:
-        J[i, 4, c], J[i, 5, c], J[i, 6, c] = f4 - dGx, f5 - dGy, f6 + dpin
+        for c in range(nl):
+            J[i, 4, c] = cols[4, c] - cols[9, c]
+            J[i, 5, c] = cols[5, c] - cols[10, c]
+            J[i, 6, c] = cols[6, c] + cols[11, c]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     p, law = G[0], int(G[1])
     pe = 0.5 * (p - 1.0)
@@ -143,11 +243,25 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         zmax = max(zmax, abs(zs[k]))
     nl = ql.shape[1]
     outer = nl == 12
-    jd0, jd1 = (0, 1) if outer else (4, 5)      # translation columns derived from the others (_derived_cols)
+    js0, js1 = (7, 8) if outer else (-1, -1)            # the race's slope pair's columns (none: inner, rigid pin)
+    jp0, jp1, jp2 = (9, 10, 11) if outer else (4, 5, 6)  # the pin body's (inner: the race body is the pin)
+    # a pass's columns (f0 … f6, dT2x, dT2y, dGx, dGy, dpin): every direction of a SIMD width's multiple jn ≥ nl, those
+    # past nl zero, the derived ones overwritten (_derived_cols): a loop of a fixed count without branches (SIMD)
+    jn = 16 if outer else 8
+    cols = np.empty((12, 16))
     acc = np.zeros((3, 12))          # moments m = 0, 1, 2 of M_k (4), N_k (4), g_k (2), ∂q_k/∂ẇ_k (2)
-    w_x, w_y, w_d, w_delta = np.empty(ns), np.empty(ns), np.empty(ns), np.empty(ns)     # a contact's slices
-    blocks, loaded = np.empty((ns if jac else 0, 12)), np.empty(ns, np.int64)    # its loaded slices' blocks
+    n = ql.shape[0]
+    mroot = root_index(pe)
+    npad = -(-ns // _LANES) * _LANES
+    slot = np.empty(n, np.int64)                        # a contact's row in the buffers below (−1: open by the bound)
+    geo = np.empty((n, _NGEO))                          # its geometry (what the second pass reads)
+    w_x, w_y, w_d, w_delta = np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns))
+    w_c, w_root = np.empty(n * npad), np.empty(n * npad)     # δ clipped to the root's range, δ^((p−1)/2)
+    w_q, w_Fx, w_Fy = np.empty(ns), np.empty(ns), np.empty(ns)
+    blocks = np.empty((ns if jac else 0, 12))           # the slices' derivative blocks (zero: open)
     thb_last, cb, sb, thp_last, cp, sp = np.nan, 0.0, 0.0, np.nan, 0.0, 0.0
+    # every contact's geometry and slice compressions, then their powers all at once (the SIMD lanes full)
+    rows = 0
     for i in range(ql.shape[0]):
         kap, mx, my, pmx, pmy, s0x, s0y = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
         R, D, K, c0, row, Rr = P[i, 7], P[i, 8], P[i, 9], P[i, 10], P[i, 11], P[i, 12]
@@ -192,38 +306,93 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         delta0 = 0.5 * D - kap * (np.sqrt(pcx_ * pcx_ + pcy_ * pcy_) - R)
         reach = zmax * abs(tau) + (abs(row) + zmax) * np.sqrt(scx * scx + scy * scy)
         if delta0 + reach <= 0.0:
-            _zero(F, Jq, Jv, i, jac)
+            slot[i] = -1
             continue
-        # the slice loop
-        S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        n_loaded = 0
-        Ks, c0s = K / ns, c0 / ns
-        for k in range(ns):          # every slice's offset and compression first: a loop without branches (SIMD)
+        r = rows
+        slot[i] = r
+        rows += 1
+        # what the second pass reads, in its order (stores one by one: a loop over a tuple costs twice as much)
+        geo[r, 0], geo[r, 1], geo[r, 2], geo[r, 3], geo[r, 4], geo[r, 5] = kap, R, D, K, c0, row
+        geo[r, 6], geo[r, 7], geo[r, 8], geo[r, 9], geo[r, 10], geo[r, 11] = Rr, tau, vr0, vr1, vr2, dtau
+        geo[r, 12], geo[r, 13], geo[r, 14], geo[r, 15], geo[r, 16], geo[r, 17] = vb0, vb1, vb2, vp2, rcx, rcy
+        geo[r, 18], geo[r, 19], geo[r, 20], geo[r, 21], geo[r, 22], geo[r, 23] = Vcx, Vcy, rpx, rpy, ux, uy
+        geo[r, 24], geo[r, 25], geo[r, 26], geo[r, 27], geo[r, 28], geo[r, 29] = rho_p, ex, ey, gx, gy, ge
+        geo[r, 30], geo[r, 31], geo[r, 32], geo[r, 33], geo[r, 34], geo[r, 35] = edx, edy, s0cx, s0cy, scx, scy
+        geo[r, 36], geo[r, 37], geo[r, 38], geo[r, 39], geo[r, 40], geo[r, 41] = dscx, dscy, k0x, k0y, srx, sry
+        geo[r, 42], geo[r, 43], geo[r, 44], geo[r, 45], geo[r, 46], geo[r, 47] = dsrx, dsry, pcx_, pcy_, wvx, wvy
+        for k in range(ns):          # every slice's offset and compression: a loop without branches (SIMD)
             zk = zs[k]
             zeta = row + zk
             wx = pcx_ + zk * srx - zeta * scx
             wy = pcy_ + zk * sry - zeta * scy
             d = np.sqrt(wx * wx + wy * wy + _ETA2)
-            w_x[k], w_y[k], w_d[k] = wx, wy, d
-            w_delta[k] = 0.5 * D - kap * (d - R) - P[i, SLICED_COLS + k]
-        for k in range(ns):
-            delta = w_delta[k]
-            if not delta > 0.0:                     # an open slice: nothing more of it
-                continue
+            w_x[r, k], w_y[r, k], w_d[r, k] = wx, wy, d
+            w_delta[r, k] = 0.5 * D - kap * (d - R) - P[i, SLICED_COLS + k]
+    _slice_roots(w_delta, w_c, w_root, rows, ns, npad, mroot, pe)
+    for i in range(n):
+        r = slot[i]
+        if r < 0:
+            _zero(F, Jq, Jv, i, jac)
+            continue
+        gr = geo[r]
+        (kap, R, D, K, c0, row, Rr, tau, vr0, vr1, vr2, dtau, vb0, vb1, vb2, vp2, rcx, rcy, Vcx, Vcy, rpx, rpy, ux,
+         uy, rho_p, ex, ey, gx, gy, ge, edx, edy, s0cx, s0cy, scx, scy, dscx, dscy, k0x, k0y, srx, sry, dsrx, dsry,
+         pcx_, pcy_, wvx, wvy) = (
+            gr[0], gr[1], gr[2], gr[3], gr[4], gr[5], gr[6], gr[7], gr[8], gr[9], gr[10], gr[11], gr[12], gr[13],
+            gr[14], gr[15], gr[16], gr[17], gr[18], gr[19], gr[20], gr[21], gr[22], gr[23], gr[24], gr[25], gr[26],
+            gr[27], gr[28], gr[29], gr[30], gr[31], gr[32], gr[33], gr[34], gr[35], gr[36], gr[37], gr[38], gr[39],
+            gr[40], gr[41], gr[42], gr[43], gr[44], gr[45], gr[46], gr[47])
+        S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        Ks, c0s = K / ns, c0 / ns
+        o = r * npad
+        for k in range(ns):          # every slice's load, open ones masked (selects, no branches: SIMD)
+            delta = w_delta[r, k]
             zk = zs[k]
             zeta = row + zk
-            wx, wy, d = w_x[k], w_y[k], w_d[k]
+            wx, wy, d = w_x[r, k], w_y[r, k], w_d[r, k]
             nx, ny = wx / d, wy / d
             vwx = wvx + zk * dsrx - zeta * dscx
             vwy = wvy + zk * dsry - zeta * dscy
             nv = nx * vwx + ny * vwy
             delta_dot = -kap * nv
-            dpe = delta ** pe                       # δ^((p−1)/2); δ^p = δ (δ^((p−1)/2))², one power a slice
+            dpe = w_root[o + k]                         # δ^((p−1)/2); δ^p = δ (δ^((p−1)/2))²
             dp1 = dpe * dpe
-            q = Ks * (delta * dp1) + c0s * dpe * delta_dot
-            if not q > 0.0:
-                continue
-            Fx, Fy = kap * q * nx, kap * q * ny
+            q_raw = Ks * (delta * dp1) + c0s * dpe * delta_dot
+            q = q_raw if (delta > 0.0) & (q_raw > 0.0) else 0.0
+            w_q[k] = q
+            w_Fx[k], w_Fy[k] = kap * q * nx, kap * q * ny
+        if jac:
+            for k in range(ns):      # the slices' derivative blocks (zero: open), a loop of its own (SIMD)
+                delta, q = w_delta[r, k], w_q[k]
+                zk = zs[k]
+                zeta = row + zk
+                wx, wy, d = w_x[r, k], w_y[r, k], w_d[r, k]
+                nx, ny = wx / d, wy / d
+                vwx = wvx + zk * dsrx - zeta * dscx
+                vwy = wvy + zk * dsry - zeta * dscy
+                nv = nx * vwx + ny * vwy
+                delta_dot = -kap * nv
+                dpe = w_root[o + k]
+                dp1 = dpe * dpe
+                on = q > 0.0
+                q_d = Ks * p * dp1 + c0s * pe * (dpe / delta) * delta_dot                     # ∂q/∂δ
+                q_d = q_d if on else 0.0
+                q_r = c0s * dpe if on else 0.0                                                 # ∂q/∂δ̇
+                i_d = 1.0 / d
+                hx, hy = (vwx - nx * nv) * i_d, (vwy - ny * nv) * i_d
+                gqx, gqy = -kap * (q_d * nx + q_r * hx), -kap * (q_d * ny + q_r * hy)
+                gvx, gvy = -kap * q_r * nx, -kap * q_r * ny
+                qd = kap * q * i_d
+                blocks[k, 0] = kap * nx * gqx + qd * (1.0 - nx * nx)
+                blocks[k, 1] = kap * nx * gqy - qd * nx * ny
+                blocks[k, 2] = kap * ny * gqx - qd * nx * ny
+                blocks[k, 3] = kap * ny * gqy + qd * (1.0 - ny * ny)
+                blocks[k, 4], blocks[k, 5] = kap * nx * gvx, kap * nx * gvy
+                blocks[k, 6], blocks[k, 7] = kap * ny * gvx, kap * ny * gvy
+                blocks[k, 8], blocks[k, 9], blocks[k, 10], blocks[k, 11] = gqx, gqy, gvx, gvy
+        for k in range(ns):          # the sums, in the slices' order
+            zk, Fx, Fy, q = zs[k], w_Fx[k], w_Fy[k], w_q[k]
+            zeta = row + zk
             S0x += Fx
             S0y += Fy
             S1x += zk * Fx
@@ -232,30 +401,11 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             S2y += zeta * Fy
             Q += q
             Qz += zk * q
-            if not jac:
-                continue
-            q_d = Ks * p * dp1 + c0s * pe * (dpe / delta) * delta_dot                         # ∂q/∂δ
-            q_r = c0s * dpe                                                                   # ∂q/∂δ̇
-            i_d = 1.0 / d
-            hx, hy = (vwx - nx * nv) * i_d, (vwy - ny * nv) * i_d
-            gqx, gqy = -kap * (q_d * nx + q_r * hx), -kap * (q_d * ny + q_r * hy)
-            gvx, gvy = -kap * q_r * nx, -kap * q_r * ny
-            qd = kap * q * i_d
-            r = n_loaded             # the slice's blocks; their moments after the loop (_moments)
-            blocks[r, 0] = kap * nx * gqx + qd * (1.0 - nx * nx)
-            blocks[r, 1] = kap * nx * gqy - qd * nx * ny
-            blocks[r, 2] = kap * ny * gqx - qd * nx * ny
-            blocks[r, 3] = kap * ny * gqy + qd * (1.0 - ny * ny)
-            blocks[r, 4], blocks[r, 5] = kap * nx * gvx, kap * nx * gvy
-            blocks[r, 6], blocks[r, 7] = kap * ny * gvx, kap * ny * gvy
-            blocks[r, 8], blocks[r, 9], blocks[r, 10], blocks[r, 11] = gqx, gqy, gvx, gvy
-            loaded[n_loaded] = k
-            n_loaded += 1
         if not Q > 0.0:
             _zero(F, Jq, Jv, i, jac)
             continue
         if jac:
-            _moments(acc, blocks, loaded, n_loaded, zs)
+            _moments(acc, blocks, ns, zs)
         # traction as the planar contact's on Q, applied at the load centroid z̄
         rho = np.sqrt(pcx_ * pcx_ + pcy_ * pcy_ + _ETA2)
         ecx, ecy = pcx_ / rho, pcy_ / rho
@@ -312,14 +462,9 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         # roller, the race body and the pin only through their relative positions: a common translation changes
         # nothing, so the roller's translation columns are the race body's and the pin's negated and summed (outer:
         # computed from them; inner, whose pin is the race body: the race body's are the roller's negated, exactly).
-        for j in range(nl):
-            if j == 2 or j == jd0 or j == jd1:
-                continue
+        for j in range(jn):
             dxr, dyr, dta, dxb, dyb, dthb = _u(j, 0), _u(j, 1), _u(j, 3), _u(j, 4), _u(j, 5), _u(j, 6)
-            if outer:
-                dsx, dsy, dxp, dyp, dthp = _u(j, 7), _u(j, 8), _u(j, 9), _u(j, 10), _u(j, 11)
-            else:
-                dsx, dsy, dxp, dyp, dthp = 0.0, 0.0, dxb, dyb, dthb
+            dsx, dsy, dxp, dyp, dthp = _u(j, js0), _u(j, js1), _u(j, jp0), _u(j, jp1), _u(j, jp2)
             drcx, drcy = -dthb * rcy, dthb * rcx
             dVcx, dVcy = -vb2 * drcy, vb2 * drcx
             drpx, drpy = -dthp * rpy, dthp * rpx
@@ -391,17 +536,14 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
                   - (drbx * Fty + rbx * dFty - drby * Ftx - rby * dFtx)
                   + dT2x * k0x + T2x * dk0x + dT2y * k0y + T2y * dk0y)
             dpin = -(drpx * Gy + rpx * dGy - drpy * Gx - rpy * dGx)
-            _race_col(Jq, i, j, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
+            cols[0, j], cols[1, j], cols[2, j], cols[3, j], cols[4, j], cols[5, j] = f0, f1, f2, ds1e, f4, f5
+            cols[6, j], cols[7, j], cols[8, j], cols[9, j], cols[10, j], cols[11, j] = f6, dT2x, dT2y, dGx, dGy, dpin
+        _race_cols(Jq, i, cols, outer)
         # Velocities: they leave the geometry (e, σ_c's turn, the contact point, the levers) and move only the rates.
         # A common velocity of the roller, the race body and the pin changes no force (as for the positions).
-        for j in range(nl):
-            if j == jd0 or j == jd1:
-                continue
+        for j in range(jn):
             dvr0, dvr1, dvr2, ddta, dvb0, dvb1, dvb2 = _u(j, 0), _u(j, 1), _u(j, 2), _u(j, 3), _u(j, 4), _u(j, 5), _u(j, 6)
-            if outer:
-                dvsx, dvsy, dvp0, dvp1, dvp2 = _u(j, 7), _u(j, 8), _u(j, 9), _u(j, 10), _u(j, 11)
-            else:
-                dvsx, dvsy, dvp0, dvp1, dvp2 = 0.0, 0.0, dvb0, dvb1, dvb2
+            dvsx, dvsy, dvp0, dvp1, dvp2 = _u(j, js0), _u(j, js1), _u(j, jp0), _u(j, jp1), _u(j, jp2)
             dVcx, dVcy = dvb0 - dvb2 * rcy, dvb1 + dvb2 * rcx
             dVpx, dVpy = dvp0 - dvp2 * rpy, dvp1 + dvp2 * rpx
             dgx, dgy = dvr0 - dVpx, dvr1 - dVpy
@@ -443,7 +585,9 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             f4, f5 = -dS0x - dFtx, -dS0y - dFty
             f6 = -(rcx * dS0y - rcy * dS0x) - (rbx * dFty - rby * dFtx) + dT2x * k0x + dT2y * k0y
             dpin = -(rpx * dGy - rpy * dGx)
-            _race_col(Jv, i, j, outer, f0, f1, f2, ds1e, f4, f5, f6, dT2x, dT2y, dGx, dGy, dpin)
+            cols[0, j], cols[1, j], cols[2, j], cols[3, j], cols[4, j], cols[5, j] = f0, f1, f2, ds1e, f4, f5
+            cols[6, j], cols[7, j], cols[8, j], cols[9, j], cols[10, j], cols[11, j] = f6, dT2x, dT2y, dGx, dGy, dpin
+        _race_cols(Jv, i, cols, outer)
         _derived_cols(Jq, Jv, i, outer)
 
 

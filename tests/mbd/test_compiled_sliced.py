@@ -10,6 +10,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from mbd.compiled.registry import kind_of
+from mbd.compiled.sliced import _LANES, _slice_roots, root_index
 from mbd.element import evaluate
 from mbd.elements import StiffnessShape
 from mbd.elements.gear_mesh import SlicedGearMesh, mesh_u0
@@ -28,9 +29,9 @@ ROLLER = lambda b: 8 + 3 * b             # noqa: E731
 TILT = lambda b: 8 + 3 * N + b           # noqa: E731
 
 
-def _family(kind, n_s, traction, *, zeta, drop, row, pin_slope):
+def _family(kind, n_s, traction, *, zeta, drop, row, pin_slope, exponent=10.0 / 9.0):
     z, _ = slice_stations(LR, n_s)
-    law = dict(D=DR, K=K_HZ, exponent=10.0 / 9.0, zeta=zeta, m_roller=M_ROLLER, traction=traction, z=z, drop=drop,
+    law = dict(D=DR, K=K_HZ, exponent=exponent, zeta=zeta, m_roller=M_ROLLER, traction=traction, z=z, drop=drop,
                row_offset=row)
     rows = []
     for b in range(N):
@@ -67,15 +68,17 @@ def _state(kind, rng, press, tilt, slope):
 @pytest.mark.parametrize("law", ["tanh", "slide_roll", "film"])
 @SETTINGS
 @given(data=st.data(), fs=frame_states(), n_s=st.sampled_from([1, 5, 21]), zeta=st.sampled_from([0.0, 0.05, 0.3]),
-       row=st.sampled_from([0.0, 3e-3, -6e-3]), seed=st.integers(0, 2 ** 31))
-def test_sliced_race_matches_reference(kind, law, data, fs, n_s, zeta, row, seed):
+       row=st.sampled_from([0.0, 3e-3, -6e-3]), seed=st.integers(0, 2 ** 31),
+       exponent=st.sampled_from([10.0 / 9.0, 1.5, 1.3]))
+def test_sliced_race_matches_reference(kind, law, data, fs, n_s, zeta, row, seed, exponent):
+    """Palmgren's p = 10/9 and p = 1.5 take the slices' root iteration ((p − 1)/2 = 1/18, 1/4), p = 1.3 np.power."""
     rng = np.random.default_rng(seed)
     press = data.draw(st.lists(st.sampled_from([-20e-6, -1e-6, 0.3e-6, 2e-6, 8e-6]), min_size=N, max_size=N))
     tilt = rng.uniform(-1e-3, 1e-3, N)
     slope = rng.uniform(-5e-4, 5e-4, 2)
     pin_slope = rng.uniform(-3e-4, 3e-4, 2) if data.draw(st.booleans()) else (0.0, 0.0)
     drop = rng.uniform(0.0, 1e-6, (N, n_s)) if data.draw(st.booleans()) else np.zeros(n_s)
-    elem = _family(kind, n_s, TRACTIONS[law], zeta=zeta, drop=drop, row=row, pin_slope=pin_slope)
+    elem = _family(kind, n_s, TRACTIONS[law], zeta=zeta, drop=drop, row=row, pin_slope=pin_slope, exponent=exponent)
     qf, vf = _state(kind, rng, press, tilt, slope)
     Fr = assert_matches_reference(elem, fs, qf, vf)
     assert np.any(Fr != 0.0) or min(press) < 0.0
@@ -96,6 +99,41 @@ def test_loaded_open_and_edge_contacts_in_one_family():
         assert_matches_reference(elem, FS, qf, vf)
         F, Jq, Jv = compiled(elem, FS, qf, vf, None, True)
         assert np.all(F[2] == 0.0) and np.all(Jq[2] == 0.0) and np.all(Jv[2] == 0.0)
+
+
+def _roots(delta, pe):
+    delta = np.asarray(delta, float)
+    npad = -(-delta.size // _LANES) * _LANES
+    x, y = np.empty(npad), np.empty(npad)
+    _slice_roots(delta[None, :], x, y, 1, delta.size, npad, root_index(pe), pe)
+    return y[:delta.size]
+
+
+@pytest.mark.skipif(np.finfo(np.longdouble).nmant < 63, reason="needs x86's 64-bit long double mantissa")
+@pytest.mark.parametrize("m", range(1, 32))
+def test_slice_roots_are_the_long_double_roots(m):
+    """δ^(1/m) by the kernel's Halley iteration is the m-th root within 1.5 ulp (the truth: np.power in long double,
+    x86's 64-bit mantissa, whose own error is ≈ 0.3 ulp of a double) from 1e-300 to 1e300 and over the contacts'
+    range 1e-12..1 m; np.power(δ, 1/m) in double is farther (its exponent 1/m is rounded: up to 115 ulp at 1e±300)."""
+    assert root_index(1.0 / m) == m
+    rng = np.random.default_rng(m)
+    x = np.concatenate([10.0 ** rng.uniform(-300, 300, 20000), 10.0 ** rng.uniform(-12, 0, 20000),
+                        [1e-300, 1e300, 0.5, 1.0, 2.0, 3e-6]])
+    truth = np.power(x.astype(np.longdouble), np.longdouble(1) / m)
+    ulps = np.abs(_roots(x, 1.0 / m) - truth) / np.spacing(truth.astype(float))
+    assert ulps.max() <= 1.5
+
+
+def test_slice_roots_outside_the_iteration_are_numpys_power():
+    """(p − 1)/2 not the reciprocal of an integer ≤ 31 (p = 1.3, p = 1 + 2/40), and any δ > 0 outside [1e-300, 1e300]
+    (subnormal, huge), take np.power; an open slice (δ ≤ 0) gets a finite value (its load is masked)."""
+    assert root_index(0.15) == 0 and root_index(1.0 / 40.0) == 0 and root_index(0.0) == 0
+    x = np.array([3e-6, 1e-9, 0.7, 5e-320, 1e-305, 1e305, 0.0, -2e-6])
+    for pe in (0.15, 1.0 / 40.0, 1.0 / 18.0):
+        y = _roots(x, pe)
+        inside = (x > 0.0) & ((x < 1e-300) | (x > 1e300) | (root_index(pe) == 0))
+        assert np.all(y[inside] == np.power(x[inside], pe))
+        assert np.all(np.isfinite(y))
 
 
 def test_family_declares_its_twin():
