@@ -180,11 +180,32 @@ def _runs(S: sp.csr_matrix, n: int) -> list[int]:
     return blocks
 
 
+def _late_order(perm, sym, late, group) -> np.ndarray:
+    """SuperLU's order ``perm`` with every ``late`` column moved after the other columns of its ``group`` (its
+    body), right before the first column eliminated after them that either couples to (the body's other
+    neighbours: elimination joins them); the late columns keep their relative order. On the sliced machine a
+    roller's tilt couples to a subset of its x, y, θ's neighbours, so minimum degree eliminates it first, one
+    column at a time; three to a block, the tilts of three rollers then join those rollers' blocks in the block
+    pattern. After the rollers and before their cage they share blocks with no such fill."""
+    n = perm.size
+    pos = np.empty(n, np.int64)
+    pos[perm] = np.arange(n)
+    key = 2 * pos                                    # the others keep their places, a late one goes between two
+    for d in np.flatnonzero(late):
+        own = np.flatnonzero((group == group[d]) & ~late)
+        near = np.unique(np.concatenate([sym.indices[sym.indptr[c]:sym.indptr[c + 1]] for c in [d, *own]]))
+        near = near[~late[near] & (group[near] != group[d])]
+        after = pos[own].max() if own.size else -1
+        near = pos[near][pos[near] > after]
+        key[d] = 2 * (near.min() if near.size else n) - 1
+    return np.lexsort((pos, key)).astype(np.int64)
+
+
 class FixedPatternLU:
     """LU of n×n CSC matrices with the pattern (indptr, indices); ``factor(data)`` then ``solve(b)``.
     ``arrays``: the factors and their pattern, for :func:`_factor` and :func:`_solve` in compiled code."""
 
-    def __init__(self, indptr, indices, n: int):
+    def __init__(self, indptr, indices, n: int, late=None, group=None):
         self.n = n = int(n)
         self.indptr = np.ascontiguousarray(indptr, dtype=np.int64)
         self.indices = np.ascontiguousarray(indices, dtype=np.int64)
@@ -200,6 +221,14 @@ class FixedPatternLU:
         # SuperLU: column c of A is column perm_c[c] of L U; perm[k]: the column of A eliminated k-th
         iperm = np.asarray(lu.perm_c, dtype=np.int64)
         perm = np.argsort(iperm)
+        if late is not None and np.any(late):
+            perm = _late_order(perm, sym, np.asarray(late, bool), np.asarray(group, np.int64))
+            iperm = np.argsort(perm)
+            ordered = sp.csc_matrix(sample[perm][:, perm])
+            ordered.sort_indices()
+            lu = spla.splu(ordered, permc_spec="NATURAL", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+            if not (np.array_equal(lu.perm_c, np.arange(n)) and np.array_equal(lu.perm_r, np.arange(n))):
+                raise RuntimeError("FixedPatternLU: SuperLU reordered the late columns' order")
         L = sp.tril(sp.csc_matrix(lu.L), k=-1).tocoo()
         U = sp.csc_matrix(lu.U).tocoo()
         self.fill = int(L.nnz + U.nnz)                   # scalar entries of L (no unit diagonal) and U
