@@ -634,8 +634,9 @@ def _unit(p, q):
 @njit(cache=True)
 def _sliced_meshes(ql, vl, P, G, F, Jq, Jv, jac):
     """The face-sliced law at local coordinates ql, rates vl (body or geometric centres): the slice loop once per
-    flank, its derivative blocks summed against the powers of ζ_k, then every direction of the local coordinates at
-    the mesh level (the differential of every line of the reference). Lumped law: a slice's force is
+    flank, its derivative blocks summed against the powers of ζ_k, then the differential of every line of the reference
+    at the mesh level along the law's own directions (δd = σ(d2 − d1), θ1, θ2, Δs = s2 − s1 and their rates): every
+    column of the local coordinates is a ±1 multiple of one of them, exactly. Lumped law: a slice's force is
     (k(p)/n_m) δ_k + (c_m/n_m) S δ̇_k, its derivative blocks ∂F_k/∂δ_k, ∂F_k/∂δ̇_k and (for k(p)) δ_k. Tooth-pair law
     (G[G_PAIRS] ≥ 0): the pairs' stiffness, gaps and roll coordinate u are the mesh's (every slice has its mesh's
     teeth: :func:`.tooth_pairs.pair_setup` once per flank), each slice their sum at its own δ_k, δ̇_k with 1/n_m of

@@ -5,11 +5,14 @@ AᵀA + A, as the numpy path asks it) and gives the patterns of L and U from a r
 pattern (no cancellation). On the DPGT that order is the bordered elimination by itself: every roller's
 DOFs first (each couples only to its cage, its planet and the carrier that holds its pin), then the
 cages, then the planets, the carrier, the sun and the ring — L and U hold 5 319 entries for the planar
-machine's 4 941.
+machine's 4 941. Columns the caller marks late (``late``, with each column's ``group``, its body) move after their
+group's other columns, right before the first column that either couples to (:func:`_late_order`): the sliced
+machine's roller tilts, which minimum degree would eliminate first, three rollers' to a block, joining those rollers
+in the block pattern. Without late columns the order is SuperLU's as it is.
 
 Blocks: the ordered columns are cut into blocks of 3 — a run of columns with one pattern (a body's x, y, θ:
 its element blocks couple all of them) fills blocks of 3, shorter runs share one (the sliced machine's
-rollers' tilt coordinates, eliminated one by one), and a block a column short is padded with a decoupled
+rollers' tilt coordinates, three rollers' of one bearing), and a block a column short is padded with a decoupled
 unit column. The block pattern is the block graph's own elimination (it holds the scalar L and U). Each
 block is a dense 3×3, so the factor and the solves run fixed-size code per block instead of a loop per
 column through index arrays.
@@ -202,7 +205,8 @@ def _late_order(perm, sym, late, group) -> np.ndarray:
 
 
 class FixedPatternLU:
-    """LU of n×n CSC matrices with the pattern (indptr, indices); ``factor(data)`` then ``solve(b)``.
+    """LU of n×n CSC matrices with the pattern (indptr, indices); ``factor(data)`` then ``solve(b)``. ``late``,
+    ``group`` (optional, (n,) bool and int): columns eliminated after the other columns of their group (module text).
     ``arrays``: the factors and their pattern, for :func:`_factor` and :func:`_solve` in compiled code."""
 
     def __init__(self, indptr, indices, n: int, late=None, group=None):
@@ -221,6 +225,9 @@ class FixedPatternLU:
         # SuperLU: column c of A is column perm_c[c] of L U; perm[k]: the column of A eliminated k-th
         iperm = np.asarray(lu.perm_c, dtype=np.int64)
         perm = np.argsort(iperm)
+        if late is not None and (np.shape(late) != (n,) or np.shape(group) != (n,)):
+            raise ValueError(f"FixedPatternLU: late and group must be arrays of shape ({n},), "
+                             f"got {np.shape(late)} and {np.shape(group)}")
         if late is not None and np.any(late):
             perm = _late_order(perm, sym, np.asarray(late, bool), np.asarray(group, np.int64))
             iperm = np.argsort(perm)
