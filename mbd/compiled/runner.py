@@ -10,7 +10,7 @@ import numpy as np
 from ..assembly import System
 from ..control import Adaptive, FixedStep
 from ..hht import HHT, StepInfo
-from ..model import State
+from ..model import TILT, State
 from .. import compiled as _compiled     # kernels_cached, compile_announced: read through the package when called
 from .registry import call
 from .sparse_lu import FixedPatternLU
@@ -84,6 +84,21 @@ def _controller_array(controller) -> np.ndarray:
                               "(FixedStep and Adaptive are)")
 
 
+def _tilts_late(model) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The sparse LU's late columns and their bodies (:class:`.sparse_lu.FixedPatternLU`): the free tilt
+    coordinates (a roller's tilt), each after its body's x, y, θ; none in a model without them (SuperLU's order
+    as it is)."""
+    free, nb3 = model.free, model.n_body_coords
+    extra = np.clip(free - nb3, 0, None)
+    is_extra = free >= nb3
+    kinds = model.extra_kind[extra] if model.extra_kind.size else np.zeros(free.size, np.int64)
+    late = is_extra & (kinds == TILT)
+    if not late.any():
+        return None, None
+    group = np.where(is_extra, model.extra_owner[extra] if model.extra_owner.size else 0, free // 3)
+    return late, group.astype(np.int64)
+
+
 class CompiledRunner:
     """HHT-α (settings of ``stepper``) with ``controller`` on the compiled twin of ``system``. Raises
     NotImplementedError naming what the compiled path cannot do (the caller then uses the numpy path).
@@ -104,7 +119,7 @@ class CompiledRunner:
         self.atol = np.where(m.angle_dofs, stepper.tol.atol_rot, stepper.tol.atol_pos).astype(float)
         self.rtol = float(stepper.tol.rtol)
         self.freeze = bool(system.freeze_internal)
-        lu = FixedPatternLU(system._indptr, system._indices, n)
+        lu = FixedPatternLU(system._indptr, system._indices, n, *_tilts_late(m))
         # the zero-pivot fallback (dense partial pivoting) needs n² floats: kept for n ≤ 1000 (8 MB); a larger
         # model whose diagonal pivot vanishes fails that step instead, and the controller shrinks h
         dense = np.zeros((n, n)) if n <= 1000 else np.zeros((0, 0))

@@ -626,11 +626,17 @@ def evaluate_sliced_gear_mesh(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv,
     mesh._from_geometric(Fg, Jqg, Jvg, r, vl, F, Jq, Jv, jac)
 
 
+@njit(cache=True, inline="always")
+def _unit(p, q):
+    return 1.0 if p == q else 0.0
+
+
 @njit(cache=True)
 def _sliced_meshes(ql, vl, P, G, F, Jq, Jv, jac):
     """The face-sliced law at local coordinates ql, rates vl (body or geometric centres): the slice loop once per
-    flank, its derivative blocks summed against the powers of ζ_k, then every direction of the local coordinates at
-    the mesh level (the differential of every line of the reference). Lumped law: a slice's force is
+    flank, its derivative blocks summed against the powers of ζ_k, then the differential of every line of the reference
+    at the mesh level along the law's own directions (δd = σ(d2 − d1), θ1, θ2, Δs = s2 − s1 and their rates): every
+    column of the local coordinates is a ±1 multiple of one of them, exactly. Lumped law: a slice's force is
     (k(p)/n_m) δ_k + (c_m/n_m) S δ̇_k, its derivative blocks ∂F_k/∂δ_k, ∂F_k/∂δ̇_k and (for k(p)) δ_k. Tooth-pair law
     (G[G_PAIRS] ≥ 0): the pairs' stiffness, gaps and roll coordinate u are the mesh's (every slice has its mesh's
     teeth: :func:`.tooth_pairs.pair_setup` once per flank), each slice their sum at its own δ_k, δ̇_k with 1/n_m of
@@ -643,7 +649,6 @@ def _sliced_meshes(ql, vl, P, G, F, Jq, Jv, jac):
     # per flank: Σ ζ^m A_k, Σ ζ^m B_k, Σ ζ^m d_k (m = 0, 1, 2), Σ ζ^m U_k, Σ ζ^m V_k (m = 0, 1)
     mom = np.zeros((2, 13))
     Ff, Mf = np.zeros(2), np.zeros(2)
-    dq, dv = np.zeros(nl), np.zeros(nl)
     kk, dk, gg, dg, d2g = np.empty(2), np.empty(2), np.empty(2), np.empty(2), np.empty(2)
     for i in range(ql.shape[0]):
         sig, rb1, rb2 = P[i, mesh.P_SIGMA], P[i, mesh.P_RB1], P[i, mesh.P_RB2]
@@ -775,22 +780,17 @@ def _sliced_meshes(ql, vl, P, G, F, Jq, Jv, jac):
             F[i, j1], F[i, j1 + 1] = -qsx, -qsy
         if not jac:
             continue
-        for j in range(2 * nl):
-            dq[:] = 0.0
-            dv[:] = 0.0
-            if j < nl:
-                dq[j] = 1.0
-            else:
-                dv[j - nl] = 1.0
-            # direction → (δd, θ1, θ2, δḋ, ω1, ω2, Δs, Δṡ)
-            pdx, pdy, pth1, pth2 = sig * (dq[3] - dq[0]), sig * (dq[4] - dq[1]), dq[2], dq[5]
-            vdx, vdy, pw1, pw2 = sig * (dv[3] - dv[0]), sig * (dv[4] - dv[1]), dv[2], dv[5]
-            pdsx, pdsy, pdvx, pdvy = 0.0, 0.0, 0.0, 0.0
-            if has1:
-                pdsx, pdsy, pdvx, pdvy = -dq[6], -dq[7], -dv[6], -dv[7]
-            if has2:
-                pdsx, pdsy = pdsx + dq[j1], pdsy + dq[j1 + 1]
-                pdvx, pdvy = pdvx + dv[j1], pdvy + dv[j1 + 1]
+        # the law depends on the local coordinates through (δd, θ1, θ2, Δs) and their rates only, linearly in each
+        # derivative: the derivative along each of these 12 directions (4 without slopes), then every column of
+        # the local coordinates a ±1 multiple of one of them (exact)
+        slopes = has1 or has2
+        for p in range(12):
+            if not slopes and (p == 4 or p == 5 or p == 10 or p == 11):
+                continue
+            pdx, pdy, pth1, pth2 = _unit(p, 0), _unit(p, 1), _unit(p, 2), _unit(p, 3)
+            pdsx, pdsy = _unit(p, 4), _unit(p, 5)
+            vdx, vdy, pw1, pw2 = _unit(p, 6), _unit(p, 7), _unit(p, 8), _unit(p, 9)
+            pdvx, pdvy = _unit(p, 10), _unit(p, 11)
             tdd_ = tx * pdx + ty * pdy                          # t·δd
             da = ex * pdx + ey * pdy
             dex, dey = tx * tdd_ * inv_a, ty * tdd_ * inv_a
@@ -845,11 +845,25 @@ def _sliced_meshes(ql, vl, P, G, F, Jq, Jv, jac):
                     + sig * sa * (dFsum * ex + F_sum * dex) + dhx)
             dFhy = (dFnet * kappa * ty + F_net * (dkappa * ty + kappa * dty)
                     + sig * sa * (dFsum * ey + F_sum * dey) + dhy)
-            J = Jq if j < nl else Jv
-            c = j if j < nl else j - nl
-            J[i, 0, c], J[i, 1, c], J[i, 2, c] = -sig * dFhx, -sig * dFhy, -sig * rb1 * dFnet
-            J[i, 3, c], J[i, 4, c], J[i, 5, c] = sig * dFhx, sig * dFhy, -1.0 * rb2 * dFnet
-            if has1:
-                J[i, 6, c], J[i, 7, c] = dqsx, dqsy
-            if has2:
-                J[i, j1, c], J[i, j1 + 1, c] = -dqsx, -dqsy
+            J = Jq if p < 6 else Jv
+            if p == 0 or p == 1 or p == 6 or p == 7:                 # δd = σ(d2 − d1): columns d1 (−σ) and d2 (σ)
+                cs = (p % 2, 3 + p % 2)
+                sc = (-sig, sig)
+            elif p == 2 or p == 3 or p == 8 or p == 9:               # θ1, θ2
+                cs = (2 + 3 * (p % 2), -1)
+                sc = (1.0, 0.0)
+            else:                                                   # Δs = s2 − s1
+                cs = (6 + p % 2 if has1 else -1, j1 + p % 2 if has2 else -1)
+                sc = (-1.0, 1.0)
+            for e in range(2):
+                c = cs[e]
+                if c < 0:
+                    continue
+                w = sc[e]
+                gx_, gy_, gn, gqx, gqy = w * dFhx, w * dFhy, w * dFnet, w * dqsx, w * dqsy
+                J[i, 0, c], J[i, 1, c], J[i, 2, c] = -sig * gx_, -sig * gy_, -sig * rb1 * gn
+                J[i, 3, c], J[i, 4, c], J[i, 5, c] = sig * gx_, sig * gy_, -1.0 * rb2 * gn
+                if has1:
+                    J[i, 6, c], J[i, 7, c] = gqx, gqy
+                if has2:
+                    J[i, j1, c], J[i, j1 + 1, c] = -gqx, -gqy

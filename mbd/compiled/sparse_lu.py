@@ -5,11 +5,14 @@ AᵀA + A, as the numpy path asks it) and gives the patterns of L and U from a r
 pattern (no cancellation). On the DPGT that order is the bordered elimination by itself: every roller's
 DOFs first (each couples only to its cage, its planet and the carrier that holds its pin), then the
 cages, then the planets, the carrier, the sun and the ring — L and U hold 5 319 entries for the planar
-machine's 4 941.
+machine's 4 941. Columns the caller marks late (``late``, with each column's ``group``, its body) move after their
+group's other columns, right before the first column that either couples to (:func:`_late_order`): the sliced
+machine's roller tilts, which minimum degree would eliminate first, three rollers' to a block, joining those rollers
+in the block pattern. Without late columns the order is SuperLU's as it is.
 
 Blocks: the ordered columns are cut into blocks of 3 — a run of columns with one pattern (a body's x, y, θ:
 its element blocks couple all of them) fills blocks of 3, shorter runs share one (the sliced machine's
-rollers' tilt coordinates, eliminated one by one), and a block a column short is padded with a decoupled
+rollers' tilt coordinates, three rollers' of one bearing), and a block a column short is padded with a decoupled
 unit column. The block pattern is the block graph's own elimination (it holds the scalar L and U). Each
 block is a dense 3×3, so the factor and the solves run fixed-size code per block instead of a loop per
 column through index arrays.
@@ -180,11 +183,33 @@ def _runs(S: sp.csr_matrix, n: int) -> list[int]:
     return blocks
 
 
+def _late_order(perm, sym, late, group) -> np.ndarray:
+    """SuperLU's order ``perm`` with every ``late`` column moved after the other columns of its ``group`` (its
+    body), right before the first column eliminated after them that either couples to (the body's other
+    neighbours: elimination joins them); the late columns keep their relative order. On the sliced machine a
+    roller's tilt couples to a subset of its x, y, θ's neighbours, so minimum degree eliminates it first, one
+    column at a time; three to a block, the tilts of three rollers then join those rollers' blocks in the block
+    pattern. After the rollers and before their cage they share blocks with no such fill."""
+    n = perm.size
+    pos = np.empty(n, np.int64)
+    pos[perm] = np.arange(n)
+    key = 2 * pos                                    # the others keep their places, a late one goes between two
+    for d in np.flatnonzero(late):
+        own = np.flatnonzero((group == group[d]) & ~late)
+        near = np.unique(np.concatenate([sym.indices[sym.indptr[c]:sym.indptr[c + 1]] for c in [d, *own]]))
+        near = near[~late[near] & (group[near] != group[d])]
+        after = pos[own].max() if own.size else -1
+        near = pos[near][pos[near] > after]
+        key[d] = 2 * (near.min() if near.size else n) - 1
+    return np.lexsort((pos, key)).astype(np.int64)
+
+
 class FixedPatternLU:
-    """LU of n×n CSC matrices with the pattern (indptr, indices); ``factor(data)`` then ``solve(b)``.
+    """LU of n×n CSC matrices with the pattern (indptr, indices); ``factor(data)`` then ``solve(b)``. ``late``,
+    ``group`` (optional, (n,) bool and int): columns eliminated after the other columns of their group (module text).
     ``arrays``: the factors and their pattern, for :func:`_factor` and :func:`_solve` in compiled code."""
 
-    def __init__(self, indptr, indices, n: int):
+    def __init__(self, indptr, indices, n: int, late=None, group=None):
         self.n = n = int(n)
         self.indptr = np.ascontiguousarray(indptr, dtype=np.int64)
         self.indices = np.ascontiguousarray(indices, dtype=np.int64)
@@ -200,6 +225,17 @@ class FixedPatternLU:
         # SuperLU: column c of A is column perm_c[c] of L U; perm[k]: the column of A eliminated k-th
         iperm = np.asarray(lu.perm_c, dtype=np.int64)
         perm = np.argsort(iperm)
+        if late is not None and (np.shape(late) != (n,) or np.shape(group) != (n,)):
+            raise ValueError(f"FixedPatternLU: late and group must be arrays of shape ({n},), "
+                             f"got {np.shape(late)} and {np.shape(group)}")
+        if late is not None and np.any(late):
+            perm = _late_order(perm, sym, np.asarray(late, bool), np.asarray(group, np.int64))
+            iperm = np.argsort(perm)
+            ordered = sp.csc_matrix(sample[perm][:, perm])
+            ordered.sort_indices()
+            lu = spla.splu(ordered, permc_spec="NATURAL", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+            if not (np.array_equal(lu.perm_c, np.arange(n)) and np.array_equal(lu.perm_r, np.arange(n))):
+                raise RuntimeError("FixedPatternLU: SuperLU reordered the late columns' order")
         L = sp.tril(sp.csc_matrix(lu.L), k=-1).tocoo()
         U = sp.csc_matrix(lu.U).tocoo()
         self.fill = int(L.nnz + U.nnz)                   # scalar entries of L (no unit diagonal) and U

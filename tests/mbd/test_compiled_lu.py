@@ -14,6 +14,7 @@ import mbd
 from components.dpgt import build_dpgt
 from components.params import with_overrides
 from components.presets import reference_dpgt
+from mbd.compiled.runner import _tilts_late
 from mbd.compiled.sparse_lu import FixedPatternLU
 
 from tests.support.dpgt_runs import ramp_state
@@ -78,6 +79,42 @@ def test_solves_like_superlu_on_every_matrix_of_the_pattern(n, density, seed, sc
         np.testing.assert_array_equal(x, _column_lu_solve(A, lu.perm, b))     # the blocks change no bit
 
 
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(2, 50), density=st.floats(0.0, 0.3), seed=st.integers(0, 2**31), groups=st.integers(1, 20))
+def test_late_columns_follow_their_group_and_change_no_solution(n, density, seed, groups):
+    """Columns marked late go after the other columns of their group and before the first column outside it that
+    they or the group couple to; the factors are still the scalar column LU's on that order, bit for bit."""
+    P = _pattern(n, density, seed)
+    rng = np.random.default_rng(seed + 2)
+    group = rng.integers(0, groups, n)
+    late = rng.random(n) < 0.3
+    late[0] = True
+    lu = FixedPatternLU(P.indptr, P.indices, n, late, group)
+    at = np.empty(n, np.int64)
+    at[lu.perm] = np.arange(n)
+    assert np.array_equal(np.sort(lu.perm), np.arange(n))
+    base = FixedPatternLU(P.indptr, P.indices, n)
+    assert np.array_equal(lu.perm[~late[lu.perm]], base.perm[~late[base.perm]])     # the others keep their order
+    for d in np.flatnonzero(late):
+        own = np.flatnonzero((group == group[d]) & ~late)
+        assert np.all(at[own] < at[d])
+        near = np.unique(np.concatenate([P.indices[P.indptr[c]:P.indptr[c + 1]] for c in [d, *own]]))
+        near = near[~late[near] & (group[near] != group[d])]
+        later = near[at[near] > (at[own].max() if own.size else -1)]
+        assert np.all(at[d] < at[later])
+        # nothing but late columns between d and the column SuperLU's order had before it
+        prev = [c for c in base.perm[:base.perm.tolist().index(min(later, key=lambda c: at[c]))]
+                if not late[c]] if later.size else []
+        assert all(at[c] < at[d] for c in prev)
+    for _ in range(2):
+        A = _dominant(P, rng, 0.0)
+        assert lu.factor(A.data)
+        b = rng.standard_normal(n)
+        x = lu.solve(b)
+        np.testing.assert_allclose(x, spla.spsolve(A, b), rtol=1e-10, atol=1e-12 * np.abs(x).max())
+        np.testing.assert_array_equal(x, _column_lu_solve(A, lu.perm, b))
+
+
 def test_a_zero_pivot_is_reported_not_divided_by():
     P = _pattern(5, 0.3, 3)
     lu = FixedPatternLU(P.indptr, P.indices, 5)
@@ -137,7 +174,8 @@ def test_the_machines_newton_matrix_is_solved_as_scipy_solves_it(newton_matrices
     it), and bit for bit the scalar column LU's on the same order; the blocks pad little."""
     system, A, F = newton_matrices[machine]
     assert np.array_equal(A.indptr, system._indptr) and np.array_equal(A.indices, system._indices)
-    lu = FixedPatternLU(system._indptr, system._indices, system.ndof)
+    late, group = _tilts_late(system.model)
+    lu = FixedPatternLU(system._indptr, system._indices, system.ndof, late, group)
     assert lu.factor(A.data)
     for b in (F, np.random.default_rng(7).standard_normal(system.ndof)):
         x = lu.solve(b)
@@ -147,3 +185,25 @@ def test_the_machines_newton_matrix_is_solved_as_scipy_solves_it(newton_matrices
         np.testing.assert_array_equal(x, _column_lu_solve(A, lu.perm, b))
     # a body's x, y, θ make a block: the planar machine's 87 bodies in 88 blocks (SuperLU splits one body)
     assert 3 * lu.blocks - system.ndof <= 0.05 * system.ndof
+    names = [system.model.coordinate_name(int(f)) for f in system.model.free]
+    if machine == "planar":                            # no tilt: SuperLU's order as it is
+        assert late is None
+        assert np.array_equal(lu.perm, FixedPatternLU(system._indptr, system._indices, system.ndof).perm)
+        return
+    # the sliced machine: every roller's tilt after its x, y, θ and before its cage, so that no block column
+    # of L joins two rollers (with the tilts first, three to a block, each tilt block joined three rollers)
+    at = {names[c]: k for k, c in enumerate(lu.perm)}
+    tilts = [nm for nm in names if nm.endswith(".tilt")]
+    assert len(tilts) == 72 and late.sum() == 72
+    for t in tilts:
+        body, bearing = t[:-len(".tilt")], t.split(".pb.")[0]
+        assert max(at[f"{body}.{c}"] for c in "xyθ") < at[t] < at[f"{bearing}.pb.cage.x"]
+    pos, BLp, BLi = lu.arrays[4], lu.arrays[5], lu.arrays[6]
+    blocks = [set() for _ in range(lu.blocks)]         # the coordinates of each block
+    for c, place in enumerate(pos):
+        blocks[place // 3].add(names[c])
+    roller = [len({nm.rsplit(".", 1)[0] for nm in b}) == 1 and ".roller" in next(iter(b))
+              and not any(nm.endswith(".tilt") for nm in b) for b in blocks]
+    assert sum(roller) == 72
+    for J in np.flatnonzero(roller):
+        assert not any(roller[I] for I in BLi[BLp[J]:BLp[J + 1]]), sorted(blocks[J])
