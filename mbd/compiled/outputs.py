@@ -4,7 +4,7 @@
 the numpy kernels' (``System.outputs_batch``) for the others. An output is written by the compiled force law where it
 computes that value for the residual (the sliced race's by the law of its evaluate kernel without the Jacobian:
 :func:`.sliced.outputs_sliced_race`); ``System.outputs_batch`` stays the reference the tests hold this to
-(tests/mbd/test_compiled_outputs.py, tests/mbd/test_compiled_sliced_outputs.py)."""
+(tests/mbd/test_compiled_outputs.py, tests/mbd/test_compiled_sliced.py)."""
 from __future__ import annotations
 
 import numpy as np

@@ -36,8 +36,8 @@ from numba.extending import overload
 
 from . import contact, generic, mesh, sliced
 
-__all__ = ["Kind", "KIND_IDS", "GROUPS", "THREADED", "THREADED_KINDS", "OUTPUT_NAMES", "output_names", "kind_of", "groups_of",
-           "groups_to_compile", "call", "evaluate_for", "evaluate_threaded_for", "update_for", "outputs_for"]
+__all__ = ["Kind", "KIND_IDS", "GROUPS", "THREADED", "THREADED_KINDS", "OUTPUT_NAMES", "output_names", "kind_of",
+           "groups_of", "groups_to_compile", "call", "evaluate_for", "evaluate_threaded_for", "update_for", "outputs_for"]
 
 
 @dataclass(frozen=True)

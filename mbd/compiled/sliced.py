@@ -876,7 +876,7 @@ def outputs_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, O):
     loads q_k = (K/n_s) δ_k^p + (c₀/n_s) δ_k^((p−1)/2) δ̇_k clipped at ≥ 0 (open slices 0), their sums, and the
     traction on Q at the load centroid — for every contact, those the open bound skips too (their load 0, their
     geometry, slip and rolling speeds as the reference gives them). Equal to the reference's outputs to round-off
-    (tests/mbd/test_compiled_sliced_outputs.py)."""
+    (tests/mbd/test_compiled_sliced.py)."""
     p, law = G[0], int(G[1])
     pe = 0.5 * (p - 1.0)
     ns = G.shape[0] - _GZ

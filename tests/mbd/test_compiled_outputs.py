@@ -102,7 +102,7 @@ def test_compiled_outputs_equal_the_reference_for_each_law_variant(overrides, op
     roller, the forces times two), the hydrodynamic cage land (its shear in the friction), the tanh and
     slide-to-roll traction laws, no cage, linear bearings (every output from the numpy kernels), a roller-centred
     cage (the pockets' radial retention instead of the land) and the sliced bearing (its races' slice loads, tilts and
-    slopes: tests/mbd/test_compiled_sliced_outputs.py holds them at random tilted states)."""
+    slopes: tests/mbd/test_compiled_sliced.py holds them at random tilted states)."""
     bs = build(with_overrides(reference_dpgt(3, "forward"), overrides), **options)
     compiled, n = _compare(bs)
     centring = "pocket_retention" if overrides.get("bearing.cage.guidance") == "rollers" else "guide"
