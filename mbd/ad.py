@@ -214,17 +214,19 @@ def wrap_angle(x):
 
 # instances × sub-points (slices): a family that evaluates k points per instance flattens them into the instance axis
 def repeat_each(x, k: int):
-    """Each instance's value repeated k times: (n,) → (n·k,) (a Dual's derivative rows with it; scalars pass)."""
+    """Each instance's value repeated k times: (n,) → (n·k,) (a Dual's derivative rows with it; scalars pass); an
+    array of K states (K, n) → (K, n·k), the instances along the last axis."""
     if isinstance(x, Dual):
         return Dual(np.repeat(x.val, k), np.repeat(x.der, k, axis=0))
-    return np.repeat(x, k) if np.ndim(x) else x
+    return np.repeat(x, k, axis=-1) if np.ndim(x) else x
 
 
 def group_sum(x, n: int, k: int):
-    """The sum over each instance's k points: (n·k,) → (n,)."""
+    """The sum over each instance's k points: (n·k,) → (n,); (K, n·k) → (K, n) for an array of K states."""
     if isinstance(x, Dual):
         return Dual(x.val.reshape(n, k).sum(axis=1), x.der.reshape(n, k, x.der.shape[-1]).sum(axis=1))
-    return np.asarray(x).reshape(n, k).sum(axis=1)
+    x = np.asarray(x)
+    return x.reshape(x.shape[:-1] + (n, k)).sum(axis=-1)
 
 
 def take(x, idx):

@@ -1,16 +1,17 @@
 """The element outputs of K states at once through the compiled kernels: the twin of
 :meth:`mbd.System.outputs_batch` for the families whose compiled twin gives its outputs
-(:data:`.registry.OUTPUT_NAMES`: the roller–race, pocket and guide-land contacts), the numpy kernels'
-(``System.outputs_batch``) for the others. An output is written by the compiled force law where it computes
-that value for the residual (one definition of each law); ``System.outputs_batch`` stays the reference the
-tests hold this to (tests/mbd/test_compiled_outputs.py)."""
+(:data:`.registry.OUTPUT_NAMES`: the roller–race, pocket and guide-land contacts, the sliced roller–race contact),
+the numpy kernels' (``System.outputs_batch``) for the others. An output is written by the compiled force law where it
+computes that value for the residual (the sliced race's by the law of its evaluate kernel without the Jacobian:
+:func:`.sliced.outputs_sliced_race`); ``System.outputs_batch`` stays the reference the tests hold this to
+(tests/mbd/test_compiled_outputs.py, tests/mbd/test_compiled_sliced.py)."""
 from __future__ import annotations
 
 import numpy as np
 from numba import literally, njit
 
 from ..assembly import System
-from .registry import OUTPUT_NAMES, call, groups_to_compile, kind_of, outputs_for
+from .registry import call, groups_to_compile, kind_of, output_names, outputs_for
 from .. import compiled as _compiled     # kernels_cached, compile_announced: read through the package when called
 
 __all__ = ["CompiledOutputs", "family_outputs"]
@@ -40,7 +41,7 @@ def family_outputs(groups, kind, t, phi, omega, domega, qf, vf, dofs, P, G, Z, O
 class CompiledOutputs:
     """``outputs_batch(t, q, v, z, families=None)`` as :meth:`mbd.System.outputs_batch` gives it (arrays (K, n)
     per family and output), the compiled families' outputs from their kernels: the names of
-    :data:`.registry.OUTPUT_NAMES`, the reference's but the race's "angle" (not a by-product of the force law:
+    :func:`.registry.output_names`, the reference's but the races' "angle" (not a by-product of the force law:
     an arctan2 per contact that the statistics do not read; the recorder's probes take the numpy kernels').
     :attr:`engines` says which path evaluates each family ("compiled" / "numpy")."""
 
@@ -49,7 +50,7 @@ class CompiledOutputs:
         self._compiled, self.engines = [], {}
         self.groups = 0        # the kernel groups of the compiled families (registry.GROUPS): compiled for these only
         for e, parts in system._evals:
-            names = OUTPUT_NAMES.get(type(e).compiled_twin)
+            names = output_names(e)
             packed = None
             if names is not None:
                 try:

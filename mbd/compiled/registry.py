@@ -36,8 +36,8 @@ from numba.extending import overload
 
 from . import contact, generic, mesh, sliced
 
-__all__ = ["Kind", "KIND_IDS", "GROUPS", "THREADED", "THREADED_KINDS", "OUTPUT_NAMES", "kind_of", "groups_of",
-           "groups_to_compile", "call", "evaluate_for", "evaluate_threaded_for", "update_for", "outputs_for"]
+__all__ = ["Kind", "KIND_IDS", "GROUPS", "THREADED", "THREADED_KINDS", "OUTPUT_NAMES", "output_names", "kind_of",
+           "groups_of", "groups_to_compile", "call", "evaluate_for", "evaluate_threaded_for", "update_for", "outputs_for"]
 
 
 @dataclass(frozen=True)
@@ -75,9 +75,20 @@ THREADED = 256
 # in docs/numerics.md §5 "Threads"); the others stay in the calling thread
 THREADED_KINDS = ("contact.race", "contact.pocket", "contact.guide", "contact.drag", "sliced.sliced_race")
 # twins that give their outputs (outputs_kind) -> the reference's names of the rows they write
-# (the meshes' are not among them: numpy's batched mesh kernel takes as long over a block as the compiled one)
+# (the meshes' are not among them: numpy's batched mesh kernels, the face-sliced one's too, take as long over a block
+# as a compiled one)
 OUTPUT_NAMES = {"contact.race": contact.RACE_OUTPUTS, "contact.pocket": contact.POCKET_OUTPUTS,
-                "contact.guide": contact.GUIDE_OUTPUTS, "contact.retention": contact.RETENTION_OUTPUTS}
+                "contact.guide": contact.GUIDE_OUTPUTS, "contact.retention": contact.RETENTION_OUTPUTS,
+                "sliced.sliced_race": sliced.SLICED_RACE_OUTPUTS}
+
+
+def output_names(elem) -> tuple | None:
+    """The names of the rows the twin of ``elem`` writes (:data:`OUTPUT_NAMES`; the sliced race's go on with a row
+    per slice of the family, :func:`.sliced.sliced_race_output_names`), or None when its twin gives no outputs."""
+    twin = type(elem).compiled_twin
+    if twin == "sliced.sliced_race":
+        return sliced.sliced_race_output_names(elem.n_s)
+    return OUTPUT_NAMES.get(twin)
 
 
 def kind_of(cls) -> Kind | None:
@@ -303,4 +314,6 @@ def outputs_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, O):
         contact.outputs_guide(t, phi, omega, domega, ql, vl, z, P, G, O)
     elif kind == _RETENTION:
         contact.outputs_retention(t, phi, omega, domega, ql, vl, z, P, G, O)
+    elif kind == _SLICED_RACE:
+        sliced.outputs_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, O)
 

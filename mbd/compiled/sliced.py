@@ -55,7 +55,7 @@ from . import mesh, tooth_pairs
 from .contact import EHL, _ehl_traction, _traction, traction_g
 
 __all__ = ["pack_sliced_race", "evaluate_sliced_race", "pack_sliced_gear_mesh", "evaluate_sliced_gear_mesh",
-           "SLICED_COLS", "MESH_EXTRA"]
+           "SLICED_COLS", "MESH_EXTRA", "outputs_sliced_race", "SLICED_RACE_OUTPUTS", "sliced_race_output_names"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -867,3 +867,144 @@ def _sliced_meshes(ql, vl, P, G, F, Jq, Jv, jac):
                     J[i, 6, c], J[i, 7, c] = gqx, gqy
                 if has2:
                     J[i, j1, c], J[i, j1 + 1, c] = -gqx, -gqy
+
+
+# ------------------------------------------------------------------------------------------- SlicedRaceContact outputs
+# the rows outputs_sliced_race writes (the reference's names but "angle", not a by-product of the force law, as the
+# planar race's), then one row per slice: "slice_load_<k>", k = 0 .. n_s − 1 (:func:`sliced_race_output_names`)
+SLICED_RACE_OUTPUTS = ("load", "deflection", "traction", "slip_velocity", "rolling_speed", "fx", "fy", "tilt", "slope",
+                       "centroid", "max_slice_load", "edge_load", "mid_load", "race_slope_x", "race_slope_y",
+                       "loaded_slices")
+
+
+def sliced_race_output_names(n_slices: int) -> tuple:
+    """The names of the rows :func:`outputs_sliced_race` writes for a family of ``n_slices`` slices."""
+    return SLICED_RACE_OUTPUTS + tuple(f"slice_load_{k}" for k in range(n_slices))
+
+
+@njit(cache=True, error_model="numpy")
+def outputs_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, O):
+    """The outputs of every contact (:func:`sliced_race_output_names`: SlicedRaceContact.kernel's) into the rows of O
+    (16 + n_s, n): the law of :func:`evaluate_sliced_race` without its generalised forces and Jacobian — the
+    geometry, the slices' compressions δ_k and their powers (:func:`_slice_roots`, all contacts at once), the slice
+    loads q_k = (K/n_s) δ_k^p + (c₀/n_s) δ_k^((p−1)/2) δ̇_k clipped at ≥ 0 (open slices 0), their sums, and the
+    traction on Q at the load centroid — for every contact, those the open bound skips too (their load 0, their
+    geometry, slip and rolling speeds as the reference gives them). Equal to the reference's outputs to round-off
+    (tests/mbd/test_compiled_sliced.py)."""
+    p, law = G[0], int(G[1])
+    pe = 0.5 * (p - 1.0)
+    ns = G.shape[0] - _GZ
+    zs = G[_GZ:]
+    zmax = 0.0
+    for k in range(ns):
+        zmax = max(zmax, abs(zs[k]))
+    n = ql.shape[0]
+    outer = ql.shape[1] == 12
+    mroot = root_index(pe)
+    npad = -(-ns // _LANES) * _LANES
+    loaded = np.empty(n, np.bool_)
+    geo = np.empty((n, 20))
+    w_x, w_y, w_d, w_delta = np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns))
+    w_c, w_root = np.empty(n * npad), np.empty(n * npad)
+    for i in range(n):
+        kap, mx, my, pmx, pmy, s0x, s0y = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
+        R, D, row = P[i, 7], P[i, 8], P[i, 11]
+        xr, yr, tau = ql[i, 0], ql[i, 1], ql[i, 3]
+        xb, yb, thb = ql[i, 4], ql[i, 5], ql[i, 6]
+        vr0, vr1, dtau = vl[i, 0], vl[i, 1], vl[i, 3]
+        vb0, vb1, vb2 = vl[i, 4], vl[i, 5], vl[i, 6]
+        if outer:
+            sx, sy, vsx, vsy = ql[i, 7], ql[i, 8], vl[i, 7], vl[i, 8]
+            xp, yp, thp, vp0, vp1, vp2 = ql[i, 9], ql[i, 10], ql[i, 11], vl[i, 9], vl[i, 10], vl[i, 11]
+        else:
+            sx, sy, vsx, vsy = 0.0, 0.0, 0.0, 0.0
+            xp, yp, thp, vp0, vp1, vp2 = xb, yb, thb, vb0, vb1, vb2
+        cb, sb, cp, sp = np.cos(thb), np.sin(thb), np.cos(thp), np.sin(thp)
+        rcx, rcy = cb * mx - sb * my, sb * mx + cb * my
+        cx, cy = xb + rcx, yb + rcy
+        Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
+        rpx, rpy = cp * pmx - sp * pmy, sp * pmx + cp * pmy
+        Vpx, Vpy = vp0 - vp2 * rpy, vp1 + vp2 * rpx
+        ux, uy = xr - (xp + rpx), yr - (yp + rpy)
+        rho_p = np.sqrt(ux * ux + uy * uy + _ETA2)
+        ex, ey = ux / rho_p, uy / rho_p
+        gx, gy = vr0 - Vpx, vr1 - Vpy
+        ge = ex * gx + ey * gy
+        edx, edy = (gx - ge * ex) / rho_p, (gy - ge * ey) / rho_p
+        s0cx, s0cy = cb * s0x - sb * s0y, sb * s0x + cb * s0y
+        scx, scy = s0cx + sx, s0cy + sy
+        dscx, dscy = -1.0 * vb2 * s0cy + vsx, vb2 * s0cx + vsy
+        srx, sry = tau * ex, tau * ey
+        dsrx, dsry = dtau * ex + tau * edx, dtau * ey + tau * edy
+        pcx_, pcy_ = xr - cx, yr - cy
+        wvx, wvy = vr0 - Vcx, vr1 - Vcy
+        g = geo[i]
+        g[0], g[1], g[2], g[3], g[4], g[5], g[6], g[7], g[8], g[9] = rcx, rcy, Vcx, Vcy, pcx_, pcy_, wvx, wvy, ex, ey
+        g[10], g[11], g[12], g[13], g[14], g[15] = scx, scy, dscx, dscy, dsrx, dsry
+        delta0 = 0.5 * D - kap * (np.sqrt(pcx_ * pcx_ + pcy_ * pcy_) - R)
+        reach = zmax * abs(tau) + (abs(row) + zmax) * np.sqrt(scx * scx + scy * scy)
+        loaded[i] = delta0 + reach > 0.0           # else every slice open (the reference's bound)
+        for k in range(ns):
+            zk = zs[k]
+            zeta = row + zk
+            wx = pcx_ + zk * srx - zeta * scx
+            wy = pcy_ + zk * sry - zeta * scy
+            d = np.sqrt(wx * wx + wy * wy + _ETA2)
+            w_x[i, k], w_y[i, k], w_d[i, k] = wx, wy, d
+            w_delta[i, k] = 0.5 * D - kap * (d - R) - P[i, SLICED_COLS + k]
+    _slice_roots(w_delta, w_c, w_root, n, ns, npad, mroot, pe)
+    for i in range(n):
+        kap, R, D, K, c0, row, Rr = P[i, 0], P[i, 7], P[i, 8], P[i, 9], P[i, 10], P[i, 11], P[i, 12]
+        tau = ql[i, 3]
+        vr0, vr1, vr2, vb0, vb1, vb2 = vl[i, 0], vl[i, 1], vl[i, 2], vl[i, 4], vl[i, 5], vl[i, 6]
+        g = geo[i]
+        rcx, rcy, Vcx, Vcy, pcx_, pcy_, wvx, wvy, ex, ey = g[0], g[1], g[2], g[3], g[4], g[5], g[6], g[7], g[8], g[9]
+        scx, scy, dscx, dscy, dsrx, dsry = g[10], g[11], g[12], g[13], g[14], g[15]
+        S0x, S0y, Q, Qz, qmax, nload = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        Ks, c0s = K / ns, c0 / ns
+        o = i * npad
+        for k in range(ns):
+            q = 0.0
+            delta = w_delta[i, k]
+            if loaded[i] and delta > 0.0:
+                zk = zs[k]
+                zeta = row + zk
+                d = w_d[i, k]
+                nx, ny = w_x[i, k] / d, w_y[i, k] / d
+                vwx = wvx + zk * dsrx - zeta * dscx
+                vwy = wvy + zk * dsry - zeta * dscy
+                delta_dot = -kap * (nx * vwx + ny * vwy)
+                dpe = w_root[o + k]
+                q_raw = Ks * (delta * (dpe * dpe)) + c0s * dpe * delta_dot
+                if q_raw > 0.0:
+                    q = q_raw
+                    S0x += kap * q * nx
+                    S0y += kap * q * ny
+                    Q += q
+                    Qz += zk * q
+                    nload += 1.0
+            O[16 + k, i] = q
+            qmax = max(qmax, q)
+        # traction as the planar contact's on Q (SlicedRaceContact.kernel)
+        rho = np.sqrt(pcx_ * pcx_ + pcy_ * pcy_ + _ETA2)
+        ecx, ecy = pcx_ / rho, pcy_ / rho
+        tx, ty = -ecy, ecx
+        rl = R - rho
+        rrx, rry = rl * ecx, rl * ecy
+        rbx, rby = rcx + R * ecx, rcy + R * ecy
+        Vrx, Vry = vr0 - vr2 * rry, vr1 + vr2 * rrx
+        Vbx, Vby = vb0 - vb2 * rby, vb1 + vb2 * rbx
+        ur, ub = Vrx * tx + Vry * ty, Vbx * tx + Vby * ty
+        v_s = ur - ub
+        u_e = 0.5 * (ur + ub) - (Vcx * tx + Vcy * ty + R * (wvx * tx + wvy * ty) / rho)
+        on = Q > 0.0
+        if law == EHL:
+            mu = _ehl_traction(G, v_s, u_e, Q if on else 1.0, Rr)[0]
+        else:
+            mu = _traction(law, G, v_s, u_e)[0]
+        Ft = -mu * Q
+        O[0, i], O[1, i], O[2, i], O[3, i], O[4, i] = Q, 0.5 * D - kap * (rho - R), Ft, v_s, u_e
+        O[5, i], O[6, i], O[7, i] = S0x + Ft * tx, S0y + Ft * ty, tau
+        O[8, i], O[9, i] = scx * ex + scy * ey - tau, Qz / Q if on else 0.0
+        O[10, i], O[11, i], O[12, i] = qmax, max(O[16, i], O[15 + ns, i]), O[16 + ns // 2, i]
+        O[13, i], O[14, i], O[15, i] = scx, scy, nload

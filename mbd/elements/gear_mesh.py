@@ -462,7 +462,7 @@ class SlicedGearMesh(GearMesh):
     ``slopes2``): full indices (n, 2) or None. ``face_width`` b [m] per mesh; ``slices`` n_m. Outputs: GearMesh's and "tilt_moment" M_+ − M_− [N m], "relative_slope" g·Δs of the loaded
     flank's line [rad]."""
     compiled_twin = "sliced.sliced_gear_mesh"
-    batched = False            # its slices flatten the instance axis: one state at a time
+    batched = True             # its slices along the instance axis: K states (K, n) in one call (ad.repeat_each)
 
     def __init__(self, name, gear1, gear2, *, slopes1=None, slopes2=None, face_width, slices, **kw):
         super().__init__(name, gear1, gear2, **kw)

@@ -96,8 +96,10 @@ def test_the_double_row_machine_reports_its_rows_profiles_and_life(double_row):
         k, j = np.unravel_index(np.argmax(Q), Q.shape)
         assert (pr["roller"][i], pr["row"][i], pr["time"][i]) == (j, j // Z, sols[k].t)
         q = pin[k, i].reshape(rows * Z, n_s)[j]
-        np.testing.assert_array_equal(pr["load_pin"][i], q)
-        np.testing.assert_array_equal(pr["load_bore"][i], bore[k, i].reshape(rows * Z, n_s)[j])
+        # the statistics read the compiled kernel's slice loads: the reference's to round-off (its slice power within
+        # 1.5 ulp, tests/mbd/test_compiled_sliced.py)
+        np.testing.assert_allclose(pr["load_pin"][i], q, rtol=1e-12)
+        np.testing.assert_allclose(pr["load_bore"][i], bore[k, i].reshape(rows * Z, n_s)[j], rtol=1e-12)
         p_pin = np.sqrt(q / width * E / math.pi * (2 / b.roller_diameter + 2 / (b.pitch_diameter - b.roller_diameter)))
         np.testing.assert_allclose(pr["pressure_pin"][i], p_pin, rtol=1e-12)
         assert p_pin.max() > 5e8                                             # a loaded roller (Pa)

@@ -2,15 +2,16 @@
 mbd.elements.sliced.SlicedRaceContact, whose Jacobians are mbd.ad's dual numbers) to round-off: forces, J_q and J_v
 to 1e-10 of each instance's block (tests.support.contact.assert_matches_reference), inner and outer raceways, the
 three traction laws, with damping, profile drops, row offsets, a pin slope, tilts and slopes drawn at random, and
-contacts fully open (skipped by the bound), partly open (an edge load) and fully closed in one family."""
+contacts fully open (skipped by the bound), partly open (an edge load) and fully closed in one family; and its outputs
+(outputs_sliced_race, what the window statistics read) equal the reference's."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from mbd.compiled.registry import kind_of
-from mbd.compiled.sliced import _LANES, _slice_roots, root_index
+from mbd.compiled.registry import OUTPUT_NAMES, kind_of, output_names
+from mbd.compiled.sliced import _LANES, _slice_roots, outputs_sliced_race, root_index
 from mbd.element import evaluate
 from mbd.elements import StiffnessShape
 from mbd.elements.gear_mesh import SlicedGearMesh, mesh_u0
@@ -325,3 +326,56 @@ def test_family_with_runout_and_teeth_packs_both_error_blocks():
     assert G[cmesh.G_OFFSET] >= 0 and G[cmesh.G_PAIRS] > G[cmesh.G_OFFSET]
     np.testing.assert_array_equal(P[:, int(G[cmesh.G_OFFSET]):int(G[cmesh.G_OFFSET]) + 2], elem.offset1)
     np.testing.assert_array_equal(P[:, -4], elem.face_width)
+
+
+# ------------------------------------------------------------------------------------------- the sliced race's outputs
+# The outputs from the compiled kernel (outputs_sliced_race, what the window statistics read on the compiled path)
+# against the reference's, SlicedRaceContact.kernel: every output of the family (the planar race's, the tilt, the slopes,
+# the load centroid, the slice loads and what the statistics take of them) at random loaded states with tilts, slopes,
+# profile drops, row offsets and damping, both raceways, every traction law and both power paths (the root iteration:
+# 10/9, 1.5; np.power: 1.3); contacts with every slice closed, with an edge load and open ones in each family.
+
+OUTPUTS_RTOL = 1e-12       # the slices' power within 1.5 ulp, sums in the reference's order: seen below 1e-14
+
+
+def _compiled_outputs(elem, qf, vf, t=0.25):
+    """{name: (n,)} of the compiled kernel; O starts NaN so that every row must be written."""
+    P, G = kind_of(type(elem)).pack(elem)
+    ql, vl = np.ascontiguousarray(qf[elem.dofs]), np.ascontiguousarray(vf[elem.dofs])
+    names = output_names(elem)
+    O = np.full((len(names), elem.n), np.nan)
+    outputs_sliced_race(t, FS.phi, FS.omega, FS.domega, ql, vl, np.zeros((elem.n, 0)), P, G, O)
+    return dict(zip(names, O))
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+@pytest.mark.parametrize("law", sorted(TRACTIONS))
+@pytest.mark.parametrize("n_s, exponent", [(1, 10.0 / 9.0), (5, 1.5), (21, 10.0 / 9.0), (21, 1.3)])
+@pytest.mark.parametrize("seed", [1, 2])
+def test_sliced_race_outputs_equal_the_reference(kind, law, n_s, exponent, seed):
+    """Every output of the compiled kernel is the reference's to 1e-12 (of itself or of the family's largest), and the
+    load, the largest slice load and the loaded slices' count are those of the family's own slice loads."""
+    rng = np.random.default_rng(seed)
+    press = [6e-6, 1e-6, -30e-6, 4e-6, 0.5e-6, 2e-6]          # loaded, loaded, open (skipped), ...
+    tilt = np.array([0.0, 8e-4, 0.0, -3e-4, 2e-4, 0.0]) + rng.uniform(-1e-4, 1e-4, N)
+    pin_slope = rng.uniform(-3e-4, 3e-4, 2)
+    drop = rng.uniform(0.0, 1e-6, (N, n_s))
+    elem = _family(kind, n_s, TRACTIONS[law], zeta=0.05, drop=drop, row=3e-3 if seed == 2 else 0.0,
+                   pin_slope=pin_slope, exponent=exponent)
+    qf, vf = _state(kind, rng, press, tilt, rng.uniform(-5e-4, 5e-4, 2))
+    _, ref, _, _ = evaluate(elem, 0.25, FS, qf, vf, None, False)
+    got = _compiled_outputs(elem, qf, vf)
+    assert set(ref) - set(got) == {"angle"} and set(got) <= set(ref)
+    assert set(got) == set(OUTPUT_NAMES["sliced.sliced_race"]) | {f"slice_load_{k}" for k in range(n_s)}
+    loads = elem.slice_loads(qf, vf)
+    assert np.all(loads[2] == 0.0) and np.all(loads[0] > 0.0)                      # an open and a loaded contact
+    if n_s > 1:
+        assert np.any(loads[1] == 0.0) and np.any(loads[1] > 0.0)                   # an edge load
+    for key, val in got.items():
+        want = np.asarray(ref[key], float)
+        assert np.all(np.isfinite(val)), key
+        np.testing.assert_allclose(val, want, rtol=OUTPUTS_RTOL, atol=OUTPUTS_RTOL * np.abs(want).max(initial=0.0), err_msg=key)
+    # what the statistics read of the slice loads, from the slice loads themselves
+    np.testing.assert_array_equal(got["loaded_slices"], (loads > 0.0).sum(axis=1))
+    np.testing.assert_allclose(got["load"], loads.sum(axis=1), rtol=1e-13)
+    np.testing.assert_allclose(got["max_slice_load"], loads.max(axis=1), rtol=1e-13)

@@ -190,3 +190,30 @@ def test_tooth_pair_sliced_mesh_jacobians_match_finite_differences():
                                    err_msg=model.coordinate_name(j))
         np.testing.assert_allclose(-C.toarray()[:, j], fv, rtol=1e-5, atol=1e-6 * np.abs(fv).max() + 1e-6,
                                    err_msg=model.coordinate_name(j))
+
+
+@pytest.mark.parametrize("law", ["lumped", "tooth_pairs"])
+def test_outputs_of_many_states_at_once_are_each_states_own(law, monkeypatch):
+    """System.outputs_batch evaluates the face-sliced mesh at K states in one call (the slices along the instance
+    axis of (K, n) arrays): every output equals the kernel's at each state alone, bit for bit, with relative slopes,
+    rates, damping, backlash and a runout (the lumped law) or the tooth-pair law."""
+    rng = np.random.default_rng(11)
+    shape = StiffnessShape.rectangular(1.6, 1.5, 0.1)
+    pairs = _tooth_pairs(rng) if law == "tooth_pairs" else None
+    model, sliced, _, sl = _meshes(n_m=7, shape=shape, c=2e3, backlash=1e-6, pairs=pairs,
+                                   offset2=(3e-6, -2e-6) if pairs is None else None)
+    states = [_state(model, sl, theta2=2e-4, ds=tuple(rng.standard_normal(2) * 2e-4), rng=rng) for _ in range(12)]
+    q, v = np.array([s[0] for s in states]), np.array([s[1] for s in states])
+    assert model.ndof == model.n_full == q.shape[1]
+    t = np.linspace(0.0, 1e-3, q.shape[0])
+    system = mbd.System(model)
+    got = system.outputs_batch(t, q, v, {})["sliced"]
+    monkeypatch.setattr(SlicedGearMesh, "batched", False)        # the reference: one state at a time
+    ref = system.outputs_batch(t, q, v, {})["sliced"]
+    assert set(got) == set(ref) and {"force", "tilt_moment", "relative_slope", "stiffness"} <= set(got)
+    assert np.all(np.abs(ref["tilt_moment"]) > 0.0) and np.abs(ref["force"]).max() > 1e3
+    for key, val in ref.items():
+        np.testing.assert_array_equal(got[key], val, err_msg=key)
+    fs = mbd.FrameState(0.0, 0.0, 0.0)
+    _, one = sliced.kernel(t[3], fs, list(q[3][sliced.dofs].T), list(v[3][sliced.dofs].T), None)
+    assert got["force"][3, 0] == one["force"][0]
