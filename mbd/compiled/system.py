@@ -107,6 +107,23 @@ def _threaded(groups, t, phi, omega, qf, vf, fams, zs, jac, par):
                                   Fl[lo:hi], Jql[lo:hi], Jvl[lo:hi], jac)
 
 
+@njit(inline="always")
+def _scatter(dofs, keep, mp, Fl, Jql, Jvl, jac, Ffull, Jq, Jv):
+    """One family's forces into the full force vector and, with ``jac``, its Jacobian blocks into the pattern (``keep``
+    the blocks' entries that land in it, ``mp`` where), in the family's own order: the serial and the threaded sets
+    scatter alike."""
+    n, k = dofs.shape
+    for i in range(n):
+        for j in range(k):
+            Ffull[dofs[i, j]] += Fl[i, j]
+    if jac:
+        flat_q = Jql.reshape(-1)
+        flat_v = Jvl.reshape(-1)
+        for e in range(keep.size):
+            Jq[mp[e]] += flat_q[keep[e]]
+            Jv[mp[e]] += flat_v[keep[e]]
+
+
 def _families_threaded(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv):
     """The families of a threaded set: those of the partition (``sysd[13]``, :func:`_partition`) on the threads for a
     Jacobian, and for a residual when the partition says it pays; the others here; then every family's scatter in the
@@ -125,15 +142,7 @@ def _families_threaded(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull
                     ql[i, j] = qf[dofs[i, j]]
                     vl[i, j] = vf[dofs[i, j]]
             evaluate_for(groups, kind, t, phi, omega, 0.0, ql, vl, zs[zi], P, G, Fl, Jql, Jvl, jac)
-        for i in range(n):
-            for j in range(k):
-                Ffull[dofs[i, j]] += Fl[i, j]
-        if jac:
-            flat_q = Jql.reshape(-1)
-            flat_v = Jvl.reshape(-1)
-            for e in range(keep.size):
-                Jq[mp[e]] += flat_q[keep[e]]
-                Jv[mp[e]] += flat_v[keep[e]]
+        _scatter(dofs, keep, mp, Fl, Jql, Jvl, jac, Ffull, Jq, Jv)
         r += 1
 
 
@@ -147,15 +156,7 @@ def _families_serial(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, 
                 ql[i, j] = qf[dofs[i, j]]
                 vl[i, j] = vf[dofs[i, j]]
         evaluate_for(groups, kind, t, phi, omega, 0.0, ql, vl, zs[zi], P, G, Fl, Jql, Jvl, jac)
-        for i in range(n):
-            for j in range(k):
-                Ffull[dofs[i, j]] += Fl[i, j]
-        if jac:
-            flat_q = Jql.reshape(-1)
-            flat_v = Jvl.reshape(-1)
-            for e in range(keep.size):
-                Jq[mp[e]] += flat_q[keep[e]]
-                Jv[mp[e]] += flat_v[keep[e]]
+        _scatter(dofs, keep, mp, Fl, Jql, Jvl, jac, Ffull, Jq, Jv)
 
 
 def families_for(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv):
