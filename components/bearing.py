@@ -186,7 +186,7 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
                        pose=(*(pin_xy + off), 0.0), vel=(*vel, wr))
     marker = np.tile(pin_local, (Z, 1))
     common = dict(D=damage.get("D", D), K=b.contact_stiffness, zeta=b.contact_damping_ratio, m_roller=b.roller_mass,
-                  multiplicity=b.rows)
+                  multiplicity=b.rows, damping_ramp=b.race_damping_ramp)
     law = dict(traction=traction(b, lubricant), exponent=b.contact_exponent)     # family-wide laws
     rolling = rolling_resistance(b, lubricant)
     if rolling is not None:

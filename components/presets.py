@@ -149,6 +149,12 @@ def reference_bearing() -> BearingParams:
         roller_density=assumed("7850 kg/m^3", "bearing steel"),
         contact_exponent=derived(10.0 / 9.0, "Palmgren line contact Q = K delta^(10/9) (docs/model.md §8.1)"),
         contact_damping_ratio=assumed(0.05, "of critical, gated to compression", span=Span(0.02, 0.15, "EHL and Hertzian contact damping, a few to 15 % of critical")),
+        race_damping_ramp=assumed("0.15 um", "the composite roughness of roller and raceway: below it the load "
+                                             "rides on asperities (Greenwood-Williamson) whose compressed volume, "
+                                             "which dissipates, grows from zero (Hunt & Crossley); about the "
+                                             "compression of a 30 N contact, so rollers in the load zone keep the "
+                                             "whole damping ratio",
+                                  span=Span("0 um", "0.45 um", "no ramp (the Kelvin-Voigt jump) to three composite roughnesses")),
         traction_law=assumed("tanh", "a smooth, bounded Coulomb-like law (docs/model.md §8.2); slide_roll: an EHL-type curve of the slide-to-roll ratio"),
         drag_law=assumed("inertial", "quadratic drag of the oil-air mixture on the roller orbit (docs/model.md "
                                      "§8.7); viscous: with the oil's viscosity, and a moment on the roller spin"),
