@@ -399,11 +399,11 @@ class RaceContact(Element):
         inner: δ = R + D/2 − ρ (roller pushed along +e),  outer: δ = ρ + D/2 − R (pushed along −e).
     Normal load Q = K δ^p + S(δ/δ_c) c(δ) δ̇ for δ > 0, clipped at ≥ 0, with c(δ) = 2ζ sqrt(m_roller · dQ/dδ)
     and dQ/dδ = p K δ^(p−1): a damping ratio ζ of the local contact oscillator. c(δ) ∝ δ^((p−1)/2) = δ^0.056 for
-    p = 10/9 is all but a jump at first touch (Kelvin–Voigt's discontinuity at impact, Machado et al. 2012 §3);
-    the damping share S (:func:`mbd.elements.tooth_pairs.damping_share`, the quintic smoothstep over the first
-    ``damping_ramp`` δ_c of compression, the mesh's law) lets the dissipation grow with the compressed zone from
-    zero, as Hunt & Crossley's (1975) does, and leaves the law unchanged from δ ≥ δ_c on (δ_c = 0, the default:
-    S = 1, the damping whole at first touch).
+    p = 10/9 is all but a jump at first touch (Kelvin–Voigt's discontinuity at impact: Machado et al. 2012, Mech.
+    Mach. Theory 53, 99–121); the damping share S (:func:`mbd.elements.tooth_pairs.damping_share`, the quintic
+    smoothstep over the first ``damping_ramp`` δ_c of compression, the mesh's law) lets the dissipation grow with the
+    compressed zone from zero, as Hunt & Crossley's (1975, J. Appl. Mech. 42, 440–445) does, and leaves the law
+    unchanged from δ ≥ δ_c on (δ_c = 0, the default: S = 1, the damping whole at first touch).
     Traction: v_s = (roller surface point − raceway surface point velocity)·t, t = k × e, at the contact
     point P = c + R e (line of centres, raceway surface); force −μ·Q along t on the roller. The normal
     and traction forces act at P on both bodies, equal and opposite.

@@ -8,7 +8,11 @@ accepts when its RMS ≤ 1, docs/numerics.md §1) is taken from the compiled run
 over the run. Printed per condition: accepted steps per simulated second, the median step (p10, p90), rejections,
 Newton iterations per step, and the shares of Σe² of the bodies' coordinates — the rollers' x, y turned into radial
 and tangential about their planet's centre, inner (a…) and outer (b…) bearings apart — with the largest single DOFs.
-docs/numerics.md §5 ("What sets the step") quotes it.
+``--onsets`` adds the split by contact state (:func:`roller_categories`): the shares of Σe² in steps where the DOF's
+roller had a raceway contact close or open, a pocket contact do so, a raceway contact loaded throughout (and by the
+time since that roller's last raceway onset or release), none; the same for the dominant DOF of every rejected step's
+first attempt (re-taken from its start state at its size on a copy of the runner, a fresh LU: how many fail Newton);
+the raceway onsets and releases per contact. docs/numerics.md §5 ("What sets the step") quotes it.
 """
 from __future__ import annotations
 
