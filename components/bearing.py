@@ -323,7 +323,8 @@ def _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local,
         scene.tilt(nm, J_r)
     sl = sliced_law(b)
     D = np.tile(np.broadcast_to(np.asarray(damage.get("D", b.roller_diameter), float), (b.rollers,)), b.rows)
-    common = dict(D=D, K=sl["K"], zeta=b.contact_damping_ratio, m_roller=b.roller_mass)
+    common = dict(D=D, K=sl["K"], zeta=b.contact_damping_ratio, m_roller=b.roller_mass,
+                  damping_ramp=b.race_damping_ramp)
     fam_law = dict(traction=law["traction"], exponent=law["exponent"], z=sl["z"], drop=sl["drop"])
     slope = np.tile(np.asarray(pin_slope, float), (Z, 1))
     row_offset = np.repeat(row_stations(b), b.rollers)      # ζ_row of every roller, row by row

@@ -213,7 +213,7 @@ def test_race_impact_dissipates_the_closed_form_laws_energy(v0, ramp):
     """A roller's impact on its raceway: the energy the element's law dissipates (1 − e², e its coefficient of
     restitution) is that of the closed form's ODE (to 1e-6 of itself: the element's δ carries the scene's round-off of
     1e-17 m), with the ramp less than without it (0.02 m/s, ≈ 0.1 µm deep: 4.4 % of the energy with δ_c = 0.15 µm,
-    0.2 % with 0.5 µm, against 26.8 % at any speed without a ramp; 0.3 m/s, ≈ 0.6 µm deep: 25.6 %)."""
+    0.2 % with 0.5 µm, against 26.8 % at any speed without a ramp; 0.3 m/s, ≈ 1 µm deep: 25.6 %)."""
     def element(ramp_):
         def law(delta, delta_dot):
             return float(_loads("inner", [delta], [delta_dot], ramp_)[0][0]) if delta > 0.0 else 0.0
