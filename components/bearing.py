@@ -186,7 +186,7 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
                        pose=(*(pin_xy + off), 0.0), vel=(*vel, wr))
     marker = np.tile(pin_local, (Z, 1))
     common = dict(D=damage.get("D", D), K=b.contact_stiffness, zeta=b.contact_damping_ratio, m_roller=b.roller_mass,
-                  multiplicity=b.rows)
+                  multiplicity=b.rows, damping_ramp=b.race_damping_ramp)
     law = dict(traction=traction(b, lubricant), exponent=b.contact_exponent)     # family-wide laws
     rolling = rolling_resistance(b, lubricant)
     if rolling is not None:
@@ -323,7 +323,8 @@ def _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local,
         scene.tilt(nm, J_r)
     sl = sliced_law(b)
     D = np.tile(np.broadcast_to(np.asarray(damage.get("D", b.roller_diameter), float), (b.rollers,)), b.rows)
-    common = dict(D=D, K=sl["K"], zeta=b.contact_damping_ratio, m_roller=b.roller_mass)
+    common = dict(D=D, K=sl["K"], zeta=b.contact_damping_ratio, m_roller=b.roller_mass,
+                  damping_ramp=b.race_damping_ramp)
     fam_law = dict(traction=law["traction"], exponent=law["exponent"], z=sl["z"], drop=sl["drop"])
     slope = np.tile(np.asarray(pin_slope, float), (Z, 1))
     row_offset = np.repeat(row_stations(b), b.rollers)      # ζ_row of every roller, row by row

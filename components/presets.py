@@ -149,6 +149,13 @@ def reference_bearing() -> BearingParams:
         roller_density=assumed("7850 kg/m^3", "bearing steel"),
         contact_exponent=derived(10.0 / 9.0, "Palmgren line contact Q = K delta^(10/9) (docs/model.md §8.1)"),
         contact_damping_ratio=assumed(0.05, "of critical, gated to compression", span=Span(0.02, 0.15, "EHL and Hertzian contact damping, a few to 15 % of critical")),
+        race_damping_ramp=assumed("0 um", "the contact damping whole at first touch: these contacts run on a full "
+                                           "film (lambda ~ 3), whose squeeze damps the approach before the surfaces "
+                                           "touch; a ramp over the asperities' scale (~ the composite roughness, "
+                                           "0.15 um) is the dry contact's law (Hunt & Crossley), elastic at low "
+                                           "approach speeds",
+                                  span=Span("0 um", "0.45 um", "the damping whole at first touch to a dry contact's "
+                                                               "ramp over three composite roughnesses")),
         traction_law=assumed("tanh", "a smooth, bounded Coulomb-like law (docs/model.md §8.2); slide_roll: an EHL-type curve of the slide-to-roll ratio"),
         drag_law=assumed("inertial", "quadratic drag of the oil-air mixture on the roller orbit (docs/model.md "
                                      "§8.7); viscous: with the oil's viscosity, and a moment on the roller spin"),

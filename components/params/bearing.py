@@ -244,6 +244,9 @@ class BearingParams(Params["BearingSI"]):
     contact_exponent: Quantity = param("dimensionless", "load-deflection exponent p of Q = K delta^p", lo=1.0,
                                        bound_text=">= 1")
     contact_damping_ratio: Quantity = nonneg("dimensionless", "roller-raceway contact damping ratio")
+    race_damping_ramp: Quantity = nonneg("length", "compression over which a roller-raceway contact's (a slice's) "
+                                                   "damping grows from 0 at first touch to the damping ratio's (0: "
+                                                   "all of it at first touch)")
     traction_law: str = param("choice", "roller-raceway traction law (ehl: from the lubricant's film)",
                               choices=("tanh", "slide_roll", "ehl"))
     drag_law: str = param("choice", "lubricant drag on the rollers: inertial (quadratic drag on the orbit, C_d "
@@ -304,6 +307,7 @@ class BearingSI(SI):
     contact_stiffness: float = computed("roller-raceway line contact stiffness K [N/m^(10/9)] (given, or Palmgren)")
     contact_exponent: float
     contact_damping_ratio: float
+    race_damping_ramp: float
     traction_law: str
     drag_law: str
     rolling_resistance: str

@@ -3,8 +3,9 @@ convention of :mod:`mbd.compiled` (pack / evaluate / update / outputs). The nump
 
 Layouts (P: one row per instance, columns in this order; G: family-wide values):
 
-``RaceContact``   P (n, 8): κ (+1 inner, −1 outer: per instance, so a fused inner + outer family packs
-                  as one), race_marker x, y [m], R_race [m], D [m], K, c₀ = 2ζ·sqrt(m_roller·p·K), multiplicity;
+``RaceContact``   P (n, 9): κ (+1 inner, −1 outer: per instance, so a fused inner + outer family packs
+                  as one), race_marker x, y [m], R_race [m], D [m], K, c₀ = 2ζ·sqrt(m_roller·p·K), multiplicity,
+                  damping_ramp δ_c [m] (0: the damping whole at first touch);
                   a family with a spall packs 4 more columns, so the kernel decides from P's width (a family
                   without one pays nothing): spall_angle [rad], (w + e)/2 [m], depth h [m], edge e [m]
                   G (11,): exponent p, traction law id, then the law's coefficients (zero-padded):
@@ -47,6 +48,7 @@ import numpy as np
 from numba import njit
 
 from ..elements import ehl, pocket_film
+from . import tooth_pairs
 from ..elements.contact import (DryLand, EHLTraction, GuideContact, HoupertRolling, HydrodynamicLand, LubricantDrag,
                                 PocketContact, PocketRetention, RaceContact, SlideRollTraction, TanhTraction)
 
@@ -96,7 +98,8 @@ def pack_race(elem):
     _require(elem, RaceContact)
     G = traction_g(elem.name, elem.traction, elem.exponent)
     mk = elem.race_marker
-    cols = [elem.kappa, mk[:, 0], mk[:, 1], elem.R_race, elem.D, elem.K, elem._c0, elem.multiplicity]
+    cols = [elem.kappa, mk[:, 0], mk[:, 1], elem.R_race, elem.D, elem.K, elem._c0, elem.multiplicity,
+            elem.damping_ramp]
     if elem.has_spall:
         cols += [elem.spall_angle, elem._spall_hi, elem.spall_depth, elem.spall_edge]
     P = _rows(*cols)
@@ -354,7 +357,7 @@ def _race_out(O, i, Q, delta, Ft, v_s, u, Fx, Fy):
     O[4, i], O[5, i], O[6, i] = u, Fx, Fy
 
 
-RACE_COLS = 8                                   # P columns of a race family without a spall
+RACE_COLS = 9                                   # P columns of a race family without a spall
 
 
 @njit(cache=True)
@@ -446,11 +449,17 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
         if spall:                                # δ_eff = δ − d(s) and its exact rate
             d_s, d_rate, hBs, hBss, s_dot = _spall(P, i, R, dx, dy, wx, wy, thb, vb2)
             delta, delta_dot = delta - d_s, delta_dot - d_rate
-        # Hertz load with contact damping, clipped at >= 0 (ad.where: zero derivative when clipped)
-        Q, dpe = 0.0, 0.0
+        # Hertz load with contact damping, clipped at >= 0 (ad.where: zero derivative when clipped); the damping
+        # times its share S(δ/δ_c) when the instance has a ramp (tooth_pairs.damping_share, the reference's law)
+        ramp = P[i, 8]
+        Q, dpe, S, dS = 0.0, 0.0, 1.0, 0.0
         if delta > 0.0:
             dpe = delta ** pe
-            Q = K * delta ** p + c0 * dpe * delta_dot
+            if ramp > 0.0:
+                S, dS = tooth_pairs.damping_share(delta, ramp)
+                Q = K * delta ** p + c0 * dpe * S * delta_dot
+            else:
+                Q = K * delta ** p + c0 * dpe * delta_dot
         if not Q > 0.0:
             _zero(F, Jq, Jv, i, jac)
             if out:                              # no load, no traction; the kinematics as for a loaded one
@@ -486,6 +495,9 @@ def _race(ql, vl, P, G, F, Jq, Jv, jac, O):
             continue
         Q_d = K * p * delta ** (p - 1.0) + c0 * pe * delta ** (pe - 1.0) * delta_dot   # ∂Q/∂δ
         Q_r = c0 * dpe                                                                  # ∂Q/∂δ̇
+        if ramp > 0.0:
+            Q_d = K * p * delta ** (p - 1.0) + c0 * (pe * delta ** (pe - 1.0) * S + dpe * dS) * delta_dot
+            Q_r = c0 * dpe * S
         rho2 = dx * dx + dy * dy + _ETA2
         num = dx * wy - dy * wx
         # Positions: the law sees the roller's and the race body's centres only through (dx, dy), so a shift of the

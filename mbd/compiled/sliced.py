@@ -74,7 +74,9 @@ def pack_sliced_race(elem):
     cols = [col(elem.kappa), elem.race_marker[:, 0], elem.race_marker[:, 1], elem.pin_marker[:, 0],
             elem.pin_marker[:, 1], elem.race_slope[:, 0], elem.race_slope[:, 1], elem.R_race, elem.D, elem.K,
             elem._c0, elem.row_offset, elem.R_red]
-    P = np.ascontiguousarray(np.column_stack([col(c) for c in cols] + [elem.drop]), dtype=np.float64)
+    # the damping ramp δ_c after the profile drops (column SLICED_COLS + n_s)
+    P = np.ascontiguousarray(np.column_stack([col(c) for c in cols] + [elem.drop, col(elem.damping_ramp)]),
+                             dtype=np.float64)
     G = np.concatenate([traction_g(elem.name, elem.traction, elem.exponent), elem.z]).astype(np.float64)
     return P, G
 
@@ -344,6 +346,7 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             gr[40], gr[41], gr[42], gr[43], gr[44], gr[45], gr[46], gr[47])
         S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
         Ks, c0s = K / ns, c0 / ns
+        ramp = P[i, SLICED_COLS + ns]                   # the damping share's δ_c (0: none, the law as written)
         o = r * npad
         for k in range(ns):          # every slice's load, open ones masked (selects, no branches: SIMD)
             delta = w_delta[r, k]
@@ -357,7 +360,8 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
             delta_dot = -kap * nv
             dpe = w_root[o + k]                         # δ^((p−1)/2); δ^p = δ (δ^((p−1)/2))²
             dp1 = dpe * dpe
-            q_raw = Ks * (delta * dp1) + c0s * dpe * delta_dot
+            S = tooth_pairs.damping_share(delta, ramp)[0] if ramp > 0.0 else 1.0
+            q_raw = Ks * (delta * dp1) + c0s * dpe * S * delta_dot
             q = q_raw if (delta > 0.0) & (q_raw > 0.0) else 0.0
             w_q[k] = q
             w_Fx[k], w_Fy[k] = kap * q * nx, kap * q * ny
@@ -376,8 +380,13 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
                 dp1 = dpe * dpe
                 on = q > 0.0
                 q_d = Ks * p * dp1 + c0s * pe * (dpe / delta) * delta_dot                     # ∂q/∂δ
+                q_r = c0s * dpe                                                                 # ∂q/∂δ̇
+                if ramp > 0.0:                                                                  # with S(δ/δ_c)
+                    S, dS = tooth_pairs.damping_share(delta, ramp)
+                    q_d = Ks * p * dp1 + c0s * (pe * (dpe / delta) * S + dpe * dS) * delta_dot
+                    q_r = c0s * dpe * S
                 q_d = q_d if on else 0.0
-                q_r = c0s * dpe if on else 0.0                                                 # ∂q/∂δ̇
+                q_r = q_r if on else 0.0
                 i_d = 1.0 / d
                 hx, hy = (vwx - nx * nv) * i_d, (vwy - ny * nv) * i_d
                 gqx, gqy = -kap * (q_d * nx + q_r * hx), -kap * (q_d * ny + q_r * hy)
@@ -962,6 +971,7 @@ def outputs_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, O):
         scx, scy, dscx, dscy, dsrx, dsry = g[10], g[11], g[12], g[13], g[14], g[15]
         S0x, S0y, Q, Qz, qmax, nload = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
         Ks, c0s = K / ns, c0 / ns
+        ramp = P[i, SLICED_COLS + ns]
         o = i * npad
         for k in range(ns):
             q = 0.0
@@ -975,7 +985,8 @@ def outputs_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, O):
                 vwy = wvy + zk * dsry - zeta * dscy
                 delta_dot = -kap * (nx * vwx + ny * vwy)
                 dpe = w_root[o + k]
-                q_raw = Ks * (delta * (dpe * dpe)) + c0s * dpe * delta_dot
+                S = tooth_pairs.damping_share(delta, ramp)[0] if ramp > 0.0 else 1.0
+                q_raw = Ks * (delta * (dpe * dpe)) + c0s * dpe * S * delta_dot
                 if q_raw > 0.0:
                     q = q_raw
                     S0x += kap * q * nx

@@ -37,7 +37,8 @@ def _box(u, centre, half, s):
 
 @njit(cache=True)
 def damping_share(comp, ramp):
-    """(S, dS/dcomp): the damping share of :func:`mbd.elements.tooth_pairs.damping_share` ((1, 0) for ramp 0)."""
+    """(S, dS/dcomp): the damping share of :func:`mbd.elements.tooth_pairs.damping_share` ((1, 0) for ramp 0); the
+    mesh kernels' and the roller–raceway kernels' (:mod:`.contact`, :mod:`.sliced`)."""
     if ramp <= 0.0:
         return 1.0, 0.0
     x = comp * (1.0 / ramp)              # the reference's order of operations

@@ -27,6 +27,7 @@ from scipy.optimize import brentq
 
 from .. import ad
 from . import ehl
+from .tooth_pairs import damping_share
 from ..element import Element, body_dofs, marker, marker_velocity, point_force
 from ..errors import ModelError
 
@@ -396,8 +397,13 @@ class RaceContact(Element):
     carrier for an inner raceway (``race_marker`` = pin centre in carrier axes), the planet for an outer
     one (``race_marker`` = (0, 0), the bore centre). With c the raceway centre, ρ = |p − c|, e = (p − c)/ρ:
         inner: δ = R + D/2 − ρ (roller pushed along +e),  outer: δ = ρ + D/2 − R (pushed along −e).
-    Normal load Q = K δ^p + c(δ) δ̇ for δ > 0, clipped at ≥ 0, with c(δ) = 2ζ sqrt(m_roller · dQ/dδ) and
-    dQ/dδ = p K δ^(p−1): a damping ratio ζ of the local contact oscillator, vanishing at first touch.
+    Normal load Q = K δ^p + S(δ/δ_c) c(δ) δ̇ for δ > 0, clipped at ≥ 0, with c(δ) = 2ζ sqrt(m_roller · dQ/dδ)
+    and dQ/dδ = p K δ^(p−1): a damping ratio ζ of the local contact oscillator. c(δ) ∝ δ^((p−1)/2) = δ^0.056 for
+    p = 10/9 is all but a jump at first touch (Kelvin–Voigt's discontinuity at impact: Machado et al. 2012, Mech.
+    Mach. Theory 53, 99–121); the damping share S (:func:`mbd.elements.tooth_pairs.damping_share`, the quintic
+    smoothstep over the first ``damping_ramp`` δ_c of compression, the mesh's law) lets the dissipation grow with the
+    compressed zone from zero, as Hunt & Crossley's (1975, J. Appl. Mech. 42, 440–445) does, and leaves the law
+    unchanged from δ ≥ δ_c on (δ_c = 0, the default: S = 1, the damping whole at first touch).
     Traction: v_s = (roller surface point − raceway surface point velocity)·t, t = k × e, at the contact
     point P = c + R e (line of centres, raceway surface); force −μ·Q along t on the roller. The normal
     and traction forces act at P on both bodies, equal and opposite.
@@ -442,7 +448,7 @@ class RaceContact(Element):
 
     def __init__(self, name, roller, race_body, *, kind, race_marker, R_race, D, K, exponent, zeta, m_roller,
                  traction: Traction, multiplicity=1, spall_angle=None, spall_width=None, spall_depth=None,
-                 spall_edge=None, rolling: "RollingResistance | None" = None):
+                 spall_edge=None, rolling: "RollingResistance | None" = None, damping_ramp=0.0):
         self.name = name
         self.dofs = body_dofs(roller, race_body)
         if kind not in ("inner", "outer"):
@@ -461,6 +467,7 @@ class RaceContact(Element):
             raise ModelError(f"{name}: parameter 'exponent' must be >= 1, got {exponent!r}")
         self.zeta = self._per_instance("zeta", zeta, nonneg=True)
         self.m_roller = self._per_instance("m_roller", m_roller, positive=True)
+        self.damping_ramp = self._per_instance("damping_ramp", damping_ramp, nonneg=True)
         self.traction = traction
         if rolling is not None and not isinstance(rolling, RollingResistance):
             raise ModelError(f"{name}: parameter 'rolling' must be a RollingResistance (one of "
@@ -471,10 +478,12 @@ class RaceContact(Element):
         self.R_red = 1.0 / (2.0 / self.D + self.kappa / self.R_race)   # reduced radius: convex inner, concave outer
         self.multiplicity = _multiplicity(self, multiplicity)
         self._multi = bool(np.any(self.multiplicity != 1.0))
+        self._ramped = bool(np.any(self.damping_ramp > 0.0))
         self._spall_params(spall_angle, spall_width, spall_depth, spall_edge)
 
     _SPALL = ("spall_angle", "spall_width", "spall_depth", "spall_edge")
-    _FUSED = ("dofs", "race_marker", "R_race", "D", "K", "zeta", "m_roller", "_c0", "kappa", "R_red", "multiplicity")
+    _FUSED = ("dofs", "race_marker", "R_race", "D", "K", "zeta", "m_roller", "_c0", "kappa", "R_red", "multiplicity",
+              "damping_ramp")
 
     def _spall_params(self, angle, width, depth, edge):
         """The defect's per-instance arrays (``has_spall`` False: none given); ``_spall_hi`` = (w + e)/2."""
@@ -508,6 +517,7 @@ class RaceContact(Element):
         f = super().fuse(parts)
         f.kind, f.exponent, f.traction, f.rolling = None, parts[0].exponent, parts[0].traction, parts[0].rolling
         f._multi = bool(np.any(f.multiplicity != 1.0))
+        f._ramped = bool(np.any(f.damping_ramp > 0.0))
         f.has_spall = parts[0].has_spall
         for a in cls._SPALL + ("_spall_hi",) if f.has_spall else ():
             setattr(f, a, np.concatenate([getattr(p, a) for p in parts]))
@@ -549,7 +559,10 @@ class RaceContact(Element):
         # normal load; powers are taken of a safe positive δ and selected afterwards (no 0^negative)
         touch = ad.value(delta) > 0.0
         ds = ad.where(touch, delta, 1.0)
-        Q_raw = self.K * ad.power(ds, p) + self._c0 * ad.power(ds, 0.5 * (p - 1.0)) * delta_dot
+        c = self._c0 * ad.power(ds, 0.5 * (p - 1.0))
+        if self._ramped:                # S(δ/δ_c) (class docstring); without a ramp the law as written, to the bit
+            c = c * damping_share(ds, self.damping_ramp)
+        Q_raw = self.K * ad.power(ds, p) + c * delta_dot
         Q = ad.where(touch & (ad.value(Q_raw) > 0.0), Q_raw, 0.0)
         # contact point P = c + R e, seen from the roller centre and from the race body's centre
         r_roll = ((R - rho) * ex, (R - rho) * ey)

@@ -41,6 +41,7 @@ from .. import ad
 from ..element import Element, marker, marker_velocity, point_force
 from ..errors import ModelError
 from .contact import Traction
+from .tooth_pairs import damping_share
 
 __all__ = ["SLICE_STIFFNESS", "ISO_16281_LAMINA_COEFFICIENT", "slice_stations", "iso_16281_stiffness",
            "SlicedContact", "SlicedResult", "SlicedRaceContact"]
@@ -179,10 +180,11 @@ class SlicedRaceContact(Element):
 
     Per slice k, w_k = p + z_k σ_r − c − ζ_k σ_c, δ_k = D/2 − κ(|w_k| − R) − P_k as :class:`SlicedContact`, and
 
-        q_k = (K/n_s) δ_k^p + (c_0/n_s) δ_k^((p−1)/2) δ̇_k   (δ_k > 0, clipped at ≥ 0),   c_0 = 2ζ √(m_r p K),
+        q_k = (K/n_s) δ_k^p + S(δ_k/δ_c) (c_0/n_s) δ_k^((p−1)/2) δ̇_k   (δ_k > 0, clipped at ≥ 0),   c_0 = 2ζ √(m_r p K),
 
-    the planar contact's law (RaceContact) per unit length of roller: a straight roller without tilt or slope gives
-    every slice 1/n_s of the planar load, damping included (its slices sum to the planar law). The slice force
+    the planar contact's law (RaceContact, its damping share S over the first ``damping_ramp`` δ_c of a slice's
+    compression included) per unit length of roller: a straight roller without tilt or slope gives every slice 1/n_s
+    of the planar load, damping included (its slices sum to the planar law). The slice force
     F_k = κ q_k w_k/|w_k| acts on the roller at station z_k and, opposite, on the race body at ζ_k = ζ_row + z_k.
     Traction: the planar law's (RaceContact) on the total load Q = Σ q_k, from the roller's and the raceway's
     in-plane motion at the contact point P = c + R e_c, applied at the load centroid z̄ = Σ z_k q_k / Q (its moments on
@@ -207,7 +209,7 @@ class SlicedRaceContact(Element):
     compiled_twin = "sliced.sliced_race"
 
     def __init__(self, name, dofs, *, kind, race_marker, pin_marker, R_race, D, K, exponent, zeta, m_roller,
-                 traction, z, drop, row_offset=0.0, race_slope=(0.0, 0.0), race_slopes=None):
+                 traction, z, drop, row_offset=0.0, race_slope=(0.0, 0.0), race_slopes=None, damping_ramp=0.0):
         self.name = name
         if kind not in ("inner", "outer"):
             raise ModelError(f"{name}: kind must be 'inner' or 'outer', got {kind!r}")
@@ -238,6 +240,8 @@ class SlicedRaceContact(Element):
             raise ModelError(f"{name}: parameter 'exponent' must be >= 1, got {exponent!r}")
         self.zeta = self._per_instance("zeta", zeta, nonneg=True)
         self.m_roller = self._per_instance("m_roller", m_roller, positive=True)
+        self.damping_ramp = self._per_instance("damping_ramp", damping_ramp, nonneg=True)
+        self._ramped = bool(np.any(self.damping_ramp > 0.0))
         self.row_offset = self._per_instance("row_offset", row_offset)
         self.z = np.asarray(z, float)
         if self.z.ndim != 1 or self.z.size < 1 or not np.all(np.isfinite(self.z)):
@@ -311,7 +315,10 @@ class SlicedRaceContact(Element):
         dsafe = ad.where(touch, delta, 1.0)
         p = self.exponent
         Ks, c0s = np.repeat(self.K[idx] / ns, ns), np.repeat(self._c0[idx] / ns, ns)
-        q_raw = Ks * ad.power(dsafe, p) + c0s * ad.power(dsafe, 0.5 * (p - 1.0)) * delta_dot
+        c = c0s * ad.power(dsafe, 0.5 * (p - 1.0))
+        if self._ramped:                # S(δ_k/δ_c) (class docstring); without a ramp the law as written, to the bit
+            c = c * damping_share(dsafe, np.repeat(self.damping_ramp[idx], ns))
+        q_raw = Ks * ad.power(dsafe, p) + c * delta_dot
         q = ad.where(touch & (ad.value(q_raw) > 0.0), q_raw, 0.0)
         return dict(q=q, n=(nx, ny), z=z, zeta=zeta, delta=delta)
 

@@ -174,9 +174,11 @@ def _lookup(table, start, tooth, face):
 
 
 def damping_share(delta, ramp):
-    """S(δ/δ_c): the share of the mesh damping at compression δ, the quintic smoothstep over [0, δ_c]: a
-    contact's dissipation grows with its compressed zone (as in Hunt & Crossley's law) instead of switching on
-    whole at first touch (δ_c = 0: S = 1, the Kelvin–Voigt jump). Dual-capable in δ; ``ramp`` per instance."""
+    """S(δ/δ_c): the share of a contact's damping at compression δ (a tooth pair's, the mesh's flanks'; the
+    roller–raceway contacts', :class:`mbd.elements.contact.RaceContact` and its slices), the quintic smoothstep over
+    [0, δ_c]: a contact's dissipation grows with its compressed zone (as in Hunt & Crossley's law) instead of
+    switching on whole at first touch (δ_c = 0: S = 1, the Kelvin–Voigt jump). Dual-capable in δ; ``ramp`` per
+    instance. The one owner of the law (the compiled twin: :func:`mbd.compiled.tooth_pairs.damping_share`)."""
     width = np.where(ramp > 0.0, ramp, 1.0)
     x = delta * (1.0 / width)
     x = ad.where(x > 1.0, 1.0, ad.where(x < 0.0, 0.0, x))

@@ -362,3 +362,22 @@ def test_the_sliced_machine_runs_compiled_as_on_the_numpy_path(machines):
     assert (rc.engine, rn.engine) == ("compiled", "numpy") and rc.counters == rn.counters
     np.testing.assert_allclose(rc.state.q, rn.state.q, rtol=0, atol=1e-10)
     np.testing.assert_allclose(rc.state.v, rn.state.v, rtol=0, atol=1e-10 / H)
+
+
+@pytest.mark.parametrize("model", ["planar", "sliced"])
+def test_the_race_damping_ramp_reaches_every_raceway_contact(model):
+    """bearing.race_damping_ramp is every roller–raceway instance's δ_c, planar and sliced, in metres; the default
+    (0) keeps the damping whole at first touch."""
+    from mbd.elements import RaceContact
+    from mbd.elements.sliced import SlicedRaceContact
+
+    p = reference_dpgt(3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for value, want in (("0.2 um", 2e-7), (None, 0.0)):
+            b = p.bearing.replace(model=model, **({"race_damping_ramp": value} if value else {}))
+            races = [e for e in build_dpgt(p.replace(bearing=b)).model.elements
+                     if isinstance(e, (RaceContact, SlicedRaceContact))]
+            assert sum(e.n for e in races) == 2 * 3 * 2 * 12          # inner and outer, 6 bearings, 12 rollers
+            for e in races:
+                np.testing.assert_array_equal(e.damping_ramp, want)

@@ -33,14 +33,18 @@ LAWS = st.sampled_from(sorted(IMPACT_LAWS))
 MULTS = st.one_of(st.just(1), st.lists(st.integers(1, 3), min_size=N, max_size=N))
 
 
-def race(kind, mk, R, traction, *, exponent=10.0 / 9.0, zeta=0.05, multiplicity=1, name="race", bodies=None):
+def race(kind, mk, R, traction, *, exponent=10.0 / 9.0, zeta=0.05, multiplicity=1, name="race", bodies=None,
+         ramp=0.0):
     rollers, race_body = bodies if bodies is not None else (np.arange(1, N + 1), 0)
     return RaceContact(name, rollers, race_body, kind=kind, race_marker=mk, R_race=R, D=DR, K=K_HZ,
-                       exponent=exponent, zeta=zeta, m_roller=M_ROLLER, traction=traction, multiplicity=multiplicity)
+                       exponent=exponent, zeta=zeta, m_roller=M_ROLLER, traction=traction, multiplicity=multiplicity,
+                       damping_ramp=ramp)
 
 
+# a damping ramp δ_c of 0, of 5 µm (the drawn compressions of 2–30 µm on and past its smoothstep), per instance
 RACE_LAW = dict(exponent=st.sampled_from([10.0 / 9.0, 1.5, 1.0]), zeta=st.sampled_from([0.0, 0.05, 0.3]),
-                multiplicity=MULTS)
+                multiplicity=MULTS, ramp=st.one_of(st.sampled_from([0.0, 5e-6, 4e-5]),
+                                                   st.lists(st.sampled_from([0.0, 1e-5]), min_size=N, max_size=N)))
 
 
 # ---------------------------------------------------------------------------------------------- race
@@ -48,9 +52,9 @@ RACE_LAW = dict(exponent=st.sampled_from([10.0 / 9.0, 1.5, 1.0]), zeta=st.sample
 @pytest.mark.parametrize("law", ["tanh", "ehl", "film"])
 @SETTINGS
 @given(data=st.data(), fs=frame_states(), **RACE_LAW)
-def test_race_matches_reference(kind, law, data, fs, exponent, zeta, multiplicity):
+def test_race_matches_reference(kind, law, data, fs, exponent, zeta, multiplicity, ramp):
     qf, vf, mk, R = race_scene(kind, *data.draw(race_states(kind)))
-    elem = race(kind, mk, R, TRACTIONS[law], exponent=exponent, zeta=zeta, multiplicity=multiplicity)
+    elem = race(kind, mk, R, TRACTIONS[law], exponent=exponent, zeta=zeta, multiplicity=multiplicity, ramp=ramp)
     assert_matches_reference(elem, fs, qf, vf)
 
 
@@ -68,11 +72,12 @@ def test_fused_inner_outer_race_family(law, data, fs, m_in, m_out):
     qo, vo, mko, Ro = race_scene("outer", *data.draw(race_states("outer")))
     qf, vf = _joined((qi, vi), (qo, vo))
     tr = TRACTIONS[law]
-    inner = race("inner", mki, Ri, tr, multiplicity=m_in, name="inner")
+    inner = race("inner", mki, Ri, tr, multiplicity=m_in, name="inner", ramp=1e-5)
     outer = race("outer", mko, Ro, tr, multiplicity=m_out, name="outer", bodies=(np.arange(N + 2, 2 * N + 2), N + 1))
     fused = RaceContact.fuse([inner, outer])
     P, G = pack_race(fused)
     np.testing.assert_array_equal(P[:, 0], [1.0] * N + [-1.0] * N)
+    np.testing.assert_array_equal(P[:, 8], [1e-5] * N + [0.0] * N)          # the damping ramp, per instance
     assert_matches_reference(fused, fs, qf, vf)
     # the fused family's compiled forces are its parts' (compiled, separately)
     F, Jq, _ = compiled(fused, fs, qf, vf, None, True)
@@ -84,8 +89,8 @@ def test_fused_inner_outer_race_family(law, data, fs, m_in, m_out):
 
 def test_race_pack_layout_and_unknown_traction():
     qf, vf, mk, R = race_scene("inner", (0, 0, 0.3), (0, 0, 0), 0.2, [1.0], [1e-5], [0], [0], [0])
-    P, G = pack_race(race("inner", mk, R, EHL, multiplicity=2, bodies=([1], 0)))
-    assert P.shape == (1, 8) and P.flags.c_contiguous and P[0, 0] == 1.0 and P[0, 7] == 2.0
+    P, G = pack_race(race("inner", mk, R, EHL, multiplicity=2, bodies=([1], 0), ramp=2e-7))
+    assert P.shape == (1, 9) and P.flags.c_contiguous and P[0, 0] == 1.0 and P[0, 7] == 2.0 and P[0, 8] == 2e-7
     np.testing.assert_array_equal(G, [10.0 / 9.0, TRACTION_IDS[SlideRollTraction], EHL.A, EHL.B, EHL.C, EHL.D,
                                       EHL.u_reg, EHL.s_eps, 0.0, 0.0, 0.0])
     assert TRACTION_IDS[TanhTraction] == 0 and pack_race(race("inner", mk, R, TANH, bodies=([1], 0)))[1][1] == 0
@@ -223,12 +228,12 @@ ROLL = HoupertRolling(eta0=0.025, E_red=2.31e11, length=9e-3, u_reg=0.1)
 @pytest.mark.parametrize("law", ["tanh", "ehl", "film"])
 @SETTINGS
 @given(data=st.data(), fs=frame_states(), **RACE_LAW)
-def test_race_with_rolling_resistance_matches_reference(kind, law, data, fs, exponent, zeta, multiplicity):
+def test_race_with_rolling_resistance_matches_reference(kind, law, data, fs, exponent, zeta, multiplicity, ramp):
     qf, vf, mk, R = race_scene(kind, *data.draw(race_states(kind)))
     rollers, race_body = np.arange(1, N + 1), 0
     elem = RaceContact("race", rollers, race_body, kind=kind, race_marker=mk, R_race=R, D=DR, K=K_HZ,
                        exponent=exponent, zeta=zeta, m_roller=M_ROLLER, traction=TRACTIONS[law],
-                       multiplicity=multiplicity, rolling=ROLL)
+                       multiplicity=multiplicity, rolling=ROLL, damping_ramp=ramp)
     assert_matches_reference(elem, fs, qf, vf)
 
 

@@ -18,7 +18,7 @@ R_IN, R_OUT = 15.75e-3, 23.26e-3
 PIN = np.array([0.004, -0.002])          # the pin centre in the pin body's axes
 
 
-def _model(n_s=21, drop=None, zeta=0.0, mu=0.0, pin_slope=(0.0, 0.0), row_offset=0.0):
+def _model(n_s=21, drop=None, zeta=0.0, mu=0.0, pin_slope=(0.0, 0.0), row_offset=0.0, ramp=0.0):
     b = mbd.ModelBuilder()
     pin = b.add_body("pin", 5.0, 0.02, pose=(0.01, 0.02, 0.1))
     planet = b.add_body("planet", 0.8, 1e-3, pose=(0.01 + 0.004 * np.cos(0.1) + 0.002 * np.sin(0.1),
@@ -29,7 +29,7 @@ def _model(n_s=21, drop=None, zeta=0.0, mu=0.0, pin_slope=(0.0, 0.0), row_offset
     z, _ = slice_stations(L, n_s)
     drop = np.zeros(n_s) if drop is None else drop
     law = dict(D=D, K=K, exponent=P_EXP, zeta=zeta, m_roller=3e-3, traction=TanhTraction(mu_max=mu, v0=0.3), z=z,
-               drop=drop, row_offset=row_offset)
+               drop=drop, row_offset=row_offset, damping_ramp=ramp)
     r, pb, pl = roller.index, pin.index, planet.index
     inner = SlicedRaceContact("in", [[3 * r, 3 * r + 1, 3 * r + 2, tau, 3 * pb, 3 * pb + 1, 3 * pb + 2]], kind="inner",
                               race_marker=PIN, pin_marker=PIN, R_race=R_IN, race_slope=pin_slope, **law)
@@ -112,12 +112,15 @@ def test_generalised_forces_are_the_slices_potential_gradient(pin_slope):
             1.0 if j < 9 else 1e-3)), model.coordinate_name(j)
 
 
-def test_straight_roller_without_tilt_is_the_planar_contact():
-    model, inner, outer = _model(zeta=0.05, mu=0.08)
+@pytest.mark.parametrize("ramp", [0.0, 1e-5])
+def test_straight_roller_without_tilt_is_the_planar_contact(ramp):
+    """With a damping ramp of 10 µm the 6 µm compressions sit on its smoothstep: the slices' share is the planar one."""
+    model, inner, outer = _model(zeta=0.05, mu=0.08, ramp=ramp)
     rng = np.random.default_rng(7)
     q, v = _state(model, rng, tilt=0.0, slope=(0.0, 0.0))
     q[9:12], v[9:12] = 0.0, 0.0
-    law = dict(D=D, K=K, exponent=P_EXP, zeta=0.05, m_roller=3e-3, traction=TanhTraction(mu_max=0.08, v0=0.3))
+    law = dict(D=D, K=K, exponent=P_EXP, zeta=0.05, m_roller=3e-3, traction=TanhTraction(mu_max=0.08, v0=0.3),
+               damping_ramp=ramp)
     planar_in = RaceContact("pi", [2], [0], kind="inner", race_marker=PIN, R_race=R_IN, **law)
     planar_out = RaceContact("po", [2], [1], kind="outer", race_marker=(0.0, 0.0), R_race=R_OUT, **law)
     fs = mbd.FrameState(0.0, 0.0, 0.0)

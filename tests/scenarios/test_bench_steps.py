@@ -52,3 +52,27 @@ def test_a_roller_moving_radially_is_called_radial(where, da, key):
     assert out["error_share"] == {key: 1.0}
     assert out["accepted_per_simulated_s"] == pytest.approx(5e5)
     assert out["rejected_share"] == 0.5 and out["newton_per_step"] == 4.0
+
+
+def test_roller_categories_by_construction():
+    """Three rollers, two raceway contacts and one pocket each, over four steps whose contact states are set by hand:
+    a sign change of a raceway deflection wins over a pocket's, a pocket's over a loaded raceway, loaded over free."""
+    from scenarios.numerics.bench_steps import CATEGORIES, roller_categories
+
+    race_roller, pocket_roller = np.array([0, 0, 1, 1, 2, 2]), np.array([0, 1, 2])
+    d0 = np.array([[-1, 2, 3, -1, -1, -1],          # roller 0 loaded, 1 loaded, 2 free
+                   [1, -1, 1, 1, -1, -1],           # roller 0 releases its first contact (1 → −1)
+                   [-1, -1, 1, -1, -1, -1],
+                   [0, 0, 0, 0, 0, 0]], float)
+    d1 = np.array([[-1, 2, 3, -1, -1, -1],
+                   [-1, -1, 1, 1, -1, 1],           # roller 2's second contact closes
+                   [-1, -1, 1, -1, -1, -1],
+                   [0, 0, 0, 0, 0, 1e-9]], float)   # δ = 0 is open: roller 2 closes from exactly zero
+    p0 = np.array([[0, 0, 0], [0, 0, 0], [0, 1, 0], [0, 0, 0]], float)
+    p1 = np.array([[0, 0, 0], [0, 0, 0], [0, 0, 0], [1, 0, 0]], float)   # step 2: roller 1's pocket opens
+    got = roller_categories(d0, d1, p0, p1, race_roller, pocket_roller, 3)
+    name = np.array(CATEGORIES)[got]
+    assert name.tolist() == [["in race contact", "in race contact", "out of contact"],
+                             ["race onset/release", "in race contact", "race onset/release"],
+                             ["out of contact", "pocket onset/release", "out of contact"],
+                             ["pocket onset/release", "out of contact", "race onset/release"]]

@@ -193,10 +193,10 @@ FILM = EHLTraction(eta0=0.025, alpha_p=2.2e-8, E_red=2.31e11, length=LR, tau_L0=
 LAW = dict(exponent=10.0 / 9.0, zeta=0.05, traction=TANH)
 
 
-def race_element(kind, n, mk, R, traction=TANH, zeta=0.05, multiplicity=1):
+def race_element(kind, n, mk, R, traction=TANH, zeta=0.05, multiplicity=1, damping_ramp=0.0):
     return RaceContact("race", np.arange(1, n + 1), 0, kind=kind, race_marker=mk, R_race=R, D=DR, K=K_HZ,
                        exponent=10.0 / 9.0, zeta=zeta, m_roller=M_ROLLER, traction=traction,
-                       multiplicity=multiplicity)
+                       multiplicity=multiplicity, damping_ramp=damping_ramp)
 
 
 N = 4
