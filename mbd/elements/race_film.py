@@ -33,9 +33,12 @@ raceway along the line of centres at the contact point (as the Hertz load; the r
 
 Range: rigid surfaces and isoviscous oil (gap ≫ the surfaces' elastic deflection under the film's pressure, the
 pressure ≪ 1/α of the oil), Newtonian, laminar, a fully flooded gap (an upper bound: the unloaded zone of a
-splash-lubricated bearing may run starved), h ≪ R (always: the gaps are micrometres, R millimetres), no
-entraining (wedge) load on the raceway's open gap (its pressure needs a loaded convergent inlet: the EHL film of the
-loaded contact), the roller parallel to its raceway (the planar model; the sliced contact of §8.8 has no film).
+splash-lubricated bearing may run starved), h ≪ R (always: the gaps are micrometres, R millimetres), the
+roller parallel to its raceway (the planar model; the sliced contact of §8.8 has no film). The squeeze film only: a
+roller rolling a few micrometres off its raceway also carries the open gap's wedge load (Martin's 4.9 η u R l/h, the
+pocket film's WEDGE_LOAD: ≈ 11 N at h = 1 µm on the pin at condition 1's entraining speed of 3.4 m/s, the order of the few newtons
+that hold an unloaded roller on its bore) and is dragged by the gap's Couette and Poiseuille shear, as the pocket
+film's roller is; neither is modelled here.
 """
 from __future__ import annotations
 
