@@ -13,6 +13,7 @@ import numpy as np
 from mbd.elements import BodySpring, SlopeGyroscopic
 from mbd.elements.sliced import SlicedRaceContact, iso_16281_stiffness, slice_stations
 from mbd.elements.pocket_film import CageDrag, PocketFilm
+from mbd.elements.race_film import RaceFilm
 from mbd.elements.contact import (IMPACT_LAWS, ROLLING_LAWS, TRACTION_LAWS, DryLand, EHLTraction, GuideContact,
                                   HoupertRolling, HydrodynamicLand, LubricantDrag, PocketContact, PocketRetention,
                                   RaceContact,
@@ -41,6 +42,8 @@ class BearingHandles:
     retention: slice | None = None            # a roller-centred cage's radial pocket retention
     guide: slice | None = None
     pocket_film: slice | None = None          # the pockets' oil film (bearing.cage.pocket_law = "hydrodynamic")
+    race_film_inner: slice | None = None      # the raceways' squeeze film (bearing.race_film = "squeeze")
+    race_film_outer: slice | None = None
     cage_drag: slice | None = None            # the mixture's drag on the cage (bearing.drag_law = "viscous")
     cage: str | None = None
     spring: slice | None = None               # the linear bearing's spring
@@ -202,8 +205,28 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
                       R_race=b.outer_raceway_radius, **common, **damage.get("outer", {}))
     handles = BearingHandles("rollers", rollers=tuple(names), race_inner=s_in, race_outer=s_out, omega_cage=wm,
                              omega_roller=wr)
+    if b.race_film == "squeeze":
+        handles = replace(handles, **_add_race_film(scene, b, names, pin_body, marker, outer_body, lubricant,
+                                                    damage.get("D", D)))
     return _add_drag_and_cage(scene, tag, b, names, psi, wm, pin_body, marker, outer_body, lubricant, pin_xy,
                               pin_vel, handles)
+
+
+def _add_race_film(scene, b, names, pin_body, marker, outer_body, lubricant, D) -> dict:
+    """The squeeze film of every roller on the pin's and the bore's raceway (docs/model.md §8.9), the oil at its
+    operating temperature (the EHL laws' viscosity): the BearingHandles fields it fills."""
+    if lubricant is None:
+        raise ParameterError.at("bearing.race_film", "'squeeze' needs a lubricant (its viscosity); this scene has none")
+    Z = len(names)
+    common = dict(D=D, length=b.roller_length, eta=lubricant.oil_viscosity, floor=b.race_film_floor,
+                  multiplicity=b.rows)
+    inner = scene.family(FAMILY["race_film_inner"], RaceFilm, ("roller", "race_body"), kind="inner")
+    s_in = inner.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker, R_race=b.inner_raceway_radius,
+                     **common)
+    outer = scene.family(FAMILY["race_film_outer"], RaceFilm, ("roller", "race_body"), kind="outer")
+    s_out = outer.add(Z, roller=names, race_body=[outer_body] * Z, race_marker=np.zeros((Z, 2)),
+                      R_race=b.outer_raceway_radius, **common)
+    return {"race_film_inner": s_in, "race_film_outer": s_out}
 
 
 def _add_drag_and_cage(scene, tag, b, names, psi, wm, pin_body, marker, outer_body, lubricant, pin_xy, pin_vel,
@@ -304,6 +327,9 @@ def _add_sliced_contacts(scene, tag, b, names, psi, wm, wr, pin_body, pin_local,
                          pin_vel, damage, law, bore_tilt_inertia, bore_spin_inertia, pin_slope):
     """The sliced raceway contacts of one bearing (:class:`mbd.elements.sliced.SlicedRaceContact`), the bore's slope
     pair and the rollers' tilts; then drag and cage as the planar model's."""
+    if b.race_film != "none":
+        raise ParameterError.at("bearing.race_film", f"{b.race_film!r} has no sliced contact; use 'none' with "
+                                                     "bearing.model 'sliced'")
     if "inner" in damage or "outer" in damage or "rolling" in law:
         raise ParameterError.at("bearing.model", "'sliced' has no raceway spall and no rolling resistance; use "
                                                  "'planar' for those")

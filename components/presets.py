@@ -156,6 +156,13 @@ def reference_bearing() -> BearingParams:
                                            "approach speeds",
                                   span=Span("0 um", "0.45 um", "the damping whole at first touch to a dry contact's "
                                                                "ramp over three composite roughnesses")),
+        race_film=assumed("none", "the source's model; squeeze: the oil's squeeze film damps a roller's approach to "
+                                  "its raceway before touch (docs/model.md §8.9)"),
+        race_film_floor=assumed("1 um", "a few composite roughnesses (0.15 um), twice the loaded contact's film "
+                                        "(lambda ~ 3): below it the film's pressure at a chattering roller's approach "
+                                        "flattens the surfaces and thickens the oil (docs/model.md §8.9)",
+                                span=Span("0.5 um", "2 um", "the loaded contact's film to where the rigid-isoviscous "
+                                                           "law holds within ~ 15 %")),
         traction_law=assumed("tanh", "a smooth, bounded Coulomb-like law (docs/model.md §8.2); slide_roll: an EHL-type curve of the slide-to-roll ratio"),
         drag_law=assumed("inertial", "quadratic drag of the oil-air mixture on the roller orbit (docs/model.md "
                                      "§8.7); viscous: with the oil's viscosity, and a moment on the roller spin"),

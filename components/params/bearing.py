@@ -247,6 +247,12 @@ class BearingParams(Params["BearingSI"]):
     race_damping_ramp: Quantity = nonneg("length", "compression over which a roller-raceway contact's (a slice's) "
                                                    "damping grows from 0 at first touch to the damping ratio's (0: "
                                                    "all of it at first touch)")
+    race_film: str = param("choice", "oil film on the roller-raceway gaps: none, or squeeze (the squeeze film of a "
+                                     "roller approaching its raceway while the gap is open, rigid cylinder near a "
+                                     "plane, cavitating on separation; planar model only)",
+                           choices=("none", "squeeze"))
+    race_film_floor: Quantity = positive("length", "gap h_f across which the raceway squeeze film hands over to the "
+                                                   "Hertz contact (the rigid law above it, zero at touch)")
     traction_law: str = param("choice", "roller-raceway traction law (ehl: from the lubricant's film)",
                               choices=("tanh", "slide_roll", "ehl"))
     drag_law: str = param("choice", "lubricant drag on the rollers: inertial (quadratic drag on the orbit, C_d "
@@ -308,6 +314,8 @@ class BearingSI(SI):
     contact_exponent: float
     contact_damping_ratio: float
     race_damping_ramp: float
+    race_film: str
+    race_film_floor: float
     traction_law: str
     drag_law: str
     rolling_resistance: str

@@ -47,7 +47,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..elements import ehl, pocket_film
+from ..elements import ehl, pocket_film, race_film
 from . import tooth_pairs
 from ..elements.contact import (DryLand, EHLTraction, GuideContact, HoupertRolling, HydrodynamicLand, LubricantDrag,
                                 PocketContact, PocketRetention, RaceContact, SlideRollTraction, TanhTraction)
@@ -55,7 +55,7 @@ from ..elements.contact import (DryLand, EHLTraction, GuideContact, HoupertRolli
 __all__ = ["traction_g", "pack_race", "evaluate_race", "outputs_race", "pack_pocket", "evaluate_pocket", "outputs_pocket",
            "update_pocket", "pack_retention", "evaluate_retention", "outputs_retention", "update_retention",
            "pack_guide", "evaluate_guide", "outputs_guide", "update_guide", "pack_drag", "evaluate_drag", "pack_pocket_film", "evaluate_pocket_film",
-           "pack_cage_drag", "evaluate_cage_drag", "TRACTION_IDS", "RACE_OUTPUTS", "POCKET_OUTPUTS", "RETENTION_OUTPUTS", "GUIDE_OUTPUTS"]
+           "pack_cage_drag", "evaluate_cage_drag", "pack_race_film", "evaluate_race_film", "TRACTION_IDS", "RACE_OUTPUTS", "POCKET_OUTPUTS", "RETENTION_OUTPUTS", "GUIDE_OUTPUTS"]
 
 _ETA2 = 1e-24          # the reference's η² (mbd.elements.contact._ETA2)
 _TWO_PI = 2.0 * np.pi
@@ -1186,3 +1186,66 @@ def evaluate_cage_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
                 Jq[i, a, b] = 0.0
                 Jv[i, a, b] = 0.0
         Jv[i, 2, 2], Jv[i, 2, 5], Jv[i, 5, 2], Jv[i, 5, 5] = dM, -dM, -dM, dM
+
+
+# ----------------------------------------------------------------------------------------------- raceway film
+# ``RaceFilm`` P (n, 8): κ (+1 inner, −1 outer), race_marker x, y [m], R_race [m], D [m],
+#              coef = SQUEEZE_LOAD·η·l·R_red^(3/2), floor h_f [m], multiplicity;  G (0,)
+# (mbd.elements.race_film; stateless, no compiled outputs: theirs come from the numpy kernel)
+def pack_race_film(elem):
+    _require(elem, race_film.RaceFilm)
+    mk = elem.race_marker
+    P = _rows(elem.kappa, mk[:, 0], mk[:, 1], elem.R_race, elem.D, elem.coef, elem.floor, elem.multiplicity)
+    return P, np.zeros(0)
+
+
+@njit(cache=True)
+def evaluate_race_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    """The raceway squeeze film while the gap is open (docs/model.md §8.9): W = coef·max(h, h_f)^(−3/2)·S(h/h_f)·
+    max(V, 0), h = −δ, V = δ̇, along κe at the contact point (through the roller's centre), the opposite on the race
+    body."""
+    for i in range(ql.shape[0]):
+        kap, mx, my, R, D, coef, hf, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6], P[i, 7]
+        xr, yr = ql[i, 0], ql[i, 1]
+        xb, yb, thb = ql[i, 3], ql[i, 4], ql[i, 5]
+        vr0, vr1 = vl[i, 0], vl[i, 1]
+        vb0, vb1, vb2 = vl[i, 3], vl[i, 4], vl[i, 5]
+        cth, sth = np.cos(thb), np.sin(thb)
+        rcx, rcy = cth * mx - sth * my, sth * mx + cth * my
+        dx, dy = xr - (xb + rcx), yr - (yb + rcy)
+        rho = np.sqrt(dx * dx + dy * dy + _ETA2)
+        ex, ey = dx / rho, dy / rho
+        delta = 0.5 * D - kap * (rho - R)
+        Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
+        wx, wy = vr0 - Vcx, vr1 - Vcy
+        V = -kap * (ex * wx + ey * wy)
+        h = -delta
+        if not (h > 0.0 and V > 0.0):
+            _zero(F, Jq, Jv, i, jac)
+            continue
+        floored = not h > hf
+        hs = hf if floored else h
+        S, dS = tooth_pairs.damping_share(h, hf)
+        hp = hs ** -1.5
+        c = coef * hp * S
+        W = c * V
+        Fx, Fy = kap * W * ex, kap * W * ey
+        _write(F, Jq, Jv, i, -1, mult, Fx, Fy, 0.0, -Fx, -Fy, -(rcx * Fy - rcy * Fx))
+        if not jac:
+            continue
+        dhp = 0.0 if floored else -1.5 * hp / hs            # d(hs^-1.5)/dh
+        dc_dh = coef * (dhp * S + hp * dS)
+        for j in range(12):
+            dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, _, dvb0, dvb1, dvb2 = _unit(j)
+            drcx, drcy = -rcy * dthb, rcx * dthb
+            ddx, ddy = dxr - dxb - drcx, dyr - dyb - drcy
+            drho = (dx * ddx + dy * ddy) / rho
+            dex, dey = (ddx - ex * drho) / rho, (ddy - ey * drho) / rho
+            dVcx, dVcy = dvb0 - dvb2 * rcy - vb2 * drcy, dvb1 + dvb2 * rcx + vb2 * drcx
+            dwx, dwy = dvr0 - dVcx, dvr1 - dVcy
+            dV = -kap * (dex * wx + ex * dwx + dey * wy + ey * dwy)
+            dh = kap * drho                                   # h = κ(ρ − R) − D/2
+            dW = dc_dh * dh * V + c * dV
+            dFx, dFy = kap * (dW * ex + W * dex), kap * (dW * ey + W * dey)
+            dM = -(drcx * Fy + rcx * dFy - drcy * Fx - rcy * dFx)
+            _write(F, Jq, Jv, i, j, mult, dFx, dFy, 0.0, -dFx, -dFy, dM)

@@ -50,7 +50,7 @@ class Kind:
 
 
 (_RACE, _POCKET, _GUIDE, _DRAG, _MESH, _SUPPORT, _BODY_SPRING, _TORSION, _TORQUE, _FORCE, _SPEED, _GYRO,
- _COORD_SPRING, _SLICED_RACE, _SLICED_MESH, _RETENTION, _POCKET_FILM, _CAGE_DRAG, _BEAM_SUPPORT) = range(19)
+ _COORD_SPRING, _SLICED_RACE, _SLICED_MESH, _RETENTION, _POCKET_FILM, _CAGE_DRAG, _BEAM_SUPPORT, _RACE_FILM) = range(20)
 
 # compiled twin (as the families declare it) -> its id in the dispatch below
 KIND_IDS = {
@@ -63,6 +63,7 @@ KIND_IDS = {
     "generic.beam_support": _BEAM_SUPPORT,
     "sliced.sliced_race": _SLICED_RACE, "sliced.sliced_gear_mesh": _SLICED_MESH,
     "contact.pocket_film": _POCKET_FILM, "contact.cage_drag": _CAGE_DRAG,
+    "contact.race_film": _RACE_FILM,
 }
 _MODULES = {"contact": contact, "generic": generic, "mesh": mesh, "sliced": sliced}
 # kernel module -> its bit in a system's ``groups`` (the unit of the lazy compile)
@@ -274,6 +275,8 @@ def evaluate_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, J
         contact.evaluate_pocket_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
     elif kind == _CAGE_DRAG:
         contact.evaluate_cage_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
+    elif kind == _RACE_FILM:
+        contact.evaluate_race_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
 
 
 def evaluate_threaded_kind(groups, kind, t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):

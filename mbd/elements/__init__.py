@@ -8,6 +8,7 @@ from .contact import (IMPACT_LAWS, LAND_LAWS, TRACTION_LAWS, DryLand, EHLTractio
                       LankaraniNikravesh, LubricantDrag, PocketContact, PocketRetention, RaceContact, SlideRollTraction, TanhTraction,
                       Traction)
 from .pocket_film import CageDrag, PocketFilm
+from .race_film import RaceFilm
 from .drives import Ramp, Schedule, SpeedDrive, TorqueSource
 from .gear_mesh import (STIFFNESS_SHAPES, ConstantStiffness, FourierStiffness, GearMesh, RectangularStiffness,
                         StiffnessShape, mesh_offset, mesh_u0)
@@ -17,7 +18,7 @@ from .tilt import BeamSupport, CoordinateSpring, SlopeGyroscopic
 
 __all__ = [
     "BodySpring", "CageDrag", "PocketFilm", "ForceSource", "GearMesh", "GroundSupport", "GuideContact", "LubricantDrag", "PocketContact",
-    "PocketRetention", "BeamSupport", "CoordinateSpring", "RaceContact", "Ramp", "Schedule", "SlopeGyroscopic", "SpeedDrive", "TorqueSource", "TorsionalSpring",
+    "PocketRetention", "BeamSupport", "CoordinateSpring", "RaceContact", "RaceFilm", "Ramp", "Schedule", "SlopeGyroscopic", "SpeedDrive", "TorqueSource", "TorsionalSpring",
     "Traction", "TanhTraction", "SlideRollTraction", "EHLTraction", "TRACTION_LAWS",
     "LandLaw", "DryLand", "HydrodynamicLand", "LAND_LAWS",
     "ImpactLaw", "ExactRestitution", "HuntCrossley", "LankaraniNikravesh", "Flores", "IMPACT_LAWS",

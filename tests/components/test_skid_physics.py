@@ -194,3 +194,36 @@ def test_the_pocket_brake_of_a_centred_spinning_roller_is_both_walls_shear():
         M = 2 * R ** 2 * lub.oil_viscosity * b.roller_length * dw * np.sqrt(2 * R / b.cage.pocket_clearance) \
             * (np.pi / 2 + 0.443554 + 3.25345 / 2)
         np.testing.assert_allclose(brake, M if law == "hydrodynamic" else 0.0, rtol=1e-5, atol=1e-15)
+
+
+def test_the_scenes_build_the_raceway_squeeze_film_when_asked():
+    """The default machine has no raceway film; bearing.race_film = "squeeze" adds one per roller on the pin and one
+    in the bore, with the oil's own viscosity at its temperature, the roller's length and diameter, the raceways'
+    radii and the floor in metres (so the reduced radii are the convex pin's and the concave bore's); the sliced
+    model and a scene without oil are refused, naming the parameter."""
+    from components.dpgt import build_dpgt
+    from components.families import FAMILY
+    from components.params import with_overrides
+    from components.units import ParameterError
+    from mbd.elements.race_film import RaceFilm
+    names = lambda sc: {e.name for e in sc.model.elements}  # noqa: E731
+    base = reference_dpgt(3)
+    assert not {FAMILY["race_film_inner"], FAMILY["race_film_outer"]} & names(build_dpgt(base))
+    p = with_overrides(base, {"bearing.race_film": "squeeze", "bearing.race_film_floor": "0.7 um"})
+    sc = build_dpgt(p)
+    si, b = p.si(), p.si().bearing
+    for key, R_race, kap in (("inner", b.inner_raceway_radius, 1.0), ("outer", b.outer_raceway_radius, -1.0)):
+        film, race = sc.model.element(FAMILY[f"race_film_{key}"]), sc.model.element(FAMILY[f"race_{key}"])
+        assert isinstance(film, RaceFilm) and film.n == race.n == 6 * 12
+        np.testing.assert_array_equal(film.dofs, race.dofs)             # the same roller and race body, in order
+        np.testing.assert_array_equal(film.race_marker, race.race_marker)
+        assert np.all(film.eta == si.lubricant.oil_viscosity) and np.all(film.floor == 7e-7)
+        assert np.all(film.length == b.roller_length) and np.all(film.R_race == R_race)
+        np.testing.assert_allclose(film.R_red, 1.0 / (2.0 / b.roller_diameter + kap / R_race), rtol=1e-15)
+    sliced = with_overrides(p, {"bearing.model": "sliced"})
+    with pytest.raises(ParameterError, match=r"^bearing\.race_film"):
+        build_dpgt(sliced)
+    rb = reference_bearing().replace(race_film="squeeze").si()
+    with pytest.raises(ParameterError, match=r"^bearing\.race_film"):
+        build_bearing_rig(rb, radial_load=2000.0, outer_speed=300.0, lubricant=None,
+                          options=SceneOptions(cage="free", drag=False))

@@ -13,6 +13,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 import mbd.elements
 from mbd.elements.pocket_film import CageDrag, PocketFilm
+from mbd.elements.race_film import RaceFilm
 from mbd.compiled.contact import TRACTION_IDS, pack_race
 from mbd.compiled.registry import kind_of
 from mbd.element import evaluate
@@ -277,8 +278,9 @@ def test_drag_zero_relative_orbit_has_zero_jacobian():
 def test_every_family_has_kernels():
     kinds = {c: kind_of(c) for c in vars(mbd.elements).values()
              if isinstance(c, type) and str(getattr(c, "compiled_twin", None)).startswith("contact.")}
-    assert set(kinds) == {RaceContact, PocketContact, PocketRetention, GuideContact, LubricantDrag, PocketFilm, CageDrag}
-    assert kinds[PocketFilm].update is None and kinds[CageDrag].update is None
+    assert set(kinds) == {RaceContact, PocketContact, PocketRetention, GuideContact, LubricantDrag, PocketFilm, CageDrag,
+                          RaceFilm}
+    assert kinds[PocketFilm].update is None and kinds[CageDrag].update is None and kinds[RaceFilm].update is None
     assert kinds[RaceContact].update is None and kinds[LubricantDrag].update is None
     assert all(kinds[c].update is not None for c in (PocketContact, PocketRetention, GuideContact))
 

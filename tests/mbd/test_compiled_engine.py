@@ -79,6 +79,31 @@ def test_the_engines_take_the_same_steps_with_the_race_damping_ramped(dpgt_state
     assert not np.array_equal(plain.state.v, c.state.v)
 
 
+def test_the_engines_take_the_same_steps_with_the_raceway_squeeze_film(dpgt_state):
+    """The raceway squeeze film on every roller (docs/model.md §8.9; the same bodies and state, two more stateless
+    families): the same steps and states on both engines, and not those of the machine without it."""
+    import warnings
+
+    from components.dpgt import build_dpgt
+    from components.params import with_overrides
+    from components.presets import reference_dpgt
+
+    model, s = dpgt_state
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        filmed = build_dpgt(with_overrides(reference_dpgt(3, "forward"), {"bearing.race_film": "squeeze"})).model
+    assert sum(type(e).__name__ == "RaceFilm" for e in filmed.elements) == 2
+    out = mbd.System(filmed).outputs(s.t, s.q, s.v, s.z, families=["race_film_inner", "race_film_outer"])
+    assert np.count_nonzero(out["race_film_outer"]["force"]) > 0          # some rollers approach an open gap
+    c, r = _run(filmed, s, 150, "compiled"), _run(filmed, s, 150, "numpy")
+    assert (c.engine, r.engine) == ("compiled", "numpy")
+    assert c.counters == r.counters and c.counters["rejected"] + c.counters["accepted"] >= 150
+    np.testing.assert_allclose(c.state.q, r.state.q, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(c.state.v, r.state.v, rtol=0, atol=1e-8 / H)
+    plain = _run(model, s, 150, "compiled")
+    assert not np.array_equal(plain.state.v, c.state.v)
+
+
 class _Log(mbd.Observer):
     def bind(self, *a):
         self.q = []

@@ -1,0 +1,190 @@
+"""The raceway squeeze film (RaceFilm, docs/model.md §8.9): the load of a roller approaching its raceway against the
+rigid cylinder-on-plane squeeze law with the contact's reduced radius (convex inner, concave outer raceway), the time
+to close a gap under a constant force against its closed form (fails on a wrong exponent or factor), no force on
+separation or in contact, the hand-over across the floor (continuous, zero at touch), exact Jacobians, balance, and
+the compiled twin against the numpy reference.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, strategies as st
+from scipy.integrate import solve_ivp
+
+from mbd.element import evaluate
+from mbd.elements import pocket_film as pf
+from mbd.elements.race_film import RaceFilm
+from mbd.errors import ModelError
+
+from tests.support.contact import (DR, FS, LR, N, R_IN, R_OUT, SETTINGS, assert_balanced, assert_jacobians,
+                                   assert_matches_reference, floats, race_scene, rot)
+from tests.support.strategies import frame_states
+
+ETA, H_F = 0.02, 1e-6            # Pa·s (a VG 68–100 oil near 70 °C), m
+# the reduced radii of the roller on the pin (convex on convex) and in the bore (concave), written out here
+R_RED = {"inner": 1.0 / (2.0 / DR + 1.0 / R_IN), "outer": 1.0 / (2.0 / DR - 1.0 / R_OUT)}
+
+
+def film(kind, mk, R, n, floor=H_F, multiplicity=1, eta=ETA):
+    return RaceFilm("race_film", np.arange(1, n + 1), 0, kind=kind, race_marker=mk, R_race=R, D=DR, length=LR,
+                    eta=eta, floor=floor, multiplicity=multiplicity)
+
+
+def one(kind, gap, v_close, pose=(0.0, 0.0, 0.3), vel=(0.0, 0.0, 0.0), **kw):
+    """One roller at the gap h (δ = −h) from its raceway, closing it at v_close (> 0: approach) [m/s]: its generalized
+    forces, outputs, the full state's positions and the raceway's centre."""
+    v_normal = -v_close if kind == "inner" else v_close         # along e: away from the pin, into the bore
+    qf, vf, mk, R = race_scene(kind, pose, vel, 0.4, [0.9], [-gap], [v_normal], [1.5], [0.0])
+    elem = film(kind, mk, R, 1, **kw)
+    F, out, _, _ = evaluate(elem, 0.0, FS, qf, vf, None, False)
+    return F[0], {k: v[0] for k, v in out.items()}, qf, rot(pose[2]) @ mk + np.asarray(pose[:2])
+
+
+def squeeze(kind, h, V):
+    """3√2 π η V l (R/h)^(3/2), written out (not the module's constant)."""
+    return 3.0 * np.sqrt(2.0) * np.pi * ETA * V * LR * (R_RED[kind] / h) ** 1.5
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+def test_load_of_an_approaching_roller_is_the_squeeze_law(kind):
+    h, V = 7e-6, 0.04
+    F, out, qf, c = one(kind, h, V)
+    assert out["force"] == pytest.approx(squeeze(kind, h, V), rel=1e-12)
+    assert out["gap"] == pytest.approx(h, rel=1e-6) and out["approach_speed"] == pytest.approx(V, rel=1e-9)
+    # it pushes the roller off the raceway along the line of centres: towards the pin's centre's far side (inner),
+    # towards the bore's centre (outer); the race body the opposite, no moment on the roller
+    e = (qf[3:5] - c) / np.linalg.norm(qf[3:5] - c)
+    away = e if kind == "inner" else -e
+    np.testing.assert_allclose(F[:2], out["force"] * away, rtol=1e-9, atol=1e-12 * out["force"])
+    np.testing.assert_allclose(F[3:5], -F[:2], rtol=0, atol=0)
+    assert F[2] == 0.0
+
+
+def test_the_concave_bore_carries_more_than_the_convex_pin():
+    """At the same gap and speed the load scales as R_red^(3/2): the outer raceway's (concave) reduced radius is the
+    larger."""
+    _, o_in, _, _ = one("inner", 5e-6, 0.03)
+    _, o_out, _, _ = one("outer", 5e-6, 0.03)
+    assert o_out["force"] / o_in["force"] == pytest.approx((R_RED["outer"] / R_RED["inner"]) ** 1.5, rel=1e-9)
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+def test_squeeze_film_closes_a_gap_in_the_closed_form_time(kind):
+    """A constant force W pushes the roller at its raceway, the film alone resisting (no inertia): dh/dt =
+    −W/c(h), c(h) = 3√2π η l R^(3/2) h^(−3/2), so from h₁ to h₂ (both above the floor) it takes
+    t = ∫c dh / W = 2·3√2π η l R^(3/2)(h₂^(−1/2) − h₁^(−1/2))/W. Integrated with the element's own force per unit
+    speed; a wrong exponent (say h^(−1)) or factor (2π for 3√2π) moves t by far more than the tolerance."""
+    W, h1, h2 = 2.0, 30e-6, 3e-6
+
+    def rate(t, y):
+        _, out, _, _ = one(kind, max(y[0], h2), 1.0)            # closing at 1 m/s: the force per unit speed (a trial
+        # step past the end, where the event stops, is taken at h₂)
+        return [-W / out["force"]]
+    ev = lambda t, y: y[0] - h2  # noqa: E731
+    ev.terminal = True
+    sol = solve_ivp(rate, (0.0, 1.0), [h1], events=ev, rtol=1e-10, atol=1e-16)
+    t_closed = 2.0 * 3.0 * np.sqrt(2.0) * np.pi * ETA * LR * R_RED[kind] ** 1.5 * (h2 ** -0.5 - h1 ** -0.5) / W
+    assert sol.t_events[0][0] == pytest.approx(t_closed, rel=1e-6)
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+def test_no_force_on_separation_at_rest_or_in_contact(kind):
+    F, out, _, _ = one(kind, 4e-6, -0.05)                         # leaving: the film cavitates
+    assert out["force"] == 0.0 and np.all(F == 0.0)
+    F, out, _, _ = one(kind, 4e-6, 0.0)                           # at rest
+    assert out["force"] == 0.0 and np.all(F == 0.0)
+    F, out, _, _ = one(kind, -2e-6, 0.05)                         # the surfaces touch: the Hertz contact carries
+    assert out["force"] == 0.0 and np.all(F == 0.0) and out["gap"] < 0.0
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+def test_the_film_hands_over_across_the_floor(kind):
+    """Above h_f the rigid law; across (0, h_f) its coefficient at h_f times the quintic smoothstep S(h/h_f) — half at
+    h_f/2, continuous at h_f and zero at touch."""
+    V = 0.02
+    at = squeeze(kind, H_F, V)
+    _, above, _, _ = one(kind, H_F * (1 + 1e-9), V)
+    _, below, _, _ = one(kind, H_F * (1 - 1e-9), V)
+    assert above["force"] == pytest.approx(at, rel=1e-8) and below["force"] == pytest.approx(at, rel=1e-8)
+    _, mid, _, _ = one(kind, 0.5 * H_F, V)
+    assert mid["force"] == pytest.approx(0.5 * at, rel=1e-6)
+    x = 0.2
+    _, low, _, _ = one(kind, x * H_F, V)
+    assert low["force"] == pytest.approx(at * x ** 3 * (10 - 15 * x + 6 * x * x), rel=1e-6)
+    _, touch, _, _ = one(kind, 1e-14, V)
+    assert touch["force"] <= 1e-20 * at
+
+
+def test_a_wrong_law_is_caught(monkeypatch):
+    """The closed-form checks above read the module's constant: a factor 2 on it fails them."""
+    import mbd.elements.race_film as rf
+    monkeypatch.setattr(rf, "SQUEEZE_LOAD", 2.0 * pf.SQUEEZE_LOAD)
+    with pytest.raises(AssertionError):
+        test_load_of_an_approaching_roller_is_the_squeeze_law("inner")
+
+
+def test_bad_parameters_name_themselves():
+    with pytest.raises(ModelError, match="floor"):
+        film("inner", np.zeros(2), R_IN, 1, floor=0.0)
+    with pytest.raises(ModelError, match="eta"):
+        film("inner", np.zeros(2), R_IN, 1, eta=-1.0)
+    with pytest.raises(ModelError, match="kind"):
+        RaceFilm("f", [1], 0, kind="side", race_marker=np.zeros(2), R_race=R_IN, D=DR, length=LR, eta=ETA,
+                 floor=H_F)
+
+
+# ------------------------------------------------------------------------------ Jacobians, balance, compiled
+@st.composite
+def film_states(draw, kind):
+    """Rollers in contact, at the floor's hand-over and with the gap open, approaching or leaving (away from the
+    kinks at V = 0 and h = h_f, h = 0, where a difference quotient is O(step) off)."""
+    lst = lambda s: draw(st.lists(s, min_size=N, max_size=N))  # noqa: E731
+    pose = (draw(floats(-2e-3, 2e-3)), draw(floats(-2e-3, 2e-3)), draw(floats(-np.pi, np.pi)))
+    vel = (draw(floats(-2.0, 2.0)), draw(floats(-2.0, 2.0)), draw(floats(-500.0, 500.0)))
+    psi = draw(floats(-np.pi, np.pi))
+    angles = lst(floats(-np.pi, np.pi))
+    deltas = lst(st.one_of(floats(2e-7, 3e-5), floats(-0.95 * H_F, -0.05 * H_F), floats(-1e-4, -1.05 * H_F)))
+    v_normal = lst(st.one_of(floats(-0.3, -1e-3), floats(1e-3, 0.3)))
+    return (kind, pose, vel, psi, angles, deltas, v_normal, lst(floats(-5.0, 5.0)), lst(floats(-2.0, 2.0)))
+
+
+def scene(state, mult):
+    qf, vf, mk, R = race_scene(*state)
+    return qf, vf, film(state[0], mk, R, N, multiplicity=mult)
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+@SETTINGS
+@given(data=st.data(), mult=st.sampled_from([1, 2]))
+def test_film_jacobian_and_balance(kind, data, mult):
+    qf, vf, elem = scene(data.draw(film_states(kind)), mult)
+    assert_jacobians(elem, qf, vf)
+    assert_balanced(elem, qf, vf)
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
+@SETTINGS
+@given(data=st.data(), fs=frame_states(), mult=st.sampled_from([1, 2]))
+def test_film_compiled_matches_reference(kind, data, fs, mult):
+    qf, vf, elem = scene(data.draw(film_states(kind)), mult)
+    assert_matches_reference(elem, fs, qf, vf)
+
+
+def test_fused_inner_and_outer_films_match():
+    """An inner and an outer family fused into one (per-instance κ, marker, radius) evaluate as the two apart."""
+    qi, vi, mki, Ri = race_scene("inner", (0.0, 0.0, 0.2), (0.1, 0.0, 3.0), 0.3, [0.5, 2.0], [-3e-6, -0.5e-6],
+                                 [-0.05, -0.02], [1.0, 1.0], [0.0, 0.0])
+    qo, vo, mko, Ro = race_scene("outer", (0.08, 0.01, 0.1), (0.0, 0.2, -4.0), 0.0, [1.0, -2.0], [-2e-6, -8e-6],
+                                 [0.03, 0.01], [1.0, 1.0], [0.0, 0.0])
+    qf, vf = np.concatenate([qi, qo]), np.concatenate([vi, vo])
+    inner = film("inner", mki, Ri, 2)
+    outer = RaceFilm("o", np.arange(4, 6), 3, kind="outer", race_marker=mko, R_race=Ro, D=DR, length=LR, eta=ETA,
+                     floor=H_F, multiplicity=2)
+    fused = RaceFilm.fuse([inner, outer])
+    Ff, _, Jqf, Jvf = evaluate(fused, 0.0, FS, qf, vf, None, True)
+    for k, e in enumerate((inner, outer)):
+        F, _, Jq, Jv = evaluate(e, 0.0, FS, qf, vf, None, True)
+        np.testing.assert_array_equal(Ff[2 * k:2 * k + 2], F)
+        np.testing.assert_array_equal(Jqf[2 * k:2 * k + 2], Jq)
+    assert np.all(Ff[:, :2].any(axis=1))                # every one of them approaches with its gap open
+    assert_matches_reference(fused, FS, qf, vf)
