@@ -10,6 +10,11 @@ Layout (one row of P per instance; G family-wide):
                        The local coordinates' count tells the layout: 7 an inner raceway on a rigid pin, 12
                        a raceway with its body's slope pair (the bore; an elastic pin's raceway, κ = +1).
 
+One law, two kernels: :func:`evaluate_sliced_race` (forces, Jacobian) and :func:`outputs_sliced_race` (the outputs the
+statistics read) take the law from the same small helpers (the section "the sliced race's law" below: the contact pass
+with a contact's geometry and open bound, a slice's offset, rate and load, the contact point's speeds, the traction
+coefficient), inlined into each kernel's loops; the contact pass is one compiled function both call.
+
 How the kernel runs. Two passes over the contacts. The first takes each contact's geometry (kept for the second) and,
 unless the reference's bound finds every slice open (δ_0 + max_k |z_k σ_r − ζ_k σ_c| ≤ 0: the contact is skipped),
 every slice's offset and compression δ_k. Between the passes the slices' powers δ_k^((p−1)/2) of all the contacts at
@@ -235,11 +240,12 @@ def _race_cols(J, i, cols, outer):
 # ------------------------------------------------------------------------------------------- the sliced race's law
 # One owner of SlicedRaceContact.kernel's law for the two kernels that take it, evaluate_sliced_race (the generalised
 # forces and their Jacobian) and outputs_sliced_race (the outputs): the family's constants (_law), a contact's geometry
-# and the open bound (_contact_geometry, _open), a slice's offset and compression (_slice_offset), its rate
+# (in the contact pass) and the open bound (_open), a slice's offset and compression (_slice_offset), its rate
 # (_slice_rate), its load and the load's partials (_slice_load, _slice_load_partials), a contact's slices
 # (_slice_pass: the compressions of every contact, their powers at once; _slice_loads, _slice_sums), the contact
-# point's speeds (_rolling) and the traction coefficient (_coefficient). Inlined where they are called: each kernel
-# compiles them into its own loops.
+# point's speeds (_rolling) and the traction coefficient (_coefficient). Inlined where they are called (each kernel
+# compiles them into its own loops, SIMD where the slices run) but _law and _slice_pass, once a call: one compile
+# serves both kernels (its flag a run-time bool, np.bool_(...), not a literal that would compile it twice).
 
 @njit(cache=True)
 def _law(G):
@@ -251,50 +257,6 @@ def _law(G):
     for k in range(ns):
         zmax = max(zmax, abs(zs[k]))
     return p, int(G[1]), 0.5 * (p - 1.0), ns, zs, zmax
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _contact_geometry(P, i, ql, vl, outer, cb, sb, cp, sp):
-    """Contact i's geometry (SlicedRaceContact._geometry) with cos, sin of its race body's (cb, sb) and its pin's (cp,
-    sp) angles: the raceway's centre offset rc (its marker turned) and velocity V_c; the pin's rp; u = p − pin centre,
-    ρ_p = |u|, e = u/ρ_p, g = ṗ − V_pin, g·e and ė = (I − e eᵀ) g/ρ_p; the bore error s_0 turned (s0c), the race's
-    slope σ_c = s0c + s and its rate; k0 = −k × s0c (the θ_b force's lever); the roller's slope σ_r = τ e and its rate;
-    p − c and ṗ − V_c."""
-    mx, my, pmx, pmy, s0x, s0y = P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
-    xr, yr, tau = ql[i, 0], ql[i, 1], ql[i, 3]
-    xb, yb = ql[i, 4], ql[i, 5]
-    vr0, vr1, dtau = vl[i, 0], vl[i, 1], vl[i, 3]
-    vb0, vb1, vb2 = vl[i, 4], vl[i, 5], vl[i, 6]
-    if outer:
-        sx, sy, vsx, vsy = ql[i, 7], ql[i, 8], vl[i, 7], vl[i, 8]
-        xp, yp, vp0, vp1, vp2 = ql[i, 9], ql[i, 10], vl[i, 9], vl[i, 10], vl[i, 11]
-    else:
-        sx, sy, vsx, vsy = 0.0, 0.0, 0.0, 0.0
-        xp, yp, vp0, vp1, vp2 = xb, yb, vb0, vb1, vb2
-    # the raceway's centre and its velocity; the pin's centre and its velocity
-    rcx, rcy = cb * mx - sb * my, sb * mx + cb * my
-    cx, cy = xb + rcx, yb + rcy
-    Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
-    rpx, rpy = cp * pmx - sp * pmy, sp * pmx + cp * pmy
-    qpx, qpy = xp + rpx, yp + rpy
-    Vpx, Vpy = vp0 - vp2 * rpy, vp1 + vp2 * rpx
-    # e: pin centre → roller centre, and ė
-    ux, uy = xr - qpx, yr - qpy
-    rho_p = np.sqrt(ux * ux + uy * uy + _ETA2)
-    ex, ey = ux / rho_p, uy / rho_p
-    gx, gy = vr0 - Vpx, vr1 - Vpy
-    ge = ex * gx + ey * gy
-    edx, edy = (gx - ge * ex) / rho_p, (gy - ge * ey) / rho_p
-    # the race's slope σ_c and its rate; k0 = ∂σ_c/∂θ_b turned (the θ_b force's lever)
-    s0cx, s0cy = cb * s0x - sb * s0y, sb * s0x + cb * s0y
-    scx, scy = s0cx + sx, s0cy + sy
-    dscx, dscy = -1.0 * vb2 * s0cy + vsx, vb2 * s0cx + vsy
-    k0x, k0y = s0cy, -1.0 * s0cx
-    # the roller's slope σ_r = τ e and its rate
-    srx, sry = tau * ex, tau * ey
-    dsrx, dsry = dtau * ex + tau * edx, dtau * ey + tau * edy
-    return (rcx, rcy, Vcx, Vcy, rpx, rpy, ux, uy, rho_p, ex, ey, gx, gy, ge, edx, edy, s0cx, s0cy, scx, scy, dscx,
-            dscy, k0x, k0y, srx, sry, dsrx, dsry, xr - cx, yr - cy, vr0 - Vcx, vr1 - Vcy)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -342,26 +304,60 @@ def _slice_load_partials(Ks, c0s, p, pe, delta, dpe, delta_dot, q):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _contact_pass(P, ql, vl, zs, zmax, every, slot, geo, w_x, w_y, w_d, w_delta):
-    """The first pass over the contacts: each one's geometry (:func:`_contact_geometry`) and the open bound
-    (:func:`_open`); a contact the bound finds loaded (with ``every``, any contact) takes the next row r: its
-    geometry into geo[r] (:func:`_geometry`'s layout) and its slices' offsets and compressions into row r of w_x, w_y,
-    w_d, w_delta. slot[i]: r (loaded), −2 − r (open, with ``every``) or −1 (open, no row). Returns the rows taken."""
+    """The first pass over the contacts: each one's geometry (SlicedRaceContact._geometry) — the raceway's centre
+    offset rc (its marker turned) and velocity V_c; the pin's rp; u = p − pin centre, ρ_p = |u|, e = u/ρ_p,
+    g = ṗ − V_pin, g·e and ė = (I − e eᵀ) g/ρ_p; the bore error s_0 turned (s0c), the race's slope σ_c = s0c + s and its
+    rate; k0 = −k × s0c (the θ_b force's lever); the roller's slope σ_r = τ e and its rate; p − c and ṗ − V_c — and the
+    open bound (:func:`_open`). A contact the bound finds loaded (with ``every``, any contact) takes the next row r: its
+    geometry into geo[r] (:func:`_geometry`'s layout) and its slices' offsets and compressions (:func:`_slice_offset`)
+    into row r of w_x, w_y, w_d, w_delta. slot[i]: r (loaded), −2 − r (open, with ``every``) or −1 (open, no row).
+    Returns the rows taken. (The geometry is written out in the loop: an inlined helper returning its 32 values cost
+    ≈ 18 ns a contact more, 7 % of a residual call.)"""
     n, ns = ql.shape[0], zs.shape[0]
     outer = ql.shape[1] == 12
     thb_last, cb, sb, thp_last, cp, sp = np.nan, 0.0, 0.0, np.nan, 0.0, 0.0
     rows = 0
     for i in range(n):
-        kap, R, D, K, c0, row, Rr = P[i, 0], P[i, 7], P[i, 8], P[i, 9], P[i, 10], P[i, 11], P[i, 12]
-        tau, thb = ql[i, 3], ql[i, 6]
-        thp = ql[i, 11] if outer else thb
-        vr0, vr1, vr2, dtau, vb0, vb1, vb2 = vl[i, 0], vl[i, 1], vl[i, 2], vl[i, 3], vl[i, 4], vl[i, 5], vl[i, 6]
-        vp2 = vl[i, 11] if outer else vb2
+        kap, mx, my, pmx, pmy, s0x, s0y = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
+        R, D, K, c0, row, Rr = P[i, 7], P[i, 8], P[i, 9], P[i, 10], P[i, 11], P[i, 12]
+        xr, yr, tau = ql[i, 0], ql[i, 1], ql[i, 3]
+        xb, yb, thb = ql[i, 4], ql[i, 5], ql[i, 6]
+        vr0, vr1, vr2, dtau = vl[i, 0], vl[i, 1], vl[i, 2], vl[i, 3]
+        vb0, vb1, vb2 = vl[i, 4], vl[i, 5], vl[i, 6]
+        if outer:
+            sx, sy, vsx, vsy = ql[i, 7], ql[i, 8], vl[i, 7], vl[i, 8]
+            xp, yp, thp, vp0, vp1, vp2 = ql[i, 9], ql[i, 10], ql[i, 11], vl[i, 9], vl[i, 10], vl[i, 11]
+        else:
+            sx, sy, vsx, vsy = 0.0, 0.0, 0.0, 0.0
+            xp, yp, thp, vp0, vp1, vp2 = xb, yb, thb, vb0, vb1, vb2
+        # the raceway's centre and its velocity; the pin's centre and its velocity
         if thb != thb_last:              # a bearing's contacts follow each other: one race body's, one pin's angle
             thb_last, cb, sb = thb, np.cos(thb), np.sin(thb)
+        rcx, rcy = cb * mx - sb * my, sb * mx + cb * my
+        cx, cy = xb + rcx, yb + rcy
+        Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
         if thp != thp_last:
             thp_last, cp, sp = thp, np.cos(thp), np.sin(thp)
-        (rcx, rcy, Vcx, Vcy, rpx, rpy, ux, uy, rho_p, ex, ey, gx, gy, ge, edx, edy, s0cx, s0cy, scx, scy, dscx, dscy,
-         k0x, k0y, srx, sry, dsrx, dsry, pcx, pcy, wvx, wvy) = _contact_geometry(P, i, ql, vl, outer, cb, sb, cp, sp)
+        rpx, rpy = cp * pmx - sp * pmy, sp * pmx + cp * pmy
+        qpx, qpy = xp + rpx, yp + rpy
+        Vpx, Vpy = vp0 - vp2 * rpy, vp1 + vp2 * rpx
+        # e: pin centre → roller centre, and ė
+        ux, uy = xr - qpx, yr - qpy
+        rho_p = np.sqrt(ux * ux + uy * uy + _ETA2)
+        ex, ey = ux / rho_p, uy / rho_p
+        gx, gy = vr0 - Vpx, vr1 - Vpy
+        ge = ex * gx + ey * gy
+        edx, edy = (gx - ge * ex) / rho_p, (gy - ge * ey) / rho_p
+        # the race's slope σ_c and its rate; k0 = ∂σ_c/∂θ_b turned (the θ_b force's lever)
+        s0cx, s0cy = cb * s0x - sb * s0y, sb * s0x + cb * s0y
+        scx, scy = s0cx + sx, s0cy + sy
+        dscx, dscy = -1.0 * vb2 * s0cy + vsx, vb2 * s0cx + vsy
+        k0x, k0y = s0cy, -1.0 * s0cx
+        # the roller's slope σ_r = τ e and its rate; p − c and ṗ − V_c
+        srx, sry = tau * ex, tau * ey
+        dsrx, dsry = dtau * ex + tau * edx, dtau * ey + tau * edy
+        pcx, pcy = xr - cx, yr - cy
+        wvx, wvy = vr0 - Vcx, vr1 - Vcy
         shut = _open(kap, R, D, row, zmax, tau, scx, scy, pcx, pcy)
         if shut and not every:
             slot[i] = -1
@@ -388,7 +384,8 @@ def _contact_pass(P, ql, vl, zs, zmax, every, slot, geo, w_x, w_y, w_d, w_delta)
 @njit(cache=True, inline="always")
 def _geometry(geo, r):
     """Row r of geo (:func:`_contact_pass`): κ, R, D, K, c₀, ζ_row, R_red, τ, the roller's velocities (ṗ, ω_r, τ̇),
-    the race body's, the pin's ω, then :func:`_contact_geometry`'s 32 values in its order."""
+    the race body's, the pin's ω, then the geometry of :func:`_contact_pass` (rc, V_c, rp, u, ρ_p, e, g, g·e, ė, s0c, σ_c,
+    σ̇_c, k0, σ_r, σ̇_r, p − c, ṗ − V_c)."""
     g = geo[r]
     return (g[0], g[1], g[2], g[3], g[4], g[5], g[6], g[7], g[8], g[9], g[10], g[11], g[12], g[13], g[14], g[15],
             g[16], g[17], g[18], g[19], g[20], g[21], g[22], g[23], g[24], g[25], g[26], g[27], g[28], g[29], g[30],
