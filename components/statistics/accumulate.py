@@ -30,7 +30,7 @@ except ImportError:      # pragma: no cover - numba is a dependency; this keeps 
         return fn
 
 __all__ = ["Accumulators", "accumulate_steps", "compile_accumulators", "IMPACT_ROWS", "FlankPeaks", "accumulate_flank",
-           "FLANK_RANGE", "FLANK_BINS", "DYNAMIC_PERCENTILE", "PeakProfiles"]
+           "FLANK_RANGE", "FLANK_BINS", "DYNAMIC_PERCENTILE", "PeakProfiles", "power_terms"]
 
 # the drive-flank force's distribution: x/F_nom in FLANK_BINS equal bins over [0, FLANK_RANGE), one more above
 FLANK_RANGE = 8.0
@@ -230,6 +230,31 @@ def accumulate_flank(t, V, t0, t_end, period, scale, hist, sums, cyc):
                     cyc[2, j] = -np.inf
                 cyc[2, j] = _max(cyc[2, j], _max(va, vb))
             s_a = s_b
+
+
+@jit
+def power_terms(x, scale, exponent, out):
+    """out[j] = (x[j]/scale)^exponent over the flat arrays ``x``, ``out``: the life's power terms of a block of states,
+    e.g. the ISO/TS 16281 slice terms (q_k/q_c,k)^e of :func:`.quantities.slice_quantities` (e = 4 and 9/2, the
+    raceways' exponents of :mod:`components.life`). A whole or half-whole exponent up to 31.5 by squaring, times √y for
+    the half ((y²)² and (y²)² √y: arithmetic only, the compiler runs it in SIMD lanes, where numpy's power is a library
+    call an element); any other by ``**``. numpy's (x/scale)**exponent to a few ulp
+    (tests/components/test_slice_terms.py)."""
+    twice = 2.0 * exponent
+    m = int(twice)
+    if m != twice or m < 0 or m > 63:
+        for j in range(x.size):
+            out[j] = (x[j] / scale) ** exponent
+        return
+    whole, half = m >> 1, (m & 1) == 1
+    for j in range(x.size):
+        y = x[j] / scale
+        r, b = 1.0, y
+        for bit in range(5):        # y^whole, a select per bit (no branch on y)
+            if (whole >> bit) & 1:
+                r = r * b
+            b = b * b
+        out[j] = r * math.sqrt(y) if half else r
 
 
 class FlankPeaks:
@@ -486,7 +511,7 @@ class Accumulators:
 
 def accumulators_cached() -> bool:
     """Does numba's disk cache hold the accumulators of this code (plain Python without numba: nothing to compile)?"""
-    return _compiled is None or (_compiled.kernels_cached(accumulate_steps) and _compiled.kernels_cached(accumulate_flank))
+    return _compiled is None or all(_compiled.kernels_cached(k) for k in (accumulate_steps, accumulate_flank, power_terms))
 
 
 def compile_accumulators() -> None:
@@ -501,6 +526,7 @@ def compile_accumulators() -> None:
                          np.zeros((2, 0)), f0, np.zeros((8, 0)))
         accumulate_flank(np.array([0.0, 1.0]), np.ones((2, 1)), 0.0, 1.0, 0.5, 1.0, np.zeros((1, FLANK_BINS + 1)),
                          np.zeros((2, 1)), np.array([[0.0], [0.0], [-np.inf], [-1.0]]))
+        power_terms(np.ones(1), 1.0, 4.5, np.empty(1))
     _compiled.compile_announced(toy, cold=not accumulators_cached(), what="the statistics' accumulator kernels",
                                 done="accumulator kernels", about="a few seconds")
 

@@ -20,6 +20,7 @@ from ..bearing import bearing_kinematics, roller_slip_pct
 from ..families import FAMILY, MESH_FAMILY
 from ..life import LIFE_EXPONENT, ROTATING_EXPONENT, STATIONARY_EXPONENT, raceway_ratings, sliced_raceway_ratings
 from ..lubrication import bearing_film, contact_pressure
+from .accumulate import power_terms
 
 __all__ = ["bearing_map", "Plan", "plan_of", "owner", "quantities", "carrier_frame_motion", "to_carrier",
            "radial_tangential", "pin_reactions", "contact_film", "traction_heat", "film_extremes",
@@ -242,8 +243,11 @@ def slice_quantities(p: Plan, ri, ro) -> dict[str, np.ndarray]:
     qc = sliced_raceway_ratings(p.bearing, p.slices)
     for race, out, e, c in (("inner", ri, STATIONARY_EXPONENT, qc[0]), ("outer", ro, ROTATING_EXPONENT, qc[1])):
         q = np.stack([np.asarray(out[f"slice_load_{k}"], float) for k in range(p.slices)], axis=-1)
-        snap[f"slice_{race}_fatigue"] = ((q / c) ** e).reshape(q.shape[:-2] + (-1,))
-        snap[f"_slice_{race}"] = q.reshape(q.shape[:-2] + (-1,))     # the loads: the peak profile (not accumulated)
+        q = q.reshape(q.shape[:-2] + (-1,))
+        terms = np.empty_like(q)
+        power_terms(q.reshape(-1), c, e, terms.reshape(-1))          # (q/c)^e, compiled
+        snap[f"slice_{race}_fatigue"] = terms
+        snap[f"_slice_{race}"] = q     # the loads: the peak profile (not accumulated)
     return snap
 
 

@@ -10,6 +10,11 @@ Layout (one row of P per instance; G family-wide):
                        The local coordinates' count tells the layout: 7 an inner raceway on a rigid pin, 12
                        a raceway with its body's slope pair (the bore; an elastic pin's raceway, κ = +1).
 
+One law, two kernels: :func:`evaluate_sliced_race` (forces, Jacobian) and :func:`outputs_sliced_race` (the outputs the
+statistics read) take the law from the same small helpers (the section "the sliced race's law" below: the contact pass
+with a contact's geometry and open bound, a slice's offset, rate and load, the contact point's speeds, the traction
+coefficient), inlined into each kernel's loops; the contact pass is one compiled function both call.
+
 How the kernel runs. Two passes over the contacts. The first takes each contact's geometry (kept for the second) and,
 unless the reference's bound finds every slice open (δ_0 + max_k |z_k σ_r − ζ_k σ_c| ≤ 0: the contact is skipped),
 every slice's offset and compression δ_k. Between the passes the slices' powers δ_k^((p−1)/2) of all the contacts at
@@ -234,37 +239,94 @@ def _race_cols(J, i, cols, outer):
             J[i, 6, c] = cols[6, c] + cols[11, c]
 
 
-@njit(cache=True, error_model="numpy")
-def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
-    p, law = G[0], int(G[1])
-    pe = 0.5 * (p - 1.0)
+# ------------------------------------------------------------------------------------------- the sliced race's law
+# One owner of SlicedRaceContact.kernel's law for the two kernels that take it, evaluate_sliced_race (the generalised
+# forces and their Jacobian) and outputs_sliced_race (the outputs): the family's constants (_law), a contact's geometry
+# (in the contact pass) and the open bound (_open), a slice's offset and compression (_slice_offset), its rate
+# (_slice_rate), its load and the load's partials (_slice_load, _slice_load_partials), a contact's slices
+# (_slice_pass: the compressions of every contact, their powers at once; _slice_loads, _slice_sums), the contact
+# point's speeds (_rolling) and the traction coefficient (_coefficient). Inlined where they are called (each kernel
+# compiles them into its own loops, SIMD where the slices run) but _law and _slice_pass, once a call: one compile
+# serves both kernels (its flag a run-time bool, np.bool_(...), not a literal that would compile it twice).
+
+@njit(cache=True)
+def _law(G):
+    """The family's law from G: (p, the traction law's id, (p − 1)/2, n_s, the slice stations z_k, max_k |z_k|)."""
+    p = G[0]
     ns = G.shape[0] - _GZ
     zs = G[_GZ:]
     zmax = 0.0
     for k in range(ns):
         zmax = max(zmax, abs(zs[k]))
-    nl = ql.shape[1]
-    outer = nl == 12
-    js0, js1 = (7, 8) if outer else (-1, -1)            # the race's slope pair's columns (none: inner, rigid pin)
-    jp0, jp1, jp2 = (9, 10, 11) if outer else (4, 5, 6)  # the pin body's (inner: the race body is the pin)
-    # a pass's columns (f0 … f6, dT2x, dT2y, dGx, dGy, dpin): every direction of a SIMD width's multiple jn ≥ nl, those
-    # past nl zero, the derived ones overwritten (_derived_cols): a loop of a fixed count without branches (SIMD)
-    jn = 16 if outer else 8
-    cols = np.empty((12, 16))
-    acc = np.zeros((3, 12))          # moments m = 0, 1, 2 of M_k (4), N_k (4), g_k (2), ∂q_k/∂ẇ_k (2)
-    n = ql.shape[0]
-    mroot = root_index(pe)
-    npad = -(-ns // _LANES) * _LANES
-    slot = np.empty(n, np.int64)                        # a contact's row in the buffers below (−1: open by the bound)
-    geo = np.empty((n, _NGEO))                          # its geometry (what the second pass reads)
-    w_x, w_y, w_d, w_delta = np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns))
-    w_c, w_root = np.empty(n * npad), np.empty(n * npad)     # δ clipped to the root's range, δ^((p−1)/2)
-    w_q, w_Fx, w_Fy = np.empty(ns), np.empty(ns), np.empty(ns)
-    blocks = np.empty((ns if jac else 0, 12))           # the slices' derivative blocks (zero: open)
+    return p, int(G[1]), 0.5 * (p - 1.0), ns, zs, zmax
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _open(kap, R, D, row, zmax, tau, scx, scy, pcx, pcy):
+    """SlicedRaceContact._open_bound: every slice certainly open, δ_0 + max_k |z_k σ_r − ζ_k σ_c| ≤ 0."""
+    delta0 = 0.5 * D - kap * (np.sqrt(pcx * pcx + pcy * pcy) - R)
+    reach = zmax * abs(tau) + (abs(row) + zmax) * np.sqrt(scx * scx + scy * scy)
+    return delta0 + reach <= 0.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _slice_offset(pcx, pcy, srx, sry, scx, scy, zk, zeta, kap, R, D, drop):
+    """Slice k's offset w_k = (p − c) + z_k σ_r − ζ_k σ_c, d_k = |w_k| (the safe norm) and compression
+    δ_k = D/2 − κ(d_k − R) − P_k (the profile drop P_k)."""
+    wx = pcx + zk * srx - zeta * scx
+    wy = pcy + zk * sry - zeta * scy
+    d = np.sqrt(wx * wx + wy * wy + _ETA2)
+    return wx, wy, d, 0.5 * D - kap * (d - R) - drop
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _slice_rate(wvx, wvy, dsrx, dsry, dscx, dscy, zk, zeta, nx, ny, kap):
+    """Slice k's offset rate ẇ_k = (ṗ − ċ) + z_k σ̇_r − ζ_k σ̇_c, n_k·ẇ_k and the compression rate δ̇_k = −κ n_k·ẇ_k."""
+    vwx = wvx + zk * dsrx - zeta * dscx
+    vwy = wvy + zk * dsry - zeta * dscy
+    nv = nx * vwx + ny * vwy
+    return vwx, vwy, nv, -kap * nv
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _slice_load(Ks, c0s, ramp, delta, dpe, delta_dot):
+    """Slice k's load q_k = (K/n_s) δ^p + (c₀/n_s) δ^((p−1)/2) S(δ/δ_c) δ̇ for δ > 0, clipped at ≥ 0, else 0, from
+    dpe = δ^((p−1)/2) (δ^p = δ dpe²; open slices masked); S the damping share over the ramp δ_c
+    (:func:`.tooth_pairs.damping_share`; 1 without a ramp)."""
+    S = tooth_pairs.damping_share(delta, ramp)[0] if ramp > 0.0 else 1.0
+    q_raw = Ks * (delta * (dpe * dpe)) + c0s * dpe * S * delta_dot
+    return q_raw if (delta > 0.0) & (q_raw > 0.0) else 0.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _slice_load_partials(Ks, c0s, ramp, p, pe, delta, dpe, delta_dot, q):
+    """∂q/∂δ and ∂q/∂δ̇ of :func:`_slice_load` at its load q (zero where it is: ad.where)."""
+    on = q > 0.0
+    q_d = Ks * p * (dpe * dpe) + c0s * pe * (dpe / delta) * delta_dot
+    q_r = c0s * dpe
+    if ramp > 0.0:                                   # with the damping share S(δ/δ_c)
+        S, dS = tooth_pairs.damping_share(delta, ramp)
+        q_d = Ks * p * (dpe * dpe) + c0s * (pe * (dpe / delta) * S + dpe * dS) * delta_dot
+        q_r = c0s * dpe * S
+    return (q_d if on else 0.0), (q_r if on else 0.0)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _contact_pass(P, ql, vl, zs, zmax, every, slot, geo, w_x, w_y, w_d, w_delta):
+    """The first pass over the contacts: each one's geometry (SlicedRaceContact._geometry) — the raceway's centre
+    offset rc (its marker turned) and velocity V_c; the pin's rp; u = p − pin centre, ρ_p = |u|, e = u/ρ_p,
+    g = ṗ − V_pin, g·e and ė = (I − e eᵀ) g/ρ_p; the bore error s_0 turned (s0c), the race's slope σ_c = s0c + s and its
+    rate; k0 = −k × s0c (the θ_b force's lever); the roller's slope σ_r = τ e and its rate; p − c and ṗ − V_c — and the
+    open bound (:func:`_open`). A contact the bound finds loaded (with ``every``, any contact) takes the next row r: its
+    geometry into geo[r] (:func:`_geometry`'s layout) and its slices' offsets and compressions (:func:`_slice_offset`)
+    into row r of w_x, w_y, w_d, w_delta. slot[i]: r (loaded), −2 − r (open, with ``every``) or −1 (open, no row).
+    Returns the rows taken. (The geometry is written out in the loop: an inlined helper returning its 32 values cost
+    ≈ 18 ns a contact more, 7 % of a residual call.)"""
+    n, ns = ql.shape[0], zs.shape[0]
+    outer = ql.shape[1] == 12
     thb_last, cb, sb, thp_last, cp, sp = np.nan, 0.0, 0.0, np.nan, 0.0, 0.0
-    # every contact's geometry and slice compressions, then their powers all at once (the SIMD lanes full)
     rows = 0
-    for i in range(ql.shape[0]):
+    for i in range(n):
         kap, mx, my, pmx, pmy, s0x, s0y = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
         R, D, K, c0, row, Rr = P[i, 7], P[i, 8], P[i, 9], P[i, 10], P[i, 11], P[i, 12]
         xr, yr, tau = ql[i, 0], ql[i, 1], ql[i, 3]
@@ -277,7 +339,7 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         else:
             sx, sy, vsx, vsy = 0.0, 0.0, 0.0, 0.0
             xp, yp, thp, vp0, vp1, vp2 = xb, yb, thb, vb0, vb1, vb2
-        # the raceway's centre and its velocity; the pin's centre and its velocity (SlicedRaceContact._geometry)
+        # the raceway's centre and its velocity; the pin's centre and its velocity
         if thb != thb_last:              # a bearing's contacts follow each other: one race body's, one pin's angle
             thb_last, cb, sb = thb, np.cos(thb), np.sin(thb)
         rcx, rcy = cb * mx - sb * my, sb * mx + cb * my
@@ -286,10 +348,10 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         if thp != thp_last:
             thp_last, cp, sp = thp, np.cos(thp), np.sin(thp)
         rpx, rpy = cp * pmx - sp * pmy, sp * pmx + cp * pmy
-        pcx, pcy = xp + rpx, yp + rpy
+        qpx, qpy = xp + rpx, yp + rpy
         Vpx, Vpy = vp0 - vp2 * rpy, vp1 + vp2 * rpx
         # e: pin centre → roller centre, and ė
-        ux, uy = xr - pcx, yr - pcy
+        ux, uy = xr - qpx, yr - qpy
         rho_p = np.sqrt(ux * ux + uy * uy + _ETA2)
         ex, ey = ux / rho_p, uy / rho_p
         gx, gy = vr0 - Vpx, vr1 - Vpy
@@ -300,20 +362,19 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         scx, scy = s0cx + sx, s0cy + sy
         dscx, dscy = -1.0 * vb2 * s0cy + vsx, vb2 * s0cx + vsy
         k0x, k0y = s0cy, -1.0 * s0cx
+        # the roller's slope σ_r = τ e and its rate; p − c and ṗ − V_c
         srx, sry = tau * ex, tau * ey
         dsrx, dsry = dtau * ex + tau * edx, dtau * ey + tau * edy
-        pcx_, pcy_ = xr - cx, yr - cy
+        pcx, pcy = xr - cx, yr - cy
         wvx, wvy = vr0 - Vcx, vr1 - Vcy
-        # the open bound (SlicedRaceContact._open_bound)
-        delta0 = 0.5 * D - kap * (np.sqrt(pcx_ * pcx_ + pcy_ * pcy_) - R)
-        reach = zmax * abs(tau) + (abs(row) + zmax) * np.sqrt(scx * scx + scy * scy)
-        if delta0 + reach <= 0.0:
+        shut = _open(kap, R, D, row, zmax, tau, scx, scy, pcx, pcy)
+        if shut and not every:
             slot[i] = -1
             continue
         r = rows
-        slot[i] = r
+        slot[i] = -2 - r if shut else r
         rows += 1
-        # what the second pass reads, in its order (stores one by one: a loop over a tuple costs twice as much)
+        # what the second pass reads, in _geometry's order (stores one by one: a loop over a tuple costs twice as much)
         geo[r, 0], geo[r, 1], geo[r, 2], geo[r, 3], geo[r, 4], geo[r, 5] = kap, R, D, K, c0, row
         geo[r, 6], geo[r, 7], geo[r, 8], geo[r, 9], geo[r, 10], geo[r, 11] = Rr, tau, vr0, vr1, vr2, dtau
         geo[r, 12], geo[r, 13], geo[r, 14], geo[r, 15], geo[r, 16], geo[r, 17] = vb0, vb1, vb2, vp2, rcx, rcy
@@ -321,72 +382,140 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
         geo[r, 24], geo[r, 25], geo[r, 26], geo[r, 27], geo[r, 28], geo[r, 29] = rho_p, ex, ey, gx, gy, ge
         geo[r, 30], geo[r, 31], geo[r, 32], geo[r, 33], geo[r, 34], geo[r, 35] = edx, edy, s0cx, s0cy, scx, scy
         geo[r, 36], geo[r, 37], geo[r, 38], geo[r, 39], geo[r, 40], geo[r, 41] = dscx, dscy, k0x, k0y, srx, sry
-        geo[r, 42], geo[r, 43], geo[r, 44], geo[r, 45], geo[r, 46], geo[r, 47] = dsrx, dsry, pcx_, pcy_, wvx, wvy
+        geo[r, 42], geo[r, 43], geo[r, 44], geo[r, 45], geo[r, 46], geo[r, 47] = dsrx, dsry, pcx, pcy, wvx, wvy
         for k in range(ns):          # every slice's offset and compression: a loop without branches (SIMD)
             zk = zs[k]
-            zeta = row + zk
-            wx = pcx_ + zk * srx - zeta * scx
-            wy = pcy_ + zk * sry - zeta * scy
-            d = np.sqrt(wx * wx + wy * wy + _ETA2)
-            w_x[r, k], w_y[r, k], w_d[r, k] = wx, wy, d
-            w_delta[r, k] = 0.5 * D - kap * (d - R) - P[i, SLICED_COLS + k]
-    _slice_roots(w_delta, w_c, w_root, rows, ns, npad, mroot, pe)
-    for i in range(n):
+            w_x[r, k], w_y[r, k], w_d[r, k], w_delta[r, k] = _slice_offset(pcx, pcy, srx, sry, scx, scy, zk, row + zk,
+                                                                           kap, R, D, P[i, SLICED_COLS + k])
+    return rows
+
+
+@njit(cache=True, inline="always")
+def _geometry(geo, r):
+    """Row r of geo (:func:`_contact_pass`): κ, R, D, K, c₀, ζ_row, R_red, τ, the roller's velocities (ṗ, ω_r, τ̇),
+    the race body's, the pin's ω, then the geometry of :func:`_contact_pass` (rc, V_c, rp, u, ρ_p, e, g, g·e, ė, s0c, σ_c,
+    σ̇_c, k0, σ_r, σ̇_r, p − c, ṗ − V_c)."""
+    g = geo[r]
+    return (g[0], g[1], g[2], g[3], g[4], g[5], g[6], g[7], g[8], g[9], g[10], g[11], g[12], g[13], g[14], g[15],
+            g[16], g[17], g[18], g[19], g[20], g[21], g[22], g[23], g[24], g[25], g[26], g[27], g[28], g[29], g[30],
+            g[31], g[32], g[33], g[34], g[35], g[36], g[37], g[38], g[39], g[40], g[41], g[42], g[43], g[44], g[45],
+            g[46], g[47])
+
+
+@njit(cache=True, error_model="numpy")
+def _slice_pass(P, ql, vl, zs, zmax, pe, every):
+    """Every contact's geometry and its slices' compressions (:func:`_contact_pass`), then the slices' powers
+    δ_k^((p−1)/2) of all the rows at once (:func:`_slice_roots`): (slot, geo, w_x, w_y, w_d, w_delta, the powers (row
+    r's at r·npad), npad)."""
+    n, ns = ql.shape[0], zs.shape[0]
+    npad = -(-ns // _LANES) * _LANES
+    slot, geo = np.empty(n, np.int64), np.empty((n, _NGEO))
+    w_x, w_y, w_d, w_delta = np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns))
+    w_c, w_root = np.empty(n * npad), np.empty(n * npad)     # δ clipped to the root's range, δ^((p−1)/2)
+    rows = _contact_pass(P, ql, vl, zs, zmax, every, slot, geo, w_x, w_y, w_d, w_delta)
+    _slice_roots(w_delta, w_c, w_root, rows, ns, npad, root_index(pe), pe)
+    return slot, geo, w_x, w_y, w_d, w_delta, w_root, npad
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _slice_loads(r, o, zs, kap, Ks, c0s, ramp, row, wvx, wvy, dsrx, dsry, dscx, dscy, w_x, w_y, w_d, w_delta, w_root, w_q,
+                 w_Fx, w_Fy):
+    """Row r's slice loads q_k (:func:`_slice_load`; its powers from w_root[o:]) into w_q and the slice forces on the
+    roller F_k = κ q_k n_k into w_Fx, w_Fy: a loop without branches (SIMD)."""
+    for k in range(zs.shape[0]):
+        zk = zs[k]
+        d = w_d[r, k]
+        nx, ny = w_x[r, k] / d, w_y[r, k] / d
+        delta_dot = _slice_rate(wvx, wvy, dsrx, dsry, dscx, dscy, zk, row + zk, nx, ny, kap)[3]
+        q = _slice_load(Ks, c0s, ramp, w_delta[r, k], w_root[o + k], delta_dot)
+        w_q[k] = q
+        w_Fx[k], w_Fy[k] = kap * q * nx, kap * q * ny
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _slice_sums(zs, row, w_q, w_Fx, w_Fy):
+    """Σ F_k, Σ z_k F_k, Σ ζ_k F_k, Q = Σ q_k and Σ z_k q_k, in the slices' order."""
+    S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    for k in range(zs.shape[0]):
+        zk, Fx, Fy, q = zs[k], w_Fx[k], w_Fy[k], w_q[k]
+        zeta = row + zk
+        S0x += Fx
+        S0y += Fy
+        S1x += zk * Fx
+        S1y += zk * Fy
+        S2x += zeta * Fx
+        S2y += zeta * Fy
+        Q += q
+        Qz += zk * q
+    return S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _rolling(R, rcx, rcy, vr0, vr1, vr2, vb0, vb1, vb2, Vcx, Vcy, pcx, pcy, wvx, wvy):
+    """The traction's kinematics, as the planar contact's (SlicedRaceContact.kernel): ρ = |p − c|, e_c, the tangent
+    t = k × e_c, the contact point's lever from the roller's centre r_r = (R − ρ) e_c and from the race body's
+    r_b = rc + R e_c, their velocities V_r, V_b, the tangential speeds u_r, u_b, (ṗ − V_c)·t, the slip v_s = u_r − u_b
+    and the rolling speed u_e = (u_r + u_b)/2 − the contact point's own tangential speed."""
+    rho = np.sqrt(pcx * pcx + pcy * pcy + _ETA2)
+    ecx, ecy = pcx / rho, pcy / rho
+    tx, ty = -ecy, ecx
+    rl = R - rho
+    rrx, rry = rl * ecx, rl * ecy
+    rbx, rby = rcx + R * ecx, rcy + R * ecy
+    Vrx, Vry = vr0 - vr2 * rry, vr1 + vr2 * rrx
+    Vbx, Vby = vb0 - vb2 * rby, vb1 + vb2 * rbx
+    ur, ub = Vrx * tx + Vry * ty, Vbx * tx + Vby * ty
+    wt = wvx * tx + wvy * ty
+    u_e = 0.5 * (ur + ub) - (Vcx * tx + Vcy * ty + R * wt / rho)
+    return rho, ecx, ecy, tx, ty, rl, rrx, rry, rbx, rby, Vrx, Vry, Vbx, Vby, ur, ub, wt, ur - ub, u_e
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _coefficient(law, G, v_s, u_e, Q, Rr):
+    """The traction coefficient μ on the load Q and its partials ∂μ/∂v_s, ∂μ/∂u_e, ∂μ/∂Q (the race contact's laws,
+    :mod:`mbd.compiled.contact`)."""
+    if law == EHL:
+        return _ehl_traction(G, v_s, u_e, Q, Rr)
+    mu, mu_s, mu_u = _traction(law, G, v_s, u_e)
+    return mu, mu_s, mu_u, 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
+    p, law, pe, ns, zs, zmax = _law(G)
+    nl = ql.shape[1]
+    outer = nl == 12
+    js0, js1 = (7, 8) if outer else (-1, -1)            # the race's slope pair's columns (none: inner, rigid pin)
+    jp0, jp1, jp2 = (9, 10, 11) if outer else (4, 5, 6)  # the pin body's (inner: the race body is the pin)
+    # a pass's columns (f0 … f6, dT2x, dT2y, dGx, dGy, dpin): every direction of a SIMD width's multiple jn ≥ nl, those
+    # past nl zero, the derived ones overwritten (_derived_cols): a loop of a fixed count without branches (SIMD)
+    jn = 16 if outer else 8
+    cols = np.empty((12, 16))
+    acc = np.zeros((3, 12))          # moments m = 0, 1, 2 of M_k (4), N_k (4), g_k (2), ∂q_k/∂ẇ_k (2)
+    # every contact's geometry and slice compressions, then their powers all at once (the SIMD lanes full)
+    slot, geo, w_x, w_y, w_d, w_delta, w_root, npad = _slice_pass(P, ql, vl, zs, zmax, pe, np.bool_(False))
+    w_q, w_Fx, w_Fy = np.empty(ns), np.empty(ns), np.empty(ns)
+    blocks = np.empty((ns if jac else 0, 12))           # the slices' derivative blocks (zero: open)
+    for i in range(ql.shape[0]):
         r = slot[i]
         if r < 0:
             _zero(F, Jq, Jv, i, jac)
             continue
-        gr = geo[r]
         (kap, R, D, K, c0, row, Rr, tau, vr0, vr1, vr2, dtau, vb0, vb1, vb2, vp2, rcx, rcy, Vcx, Vcy, rpx, rpy, ux,
          uy, rho_p, ex, ey, gx, gy, ge, edx, edy, s0cx, s0cy, scx, scy, dscx, dscy, k0x, k0y, srx, sry, dsrx, dsry,
-         pcx_, pcy_, wvx, wvy) = (
-            gr[0], gr[1], gr[2], gr[3], gr[4], gr[5], gr[6], gr[7], gr[8], gr[9], gr[10], gr[11], gr[12], gr[13],
-            gr[14], gr[15], gr[16], gr[17], gr[18], gr[19], gr[20], gr[21], gr[22], gr[23], gr[24], gr[25], gr[26],
-            gr[27], gr[28], gr[29], gr[30], gr[31], gr[32], gr[33], gr[34], gr[35], gr[36], gr[37], gr[38], gr[39],
-            gr[40], gr[41], gr[42], gr[43], gr[44], gr[45], gr[46], gr[47])
-        S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+         pcx_, pcy_, wvx, wvy) = _geometry(geo, r)
         Ks, c0s = K / ns, c0 / ns
         ramp = P[i, SLICED_COLS + ns]                   # the damping share's δ_c (0: none, the law as written)
         o = r * npad
-        for k in range(ns):          # every slice's load, open ones masked (selects, no branches: SIMD)
-            delta = w_delta[r, k]
-            zk = zs[k]
-            zeta = row + zk
-            wx, wy, d = w_x[r, k], w_y[r, k], w_d[r, k]
-            nx, ny = wx / d, wy / d
-            vwx = wvx + zk * dsrx - zeta * dscx
-            vwy = wvy + zk * dsry - zeta * dscy
-            nv = nx * vwx + ny * vwy
-            delta_dot = -kap * nv
-            dpe = w_root[o + k]                         # δ^((p−1)/2); δ^p = δ (δ^((p−1)/2))²
-            dp1 = dpe * dpe
-            S = tooth_pairs.damping_share(delta, ramp)[0] if ramp > 0.0 else 1.0
-            q_raw = Ks * (delta * dp1) + c0s * dpe * S * delta_dot
-            q = q_raw if (delta > 0.0) & (q_raw > 0.0) else 0.0
-            w_q[k] = q
-            w_Fx[k], w_Fy[k] = kap * q * nx, kap * q * ny
+        _slice_loads(r, o, zs, kap, Ks, c0s, ramp, row, wvx, wvy, dsrx, dsry, dscx, dscy, w_x, w_y, w_d, w_delta, w_root, w_q,
+                     w_Fx, w_Fy)
         if jac:
             for k in range(ns):      # the slices' derivative blocks (zero: open), a loop of its own (SIMD)
-                delta, q = w_delta[r, k], w_q[k]
-                zk = zs[k]
-                zeta = row + zk
-                wx, wy, d = w_x[r, k], w_y[r, k], w_d[r, k]
-                nx, ny = wx / d, wy / d
-                vwx = wvx + zk * dsrx - zeta * dscx
-                vwy = wvy + zk * dsry - zeta * dscy
-                nv = nx * vwx + ny * vwy
-                delta_dot = -kap * nv
-                dpe = w_root[o + k]
-                dp1 = dpe * dpe
-                on = q > 0.0
-                q_d = Ks * p * dp1 + c0s * pe * (dpe / delta) * delta_dot                     # ∂q/∂δ
-                q_r = c0s * dpe                                                                 # ∂q/∂δ̇
-                if ramp > 0.0:                                                                  # with S(δ/δ_c)
-                    S, dS = tooth_pairs.damping_share(delta, ramp)
-                    q_d = Ks * p * dp1 + c0s * (pe * (dpe / delta) * S + dpe * dS) * delta_dot
-                    q_r = c0s * dpe * S
-                q_d = q_d if on else 0.0
-                q_r = q_r if on else 0.0
+                zk, q = zs[k], w_q[k]
+                d = w_d[r, k]
+                nx, ny = w_x[r, k] / d, w_y[r, k] / d
+                vwx, vwy, nv, delta_dot = _slice_rate(wvx, wvy, dsrx, dsry, dscx, dscy, zk, row + zk, nx, ny, kap)
+                q_d, q_r = _slice_load_partials(Ks, c0s, ramp, p, pe, w_delta[r, k], w_root[o + k], delta_dot, q)
                 i_d = 1.0 / d
                 hx, hy = (vwx - nx * nv) * i_d, (vwy - ny * nv) * i_d
                 gqx, gqy = -kap * (q_d * nx + q_r * hx), -kap * (q_d * ny + q_r * hy)
@@ -399,40 +528,16 @@ def evaluate_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac)
                 blocks[k, 4], blocks[k, 5] = kap * nx * gvx, kap * nx * gvy
                 blocks[k, 6], blocks[k, 7] = kap * ny * gvx, kap * ny * gvy
                 blocks[k, 8], blocks[k, 9], blocks[k, 10], blocks[k, 11] = gqx, gqy, gvx, gvy
-        for k in range(ns):          # the sums, in the slices' order
-            zk, Fx, Fy, q = zs[k], w_Fx[k], w_Fy[k], w_q[k]
-            zeta = row + zk
-            S0x += Fx
-            S0y += Fy
-            S1x += zk * Fx
-            S1y += zk * Fy
-            S2x += zeta * Fx
-            S2y += zeta * Fy
-            Q += q
-            Qz += zk * q
+        S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = _slice_sums(zs, row, w_q, w_Fx, w_Fy)
         if not Q > 0.0:
             _zero(F, Jq, Jv, i, jac)
             continue
         if jac:
             _moments(acc, blocks, ns, zs)
         # traction as the planar contact's on Q, applied at the load centroid z̄
-        rho = np.sqrt(pcx_ * pcx_ + pcy_ * pcy_ + _ETA2)
-        ecx, ecy = pcx_ / rho, pcy_ / rho
-        tx, ty = -ecy, ecx
-        rl = R - rho
-        rrx, rry = rl * ecx, rl * ecy
-        rbx, rby = rcx + R * ecx, rcy + R * ecy
-        Vrx, Vry = vr0 - vr2 * rry, vr1 + vr2 * rrx
-        Vbx, Vby = vb0 - vb2 * rby, vb1 + vb2 * rbx
-        ur, ub = Vrx * tx + Vry * ty, Vbx * tx + Vby * ty
-        v_s = ur - ub
-        wt = wvx * tx + wvy * ty
-        u_e = 0.5 * (ur + ub) - (Vcx * tx + Vcy * ty + R * wt / rho)
-        mu_Q = 0.0
-        if law == EHL:
-            mu, mu_s, mu_u, mu_Q = _ehl_traction(G, v_s, u_e, Q, Rr)
-        else:
-            mu, mu_s, mu_u = _traction(law, G, v_s, u_e)
+        (rho, ecx, ecy, tx, ty, rl, rrx, rry, rbx, rby, Vrx, Vry, Vbx, Vby, ur, ub, wt, v_s,
+         u_e) = _rolling(R, rcx, rcy, vr0, vr1, vr2, vb0, vb1, vb2, Vcx, Vcy, pcx_, pcy_, wvx, wvy)
+        mu, mu_s, mu_u, mu_Q = _coefficient(law, G, v_s, u_e, Q, Rr)
         Ft = -mu * Q
         Ftx, Fty = Ft * tx, Ft * ty
         zbar = Qz / Q
@@ -894,126 +999,39 @@ def sliced_race_output_names(n_slices: int) -> tuple:
 @njit(cache=True, error_model="numpy")
 def outputs_sliced_race(t, phi, omega, domega, ql, vl, z, P, G, O):
     """The outputs of every contact (:func:`sliced_race_output_names`: SlicedRaceContact.kernel's) into the rows of O
-    (16 + n_s, n): the law of :func:`evaluate_sliced_race` without its generalised forces and Jacobian — the
-    geometry, the slices' compressions δ_k and their powers (:func:`_slice_roots`, all contacts at once), the slice
-    loads q_k = (K/n_s) δ_k^p + (c₀/n_s) δ_k^((p−1)/2) δ̇_k clipped at ≥ 0 (open slices 0), their sums, and the
-    traction on Q at the load centroid — for every contact, those the open bound skips too (their load 0, their
-    geometry, slip and rolling speeds as the reference gives them). Equal to the reference's outputs to round-off
-    (tests/mbd/test_compiled_sliced.py)."""
-    p, law = G[0], int(G[1])
-    pe = 0.5 * (p - 1.0)
-    ns = G.shape[0] - _GZ
-    zs = G[_GZ:]
-    zmax = 0.0
-    for k in range(ns):
-        zmax = max(zmax, abs(zs[k]))
-    n = ql.shape[0]
-    outer = ql.shape[1] == 12
-    mroot = root_index(pe)
-    npad = -(-ns // _LANES) * _LANES
-    loaded = np.empty(n, np.bool_)
-    geo = np.empty((n, 20))
-    w_x, w_y, w_d, w_delta = np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns)), np.empty((n, ns))
-    w_c, w_root = np.empty(n * npad), np.empty(n * npad)
-    for i in range(n):
-        kap, mx, my, pmx, pmy, s0x, s0y = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6]
-        R, D, row = P[i, 7], P[i, 8], P[i, 11]
-        xr, yr, tau = ql[i, 0], ql[i, 1], ql[i, 3]
-        xb, yb, thb = ql[i, 4], ql[i, 5], ql[i, 6]
-        vr0, vr1, dtau = vl[i, 0], vl[i, 1], vl[i, 3]
-        vb0, vb1, vb2 = vl[i, 4], vl[i, 5], vl[i, 6]
-        if outer:
-            sx, sy, vsx, vsy = ql[i, 7], ql[i, 8], vl[i, 7], vl[i, 8]
-            xp, yp, thp, vp0, vp1, vp2 = ql[i, 9], ql[i, 10], ql[i, 11], vl[i, 9], vl[i, 10], vl[i, 11]
+    (16 + n_s, n): the law of :func:`evaluate_sliced_race` (its helpers) without its generalised forces and Jacobian —
+    the geometry, the slices' compressions δ_k and their powers (:func:`_slice_pass`, all contacts at once), the slice
+    loads (:func:`_slice_loads`: open slices 0), their sums, and the traction on Q at the load centroid — for every
+    contact, those the open bound finds open too (their load 0, their geometry, slip and rolling speeds as the
+    reference gives them). Equal to the reference's outputs to round-off (tests/mbd/test_compiled_sliced.py)."""
+    p, law, pe, ns, zs, zmax = _law(G)
+    slot, geo, w_x, w_y, w_d, w_delta, w_root, npad = _slice_pass(P, ql, vl, zs, zmax, pe, np.bool_(True))
+    w_q, w_Fx, w_Fy = np.empty(ns), np.empty(ns), np.empty(ns)
+    for i in range(ql.shape[0]):
+        r = slot[i]
+        loaded = r >= 0
+        r = r if loaded else -2 - r
+        (kap, R, D, K, c0, row, Rr, tau, vr0, vr1, vr2, dtau, vb0, vb1, vb2, vp2, rcx, rcy, Vcx, Vcy, rpx, rpy, ux,
+         uy, rho_p, ex, ey, gx, gy, ge, edx, edy, s0cx, s0cy, scx, scy, dscx, dscy, k0x, k0y, srx, sry, dsrx, dsry,
+         pcx_, pcy_, wvx, wvy) = _geometry(geo, r)
+        if loaded:
+            _slice_loads(r, r * npad, zs, kap, K / ns, c0 / ns, P[i, SLICED_COLS + ns], row, wvx, wvy, dsrx, dsry, dscx, dscy, w_x, w_y, w_d,
+                         w_delta, w_root, w_q, w_Fx, w_Fy)
         else:
-            sx, sy, vsx, vsy = 0.0, 0.0, 0.0, 0.0
-            xp, yp, thp, vp0, vp1, vp2 = xb, yb, thb, vb0, vb1, vb2
-        cb, sb, cp, sp = np.cos(thb), np.sin(thb), np.cos(thp), np.sin(thp)
-        rcx, rcy = cb * mx - sb * my, sb * mx + cb * my
-        cx, cy = xb + rcx, yb + rcy
-        Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
-        rpx, rpy = cp * pmx - sp * pmy, sp * pmx + cp * pmy
-        Vpx, Vpy = vp0 - vp2 * rpy, vp1 + vp2 * rpx
-        ux, uy = xr - (xp + rpx), yr - (yp + rpy)
-        rho_p = np.sqrt(ux * ux + uy * uy + _ETA2)
-        ex, ey = ux / rho_p, uy / rho_p
-        gx, gy = vr0 - Vpx, vr1 - Vpy
-        ge = ex * gx + ey * gy
-        edx, edy = (gx - ge * ex) / rho_p, (gy - ge * ey) / rho_p
-        s0cx, s0cy = cb * s0x - sb * s0y, sb * s0x + cb * s0y
-        scx, scy = s0cx + sx, s0cy + sy
-        dscx, dscy = -1.0 * vb2 * s0cy + vsx, vb2 * s0cx + vsy
-        srx, sry = tau * ex, tau * ey
-        dsrx, dsry = dtau * ex + tau * edx, dtau * ey + tau * edy
-        pcx_, pcy_ = xr - cx, yr - cy
-        wvx, wvy = vr0 - Vcx, vr1 - Vcy
-        g = geo[i]
-        g[0], g[1], g[2], g[3], g[4], g[5], g[6], g[7], g[8], g[9] = rcx, rcy, Vcx, Vcy, pcx_, pcy_, wvx, wvy, ex, ey
-        g[10], g[11], g[12], g[13], g[14], g[15] = scx, scy, dscx, dscy, dsrx, dsry
-        delta0 = 0.5 * D - kap * (np.sqrt(pcx_ * pcx_ + pcy_ * pcy_) - R)
-        reach = zmax * abs(tau) + (abs(row) + zmax) * np.sqrt(scx * scx + scy * scy)
-        loaded[i] = delta0 + reach > 0.0           # else every slice open (the reference's bound)
+            for k in range(ns):
+                w_q[k], w_Fx[k], w_Fy[k] = 0.0, 0.0, 0.0
+        S0x, S0y, S1x, S1y, S2x, S2y, Q, Qz = _slice_sums(zs, row, w_q, w_Fx, w_Fy)
+        qmax, nload = 0.0, 0.0
         for k in range(ns):
-            zk = zs[k]
-            zeta = row + zk
-            wx = pcx_ + zk * srx - zeta * scx
-            wy = pcy_ + zk * sry - zeta * scy
-            d = np.sqrt(wx * wx + wy * wy + _ETA2)
-            w_x[i, k], w_y[i, k], w_d[i, k] = wx, wy, d
-            w_delta[i, k] = 0.5 * D - kap * (d - R) - P[i, SLICED_COLS + k]
-    _slice_roots(w_delta, w_c, w_root, n, ns, npad, mroot, pe)
-    for i in range(n):
-        kap, R, D, K, c0, row, Rr = P[i, 0], P[i, 7], P[i, 8], P[i, 9], P[i, 10], P[i, 11], P[i, 12]
-        tau = ql[i, 3]
-        vr0, vr1, vr2, vb0, vb1, vb2 = vl[i, 0], vl[i, 1], vl[i, 2], vl[i, 4], vl[i, 5], vl[i, 6]
-        g = geo[i]
-        rcx, rcy, Vcx, Vcy, pcx_, pcy_, wvx, wvy, ex, ey = g[0], g[1], g[2], g[3], g[4], g[5], g[6], g[7], g[8], g[9]
-        scx, scy, dscx, dscy, dsrx, dsry = g[10], g[11], g[12], g[13], g[14], g[15]
-        S0x, S0y, Q, Qz, qmax, nload = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        Ks, c0s = K / ns, c0 / ns
-        ramp = P[i, SLICED_COLS + ns]
-        o = i * npad
-        for k in range(ns):
-            q = 0.0
-            delta = w_delta[i, k]
-            if loaded[i] and delta > 0.0:
-                zk = zs[k]
-                zeta = row + zk
-                d = w_d[i, k]
-                nx, ny = w_x[i, k] / d, w_y[i, k] / d
-                vwx = wvx + zk * dsrx - zeta * dscx
-                vwy = wvy + zk * dsry - zeta * dscy
-                delta_dot = -kap * (nx * vwx + ny * vwy)
-                dpe = w_root[o + k]
-                S = tooth_pairs.damping_share(delta, ramp)[0] if ramp > 0.0 else 1.0
-                q_raw = Ks * (delta * (dpe * dpe)) + c0s * dpe * S * delta_dot
-                if q_raw > 0.0:
-                    q = q_raw
-                    S0x += kap * q * nx
-                    S0y += kap * q * ny
-                    Q += q
-                    Qz += zk * q
-                    nload += 1.0
+            q = w_q[k]
             O[16 + k, i] = q
             qmax = max(qmax, q)
+            nload += 1.0 if q > 0.0 else 0.0
         # traction as the planar contact's on Q (SlicedRaceContact.kernel)
-        rho = np.sqrt(pcx_ * pcx_ + pcy_ * pcy_ + _ETA2)
-        ecx, ecy = pcx_ / rho, pcy_ / rho
-        tx, ty = -ecy, ecx
-        rl = R - rho
-        rrx, rry = rl * ecx, rl * ecy
-        rbx, rby = rcx + R * ecx, rcy + R * ecy
-        Vrx, Vry = vr0 - vr2 * rry, vr1 + vr2 * rrx
-        Vbx, Vby = vb0 - vb2 * rby, vb1 + vb2 * rbx
-        ur, ub = Vrx * tx + Vry * ty, Vbx * tx + Vby * ty
-        v_s = ur - ub
-        u_e = 0.5 * (ur + ub) - (Vcx * tx + Vcy * ty + R * (wvx * tx + wvy * ty) / rho)
+        (rho, ecx, ecy, tx, ty, rl, rrx, rry, rbx, rby, Vrx, Vry, Vbx, Vby, ur, ub, wt, v_s,
+         u_e) = _rolling(R, rcx, rcy, vr0, vr1, vr2, vb0, vb1, vb2, Vcx, Vcy, pcx_, pcy_, wvx, wvy)
         on = Q > 0.0
-        if law == EHL:
-            mu = _ehl_traction(G, v_s, u_e, Q if on else 1.0, Rr)[0]
-        else:
-            mu = _traction(law, G, v_s, u_e)[0]
-        Ft = -mu * Q
+        Ft = -_coefficient(law, G, v_s, u_e, Q if on else 1.0, Rr)[0] * Q
         O[0, i], O[1, i], O[2, i], O[3, i], O[4, i] = Q, 0.5 * D - kap * (rho - R), Ft, v_s, u_e
         O[5, i], O[6, i], O[7, i] = S0x + Ft * tx, S0y + Ft * ty, tau
         O[8, i], O[9, i] = scx * ex + scy * ey - tau, Qz / Q if on else 0.0
