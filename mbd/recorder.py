@@ -141,6 +141,9 @@ class DerivedOutput:
     batched: bool = False
 
 
+WRITE_BYTES = 64 * 2**20     # the chunks joined in memory up to this size when the results file is written
+
+
 class Recorder:
     def __init__(self, path, dt: float, probes: Sequence, t_start: float = 0.0, chunk: int = 2000,
                  attrs: dict | None = None):
@@ -389,11 +392,31 @@ class Recorder:
                 names = list(d["names"])
                 yield {nm: d[f"v{j}"] for j, nm in enumerate(names)}
 
+    def _chunk_groups(self):
+        """The chunks joined into groups of up to :data:`WRITE_BYTES` (each variable written once per group: a
+        write into the file costs about as much for one sample as for thousands)."""
+        group, size = [], 0
+        for c in self._chunks():
+            group.append(c)
+            size += sum(x.nbytes for x in c.values())
+            if size >= WRITE_BYTES:
+                yield {k: np.concatenate([g[k] for g in group]) for k in group[0]}
+                group, size = [], 0
+        if group:
+            yield group[0] if len(group) == 1 else {k: np.concatenate([g[k] for g in group]) for k in group[0]}
+
+    def _samples_on_disk(self) -> int:
+        total = 0
+        for i in range(self.n_chunks):
+            with np.load(self.parts / f"chunk_{i:06d}.npz") as d:
+                total += d[f"v{list(d['names']).index('time')}"].shape[0]
+        return total
+
     def finalize(self, attrs: dict | None = None) -> Path:
         """Stream all chunks into the results file (netCDF4 via h5netcdf) atomically; the chunks are removed
         only once the file is in place (a failed write keeps them and the checkpoint: the run can resume)."""
         self.flush()
-        total = sum(c["time"].shape[0] for c in self._chunks())
+        total = self._samples_on_disk()
         self.path.parent.mkdir(parents=True, exist_ok=True)
         tmp = _tmp_for(self.path)
         with _discard_on_failure(tmp):
@@ -430,7 +453,7 @@ class Recorder:
                 created[name] = f.create_variable(name, dims, float, chunks=None)
                 created[name].attrs.update(vattrs)
             i0 = 0
-            for c in self._chunks():
+            for c in self._chunk_groups():
                 n = c["time"].shape[0]
                 tv[i0: i0 + n] = c["time"]
                 for name in self.vars:

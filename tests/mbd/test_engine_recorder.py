@@ -322,3 +322,18 @@ def test_block_samples_equal_the_samples_taken_one_by_one(tmp_path, frame):
             assert np.array_equal(a[name].values, b[name].values), name
         np.testing.assert_array_equal(a["spin_rows"].values, a["spin_ones"].values)
         assert np.ptp(a["link.work_rate"].values) > 0 and np.ptp(a["spin_rows"].values) > 0     # not constants
+
+
+def test_results_file_the_same_whatever_the_chunks_joined_per_write(tmp_path, monkeypatch):
+    """finalize joins the chunks into groups of up to WRITE_BYTES per write: one group or one chunk per write, the
+    file holds the same samples (every chunk in its place, none twice)."""
+    import mbd.recorder as recorder
+
+    whole = run(scene(), tmp_path / "whole.nc", t_end=0.03, chunk=4)
+    monkeypatch.setattr(recorder, "WRITE_BYTES", 1)        # every chunk written on its own
+    parts = run(scene(), tmp_path / "parts.nc", t_end=0.03, chunk=4)
+    with xr.open_dataset(whole.results_path, engine="h5netcdf") as a, \
+            xr.open_dataset(parts.results_path, engine="h5netcdf") as b:
+        assert a.sizes["time"] == 16 and np.all(np.diff(a["time"].values) > 0)
+        for name in a.variables:
+            assert np.array_equal(a[name].values, b[name].values), name
