@@ -292,7 +292,8 @@ def history_groups(runs: dict) -> dict[str, tuple[list, list[str]]]:
                 continue
             col = b["kind"]
             if "bearing.load_radial" in out:
-                put("bearing_loads", "bearing load, radial (+ outward)", "N", col, d, t, out["bearing.load_radial"][:, i])
+                put("bearing_loads", "bearing load, radial (+ outward)", "N", col, d, t,
+                    out["bearing.load_radial"][:, i])
                 put("bearing_loads", "bearing load, tangential", "N", col, d, t, out["bearing.load_tangential"][:, i])
             if b["type"] != "rollers":
                 continue
@@ -343,8 +344,15 @@ def headline_values(results: dict) -> dict[tuple, float | None]:
     return vals
 
 
-def point_figures(results: dict, out: Path, c) -> list[Path]:
-    """Point ``c``'s own figures: its time histories in groups and its cage orbits, forward and reverse."""
+# a point's figures in two pieces of about equal work, drawn at once on two workers beside the runs (each reads the
+# point's two results files): the time histories of the bearing loads, the roller contacts and the meshes; the cage
+# histories and the cage orbits
+POINT_PIECES = (("bearing_loads", "roller_contacts", "mesh"), ("cage", "cage_orbits"))
+
+
+def point_figures(results: dict, out: Path, c, figures=None) -> list[Path]:
+    """Point ``c``'s own figures: its time histories in groups (:data:`HISTORY_GROUPS`) and its cage orbits
+    ("cage_orbits"), forward and reverse; ``figures``: those of them (None: all)."""
     # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
     from viz import plots as vp
     from viz.results import load_run, study_cage_pictures
@@ -357,6 +365,8 @@ def point_figures(results: dict, out: Path, c) -> list[Path]:
     f_m = [results[_label_of(results, c, d)].get("f_m_hz") for d in runs]
     mesh_period = 1.0 / f_m[0] if f_m and f_m[0] else None
     for g, (rows, cols) in history_groups(runs).items():
+        if figures is not None and g not in figures:
+            continue
         titles = {"inner": "inner planet bearing", "outer": "outer planet bearing", **MESH_COLUMNS}
         # forward and reverse in rows of their own; the mesh histories, sampled a few times per mesh cycle, as
         # their envelope over a mesh period
@@ -364,15 +374,17 @@ def point_figures(results: dict, out: Path, c) -> list[Path]:
                                            column_titles=titles, title=f"{_title(c)}: {HISTORY_GROUPS[g]}",
                                            separate_runs=True, envelope=mesh_period if g == "mesh" else None,
                                            envelope_words="mesh cycle"))
-    paths += study_cage_pictures(runs, out, prefix=f"{point_tag(c)}_",
-                                 title=f"{_title(c)}: cage orbits in the guide clearance")
+    if figures is None or "cage_orbits" in figures:
+        paths += study_cage_pictures(runs, out, prefix=f"{point_tag(c)}_",
+                                     title=f"{_title(c)}: cage orbits in the guide clearance")
     return paths
 
 
-def point_work(results: dict, out: Path, c, with_animation: bool) -> list[Path]:
-    """What a point's finished runs give on their own — its figures and (``with_animation``) its animation — done
-    beside the other points' runs (:meth:`PaperStudy.beside`)."""
-    return point_figures(results, out, c) + (animate(results, out, only=[c]) if with_animation else [])
+def point_work(results: dict, out: Path, c, piece) -> list[Path]:
+    """One piece of what a point's finished runs give on their own — some of its figures (a :data:`POINT_PIECES`
+    of :func:`point_figures`) or its animation ("animation") — done beside the other points' runs
+    (:meth:`PaperStudy.beside`)."""
+    return animate(results, out, only=[c]) if piece == "animation" else point_figures(results, out, c, piece)
 
 
 def plots(results: dict, out: Path, machine: str = "", drawn=()) -> list[Path]:
@@ -481,7 +493,9 @@ class PaperStudy(Study):
             if not all(o.ok for o in outcomes.values()):    # a failed run: the report draws what it can
                 return None
             results = {label: Summary.of(o.summary) for label, o in outcomes.items()}
-            return point_work, (results, out, c, animation)
+            # in pieces, each on a worker: the last point's figures do not wait on one worker while the other idles
+            return [(point_work, (results, out, c, piece)) for piece in (*POINT_PIECES, *(("animation",) if animation
+                                                                                          else ()))]
         return Beside(key=lambda case: case.condition, task=task)
 
     def machine_identity(self) -> dict:
