@@ -97,8 +97,8 @@ class BearingSeries:
         """The recorded series; each takes a block's samples at once (``batched``)."""
         where = "radial: from the carrier axis through the planet; tangential 90 deg ahead"
         out = [mbd.DerivedOutput("bearing.load_radial", lambda *a: self.load(*a)[0], "N",
-                                 f"planet bearing load (pin reaction), radial component ({where})", instances=self.names,
-                                 batched=True),
+                                 f"planet bearing load (pin reaction), radial component ({where})",
+                                 instances=self.names, batched=True),
                mbd.DerivedOutput("bearing.load_tangential", lambda *a: self.load(*a)[1], "N",
                                  f"planet bearing load (pin reaction), tangential component ({where})",
                                  instances=self.names, batched=True)]

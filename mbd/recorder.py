@@ -316,8 +316,9 @@ class Recorder:
                 continue
             if kind == "elem" and (p.derived is None or p.batched):
                 o = p.evaluate({key: np.ascontiguousarray(x, dtype=float) for key, x in outs[p.element].items()})
+                shape = (S, self.dims[f"{p.element}.instance"])
                 for k in sel:
-                    cols[f"{p.element}.{k}"] = np.array(np.broadcast_to(np.asarray(o[k], dtype=float), (S, self.dims[f"{p.element}.instance"])))
+                    cols[f"{p.element}.{k}"] = np.array(np.broadcast_to(np.asarray(o[k], dtype=float), shape))
                 continue
             if rows is None:                                 # sample by sample: each sample's outputs, read lazily
                 rows = [_SampleOutputs(outs, n) for n in range(S)]
