@@ -788,7 +788,8 @@ def display_unit(unit: str | None, values=()) -> tuple[float, str]:
     """(factor, unit) to show SI ``values`` of ``unit`` with: forces in kN from 1 kN on, lengths in µm or mm,
     times in ms below 2 s, exponents written as superscripts. Multiply the data by the factor."""
     unit = unit or ""
-    v = np.asarray([x for x in np.ravel(np.asarray(values, dtype=float)) if np.isfinite(x)], float)
+    v = np.ravel(np.asarray(values, dtype=float))
+    v = v[np.isfinite(v)]
     big = float(np.max(np.abs(v))) if v.size else 0.0
     if unit == "N":
         return (1e-3, "kN") if big >= 1e3 else (1.0, "N")
