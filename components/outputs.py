@@ -53,41 +53,61 @@ class BearingSeries:
         bm = bearing_map(scene)
         self.names = tuple(b["name"] for b in bm)
         self.rollers = tuple(r for b in bm for r in b.get("rollers", ()))
+        self._last = None          # (t, outputs, loads) of the last samples: radial and tangential share them
 
     def load(self, t, X, V, A, outputs) -> np.ndarray:
-        """(radial, tangential) pin reaction per bearing [N], (2, nb)."""
+        """(radial, tangential) pin reaction per bearing [N]: (2, nb) at one sample (X (nb, 3), outputs (n,)), (2, S,
+        nb) at S samples (X (S, nb, 3), outputs (S, n); each sample's pin reaction as one sample's, the same sums)."""
+        last = self._last
+        if last is not None and last[0] is t and last[1] is outputs:
+            return last[2]
         p = self.plan
+        X = np.asarray(X, float)
         if p.rollers:
-            pin = pin_reactions(outputs[FAMILY["race_inner"]], slice(None), p.roller_bearing, p.planet.size, p.rows)
+            ri = outputs[FAMILY["race_inner"]]
+            if X.ndim == 2:
+                pin = pin_reactions(ri, slice(None), p.roller_bearing, p.planet.size, p.rows)
+            else:       # sample by sample: a matrix product of all rows would sum in another order (round-off)
+                fx, fy = np.asarray(ri["fx"], float), np.asarray(ri["fy"], float)
+                pin = np.stack([pin_reactions({"fx": fx[n], "fy": fy[n]}, slice(None), p.roller_bearing, p.planet.size,
+                                              p.rows) for n in range(fx.shape[0])])
         else:
             lin = outputs[FAMILY["linear"]]
-            pin = -np.column_stack([lin["fx"][p.spring], lin["fy"][p.spring]])
-        return np.array(radial_tangential(pin, X[p.planet, :2], X[p.carrier, :2]))
+            fx, fy = np.asarray(lin["fx"], float), np.asarray(lin["fy"], float)
+            pin = -np.stack([fx[..., p.spring], fy[..., p.spring]], axis=-1)
+        out = np.array(radial_tangential(pin, X[..., p.planet, :2], X[..., p.carrier, None, :2]))
+        self._last = (t, outputs, out)
+        return out
 
     def slip(self, t, X, V, A, outputs) -> np.ndarray:
-        """Cage slip per bearing [%] (:func:`components.bearing.cage_slip_pct`) from the body speeds ``V``."""
+        """Cage slip per bearing [%] (:func:`components.bearing.cage_slip_pct`) from the body speeds ``V`` (nb, 3), or
+        at S samples (S, nb, 3)."""
         p = self.plan
-        return cage_slip_pct(p.bearing, V[p.cage, 2] - V[p.carrier, 2], V[p.planet, 2] - V[p.carrier, 2])
+        w_c = V[..., p.carrier, None, 2]
+        return cage_slip_pct(p.bearing, V[..., p.cage, 2] - w_c, V[..., p.planet, 2] - w_c)
 
     def roller_slip(self, t, X, V, A, outputs) -> np.ndarray:
-        """Roller slip per roller [%] (:func:`components.bearing.roller_slip_pct`) from the body speeds ``V``."""
+        """Roller slip per roller [%] (:func:`components.bearing.roller_slip_pct`) from the body speeds ``V`` (nb, 3),
+        or at S samples (S, nb, 3)."""
         p = self.plan
-        return roller_slip_pct(p.bearing, V[p.roller_body, 2] - V[p.carrier, 2],
-                               V[p.planet[p.roller_bearing], 2] - V[p.carrier, 2])
+        w_c = V[..., p.carrier, None, 2]
+        return roller_slip_pct(p.bearing, V[..., p.roller_body, 2] - w_c, V[..., p.planet[p.roller_bearing], 2] - w_c)
 
     def probes(self) -> list:
+        """The recorded series; each takes a block's samples at once (``batched``)."""
         where = "radial: from the carrier axis through the planet; tangential 90 deg ahead"
         out = [mbd.DerivedOutput("bearing.load_radial", lambda *a: self.load(*a)[0], "N",
-                                 f"planet bearing load (pin reaction), radial component ({where})", instances=self.names),
+                                 f"planet bearing load (pin reaction), radial component ({where})",
+                                 instances=self.names, batched=True),
                mbd.DerivedOutput("bearing.load_tangential", lambda *a: self.load(*a)[1], "N",
                                  f"planet bearing load (pin reaction), tangential component ({where})",
-                                 instances=self.names)]
+                                 instances=self.names, batched=True)]
         if self.plan.cage is not None:
             out.append(mbd.DerivedOutput("bearing.cage_slip", self.slip, "percent",
                                          "cage speed below its epicyclic speed, relative to the carrier",
-                                         instances=self.names))
+                                         instances=self.names, batched=True))
         if self.plan.rollers:
             out.append(mbd.DerivedOutput("bearing.roller_slip", self.roller_slip, "percent",
                                          "roller spin below its pure-rolling spin, relative to the carrier",
-                                         instances=self.rollers))
+                                         instances=self.rollers, batched=True))
         return out

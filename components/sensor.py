@@ -41,7 +41,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import signal
 
 import mbd
 from mbd.ad import wrap_angle
@@ -100,6 +99,8 @@ def mode_acceleration(t, load, inertia: float, frequency: float, damping_ratio: 
     k, c = wn * wn, 2.0 * damping_ratio * wn                       # per unit inertia
     mode = (np.array([[0.0, 1.0], [-k, -c]]), np.array([[0.0], [1.0 / inertia]]), np.array([[-k, -c]]),
             np.array([[1.0 / inertia]]))
+    from scipy import signal  # deferred: scipy.signal (≈ 0.5 s, with scipy.stats) only for a housing response
+
     return signal.lsim(mode, load, np.asarray(t, float), X0=[load[0] / (inertia * k), 0.0], interp=True)[1]
 
 

@@ -30,7 +30,8 @@ import os
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Mapping, Sequence
+from collections.abc import Mapping
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -108,12 +109,15 @@ class ElementOutput:
     names), others (e.g. "planet", "pair") become extra coordinates ``<family>.<name>`` along it.
     ``derived`` (optional): a function of the family's outputs (the dict of one evaluation) returning
     further per-instance arrays a caller derives from them (e.g. the film of a contact), recorded under
-    their keys like the family's own."""
+    their keys like the family's own. ``batched``: ``derived`` is elementwise over the samples, so a block's
+    samples are handed to it at once (each output (S, n), each result (S, n)); else it is called sample by
+    sample."""
     element: str
     keys: Sequence[str] | None = None
     meta: Mapping[str, tuple[str, str]] | None = None
     instances: Mapping[str, tuple[str, Sequence]] | None = None
     derived: Callable[[Mapping[str, np.ndarray]], Mapping[str, np.ndarray]] | None = None
+    batched: bool = False
 
     def evaluate(self, outputs: Mapping[str, np.ndarray]) -> Mapping[str, np.ndarray]:
         """The family's outputs with the derived ones added."""
@@ -125,12 +129,19 @@ class DerivedOutput:
     """A quantity derived from each sample: ``fn(t, X, V, A, outputs)`` → one float per instance, where
     X, V, A are (n_bodies, 3) arrays of every body in the reference frame R (bodies at rest in I with
     their frame acceleration) and ``outputs`` the element outputs at the sample (evaluated once per sample
-    and shared with the :class:`ElementOutput` probes). Recorded as ``<name>`` along ``<name>.instance``."""
+    and shared with the :class:`ElementOutput` probes). Recorded as ``<name>`` along ``<name>.instance``.
+    ``batched``: ``fn`` is elementwise over the samples and takes a block's S samples at once — ``t`` (S,),
+    X, V, A (S, n_bodies, 3), the outputs (S, n) — returning (S, n_instances); else it is called sample by
+    sample."""
     name: str
     fn: Callable
     units: str
     long_name: str
     instances: Sequence[str] = ("0",)
+    batched: bool = False
+
+
+WRITE_BYTES = 64 * 2**20     # the chunks joined in memory up to this size when the results file is written
 
 
 class Recorder:
@@ -250,8 +261,9 @@ class Recorder:
 
     def record_block(self, block) -> None:
         """Every sample time in a compiled block's span (its start state's t, its last step's end], as
-        :meth:`record` step by step; the element outputs of all its samples in one call
-        (:meth:`mbd.System.outputs_batch`)."""
+        :meth:`record` step by step, all its samples at once: the element outputs in one call
+        (:meth:`mbd.System.outputs_batch`), the bodies' motion as (S, ...) arrays, appended to the chunk
+        buffers as one block."""
         t = np.concatenate([[block.start.t], block.log[:, 0]])
         ks = self.sample_times(t[0], t[-1], include_start=False)
         if ks.size == 0:
@@ -265,61 +277,96 @@ class Recorder:
         q, v, a = hermite_rows(Q[j], V[j], A[j], Q[j + 1], V[j + 1], A[j + 1], th, h)
         z = {k: x[j] for k, x in Z.items()}                 # the step's start (as record: s0.z)
         outs = self.system.outputs_batch(ts, q, v, z) if self._needs_outputs else None
-        for n, k in enumerate(ks):
-            one = None if outs is None else {f: {key: x[n] for key, x in o.items()} for f, o in outs.items()}
-            self._sample(ts[n], q[n], v[n], a[n], {key: x[n] for key, x in z.items()}, one)
-            self.next_index = k + 1
+        self._samples(ts, q, v, a, outs)
+        self.next_index = int(ks[-1]) + 1
 
     @property
     def _needs_outputs(self) -> bool:
         return any(kind != "body" for kind, _, _ in self._plan)
 
-    def _sample(self, t, q, v, a, z, outs=None):
+    def _samples(self, ts, q, v, a, outs) -> None:
+        """S samples at times ``ts`` (S,) from their states ``q``, ``v``, ``a`` (S, n_free) and element outputs
+        ``outs`` ({family: {key: (S, n)}}): the values :meth:`_sample` takes one by one, as (S, ...) arrays (the
+        same operations, elementwise over the samples); a derived quantity whose function is not ``batched`` is
+        evaluated sample by sample."""
         m = self.model
-        qf, vf = m.full(t, q, v)
+        S = ts.size
+        qf, vf = m.full_batch(ts, q, v)
         af = np.zeros_like(qf)
-        af[m.free] = a
-        fs = m.frame.at(t)
+        af[:, m.free] = a
+        fs = m.frame_batch(ts)                               # (S, 1) columns
         if m.fixed.any() and not m.frame.is_inertial:
             _fixed_body_acceleration(m, fs, qf, vf, af)
+        X, Vb, Ab = m.body_poses(qf), m.body_poses(vf), m.body_poses(af)      # (S, nb, 3)
+        rows = None
+        cols = {}
         for kind, p, sel in self._plan:
             if kind == "body":
-                Q, V, A = m.poses(qf)[sel], m.poses(vf)[sel], m.poses(af)[sel]
+                Qs, Vs, As = X[:, sel], Vb[:, sel], Ab[:, sel]
                 if p.frame == "fixed":
-                    Q, V, A = to_fixed(Q, V, fs, A)
-                for qty, arr in zip("qva", (Q, V, A)):
+                    Qs, Vs, As = to_fixed(Qs, Vs, fs, As)
+                for qty, arr in zip("qva", (Qs, Vs, As)):
                     if qty in p.quantities:
                         (lin, _, _), (ang, _, _) = BODY_QUANTITIES[qty]
-                        self._buf[f"{p.name}.{lin}"].append(np.array(arr[:, :2]))
-                        self._buf[f"{p.name}.{ang}"].append(np.array(arr[:, 2]))
-            else:
-                if outs is None:
-                    outs = self.system.outputs(t, q, v, z)
-                if kind == "derived":
-                    X, V, A = m.poses(qf), m.poses(vf), m.poses(af)
-                    self._buf[p.name].append(np.asarray(p.fn(t, X, V, A, outs), dtype=float).reshape(-1).copy())
-                    continue
-                o = p.evaluate(outs[p.element])
+                        cols[f"{p.name}.{lin}"] = np.array(arr[..., :2])
+                        cols[f"{p.name}.{ang}"] = np.array(arr[..., 2])
+                continue
+            if kind == "derived" and p.batched:
+                cols[p.name] = np.asarray(p.fn(ts, X, Vb, Ab, outs), dtype=float).reshape(S, -1).copy()
+                continue
+            if kind == "elem" and (p.derived is None or p.batched):
+                o = p.evaluate({key: np.ascontiguousarray(x, dtype=float) for key, x in outs[p.element].items()})
+                shape = (S, self.dims[f"{p.element}.instance"])
                 for k in sel:
-                    self._buf[f"{p.element}.{k}"].append(np.asarray(o[k], dtype=float).copy())
-        self._times.append(t)
-        if len(self._times) >= self.chunk:
-            self.flush()
+                    cols[f"{p.element}.{k}"] = np.array(np.broadcast_to(np.asarray(o[k], dtype=float), shape))
+                continue
+            if rows is None:                                 # sample by sample: each sample's outputs, read lazily
+                rows = [_SampleOutputs(outs, n) for n in range(S)]
+            if kind == "derived":
+                cols[p.name] = np.stack([np.asarray(p.fn(ts[n], X[n], Vb[n], Ab[n], rows[n]), dtype=float).reshape(-1)
+                                         for n in range(S)])
+            else:
+                per = [p.evaluate(rows[n][p.element]) for n in range(S)]
+                for k in sel:
+                    cols[f"{p.element}.{k}"] = np.stack([np.asarray(o[k], dtype=float) for o in per])
+        self._append(ts, cols)
+
+    def _sample(self, t, q, v, a, z, outs=None):
+        """One sample (the numpy engine's path, :meth:`record`): its outputs evaluated at the state unless given."""
+        if outs is None and self._needs_outputs:
+            outs = self.system.outputs(t, q, v, z)
+        one = None if outs is None else {f: {key: np.asarray(x)[None] for key, x in o.items()} for f, o in outs.items()}
+        self._samples(np.array([t], dtype=float), np.asarray(q)[None], np.asarray(v)[None], np.asarray(a)[None], one)
+
+    def _append(self, ts, cols) -> None:
+        """Buffer S samples (``cols``: each variable's (S, ...) array); whole chunks of ``chunk`` samples go to
+        disk as soon as they are full (memory stays bounded)."""
+        self._times.extend(float(x) for x in ts)
+        for k, x in cols.items():
+            self._buf[k].append(x)
+        while len(self._times) >= self.chunk:
+            self._write_chunk(self.chunk)
 
     # chunks, checkpoints, final file -----------------------------------------------------------
     def flush(self) -> None:
-        if not self._times:
-            return
+        """Write every buffered sample to a chunk file."""
+        if self._times:
+            self._write_chunk(len(self._times))
+
+    def _write_chunk(self, n: int) -> None:
+        """The first ``n`` buffered samples to the next chunk file (atomic); the rest stay buffered."""
         self.parts.mkdir(parents=True, exist_ok=True)
-        arrays = {"time": np.array(self._times)}
+        arrays = {"time": np.array(self._times[:n])}
+        rest = {}
         for k, lst in self._buf.items():
-            arrays[k] = np.stack(lst)
+            x = lst[0] if len(lst) == 1 else np.concatenate(lst)
+            arrays[k], rest[k] = x[:n], x[n:]
         bio = io.BytesIO()
         np.savez(bio, **{f"v{i}": a for i, a in enumerate(arrays.values())}, names=np.array(list(arrays)))
         atomic_write_bytes(self.parts / f"chunk_{self.n_chunks:06d}.npz", bio.getvalue())
         self.n_chunks += 1
-        self._times = []
-        self._buf = {k: [] for k in self._buf}
+        self._times = self._times[n:]
+        self._buf = {k: ([rest[k]] if self._times else []) for k in self._buf}
 
     def checkpoint_state(self) -> dict:
         self.flush()
@@ -346,11 +393,31 @@ class Recorder:
                 names = list(d["names"])
                 yield {nm: d[f"v{j}"] for j, nm in enumerate(names)}
 
+    def _chunk_groups(self):
+        """The chunks joined into groups of up to :data:`WRITE_BYTES` (each variable written once per group: a
+        write into the file costs about as much for one sample as for thousands)."""
+        group, size = [], 0
+        for c in self._chunks():
+            group.append(c)
+            size += sum(x.nbytes for x in c.values())
+            if size >= WRITE_BYTES:
+                yield {k: np.concatenate([g[k] for g in group]) for k in group[0]}
+                group, size = [], 0
+        if group:
+            yield group[0] if len(group) == 1 else {k: np.concatenate([g[k] for g in group]) for k in group[0]}
+
+    def _samples_on_disk(self) -> int:
+        total = 0
+        for i in range(self.n_chunks):
+            with np.load(self.parts / f"chunk_{i:06d}.npz") as d:
+                total += d[f"v{list(d['names']).index('time')}"].shape[0]
+        return total
+
     def finalize(self, attrs: dict | None = None) -> Path:
         """Stream all chunks into the results file (netCDF4 via h5netcdf) atomically; the chunks are removed
         only once the file is in place (a failed write keeps them and the checkpoint: the run can resume)."""
         self.flush()
-        total = sum(c["time"].shape[0] for c in self._chunks())
+        total = self._samples_on_disk()
         self.path.parent.mkdir(parents=True, exist_ok=True)
         tmp = _tmp_for(self.path)
         with _discard_on_failure(tmp):
@@ -387,7 +454,7 @@ class Recorder:
                 created[name] = f.create_variable(name, dims, float, chunks=None)
                 created[name].attrs.update(vattrs)
             i0 = 0
-            for c in self._chunks():
+            for c in self._chunk_groups():
                 n = c["time"].shape[0]
                 tv[i0: i0 + n] = c["time"]
                 for name in self.vars:
@@ -395,15 +462,47 @@ class Recorder:
                 i0 += n
 
 
+class _SampleOutputs(Mapping):
+    """Sample ``n`` of a block's element outputs ({family: {key: (S, n)}}) as one evaluation's {family: {key: (n,)}},
+    each row read when asked for (a derived quantity evaluated sample by sample reads a few of them)."""
+
+    def __init__(self, outs, n: int):
+        self._outs, self._n = outs, n
+
+    def __getitem__(self, family):
+        return _SampleRow(self._outs[family], self._n)
+
+    def __iter__(self):
+        return iter(self._outs)
+
+    def __len__(self):
+        return len(self._outs)
+
+
+class _SampleRow(Mapping):
+    def __init__(self, out, n: int):
+        self._out, self._n = out, n
+
+    def __getitem__(self, key):
+        return self._out[key][self._n]
+
+    def __iter__(self):
+        return iter(self._out)
+
+    def __len__(self):
+        return len(self._out)
+
+
 def _fixed_body_acceleration(m, fs, qf, vf, af) -> None:
     """Acceleration in R of the bodies at rest in I (the frame terms with F = 0, docs/model.md §2.3):
-    a fixed body seen from a rotating R accelerates, and to_fixed must map it back to zero."""
+    a fixed body seen from a rotating R accelerates, and to_fixed must map it back to zero. ``qf``, ``vf``,
+    ``af`` (S, n_full) at S samples, the frame state ``fs`` of (S, 1) columns."""
     idx = np.flatnonzero(m.fixed)
-    x, y, vx, vy = qf[3 * idx], qf[3 * idx + 1], vf[3 * idx], vf[3 * idx + 1]
+    x, y, vx, vy = qf[:, 3 * idx], qf[:, 3 * idx + 1], vf[:, 3 * idx], vf[:, 3 * idx + 1]
     W, dW = fs.omega, fs.domega
-    af[3 * idx] = W * W * x + 2 * W * vy + dW * y
-    af[3 * idx + 1] = W * W * y - 2 * W * vx - dW * x
-    af[3 * idx + 2] = -dW
+    af[:, 3 * idx] = W * W * x + 2 * W * vy + dW * y
+    af[:, 3 * idx + 1] = W * W * y - 2 * W * vx - dW * x
+    af[:, 3 * idx + 2] = -dW
 
 
 def hermite_rows(q0, v0, a0, q1, v1, a1, th, h):

@@ -26,7 +26,7 @@ from components.families import MESH_FAMILY
 from components.static import DEFAULT_SNAPSHOTS, STATIC_LIVES_NOTE
 from components.outputs import FAMILY, radial_tangential
 from components.outputs import relative_life as iso_relative_life
-from components.results import SUMMARY_WORDS, Summary, json_attr, open_run, percent_change
+from components.results import SUMMARY_WORDS, Summary, open_run, percent_change
 from components.results.io import atomic_write_text, write_summary
 
 from .core.integrity import read_summary
@@ -267,59 +267,60 @@ MESH_COLUMNS = {"sun_inner": "sun – inner planet", "inner_outer": "inner – o
 MESH_FORCE_WORDS = "drive-flank force − coast-flank force"     # drive: the flank the torque path loads
 
 
-def history_groups(runs: dict[str, Path]) -> dict[str, tuple[list, list[str]]]:
+def history_groups(runs: dict) -> dict[str, tuple[list, list[str]]]:
     """The time histories of one condition's runs in readable groups (:data:`HISTORY_GROUPS`): group -> (rows of
-    :func:`viz.plots.time_history_group`, its columns). SI values from results.nc; the cage accelerations
-    relative to the planet are split radial/tangential here (physics stays out of viz)."""
+    :func:`viz.plots.time_history_group`, its columns). ``runs``: direction -> results.nc, or that file read
+    already (:func:`viz.results.load_run`: a point's figures read each file once). SI values from results.nc;
+    the cage accelerations relative to the planet are split radial/tangential here (physics stays out of viz)."""
+    from viz.results import Run, load_run  # deferred: matplotlib (viz), only when the figures are drawn
+
     rows: dict[str, dict[tuple, dict]] = {g: {} for g in HISTORY_GROUPS}   # group -> (words, unit) -> col -> run
 
     def put(group, words, unit, col, run, t, y):
         rows[group].setdefault((words, unit), {}).setdefault(col, {})[run] = (t, np.asarray(y, float))
 
-    for d, p in runs.items():
+    for d, r in runs.items():
+        run = r if isinstance(r, Run) else load_run(r)
+        out = run.outputs
         # the flank the torque path loads, per mesh, as the run recorded it (reverse loads the other flanks)
-        run = open_run(p)
-        drive = {k: m.get("drive_flank") for k, m in (read_summary(run.summary_path) or Summary()).meshes.items()}
-        with run.dataset() as ds:
-            bmap = json_attr(ds.attrs, "bearings", p)
-            t = np.asarray(ds["time"].values, float)
-            bodies = list(ds["motion.body"].values)
-            for i, b in enumerate(bmap):
-                if b["pair"] != 0:
-                    continue
-                col = b["kind"]
-                if "bearing.load_radial" in ds:
-                    put("bearing_loads", "bearing load, radial (+ outward)", "N", col, d, t,
-                        ds["bearing.load_radial"].values[:, i])
-                    put("bearing_loads", "bearing load, tangential", "N", col, d, t,
-                        ds["bearing.load_tangential"].values[:, i])
-                if b["type"] != "rollers":
-                    continue
-                put("roller_contacts", "roller–inner race load", "N", col, d, t,
-                    ds[f"{FAMILY['race_inner']}.load"].values[:, b["race_inner"][0]])
-                put("roller_contacts", "roller–outer race load", "N", col, d, t,
-                    ds[f"{FAMILY['race_outer']}.load"].values[:, b["race_outer"][0]])
-                if "pocket" in b:
-                    put("roller_contacts", "roller–cage pocket force", "N", col, d, t,
-                        ds[f"{FAMILY['pocket']}.force"].values[:, b["pocket"][0]])
-                if "guide" in b:
-                    put("cage", "cage–guide force", "N", col, d, t, ds[f"{FAMILY['guide']}.force"].values[:, b["guide"]])
-                    a, pos = ds["motion.acceleration"].values, ds["motion.position"].values
-                    ic, ip, ik = (bodies.index(x) for x in (b["cage"], b["planet"], "carrier"))
-                    rad, tan = radial_tangential(a[:, ic] - a[:, ip], pos[:, ip], pos[:, ik])
-                    put("cage", "cage acc. rel. planet, radial", "m/s^2", col, d, t, rad)
-                    put("cage", "cage acc. rel. planet, tangential", "m/s^2", col, d, t, tan)
-                if "bearing.cage_slip" in ds:
-                    put("cage", "cage slip", "%", col, d, t, ds["bearing.cage_slip"].values[:, i])
-            for key in MESH_COLUMNS:
-                fam = MESH_FAMILY[key]
-                if f"{fam}.force" in ds and drive.get(key) in (1, -1):
-                    # the file's force is flank +1's minus flank −1's: times the drive flank's sign it reads
-                    # drive − coast, > 0 while the loaded flank carries the load, in either direction
-                    put("mesh", MESH_FORCE_WORDS, "N", key, d, t, drive[key] * ds[f"{fam}.force"].values[:, 0])
-                if f"{fam}.transmission_error" in ds:
-                    put("mesh", "loaded transmission error", "m", key, d, t,
-                        ds[f"{fam}.transmission_error"].values[:, 0])
+        drive = {k: m.get("drive_flank")
+                 for k, m in (read_summary(open_run(run.path).summary_path) or Summary()).meshes.items()}
+        t = run.t
+        bodies = list(run.bodies)
+        for i, b in enumerate(run.bearings):
+            if b["pair"] != 0:
+                continue
+            col = b["kind"]
+            if "bearing.load_radial" in out:
+                put("bearing_loads", "bearing load, radial (+ outward)", "N", col, d, t,
+                    out["bearing.load_radial"][:, i])
+                put("bearing_loads", "bearing load, tangential", "N", col, d, t, out["bearing.load_tangential"][:, i])
+            if b["type"] != "rollers":
+                continue
+            put("roller_contacts", "roller–inner race load", "N", col, d, t,
+                out[f"{FAMILY['race_inner']}.load"][:, b["race_inner"][0]])
+            put("roller_contacts", "roller–outer race load", "N", col, d, t,
+                out[f"{FAMILY['race_outer']}.load"][:, b["race_outer"][0]])
+            if "pocket" in b:
+                put("roller_contacts", "roller–cage pocket force", "N", col, d, t,
+                    out[f"{FAMILY['pocket']}.force"][:, b["pocket"][0]])
+            if "guide" in b:
+                put("cage", "cage–guide force", "N", col, d, t, out[f"{FAMILY['guide']}.force"][:, b["guide"]])
+                a, pos = run.a[..., :2], run.q[..., :2]         # the bodies' x, y in R
+                ic, ip, ik = (bodies.index(x) for x in (b["cage"], b["planet"], "carrier"))
+                rad, tan = radial_tangential(a[:, ic] - a[:, ip], pos[:, ip], pos[:, ik])
+                put("cage", "cage acc. rel. planet, radial", "m/s^2", col, d, t, rad)
+                put("cage", "cage acc. rel. planet, tangential", "m/s^2", col, d, t, tan)
+            if "bearing.cage_slip" in out:
+                put("cage", "cage slip", "%", col, d, t, out["bearing.cage_slip"][:, i])
+        for key in MESH_COLUMNS:
+            fam = MESH_FAMILY[key]
+            if f"{fam}.force" in out and drive.get(key) in (1, -1):
+                # the file's force is flank +1's minus flank −1's: times the drive flank's sign it reads
+                # drive − coast, > 0 while the loaded flank carries the load, in either direction
+                put("mesh", MESH_FORCE_WORDS, "N", key, d, t, drive[key] * out[f"{fam}.force"][:, 0])
+            if f"{fam}.transmission_error" in out:
+                put("mesh", "loaded transmission error", "m", key, d, t, out[f"{fam}.transmission_error"][:, 0])
     out = {}
     for g, by_row in rows.items():
         if by_row:
@@ -343,19 +344,29 @@ def headline_values(results: dict) -> dict[tuple, float | None]:
     return vals
 
 
-def point_figures(results: dict, out: Path, c) -> list[Path]:
-    """Point ``c``'s own figures: its time histories in groups and its cage orbits, forward and reverse."""
+# a point's figures in two pieces of about equal work, drawn at once on two workers beside the runs (each reads the
+# point's two results files): the time histories of the bearing loads, the roller contacts and the meshes; the cage
+# histories and the cage orbits
+POINT_PIECES = (("bearing_loads", "roller_contacts", "mesh"), ("cage", "cage_orbits"))
+
+
+def point_figures(results: dict, out: Path, c, figures=None) -> list[Path]:
+    """Point ``c``'s own figures: its time histories in groups (:data:`HISTORY_GROUPS`) and its cage orbits
+    ("cage_orbits"), forward and reverse; ``figures``: those of them (None: all)."""
     # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
     from viz import plots as vp
-    from viz.results import study_cage_pictures
+    from viz.results import load_run, study_cage_pictures
 
     runs = _runs_of(results, out, c)
     if not runs:
         return []
+    runs = {d: load_run(p) for d, p in runs.items()}        # each file read once for all the point's figures
     paths = []
     f_m = [results[_label_of(results, c, d)].get("f_m_hz") for d in runs]
     mesh_period = 1.0 / f_m[0] if f_m and f_m[0] else None
     for g, (rows, cols) in history_groups(runs).items():
+        if figures is not None and g not in figures:
+            continue
         titles = {"inner": "inner planet bearing", "outer": "outer planet bearing", **MESH_COLUMNS}
         # forward and reverse in rows of their own; the mesh histories, sampled a few times per mesh cycle, as
         # their envelope over a mesh period
@@ -363,15 +374,17 @@ def point_figures(results: dict, out: Path, c) -> list[Path]:
                                            column_titles=titles, title=f"{_title(c)}: {HISTORY_GROUPS[g]}",
                                            separate_runs=True, envelope=mesh_period if g == "mesh" else None,
                                            envelope_words="mesh cycle"))
-    paths += study_cage_pictures(runs, out, prefix=f"{point_tag(c)}_",
-                                 title=f"{_title(c)}: cage orbits in the guide clearance")
+    if figures is None or "cage_orbits" in figures:
+        paths += study_cage_pictures(runs, out, prefix=f"{point_tag(c)}_",
+                                     title=f"{_title(c)}: cage orbits in the guide clearance")
     return paths
 
 
-def point_work(results: dict, out: Path, c, with_animation: bool) -> list[Path]:
-    """What a point's finished runs give on their own — its figures and (``with_animation``) its animation — done
-    beside the other points' runs (:meth:`PaperStudy.beside`)."""
-    return point_figures(results, out, c) + (animate(results, out, only=[c]) if with_animation else [])
+def point_work(results: dict, out: Path, c, piece) -> list[Path]:
+    """One piece of what a point's finished runs give on their own — some of its figures (a :data:`POINT_PIECES`
+    of :func:`point_figures`) or its animation ("animation") — done beside the other points' runs
+    (:meth:`PaperStudy.beside`)."""
+    return animate(results, out, only=[c]) if piece == "animation" else point_figures(results, out, c, piece)
 
 
 def plots(results: dict, out: Path, machine: str = "", drawn=()) -> list[Path]:
@@ -480,7 +493,9 @@ class PaperStudy(Study):
             if not all(o.ok for o in outcomes.values()):    # a failed run: the report draws what it can
                 return None
             results = {label: Summary.of(o.summary) for label, o in outcomes.items()}
-            return point_work, (results, out, c, animation)
+            # in pieces, each on a worker: the last point's figures do not wait on one worker while the other idles
+            return [(point_work, (results, out, c, piece)) for piece in (*POINT_PIECES, *(("animation",) if animation
+                                                                                          else ()))]
         return Beside(key=lambda case: case.condition, task=task)
 
     def machine_identity(self) -> dict:

@@ -20,7 +20,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.patches import Patch
+from matplotlib.patches import Patch, Polygon
 from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator
 
 from components.results import percent_change
@@ -788,7 +788,8 @@ def display_unit(unit: str | None, values=()) -> tuple[float, str]:
     """(factor, unit) to show SI ``values`` of ``unit`` with: forces in kN from 1 kN on, lengths in µm or mm,
     times in ms below 2 s, exponents written as superscripts. Multiply the data by the factor."""
     unit = unit or ""
-    v = np.asarray([x for x in np.ravel(np.asarray(values, dtype=float)) if np.isfinite(x)], float)
+    v = np.ravel(np.asarray(values, dtype=float))
+    v = v[np.isfinite(v)]
     big = float(np.max(np.abs(v))) if v.size else 0.0
     if unit == "N":
         return (1e-3, "kN") if big >= 1e3 else (1.0, "N")
@@ -1014,7 +1015,10 @@ def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = Non
             for row, ax in enumerate(axes[:, k]):
                 if r_out > C:             # beyond the circle: the cage presses into its land, an elastic contact
                     ring = np.concatenate([C * np.exp(1j * circle), r_out * np.exp(-1j * circle)])
-                    ax.fill(ring.real, ring.imag, color="#f2c14e", alpha=0.35, lw=0, gid="land_deflection")
+                    # the axes' limits are set below: added as an artist, its 7202 vertices are not scanned for
+                    # data limits (Axes.fill's add_patch: a second a figure)
+                    ax.add_artist(Polygon(np.column_stack([ring.real, ring.imag]), closed=True, color="#f2c14e",
+                                          alpha=0.35, lw=0, gid="land_deflection"))
                     beyond = max(beyond, r_out - C)
                 ax.plot(C * np.cos(circle), C * np.sin(circle), color="0.45", lw=1.4, ls="--")
                 ax.plot([0], [0], marker="+", color="0.35", ms=9, mew=1.2, ls="none")

@@ -193,7 +193,9 @@ def element_probes(scene) -> list[ElementOutput]:
                      f"{flanks[f]:+d}, the one the torque path loads) along its line of action (0: perfect rigid "
                      "teeth touching; < 0: that flank open)")}
             derived = partial(loaded_transmission_error, flank=flanks[f])
-        probes.append(ElementOutput(f, list(meta), meta=meta, instances=coords.get(f), derived=derived))
+        # every derived quantity here is elementwise over the samples: a block's samples at once
+        probes.append(ElementOutput(f, list(meta), meta=meta, instances=coords.get(f), derived=derived,
+                                    batched=True))
     return probes
 
 

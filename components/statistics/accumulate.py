@@ -279,8 +279,11 @@ class FlankPeaks:
 
     def add_steps(self, t, rows) -> None:
         """K steps: their K+1 ends ``t`` and the quantities at them (``rows``, the drive forces among them)."""
-        V = np.concatenate([np.asarray(rows[k], float).reshape(t.size, -1) for k in self.keys], axis=1)
-        accumulate_flank(np.asarray(t, float), V, self.t0, self.t_end, self.period, self.scale, self.hist, self.sums,
+        # C order, as compile_accumulators compiles the kernel (the outputs' columns join in F order: a second
+        # compile, about a second, in every process whose cache lacked it)
+        V = np.ascontiguousarray(np.concatenate([np.asarray(rows[k], float).reshape(t.size, -1) for k in self.keys],
+                                                axis=1))
+        accumulate_flank(np.ascontiguousarray(t, float), V, self.t0, self.t_end, self.period, self.scale, self.hist, self.sums,
                          self.cyc)
 
     def complete(self) -> bool:

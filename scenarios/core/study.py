@@ -41,7 +41,8 @@ from .points import machine_identity
 from .memory import process_peak_mb
 from .plausibility import check_runs, estimated_wall_s
 from .runner import RunConfig, run_report
-from .sweep import Beside, Case, Outcome, Status, _case_cfg, _is_finished, build_params, check_folders, sweep, validate_cases
+from .sweep import (Beside, Case, Outcome, Status, _case_cfg, _is_finished, build_params, check_folders, join_closing,
+                    sweep, validate_cases)
 
 __all__ = ["Study", "StudyRun", "run_lines", "runs_line", "TIMING_ENV"]
 
@@ -200,8 +201,9 @@ class Study(abc.ABC):
         self.prepare(cfg, cases)
         t_sweep, sweep_timing = time.perf_counter(), {}
         beside = self.beside(cfg)
+        # the local cluster closes behind the study (its workers' exit, seconds) while the report is drawn
         outcomes = sweep(cases, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
-                         overwrite=a.overwrite, announce=True, timing=sweep_timing, beside=beside)
+                         overwrite=a.overwrite, announce=True, timing=sweep_timing, beside=beside, close_behind=True)
         self._stamp(outcomes, machine)
         run = StudyRun(self.out, cases, outcomes, beside=beside.done if beside is not None else {})
         more = self.second_phase(run)
@@ -213,8 +215,10 @@ class Study(abc.ABC):
                 print(f"warning (--force): {w}")
             check_folders(more, cfg, a.overwrite)
             self.say_before(more, cfg, advice)
+            join_closing()              # the first sweep's cluster closed before the second one's starts
             second = sweep(more, cfg, workers=a.workers, scheduler=a.scheduler, progress=not a.no_progress,
-                           overwrite=a.overwrite, announce=True, timing=sweep_timing.setdefault("second_phase", {}))
+                           overwrite=a.overwrite, announce=True, timing=sweep_timing.setdefault("second_phase", {}),
+                           close_behind=True)
             self._stamp(second, machine)
             outcomes = {**outcomes, **second}
             cases = [*cases, *more]
@@ -224,11 +228,13 @@ class Study(abc.ABC):
         if self.keep_earlier:
             run.kept = self._earlier(run)
         extra = self.report(run)
+        t_join = time.perf_counter()
+        join_closing()                  # the cluster closing behind the report (sweep_timing: cluster_close_wait_s)
         t_end = time.perf_counter()
         if os.environ.get(TIMING_ENV):
             atomic_write_text(Path(os.environ[TIMING_ENV]), json.dumps({
                 "checks_s": t_prepare - t0, "prepare_s": t_sweep - t_prepare, "sweep_s": t_report - t_sweep,
-                "sweep": sweep_timing, "report_s": t_end - t_report, "steps_s": run.step_s, "total_s": t_end - t0,
+                "sweep": sweep_timing, "report_s": t_join - t_report, "steps_s": run.step_s, "total_s": t_end - t0,
                 "peak_rss_MB": process_peak_mb(), "runs": {k: o.span for k, o in outcomes.items()}}, indent=1))
         if self.record:
             atomic_write_text(self.out / "study.json", json.dumps(

@@ -50,6 +50,7 @@ from .integrity import OtherResults, claim_folder, differences, read_summary
 from .runner import code_digest, finished_run, parameters_fingerprint, run_case, run_description, run_fingerprint
 
 __all__ = ["Case", "Status", "Outcome", "Beside", "Travelled", "sweep", "run_sweep", "execute_case", "execute_on_worker",
+           "join_closing",
            "check_folders", "user_overrides", "validate_cases", "dask_client", "OPERATING_AXES", "RETRIES",
            "say_design_warnings"]
 
@@ -308,9 +309,12 @@ def execute_on_worker(case: Case, cfg, overwrite: bool, code: str, texts: dict) 
 class Beside:
     """Work to do beside the runs, e.g. one operating point's figures: the cases fall into groups (``key(case)``;
     None: in none), and once every case of a group has its outcome, ``task(key, {label: outcome})`` gives
-    ``(function, args)`` or None. On a local cluster the function runs on a worker, ahead of the runs still
-    queued, while the other runs go on; without Dask, or on a cluster whose workers share no filesystem with this
-    process, it runs here at that moment. ``done``: {key: its return value, or the exception it raised}."""
+    ``(function, args)``, a list of them (pieces of the group's work that can run at once: on a cluster, on as many
+    workers; the last group's work then does not wait on one worker while the others idle) or None. On a local
+    cluster each function runs on a worker, ahead of the runs still queued, while the other runs go on; without
+    Dask, or on a cluster whose workers share no filesystem with this process, it runs here at that moment.
+    ``done``: {key: its return value (pieces that return lists: their lists joined, in the order of the pieces),
+    or the exception one of its pieces raised}."""
     key: Callable[[Case], object]
     task: Callable[[object, dict], tuple | None]
     done: dict = field(default_factory=dict)
@@ -325,21 +329,28 @@ class Beside:
         return out
 
     def ready(self, groups: dict, results: dict, started: set):
-        """(key, (function, args)) of every group whose cases all have outcomes now, each once."""
+        """(key, (function, args)) of every piece of every group whose cases all have outcomes now, each once."""
         for k, labels in groups.items():
             if k not in started and all(lab in results for lab in labels):
                 started.add(k)
                 work = self.task(k, {lab: results[lab] for lab in labels})
-                if work is not None:
-                    yield k, work
+                for piece in ([] if work is None else work if isinstance(work, list) else [work]):
+                    yield k, piece
 
     def here(self, k, work) -> None:
         fn, fargs = work
         self.took(k, timed_call(fn, *fargs))
 
     def took(self, k, got: tuple) -> None:
-        """Keep what :func:`timed_call` gave for group ``k``: its value (or exception) and its span."""
-        self.done[k], span = got
+        """Keep what :func:`timed_call` gave for a piece of group ``k``: its value (or exception; a group's first
+        exception stays) and its span. Pieces are taken in the order :meth:`ready` gave them."""
+        value, span = got
+        if k not in self.done:
+            self.done[k] = value
+        elif not isinstance(self.done[k], BaseException):
+            self.done[k] = (value if isinstance(value, BaseException)
+                            else [*self.done[k], *value] if isinstance(value, list) and isinstance(self.done[k], list)
+                            else value)
         self.spans.append(span)
 
 
@@ -402,7 +413,7 @@ def run_sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str
 
 def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | None = None,
           progress: bool = True, overwrite: bool = False, announce: bool = False,
-          timing: dict | None = None, beside: Beside | None = None) -> dict[str, Outcome]:
+          timing: dict | None = None, beside: Beside | None = None, close_behind: bool = False) -> dict[str, Outcome]:
     """Run every case; returns {label: :class:`Outcome`}. One case runs in-process (no cluster).
     ``overwrite``: replace finished results of other parameters (else :func:`check_folders` refuses);
     ``announce``: say first how many runs will run and how many are reused; ``timing``: a dict to fill with the
@@ -410,7 +421,9 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
     workers started —, ``runs_s`` from the first submission to the last result, ``cluster_close_s``; the runs'
     phase as wall-clock stamps ``runs_start_unix_s``, ``runs_end_unix_s``; ``workers``, ``dask``); ``beside``: work
     done group by group as the runs finish (:class:`Beside`), its wall seconds after the last run ``beside_tail_s``
-    and each piece's span ``beside_spans`` (:func:`timed_call`)."""
+    and each piece's span ``beside_spans`` (:func:`timed_call`); ``close_behind``: a local cluster closes behind the
+    caller once its runs are in (:func:`dask_client`; the caller's :func:`join_closing` waits for it, and sets
+    ``cluster_close_s`` and ``cluster_close_wait_s``)."""
     timing = {} if timing is None else timing
     groups, started = (beside.groups(cases), set()) if beside is not None else ({}, set())
 
@@ -430,7 +443,8 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
         for k, work in ready(results):
             beside.here(k, work)
         return results
-    n_workers = workers or min(len(todo), os.cpu_count() or 1)
+    # never more workers than runs left: one run left runs here, without starting a cluster for it
+    n_workers = min(workers or os.cpu_count() or 1, len(todo))
     timing.update(workers=n_workers, dask=not (scheduler is None and n_workers <= 1), runs_start_unix_s=time.time())
     # bars on a terminal; a log file or a pipe gets one plain line per finished run instead of escape codes
     plain = progress and not sys.stderr.isatty()
@@ -447,9 +461,9 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
         timing["beside_spans"] = list(beside.spans) if beside is not None else []
         return results
     wcfg = replace(cfg, progress=False)   # per-run bars would interleave; the sweep bar shows progress
-    futs, side = {}, {}
+    futs, side = {}, []           # side: (group, future) of each piece of work beside the runs
     t_start = time.perf_counter()
-    with dask_client(n_workers, scheduler) as client:
+    with dask_client(n_workers, scheduler, close_behind=timing if close_behind else None) as client:
         timing["cluster_start_s"] = time.perf_counter() - t_start
         timing["runs_start_unix_s"] = time.time()
         try:
@@ -493,26 +507,27 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
                     bar.write(f"run {c.label} failed: {results[c.label].error}")
                 for k, (fn, fargs) in ready(results):
                     if scheduler is None:       # a worker shares this filesystem: there, ahead of the queued runs
-                        side[k] = client.submit(timed_call, fn, *fargs, pure=False, priority=1,
-                                                key=f"beside-{time.time_ns()}")
+                        side.append((k, client.submit(timed_call, fn, *fargs, pure=False, priority=1,
+                                                      key=f"beside-{time.time_ns()}")))
                     else:
                         beside.here(k, (fn, fargs))
             runs.close()
             bar.close()
             timing["runs_end_unix_s"] = time.time()
-            for k, f in side.items():
+            for k, f in side:
                 try:
                     beside.took(k, f.result())
                 except Exception as exc:      # the worker itself was lost
                     beside.done[k] = exc
         except BaseException:       # Ctrl-C or a failure of the client: take its runs off the scheduler
-            client.cancel([*futs, *side.values()], force=True)
+            client.cancel([*futs, *(f for _, f in side)], force=True)
             raise
         timing["runs_s"] = timing["runs_end_unix_s"] - timing["runs_start_unix_s"]
         timing["beside_tail_s"] = time.time() - timing["runs_end_unix_s"]
         timing["beside_spans"] = list(beside.spans) if beside is not None else []
         t_close = time.perf_counter()
-    timing["cluster_close_s"] = time.perf_counter() - t_close
+    if not close_behind:
+        timing["cluster_close_s"] = time.perf_counter() - t_close
     return results
 
 
@@ -530,8 +545,24 @@ def _worker_failure(case: Case, exc: BaseException) -> Outcome:
     return Outcome(case, Status.FAILED, error=info.error)
 
 
+_CLOSING: list = []      # (thread, timing dict) of the local clusters closing behind their study (dask_client)
+
+
+def join_closing() -> float:
+    """Wait for the clusters still closing behind this process's work (:func:`dask_client` with ``close_behind``);
+    the seconds waited. Each one's own close time is in its sweep's timing (``cluster_close_s``), the wait added as
+    ``cluster_close_wait_s``."""
+    t0 = time.perf_counter()
+    while _CLOSING:
+        thread, timing = _CLOSING.pop()
+        t = time.perf_counter()
+        thread.join()
+        timing["cluster_close_wait_s"] = timing.get("cluster_close_wait_s", 0.0) + time.perf_counter() - t
+    return time.perf_counter() - t0
+
+
 @contextlib.contextmanager
-def dask_client(n_workers: int, scheduler: str | None = None):
+def dask_client(n_workers: int, scheduler: str | None = None, close_behind: dict | None = None):
     """A Dask client of the scheduler at ``scheduler`` (its workers checked first:
     :func:`scenarios.core.cluster.check_workers`), or of a local cluster of ``n_workers`` single-threaded processes
     that stops with it (its workers with it).
@@ -541,7 +572,12 @@ def dask_client(n_workers: int, scheduler: str | None = None):
     started with SIGINT blocked, a mask they keep (:func:`_ctrl_c_held`), and only this process takes the Ctrl-C: held
     while the cluster starts, raised once it has (then it is stopped cleanly), and the command says "interrupted: ..."
     alone. Its log messages are silenced below CRITICAL for the same reason (a failed run is reported by its
-    outcome)."""
+    outcome).
+
+    ``close_behind`` (a timing dict): a block that ends normally leaves the client and a local cluster to close in a
+    thread of this process while the caller goes on (its workers' exit takes seconds: their interpreters tear down
+    numba, SciPy, matplotlib); :func:`join_closing` waits for it, as the interpreter does before it exits. The
+    close's wall seconds go into ``close_behind["cluster_close_s"]``. An exception or Ctrl-C closes at once."""
     cluster = client = None
     with _ctrl_c_held(scheduler is None) as release:
         try:
@@ -559,11 +595,27 @@ def dask_client(n_workers: int, scheduler: str | None = None):
             if scheduler is not None:
                 check_workers(client, scheduler)      # same code everywhere; cold workers named
             yield client
+            if close_behind is not None:
+                thread = threading.Thread(target=_close, args=(client, cluster, close_behind), name="dpgt-dask-close")
+                thread.start()
+                _CLOSING.append((thread, close_behind))
+                client = cluster = None
         finally:
             if client is not None:
                 client.close()
             if cluster is not None:
                 cluster.close()
+
+
+def _close(client, cluster, timing: dict) -> None:
+    """Close ``client`` and ``cluster`` (None: none), its wall seconds into ``timing["cluster_close_s"]``."""
+    t0 = time.perf_counter()
+    try:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    finally:
+        timing["cluster_close_s"] = time.perf_counter() - t0
 
 
 @contextlib.contextmanager

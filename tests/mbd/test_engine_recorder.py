@@ -267,3 +267,73 @@ def test_observers_see_every_accepted_step_and_time_means_are_trapezoids(tmp_pat
     covered = ends[(ends[:, 1] > 0.01) & (ends[:, 0] < 0.03)]
     assert mean.mean[0] == pytest.approx(0.5 * (covered[0, 0] + covered[-1, 1]), rel=1e-12)
     assert mean.mean[1] == pytest.approx(2.0, rel=1e-12)
+
+
+class _Steps(mbd.Observer):
+    """The accepted steps of a compiled run, block by block (to replay them into a second recorder)."""
+
+    def __init__(self):
+        self.steps = []
+
+    def step(self, s0, s1):
+        self.steps.append((s0, s1))
+
+
+def _link_speed(outputs):
+    """An elementwise quantity derived from the link's outputs (a caller's film or error, say)."""
+    return {"work_rate": np.asarray(outputs["fx"], float) * np.exp(-np.asarray(outputs["deflection"], float) ** 2)}
+
+
+def _arm_spin(t, X, V, A, outputs):
+    """An elementwise quantity of the bodies and one family's outputs, one sample or a block's (..., nb, 3)."""
+    return np.cos(X[..., 1, 2]) * V[..., 2, 2] + np.asarray(outputs["bearing"]["fx"], float)[..., 0] * t
+
+
+@pytest.mark.parametrize("frame", [None, mbd.Frame.rotating(25.0)], ids=["inertial", "rotating"])
+def test_block_samples_equal_the_samples_taken_one_by_one(tmp_path, frame):
+    """The compiled path records a block's samples at once (record_block: the motion as arrays over the samples, a
+    ``batched`` derived quantity over all of them); the numpy path takes them one by one (record). Replaying the same
+    accepted steps both ways gives the same file to the last bit, a derived quantity marked batched equal to the same
+    one evaluated sample by sample (a rotating frame: its fixed bodies' frame accelerations, the fixed-frame motion)."""
+    probes = [*PROBES,
+              mbd.ElementOutput("link", keys=["work_rate"], derived=_link_speed, batched=True),
+              mbd.DerivedOutput("spin_rows", _arm_spin, "1", "arm spin, a block at once", batched=True),
+              mbd.DerivedOutput("spin_ones", _arm_spin, "1", "arm spin, sample by sample")]
+    model = scene(frame)
+    q0, v0 = q0v0(model)
+    seen = _Steps()
+    blocks = mbd.Recorder(tmp_path / "blocks.nc", dt=7e-4, probes=probes, chunk=5)
+    res = mbd.simulate(model, q0, v0, 0.03, controller=mbd.Adaptive(h0=1e-4, h_min=1e-9), recorder=blocks,
+                       observers=[seen], engine="compiled", progress=False)
+    assert res.engine == "compiled" and len(seen.steps) == res.steps
+    one = mbd.Recorder(tmp_path / "ones.nc", dt=7e-4, probes=probes, chunk=3)
+    first = seen.steps[0][0]
+    one.bind(model, mbd.System(model), first)
+    one.reset()
+    one.record(first, None, first=True)
+    for s0, s1 in seen.steps:
+        one.record(s0, s1)
+    one.finalize()
+    with xr.open_dataset(tmp_path / "blocks.nc", engine="h5netcdf") as a, \
+            xr.open_dataset(tmp_path / "ones.nc", engine="h5netcdf") as b:
+        assert a.sizes["time"] == b.sizes["time"] == int(np.floor(0.03 / 7e-4 + 1e-9)) + 1
+        assert set(a.variables) == set(b.variables)
+        for name in a.variables:
+            assert np.array_equal(a[name].values, b[name].values), name
+        np.testing.assert_array_equal(a["spin_rows"].values, a["spin_ones"].values)
+        assert np.ptp(a["link.work_rate"].values) > 0 and np.ptp(a["spin_rows"].values) > 0     # not constants
+
+
+def test_results_file_the_same_whatever_the_chunks_joined_per_write(tmp_path, monkeypatch):
+    """finalize joins the chunks into groups of up to WRITE_BYTES per write: one group or one chunk per write, the
+    file holds the same samples (every chunk in its place, none twice)."""
+    import mbd.recorder as recorder
+
+    whole = run(scene(), tmp_path / "whole.nc", t_end=0.03, chunk=4)
+    monkeypatch.setattr(recorder, "WRITE_BYTES", 1)        # every chunk written on its own
+    parts = run(scene(), tmp_path / "parts.nc", t_end=0.03, chunk=4)
+    with xr.open_dataset(whole.results_path, engine="h5netcdf") as a, \
+            xr.open_dataset(parts.results_path, engine="h5netcdf") as b:
+        assert a.sizes["time"] == 16 and np.all(np.diff(a["time"].values) > 0)
+        for name in a.variables:
+            assert np.array_equal(a[name].values, b[name].values), name

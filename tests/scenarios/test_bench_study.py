@@ -161,3 +161,20 @@ def test_a_runs_peak_is_its_own_not_the_processes_so_far():
     small = second.mb()
     assert big - base >= 390 and small <= big - 350
     assert process_peak_mb() >= big - 1.0      # the kernel's RSS counters are batched per CPU: < 1 MiB behind
+
+
+def test_a_cluster_closing_behind_the_report_counts_only_the_wait_for_it():
+    """A cluster that closes behind the report (scenarios.core.sweep.dask_client, close_behind): its close (5 s) ran
+    beside the report, outside the sweep; only the wait for it after the report (1.5 s, in total_s, not in report_s)
+    is wall time, and the rows still add up to the wall time."""
+    job = _study()
+    T, sw = job["study"], job["study"]["sweep"]
+    sw.update(cluster_close_s=5.0, cluster_close_wait_s=1.5)
+    T["sweep_s"] -= 2.0                  # the close no longer inside the sweep
+    T["total_s"] += -2.0 + 1.5           # the wait after the report
+    job["wall_s"] += -2.0 + 1.5
+    rows = {what: s for _, what, s in profile(job)}
+    assert sum(rows.values()) == pytest.approx(job["wall_s"], abs=1e-9)
+    assert rows["cluster close, waited for after the report (it closes behind the report)"] == 1.5
+    assert "cluster close" not in rows
+    assert rows["the study's rest (sweep bookkeeping, epilogue)"] == pytest.approx(0.25 + 76 - 1 - 62.75 - 12)

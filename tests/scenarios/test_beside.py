@@ -47,10 +47,31 @@ def test_the_paper_study_draws_a_point_beside_only_when_both_its_runs_finished(t
     b = study.beside(study.config())
     f, r = _case(3, "forward"), _case(3, "reverse")
     assert b.task(3, {f.label: _done(f), r.label: _done(r, ok=False)}) is None
-    fn, fargs = b.task(3, {f.label: _done(f), r.label: _done(r)})
-    assert fn is paper_study.point_work and fargs[2] == 3
+    pieces = b.task(3, {f.label: _done(f), r.label: _done(r)})
+    assert all(fn is paper_study.point_work and fargs[2] == 3 for fn, fargs in pieces)
+    assert [fargs[3] for _, fargs in pieces] == list(paper_study.POINT_PIECES)      # each on a worker of its own
+    assert sorted(f for piece in paper_study.POINT_PIECES for f in piece) == sorted([*paper_study.HISTORY_GROUPS, "cage_orbits"])
     static = paper_study.PaperStudy(paper_study.parse_args(["--conditions", "3", "--mode", "static",
                                                             "--out", str(tmp_path)]))
     assert static.beside(static.config()) is None
     one = paper_study.PaperStudy(paper_study.parse_args(["--conditions", "3", "--out", str(tmp_path)]))
     assert one.beside(one.config()) is None     # one point (the demo): nothing runs beside its figures
+
+
+def test_a_group_in_pieces_starts_each_piece_once_and_joins_their_lists_in_order():
+    """A group's work in pieces (a list of (function, args)): every piece starts when the group is in, once; their
+    lists are joined in the order of the pieces, whatever order they finish in; a piece that raises is the group's
+    result (the report redraws that point)."""
+    cases = [_case(1, "forward"), _case(1, "reverse")]
+    b = Beside(key=lambda c: c.condition, task=lambda k, outs: [(list, ("ab",)), (list, ("cd",))])
+    groups, started = b.groups(cases), set()
+    results = {c.label: _done(c) for c in cases}
+    ready = list(b.ready(groups, results, started))
+    assert [k for k, _ in ready] == [1, 1] and list(b.ready(groups, results, started)) == []
+    for k, work in ready:
+        b.here(k, work)
+    assert b.done == {1: ["a", "b", "c", "d"]} and len(b.spans) == 2
+    bad = Beside(key=lambda c: c.condition, task=lambda k, outs: [(list, ("ab",)), (int, ("x",)), (list, ("cd",))])
+    for k, work in bad.ready(bad.groups(cases), results, set()):
+        bad.here(k, work)
+    assert isinstance(bad.done[1], ValueError)

@@ -300,3 +300,49 @@ def test_output_size_is_estimated_and_checked_before_starting(tmp_path, monkeypa
     monkeypatch.setattr(plausibility, "_free", lambda folder: 1e3)                  # a nearly full disk
     assert paper_study.main(TINY + ["--out", str(tmp_path)]) == 2
     assert "GB free" in capsys.readouterr().err and not (tmp_path / "c4_forward").exists()
+
+
+def test_a_cluster_closes_behind_its_caller_and_at_once_on_an_error(monkeypatch):
+    """dask_client(close_behind=timing): a block that ends normally returns before its client and local cluster are
+    closed — a thread closes them while the caller goes on — and join_closing waits for that, its time in the timing;
+    a block that raises closes them at once, before the error reaches the caller."""
+    import threading
+
+    import dask.distributed
+
+    from scenarios.core import sweep as sw
+
+    _FakeClient.made.clear()
+    _FakeCluster.made.clear()
+    monkeypatch.setattr(dask.distributed, "Client", _FakeClient)
+    monkeypatch.setattr(dask.distributed, "LocalCluster", _FakeCluster)
+    gate = threading.Event()
+    monkeypatch.setattr(_FakeCluster, "close", lambda self: (gate.wait(10.0), setattr(self, "closed", True)))
+    timing = {}
+    with sw.dask_client(2, close_behind=timing):
+        pass
+    cluster, = _FakeCluster.made
+    assert not cluster.closed and "cluster_close_s" not in timing       # still closing: the caller went on
+    gate.set()
+    assert sw.join_closing() >= 0.0 and cluster.closed and _FakeClient.made[0].closed
+    assert timing["cluster_close_s"] >= 0.0 and timing["cluster_close_wait_s"] >= 0.0
+    _FakeCluster.made.clear()
+    with pytest.raises(RuntimeError, match="boom"):
+        with sw.dask_client(2, close_behind={}):
+            raise RuntimeError("boom")
+    assert _FakeCluster.made[0].closed and sw._CLOSING == []
+
+
+def test_one_run_left_runs_here_whatever_the_workers_asked(tmp_path, monkeypatch):
+    """--workers 2 with one run left: no cluster is started for it (the run goes in this process)."""
+    import dask.distributed
+
+    from scenarios.core import sweep as sw
+
+    monkeypatch.setattr(dask.distributed, "LocalCluster", lambda **k: pytest.fail("a cluster for one run"))
+    monkeypatch.setattr(sw, "execute_case", lambda c, cfg, overwrite=False: sw.Outcome(c, sw.Status.FINISHED,
+                                                                                         summary={}))
+    monkeypatch.setattr(sw, "_is_finished", lambda c, cfg: False)
+    timing = {}
+    out = sw.sweep([_case(tmp_path / "a")], CFG, workers=2, progress=False, timing=timing)
+    assert list(out) == [_case(tmp_path / "a").label] and timing["dask"] is False and timing["workers"] == 1
