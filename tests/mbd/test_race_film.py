@@ -189,6 +189,21 @@ def test_a_rolling_roller_is_held_back_by_the_poiseuille_shear(kind):
 
 
 @pytest.mark.parametrize("kind", ["inner", "outer"])
+def test_a_free_roller_by_a_turning_raceway_spins_at_the_torque_free_speed(kind):
+    """A roller held at a gap from a raceway whose surface moves at U spins, as the film alone drives it, where its
+    moment vanishes: the Couette drive −(π/2 + γ_e)Δu balances the Poiseuille drag c_P ũ (Δu = u₁ − U,
+    ũ = (u₁ + U)/2 − u_P), u₁ = [U(π/2 + γ_e − c_P/2) + c_P u_P]/(π/2 + γ_e + c_P/2) — 0.106 U for a contact point at
+    rest: the gap's own film barely turns a roller (the Sommerfeld film, without cavitation, not at all). A wrong sign
+    of the Poiseuille moment puts the root at 9.4 U, a wrong share of it (the moment of 2F_P, of none) elsewhere."""
+    h, race_spin = 3e-6, 60.0
+    U, u_P = rolling(kind, h, 0.0, race_spin=race_spin)[2][5:]
+    slip = brentq(lambda sl: rolling(kind, h, 0.0, slip=sl, race_spin=race_spin)[0][2], -3.0 * abs(U), 3.0 * abs(U),
+                  xtol=1e-14, rtol=1e-13)
+    C = 0.5 * np.pi + GAMMA_E
+    assert U + slip == pytest.approx((U * (C - 0.5 * C_P) + C_P * u_P) / (C + 0.5 * C_P), rel=1e-4)
+
+
+@pytest.mark.parametrize("kind", ["inner", "outer"])
 def test_the_wedge_acts_on_separation_the_squeeze_does_not(kind):
     """Leaving its raceway, a rolling roller keeps the wedge load (the surfaces entrain oil), not the squeeze; closing,
     it carries both (Reynolds' equation is linear in p: they add); at rest and leaving, none."""
