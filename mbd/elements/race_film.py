@@ -139,7 +139,7 @@ class RaceFilm(Element):
         hs = ad.where(hv > self.floor, h, self.floor)     # the film's thickness, floored at h_f (rates kept)
         S = damping_share(ad.where(hv > 0.0, h, 0.0), self.floor)
         if self.law == "full":
-            return self._full(qr, qb, vr, vb, rc, Vc, rho, ex, ey, wx, wy, h, hs, S, V)
+            return self._full(vr, vb, rc, Vc, rho, ex, ey, wx, wy, h, hs, S, V)
         c = self.coef * ad.power(hs, -1.5) * S
         W = ad.where((hv > 0.0) & (ad.value(V) > 0.0), c * V, 0.0)
         Fx, Fy = kap * W * ex, kap * W * ey
@@ -149,7 +149,7 @@ class RaceFilm(Element):
         forces = _scaled(forces, self.multiplicity, self._multi)
         return forces, {"force": W, "gap": h, "approach_speed": V}
 
-    def _full(self, qr, qb, vr, vb, rc, Vc, rho, ex, ey, wx, wy, h, hs, S, V):
+    def _full(self, vr, vb, rc, Vc, rho, ex, ey, wx, wy, h, hs, S, V):
         """The open gap's squeeze and wedge loads and its Couette and Poiseuille shear (module docstring), faded by
         S(h/h_f) and none once the surfaces touch (S = 0 for h ≤ 0)."""
         R, kap = self.R_race, self.kappa
