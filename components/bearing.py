@@ -42,7 +42,7 @@ class BearingHandles:
     retention: slice | None = None            # a roller-centred cage's radial pocket retention
     guide: slice | None = None
     pocket_film: slice | None = None          # the pockets' oil film (bearing.cage.pocket_law = "hydrodynamic")
-    race_film_inner: slice | None = None      # the raceways' squeeze film (bearing.race_film = "squeeze")
+    race_film_inner: slice | None = None      # the raceways' film of the open gaps (bearing.race_film)
     race_film_outer: slice | None = None
     cage_drag: slice | None = None            # the mixture's drag on the cage (bearing.drag_law = "viscous")
     cage: str | None = None
@@ -205,7 +205,7 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
                       R_race=b.outer_raceway_radius, **common, **damage.get("outer", {}))
     handles = BearingHandles("rollers", rollers=tuple(names), race_inner=s_in, race_outer=s_out, omega_cage=wm,
                              omega_roller=wr)
-    if b.race_film == "squeeze":
+    if b.race_film != "none":
         handles = replace(handles, **_add_race_film(scene, b, names, pin_body, marker, outer_body, lubricant,
                                                     damage.get("D", D)))
     return _add_drag_and_cage(scene, tag, b, names, psi, wm, pin_body, marker, outer_body, lubricant, pin_xy,
@@ -213,17 +213,21 @@ def add_planet_bearing(scene: Scene, tag: str, *, pin_body: str, pin_local, oute
 
 
 def _add_race_film(scene, b, names, pin_body, marker, outer_body, lubricant, D) -> dict:
-    """The squeeze film of every roller on the pin's and the bore's raceway (docs/model.md §8.9), the oil at its
-    operating temperature (the EHL laws' viscosity): the BearingHandles fields it fills."""
+    """The oil film of every roller's open gap on the pin's and the bore's raceway (docs/model.md §8.9; the law
+    bearing.race_film names), the oil at its operating temperature (the EHL laws' viscosity): the BearingHandles
+    fields it fills."""
     if lubricant is None:
-        raise ParameterError.at("bearing.race_film", "'squeeze' needs a lubricant (its viscosity); this scene has none")
+        raise ParameterError.at("bearing.race_film", f"{b.race_film!r} needs a lubricant (its viscosity); this scene "
+                                                     "has none")
     Z = len(names)
     common = dict(D=D, length=b.roller_length, eta=lubricant.oil_viscosity, floor=b.race_film_floor,
                   multiplicity=b.rows)
-    inner = scene.family(FAMILY["race_film_inner"], RaceFilm, ("roller", "race_body"), kind="inner")
+    inner = scene.family(FAMILY["race_film_inner"], RaceFilm, ("roller", "race_body"), kind="inner",
+                         law=b.race_film)
     s_in = inner.add(Z, roller=names, race_body=[pin_body] * Z, race_marker=marker, R_race=b.inner_raceway_radius,
                      **common)
-    outer = scene.family(FAMILY["race_film_outer"], RaceFilm, ("roller", "race_body"), kind="outer")
+    outer = scene.family(FAMILY["race_film_outer"], RaceFilm, ("roller", "race_body"), kind="outer",
+                         law=b.race_film)
     s_out = outer.add(Z, roller=names, race_body=[outer_body] * Z, race_marker=np.zeros((Z, 2)),
                       R_race=b.outer_raceway_radius, **common)
     return {"race_film_inner": s_in, "race_film_outer": s_out}

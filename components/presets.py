@@ -157,7 +157,8 @@ def reference_bearing() -> BearingParams:
                                   span=Span("0 um", "0.45 um", "the damping whole at first touch to a dry contact's "
                                                                "ramp over three composite roughnesses")),
         race_film=assumed("none", "the source's model; squeeze: the oil's squeeze film damps a roller's approach to "
-                                  "its raceway before touch (docs/model.md §8.9)"),
+                                  "its raceway before touch; full: the open gap's wedge load and Couette and "
+                                  "Poiseuille shear as well (docs/model.md §8.9)"),
         race_film_floor=assumed("1 um", "a few composite roughnesses (0.15 um), twice the loaded contact's film "
                                         "(lambda ~ 3): below it the film's pressure at a chattering roller's approach "
                                         "flattens the surfaces and thickens the oil (docs/model.md §8.9)",

@@ -247,10 +247,11 @@ class BearingParams(Params["BearingSI"]):
     race_damping_ramp: Quantity = nonneg("length", "compression over which a roller-raceway contact's (a slice's) "
                                                    "damping grows from 0 at first touch to the damping ratio's (0: "
                                                    "all of it at first touch)")
-    race_film: str = param("choice", "oil film on the roller-raceway gaps: none, or squeeze (the squeeze film of a "
-                                     "roller approaching its raceway while the gap is open, rigid cylinder near a "
-                                     "plane, cavitating on separation; planar model only)",
-                           choices=("none", "squeeze"))
+    race_film: str = param("choice", "oil film on the roller-raceway gaps while open: none; squeeze (the squeeze "
+                                     "film of a roller approaching its raceway, rigid cylinder near a plane, "
+                                     "cavitating on separation); full (squeeze and wedge loads, Couette and "
+                                     "Poiseuille shear); planar model only",
+                           choices=("none", "squeeze", "full"))
     race_film_floor: Quantity = positive("length", "gap h_f across which the raceway squeeze film hands over to the "
                                                    "Hertz contact (the rigid law above it, zero at touch)")
     traction_law: str = param("choice", "roller-raceway traction law (ehl: from the lubricant's film)",

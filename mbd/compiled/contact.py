@@ -1189,14 +1189,16 @@ def evaluate_cage_drag(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
 
 
 # ----------------------------------------------------------------------------------------------- raceway film
-# ``RaceFilm`` P (n, 8): κ (+1 inner, −1 outer), race_marker x, y [m], R_race [m], D [m],
-#              coef = SQUEEZE_LOAD·η·l·R_red^(3/2), floor h_f [m], multiplicity;  G (0,)
+# ``RaceFilm`` P (n, 10): κ (+1 inner, −1 outer), race_marker x, y [m], R_race [m], D [m],
+#              coef = SQUEEZE_LOAD·η·l·R_red^(3/2), floor h_f [m], multiplicity, η·l [Pa·s·m], R_red [m];
+#              G (1,): 1 for the law "full" (squeeze, wedge and shear), 0 for "squeeze"
 # (mbd.elements.race_film; stateless, no compiled outputs: theirs come from the numpy kernel)
 def pack_race_film(elem):
     _require(elem, race_film.RaceFilm)
     mk = elem.race_marker
-    P = _rows(elem.kappa, mk[:, 0], mk[:, 1], elem.R_race, elem.D, elem.coef, elem.floor, elem.multiplicity)
-    return P, np.zeros(0)
+    P = _rows(elem.kappa, mk[:, 0], mk[:, 1], elem.R_race, elem.D, elem.coef, elem.floor, elem.multiplicity,
+              elem.el, elem.R_red)
+    return P, np.array([1.0 if elem.law == "full" else 0.0])
 
 
 @njit(cache=True)
@@ -1204,6 +1206,9 @@ def evaluate_race_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     """The raceway squeeze film while the gap is open (docs/model.md §8.9): W = coef·max(h, h_f)^(−3/2)·S(h/h_f)·
     max(V, 0), h = −δ, V = δ̇, along κe at the contact point (through the roller's centre), the opposite on the race
     body."""
+    if G[0] > 0.0:
+        _race_film_full(ql, vl, P, F, Jq, Jv, jac)
+        return
     for i in range(ql.shape[0]):
         kap, mx, my, R, D, coef, hf, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6], P[i, 7]
         xr, yr = ql[i, 0], ql[i, 1]
@@ -1249,3 +1254,92 @@ def evaluate_race_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
             dFx, dFy = kap * (dW * ex + W * dex), kap * (dW * ey + W * dey)
             dM = -(drcx * Fy + rcx * dFy - drcy * Fx - rcy * dFx)
             _write(F, Jq, Jv, i, j, mult, dFx, dFy, 0.0, -dFx, -dFy, dM)
+
+
+@njit(cache=True)
+def _race_film_full(ql, vl, P, F, Jq, Jv, jac):
+    """The law "full" of the raceway film (docs/model.md §8.9): S(h/h_f)·(the gap's wedge and squeeze loads, Couette
+    and Poiseuille shear) of the pocket film's gap law (:func:`_film_wall`'s constants) with the raceway contact's
+    kinematics (:func:`_race_surfaces`), the load along κe and the Couette shear along t at P, the Poiseuille shear
+    with the pressure's tangential resultant through the centres (as the race contact's rolling resistance)."""
+    for i in range(ql.shape[0]):
+        kap, mx, my, R, D, hf, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 6], P[i, 7]
+        el, Rr = P[i, 8], P[i, 9]
+        xr, yr = ql[i, 0], ql[i, 1]
+        xb, yb, thb = ql[i, 3], ql[i, 4], ql[i, 5]
+        vr0, vr1, vr2 = vl[i, 0], vl[i, 1], vl[i, 2]
+        vb0, vb1, vb2 = vl[i, 3], vl[i, 4], vl[i, 5]
+        cth, sth = np.cos(thb), np.sin(thb)
+        rcx, rcy = cth * mx - sth * my, sth * mx + cth * my
+        dx, dy = xr - (xb + rcx), yr - (yb + rcy)
+        rho = np.sqrt(dx * dx + dy * dy + _ETA2)
+        ex, ey = dx / rho, dy / rho
+        tx, ty = -ey, ex
+        delta = 0.5 * D - kap * (rho - R)
+        h = -delta
+        if not h > 0.0:
+            _zero(F, Jq, Jv, i, jac)
+            continue
+        Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
+        wx, wy = vr0 - Vcx, vr1 - Vcy
+        V = -kap * (ex * wx + ey * wy)
+        rl, rrx, rry, rbx, rby, Vrx, Vry, Vbx, Vby, ur, ub, v_s, wt, u = _race_surfaces(
+            R, rho, ex, ey, tx, ty, rcx, rcy, vr0, vr1, vr2, vb0, vb1, vb2, Vcx, Vcy, wx, wy)
+        floored = not h > hf
+        hs = hf if floored else h
+        S, dS = tooth_pairs.damping_share(h, hf)
+        rr = Rr / hs
+        root = np.sqrt(2.0 * rr)
+        srr = np.sqrt(rr)
+        Vp = V if V > 0.0 else 0.0
+        Wg = (_PF_W * el) * abs(u) * rr + (_PF_S * el) * rr * srr * Vp
+        Tg = -(_PF_C * el) * v_s * root
+        Pg = (_PF_P * el) * u * root
+        W, T, FP = S * Wg, S * Tg, S * Pg
+        Fx, Fy = kap * W * ex + T * tx, kap * W * ey + T * ty
+        a1 = 2.0 * R / rho
+        g = FP * (a1 - 1.0)
+        gx, gy = g * tx, g * ty
+        _write(F, Jq, Jv, i, -1, mult, Fx + gx, Fy + gy, rrx * Fy - rry * Fx + (rho - R) * FP, -Fx - gx, -Fy - gy,
+               -(rbx * Fy - rby * Fx) - (rcx * gy - rcy * gx) - R * FP)
+        if not jac:
+            continue
+        for j in range(12):
+            dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, dvr2, dvb0, dvb1, dvb2 = _unit(j)
+            drcx, drcy = -rcy * dthb, rcx * dthb
+            ddx, ddy = dxr - dxb - drcx, dyr - dyb - drcy
+            drho = (dx * ddx + dy * ddy) / rho
+            dex, dey = (ddx - ex * drho) / rho, (ddy - ey * drho) / rho
+            dtx, dty = -dey, dex
+            dVcx, dVcy = dvb0 - dvb2 * rcy - vb2 * drcy, dvb1 + dvb2 * rcx + vb2 * drcx
+            dwx, dwy = dvr0 - dVcx, dvr1 - dVcy
+            dV = -kap * (dex * wx + ex * dwx + dey * wy + ey * dwy)
+            dh = kap * drho                                   # h = κ(ρ − R) − D/2
+            drrx, drry = -drho * ex + rl * dex, -drho * ey + rl * dey
+            drbx, drby = drcx + R * dex, drcy + R * dey
+            dVrx, dVry = dvr0 - dvr2 * rry - vr2 * drry, dvr1 + dvr2 * rrx + vr2 * drrx
+            dVbx, dVby = dvb0 - dvb2 * rby - vb2 * drby, dvb1 + dvb2 * rbx + vb2 * drbx
+            dur = dVrx * tx + Vrx * dtx + dVry * ty + Vry * dty
+            dub = dVbx * tx + Vbx * dtx + dVby * ty + Vby * dty
+            dwt = dwx * tx + wx * dtx + dwy * ty + wy * dty
+            dvP = dVcx * tx + Vcx * dtx + dVcy * ty + Vcy * dty + R * (dwt - wt * drho / rho) / rho
+            du = 0.5 * (dur + dub) - dvP
+            dvs = dur - dub
+            dhs = 0.0 if floored else dh
+            drr = -rr * dhs / hs
+            droot = -0.5 * root * dhs / hs
+            dVp = dV if V > 0.0 else 0.0
+            dWg = (_PF_W * el) * (_sign(u) * du * rr + abs(u) * drr) \
+                + (_PF_S * el) * (1.5 * srr * drr * Vp + rr * srr * dVp)
+            dTg = -(_PF_C * el) * (dvs * root + v_s * droot)
+            dPg = (_PF_P * el) * (du * root + u * droot)
+            dSh = dS * dh
+            dW, dT, dFP = dSh * Wg + S * dWg, dSh * Tg + S * dTg, dSh * Pg + S * dPg
+            dFx = kap * (dW * ex + W * dex) + dT * tx + T * dtx
+            dFy = kap * (dW * ey + W * dey) + dT * ty + T * dty
+            dg = dFP * (a1 - 1.0) - FP * 2.0 * R * drho / (rho * rho)
+            dgx, dgy = dg * tx + g * dtx, dg * ty + g * dty
+            dMr = _d_cross(rrx, rry, drrx, drry, Fx, Fy, dFx, dFy) + drho * FP + (rho - R) * dFP
+            dMb = -_d_cross(rbx, rby, drbx, drby, Fx, Fy, dFx, dFy) - _d_cross(rcx, rcy, drcx, drcy, gx, gy, dgx, dgy) \
+                - R * dFP
+            _write(F, Jq, Jv, i, j, mult, dFx + dgx, dFy + dgy, dMr, -dFx - dgx, -dFy - dgy, dMb)

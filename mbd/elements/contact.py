@@ -390,6 +390,36 @@ def spall_profile(s, hi, edge):
     return B, B_s
 
 
+def race_surfaces(vr, vb, Vc, rc, ex, ey, tx, ty, rho, R, wx, wy):
+    """The raceway contact's kinematics (:class:`RaceContact`): the contact point P = c + R e seen from the roller's
+    centre (r_roll) and from the race body's centre (r_race), the slip v_s = (roller surface − raceway surface
+    velocity at P)·t and the entraining speed u_e, the surfaces' mean speed along t relative to the geometric contact
+    point P, whose velocity along t is ċ·t + R (ṗ − ċ)·t / ρ. vr, vb the bodies' velocities, Vc the raceway centre's,
+    w = ṗ − ċ."""
+    r_roll = ((R - rho) * ex, (R - rho) * ey)
+    r_race = (rc[0] + R * ex, rc[1] + R * ey)
+    Vr = marker_velocity(vr, r_roll)
+    Vb = marker_velocity(vb, r_race)
+    ur = Vr[0] * tx + Vr[1] * ty
+    ub = Vb[0] * tx + Vb[1] * ty
+    v_s = ur - ub
+    vP = Vc[0] * tx + Vc[1] * ty + R * (wx * tx + wy * ty) / rho
+    u_e = 0.5 * (ur + ub) - vP
+    return r_roll, r_race, v_s, u_e
+
+
+def poiseuille_forces(F, rho, tx, ty, rc, R):
+    """Generalized forces (roller, race body) of a film's Poiseuille shear F at the raceway contact point P along −t
+    on both surfaces (against the entraining direction) with the pressure's tangential resultant 2F along +t shared
+    through the centres of curvature, a_roller = 2R/ρ, a_race = 2(ρ − R)/ρ (:class:`RaceContact`, docs/model.md
+    §9.5): on the roller F(2R/ρ − 1) along t and the moment (ρ − R)F; on the race body the opposite force and the
+    moment −rc × f − R F."""
+    g = F * (2.0 * R / rho - 1.0)
+    fx, fy = g * tx, g * ty
+    Mb = -1.0 * (rc[0] * fy - rc[1] * fx) - R * F
+    return [fx, fy, (rho - R) * F, -1.0 * fx, -1.0 * fy, Mb]
+
+
 class RaceContact(Element):
     """Roller–raceway Hertz line contact (Palmgren) with damping and traction.
 
@@ -532,14 +562,10 @@ class RaceContact(Element):
         return delta - h * B, delta_dot - h * B_s * s_dot
 
     def _rolling_forces(self, Q, u_e, rho, tx, ty, rc, R):
-        """Generalized forces of the rolling resistance (class docstring): on the roller F(2R/ρ − 1) along t and
-        the moment (ρ − R)F; on the race body the opposite force and the moment −rc × f − R F."""
+        """Generalized forces of the rolling resistance (class docstring)."""
         loaded = ad.value(Q) > 0.0
         F = ad.where(loaded, self.rolling.force(ad.where(loaded, Q, 1.0), u_e, self.R_red), 0.0)
-        g = F * (2.0 * R / rho - 1.0)
-        fx, fy = g * tx, g * ty
-        Mb = -1.0 * (rc[0] * fy - rc[1] * fx) - R * F
-        return [fx, fy, (rho - R) * F, -1.0 * fx, -1.0 * fy, Mb]
+        return poiseuille_forces(F, rho, tx, ty, rc, R)
 
     def kernel(self, t, fs, q, v, z):
         qr, qb, vr, vb = q[:3], q[3:], v[:3], v[3:]
@@ -564,18 +590,7 @@ class RaceContact(Element):
             c = c * damping_share(ds, self.damping_ramp)
         Q_raw = self.K * ad.power(ds, p) + c * delta_dot
         Q = ad.where(touch & (ad.value(Q_raw) > 0.0), Q_raw, 0.0)
-        # contact point P = c + R e, seen from the roller centre and from the race body's centre
-        r_roll = ((R - rho) * ex, (R - rho) * ey)
-        r_race = (rc[0] + R * ex, rc[1] + R * ey)
-        Vr = marker_velocity(vr, r_roll)
-        Vb = marker_velocity(vb, r_race)
-        ur = Vr[0] * tx + Vr[1] * ty
-        ub = Vb[0] * tx + Vb[1] * ty
-        v_s = ur - ub
-        # entraining (rolling) speed: the surfaces' mean speed relative to the geometric contact point P,
-        # whose velocity along t is ċ·t + R (ṗ − ċ)·t / ρ
-        vP = Vc[0] * tx + Vc[1] * ty + R * (wx * tx + wy * ty) / rho
-        u_e = 0.5 * (ur + ub) - vP
+        r_roll, r_race, v_s, u_e = race_surfaces(vr, vb, Vc, rc, ex, ey, tx, ty, rho, R, wx, wy)
         tr = self.traction
         if tr.needs_load:           # a law of the film: the load per contact (1 N where none: F_t = −μQ = 0)
             mu = tr.coefficient(v_s, u_e, ad.where(ad.value(Q) > 0.0, Q, 1.0), self.R_red)

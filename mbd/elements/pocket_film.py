@@ -51,7 +51,7 @@ from ..errors import ModelError
 from .contact import _ETA2, _multiplicity, _scaled
 
 __all__ = ["PocketFilm", "CageDrag", "OUTLET_ANGLE", "WEDGE_LOAD", "SQUEEZE_LOAD", "COUETTE_EXTENT",
-           "POISEUILLE_SHEAR", "DISK_MOMENT"]
+           "POISEUILLE_SHEAR", "DISK_MOMENT", "gap_film"]
 
 
 def _outlet_angle() -> float:
@@ -72,6 +72,21 @@ COUETTE_EXTENT = 0.5 * np.pi + OUTLET_ANGLE                  # ∫dx/h = √(2R/
 POISEUILLE_SHEAR = 6.0 * (COUETTE_EXTENT - (0.25 * np.pi + 0.5 * OUTLET_ANGLE + 0.25 * np.sin(2.0 * OUTLET_ANGLE))
                           / np.cos(OUTLET_ANGLE) ** 2)      # 3.2535: −(h/2)dp/dx integrated, per η ũ l √(2R/h)
 DISK_MOMENT = 0.616 * np.pi                                  # Cochran: 2M = 0.616 π ρ R⁴ √(ν ω³)
+
+
+def gap_film(el, R, inv_h, ue, du, Vp):
+    """The gap's law (module docstring) of a rigid cylinder of radius R near a plane at the gap h (inv_h = 1/h), for
+    η·l = el, the entraining speed ũ = ue relative to the contact point, the sliding Δu = du of the cylinder's surface
+    on the plane's and the approach speed's positive part Vp = max(V, 0): (W, T_C, F_P) — the normal load
+    W = WEDGE_LOAD η|ũ|Rl/h + SQUEEZE_LOAD η l (R/h)^(3/2) Vp pushing them apart, the Couette shear on the cylinder
+    T_C = −COUETTE_EXTENT η Δu l √(2R/h) (the plane's the opposite) and the Poiseuille shear's size
+    F_P = POISEUILLE_SHEAR η ũ l √(2R/h), which acts as −F_P on both surfaces along ũ while the pressure's tangential
+    resultant is +2F_P (the film's force balance). The element owns the geometry (which surface, which point)."""
+    rr = R * inv_h
+    root = ad.sqrt(2.0 * rr)
+    W = (WEDGE_LOAD * el) * ad.abs_(ue) * rr + (SQUEEZE_LOAD * el) * rr * ad.sqrt(rr) * Vp
+    poi = (POISEUILLE_SHEAR * el) * ue * root
+    return W, -1.0 * (COUETTE_EXTENT * el) * du * root, poi
 
 
 class PocketFilm(Element):
@@ -136,18 +151,15 @@ class PocketFilm(Element):
         for w in (1.0, -1.0):
             h = self.clearance - w * s
             inv_h = 1.0 / ad.where(ad.value(h) > self.min_film, h, self.min_film)
-            rr = R * inv_h
-            root = ad.sqrt(2.0 * rr)
             ue = -0.5 * v_c - (0.5 * w) * R * dw
             du = v_c - w * R * dw
             V = w * s_dot
             # max(V, 0) with the slope 1/2 at V = 0 (the mean of its one-sided slopes: a centred roller's two walls
             # then sum to the smooth law they form there)
             Vp = ad.where(ad.value(V) > 0.0, V, ad.where(ad.value(V) == 0.0, 0.5 * V, 0.0))
-            W = (WEDGE_LOAD * el) * ad.abs_(ue) * rr + (SQUEEZE_LOAD * el) * rr * ad.sqrt(rr) * Vp
+            W, cou, poi = gap_film(el, R, inv_h, ue, du, Vp)
             N = N + w * W
-            poi = (POISEUILLE_SHEAR * el) * ue * root
-            T = -1.0 * (COUETTE_EXTENT * el) * du * root + poi
+            T = cou + poi
             shear = shear + T
             rwx, rwy = -1.0 * w * R * ey, w * R * ex              # P_w − p = w R t
             fr = point_force((rwx, rwy), (T * ex, T * ey))

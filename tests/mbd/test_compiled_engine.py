@@ -79,9 +79,11 @@ def test_the_engines_take_the_same_steps_with_the_race_damping_ramped(dpgt_state
     assert not np.array_equal(plain.state.v, c.state.v)
 
 
-def test_the_engines_take_the_same_steps_with_the_raceway_squeeze_film(dpgt_state):
-    """The raceway squeeze film on every roller (docs/model.md §8.9; the same bodies and state, two more stateless
-    families): the same steps and states on both engines, and not those of the machine without it."""
+@pytest.mark.parametrize("law", ["squeeze", "full"])
+def test_the_engines_take_the_same_steps_with_the_raceway_film(dpgt_state, law):
+    """The raceway film on every roller (docs/model.md §8.9; the same bodies and state, two more stateless
+    families), the squeeze alone and the full law: the same steps and states on both engines, and not those of the
+    machine without it."""
     import warnings
 
     from components.dpgt import build_dpgt
@@ -91,7 +93,7 @@ def test_the_engines_take_the_same_steps_with_the_raceway_squeeze_film(dpgt_stat
     model, s = dpgt_state
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        filmed = build_dpgt(with_overrides(reference_dpgt(3, "forward"), {"bearing.race_film": "squeeze"})).model
+        filmed = build_dpgt(with_overrides(reference_dpgt(3, "forward"), {"bearing.race_film": law})).model
     assert sum(type(e).__name__ == "RaceFilm" for e in filmed.elements) == 2
     out = mbd.System(filmed).outputs(s.t, s.q, s.v, s.z, families=["race_film_inner", "race_film_outer"])
     assert np.count_nonzero(out["race_film_outer"]["force"]) > 0          # some rollers approach an open gap
