@@ -402,12 +402,12 @@ def _race_surfaces(R, rho, ex, ey, tx, ty, rcx, rcy, vr0, vr1, vr2, vb0, vb1, vb
 RACE_OUTPUTS = ("load", "deflection", "traction", "slip_velocity", "rolling_speed", "fx", "fy")
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def evaluate_race(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     _race(ql, vl, P, G, F, Jq, Jv, jac, np.empty((0, 0)))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def outputs_race(t, phi, omega, domega, ql, vl, z, P, G, O):
     """The outputs :data:`RACE_OUTPUTS` of every instance into the rows of O (7, n): the force law of
     :func:`evaluate_race`, evaluated once (the reference's outputs; per physical contact)."""
@@ -589,12 +589,12 @@ def _pocket_gap(xr, yr, xg, yg, thg, vr0, vr1, vg0, vg1, vg2, psi, rm, clearance
 POCKET_OUTPUTS = ("force", "offset", "penetration", "penetration_rate", "approach_speed")
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def evaluate_pocket(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     _pocket(ql, vl, z, P, F, Jq, Jv, jac, np.empty((0, 0)))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def outputs_pocket(t, phi, omega, domega, ql, vl, z, P, G, O):
     """The outputs :data:`POCKET_OUTPUTS` into the rows of O (5, n), by the law of :func:`evaluate_pocket`."""
     n = ql.shape[0]
@@ -708,12 +708,12 @@ def _retention_gap(xr, yr, xg, yg, vr0, vr1, vg0, vg1, rm, clearance):
 RETENTION_OUTPUTS = ("force", "offset", "penetration", "penetration_rate", "approach_speed", "friction")
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def evaluate_retention(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     _retention(ql, vl, z, P, F, Jq, Jv, jac, np.empty((0, 0)))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def outputs_retention(t, phi, omega, domega, ql, vl, z, P, G, O):
     """The outputs :data:`RETENTION_OUTPUTS` into the rows of O (6, n), by the law of :func:`evaluate_retention`."""
     n = ql.shape[0]
@@ -865,12 +865,12 @@ GUIDE_OUTPUTS = ("force", "eccentricity", "friction", "fx", "fy", "sliding_speed
                  "approach_speed")
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def evaluate_guide(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     _guide(ql, vl, z, P, G, F, Jq, Jv, jac, np.empty((0, 0)))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def outputs_guide(t, phi, omega, domega, ql, vl, z, P, G, O):
     """The outputs :data:`GUIDE_OUTPUTS` into the rows of O (8, n), by the law of :func:`evaluate_guide`."""
     n = ql.shape[0]
