@@ -43,13 +43,13 @@ from .statistics.accumulate import accumulate_steps, accumulators_cached, compil
 
 __all__ = ["warm", "warm_line", "ESTIMATES", "usable_cores", "idle_cores"]
 
-# CPU seconds of the first compile, measured on the reference machine (2 cores, load 7-10 from other work, numba
-# 0.68, condition 3's scene; docs/numerics.md "The compile"): what warm announces. In one process or two (the second
-# costs its own start and kernels both reach); "wall, two processes": estimated from the parts for two free cores
-# (the second process's start, then the longer of its assembly and this one's kernels, update, accumulators and
-# outputs, then the step loop); the parts: "assembly" in the second process, with its start; "update" the
-# internal-state update.
-ESTIMATES = {"one process": 40.0, "two processes": 47.0, "wall, two processes": 30.0, "assembly": 16.0, "update": 2.0}
+# CPU seconds of the first compile, measured on the reference machine (2 cores shared with other work, 1-minute load
+# 3.2-4.5, numba 0.68, condition 3's scene, an empty cache; docs/numerics.md "The compile"): what warm announces. In one
+# process (47.0 and 48.6 s) or two (52.7 s: the second costs its own start and kernels both reach); "wall, two
+# processes": estimated from that run's parts for two free cores (the first process's start, then the longer of the
+# second's assembly, 20 s, and this one's kernels, update, accumulators and outputs, 19 s, then the step loop, 10 s);
+# the parts: "assembly" in the second process, with its start; "update" the internal-state update.
+ESTIMATES = {"one process": 47.0, "two processes": 52.0, "wall, two processes": 33.0, "assembly": 20.0, "update": 2.0}
 
 
 def usable_cores() -> int:

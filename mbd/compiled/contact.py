@@ -150,8 +150,9 @@ def pack_drag(elem):
 
 
 # ----------------------------------------------------------------------------------- scalar helpers
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _u(j, m):
+    """1 if j == m else 0 (inlined: the callers pass m as a literal, one compiled copy per value otherwise)."""
     return 1.0 if j == m else 0.0
 
 

@@ -339,10 +339,10 @@ def _meshes(ql, vl, P, G, F, Jq, Jv, jac):
             dkappa = -ka * ej
             hx[j] += F_net * (dkappa * tx - kappa * ex * tj * inv_a) + sig * sa * F_sum * tx * tj * inv_a
             hy[j] += F_net * (dkappa * ty - kappa * ey * tj * inv_a) + sig * sa * F_sum * ty * tj * inv_a
-        _put_row(Jq, Jv, i, 0, -sig, hx, sig)
-        _put_row(Jq, Jv, i, 1, -sig, hy, sig)
-        _put_row(Jq, Jv, i, 2, -sig * rb1, hnet, sig)
-        _put_row(Jq, Jv, i, 3, sig, hx, sig)
-        _put_row(Jq, Jv, i, 4, sig, hy, sig)
-        _put_row(Jq, Jv, i, 5, -1.0 * rb2, hnet, sig)
+        _put_row(Jq, Jv, i, int(0), -sig, hx, sig)           # int(r): a run-time row (a literal would compile
+        _put_row(Jq, Jv, i, int(1), -sig, hy, sig)           # _put_row once per row)
+        _put_row(Jq, Jv, i, int(2), -sig * rb1, hnet, sig)
+        _put_row(Jq, Jv, i, int(3), sig, hx, sig)
+        _put_row(Jq, Jv, i, int(4), sig, hy, sig)
+        _put_row(Jq, Jv, i, int(5), -1.0 * rb2, hnet, sig)
 

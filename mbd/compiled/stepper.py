@@ -11,9 +11,10 @@ reports with the last good state). A zero diagonal pivot falls back to a dense L
 Compiled as one function, for a short first compile: numba links a callee's code into its caller and optimises it
 again there, once per level, so the loop's helpers (:func:`_step`, :func:`_newton`, :func:`_refresh_at`,
 :func:`_refresh`, :func:`_lu_solve`, :func:`_scale`) are inlined into :func:`advance` at numba's IR level
-(``inline="always"``), and the assembly gets ``jac`` as a run-time bool (``bool(True)``: a constant would be typed
-as a literal and compile the assembly and every family kernel twice; the kernels branch on it per contact).
-docs/numerics.md §5 "The compile" has the measurements.
+(``inline="always"``; the Newton loop refreshes the Jacobian and LU at one place, so one inlined copy of the assembly
+call and the factorisation serves both the first refresh and those the rules ask for), and the assembly gets ``jac`` as
+a run-time bool (``bool(True)``: a constant would be typed as a literal and compile the assembly and every family
+kernel twice; the kernels branch on it per contact). docs/numerics.md §5 "The compile" has the measurements.
 """
 from __future__ import annotations
 
@@ -143,13 +144,19 @@ def _newton(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, 
     have_F = False
     refreshes = 0
     rate = 0.0
-    if cache[0] == 0.0 or cache[1] != h or not reuse:
-        if not _refresh_at(groups, t + h, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
-            return False, 0, np.inf, _SINGULAR
-        have_F = True
+    refresh = cache[0] == 0.0 or cache[1] != h or not reuse
     has_prev = False
     prev = 0.0
-    for it in range(1, max_iter + 1):
+    it = 0
+    while True:
+        if refresh:           # the one place the Jacobian and LU are refreshed (one inlined copy of the assembly call)
+            if not _refresh_at(groups, t + h, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
+                return False, it, np.inf if it == 0 else rate, _SINGULAR
+            have_F = True
+            refresh = False
+        it += 1
+        if it > max_iter:
+            break
         for i in range(n):
             q1[i] = qp[i] + bh2 * a1[i]
             v1[i] = vp[i] + gh * a1[i]
@@ -188,9 +195,7 @@ def _newton(groups, t, q, v, a, f, h, prm, atol, rtol, fams, zs, sysd, pat, lu, 
             if action == rules.REFRESH_AT_PREVIOUS:
                 for i in range(n):
                     a1[i] += da[i]
-            if not _refresh_at(groups, t + h, h, bh2, gh, c_C, c_K, fams, zs, sysd, pat, lu, cache, work, cnt):
-                return False, it, rate, _SINGULAR
-            have_F = True
+            refresh = True    # at the loop's top, before the next iteration (or the end of the iterations)
             refreshes += 1
             has_prev = False
             continue

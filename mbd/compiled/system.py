@@ -7,12 +7,12 @@ compiled :func:`assemble` loops over the records and dispatches on the family's 
 
 Threads (``threads`` > 1, opt-in): the families of :data:`.registry.THREADED_KINDS` (every bearing's contacts) are
 cut into ``threads`` fixed chunks of instances and evaluated at once on the threads (:func:`_threaded`, the engine's
-one parallel function), for every Jacobian and, on the sliced machine, for every residual (:func:`_partition`,
-:func:`_families_threaded`); the
-other families, and then the scatter of every family into the forces and the pattern in the family order, stay in the
-calling thread. A kernel's instances are independent of each other, so every force, Jacobian entry and step is
-bit-identical to the serial assembly's, whatever the thread count (docs/numerics.md §5 "Threads"). A set of families
-without the :data:`.registry.THREADED` flag (one thread, the default) compiles no parallel code.
+one parallel function, called through :func:`threads_run`), for every Jacobian and, on the sliced machine, for every
+residual (:func:`_partition`); the other families, and then the scatter of every family into the forces and the
+pattern in the family order, stay in the calling thread. A kernel's instances are independent of each other, so
+every force, Jacobian entry and step is bit-identical to the serial assembly's, whatever the thread count
+(docs/numerics.md §5 "Threads"). A set of families without the :data:`.registry.THREADED` flag (one thread, the
+default) compiles no parallel code.
 """
 from __future__ import annotations
 
@@ -107,69 +107,30 @@ def _threaded(groups, t, phi, omega, qf, vf, fams, zs, jac, par):
                                   Fl[lo:hi], Jql[lo:hi], Jvl[lo:hi], jac)
 
 
-@njit(inline="always")
-def _scatter(dofs, keep, mp, Fl, Jql, Jvl, jac, Ffull, Jq, Jv):
-    """One family's forces into the full force vector and, with ``jac``, its Jacobian blocks into the pattern (``keep``
-    the blocks' entries that land in it, ``mp`` where), in the family's own order: the serial and the threaded sets
-    scatter alike."""
-    n, k = dofs.shape
-    for i in range(n):
-        for j in range(k):
-            Ffull[dofs[i, j]] += Fl[i, j]
-    if jac:
-        flat_q = Jql.reshape(-1)
-        flat_v = Jvl.reshape(-1)
-        for e in range(keep.size):
-            Jq[mp[e]] += flat_q[keep[e]]
-            Jv[mp[e]] += flat_v[keep[e]]
-
-
-def _families_threaded(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv):
-    """The families of a threaded set: those of the partition (``sysd[13]``, :func:`_partition`) on the threads for a
-    Jacobian, and for a residual when the partition says it pays; the others here; then every family's scatter in the
-    family order, as :func:`_families_serial`."""
-    par = sysd[13]
-    threaded = jac or par[3][0]
-    if threaded:
-        _threaded(groups, t, phi, omega, qf, vf, fams, zs, jac, par)
-    r = 0
-    for rec in fams:
-        kind, dofs, P, G, zi, keep, mp, ql, vl, Fl, Jql, Jvl = rec
-        n, k = dofs.shape
-        if not (threaded and par[2][r]):      # else evaluated on the threads
-            for i in range(n):
-                for j in range(k):
-                    ql[i, j] = qf[dofs[i, j]]
-                    vl[i, j] = vf[dofs[i, j]]
-            evaluate_for(groups, kind, t, phi, omega, 0.0, ql, vl, zs[zi], P, G, Fl, Jql, Jvl, jac)
-        _scatter(dofs, keep, mp, Fl, Jql, Jvl, jac, Ffull, Jq, Jv)
-        r += 1
-
-
-def _families_serial(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv):
-    """The families one after another: each gathered, evaluated and scattered into the forces and the pattern."""
-    for rec in fams:
-        kind, dofs, P, G, zi, keep, mp, ql, vl, Fl, Jql, Jvl = rec
-        n, k = dofs.shape
-        for i in range(n):
-            for j in range(k):
-                ql[i, j] = qf[dofs[i, j]]
-                vl[i, j] = vf[dofs[i, j]]
-        evaluate_for(groups, kind, t, phi, omega, 0.0, ql, vl, zs[zi], P, G, Fl, Jql, Jvl, jac)
-        _scatter(dofs, keep, mp, Fl, Jql, Jvl, jac, Ffull, Jq, Jv)
-
-
-def families_for(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv):
+def threads_run(groups, t, phi, omega, qf, vf, fams, zs, jac, par):
     raise NotImplementedError("compiled code only")
 
 
-@overload(families_for, prefer_literal=True, inline="always")
-def _families_for(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv):
-    """:func:`_families_threaded` for a set with the :data:`.registry.THREADED` flag, else :func:`_families_serial`
-    (inlined into the assembly: a serial set compiles no parallel code and no test of it)."""
+@overload(threads_run, prefer_literal=True)
+def _threads_run(groups, t, phi, omega, qf, vf, fams, zs, jac, par):
+    """For a set with the :data:`.registry.THREADED` flag: the families of the partition ``par`` (:func:`_partition`)
+    evaluated on the threads (:func:`_threaded`) for a Jacobian, and for a residual when the partition says it pays;
+    returns whether they were. For a serial set a function returning False: no parallel code and, once LLVM has
+    inlined it, no test in the assembly's loop. A called function, not an inlined overload: numba compiles an inlined
+    overload's implementation on its own first and then types it again where it is inlined (with its callees: the
+    dispatch and every family kernel once more, ≈ 3 s of the first compile)."""
     if not isinstance(groups, nbtypes.IntegerLiteral):
-        raise TypingError("families_for: groups must be a literal int (numba.literally at the entry point)")
-    return _families_threaded if groups.literal_value & THREADED else _families_serial
+        raise TypingError("threads_run: groups must be a literal int (numba.literally at the entry point)")
+    if groups.literal_value & THREADED:
+        def run(groups, t, phi, omega, qf, vf, fams, zs, jac, par):
+            threaded = jac or par[3][0] != 0
+            if threaded:
+                _threaded(groups, t, phi, omega, qf, vf, fams, zs, jac, par)
+            return threaded
+    else:
+        def run(groups, t, phi, omega, qf, vf, fams, zs, jac, par):
+            return False
+    return run
 
 
 @njit(cache=True)
@@ -177,14 +138,34 @@ def assemble(groups, t, q, v, fams, zs, jac, sysd, F, Jq, Jv):
     """Generalized forces F on the free DOFs and, with ``jac``, J_q, J_v on the pattern (in place). ``groups``: the
     family groups of ``fams`` (:func:`.registry.groups_of`), compiled as a literal (one specialisation per set)."""
     literally(groups)
-    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full, _) = sysd
+    (free, fixed_idx, fixed_q_I, omega, gx, gy, mx, Jb, bx, by, bt, frame_map, n_full, par) = sysd
     qf, vf = _full(t, q, v, free, fixed_idx, fixed_q_I, omega, n_full)
     phi = omega * t
     Ffull = np.zeros(n_full)
     if jac:
         Jq[:] = 0.0
         Jv[:] = 0.0
-    families_for(groups, t, phi, omega, qf, vf, fams, zs, jac, sysd, Ffull, Jq, Jv)
+    threaded = threads_run(groups, t, phi, omega, qf, vf, fams, zs, jac, par)
+    r = 0
+    for rec in fams:                          # each family gathered, evaluated (unless on the threads above) and
+        kind, dofs, P, G, zi, keep, mp, ql, vl, Fl, Jql, Jvl = rec      # scattered, in the family order
+        n, k = dofs.shape
+        if not (threaded and par[2][r]):
+            for i in range(n):
+                for j in range(k):
+                    ql[i, j] = qf[dofs[i, j]]
+                    vl[i, j] = vf[dofs[i, j]]
+            evaluate_for(groups, kind, t, phi, omega, 0.0, ql, vl, zs[zi], P, G, Fl, Jql, Jvl, jac)
+        for i in range(n):
+            for j in range(k):
+                Ffull[dofs[i, j]] += Fl[i, j]
+        if jac:
+            flat_q = Jql.reshape(-1)
+            flat_v = Jvl.reshape(-1)
+            for e in range(keep.size):
+                Jq[mp[e]] += flat_q[keep[e]]
+                Jv[mp[e]] += flat_v[keep[e]]
+        r += 1
     for j in range(free.size):
         F[j] = Ffull[free[j]]
     c, s = np.cos(phi), np.sin(phi)

@@ -2,7 +2,7 @@
 
     python -m scenarios.warm [--jobs N]
 
-numba caches the compiled kernels on disk; the first run of the code on a machine compiles them (about 40 s of CPU,
+numba caches the compiled kernels on disk; the first run of the code on a machine compiles them (about 45 s of CPU,
 docs/numerics.md "The compile"), every later run loads them in about a second. Doing it here, once, says so and
 keeps it out of the runs that follow (and out of parallel test workers, which would each compile it). With two idle
 cores or more (``--jobs``: by default the usable cores less the 1-minute load; 1 compiles in this process only) the
