@@ -25,8 +25,9 @@ h(x) = h + x²/(2R) (h ≪ R) gives:
   resultant +2c_P η ũ l √(2R/h) (as §9.5's rolling resistance on a flat raceway): the roller's net tangential
   force is the wall's shear reversed, its moment about its centre that of its own shear.
 
-The wedge and squeeze loads add (Reynolds' equation is linear in p; each keeps its own cavitation boundary), and
-the two walls add: a centred roller feels both walls' shear and no net load. Below the thinnest film h_min the
+The wedge and squeeze loads are added, each with its own cavitation boundary: an approximation (the Reynolds
+outlet is a free boundary, so the two do not superpose: the sum overstates the combined gap's load by up to 22 % on
+approach, the wedge alone overstates it on separation; docs/model.md §8.9), and the two walls add: a centred roller feels both walls' shear and no net load. Below the thinnest film h_min the
 film is taken at h_min (its rates kept: the force stays continuous) and the solid contact of §8.4 carries the
 roller when the gap closes. Range: rigid surfaces (the film's pressure ≪ the Hertz pressure that would flatten
 them: a few MPa here), isoviscous oil, Newtonian, laminar, fully flooded pocket (an upper bound), h ≪ R, flat

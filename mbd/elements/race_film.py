@@ -18,7 +18,9 @@ speed along t relative to the moving contact point) and the sliding Δu = v_s (r
                    resultant 2F_P along +t through the two centres of curvature, shared by curvature
                    (:func:`mbd.elements.contact.poiseuille_forces`, as the loaded contact's rolling resistance).
 
-The loads add (Reynolds' equation is linear in p) and push the roller off the raceway along the line of centres at P;
+The loads are added (an approximation: the Reynolds outlet is a free boundary, so the squeeze and wedge pressures
+do not superpose; the sum overstates the combined gap's load by up to 22 % on approach, the wedge alone overstates it
+by up to a half on separation: docs/model.md §8.9) and push the roller off the raceway along the line of centres at P;
 the race body gets every part reversed at P. ``law`` "squeeze": the squeeze load alone; "full": all four.
 
 The film's hand-over to the loaded contact. The rigid-isoviscous law holds while the film's pressure neither

@@ -1,8 +1,10 @@
-"""The raceway squeeze film (RaceFilm, docs/model.md §8.9): the load of a roller approaching its raceway against the
+"""The raceway film (RaceFilm, docs/model.md §8.9): the load of a roller approaching its raceway against the
 rigid cylinder-on-plane squeeze law with the contact's reduced radius (convex inner, concave outer raceway), the time
 to close a gap under a constant force against its closed form (fails on a wrong exponent or factor), no force on
-separation or in contact, the hand-over across the floor (continuous, zero at touch), exact Jacobians, balance, and
-the compiled twin against the numpy reference.
+separation or in contact, the hand-over across the floor (continuous, zero at touch); the full law's wedge (a rolling
+roller floats at Martin's film, pushed off its raceway), Couette and Poiseuille shear and their moments, a film-driven
+roller's torque-free spin, the wedge on separation without the squeeze; exact Jacobians, balance, and the compiled
+twin against the numpy reference.
 """
 from __future__ import annotations
 
@@ -151,9 +153,11 @@ def test_a_rolling_roller_floats_at_martins_film(kind):
     wrong radius (the roller's own) moves h by far more."""
     W, u_orbit = 3.0, 2.5                                  # N, m/s
     gap = brentq(lambda h: rolling(kind, h, u_orbit)[1]["force"] - W, 1.1 * H_F, 1e-3, xtol=1e-18, rtol=1e-13)
-    _, out, (_, _, _, u_e, _, _, _) = rolling(kind, gap, u_orbit)
+    F, out, (e, _, _, u_e, _, _, _) = rolling(kind, gap, u_orbit)
     assert out["rolling_speed"] == pytest.approx(u_e, rel=1e-9)
     assert gap / R_RED[kind] == pytest.approx(MARTIN * ETA * abs(u_e) * LR / W, rel=2e-3)
+    away = e if kind == "inner" else -e                    # off the pin outwards, off the bore inwards
+    assert F[:2] @ away == pytest.approx(W, rel=1e-9)      # the load pushes the roller off its raceway
 
 
 @pytest.mark.parametrize("kind", ["inner", "outer"])
@@ -206,7 +210,7 @@ def test_a_free_roller_by_a_turning_raceway_spins_at_the_torque_free_speed(kind)
 @pytest.mark.parametrize("kind", ["inner", "outer"])
 def test_the_wedge_acts_on_separation_the_squeeze_does_not(kind):
     """Leaving its raceway, a rolling roller keeps the wedge load (the surfaces entrain oil), not the squeeze; closing,
-    it carries both (Reynolds' equation is linear in p: they add); at rest and leaving, none."""
+    it carries both, added (the law's approximation, docs/model.md §8.9); at rest and leaving, none."""
     h, u_orbit, V = 5e-6, 1.5, 0.03
     _, leave, (_, _, _, u_e, _, _, _) = rolling(kind, h, u_orbit, v_close=-V)
     wedge = MARTIN * ETA * abs(u_e) * R_RED[kind] * LR / h
