@@ -162,7 +162,9 @@ def race_scene(kind, pose, vel, psi, angles, deltas, v_normal, v_orbit, slips):
     """Rollers pressed δ_j into the raceway at angles_j (in race-body axes), with normal and
     tangential centre velocities relative to the raceway centre, and the spin that gives slip v_s."""
     n = len(angles)
-    mk = np.array([RCA * np.cos(psi), RCA * np.sin(psi)]) if kind == "inner" else np.zeros(2)
+    # the pin's marker at the carrier's pin radius; the bore's a little off the planet's centre (a pinhole-sized
+    # offset), so that the race body's moment about its centre is exercised for both raceways
+    mk = (RCA if kind == "inner" else 5e-5) * np.array([np.cos(psi), np.sin(psi)])
     R = R_IN if kind == "inner" else R_OUT
     qf, vf = np.zeros(3 * (n + 1)), np.zeros(3 * (n + 1))
     qf[:3], vf[:3] = pose, vel
