@@ -1202,6 +1202,28 @@ def pack_race_film(elem):
     return P, np.array([1.0 if elem.law == "full" else 0.0])
 
 
+@njit(cache=True, inline="always")
+def _film_geometry(P, ql, vl, i):
+    """Instance i's raceway geometry for the film kernels (RaceContact's, §8.1): the raceway centre's offset rc and
+    velocity V_c, p − c = (dx, dy), ρ, e, the deflection δ, the roller's velocity relative to V_c and the approach
+    speed V = δ̇."""
+    kap, mx, my, R, D = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4]
+    xr, yr = ql[i, 0], ql[i, 1]
+    xb, yb, thb = ql[i, 3], ql[i, 4], ql[i, 5]
+    vr0, vr1 = vl[i, 0], vl[i, 1]
+    vb0, vb1, vb2 = vl[i, 3], vl[i, 4], vl[i, 5]
+    cth, sth = np.cos(thb), np.sin(thb)
+    rcx, rcy = cth * mx - sth * my, sth * mx + cth * my
+    dx, dy = xr - (xb + rcx), yr - (yb + rcy)
+    rho = np.sqrt(dx * dx + dy * dy + _ETA2)
+    ex, ey = dx / rho, dy / rho
+    delta = 0.5 * D - kap * (rho - R)
+    Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
+    wx, wy = vr0 - Vcx, vr1 - Vcy
+    V = -kap * (ex * wx + ey * wy)
+    return kap, R, D, vb2, rcx, rcy, dx, dy, rho, ex, ey, delta, Vcx, Vcy, wx, wy, V
+
+
 @njit(cache=True)
 def evaluate_race_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     """The raceway squeeze film while the gap is open (docs/model.md §8.9): W = coef·max(h, h_f)^(−3/2)·S(h/h_f)·
@@ -1211,20 +1233,8 @@ def evaluate_race_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         _race_film_full(ql, vl, P, F, Jq, Jv, jac)
         return
     for i in range(ql.shape[0]):
-        kap, mx, my, R, D, coef, hf, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 5], P[i, 6], P[i, 7]
-        xr, yr = ql[i, 0], ql[i, 1]
-        xb, yb, thb = ql[i, 3], ql[i, 4], ql[i, 5]
-        vr0, vr1 = vl[i, 0], vl[i, 1]
-        vb0, vb1, vb2 = vl[i, 3], vl[i, 4], vl[i, 5]
-        cth, sth = np.cos(thb), np.sin(thb)
-        rcx, rcy = cth * mx - sth * my, sth * mx + cth * my
-        dx, dy = xr - (xb + rcx), yr - (yb + rcy)
-        rho = np.sqrt(dx * dx + dy * dy + _ETA2)
-        ex, ey = dx / rho, dy / rho
-        delta = 0.5 * D - kap * (rho - R)
-        Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
-        wx, wy = vr0 - Vcx, vr1 - Vcy
-        V = -kap * (ex * wx + ey * wy)
+        coef, hf, mult = P[i, 5], P[i, 6], P[i, 7]
+        kap, R, D, vb2, rcx, rcy, dx, dy, rho, ex, ey, delta, Vcx, Vcy, wx, wy, V = _film_geometry(P, ql, vl, i)
         h = -delta
         if not (h > 0.0 and V > 0.0):
             _zero(F, Jq, Jv, i, jac)
@@ -1264,26 +1274,15 @@ def _race_film_full(ql, vl, P, F, Jq, Jv, jac):
     kinematics (:func:`_race_surfaces`), the load along κe and the Couette shear along t at P, the Poiseuille shear
     with the pressure's tangential resultant through the centres (as the race contact's rolling resistance)."""
     for i in range(ql.shape[0]):
-        kap, mx, my, R, D, hf, mult = P[i, 0], P[i, 1], P[i, 2], P[i, 3], P[i, 4], P[i, 6], P[i, 7]
-        el, Rr = P[i, 8], P[i, 9]
-        xr, yr = ql[i, 0], ql[i, 1]
-        xb, yb, thb = ql[i, 3], ql[i, 4], ql[i, 5]
+        hf, mult, el, Rr = P[i, 6], P[i, 7], P[i, 8], P[i, 9]
+        kap, R, D, vb2, rcx, rcy, dx, dy, rho, ex, ey, delta, Vcx, Vcy, wx, wy, V = _film_geometry(P, ql, vl, i)
         vr0, vr1, vr2 = vl[i, 0], vl[i, 1], vl[i, 2]
-        vb0, vb1, vb2 = vl[i, 3], vl[i, 4], vl[i, 5]
-        cth, sth = np.cos(thb), np.sin(thb)
-        rcx, rcy = cth * mx - sth * my, sth * mx + cth * my
-        dx, dy = xr - (xb + rcx), yr - (yb + rcy)
-        rho = np.sqrt(dx * dx + dy * dy + _ETA2)
-        ex, ey = dx / rho, dy / rho
+        vb0, vb1 = vl[i, 3], vl[i, 4]
         tx, ty = -ey, ex
-        delta = 0.5 * D - kap * (rho - R)
         h = -delta
         if not h > 0.0:
             _zero(F, Jq, Jv, i, jac)
             continue
-        Vcx, Vcy = vb0 - vb2 * rcy, vb1 + vb2 * rcx
-        wx, wy = vr0 - Vcx, vr1 - Vcy
-        V = -kap * (ex * wx + ey * wy)
         rl, rrx, rry, rbx, rby, Vrx, Vry, Vbx, Vby, ur, ub, v_s, wt, u = _race_surfaces(
             R, rho, ex, ey, tx, ty, rcx, rcy, vr0, vr1, vr2, vb0, vb1, vb2, Vcx, Vcy, wx, wy)
         floored = not h > hf
