@@ -1224,6 +1224,21 @@ def _film_geometry(P, ql, vl, i):
     return kap, R, D, vb2, rcx, rcy, dx, dy, rho, ex, ey, delta, Vcx, Vcy, wx, wy, V
 
 
+@njit(cache=True, inline="always")
+def _film_dgeometry(j, kap, vb2, rcx, rcy, dx, dy, rho, ex, ey, wx, wy):
+    """The derivatives of :func:`_film_geometry`'s values along direction j (:func:`_unit`): drc, dρ, de, dV_c, dw
+    and dV, then the direction's velocity components (roller v_x, v_y, ω; race body v_x, v_y, ω)."""
+    dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, dvr2, dvb0, dvb1, dvb2 = _unit(j)
+    drcx, drcy = -rcy * dthb, rcx * dthb
+    ddx, ddy = dxr - dxb - drcx, dyr - dyb - drcy
+    drho = (dx * ddx + dy * ddy) / rho
+    dex, dey = (ddx - ex * drho) / rho, (ddy - ey * drho) / rho
+    dVcx, dVcy = dvb0 - dvb2 * rcy - vb2 * drcy, dvb1 + dvb2 * rcx + vb2 * drcx
+    dwx, dwy = dvr0 - dVcx, dvr1 - dVcy
+    dV = -kap * (dex * wx + ex * dwx + dey * wy + ey * dwy)
+    return drcx, drcy, drho, dex, dey, dVcx, dVcy, dwx, dwy, dV, dvr0, dvr1, dvr2, dvb0, dvb1, dvb2
+
+
 @njit(cache=True)
 def evaluate_race_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
     """The raceway squeeze film while the gap is open (docs/model.md §8.9): W = coef·max(h, h_f)^(−3/2)·S(h/h_f)·
@@ -1252,14 +1267,8 @@ def evaluate_race_film(t, phi, omega, domega, ql, vl, z, P, G, F, Jq, Jv, jac):
         dhp = 0.0 if floored else -1.5 * hp / hs            # d(hs^-1.5)/dh
         dc_dh = coef * (dhp * S + hp * dS)
         for j in range(12):
-            dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, _, dvb0, dvb1, dvb2 = _unit(j)
-            drcx, drcy = -rcy * dthb, rcx * dthb
-            ddx, ddy = dxr - dxb - drcx, dyr - dyb - drcy
-            drho = (dx * ddx + dy * ddy) / rho
-            dex, dey = (ddx - ex * drho) / rho, (ddy - ey * drho) / rho
-            dVcx, dVcy = dvb0 - dvb2 * rcy - vb2 * drcy, dvb1 + dvb2 * rcx + vb2 * drcx
-            dwx, dwy = dvr0 - dVcx, dvr1 - dVcy
-            dV = -kap * (dex * wx + ex * dwx + dey * wy + ey * dwy)
+            drcx, drcy, drho, dex, dey, _, _, _, _, dV, _, _, _, _, _, _ = _film_dgeometry(
+                j, kap, vb2, rcx, rcy, dx, dy, rho, ex, ey, wx, wy)
             dh = kap * drho                                   # h = κ(ρ − R) − D/2
             dW = dc_dh * dh * V + c * dV
             dFx, dFy = kap * (dW * ex + W * dex), kap * (dW * ey + W * dey)
@@ -1305,15 +1314,9 @@ def _race_film_full(ql, vl, P, F, Jq, Jv, jac):
         if not jac:
             continue
         for j in range(12):
-            dxr, dyr, _, dxb, dyb, dthb, dvr0, dvr1, dvr2, dvb0, dvb1, dvb2 = _unit(j)
-            drcx, drcy = -rcy * dthb, rcx * dthb
-            ddx, ddy = dxr - dxb - drcx, dyr - dyb - drcy
-            drho = (dx * ddx + dy * ddy) / rho
-            dex, dey = (ddx - ex * drho) / rho, (ddy - ey * drho) / rho
+            drcx, drcy, drho, dex, dey, dVcx, dVcy, dwx, dwy, dV, dvr0, dvr1, dvr2, dvb0, dvb1, dvb2 = _film_dgeometry(
+                j, kap, vb2, rcx, rcy, dx, dy, rho, ex, ey, wx, wy)
             dtx, dty = -dey, dex
-            dVcx, dVcy = dvb0 - dvb2 * rcy - vb2 * drcy, dvb1 + dvb2 * rcx + vb2 * drcx
-            dwx, dwy = dvr0 - dVcx, dvr1 - dVcy
-            dV = -kap * (dex * wx + ex * dwx + dey * wy + ey * dwy)
             dh = kap * drho                                   # h = κ(ρ − R) − D/2
             drrx, drry = -drho * ex + rl * dex, -drho * ey + rl * dey
             drbx, drby = drcx + R * dex, drcy + R * dey
