@@ -33,7 +33,7 @@ from .core.integrity import read_summary
 from .core.runner import SETTLED_SPEED_ERROR_PCT, RunConfig
 from .core.study import Study, StudyRun
 from .core.points import machine_identity, machine_overrides, point_label, point_order, point_tag, points_of
-from .core.sweep import Beside, Case, user_overrides
+from .core.sweep import ALL, Beside, Case, user_overrides
 from .core import args
 from .core.command import command
 from .core.lock import holds_out_folder
@@ -348,6 +348,8 @@ def headline_values(results: dict) -> dict[tuple, float | None]:
 # point's two results files): the time histories of the bearing loads, the roller contacts and the meshes; the cage
 # histories and the cage orbits
 POINT_PIECES = (("bearing_loads", "roller_contacts", "mesh"), ("cage", "cage_orbits"))
+# the figures across the points, each a piece of its own beside the last point's (:func:`across_figures`)
+ACROSS_PIECES = ("headline", "bars")
 
 
 def point_figures(results: dict, out: Path, c, figures=None) -> list[Path]:
@@ -387,17 +389,25 @@ def point_work(results: dict, out: Path, c, piece) -> list[Path]:
     return animate(results, out, only=[c]) if piece == "animation" else point_figures(results, out, c, piece)
 
 
-def plots(results: dict, out: Path, machine: str = "", drawn=()) -> list[Path]:
+def plots(results: dict, out: Path, machine: str = "", drawn=(), across=True) -> list[Path]:
     """Every figure of a dynamic study, the points in ``drawn`` (their figures made beside the runs) left out of the
-    per-point ones; ``machine``: the machine's label, in the headline figure's title."""
+    per-point ones, and the figures across the points unless ``across`` is False (made beside the runs too);
+    ``machine``: the machine's label, in the headline figure's title."""
+    paths = []
+    for c in _conds(results):
+        if c not in drawn:
+            paths += point_figures(results, out, c)
+    return paths + (across_figures(results, out, machine) if across else [])
+
+
+def across_figures(results: dict, out: Path, machine: str = "", figures=None) -> list[Path]:
+    """The figures across a dynamic study's points: the headline (mean load and lives, forward vs reverse,
+    "headline") and the bars of RMS values ("bars"); ``figures``: those of them (None: both)."""
     from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
     paths = []
     conds = _conds(results)
-    for c in conds:
-        if c not in drawn:
-            paths += point_figures(results, out, c)
-    vals = headline_values(results)
+    vals = headline_values(results) if figures is None or "headline" in figures else {}
     if vals:
         one = f", {_title(conds[0]).lower()}" if len(conds) == 1 else ""
         paths.append(vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
@@ -405,7 +415,7 @@ def plots(results: dict, out: Path, machine: str = "", drawn=()) -> list[Path]:
                                                        f"reverse{one}" + (f"\n{machine}" if machine else "")))
     table, bar_units, ylabels = {}, {}, {}
     for q, unit in QUANTITIES:
-        if q not in BAR_QUANTITIES:
+        if q not in BAR_QUANTITIES or not (figures is None or "bars" in figures):
             continue
         for kind in ("inner", "outer"):
             key = f"{kind} planets\n{SUMMARY_WORDS[q][0]}"
@@ -482,12 +492,14 @@ class PaperStudy(Study):
 
     def beside(self, cfg: RunConfig) -> Beside | None:
         """A dynamic study of several points draws each point's figures (and animation) as soon as both its runs are
-        in, on a worker while the other points run; the tables and the figures across points wait for every run. One
-        point (the demo) has nothing to draw beside: its figures wait for its runs either way, and the report draws
-        them in this process without handing the results to a worker."""
+        in, on a worker while the other points run, and the figures across the points once every run is in, beside
+        the last point's; the report is left with the tables. One point (the demo) has nothing to draw beside: its
+        figures wait for its runs either way, and the report draws them in this process without handing the results
+        to a worker."""
         if cfg.mode == "static" or len({c.condition for c in self.cases()}) < 2:
             return None
         out, animation = self.out, bool(self.a.animate)
+        machine = self.machine_identity()["label"]
 
         def task(c, outcomes):
             if not all(o.ok for o in outcomes.values()):    # a failed run: the report draws what it can
@@ -496,7 +508,16 @@ class PaperStudy(Study):
             # in pieces, each on a worker: the last point's figures do not wait on one worker while the other idles
             return [(point_work, (results, out, c, piece)) for piece in (*POINT_PIECES, *(("animation",) if animation
                                                                                           else ()))]
-        return Beside(key=lambda case: case.condition, task=task)
+
+        def last(outcomes):
+            """The figures across the points, beside the last point's, once every run is in (a failed run: the
+            report draws them, with the earlier results it keeps)."""
+            if not all(o.ok for o in outcomes.values()):
+                return None
+            results = {label: Summary.of(o.summary) for label, o in outcomes.items()}
+            return [(across_figures, (results, out, machine, (piece,))) for piece in ACROSS_PIECES]
+
+        return Beside(key=lambda case: case.condition, task=task, last=last)
 
     def machine_identity(self) -> dict:
         over = {k: v for k, v in args.parse_sets(self.a.set).items() if not k.startswith("operating.")}
@@ -529,13 +550,19 @@ class PaperStudy(Study):
             print(f"note: {STATIC_LIVES_NOTE}")
             atomic_write_text(md_p, text + f"\nNote: {STATIC_LIVES_NOTE}.\n")
         run.step("tables", lambda: [csv_p, md_p])
-        made = {c: v for c, v in run.beside.items() if isinstance(v, list)}      # figures made beside the runs
+        # figures made beside the runs: each point's, and those across the points (key ALL)
+        made = {c: v for c, v in run.beside.items() if isinstance(v, list)}
         for c, v in run.beside.items():
-            if not isinstance(v, list):
-                print(f"figures of {_title(c).lower()} beside the runs failed ({v}); drawn now")
-        early = run.step("figures beside the runs", lambda: [p for v in made.values() for p in v])
-        figs = [p for p in early if p.suffix != ".gif"] + (run.step("figures", plots, results, self.out, machine["label"], drawn=set(made)) if not static
-                        else run.step("figures", static_plots, results, self.out, machine["label"]))
+            if not isinstance(v, list) and v is not None:
+                what = "across the points" if c is ALL else f"of {_title(c).lower()}"
+                print(f"figures {what} beside the runs failed ({v}); drawn now")
+        across = ALL not in made
+        made.pop(ALL, None)
+        early = run.step("figures beside the runs", lambda: [p for v in (*(made[c] for c in _conds(results) if c in made),
+                                                                     run.beside.get(ALL)) if isinstance(v, list) for p in v])
+        figs = [p for p in early if p.suffix != ".gif"] + (
+            run.step("figures", plots, results, self.out, machine["label"], drawn=set(made), across=across)
+            if not static else run.step("figures", static_plots, results, self.out, machine["label"]))
         anims = [p for p in early if p.suffix == ".gif"]
         left = [c for c in _conds(results) if c not in made]
         if self.a.animate and not static and left:

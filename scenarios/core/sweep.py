@@ -49,7 +49,7 @@ from .cluster import check_workers, done_on_worker, folder_files, land, other_co
 from .integrity import OtherResults, claim_folder, differences, read_summary
 from .runner import code_digest, finished_run, parameters_fingerprint, run_case, run_description, run_fingerprint
 
-__all__ = ["Case", "Status", "Outcome", "Beside", "Travelled", "sweep", "run_sweep", "execute_case", "execute_on_worker",
+__all__ = ["Case", "Status", "Outcome", "Beside", "ALL", "Travelled", "sweep", "run_sweep", "execute_case", "execute_on_worker",
            "join_closing",
            "check_folders", "user_overrides", "validate_cases", "dask_client", "OPERATING_AXES", "RETRIES",
            "say_design_warnings"]
@@ -305,6 +305,16 @@ def execute_on_worker(case: Case, cfg, overwrite: bool, code: str, texts: dict) 
     return Travelled(o, files)
 
 
+class _AllRuns:
+    """The key of :class:`Beside`'s work across every case (``Beside.last``): a key no case's group can have."""
+
+    def __repr__(self) -> str:
+        return "ALL"
+
+
+ALL = _AllRuns()
+
+
 @dataclass
 class Beside:
     """Work to do beside the runs, e.g. one operating point's figures: the cases fall into groups (``key(case)``;
@@ -313,10 +323,13 @@ class Beside:
     workers; the last group's work then does not wait on one worker while the others idle) or None. On a local
     cluster each function runs on a worker, ahead of the runs still queued, while the other runs go on; without
     Dask, or on a cluster whose workers share no filesystem with this process, it runs here at that moment.
-    ``done``: {key: its return value (pieces that return lists: their lists joined, in the order of the pieces),
-    or the exception one of its pieces raised}."""
+    ``last(outcomes)``: the work that needs every case's outcome (figures across the groups), in the same form as
+    ``task``'s, done beside the last groups' work as soon as the last run is in; its value is under the key
+    :data:`ALL`. ``done``: {key: its return value (pieces that return lists: their lists joined, in the order of
+    the pieces), or the exception one of its pieces raised}."""
     key: Callable[[Case], object]
     task: Callable[[object, dict], tuple | None]
+    last: Callable[[dict], tuple | list | None] | None = None
     done: dict = field(default_factory=dict)
     spans: list = field(default_factory=list)   # where and when each piece of work ran (as Outcome.span)
 
@@ -326,6 +339,8 @@ class Beside:
             k = self.key(c)
             if k is not None:
                 out.setdefault(k, []).append(c.label)
+        if self.last is not None:       # after the groups: the last group's pieces go first
+            out[ALL] = [c.label for c in cases]
         return out
 
     def ready(self, groups: dict, results: dict, started: set):
@@ -333,7 +348,8 @@ class Beside:
         for k, labels in groups.items():
             if k not in started and all(lab in results for lab in labels):
                 started.add(k)
-                work = self.task(k, {lab: results[lab] for lab in labels})
+                got = {lab: results[lab] for lab in labels}
+                work = self.last(got) if k is ALL else self.task(k, got)
                 for piece in ([] if work is None else work if isinstance(work, list) else [work]):
                     yield k, piece
 
@@ -464,6 +480,7 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
     futs, side = {}, []           # side: (group, future) of each piece of work beside the runs
     t_start = time.perf_counter()
     with dask_client(n_workers, scheduler, close_behind=timing if close_behind else None) as client:
+        from dask.distributed import wait as dask_wait  # deferred: Dask, imported by dask_client just now
         timing["cluster_start_s"] = time.perf_counter() - t_start
         timing["runs_start_unix_s"] = time.time()
         try:
@@ -483,7 +500,9 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
                     if all(futs[f].label in results for f in futs):
                         break
                     runs.poll()
-                    time.sleep(0.5)
+                    # back as soon as a run ends (its point's figures start then), the bars fed every 0.5 s
+                    with contextlib.suppress(TimeoutError):
+                        dask_wait([f for f in futs if not f.done()], timeout=0.5, return_when="FIRST_COMPLETED")
                     continue
                 fut = done[0]
                 c = futs[fut]

@@ -1,5 +1,5 @@
 """Work beside the runs (scenarios.core.sweep.Beside): each group's task starts once, when its last case is in."""
-from scenarios.core.sweep import Beside, Case, Outcome, Status
+from scenarios.core.sweep import ALL, Beside, Case, Outcome, Status
 
 
 def _case(cond, d):
@@ -75,3 +75,71 @@ def test_a_group_in_pieces_starts_each_piece_once_and_joins_their_lists_in_order
     for k, work in bad.ready(bad.groups(cases), results, set()):
         bad.here(k, work)
     assert isinstance(bad.done[1], ValueError)
+
+
+def test_the_work_across_all_cases_starts_once_with_the_last_case_after_that_groups_pieces():
+    """``last``: given every case's outcome, once, when the last case is in; its pieces come after the last group's
+    (so they are submitted behind them), and its value is kept under ALL, apart from every group's."""
+    cases = [_case(c, d) for c in (1, 2) for d in ("forward", "reverse")]
+    seen = []
+    b = Beside(key=lambda c: c.condition, task=lambda k, outs: (len, (outs,)),
+               last=lambda outs: (seen.append(sorted(outs)) or [(len, ("abc",)), (len, ("de",))]))
+    groups, started, results = b.groups(cases), set(), {}
+    for c in cases[:3]:
+        results[c.label] = _done(c)
+    assert [k for k, _ in b.ready(groups, results, started)] == [1] and seen == []
+    results[cases[3].label] = _done(cases[3])
+    ready = list(b.ready(groups, results, started))
+    assert [k for k, _ in ready] == [2, ALL, ALL]
+    assert seen == [sorted(c.label for c in cases)]
+    assert list(b.ready(groups, results, started)) == []          # never twice
+    for k, work in ready:
+        b.here(k, work)
+    assert b.done == {2: 2, ALL: 2}     # the pieces' values are not lists: the last one's stays
+
+
+def test_the_paper_study_draws_the_figures_across_its_points_beside_only_when_every_run_finished(tmp_path):
+    from scenarios import paper_study
+    study = paper_study.PaperStudy(paper_study.parse_args(["--conditions", "2,3", "--out", str(tmp_path)]))
+    b = study.beside(study.config())
+    cases = [_case(c, d) for c in (2, 3) for d in ("forward", "reverse")]
+    assert b.last({c.label: _done(c, ok=c.label != "c3_reverse") for c in cases}) is None  # the report draws them
+    pieces = b.last({c.label: _done(c) for c in cases})
+    assert all(fn is paper_study.across_figures for fn, _ in pieces)
+    assert [fargs[3] for _, fargs in pieces] == [(p,) for p in paper_study.ACROSS_PIECES]
+    assert sorted(paper_study.ACROSS_PIECES) == ["bars", "headline"]
+
+
+TINY = ["--conditions", "3,4", "--directions", "forward", "--settle", "0.0005", "--window", "0.0005",
+        "--set", "bearing.rollers=8", "--no-progress", "--workers", "1"]
+
+
+def test_a_study_of_two_points_draws_every_figure_once_beside_its_runs_and_redraws_what_failed_there(
+        tmp_path, capsys, monkeypatch):
+    """In-process (one worker): each point's figures after its run, those across the points after the last run;
+    the report draws nothing again. A piece across the points that fails beside the runs is drawn by the report,
+    and said so."""
+    from scenarios import paper_study
+
+    r = paper_study.run(paper_study.parse_args([*TINY, "--out", str(tmp_path / "ok")]))
+    names = [p.name for p in r["figures"]]
+    want = {f"c{c}_{g}.png" for c in (3, 4) for g in paper_study.HISTORY_GROUPS} | {
+        f"c{c}_cage_orbit_{k}.png" for c in (3, 4) for k in ("inner", "outer")} | {"bearing_load_life.png", "bars.png"}
+    assert sorted(names) == sorted(want)                       # each once
+    assert names.index("c3_cage.png") < names.index("c4_cage.png") < names.index("bearing_load_life.png")
+    assert "figures: nothing to write" in capsys.readouterr().out
+
+    real = paper_study.across_figures
+
+    def failing_beside(results, out, machine="", figures=None):
+        if figures == ("bars",):            # the piece beside the runs; the report asks for both (None)
+            raise RuntimeError("no bars here")
+        return real(results, out, machine, figures)
+
+    monkeypatch.setattr(paper_study, "across_figures", failing_beside)
+    r = paper_study.run(paper_study.parse_args([*TINY, "--out", str(tmp_path / "redo")]))
+    text = capsys.readouterr().out
+    assert "figures across the points beside the runs failed (no bars here); drawn now" in text
+    figures_line = next(x for x in text.splitlines() if x.startswith("figures: "))
+    assert "bars.png" in figures_line and "bearing_load_life.png" in figures_line   # the report drew both
+    assert sorted(p.name for p in r["figures"]).count("bearing_load_life.png") == 1
