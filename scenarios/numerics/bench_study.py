@@ -14,7 +14,8 @@ before/after ratio of each pair run back to back.
 (:data:`scenarios.core.study.TIMING_ENV`: its checks, Dask phases, each run's span on its worker, the report's
 steps) and each run's ``timing`` in its summary.json (engine, statistics, recording, set-up, kernels); the time
 outside the study's own clock is the interpreter's start, the imports and the exit. On Dask the runs' parts are
-worker-seconds shared out over the workers, so the rows add up to the wall time.
+worker-seconds shared out over the workers, so the rows add up to the wall time. Then the wall time against its
+target (:func:`target`): ``1.15 × (the runs' worker-seconds / workers) + (1 − 1/workers) × the longest run``.
 
 Memory: each run's own peak resident memory (``timing.peak_rss_MB`` of its summary.json: the worker's high-water
 mark reset when the run starts), max and median over the runs; the study process's own peak; and the largest of the
@@ -154,7 +155,7 @@ def profile(job: dict) -> list[tuple[str, str, float]]:
     if sw.get("dask"):
         add("dask", "a worker's first task: the imports, transfer, start", first / n)
         add("dask", "between a worker's tasks: scheduling, transfer", gaps / n)
-        add("dask", "idle at the end: waiting for the other worker's last run, the client's 0.5 s poll", tail / n)
+        add("dask", "idle at the end: waiting for the other worker's last run", tail / n)
     else:
         add("other", "between runs (in-process)", (first + gaps + tail) / n)
     steps = T.get("steps_s", {})
@@ -167,6 +168,38 @@ def profile(job: dict) -> list[tuple[str, str, float]]:
     add("other", "the study's rest (sweep bookkeeping, epilogue)", T["total_s"] - T["checks_s"] - T["prepare_s"]
         - T["sweep_s"] - T["report_s"] - (close if behind else 0.0) + sweep_rest)
     return rows
+
+
+def target(job: dict) -> dict | None:
+    """The study's wall time against its target: its runs' worker-seconds ``W`` (each run's span on its worker: the
+    engine, its statistics and recording — the work only the runs do) shared over the ``n`` workers, 15 % on top,
+    plus the longest run's tail ``(1 − 1/n) p_max`` — the most a greedy schedule of the runs (Graham's bound) can
+    leave a run going alone: ``target = 1.15 W / n + (1 − 1/n) p_max``; ``ratio`` = wall / target (≤ 1: met).
+    None for a job without a sweep on workers."""
+    T = job["study"]
+    if T is None:
+        return None
+    spans = [v["end_unix_s"] - v["start_unix_s"] for v in T["runs"].values() if v]
+    n = max(int(T["sweep"].get("workers", 1)), 1)
+    if not spans:
+        return None
+    W, p_max = sum(spans), max(spans)
+    tgt = 1.15 * W / n + (1.0 - 1.0 / n) * p_max
+    return {"wall_s": job["wall_s"], "runs_worker_s": W, "workers": n, "longest_run_s": p_max, "target_s": tgt,
+            "ratio": job["wall_s"] / tgt}
+
+
+def target_line(name: str, jobs: list[dict]) -> str:
+    """One line per job: wall, target and their ratio (:func:`target`)."""
+    out = []
+    for j in jobs:
+        t = target(j)
+        if t is not None:
+            out.append(f"{name}: wall {t['wall_s']:.1f} s against the target 1.15 × {t['runs_worker_s']:.1f} / "
+                       f"{t['workers']} + (1 − 1/{t['workers']}) × {t['longest_run_s']:.1f} = {t['target_s']:.1f} s "
+                       f"(runs' worker-seconds over the workers, 15 % on top, the longest run's tail): "
+                       f"ratio {t['ratio']:.2f}" + (" — met" if t["ratio"] <= 1 else " — not met"))
+    return "\n".join(out)
 
 
 def _beside_in_phase(sw: dict, by_pid: dict) -> dict[str, float]:
@@ -321,11 +354,14 @@ def main(argv=None) -> int:
     result = compare_runs(a, repos)
     if a.profile:
         for job, ds in result["this"]["jobs"].items():
-            print("\n" + profile_table(f"{job} ({HERE})", [d for d in ds if d["rc"] == 0]))
+            ok = [d for d in ds if d["rc"] == 0]
+            print("\n" + profile_table(f"{job} ({HERE})", ok))
+            print(target_line(f"{job} ({HERE})", ok))
     summary = summarise(result, list(repos))
     if a.profile:
         summary["profile"] = {job: profile([d for d in ds if d["rc"] == 0][-1]) if any(d["rc"] == 0 for d in ds) else []
                               for job, ds in result["this"]["jobs"].items()}
+        summary["target"] = {job: [target(d) for d in ds if d["rc"] == 0] for job, ds in result["this"]["jobs"].items()}
     print(json.dumps(summary))
     return 0
 

@@ -12,7 +12,7 @@ import mbd
 from components.planetary import build_single_planetary
 from mbd.simulate import TIMING_PARTS
 from scenarios.core.memory import RunPeak, process_peak_mb
-from scenarios.numerics.bench_study import RUN_PARTS, profile
+from scenarios.numerics.bench_study import RUN_PARTS, profile, target
 
 DELAY = 10e-3      # s per accepted step, planted in the observer or in the recorder
 
@@ -98,11 +98,21 @@ def test_the_profile_adds_up_to_the_wall_time_and_shares_worker_seconds_over_the
     assert rows["engine: the integration steps"] == pytest.approx((15 + 25 + 35) / 2)
     assert rows["a worker's first task: the imports, transfer, start"] == pytest.approx((2 + 3) / 2)
     assert rows["between a worker's tasks: scheduling, transfer"] == pytest.approx(1 / 2)
-    assert rows["idle at the end: waiting for the other worker's last run, the client's 0.5 s poll"] == \
+    assert rows["idle at the end: waiting for the other worker's last run"] == \
         pytest.approx((1 + 11) / 2)
     assert rows["a run's case outside the runner (parameters, lock, folder checks)"] == pytest.approx(3 * 0.5 / 2)
     assert rows["report: figures"] == 8.0 and rows["report: relative lives into each summary.json, headline tables"] == 3.0
     assert rows["the study's rest (sweep bookkeeping, epilogue)"] == pytest.approx(76 - 1 - 62.75 - 12 + 0.25)
+
+
+def test_the_target_is_the_runs_worker_seconds_shared_out_with_15_percent_and_the_longest_runs_tail():
+    """Runs of 20, 30 and 40 s on 2 workers: 1.15 × 90 / 2 + (1 − 1/2) × 40 = 71.75 s; the job's 85 s miss it."""
+    t = target(_study())
+    assert t["runs_worker_s"] == 90.0 and t["longest_run_s"] == 40.0 and t["workers"] == 2
+    assert t["target_s"] == pytest.approx(71.75) and t["ratio"] == pytest.approx(85.0 / 71.75)
+    one = _study()
+    one["study"]["sweep"]["workers"] = 1       # one worker: no tail, the runs one after another
+    assert target(one)["target_s"] == pytest.approx(1.15 * 90.0)
 
 
 def test_a_worker_that_ran_nothing_counts_as_idle():
@@ -113,7 +123,7 @@ def test_a_worker_that_ran_nothing_counts_as_idle():
     job["study"]["sweep"]["runs_end_unix_s"] = 1054.0
     rows = {what: s for _, what, s in profile(job)}
     assert sum(rows.values()) == pytest.approx(85.0, abs=1e-9)
-    assert rows["idle at the end: waiting for the other worker's last run, the client's 0.5 s poll"] == \
+    assert rows["idle at the end: waiting for the other worker's last run"] == \
         pytest.approx((0 + 54) / 2)
 
 
@@ -136,7 +146,7 @@ def test_figures_drawn_on_a_worker_leave_its_idle_rows_and_the_tail_leaves_the_r
         pytest.approx((4 + 0.5) / 2)
     assert rows["figures beside the runs, waited for after the last run"] == 3.0
     assert rows["between a worker's tasks: scheduling, transfer"] == pytest.approx((1 - 0.5) / 2)
-    assert rows["idle at the end: waiting for the other worker's last run, the client's 0.5 s poll"] == \
+    assert rows["idle at the end: waiting for the other worker's last run"] == \
         pytest.approx((1 + 11 - 4) / 2)
     assert rows["the study's rest (sweep bookkeeping, epilogue)"] == pytest.approx(76 - 1 - 62.75 - 12 + 0.25)
 
