@@ -68,8 +68,16 @@ def _save(fig: Figure, path) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     FigureCanvasAgg(fig)
+    dpi = mpl.rcParams["savefig.dpi"]
+    layout = fig.get_layout_engine()
+    if layout is not None and dpi != "figure":
+        # laid out once at the saved resolution, then drawn once: with its layout engine on, savefig draws the
+        # figure twice (a pass to lay it out, then the picture); the same pixels
+        fig.set_dpi(dpi)
+        layout.execute(fig)
+        fig.set_layout_engine("none")
     # zlib level 3 instead of PIL's 6: the same pixels, 4-8 % larger files, 30-40 % less encoding time
-    fig.savefig(path, format="png", pil_kwargs={"compress_level": 3})
+    fig.savefig(path, format="png", dpi=dpi, pil_kwargs={"compress_level": 3})
     return path
 
 
