@@ -593,10 +593,11 @@ def dask_client(n_workers: int, scheduler: str | None = None, close_behind: dict
     alone. Its log messages are silenced below CRITICAL for the same reason (a failed run is reported by its
     outcome).
 
+    A local cluster's workers exit without their interpreter's finalisation (:mod:`scenarios.core.quick_exit`).
     ``close_behind`` (a timing dict): a block that ends normally leaves the client and a local cluster to close in a
-    thread of this process while the caller goes on (its workers' exit takes seconds: their interpreters tear down
-    numba, SciPy, matplotlib); :func:`join_closing` waits for it, as the interpreter does before it exits. The
-    close's wall seconds go into ``close_behind["cluster_close_s"]``. An exception or Ctrl-C closes at once."""
+    thread of this process while the caller goes on; :func:`join_closing` waits for it, as the interpreter does
+    before it exits. The close's wall seconds go into ``close_behind["cluster_close_s"]``. An exception or Ctrl-C
+    closes at once."""
     cluster = client = None
     with _ctrl_c_held(scheduler is None) as release:
         try:
@@ -608,6 +609,9 @@ def dask_client(n_workers: int, scheduler: str | None = None, close_behind: dict
                 cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                                        dashboard_address=":0", silence_logs=logging.CRITICAL)
                 client = Client(cluster)
+                from .quick_exit import QuickExit  # deferred: it imports Dask's distributed
+
+                client.register_plugin(QuickExit())      # its workers leave without finalising their interpreters
             else:
                 client = Client(scheduler)
             release()               # a Ctrl-C pressed while the cluster started is raised here

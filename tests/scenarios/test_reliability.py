@@ -193,6 +193,9 @@ class _FakeClient:
     def run(self, fn):                                        # no worker to disagree with the client's code
         return {}
 
+    def register_plugin(self, plugin):
+        self.plugins = [*getattr(self, "plugins", []), plugin]
+
 
 class _FakeCluster:
     made = []
@@ -207,8 +210,6 @@ class _FakeCluster:
 
 @pytest.mark.parametrize("scheduler", ["tcp://elsewhere:8786", None])
 def test_an_interrupted_sweep_cancels_its_runs_and_stops_local_workers(scheduler, tmp_path, monkeypatch):
-    import time
-
     import dask.distributed
 
     _FakeClient.made.clear()
@@ -216,15 +217,17 @@ def test_an_interrupted_sweep_cancels_its_runs_and_stops_local_workers(scheduler
     monkeypatch.setattr(dask.distributed, "Client", _FakeClient)
     monkeypatch.setattr(dask.distributed, "LocalCluster", _FakeCluster)
 
-    def ctrl_c(_):
+    def ctrl_c(*a, **k):
         raise KeyboardInterrupt
-    monkeypatch.setattr(time, "sleep", ctrl_c)        # the user presses Ctrl-C while the runs are out
+    monkeypatch.setattr(dask.distributed, "wait", ctrl_c)      # the user presses Ctrl-C while the runs are out
     cases = [_case(tmp_path / "a"), Case(4, "reverse", str(tmp_path / "b"), {"bearing.rollers": 8})]
     with pytest.raises(KeyboardInterrupt):
         run_sweep(cases, CFG, workers=2, scheduler=scheduler, progress=False)
     client, = _FakeClient.made
     assert len(client.submitted) == 2 and client.cancelled == client.submitted and client.closed
     assert [c.closed for c in _FakeCluster.made] == ([] if scheduler else [True])
+    # the quick exit only for the workers of a cluster it started itself, never a scheduler's it was given
+    assert [type(p).__name__ for p in getattr(client, "plugins", [])] == ([] if scheduler else ["QuickExit"])
 
 
 def test_a_fixed_step_run_beyond_its_tolerance_warns(finished, tmp_path, capsys):

@@ -1,0 +1,50 @@
+"""A local cluster's workers leave without finalising their interpreters (scenarios.core.quick_exit): what their tasks
+wrote is whole, and the processes are gone once the cluster is closed."""
+import os
+import time
+
+import pytest
+
+from scenarios.core.quick_exit import QuickExit
+from scenarios.core.sweep import dask_client
+
+
+def test_teardown_exits_the_process_at_once_with_a_clean_code(monkeypatch):
+    codes = []
+
+    def exit_(code):
+        codes.append(code)
+        raise SystemExit(code)
+    monkeypatch.setattr(os, "_exit", exit_)
+    with pytest.raises(SystemExit):
+        QuickExit().teardown(worker=None)
+    assert codes == [0]
+
+
+def _write(path: str, n: int) -> int:
+    import numpy as np
+
+    np.save(path, np.arange(n, dtype=float))        # whole before the task returns
+    return os.getpid()
+
+
+def _gone(pid: int, wait_s: float = 10.0) -> bool:
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < wait_s:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return True
+        time.sleep(0.05)
+    return False
+
+
+def test_a_local_clusters_workers_exit_after_their_work_is_written(tmp_path):
+    with dask_client(2) as client:
+        futs = [client.submit(_write, str(tmp_path / f"a{i}.npy"), 100_000 + i, pure=False) for i in range(4)]
+        pids = set(client.gather(futs))
+    import numpy as np
+
+    for i in range(4):
+        assert np.array_equal(np.load(tmp_path / f"a{i}.npy"), np.arange(100_000 + i, dtype=float))
+    assert pids and os.getpid() not in pids and all(_gone(p) for p in pids)
