@@ -260,8 +260,10 @@ def _read_open(f, path: Path, wanted: set | None, h5py) -> Results:
             continue
         va = {k: _attr_value(attrs[k]) for k in keys if k not in _NC4_HIDDEN}
         refused = [k for k in _CF_REFUSED if k in va]
-        if refused or " since " in str(va.get("units", "")):
-            refuse(name, f"is CF-encoded ({', '.join(refused) or 'units ' + repr(va['units'])})")
+        if " since " in str(va.get("units", "")):
+            refused.append(f"units {va['units']!r}")
+        if refused:
+            refuse(name, f"is CF-encoded ({', '.join(refused)})")
         sinfo = h5py.check_string_dtype(obj.dtype)
         fills = [va[k] for k in ("_FillValue", "missing_value") if k in va]
         if sinfo is not None:
