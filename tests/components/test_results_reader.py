@@ -275,3 +275,16 @@ def test_a_dataset_that_does_not_read_is_damaged(run_file, tmp_path):
     with pytest.raises(DamagedResults, match="does not open as netCDF4/HDF5: OSError") as e:
         read_results(path)
     assert e.value.why.startswith("does not open as netCDF4/HDF5")
+
+
+def test_the_slip_readers_give_from_a_read_of_their_variables_what_they_give_from_xarray(run_file):
+    """components.skid reads a run's file by the names it declares (ZONE_VARIABLES, SERIES_VARIABLES): the same
+    numbers from read_results of those alone as from xarray's Dataset of the whole file."""
+    from components.presets import reference_dpgt
+    from components.skid import SERIES_VARIABLES, ZONE_VARIABLES, roller_slip_zones, slip_series
+    b = reference_dpgt(3).si().bearing
+    with xr.open_dataset(run_file, engine="h5netcdf") as ds:
+        zones, series = roller_slip_zones(ds, b, bins=8), slip_series(ds, 2e-4)
+    assert set(zones) == {"inner", "outer"} and np.isfinite(zones["inner"]["slip_by_angle_pct"]).any()
+    np.testing.assert_equal(roller_slip_zones(read_results(run_file, ZONE_VARIABLES), b, bins=8), zones)
+    np.testing.assert_equal(slip_series(read_results(run_file, SERIES_VARIABLES), 2e-4), series)
