@@ -180,7 +180,7 @@ def read_results(path, variables: Iterable[str] | None = None) -> Results:
     caller tests ``name in results``).
 
     A missing file is a :class:`ResultsError`; a file that is not netCDF4/HDF5 one with :func:`open_dataset`'s words
-    ("is not a netCDF4/HDF5 results file"); a dataset that does not read (a truncated file) is
+    ("is not a netCDF4/HDF5 results file"); a dataset that does not read (a damaged chunk) is
     :class:`DamagedResults` ("does not open as netCDF4/HDF5", the words of :func:`count_samples`)."""
     import h5py  # deferred: HDF5 only when a file is read, not in every command's start-up
 
@@ -205,7 +205,7 @@ def _read_open(f, path: Path, wanted: set | None, h5py) -> Results:
         raise ResultsError(f"{path}: variable {name!r} {why}; this reader reads the DPGT recorder's layout "
                            "(open_dataset reads the file)")
 
-    entries = []                   # (variable name or None for a bare dimension, dataset, its attrs, their names)
+    entries = []                   # (variable name, dataset, its attrs, their names): every variable
     dimids: dict[int, str] = {}    # netCDF-4 dimension id -> dimension name
     scales: set[str] = set()
     for hname, obj in f.items():
@@ -218,8 +218,8 @@ def _read_open(f, path: Path, wanted: set | None, h5py) -> Results:
             scales.add(hname)
             if "_Netcdf4Dimid" in keys:
                 dimids[int(attrs["_Netcdf4Dimid"])] = hname
-            if "NAME" in keys and bytes(attrs["NAME"]).startswith(_NOT_A_VARIABLE):
-                continue
+            if "NAME" in keys and _attr_value(attrs["NAME"]).startswith(_NOT_A_VARIABLE.decode()):
+                continue           # a dimension without a coordinate variable
         entries.append((name, obj, attrs, keys))
 
     dims: dict[str, tuple[str, ...]] = {}
@@ -230,8 +230,9 @@ def _read_open(f, path: Path, wanted: set | None, h5py) -> Results:
             if all(i in dimids for i in ids):
                 d = tuple(dimids[i] for i in ids)
         if d is None or len(d) != obj.ndim:
-            if "DIMENSION_LIST" in keys:
-                d = tuple(f[refs[-1]].name.rsplit("/", 1)[-1] for refs in attrs["DIMENSION_LIST"])
+            if "DIMENSION_LIST" in keys:        # an HDF5 object look-up per axis: its last scale's name
+                refs = attrs["DIMENSION_LIST"]
+                d = tuple(f[r[-1]].name.rsplit("/", 1)[-1] for r in refs) if all(len(r) for r in refs) else None
             elif obj.ndim == 1 and obj.name.rsplit("/", 1)[-1] in scales:
                 d = (name,)
             elif obj.ndim == 0:
