@@ -20,7 +20,7 @@ import numpy as np
 from mbd.element import evaluate
 
 from .families import FAMILY
-from .results.reader import open_dataset
+from .results.reader import read_results
 
 __all__ = ["pocket_brake", "run_pocket_brake"]
 
@@ -48,20 +48,21 @@ def run_pocket_brake(model, run_dir) -> dict:
     """Per bearing kind of a run's recording (``run_dir``/results.nc, made with ``model``): the mean pocket brake
     [N·m] on the rollers out of the load zone (not loaded on the pin) and in it, and the share of the pocket samples in
     solid contact."""
-    ds = open_dataset(run_dir)
-    if not np.array_equal(ds["pocket.roller"].values, ds["race_inner.roller"].values):
+    ds = read_results(run_dir, ("race_inner.load", *(f"{g}.{k}" for g in ("motion", "fixed")
+                                                      for k in ("position", "angle", "velocity", "angular_velocity"))))
+    if not np.array_equal(ds["pocket.roller"], ds["race_inner.roller"]):
         raise ValueError(f"{run_dir}: the pockets' instances do not follow the pin contacts' rollers")
-    X = np.zeros((len(ds.time), model.n_bodies, 3))
+    X = np.zeros((len(ds["time"]), model.n_bodies, 3))
     V = np.zeros_like(X)
     for grp in ("motion", "fixed"):
-        idx = [model.body_names.index(str(nm)) for nm in ds[f"{grp}.body"].values]
-        X[:, idx, :2], X[:, idx, 2] = ds[f"{grp}.position"].values, ds[f"{grp}.angle"].values
-        V[:, idx, :2], V[:, idx, 2] = ds[f"{grp}.velocity"].values, ds[f"{grp}.angular_velocity"].values
+        idx = [model.body_names.index(str(nm)) for nm in ds[f"{grp}.body"]]
+        X[:, idx, :2], X[:, idx, 2] = ds[f"{grp}.position"], ds[f"{grp}.angle"]
+        V[:, idx, :2], V[:, idx, 2] = ds[f"{grp}.velocity"], ds[f"{grp}.angular_velocity"]
     rows = [pocket_brake(model, float(t), model.full_of_poses(X[k]), model.full_of_poses(V[k]))
-            for k, t in enumerate(ds.time.values)]
+            for k, t in enumerate(ds["time"])]
     brake, touch = np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
-    loaded = ds["race_inner.load"].values > 0.0          # the pocket's instances follow the rollers', as the races'
-    kind = ds["pocket.bearing_kind"].values
+    loaded = ds["race_inner.load"] > 0.0          # the pocket's instances follow the rollers', as the races'
+    kind = ds["pocket.bearing_kind"]
     out = {}
     for k in np.unique(kind):
         sel = kind == k

@@ -23,25 +23,32 @@ import numpy as np
 from .bearing import roller_slip_pct
 from .results.reader import json_attr
 
-__all__ = ["ANGLE_BINS", "SKID_PCT", "roller_slip_zones", "slip_series", "transient_numbers", "SERIES"]
+__all__ = ["ANGLE_BINS", "SKID_PCT", "roller_slip_zones", "slip_series", "transient_numbers", "SERIES", "ZONE_VARIABLES",
+           "SERIES_VARIABLES"]
 
 SKID_PCT = 5.0           # [assumed] a cage or roller slipping more than this below its rolling speed skids
 ANGLE_BINS = 24          # angle bins of the roller slip about the pin (15° each: 12 rollers, two samples apart)
 
+# the variables of results.nc each function reads (besides the coordinates): a caller reads only these
+# (components.results.read_results(path, ZONE_VARIABLES))
+ZONE_VARIABLES = ("motion.angular_velocity", "motion.position", "motion.angle", "race_inner.load", "race_inner.angle")
+SERIES_VARIABLES = ("time", "bearing.cage_slip", "bearing.roller_slip", "race_inner.load", "race_inner.angle")
+
 
 def roller_slip_zones(ds, b, bins: int = ANGLE_BINS) -> dict:
-    """Per bearing type (``"inner"``, ``"outer"``: every planet's bearing of the type pooled) from the dataset ``ds``
-    of a run's results.nc and the bearing ``b`` (its BearingSI), by angle about the pin from the planet's radial
+    """Per bearing type (``"inner"``, ``"outer"``: every planet's bearing of the type pooled) from ``ds``, a run's
+    results.nc read (:func:`components.results.read_results`, :data:`ZONE_VARIABLES` enough) or its xarray Dataset,
+    and the bearing ``b`` (its BearingSI), by angle about the pin from the planet's radial
     direction on the carrier, positive in the carrier's sense of rotation (``angle_deg``, the bins' centres): the mean
     roller slip [%] over the samples in each bin (``slip_by_angle_pct``) and the share of them loaded on the pin
     (``loaded_by_angle``)."""
-    w = np.asarray(ds["motion.angular_velocity"].values, float)
-    body = {str(n): i for i, n in enumerate(ds["motion.body"].values)}
+    w = np.asarray(ds["motion.angular_velocity"], float)
+    body = {str(n): i for i, n in enumerate(np.asarray(ds["motion.body"]))}
     w_c = w[:, body["carrier"]]
-    load_i = np.asarray(ds["race_inner.load"].values, float)
-    angle = np.asarray(ds["race_inner.angle"].values, float)
-    pos = np.asarray(ds["motion.position"].values, float)
-    theta_c = np.asarray(ds["motion.angle"].values, float)[:, body["carrier"]]
+    load_i = np.asarray(ds["race_inner.load"], float)
+    angle = np.asarray(ds["race_inner.angle"], float)
+    pos = np.asarray(ds["motion.position"], float)
+    theta_c = np.asarray(ds["motion.angle"], float)[:, body["carrier"]]
     edges = np.linspace(0.0, 2.0 * np.pi, bins + 1)
     pooled: dict[str, list] = {}
     for bm in json_attr(ds.attrs, "bearings"):
@@ -87,21 +94,22 @@ def _entries(loaded: np.ndarray, angle: np.ndarray, pitch: float) -> np.ndarray:
 
 
 def slip_series(ds, bin_s: float) -> dict:
-    """Per bearing type (``"inner"``, ``"outer"``: every planet's bearing of the type pooled) from the dataset ``ds``
-    of a run's results.nc: in bins of ``bin_s`` [s] from the recording's start, the bins' centres ``time_s``, the
+    """Per bearing type (``"inner"``, ``"outer"``: every planet's bearing of the type pooled) from ``ds``, a run's
+    results.nc read (:func:`components.results.read_results`, :data:`SERIES_VARIABLES` enough) or its xarray
+    Dataset: in bins of ``bin_s`` [s] from the recording's start, the bins' centres ``time_s``, the
     cage slip [%] (mean over the samples and bearings, ``cage``), the roller slip out of the load zone (mean over
     the samples and rollers not loaded on the pin, ``unloaded``) and at its entry (mean over the entries in the bin,
     ``entry``: the slip at the last sample before a roller takes load after a roller pitch of its orbit out of the
     zone, §13.5 at the recording's resolution); NaN where a bin has none. ``entries``: each entry's (time, slip)."""
     if not bin_s > 0:
         raise ValueError(f"bin_s must be > 0 s, got {bin_s!r}")
-    t = np.asarray(ds["time"].values, float)
-    cage = np.asarray(ds["bearing.cage_slip"].values, float)
-    roller = np.asarray(ds["bearing.roller_slip"].values, float)
-    load_i = np.asarray(ds["race_inner.load"].values, float)
-    angle = np.asarray(ds["race_inner.angle"].values, float)
-    roller_names = [str(x) for x in ds["bearing.roller_slip.instance"].values]
-    bearing_names = [str(x) for x in ds["bearing.cage_slip.instance"].values]
+    t = np.asarray(ds["time"], float)
+    cage = np.asarray(ds["bearing.cage_slip"], float)
+    roller = np.asarray(ds["bearing.roller_slip"], float)
+    load_i = np.asarray(ds["race_inner.load"], float)
+    angle = np.asarray(ds["race_inner.angle"], float)
+    roller_names = [str(x) for x in np.asarray(ds["bearing.roller_slip.instance"])]
+    bearing_names = [str(x) for x in np.asarray(ds["bearing.cage_slip.instance"])]
     edges = t[0] + bin_s * np.arange(int(np.floor((t[-1] - t[0]) / bin_s + 1e-9)) + 2)
     which = np.clip(np.digitize(t, edges) - 1, 0, edges.size - 2)
     nb = edges.size - 1

@@ -56,9 +56,10 @@ import numpy as np
 
 import mbd
 from components.presets import OIL_GRADES, oil_grade
-from components.results import RESULTS_NAME, open_dataset
+from components.results import RESULTS_NAME, read_results
 from components.results.io import atomic_write_text
-from components.skid import SERIES, SKID_PCT, roller_slip_zones, slip_series, transient_numbers
+from components.skid import (SERIES, SERIES_VARIABLES, SKID_PCT, ZONE_VARIABLES, roller_slip_zones, slip_series,
+                             transient_numbers)
 
 from .core import args
 from .core.command import command
@@ -260,8 +261,7 @@ def _roller_zones(case: Case) -> dict:
     path = Path(case.out_dir) / RESULTS_NAME
     if not path.is_file():
         return {}
-    with open_dataset(path) as ds:
-        return roller_slip_zones(ds, build_params(case).si().bearing)
+    return roller_slip_zones(read_results(path, ZONE_VARIABLES), build_params(case).si().bearing)
 
 
 def answer(rows: list[dict]) -> str:
@@ -411,8 +411,7 @@ beside it); and per transient run its binned series and schedule for the figure.
         ref_case = steady.get((hi if case.tag == "startup" else lo, T, case.direction))
         ref = None if ref_case is None else results.get(ref_case.label)
         ref_binned = _steady_series(ref_case, a.bin) if ref is not None and not ref.failed else {}
-        with open_dataset(path) as ds:
-            binned = slip_series(ds, a.bin)
+        binned = slip_series(read_results(path, SERIES_VARIABLES), a.bin)
         series.append({"transient": case.tag, "oil_temperature_C": T, "direction": case.direction, "change_s": t0,
                        "length_s": length, "knots": knots, "binned": binned})
         for kind in ("inner", "outer"):
@@ -438,8 +437,7 @@ def _steady_series(case: Case | None, bin_s: float) -> dict:
     path = None if case is None else Path(case.out_dir) / RESULTS_NAME
     if path is None or not path.is_file():
         return {}
-    with open_dataset(path) as ds:
-        return slip_series(ds, bin_s)
+    return slip_series(read_results(path, SERIES_VARIABLES), bin_s)
 
 
 def _v(x, fmt=".1f", unit="") -> str:

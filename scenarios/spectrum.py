@@ -46,7 +46,7 @@ import mbd
 from components.geometry import check_design, sideband_origin
 from components.params import flatten, overrides_from_toml, with_overrides
 from components.presets import SENSOR_PRESETS, reference_dpgt, typical_errors
-from components.results import open_dataset
+from components.results import read_results
 from components.sensor import PATHS as SENSOR_PATHS
 from components.results.io import atomic_write_text
 from components.units import ParameterError
@@ -270,8 +270,8 @@ def _signals(path: Path, sensor: str, at=None) -> tuple[np.ndarray, dict]:
     (``at``: its :class:`components.params.SensorSI`, the run's own unless given) and their sum, and the axis
     sensor's x and y."""
     t, signals = sensor_paths(path, at)
-    with open_dataset(path) as ds:
-        acc = ds["fixed.acceleration"].values[:, list(ds["fixed.body"].values).index("carrier")]
+    ds = read_results(path, ("fixed.acceleration",))
+    acc = ds["fixed.acceleration"][:, list(ds["fixed.body"]).index("carrier")]
     signals.update({"axis_x": acc[:, 0], "axis_y": acc[:, 1]})
     return t, {"amplitude": signals["axis_x" if sensor == "axis" else sensor], **signals}
 

@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from components.results import ResultsError, json_attr, open_dataset, results_path
+from components.results import ResultsError, json_attr, open_dataset, read_results
 
 from .plots import cage_orbit_picture
 
@@ -140,14 +140,13 @@ class Run:
         return sorted({int(b["pair"]) for b in self.bearings})
 
 
-def _pose(ds, probe: str, linear: str, angular: str) -> np.ndarray | None:
+def _pose(res, probe: str, linear: str, angular: str) -> np.ndarray | None:
     """(n_t, n_bodies, 3) array (x, y, θ) from the file's ``<probe>.<linear>`` (time, body, axis) and
     ``<probe>.<angular>`` (time, body) variables; None when the file lacks them."""
     lin, ang = f"{probe}.{linear}", f"{probe}.{angular}"
-    if lin not in ds or ang not in ds:
+    if lin not in res or ang not in res:
         return None
-    return np.concatenate([np.asarray(ds[lin].values, float), np.asarray(ds[ang].values, float)[..., None]],
-                          axis=-1)
+    return np.concatenate([np.asarray(res[lin], float), np.asarray(res[ang], float)[..., None]], axis=-1)
 
 
 def load_run(path, fallback_geometry: Mapping | None = None) -> Run:
@@ -156,31 +155,30 @@ def load_run(path, fallback_geometry: Mapping | None = None) -> Run:
     ``fallback_geometry`` (the layout of :func:`components.results.schema.drawing_geometry`) supplies
     whatever drawing geometry the file lacks; it is checked against the recorded motion.
 
-    Raises :class:`ResultsError` with a clear message for a missing file, a file that is not
-    netCDF4/HDF5, or a netCDF file without the DPGT layout (time, motion.position, motion.angle,
-    bearings, meta)."""
-    path = results_path(path)
-    ds = open_dataset(path)
-    with ds:
-        missing = [v for v in _REQUIRED_VARS if v not in ds.variables]
-        missing += [f"attribute {a!r}" for a in _REQUIRED_ATTRS if a not in ds.attrs]
-        if missing:
-            raise ResultsError(f"{path} is not a DPGT results file: it lacks {', '.join(missing)}")
-        t = np.asarray(ds["time"].values, float)
-        if t.ndim != 1 or t.size == 0:
-            raise ResultsError(f"{path}: the results hold no samples (time is empty)")
-        pos = ds["motion.position"]
-        if pos.dims != ("time", "motion.body", "axis") or pos.shape[2] != 2:
-            raise ResultsError(f"{path} is not a DPGT results file: motion.position has dims {pos.dims}")
-        bodies = tuple(str(b) for b in ds["motion.body"].values)
-        q = _pose(ds, "motion", "position", "angle")
-        v = _pose(ds, "motion", "velocity", "angular_velocity")
-        a = _pose(ds, "motion", "acceleration", "angular_acceleration")
-        fixed_q = _pose(ds, "fixed", "position", "angle") if "fixed.body" in ds.variables else None
-        fixed_bodies = tuple(str(b) for b in ds["fixed.body"].values) if fixed_q is not None else ()
-        outputs = {k: np.asarray(ds[k].values, float) for k in ds.data_vars
-                   if not (k.startswith("motion.") or k.startswith("fixed."))}
-        attrs = dict(ds.attrs)
+    The file is read whole with :func:`components.results.read_results` (h5py, no xarray). Raises
+    :class:`ResultsError` with a clear message for a missing file, a file that is not netCDF4/HDF5, or a netCDF
+    file without the DPGT layout (time, motion.position, motion.angle, bearings, meta)."""
+    res = read_results(path)
+    path = res.path
+    missing = [v for v in _REQUIRED_VARS if v not in res]
+    missing += [f"attribute {a!r}" for a in _REQUIRED_ATTRS if a not in res.attrs]
+    if missing:
+        raise ResultsError(f"{path} is not a DPGT results file: it lacks {', '.join(missing)}")
+    t = np.asarray(res["time"], float)
+    if t.ndim != 1 or t.size == 0:
+        raise ResultsError(f"{path}: the results hold no samples (time is empty)")
+    if res.dims["motion.position"] != ("time", "motion.body", "axis") or res["motion.position"].shape[2] != 2:
+        raise ResultsError(f"{path} is not a DPGT results file: motion.position has dims "
+                           f"{res.dims['motion.position']}")
+    bodies = tuple(str(b) for b in res["motion.body"])
+    q = _pose(res, "motion", "position", "angle")
+    v = _pose(res, "motion", "velocity", "angular_velocity")
+    a = _pose(res, "motion", "acceleration", "angular_acceleration")
+    fixed_q = _pose(res, "fixed", "position", "angle") if "fixed.body" in res else None
+    fixed_bodies = tuple(str(b) for b in res["fixed.body"]) if fixed_q is not None else ()
+    outputs = {k: np.asarray(res[k], float) for k in res.data_vars
+               if not (k.startswith("motion.") or k.startswith("fixed."))}
+    attrs = dict(res.attrs)
     bearings = json_attr(attrs, "bearings", path)
     meta = json_attr(attrs, "meta", path)
     if not isinstance(bearings, list) or not isinstance(meta, dict):

@@ -9,7 +9,7 @@ import numpy as np
 from scipy import signal
 
 from components.families import MESH_FAMILY
-from components.results import json_attr, open_dataset
+from components.results import json_attr, read_results
 from components.sensor import paths as sensor_path_signals, sensor_from_dict
 
 __all__ = ["amplitude_spectrum", "peak_table", "band_floor", "carrier_orders", "line_table", "sideband_resolution",
@@ -132,23 +132,24 @@ def sensor_paths(path: Path, sensor=None) -> tuple[np.ndarray, dict]:
     :func:`components.sensor.paths` from the recorded outer planets' angles and ring-mesh forces and the loads on
     the housing. ``sensor`` (:class:`components.params.SensorSI`): the run's own (stored with it) unless given.
     The one place a run's file becomes the sensor's signals: the spectrum and the fault study read through it."""
-    with open_dataset(path) as ds:
-        if "housing.force_x" not in ds:
-            raise ValueError(f"{path}: the run recorded no loads on the housing (run it with RunConfig(sensor=True))")
-        sensor = sensor if sensor is not None else sensor_from_dict(json_attr(ds.attrs, "sensor", path))
-        t = ds["time"].values
-        bodies = list(ds["motion.body"].values)
-        phi = (ds["fixed.angle"].values[:, list(ds["fixed.body"].values).index("carrier")]
-               - ds["motion.angle"].values[:, bodies.index("carrier")])           # the frame's angle
-        fam = MESH_FAMILY["outer_ring"]
-        P = ds["motion.position"].values[:, [bodies.index(g) for g in ds[f"{fam}.gear1"].values]]
-        psi = np.arctan2(P[..., 1], P[..., 0]) + phi[:, None]
-        c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
-        fx, fy = ds[f"{fam}.fx"].values, ds[f"{fam}.fy"].values                 # on the ring, in R
-        ring = np.stack([c * fx - s * fy, s * fx + c * fy], axis=-1)
-        force = np.column_stack([ds["housing.force_x"].values.sum(axis=1), ds["housing.force_y"].values.sum(axis=1)])
-        torque = ds["housing.torque"].values.sum(axis=1)
-        return t, sensor_path_signals(t, psi, ring, force, torque, sensor)
+    fam = MESH_FAMILY["outer_ring"]
+    ds = read_results(path, ("time", "motion.position", "motion.angle", "fixed.angle", f"{fam}.fx", f"{fam}.fy",
+                             "housing.force_x", "housing.force_y", "housing.torque"))
+    if "housing.force_x" not in ds:
+        raise ValueError(f"{path}: the run recorded no loads on the housing (run it with RunConfig(sensor=True))")
+    sensor = sensor if sensor is not None else sensor_from_dict(json_attr(ds.attrs, "sensor", path))
+    t = ds["time"]
+    bodies = list(ds["motion.body"])
+    phi = (ds["fixed.angle"][:, list(ds["fixed.body"]).index("carrier")]
+           - ds["motion.angle"][:, bodies.index("carrier")])                   # the frame's angle
+    P = ds["motion.position"][:, [bodies.index(g) for g in ds[f"{fam}.gear1"]]]
+    psi = np.arctan2(P[..., 1], P[..., 0]) + phi[:, None]
+    c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
+    fx, fy = ds[f"{fam}.fx"], ds[f"{fam}.fy"]                                   # on the ring, in R
+    ring = np.stack([c * fx - s * fy, s * fx + c * fy], axis=-1)
+    force = np.column_stack([ds["housing.force_x"].sum(axis=1), ds["housing.force_y"].sum(axis=1)])
+    torque = ds["housing.torque"].sum(axis=1)
+    return t, sensor_path_signals(t, psi, ring, force, torque, sensor)
 
 
 def sensor_signal(path: Path, f_c: float, sensor: str = "housing", cycle: int = 1) -> tuple[np.ndarray, np.ndarray]:
