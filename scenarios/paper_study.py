@@ -491,12 +491,13 @@ class PaperStudy(Study):
         return make_cases(self.a, self.out)
 
     def beside(self, cfg: RunConfig) -> Beside | None:
-        """A dynamic study of several points draws each point's figures (and animation) as soon as both its runs are
-        in, on a worker while the other points run, and the figures across the points once every run is in, beside
-        the last point's; the report is left with the tables. One point (the demo) has nothing to draw beside: its
-        figures wait for its runs either way, and the report draws them in this process without handing the results
-        to a worker."""
-        if cfg.mode == "static" or len({c.condition for c in self.cases()}) < 2:
+        """A dynamic study draws each point's figures (and animation) as soon as both its runs are in, in pieces on
+        the workers while the other points run, and the figures across the points once every run is in, beside the
+        last point's; the report is left with the tables. One point (the demo) has its pieces drawn side by side on
+        the workers its two runs leave free; one point on one worker, or of one run, has nothing to draw beside (its
+        figures wait for its runs either way: the report draws them, after the headline)."""
+        cases = self.cases()
+        if cfg.mode == "static" or (len({c.condition for c in cases}) < 2 and (self.a.workers == 1 or len(cases) < 2)):
             return None
         out, animation = self.out, bool(self.a.animate)
         machine = self.machine_identity()["label"]

@@ -55,7 +55,10 @@ def test_the_paper_study_draws_a_point_beside_only_when_both_its_runs_finished(t
                                                             "--out", str(tmp_path)]))
     assert static.beside(static.config()) is None
     one = paper_study.PaperStudy(paper_study.parse_args(["--conditions", "3", "--out", str(tmp_path)]))
-    assert one.beside(one.config()) is None     # one point (the demo): nothing runs beside its figures
+    assert one.beside(one.config()) is not None   # one point (the demo): its pieces side by side on the workers
+    for argv in (["--workers", "1"], ["--directions", "forward"]):     # ... but not one after another here
+        alone = paper_study.PaperStudy(paper_study.parse_args(["--conditions", "3", *argv, "--out", str(tmp_path)]))
+        assert alone.beside(alone.config()) is None
 
 
 def test_a_group_in_pieces_starts_each_piece_once_and_joins_their_lists_in_order():
