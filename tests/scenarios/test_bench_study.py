@@ -108,11 +108,13 @@ def test_the_profile_adds_up_to_the_wall_time_and_shares_worker_seconds_over_the
 def test_the_target_is_the_runs_worker_seconds_shared_out_with_15_percent_and_the_longest_runs_tail():
     """Runs of 20, 30 and 40 s on 2 workers: 1.15 × 90 / 2 + (1 − 1/2) × 40 = 71.75 s; the job's 85 s miss it."""
     t = target(_study())
-    assert t["runs_worker_s"] == 90.0 and t["longest_run_s"] == 40.0 and t["workers"] == 2
-    assert t["target_s"] == pytest.approx(71.75) and t["ratio"] == pytest.approx(85.0 / 71.75)
+    assert t["runs"]["work_s"] == 90.0 and t["longest_run_s"] == 40.0 and t["workers"] == 2
+    assert t["runs"]["target_s"] == pytest.approx(71.75) and t["runs"]["ratio"] == pytest.approx(85.0 / 71.75)
+    # the strict reading: the engine's 15 + 25 + 35 s alone
+    assert t["engine"]["work_s"] == 75.0 and t["engine"]["target_s"] == pytest.approx(1.15 * 75 / 2 + 20)
     one = _study()
     one["study"]["sweep"]["workers"] = 1       # one worker: no tail, the runs one after another
-    assert target(one)["target_s"] == pytest.approx(1.15 * 90.0)
+    assert target(one)["runs"]["target_s"] == pytest.approx(1.15 * 90.0)
 
 
 def test_a_worker_that_ran_nothing_counts_as_idle():
