@@ -506,9 +506,10 @@ class PaperStudy(Study):
             if not all(o.ok for o in outcomes.values()):    # a failed run: the report draws what it can
                 return None
             results = {label: Summary.of(o.summary) for label, o in outcomes.items()}
-            # in pieces, each on a worker: the last point's figures do not wait on one worker while the other idles
-            return [(point_work, (results, out, c, piece)) for piece in (*POINT_PIECES, *(("animation",) if animation
-                                                                                          else ()))]
+            # in pieces, each on a worker: the last point's figures do not wait on one worker while the other idles;
+            # the animation, the longest piece, first
+            return [(point_work, (results, out, c, piece)) for piece in ((("animation",) if animation else ())
+                                                                         + POINT_PIECES)]
 
         def last(outcomes):
             """The figures across the points, beside the last point's, once every run is in (a failed run: the

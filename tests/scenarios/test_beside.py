@@ -51,6 +51,10 @@ def test_the_paper_study_draws_a_point_beside_only_when_both_its_runs_finished(t
     assert all(fn is paper_study.point_work and fargs[2] == 3 for fn, fargs in pieces)
     assert [fargs[3] for _, fargs in pieces] == list(paper_study.POINT_PIECES)      # each on a worker of its own
     assert sorted(f for piece in paper_study.POINT_PIECES for f in piece) == sorted([*paper_study.HISTORY_GROUPS, "cage_orbits"])
+    animated = paper_study.PaperStudy(paper_study.parse_args(["--conditions", "2,3", "--animate", "--out", str(tmp_path)]))
+    pieces = animated.beside(animated.config()).task(3, {f.label: _done(f), r.label: _done(r)})
+    # the animation, the longest piece, goes out first: it does not start after the figures on the same worker
+    assert [fargs[3] for _, fargs in pieces] == ["animation", *paper_study.POINT_PIECES]
     static = paper_study.PaperStudy(paper_study.parse_args(["--conditions", "3", "--mode", "static",
                                                             "--out", str(tmp_path)]))
     assert static.beside(static.config()) is None
