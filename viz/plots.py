@@ -71,11 +71,12 @@ def _save(fig: Figure, path) -> Path:
     dpi = mpl.rcParams["savefig.dpi"]
     layout = fig.get_layout_engine()
     if layout is not None and dpi != "figure":
-        # laid out once at the saved resolution, then drawn once: with its layout engine on, savefig draws the
-        # figure twice (a pass to lay it out, then the picture); the same pixels
+        # laid out at the saved resolution, then the engine taken off: savefig with an engine on (even the
+        # placeholder "none" leaves) draws the figure twice, a pass without rendering to lay it out, then the picture;
+        # without one it draws once. The same pixels
         fig.set_dpi(dpi)
         layout.execute(fig)
-        fig.set_layout_engine("none")
+        fig.set_layout_engine(None)
     # zlib level 3 instead of PIL's 6: the same pixels, 4-8 % larger files, 30-40 % less encoding time
     fig.savefig(path, format="png", dpi=dpi, pil_kwargs={"compress_level": 3})
     return path

@@ -4,7 +4,7 @@
   asked: :attr:`RunFiles.summary`, :meth:`RunFiles.read`, :meth:`RunFiles.dataset`, :meth:`RunFiles.samples`.
 * :func:`read_results` — results.nc's arrays, dimension names, coordinates and attributes in memory
   (:class:`Results`), read with h5py alone: what a reader of arrays takes (viz, the studies' figures and tables),
-  about ten times faster than xarray's open of the same file.
+  in 28–56 ms a seed-study file where xarray's open takes 218–250 ms.
 * :func:`open_dataset` — results.nc as a lazily loaded :class:`xarray.Dataset` (for a caller that wants one: labelled
   selection, the user-facing API); :func:`json_attr` one of its JSON attributes ("meta", "bearings", "sensor", ...).
 * :func:`load_summary` — summary.json as a :class:`~components.results.summary.Summary` (None when absent).

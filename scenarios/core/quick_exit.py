@@ -3,16 +3,21 @@
 
 A worker process closes with the interpreter's finalisation of what its runs and figures imported — numba and
 llvmlite, SciPy, matplotlib, h5py: 0.3–1 s a worker on a quiet machine, 2–3 s on a busy one, and the study waits
-for it at its end. Nothing of a worker needs finishing by then: a cluster closes after every result was gathered,
-and each run and figure writes its files whole (atomically) before its task returns; a cluster stopped early
-(Ctrl-C, a failure of the client) leaves what a killed worker leaves, which a run's resume handles. So the worker's
-last act, after Dask's own close of its connections and plugins, is ``os._exit(0)``; the nanny sees a clean exit.
+for it at its end. Nothing of a worker needs finishing by then: a sweep closes its cluster after every result was
+gathered, and a run writes its results, summary and checkpoints atomically before its task returns. Dask calls a
+plugin's ``teardown`` as the worker starts to close (its status "closing", before its connections and its task
+thread are shut), so the worker leaves there with ``os._exit(0)``; the nanny sees a clean exit, and the worker's
+directory lock stays behind in Dask's scratch folder until the next cluster's start purges it. A cluster stopped
+early (Ctrl-C, a failure of the client) cuts its running tasks at once: a run resumes from its checkpoint, and a figure
+being drawn then may be left unfinished until the study is run again (it redraws every figure). A teardown outside
+a close — the plugin registered a second time, which removes the first — leaves the worker running.
 """
 from __future__ import annotations
 
 import os
 
 from distributed import WorkerPlugin
+from distributed.core import Status
 
 
 class QuickExit(WorkerPlugin):
@@ -22,4 +27,5 @@ class QuickExit(WorkerPlugin):
     name = "dpgt-quick-exit"
 
     def teardown(self, worker) -> None:
-        os._exit(0)
+        if worker.status in (Status.closing, Status.closing_gracefully):
+            os._exit(0)

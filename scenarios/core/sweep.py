@@ -323,6 +323,7 @@ class Beside:
     workers; the last group's work then does not wait on one worker while the others idle) or None. On a local
     cluster each function runs on a worker, ahead of the runs still queued, while the other runs go on; without
     Dask, or on a cluster whose workers share no filesystem with this process, it runs here at that moment.
+    A sweep that runs nothing (every case reused) does nothing beside.
     ``last(outcomes)``: the work that needs every case's outcome (figures across the groups), in the same form as
     ``task``'s, done beside the last groups' work as soon as the last run is in; its value is under the key
     :data:`ALL`. ``done``: {key: its return value (pieces that return lists: their lists joined, in the order of
@@ -455,9 +456,7 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
             print(f"resuming: {len(cases) - len(todo)} of {len(cases)} runs finished earlier", flush=True)
     results = {c.label: execute_case(c, cfg) for c in cases if c not in todo}   # finished: just load
     timing["reuse_check_s"] = time.perf_counter() - t0
-    if not todo:
-        for k, work in ready(results):
-            beside.here(k, work)
+    if not todo:            # nothing runs: nothing to draw beside (the caller's report draws it, after its headline)
         return results
     # never more workers than runs left: one run left runs here, without starting a cluster for it
     n_workers = min(workers or os.cpu_count() or 1, len(todo))

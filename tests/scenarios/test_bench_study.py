@@ -105,16 +105,23 @@ def test_the_profile_adds_up_to_the_wall_time_and_shares_worker_seconds_over_the
     assert rows["the study's rest (sweep bookkeeping, epilogue)"] == pytest.approx(76 - 1 - 62.75 - 12 + 0.25)
 
 
-def test_the_target_is_the_runs_worker_seconds_shared_out_with_15_percent_and_the_longest_runs_tail():
-    """Runs of 20, 30 and 40 s on 2 workers: 1.15 × 90 / 2 + (1 − 1/2) × 40 = 71.75 s; the job's 85 s miss it."""
+def test_the_target_is_the_work_shared_out_with_15_percent_and_the_runs_tail():
+    """Runs of 20 and 30 s on worker 1 (its last ends at 1053), 40 s on worker 2 (ends at 1043) — the measured tail
+    10 s; the bound (1 − 1/2) × 40 = 20 s; the engine's 15 + 25 + 35 = 75 s, the runs' 90 s."""
     t = target(_study())
-    assert t["runs"]["work_s"] == 90.0 and t["longest_run_s"] == 40.0 and t["workers"] == 2
-    assert t["runs"]["target_s"] == pytest.approx(71.75) and t["runs"]["ratio"] == pytest.approx(85.0 / 71.75)
-    # the strict reading: the engine's 15 + 25 + 35 s alone
-    assert t["engine"]["work_s"] == 75.0 and t["engine"]["target_s"] == pytest.approx(1.15 * 75 / 2 + 20)
+    assert t["works_s"] == {"engine": 75.0, "runs": 90.0} and t["workers"] == 2
+    assert t["tails_s"]["measured"] == pytest.approx(10.0) and t["tails_s"]["bound"] == pytest.approx(20.0)
+    assert t["engine, measured"]["target_s"] == pytest.approx(1.15 * 75 / 2 + 10)
+    assert t["runs, measured"]["target_s"] == pytest.approx(1.15 * 90 / 2 + 10)
+    assert t["runs, bound"]["target_s"] == pytest.approx(71.75)
+    assert t["runs, bound"]["ratio"] == pytest.approx(85.0 / 71.75)
     one = _study()
-    one["study"]["sweep"]["workers"] = 1       # one worker: no tail, the runs one after another
-    assert target(one)["runs"]["target_s"] == pytest.approx(1.15 * 90.0)
+    one["study"]["sweep"]["workers"] = 1       # one worker: no tail bound, the runs one after another
+    assert target(one)["runs, bound"]["target_s"] == pytest.approx(1.15 * 90.0)
+    alone = _study()
+    for k in ("a", "b", "c"):
+        alone["study"]["runs"][k]["pid"] = 1     # worker 2 ran nothing: it ran out at the start (1000)
+    assert target(alone)["tails_s"]["measured"] == pytest.approx(53.0)
 
 
 def test_a_worker_that_ran_nothing_counts_as_idle():

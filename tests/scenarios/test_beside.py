@@ -138,6 +138,29 @@ def test_a_study_of_two_points_draws_every_figure_once_beside_its_runs_and_redra
     assert sum(x.startswith("figures beside the runs: ") for x in lines) == 1
     assert not any(x.startswith("figures: ") for x in lines)          # nothing left for the report to draw
 
+    paper_study.run(paper_study.parse_args([*TINY, "--out", str(tmp_path / "ok")]))      # every run reused
+    lines = capsys.readouterr().out.splitlines()
+    assert not any(x.startswith("figures beside the runs") for x in lines)       # nothing ran: nothing beside
+    head = next(i for i, x in enumerate(lines) if x.startswith("headline ("))
+    figures = next(i for i, x in enumerate(lines) if x.startswith("figures: "))
+    assert head < figures and all(n in lines[figures] for n in ("c3_cage.png", "c4_mesh.png", "bars.png"))
+
+    real_point = paper_study.point_work
+
+    def failing_point(results, out, c, piece):
+        if c == 3 and piece == paper_study.POINT_PIECES[1]:
+            raise RuntimeError("no cage here")
+        return real_point(results, out, c, piece)
+
+    monkeypatch.setattr(paper_study, "point_work", failing_point)
+    r = paper_study.run(paper_study.parse_args([*TINY, "--out", str(tmp_path / "point")]))
+    text = capsys.readouterr().out
+    assert "figures of condition 3 beside the runs failed (no cage here); drawn now" in text
+    figures_line = next(x for x in text.splitlines() if x.startswith("figures: "))
+    assert "c3_cage.png" in figures_line and "c3_bearing_loads.png" in figures_line and "c4_cage.png" not in figures_line
+    assert sorted(p.name for p in r["figures"]).count("c3_cage.png") == 1
+    monkeypatch.setattr(paper_study, "point_work", real_point)
+
     real = paper_study.across_figures
 
     def failing_beside(results, out, machine="", figures=None):

@@ -9,16 +9,25 @@ from scenarios.core.quick_exit import QuickExit
 from scenarios.core.sweep import dask_client
 
 
-def test_teardown_exits_the_process_at_once_with_a_clean_code(monkeypatch):
+def test_teardown_exits_a_closing_worker_at_once_with_a_clean_code_and_leaves_a_running_one(monkeypatch):
+    """A worker that closes leaves with code 0; a teardown while it runs (the plugin registered again, which removes
+    the first) leaves it alone."""
+    from types import SimpleNamespace
+
+    from distributed.core import Status
+
     codes = []
 
     def exit_(code):
         codes.append(code)
         raise SystemExit(code)
     monkeypatch.setattr(os, "_exit", exit_)
-    with pytest.raises(SystemExit):
-        QuickExit().teardown(worker=None)
-    assert codes == [0]
+    QuickExit().teardown(worker=SimpleNamespace(status=Status.running))
+    assert codes == []
+    for status in (Status.closing, Status.closing_gracefully):
+        with pytest.raises(SystemExit):
+            QuickExit().teardown(worker=SimpleNamespace(status=status))
+    assert codes == [0, 0]
 
 
 def _write(path: str, n: int) -> int:
@@ -48,3 +57,9 @@ def test_a_local_clusters_workers_exit_after_their_work_is_written(tmp_path):
     for i in range(4):
         assert np.array_equal(np.load(tmp_path / f"a{i}.npy"), np.arange(100_000 + i, dtype=float))
     assert pids and os.getpid() not in pids and all(_gone(p) for p in pids)
+
+
+def test_registering_the_quick_exit_again_leaves_the_workers_running():
+    with dask_client(1) as client:
+        client.register_plugin(QuickExit())          # a second time: Dask removes the first (its teardown)
+        assert client.submit(os.getpid, pure=False).result(timeout=30) > 0

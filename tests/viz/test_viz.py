@@ -411,3 +411,34 @@ def test_a_failed_film_leaves_no_file(tmp_path):
     with pytest.raises(RuntimeError, match="renderer died"):
         animate._write_film(tmp_path / "f.gif", 20.0, np.arange(12), render)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_figure_is_laid_out_and_drawn_once_with_the_pixels_of_matplotlibs_own_save(tmp_path, monkeypatch):
+    """plots._save takes the layout engine off after laying the figure out at the saved resolution: one draw instead
+    of savefig's two, and the PNG pixel for pixel the one savefig writes with the engine on (a skipped or misplaced
+    layout, or a layout at the figure's own dpi, moves pixels)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    t = np.linspace(0.0, 0.02, 400)
+    rows = [("bearing load, radial", "N", {"inner": {"forward": (t, 9e3 + 800 * np.sin(900 * t)),
+                                                     "reverse": (t, 1.2e4 + 500 * np.cos(700 * t))},
+                                           "outer": {"forward": (t, 1.1e4 + 0 * t)}}),
+            ("cage slip", "%", {"inner": {"forward": (t, 0.5 + 0.2 * np.sin(300 * t))}})]
+    draws = []
+    real_draw = Figure.draw
+    monkeypatch.setattr(Figure, "draw", lambda self, r: (draws.append(1), real_draw(self, r))[1])
+    ours = plots.time_history_group(rows, tmp_path / "ours.png", columns=["inner", "outer"], title="t",
+                                    separate_runs=True)
+    assert len(draws) == 1
+
+    def plain(fig, path):
+        FigureCanvasAgg(fig)
+        fig.savefig(path, format="png")
+        return Path(path)
+    monkeypatch.setattr(plots, "_save", plain)
+    theirs = plots.time_history_group(rows, tmp_path / "theirs.png", columns=["inner", "outer"], title="t",
+                                      separate_runs=True)
+    assert len(draws) == 3                                   # matplotlib's own: a layout pass, then the picture
+    a, b = iio.imread(ours), iio.imread(theirs)
+    assert a.shape == b.shape and np.array_equal(a, b)
