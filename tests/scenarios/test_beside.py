@@ -145,33 +145,35 @@ def test_a_study_of_two_points_draws_every_figure_once_beside_its_runs_and_redra
     figures = next(i for i, x in enumerate(lines) if x.startswith("figures: "))
     assert head < figures and all(n in lines[figures] for n in ("c3_cage.png", "c4_mesh.png", "bars.png"))
 
-    real_point = paper_study.point_work
-
-    def failing_point(results, out, c, piece):
-        if c == 3 and piece == paper_study.POINT_PIECES[1]:
-            raise RuntimeError("no cage here")
-        return real_point(results, out, c, piece)
-
-    monkeypatch.setattr(paper_study, "point_work", failing_point)
-    r = paper_study.run(paper_study.parse_args([*TINY, "--out", str(tmp_path / "point")]))
-    text = capsys.readouterr().out
-    assert "figures of condition 3 beside the runs failed (no cage here); drawn now" in text
-    figures_line = next(x for x in text.splitlines() if x.startswith("figures: "))
+    # a point's piece fails beside the runs: the report draws that point's figures, and only that point's
+    r, text, figures_line = _with_a_failing_piece(monkeypatch, capsys, tmp_path / "point", "point_work",
+                                                  lambda *a: a[2] == 3 and a[3] == paper_study.POINT_PIECES[1])
+    assert "figures of condition 3 beside the runs failed (failed here); drawn now" in text
     assert "c3_cage.png" in figures_line and "c3_bearing_loads.png" in figures_line and "c4_cage.png" not in figures_line
     assert sorted(p.name for p in r["figures"]).count("c3_cage.png") == 1
-    monkeypatch.setattr(paper_study, "point_work", real_point)
-
-    real = paper_study.across_figures
-
-    def failing_beside(results, out, machine="", figures=None):
-        if figures == ("bars",):            # the piece beside the runs; the report asks for both (None)
-            raise RuntimeError("no bars here")
-        return real(results, out, machine, figures)
-
-    monkeypatch.setattr(paper_study, "across_figures", failing_beside)
-    r = paper_study.run(paper_study.parse_args([*TINY, "--out", str(tmp_path / "redo")]))
-    text = capsys.readouterr().out
-    assert "figures across the points beside the runs failed (no bars here); drawn now" in text
-    figures_line = next(x for x in text.splitlines() if x.startswith("figures: "))
-    assert "bars.png" in figures_line and "bearing_load_life.png" in figures_line   # the report drew both
+    # a piece across the points fails beside the runs (the report asks for both: figures=None): it draws both
+    r, text, figures_line = _with_a_failing_piece(monkeypatch, capsys, tmp_path / "redo", "across_figures",
+                                                  lambda *a: len(a) == 4 and a[3] == ("bars",))
+    assert "figures across the points beside the runs failed (failed here); drawn now" in text
+    assert "bars.png" in figures_line and "bearing_load_life.png" in figures_line
     assert sorted(p.name for p in r["figures"]).count("bearing_load_life.png") == 1
+
+
+def _with_a_failing_piece(monkeypatch, capsys, out, name, fails):
+    """The tiny two-point study with paper_study's ``name`` raising where ``fails(*its arguments)``: its result, what
+    it printed, and its "figures: " line (what the report drew)."""
+    from scenarios import paper_study
+
+    real = getattr(paper_study, name)
+
+    def failing(*a):
+        if fails(*a):
+            raise RuntimeError("failed here")
+        return real(*a)
+    monkeypatch.setattr(paper_study, name, failing)
+    try:
+        r = paper_study.run(paper_study.parse_args([*TINY, "--out", str(out)]))
+    finally:
+        monkeypatch.setattr(paper_study, name, real)
+    text = capsys.readouterr().out
+    return r, text, next(x for x in text.splitlines() if x.startswith("figures: "))
