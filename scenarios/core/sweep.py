@@ -485,12 +485,12 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
         try:
             if scheduler is None:     # a local cluster: its workers write into the case folders (absolute paths)
                 futs = {client.submit(execute_case, replace(c, out_dir=str(Path(c.out_dir).resolve())), wcfg,
-                                      overwrite, pure=False, retries=RETRIES, key=f"{c.label}-{time.time_ns()}"): c
+                                      overwrite, pure=False, retries=RETRIES, key=f"run-{c.label}-{time.time_ns()}"): c
                         for c in todo}
             else:                     # no shared filesystem: the runs' files travel back (scenarios.core.cluster)
                 code, texts = code_digest(), params_texts(todo)
                 futs = {client.submit(execute_on_worker, c, wcfg, overwrite, code, texts, pure=False,
-                                      retries=RETRIES, key=f"{c.label}-{time.time_ns()}"): c for c in todo}
+                                      retries=RETRIES, key=f"run-{c.label}-{time.time_ns()}"): c for c in todo}
             bar = tqdm(total=len(futs), desc="runs", disable=not bars, position=0)
             runs = _RunBars(todo, bars)
             while True:
@@ -600,13 +600,19 @@ def dask_client(n_workers: int, scheduler: str | None = None, close_behind: dict
     cluster = client = None
     with _ctrl_c_held(scheduler is None) as release:
         try:
-            from dask.distributed import Client, LocalCluster  # deferred: Dask (≈ 0.2–0.4 s) only when a sweep runs on it
+            import dask  # deferred: Dask (≈ 0.2–0.4 s) only when a sweep runs on it
+            from dask.distributed import Client, LocalCluster  # deferred: as above
 
             if scheduler is None:
                 # ":0": the scheduler's HTTP server on a free port (None still asks for 8787, and a second study running
                 # beside the first warned that it was taken)
-                cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=":0", silence_logs=logging.CRITICAL)
+                # the runs ("run-...") are one task group, which Dask queues on its scheduler once it outnumbers twice
+                # the workers' threads, handing each worker its next task in the order submitted (the longest runs
+                # first) as it frees; worker saturation 1 hands it over when the worker has none left, not one more
+                # to wait behind its running task (Dask's default, 1.1) until work stealing moves it
+                with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
+                    cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                                           dashboard_address=":0", silence_logs=logging.CRITICAL)
                 client = Client(cluster)
                 from .quick_exit import QuickExit  # deferred: it imports Dask's distributed
 

@@ -179,6 +179,7 @@ class _FakeClient:
 
     def submit(self, fn, *a, **k):
         self.submitted.append(_FakeFuture())
+        self.keys = [*getattr(self, "keys", []), k.get("key")]
         return self.submitted[-1]
 
     def cancel(self, futures, force=False):
@@ -228,6 +229,10 @@ def test_an_interrupted_sweep_cancels_its_runs_and_stops_local_workers(scheduler
     assert [c.closed for c in _FakeCluster.made] == ([] if scheduler else [True])
     # the quick exit only for the workers of a cluster it started itself, never a scheduler's it was given
     assert [type(p).__name__ for p in getattr(client, "plugins", [])] == ([] if scheduler else ["QuickExit"])
+    from dask.utils import key_split
+
+    # the runs are one task group (Dask queues a large one on its scheduler, in the order submitted), keys unique
+    assert {key_split(k) for k in client.keys} == {"run"} and len(set(client.keys)) == 2
 
 
 def test_a_fixed_step_run_beyond_its_tolerance_warns(finished, tmp_path, capsys):

@@ -1,5 +1,6 @@
-"""A local cluster's workers leave without finalising their interpreters (scenarios.core.quick_exit): what their tasks
-wrote is whole, and the processes are gone once the cluster is closed."""
+"""The local cluster a sweep starts (scenarios.core.sweep.dask_client): its workers leave without finalising their
+interpreters (scenarios.core.quick_exit) — what their tasks wrote is whole, and the processes are gone once the
+cluster is closed — and each is handed its next task only when it has none left."""
 import os
 import time
 
@@ -63,3 +64,9 @@ def test_registering_the_quick_exit_again_leaves_the_workers_running():
     with dask_client(1) as client:
         client.register_plugin(QuickExit())          # a second time: Dask removes the first (its teardown)
         assert client.submit(os.getpid, pure=False).result(timeout=30) > 0
+
+
+def test_a_local_cluster_hands_a_worker_its_next_task_only_when_it_has_none_left():
+    """Worker saturation 1 on the clusters a sweep starts (Dask's default, 1.1, queues one more task per worker)."""
+    with dask_client(2) as client:
+        assert client.run_on_scheduler(lambda dask_scheduler: dask_scheduler.WORKER_SATURATION) == 1.0
