@@ -190,7 +190,8 @@ def test_a_worker_killed_during_a_run_loses_no_finished_run_and_the_run_complete
     # configured for a scheduler no client serves (xarray then fails to write netCDF in later tests)
     with Client(cluster.address, timeout=30, set_as_default=False) as watch:
         while victim is None and time.monotonic() < deadline and t.is_alive():
-            running_long = [w for w, keys in watch.processing().items() if any(k.startswith(long.label) for k in keys)]
+            running_long = [w for w, keys in watch.processing().items()
+                            if any(k.startswith(f"run-{long.label}-") for k in keys)]    # the sweep's task keys
             if landed.exists() and running_long:
                 time.sleep(1.0)                  # into the run
                 victim = next(n for n, a in cluster.workers.items() if a == running_long[0])
