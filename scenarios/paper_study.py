@@ -403,19 +403,34 @@ def plots(results: dict, out: Path, machine: str = "", drawn=(), across=True) ->
 def across_figures(results: dict, out: Path, machine: str = "", figures=None) -> list[Path]:
     """The figures across a dynamic study's points: the headline (mean load and lives, forward vs reverse,
     "headline") and the bars of RMS values ("bars"); ``figures``: those of them (None: both)."""
+    want = ACROSS_PIECES if figures is None else figures
+    return [*(_headline(results, out, machine) if "headline" in want else []),
+            *(_bars(results, out) if "bars" in want else [])]
+
+
+def _headline(results: dict, out: Path, machine: str, how: str = "") -> list[Path]:
+    """bearing_load_life.png: mean load and L10 lives, forward vs reverse (none without a bearing's values); ``how``
+    says how the values were found (", quasi-static")."""
     from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
 
-    paths = []
+    vals = headline_values(results)
+    if not vals:
+        return []
     conds = _conds(results)
-    vals = headline_values(results) if figures is None or "headline" in figures else {}
-    if vals:
-        one = f", {_title(conds[0]).lower()}" if len(conds) == 1 else ""
-        paths.append(vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
-                                                 title=f"Planet bearings (pair 1): mean load and L10 life, forward vs "
-                                                       f"reverse{one}" + (f"\n{machine}" if machine else "")))
+    one = f", {_title(conds[0]).lower()}" if len(conds) == 1 else ""
+    return [vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
+                                        title=f"Planet bearings (pair 1){how}: mean load and L10 life, forward vs "
+                                              f"reverse{one}" + (f"\n{machine}" if machine else ""))]
+
+
+def _bars(results: dict, out: Path) -> list[Path]:
+    """bars.png: the RMS values of :data:`BAR_QUANTITIES` per point, forward vs reverse, each bearing type."""
+    from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
+
+    conds = _conds(results)
     table, bar_units, ylabels = {}, {}, {}
     for q, unit in QUANTITIES:
-        if q not in BAR_QUANTITIES or not (figures is None or "bars" in figures):
+        if q not in BAR_QUANTITIES:
             continue
         for kind in ("inner", "outer"):
             key = f"{kind} planets\n{SUMMARY_WORDS[q][0]}"
@@ -427,27 +442,18 @@ def across_figures(results: dict, out: Path, machine: str = "", figures=None) ->
                 fv = f.get(kind, {}).get(q) if not f.failed else None
                 rv = r.get(kind, {}).get(q) if not r.failed else None
                 table[key][c] = (fv, rv)
-    if conds and table:
-        paths.append(vp.bar_chart([_title(c).lower() for c in conds], {k: {_title(c).lower(): v for c, v in by.items()}
-                                                                       for k, by in table.items()},
-                                  bar_units, out / "bars.png", ylabels=ylabels, ncols=2,
-                                  title=("RMS per condition: forward vs reverse" if len(conds) > 1 else
-                                         f"RMS at {_title(conds[0]).lower()}: forward vs reverse")))
-    return paths
+    if not (conds and table):
+        return []
+    return [vp.bar_chart([_title(c).lower() for c in conds], {k: {_title(c).lower(): v for c, v in by.items()}
+                                                              for k, by in table.items()},
+                         bar_units, out / "bars.png", ylabels=ylabels, ncols=2,
+                         title=("RMS per condition: forward vs reverse" if len(conds) > 1 else
+                                f"RMS at {_title(conds[0]).lower()}: forward vs reverse"))]
 
 
 def static_plots(results: dict, out: Path, machine: str = "") -> list[Path]:
     """Static mode's figure: the headline (mean load and lives, forward vs reverse); the others need time series."""
-    from viz import plots as vp  # deferred: matplotlib (≈ 0.5 s) only when the figures are drawn
-
-    vals = headline_values(results)
-    if not vals:
-        return []
-    conds = _conds(results)
-    one = f", {_title(conds[0]).lower()}" if len(conds) == 1 else ""
-    return [vp.forward_reverse_headline(vals, out / "bearing_load_life.png",
-                                        title=f"Planet bearings (pair 1), quasi-static: mean load and L10 life, "
-                                              f"forward vs reverse{one}" + (f"\n{machine}" if machine else ""))]
+    return _headline(results, out, machine, how=", quasi-static")
 
 
 def animate(results: dict, out: Path, only=None) -> list[Path]:
