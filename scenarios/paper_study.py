@@ -459,22 +459,30 @@ def static_plots(results: dict, out: Path, machine: str = "") -> list[Path]:
 def animate(results: dict, out: Path, only=None) -> list[Path]:
     """The cage-orbit animation of every point (``only``: of those), forward beside reverse."""
     paths = []
+    # deferred: matplotlib and VTK (viz), only for --animate
+    from viz.render_check import check_offscreen, check_offscreen_beside
+
+    # the offscreen probe (a subprocess, ≈ 1.4 s) runs while VTK is imported and the runs are read: the animation
+    # waits for its answer before its first render (viz.animate's require_offscreen)
+    check_offscreen_beside()
     try:
-        from viz.results import study_cage_animation  # deferred: matplotlib and VTK (viz), only for --animate
+        from viz.results import study_cage_animation  # deferred: as above
     except ImportError as exc:   # pragma: no cover - viz integration missing
         print(f"animation skipped: {exc}")
-        return paths
-    from viz.render_check import check_offscreen  # deferred: matplotlib (viz), only for --animate
-
-    ok, msg = check_offscreen()
-    if not ok:
-        print(f"animation skipped: {msg}")
         return paths
     for c in (_conds(results) if only is None else only):
         f = out / str(_label_of(results, c, "forward")) / "results.nc"
         r = out / str(_label_of(results, c, "reverse")) / "results.nc"
         if f.exists() and r.exists():
-            paths.append(Path(study_cage_animation(f, r, out / f"{point_tag(c)}_cage_orbits.gif", max_frames=150)))
+            try:
+                paths.append(Path(study_cage_animation(f, r, out / f"{point_tag(c)}_cage_orbits.gif",
+                                                       max_frames=150)))
+            except RuntimeError:
+                ok, msg = check_offscreen()
+                if ok:
+                    raise
+                print(f"animation skipped: {msg}")
+                return paths
         else:      # the animation sets forward beside reverse
             missing = "reverse" if f.exists() else "forward"
             print(f"animation of {_title(c).lower()} skipped: it shows forward beside reverse, and "

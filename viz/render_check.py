@@ -18,8 +18,9 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 
-__all__ = ["check_offscreen", "require_offscreen", "DEBIAN_PACKAGES"]
+__all__ = ["check_offscreen", "check_offscreen_beside", "require_offscreen", "DEBIAN_PACKAGES"]
 
 DEBIAN_PACKAGES = "libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6"
 
@@ -118,9 +119,19 @@ def _check(timeout: float) -> tuple[bool, str]:
                    f"Debian packages: apt-get install {DEBIAN_PACKAGES}")
 
 
+_CHECKING = threading.Lock()     # one probe at a time: a second caller waits for the first one's cached answer
+
+
 def check_offscreen(timeout: float = 60.0) -> tuple[bool, str]:
     """Return (ok, message).  Never crashes the caller; the result is cached for the process."""
-    return _check(float(timeout))
+    with _CHECKING:
+        return _check(float(timeout))
+
+
+def check_offscreen_beside(timeout: float = 60.0) -> None:
+    """Start :func:`check_offscreen` in a thread and return at once: the probe's subprocess (≈ 1.4 s) runs while
+    the caller imports and reads its data; the caller's own :func:`check_offscreen` then waits for its answer."""
+    threading.Thread(target=check_offscreen, args=(timeout,), name="dpgt-offscreen-check", daemon=True).start()
 
 
 def require_offscreen() -> str:

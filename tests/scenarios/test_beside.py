@@ -177,3 +177,25 @@ def _with_a_failing_piece(monkeypatch, capsys, out, name, fails):
         monkeypatch.setattr(paper_study, name, real)
     text = capsys.readouterr().out
     return r, text, next(x for x in text.splitlines() if x.startswith("figures: "))
+
+
+def test_an_animation_without_offscreen_rendering_is_skipped_in_words(tmp_path, capsys, monkeypatch):
+    """The animation's offscreen probe runs beside its reading of the runs; where no offscreen rendering works, the
+    point's animation is skipped with the probe's reason, nothing raised and no file written."""
+    from scenarios import paper_study
+    from viz import render_check
+
+    args = [*TINY, "--conditions", "3", "--directions", "forward,reverse", "--out", str(tmp_path)]
+    r = paper_study.run(paper_study.parse_args(args))
+    capsys.readouterr()
+    monkeypatch.delenv("VTK_DEFAULT_OPENGL_WINDOW", raising=False)
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.setattr(render_check, "_find_libs", lambda: {"EGL": None, "OSMesa": None})
+    render_check._check.cache_clear()
+    try:
+        assert paper_study.animate(r["results"], tmp_path) == []
+    finally:
+        render_check._check.cache_clear()
+    said = capsys.readouterr().out
+    assert "animation skipped: no offscreen OpenGL library found" in said
+    assert not list(tmp_path.glob("*.gif"))

@@ -328,6 +328,37 @@ def test_probe_finds_a_working_backend(fresh_probe):
     assert os.environ["VTK_DEFAULT_OPENGL_WINDOW"] in msg  # exported for in-process renders
 
 
+
+def test_a_probe_started_beside_answers_the_caller_once(fresh_probe):
+    """check_offscreen_beside starts the probe in a thread and returns before it ends; the caller's check_offscreen
+    then waits for that probe's answer instead of starting a second subprocess."""
+    import threading
+
+    calls, release = [], threading.Event()
+
+    def probe(cls, timeout):
+        calls.append(cls)
+        release.wait(10)            # the probe's subprocess, still running when the caller asks
+        return True, f"offscreen rendering works via {cls}"
+
+    fresh_probe.setattr(render_check, "_find_libs", lambda: {"EGL": "libEGL.so.1", "OSMesa": None})
+    fresh_probe.setattr(render_check, "_probe", probe)
+    render_check.check_offscreen_beside()
+    for _ in range(200):            # the thread has started its probe
+        if calls:
+            break
+        threading.Event().wait(0.01)
+    assert calls == ["vtkEGLRenderWindow"]
+    answer = []
+    asking = threading.Thread(target=lambda: answer.append(render_check.check_offscreen()))
+    asking.start()
+    asking.join(0.2)
+    assert asking.is_alive() and not answer       # the caller waits for the running probe
+    release.set()
+    asking.join(10)
+    assert answer == [(True, "offscreen rendering works via vtkEGLRenderWindow (EGL: libEGL.so.1)")]
+    assert calls == ["vtkEGLRenderWindow"]        # one probe for both
+
 # ----------------------------------------------------------------------------------- GIF streaming
 def _film(n: int, size=(240, 160)) -> list[np.ndarray]:
     """Synthetic frames of few colours: a square moving over a white ground, a bar growing, one frame repeated and
