@@ -660,7 +660,7 @@ def start_early(n_workers: int) -> None:
         try:
             box["cluster"] = _local_cluster(n_workers)
         except BaseException as exc:  # noqa: BLE001 — raised where the cluster is taken (dask_client)
-            box["error"] = exc
+            box["raised"] = exc
 
     with _ctrl_c_held(True) as release:
         thread = threading.Thread(target=start, name="dpgt-dask-start", daemon=True)
@@ -670,7 +670,7 @@ def start_early(n_workers: int) -> None:
 
 
 def _joined_early() -> tuple[dict, int | None]:
-    """What :func:`start_early`'s thread gave ({"cluster": ...} or {"error": ...}) once its start is over, and the
+    """What :func:`start_early`'s thread gave ({"cluster": ...} or {"raised": ...}) once its start is over, and the
     workers asked of it; ({}, None) when none is starting. It is then no longer the early one."""
     if not _EARLY:
         return {}, None
@@ -687,8 +687,8 @@ def _take_early(n_workers: int):
         if "cluster" in box:
             box["cluster"].close()
         return None
-    if "error" in box:
-        raise box["error"]
+    if "raised" in box:
+        raise box["raised"]
     return box["cluster"]
 
 
