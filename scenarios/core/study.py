@@ -41,8 +41,8 @@ from .points import machine_identity
 from .memory import process_peak_mb
 from .plausibility import check_runs, estimated_wall_s
 from .runner import RunConfig, run_report
-from .sweep import (Beside, Case, Outcome, Status, _case_cfg, _is_finished, build_params, check_folders, drop_early,
-                    join_closing, start_early, sweep, validate_cases)
+from .sweep import (Beside, Case, Outcome, Status, _case_cfg, _is_finished, build_params, check_folders, join_closing,
+                    sweep, validate_cases)
 
 __all__ = ["Study", "StudyRun", "run_lines", "runs_line", "TIMING_ENV"]
 
@@ -178,8 +178,7 @@ class Study(abc.ABC):
 
     # -- the skeleton -----------------------------------------------------------------------------------------
     def run(self) -> dict:
-        """Cases → validate → check runs and folders (a fresh study's local cluster starting meanwhile) → sweep →
-        report → epilogue; returns {"results",
+        """Cases → validate → check runs and folders → sweep → report → epilogue; returns {"results",
         "outcomes", "failed", "files", ...the report's}. With the environment variable ``DPGT_TIMING`` set to a file
         name, where the study's time went is written there as JSON (:data:`TIMING_ENV`; ``scenarios.bench_study
         --profile`` reads it)."""
@@ -190,19 +189,6 @@ class Study(abc.ABC):
             cfg = dataclasses.replace(cfg, threads=a.threads)
         cases = self.cases()
         validate_cases(cases, lambda c: self._check(c, cfg))     # every parameter checked before any run starts
-        try:
-            return self._run(cfg, cases, t0)
-        finally:
-            drop_early()              # a cluster started early that no sweep took (the checks refused the study)
-
-    def _run(self, cfg: RunConfig, cases: list[Case], t0: float) -> dict:
-        a = self.a
-        workers = min(a.workers or os.cpu_count() or 1, len(cases))
-        if (a.scheduler is None and workers > 1
-                and not any((Path(c.out_dir) / "summary.json").exists() for c in cases)):
-            # a fresh study (no run finished before) runs on a local cluster: its workers start while the runs and
-            # folders are checked (start_early); a study that may reuse runs starts one only for those left
-            start_early(workers)
         machine = self.machine_identity()
         print(f"machine: {machine['label']}", flush=True)
         self.out.mkdir(parents=True, exist_ok=True)

@@ -592,8 +592,7 @@ def dask_client(n_workers: int, scheduler: str | None = None, close_behind: dict
     alone. Its log messages are silenced below CRITICAL for the same reason (a failed run is reported by its
     outcome).
 
-    A local cluster of ``n_workers`` started early (:func:`start_early`) is taken over, its start waited for. A local
-    cluster's workers exit without their interpreter's finalisation (:mod:`scenarios.core.quick_exit`).
+    A local cluster's workers exit without their interpreter's finalisation (:mod:`scenarios.core.quick_exit`).
     ``close_behind`` (a timing dict): a block that ends normally leaves the client and a local cluster to close in a
     thread of this process while the caller goes on; :func:`join_closing` waits for it, as the interpreter does
     before it exits. The close's wall seconds go into ``close_behind["cluster_close_s"]``. An exception or Ctrl-C
@@ -601,10 +600,19 @@ def dask_client(n_workers: int, scheduler: str | None = None, close_behind: dict
     cluster = client = None
     with _ctrl_c_held(scheduler is None) as release:
         try:
-            from dask.distributed import Client  # deferred: Dask (≈ 0.2–0.4 s) only when a sweep runs on it
+            import dask  # deferred: Dask (≈ 0.2–0.4 s) only when a sweep runs on it
+            from dask.distributed import Client, LocalCluster  # deferred: as above
 
             if scheduler is None:
-                cluster = _take_early(n_workers) or _local_cluster(n_workers)
+                # ":0": the scheduler's HTTP server on a free port (None still asks for 8787, and a second study running
+                # beside the first warned that it was taken)
+                # the runs ("run-...") are one task group, which Dask queues on its scheduler once it outnumbers twice
+                # the workers' threads, handing each worker its next task in the order submitted (the longest runs
+                # first) as it frees; worker saturation 1 hands it over when the worker has none left, not one more
+                # to wait behind its running task (Dask's default, 1.1) until work stealing moves it
+                with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
+                    cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                                           dashboard_address=":0", silence_logs=logging.CRITICAL)
                 client = Client(cluster)
                 from .quick_exit import QuickExit  # deferred: it imports Dask's distributed
 
@@ -625,78 +633,6 @@ def dask_client(n_workers: int, scheduler: str | None = None, close_behind: dict
                 client.close()
             if cluster is not None:
                 cluster.close()
-
-
-def _local_cluster(n_workers: int):
-    """A local Dask cluster of ``n_workers`` single-threaded worker processes (call with SIGINT held:
-    :func:`_ctrl_c_held`)."""
-    import dask  # deferred: Dask (≈ 0.2–0.4 s) only when a sweep runs on it
-    from dask.distributed import LocalCluster  # deferred: as above
-
-    # ":0": the scheduler's HTTP server on a free port (None still asks for 8787, and a second study running beside
-    # the first warned that it was taken)
-    # the runs ("run-...") are one task group, which Dask queues on its scheduler once it outnumbers twice the
-    # workers' threads, handing each worker its next task in the order submitted (the longest runs first) as it
-    # frees; worker saturation 1 hands it over when the worker has none left, not one more to wait behind its running
-    # task (Dask's default, 1.1) until work stealing moves it
-    with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
-        return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0",
-                            silence_logs=logging.CRITICAL)
-
-
-_EARLY: dict = {}      # the local cluster starting early (start_early): n_workers, its thread, what it gave
-
-
-def start_early(n_workers: int) -> None:
-    """Start a local cluster of ``n_workers`` in a thread and return at once: its workers start (each imports the
-    study's code, ≈ 1–1.5 s) while the caller checks its runs. The sweep's :func:`dask_client` of that many local
-    workers takes it over, waiting for the rest of its start; :func:`drop_early` closes one nobody took. SIGINT is
-    held while the thread starts (:func:`_ctrl_c_held`), so that the cluster's threads and processes keep it
-    blocked; this process takes Ctrl-C at once."""
-    drop_early()
-    box: dict = {}
-
-    def start():
-        try:
-            box["cluster"] = _local_cluster(n_workers)
-        except BaseException as exc:  # noqa: BLE001 — raised where the cluster is taken (dask_client)
-            box["raised"] = exc
-
-    with _ctrl_c_held(True) as release:
-        thread = threading.Thread(target=start, name="dpgt-dask-start", daemon=True)
-        thread.start()
-        _EARLY.update(n=n_workers, thread=thread, box=box)
-        release()               # a Ctrl-C pressed meanwhile is raised here (the caller's drop_early closes it)
-
-
-def _joined_early() -> tuple[dict, int | None]:
-    """What :func:`start_early`'s thread gave ({"cluster": ...} or {"raised": ...}) once its start is over, and the
-    workers asked of it; ({}, None) when none is starting. It is then no longer the early one."""
-    if not _EARLY:
-        return {}, None
-    n, thread, box = _EARLY.pop("n"), _EARLY.pop("thread"), _EARLY.pop("box")
-    thread.join()
-    return box, n
-
-
-def _take_early(n_workers: int):
-    """The cluster :func:`start_early` started, if it has ``n_workers`` (its start's error raised); else None (one
-    of another size closed)."""
-    box, n = _joined_early()
-    if n != n_workers:
-        if "cluster" in box:
-            box["cluster"].close()
-        return None
-    if "raised" in box:
-        raise box["raised"]
-    return box["cluster"]
-
-
-def drop_early() -> None:
-    """Close the cluster :func:`start_early` started if no sweep took it (its start waited for first)."""
-    box, _ = _joined_early()
-    if "cluster" in box:
-        box["cluster"].close()
 
 
 def _close(client, cluster, timing: dict) -> None:

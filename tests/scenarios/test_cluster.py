@@ -304,7 +304,7 @@ def test_a_run_s_files_land_atomically_with_the_summary_last(tmp_path, monkeypat
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("when", ["checks", "cluster starting", "runs running"])
+@pytest.mark.parametrize("when", ["cluster starting", "runs running"])
 def test_ctrl_c_of_a_study_on_a_local_cluster_says_interrupted_and_nothing_else(when, tmp_path):
     """Ctrl-C reaches the terminal's whole process group: the local cluster's workers too. The command ends with its
     one line, no worker's or nanny's traceback, and leaves no process behind."""
@@ -318,12 +318,9 @@ def test_ctrl_c_of_a_study_on_a_local_cluster_says_interrupted_and_nothing_else(
                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         deadline = time.monotonic() + STUDY_S
-        if when != "runs running":
-            # a fresh study starts its cluster, then names its machine and checks its runs; the sweep says how many
-            # runs it has, then takes the cluster
-            first = "machine:" if when == "checks" else "runs:"
+        if when == "cluster starting":      # the sweep says how many runs it has, then starts its cluster
             for line in p.stdout:
-                if line.startswith(first) or time.monotonic() > deadline:
+                if line.startswith("runs:") or time.monotonic() > deadline:
                     break
         else:                               # a run writes its progress once it integrates
             while not list(out.glob("*/progress.json")) and p.poll() is None and time.monotonic() < deadline:
