@@ -458,7 +458,18 @@ def static_plots(results: dict, out: Path, machine: str = "") -> list[Path]:
 
 def animate(results: dict, out: Path, only=None) -> list[Path]:
     """The cage-orbit animation of every point (``only``: of those), forward beside reverse."""
-    paths = []
+    pairs = []
+    for c in (_conds(results) if only is None else only):
+        f = out / str(_label_of(results, c, "forward")) / "results.nc"
+        r = out / str(_label_of(results, c, "reverse")) / "results.nc"
+        if f.exists() and r.exists():
+            pairs.append((c, f, r))
+        else:      # the animation sets forward beside reverse
+            missing = "reverse" if f.exists() else "forward"
+            print(f"animation of {_title(c).lower()} skipped: it shows forward beside reverse, and "
+                  f"{point_tag(c)}_{missing} was not run (--directions forward,reverse)")
+    if not pairs:
+        return []
     # deferred: matplotlib and VTK (viz), only for --animate
     from viz.render_check import check_offscreen, check_offscreen_beside
 
@@ -469,24 +480,17 @@ def animate(results: dict, out: Path, only=None) -> list[Path]:
         from viz.results import study_cage_animation  # deferred: as above
     except ImportError as exc:   # pragma: no cover - viz integration missing
         print(f"animation skipped: {exc}")
-        return paths
-    for c in (_conds(results) if only is None else only):
-        f = out / str(_label_of(results, c, "forward")) / "results.nc"
-        r = out / str(_label_of(results, c, "reverse")) / "results.nc"
-        if f.exists() and r.exists():
-            try:
-                paths.append(Path(study_cage_animation(f, r, out / f"{point_tag(c)}_cage_orbits.gif",
-                                                       max_frames=150)))
-            except RuntimeError:
-                ok, msg = check_offscreen()
-                if ok:
-                    raise
-                print(f"animation skipped: {msg}")
-                return paths
-        else:      # the animation sets forward beside reverse
-            missing = "reverse" if f.exists() else "forward"
-            print(f"animation of {_title(c).lower()} skipped: it shows forward beside reverse, and "
-                  f"{point_tag(c)}_{missing} was not run (--directions forward,reverse)")
+        return []
+    paths = []
+    for c, f, r in pairs:
+        try:
+            paths.append(Path(study_cage_animation(f, r, out / f"{point_tag(c)}_cage_orbits.gif", max_frames=150)))
+        except RuntimeError:
+            ok, msg = check_offscreen()
+            if ok:              # the animation's own error, not the machine's rendering
+                raise
+            print(f"animation skipped: {msg}")
+            return paths
     return paths
 
 

@@ -89,7 +89,8 @@ def _probe(window_class: str | None, timeout: float) -> tuple[bool, str]:
 
 
 @functools.lru_cache(maxsize=1)
-def _check(timeout: float) -> tuple[bool, str]:
+def _check(timeout: float) -> tuple[bool, str, str | None]:
+    """(ok, message, the window class proven here — None when the user chose it)."""
     libs = _find_libs()
     requested = os.environ.get(_ENV)
     if requested:
@@ -105,33 +106,40 @@ def _check(timeout: float) -> tuple[bool, str]:
         if not candidates:
             return False, ("no offscreen OpenGL library found (neither libEGL.so.1 nor libOSMesa "
                            "can be loaded) and no X display; VTK would segfault. Install the Debian "
-                           f"packages: apt-get install {DEBIAN_PACKAGES}")
+                           f"packages: apt-get install {DEBIAN_PACKAGES}"), None
     failures = []
     for cls in candidates:
         ok, msg = _probe(cls, timeout)
         if ok:
-            if not requested:
-                os.environ[_ENV] = cls  # later in-process renders take the proven path
             found = ", ".join(f"{k}: {v}" for k, v in libs.items() if v) or "no GL libraries"
-            return True, f"{msg} ({found})"
+            return True, f"{msg} ({found})", (None if requested else cls)
         failures.append(f"{cls}: {msg}")
     return False, ("offscreen rendering is not usable (" + "; ".join(failures) + "). Install the "
-                   f"Debian packages: apt-get install {DEBIAN_PACKAGES}")
+                   f"Debian packages: apt-get install {DEBIAN_PACKAGES}"), None
 
 
 _CHECKING = threading.Lock()     # one probe at a time: a second caller waits for the first one's cached answer
 
 
-def check_offscreen(timeout: float = 60.0) -> tuple[bool, str]:
-    """Return (ok, message).  Never crashes the caller; the result is cached for the process."""
+def _answer(timeout: float) -> tuple[bool, str, str | None]:
     with _CHECKING:
         return _check(float(timeout))
 
 
+def check_offscreen(timeout: float = 60.0) -> tuple[bool, str]:
+    """Return (ok, message).  Never crashes the caller; the result is cached for the process.  The window class
+    that worked is exported here, in the caller's thread, for its later in-process renders."""
+    ok, msg, proven = _answer(timeout)
+    if proven is not None:
+        os.environ[_ENV] = proven  # later in-process renders take the proven path
+    return ok, msg
+
+
 def check_offscreen_beside(timeout: float = 60.0) -> None:
-    """Start :func:`check_offscreen` in a thread and return at once: the probe's subprocess (≈ 1.4 s) runs while
-    the caller imports and reads its data; the caller's own :func:`check_offscreen` then waits for its answer."""
-    threading.Thread(target=check_offscreen, args=(timeout,), name="dpgt-offscreen-check", daemon=True).start()
+    """Start the check in a thread and return at once: the probe's subprocess (≈ 1.4 s) runs while the caller
+    imports and reads its data; the caller's own :func:`check_offscreen` then waits for its answer (and exports
+    the window class: the thread leaves the environment alone while the caller imports)."""
+    threading.Thread(target=_answer, args=(timeout,), name="dpgt-offscreen-check", daemon=True).start()
 
 
 def require_offscreen() -> str:

@@ -91,6 +91,15 @@ def stale_modules(stored: dict, keys: dict) -> set:
 _ALL = "all sources"     # the stamp's hash of every source together (:func:`_drop_stale_kernels`)
 
 
+def sources_hash(sources, root) -> str:
+    """One sha256 of every source's name (relative to ``root``) and content: the keys (:func:`source_keys`) are a
+    function of it, so a stamp whose hash is current holds current keys."""
+    whole = _hashlib.sha256()
+    for p in sources:
+        whole.update(_Path(p).relative_to(root).as_posix().encode() + b"\0" + _Path(p).read_bytes() + b"\0")
+    return whole.hexdigest()
+
+
 def _drop_stale_kernels() -> None:
     """numba keys a cached function on its own source file only (the file's time stamp and size, and the
     function's bytecode): a kernel compiled into a caller in another file — the dispatch (registry), the assembly,
@@ -109,19 +118,22 @@ def _drop_stale_kernels() -> None:
         # the keys are a function of the sources alone: sources unchanged since the stamp (one hash of them all,
         # under a name no module has) need no parse of their imports (≈ 0.16 s in every process that imports mbd)
         sources = _sources()
-        whole = _hashlib.sha256()
-        for p in sources:
-            whole.update(p.relative_to(here.parent).as_posix().encode() + b"\0" + p.read_bytes() + b"\0")
-        if stored.get(_ALL) == whole.hexdigest():
+        whole = sources_hash(sources, here.parent)
+        if stored.get(_ALL) == whole:
             return
         keys = source_keys(sources)
         stale = stale_modules(stored, keys)
-        keys[_ALL] = whole.hexdigest()
+        # a source edited while the keys were computed: its stale kernels go, but no stamp vouches for keys that may
+        # belong to other contents than the hash (the next import computes them again)
+        settled = sources_hash(sources, here.parent) == whole
+        keys[_ALL] = whole
         names = tuple(stem + "." for stem in stale)
         for root in roots:
             for f in root.rglob("*.nb[ic]") if root.is_dir() else ():
                 if f.name.startswith(names):
                     f.unlink(missing_ok=True)
+        if not settled:
+            return
         stamp.parent.mkdir(parents=True, exist_ok=True)
         tmp = stamp.with_suffix(f".{_os.getpid()}.tmp")
         tmp.write_text(_json.dumps(keys, indent=0, sort_keys=True))

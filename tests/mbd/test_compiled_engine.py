@@ -10,6 +10,7 @@ spin after 300 steps. So the engines are held together over 150 steps exactly (c
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -258,6 +259,25 @@ def _package_copy(tmp_path):
         shutil.copyfile(src, dst)
         copies.append(dst)
     return copies
+
+
+def test_the_hash_of_all_sources_follows_every_byte_and_name_of_them(tmp_path):
+    """The stamp's hash (mbd.compiled.sources_hash), which stands for the keys: the same for a copy of the sources
+    elsewhere, another after an edit of one source's content (its name kept) or a rename; the keys move with it."""
+    import mbd.compiled as mc
+    copies = _package_copy(tmp_path)
+    here = Path(mc.__file__).resolve().parent.parent
+    before, keys = mc.sources_hash(copies, tmp_path / "mbd"), mc.source_keys(copies)
+    assert before == mc.sources_hash(mc._sources(), here)
+    target = next(p for p in copies if p.name == "contact.py")
+    text = target.read_text()
+    target.write_text(text.replace("return", "return ", 1))          # one byte more, the name kept
+    assert mc.sources_hash(copies, tmp_path / "mbd") != before and mc.source_keys(copies) != keys
+    target.write_text(text)
+    assert mc.sources_hash(copies, tmp_path / "mbd") == before
+    renamed = target.with_name("contact2.py")
+    target.rename(renamed)
+    assert mc.sources_hash([renamed if p == target else p for p in copies], tmp_path / "mbd") != before
 
 
 @pytest.mark.parametrize("edited, stale", [

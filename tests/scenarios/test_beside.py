@@ -1,4 +1,6 @@
 """Work beside the runs (scenarios.core.sweep.Beside): each group's task starts once, when its last case is in."""
+import pytest
+
 from scenarios.core.sweep import ALL, Beside, Case, Outcome, Status
 
 
@@ -199,3 +201,20 @@ def test_an_animation_without_offscreen_rendering_is_skipped_in_words(tmp_path, 
     said = capsys.readouterr().out
     assert "animation skipped: no offscreen OpenGL library found" in said
     assert not list(tmp_path.glob("*.gif"))
+
+    # where offscreen rendering works, an error of the animation itself is raised, not taken for the machine's
+    import viz.results
+
+    def broken(*a, **k):
+        raise RuntimeError("the animation's own")
+
+    monkeypatch.setattr(render_check, "_find_libs", lambda: {"EGL": "libEGL.so.1", "OSMesa": None})
+    monkeypatch.setattr(render_check, "_probe", lambda cls, timeout: (True, f"offscreen rendering works via {cls}"))
+    monkeypatch.setattr(viz.results, "study_cage_animation", broken)
+    render_check._check.cache_clear()
+    try:
+        with pytest.raises(RuntimeError, match="the animation's own"):
+            paper_study.animate(r["results"], tmp_path)
+    finally:
+        render_check._check.cache_clear()
+    assert "animation skipped" not in capsys.readouterr().out

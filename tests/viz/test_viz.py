@@ -359,6 +359,21 @@ def test_a_probe_started_beside_answers_the_caller_once(fresh_probe):
     assert answer == [(True, "offscreen rendering works via vtkEGLRenderWindow (EGL: libEGL.so.1)")]
     assert calls == ["vtkEGLRenderWindow"]        # one probe for both
 
+
+def test_a_probe_started_beside_leaves_the_environment_to_the_caller(fresh_probe):
+    """The thread only finds the answer; the caller's check_offscreen exports the proven window class (the
+    environment is not written while the caller imports VTK)."""
+    import os
+    import threading
+
+    fresh_probe.setattr(render_check, "_find_libs", lambda: {"EGL": "libEGL.so.1", "OSMesa": None})
+    fresh_probe.setattr(render_check, "_probe", lambda cls, timeout: (True, f"offscreen rendering works via {cls}"))
+    render_check.check_offscreen_beside()
+    for t in [t for t in threading.enumerate() if t.name == "dpgt-offscreen-check"]:
+        t.join(10)
+    assert render_check._check.cache_info().currsize == 1 and "VTK_DEFAULT_OPENGL_WINDOW" not in os.environ
+    assert render_check.check_offscreen()[0] and os.environ["VTK_DEFAULT_OPENGL_WINDOW"] == "vtkEGLRenderWindow"
+
 # ----------------------------------------------------------------------------------- GIF streaming
 def _film(n: int, size=(240, 160)) -> list[np.ndarray]:
     """Synthetic frames of few colours: a square moving over a white ground, a bar growing, one frame repeated and
