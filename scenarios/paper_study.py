@@ -576,18 +576,17 @@ class PaperStudy(Study):
             if not isinstance(v, list) and v is not None:
                 what = "across the points" if c is ALL else f"of {_title(c).lower()}"
                 print(f"figures {what} beside the runs failed ({v}); drawn now")
-        across = ALL not in made
-        made.pop(ALL, None)
-        early = [p for v in (*(made[c] for c in _conds(results) if c in made), run.beside.get(ALL)) if isinstance(v, list)
-                 for p in v]
+        across_made = made.pop(ALL, None)
+        early = [p for c in _conds(results) for p in made.get(c, [])] + (across_made or [])
         figs = run.step("figures beside the runs", lambda: [p for p in early if p.suffix != ".gif"]) if early else []
         anims = (run.step("animation beside the runs", lambda: [p for p in early if p.suffix == ".gif"])
                  if any(p.suffix == ".gif" for p in early) else [])
         left = [c for c in _conds(results) if c not in made]
         if static:
             figs += run.step("figures", static_plots, results, self.out, machine["label"])
-        elif left or across:            # what was not drawn beside the runs (none beside, or a piece failed there)
-            figs += run.step("figures", plots, results, self.out, machine["label"], drawn=set(made), across=across)
+        elif left or across_made is None:       # what was not drawn beside the runs (none, or a piece failed there)
+            figs += run.step("figures", plots, results, self.out, machine["label"], drawn=set(made),
+                             across=across_made is None)
         if self.a.animate and not static and left:
             anims += run.step("animation", animate, results, self.out, only=left)
         return {"rows": rows, "figures": figs, "animations": anims}
