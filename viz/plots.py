@@ -1126,6 +1126,7 @@ def binned_series(series: Mapping[str, Sequence[float]], names: Sequence[str], p
                    title_fontsize=7.5)
         if title:
             fig.suptitle(textwrap.fill(title, 100), fontsize=9.5)
+        return _save(fig, path)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -48,15 +48,23 @@ hours = 10
 '''
 
 
+# a logged series: 20 min at standstill, then 40 min at 4200 r/min and 450 N m (one bin), sampled every 5 min
+SERIES = "time [s],carrier_speed [rpm],torque [N*m]\n" + "".join(
+    f"{300 * k},{0 if k < 4 else 4200},{0 if k < 4 else 450}\n" for k in range(13))
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    """The two-bin and the one-bin cycle, and the paper study's condition 3 beside a user point equal to it."""
+    """The two-bin and the one-bin cycle, a logged series, and the paper study's condition 3 beside a user point
+    equal to it."""
     tmp = tmp_path_factory.mktemp("duty")
     two = _cycle(tmp, "two.toml", TWO_BINS)
     one = _cycle(tmp, "one.toml", ONE_BIN)
+    series = _cycle(tmp, "series.csv", SERIES)
     common = ["--snapshots", SNAPSHOTS, "--workers", "1", "--no-progress"]
     assert duty_cycle.main(["--cycle", str(two), "--out", str(tmp / "two"), *common]) == 0
     assert duty_cycle.main(["--cycle", str(one), "--out", str(tmp / "one"), *common]) == 0
+    assert duty_cycle.main(["--cycle", str(series), "--out", str(tmp / "series"), *common]) == 0
     assert paper_study.main(["--mode", "static", "--conditions", "3", "--operating", "u3: 4200 rpm, 200 kW",
                              "--directions", "forward", "--out", str(tmp / "paper"), *common]) == 0
     return tmp
@@ -126,6 +134,14 @@ def test_every_output_names_the_machine(runs):
     assert m["label"] in (runs / "two" / "duty_cycle.md").read_text()
     assert (runs / "two" / "duty_cycle.csv").read_text().splitlines()[1].startswith(m["label"])
     assert (runs / "two" / "damage_share.png").stat().st_size > 10_000
+
+
+def test_a_logged_series_is_binned_and_its_binning_drawn(runs):
+    """The series' one bin holds its 40 moving minutes (the standstill left out) and binning.png is written."""
+    rec = _json(runs / "series" / "duty_cycle.json")
+    assert len(rec["bins"]) == 1 and rec["bins"][0]["name"].startswith("fwd_4200-4725rpm_450-")
+    assert rec["bins"][0]["hours"] == pytest.approx(40 / 60, rel=1e-12)
+    assert (runs / "series" / "binning.png").stat().st_size > 10_000
 
 
 def test_binning_a_synthetic_series_gives_its_known_times_and_revolutions():
