@@ -515,7 +515,7 @@ FAULT_QUANTITIES = (
     ("bearing_load_max_N", "largest bearing load", "N", None),
     ("life_relative", "life change against the perfect machine", "%", "excess"),
     ("cage_slip_pct", "cage slip", "%", None),
-    ("pocket_impacts_per_rev", "pocket impacts", "per cage rev.", None))
+    ("pocket_impacts_per_rev", "pocket impacts", "per bearing and cage rev.", None))
 
 
 def fault_loads(rows: Sequence[Mapping], path, *, quantities: Sequence[tuple] = FAULT_QUANTITIES,

@@ -182,8 +182,9 @@ def pin_summary(d, sums, ref, sel) -> None:
 
 
 def impact_summary(d, sums, pk, sel) -> None:
-    """Pocket impacts of the pockets ``pk`` (a mask) in the windows of the bearings ``sel``: their count, per cage
-    revolution relative to the carrier (touches too), approach speed and peak force (max and mean)."""
+    """Pocket impacts of the pockets ``pk`` (a mask) in the windows of the bearings ``sel``: their count over the
+    bearings, per bearing and cage revolution relative to the carrier (the count over their revolutions summed;
+    touches too), approach speed and peak force (max and mean)."""
     im = sums.impact
     count = im["count"][pk].sum()
     revs = sums.cage_revolutions(sel)
