@@ -38,11 +38,18 @@ import numpy as np
 from .errors import ModelError
 from .model import to_fixed
 
-__all__ = ["BodyMotion", "ElementOutput", "DerivedOutput", "Recorder", "atomic_write_bytes", "atomic_write_text", "hermite"]
+__all__ = ["BodyMotion", "ElementOutput", "DerivedOutput", "Recorder", "atomic_write_bytes", "atomic_write_text", "hermite",
+           "temporaries"]
 
 
 def _tmp_for(path: Path) -> Path:
     return path.with_name(f".{path.name}.tmp{os.getpid()}")
+
+
+def temporaries(folder, pid: int) -> list[Path]:
+    """The temporary files of the atomic writes process ``pid`` began below ``folder`` and never finished (a
+    process killed in a write leaves its file: no handler runs)."""
+    return sorted(Path(folder).rglob(f".*.tmp{int(pid)}"))
 
 
 @contextlib.contextmanager

@@ -1,5 +1,6 @@
 """One run per output folder: a lock file holding the holder's pid, host and start time. A second run refuses
-with a clear message; a lock left by a process that no longer exists (on this host) is taken over."""
+with a clear message; a lock left by a process that no longer exists (on this host) is taken over, and the temporary
+files that process left in the folder are removed with it."""
 from __future__ import annotations
 
 import contextlib
@@ -10,7 +11,9 @@ import socket
 import time
 from pathlib import Path
 
-__all__ = ["FolderLocked", "folder_lock", "holds_out_folder", "LOCK_NAME"]
+from mbd.recorder import temporaries
+
+__all__ = ["FolderLocked", "folder_lock", "holds_out_folder", "release_dead", "LOCK_NAME"]
 
 LOCK_NAME = ".dpgt.lock"
 
@@ -29,6 +32,30 @@ def _alive(pid: int) -> bool:
     return True
 
 
+def _holder(lock: Path) -> dict:
+    try:
+        return json.loads(lock.read_text() or "{}")
+    except (OSError, ValueError):
+        return {}
+
+
+def _dead(held: dict) -> bool:
+    return held.get("host") == socket.gethostname() and isinstance(held.get("pid"), int) and not _alive(held["pid"])
+
+
+def release_dead(folder) -> bool:
+    """Remove ``folder``'s lock if its holder was a process of this host that no longer exists (a worker stopped in
+    the middle of a run), and the temporary files that process left below the folder; whether there was one."""
+    lock = Path(folder) / LOCK_NAME
+    held = _holder(lock)
+    if not _dead(held):
+        return False
+    for tmp in temporaries(folder, held["pid"]):
+        tmp.unlink(missing_ok=True)
+    lock.unlink(missing_ok=True)
+    return True
+
+
 @contextlib.contextmanager
 def folder_lock(folder):
     """Hold ``folder``'s lock for the duration (re-entrant for this process: a study and its in-process runs)."""
@@ -40,15 +67,11 @@ def folder_lock(folder):
         try:
             fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
         except FileExistsError:
-            try:
-                held = json.loads(lock.read_text() or "{}")
-            except (OSError, ValueError):
-                held = {}
+            held = _holder(lock)
             if held.get("pid") == me["pid"] and held.get("host") == me["host"]:
                 yield folder                          # this process holds it already
                 return
-            if held.get("host") == me["host"] and isinstance(held.get("pid"), int) and not _alive(held["pid"]):
-                lock.unlink(missing_ok=True)          # a dead holder on this host: take the lock over
+            if release_dead(folder):                  # a dead holder on this host: take the lock over
                 continue
             raise FolderLocked(f"{folder} is in use by pid {held.get('pid', '?')} on {held.get('host', '?')} since "
                                f"{held.get('started', '?')}; wait for that run, or delete {lock} if it is gone")

@@ -31,11 +31,12 @@ from mbd.recorder import Recorder
 __all__ = ["Implausible", "check_runs", "output_bytes", "MAX_OUTPUT_BYTES", "run_advice", "estimated_wall_s"]
 
 MAX_OUTPUT_BYTES = 5e9    # [assumed] more than 5 GB of histories is a mistaken --sample-rate, not a study
-# [measured] wall seconds per simulated second of a dynamic run (the duty-cycle example's 4200 rpm bins: 44 s for
-# 0.051 s, two at a time on a shared 2-core machine) and of one static solution (its 16-snapshot bins: 5-30 s);
-# an order of magnitude for the estimate said before a study runs, not a benchmark (scenarios.bench_study)
-WALL_PER_SIMULATED_S = 900.0
-STATIC_WALL_S = 15.0
+# [measured] wall seconds per simulated second of a dynamic run, two at a time on a shared 2-core machine: the seed
+# study's runs 50 (condition 4) to 115 (condition 1), a new user's `make demo` beside other work 150; and of one
+# static solution (16 snapshots): 0.8-2 s quiet, up to 12 s loaded (a new user's duty cycles and static studies).
+# An order of magnitude for the estimate said before a study runs, not a benchmark (scenarios.bench_study)
+WALL_PER_SIMULATED_S = 120.0
+STATIC_WALL_S = 3.0
 
 
 class Implausible(Exception):

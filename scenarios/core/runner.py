@@ -48,7 +48,7 @@ from .integrity import checkpoint_usable, claim_folder, read_summary, results_in
 from .lock import folder_lock
 from .memory import RunPeak
 
-__all__ = ["RunConfig", "run_case", "engine_record", "time_record", "TIME_NOTE", "finished_run", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
+__all__ = ["RunConfig", "run_case", "engine_record", "time_record", "TIME_NOTE", "finished_run", "checkpoint_time", "run_fingerprint", "parameters_fingerprint", "run_description", "statistics_window", "run_report",
            "accuracy_line", "code_digest", "FIXED_STEP_ERROR_FACTOR"]
 
 # A fixed-step run whose RMS local error estimate exceeds its tolerance (atol) by more than this factor ends
@@ -180,6 +180,27 @@ def finished_run(out_dir, params: DPGTParams, cfg: RunConfig) -> Summary | None:
     return s if results_intact(out / "results.nc", s.get("samples")) else None
 
 
+def _own_checkpoint(out_dir: Path, fp: str) -> bool:
+    """Whether ``out_dir`` holds a checkpoint of the run whose fingerprint is ``fp`` (the folder's fingerprint file is
+    written as a run starts)."""
+    fp_file = out_dir / "fingerprint"
+    return (out_dir / "checkpoint.npz").exists() and fp_file.exists() and \
+        fp_file.read_text(errors="replace").strip() == fp
+
+
+def checkpoint_time(out_dir, params: DPGTParams, cfg: RunConfig) -> float | None:
+    """The simulated time [s] a run of these parameters, settings and code would resume from in ``out_dir`` (its
+    checkpoint's), else None (no checkpoint of this run there, or one that does not load)."""
+    out = Path(out_dir)
+    if not _own_checkpoint(out, run_fingerprint(params, cfg)):
+        return None
+    try:
+        with np.load(out / "checkpoint.npz") as d:
+            return float(d["t"])
+    except Exception:       # damaged: the run moves it aside and starts afresh (checkpoint_usable)
+        return None
+
+
 def run_case(params: DPGTParams, cfg: RunConfig, out_dir, label: dict | None = None, overwrite: bool = False) -> Summary:
     """Run one operating point; write results.nc and summary.json atomically into out_dir.
     An interrupted run resumes from out_dir/checkpoint.npz. One run at a time per folder (scenarios.core.lock).
@@ -288,7 +309,7 @@ def _run_case(params: DPGTParams, cfg: RunConfig, out_dir: Path, label: dict | N
     fp = run_fingerprint(params, cfg)
     fp_file = out_dir / "fingerprint"
     ckpt = out_dir / "checkpoint.npz"
-    if ckpt.exists() and (not fp_file.exists() or fp_file.read_text(errors="replace").strip() != fp):
+    if ckpt.exists() and not _own_checkpoint(out_dir, fp):
         # a checkpoint of another run (other parameters, settings or code): start afresh, say so
         print(f"{out_dir}: the checkpoint there is from a different run (parameters, settings or code); starting afresh")
         ckpt.unlink()

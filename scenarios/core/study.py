@@ -42,7 +42,7 @@ from .memory import process_peak_mb
 from .plausibility import check_runs, estimated_wall_s
 from .runner import RunConfig, run_report
 from .sweep import (Beside, Case, Outcome, Status, _case_cfg, _is_finished, build_params, check_folders, join_closing,
-                    sweep, validate_cases)
+                    resume_times, sweep, validate_cases)
 
 __all__ = ["Study", "StudyRun", "run_lines", "runs_line", "TIMING_ENV"]
 
@@ -255,8 +255,10 @@ class Study(abc.ABC):
         for msg, labels in said.items():
             who = ", ".join(labels[:3]) + (f" and {len(labels) - 3} more" if len(labels) > 3 else "")
             print(f"warning before the run ({who}): {msg}", flush=True)
-        todo = {c.label for c in cases if not _is_finished(c, cfg)}
-        runs = [(label, t) for kind, label, t in (x for x in advice if x[0] == "time") if label in todo]
+        todo = [c for c in cases if not _is_finished(c, cfg)]
+        done = resume_times(todo, cfg)          # a resumed run has only the rest of its simulated time to go
+        runs = [(label, t if t is None else max(t - done.get(label, 0.0), 0.0))
+                for kind, label, t in (x for x in advice if x[0] == "time") if label in {c.label for c in todo}]
         if not runs:
             return
         workers = getattr(self.a, "workers", None) or min(len(runs), os.cpu_count() or 1)

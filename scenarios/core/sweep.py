@@ -47,7 +47,9 @@ from components.units import ParameterError
 from .points import Point, file_overrides, point_overrides
 from .cluster import check_workers, done_on_worker, folder_files, land, other_code, params_texts, relocated, scratch_folder
 from .integrity import OtherResults, claim_folder, differences, read_summary
-from .runner import code_digest, finished_run, parameters_fingerprint, run_case, run_description, run_fingerprint
+from .lock import release_dead
+from .runner import (checkpoint_time, code_digest, finished_run, parameters_fingerprint, run_case, run_description,
+                     run_fingerprint)
 
 __all__ = ["Case", "Status", "Outcome", "Beside", "ALL", "Travelled", "sweep", "run_sweep", "execute_case", "execute_on_worker",
            "join_closing",
@@ -224,6 +226,19 @@ def check_folders(cases: list[Case], cfg, overwrite: bool = False) -> None:
     if others:
         raise OtherResults(f"{', '.join(others)} hold{'s' if len(others) == 1 else ''} finished results of other "
                            f"parameters or settings; pass --overwrite to replace them, or choose another --out")
+
+
+def resume_times(cases: list[Case], cfg) -> dict[str, float]:
+    """{label: simulated time [s]} of the cases that will resume from a checkpoint of their own run."""
+    out = {}
+    for c in cases:
+        try:
+            t = checkpoint_time(c.out_dir, build_params(c), _case_cfg(c, cfg))
+        except Exception:     # bad parameters: execute_case reports them
+            t = None
+        if t is not None:
+            out[c.label] = t
+    return out
 
 
 def _is_finished(case: Case, cfg) -> bool:
@@ -450,8 +465,10 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
     t0 = time.perf_counter()
     todo = [c for c in cases if not _is_finished(c, cfg)]
     if announce:
-        print(f"runs: {len(todo)} to run, {len(cases) - len(todo)} reused (finished earlier with the same parameters, "
-              f"settings and code)", flush=True)
+        resumes = resume_times(todo, cfg)
+        said = "".join(f", {k} from its checkpoint at {1e3 * t:.3g} ms" for k, t in resumes.items())
+        print(f"runs: {len(todo)} to run{said}, {len(cases) - len(todo)} reused (finished earlier with the same "
+              f"parameters, settings and code)", flush=True)
         if todo and len(todo) < len(cases):
             print(f"resuming: {len(cases) - len(todo)} of {len(cases)} runs finished earlier", flush=True)
     results = {c.label: execute_case(c, cfg) for c in cases if c not in todo}   # finished: just load
@@ -478,7 +495,8 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
     wcfg = replace(cfg, progress=False)   # per-run bars would interleave; the sweep bar shows progress
     futs, side = {}, []           # side: (group, future) of each piece of work beside the runs
     t_start = time.perf_counter()
-    with dask_client(n_workers, scheduler, close_behind=timing if close_behind else None) as client:
+    with _dead_runs_released(todo, scheduler is None), \
+            dask_client(n_workers, scheduler, close_behind=timing if close_behind else None) as client:
         from dask.distributed import wait as dask_wait  # deferred: Dask, imported by dask_client just now
         timing["cluster_start_s"] = time.perf_counter() - t_start
         timing["runs_start_unix_s"] = time.time()
@@ -547,6 +565,19 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
     if not close_behind:
         timing["cluster_close_s"] = time.perf_counter() - t_close
     return results
+
+
+@contextlib.contextmanager
+def _dead_runs_released(cases: list[Case], local: bool):
+    """On Ctrl-C or a failure, once a local cluster has stopped (the block inside this one closes it): the locks and
+    unfinished writes its workers left in the cases' folders removed (:func:`scenarios.core.lock.release_dead`)."""
+    try:
+        yield
+    except BaseException:
+        if local:
+            for c in cases:
+                release_dead(c.out_dir)
+        raise
 
 
 def _worker_failure(case: Case, exc: BaseException) -> Outcome:

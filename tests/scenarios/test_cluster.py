@@ -307,7 +307,7 @@ def test_a_run_s_files_land_atomically_with_the_summary_last(tmp_path, monkeypat
 @pytest.mark.parametrize("when", ["cluster starting", "runs running"])
 def test_ctrl_c_of_a_study_on_a_local_cluster_says_interrupted_and_nothing_else(when, tmp_path):
     """Ctrl-C reaches the terminal's whole process group: the local cluster's workers too. The command ends with its
-    one line, no worker's or nanny's traceback, and leaves no process behind."""
+    one line, no worker's or nanny's traceback, and leaves no process, lock or temporary file behind."""
     out = tmp_path / "out"
     p = subprocess.Popen([sys.executable, "-m", "scenarios.paper_study", "--conditions", "4", "--directions",
                           "forward,reverse", "--settle", "0.002", "--window", "0.05", "--workers", "2", "--no-progress",
@@ -331,6 +331,9 @@ def test_ctrl_c_of_a_study_on_a_local_cluster_says_interrupted_and_nothing_else(
         assert p.returncode == 130, err
         assert err.strip().splitlines()[-1].startswith("interrupted: finished runs and checkpoints are kept"), err
         assert "Traceback" not in err and "CancelledError" not in err and "Error" not in err, err
+        # the stopped workers' locks and unfinished writes are gone; their checkpoints stay for the resume
+        left = sorted(str(f.relative_to(out)) for f in [*out.rglob(".dpgt.lock"), *out.rglob(".*.tmp*")])
+        assert left == [], left
         time.sleep(2.0)
         with pytest.raises(ProcessLookupError):    # the workers stopped with it
             os.killpg(p.pid, 0)

@@ -248,14 +248,17 @@ def test_a_fixed_step_run_beyond_its_tolerance_warns(finished, tmp_path, capsys)
     assert f"c4_forward: warning: {accuracy(s)[0]}" in capsys.readouterr().out
 
 
-def test_wall_time_of_a_resumed_run_counts_every_segment(tmp_path, monkeypatch):
+def test_wall_time_of_a_resumed_run_counts_every_segment(tmp_path, monkeypatch, capsys):
     """Interrupted late in its run, resumed from the checkpoint: wall_s is the first segment's time plus
-    the second's, not the second's alone."""
+    the second's, not the second's alone; before it runs, the sweep says it resumes and from which simulated time (the
+    one the run then resumes from)."""
     import dataclasses
+    import re
     import time
 
     import mbd
     from scenarios.core import runner
+    from scenarios.core.sweep import resume_times, sweep
 
     real = mbd.simulate
     calls = []
@@ -274,11 +277,15 @@ def test_wall_time_of_a_resumed_run_counts_every_segment(tmp_path, monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         runner.run_case(params, cfg, tmp_path)
     first = json.loads((tmp_path / "progress.json").read_text())["wall_s"]
+    assert resume_times([_case(tmp_path, rollers=9)], cfg) == {}        # not a checkpoint of that run
+    capsys.readouterr()
     t0 = time.perf_counter()
-    s = runner.run_case(params, cfg, tmp_path)
+    s = sweep([_case(tmp_path)], cfg, workers=1, progress=False, announce=True)["c4_forward"].summary
     second = time.perf_counter() - t0
     assert s["resumed_from_s"] is not None and s["resumed_from_s"] > 0.5 * (CFG.settle + CFG.window)
     assert first < s["wall_s"] <= first + second
+    said = re.search(r"runs: 1 to run, c4_forward from its checkpoint at ([\d.]+) ms, 0 reused", capsys.readouterr().out)
+    assert said and float(said.group(1)) == pytest.approx(1e3 * s["resumed_from_s"], rel=5e-3)
 
 
 def test_colliding_gears_are_refused_unless_forced(tmp_path, capsys):
@@ -354,3 +361,17 @@ def test_one_run_left_runs_here_whatever_the_workers_asked(tmp_path, monkeypatch
     timing = {}
     out = sw.sweep([_case(tmp_path / "a")], CFG, workers=2, progress=False, timing=timing)
     assert list(out) == [_case(tmp_path / "a").label] and timing["dask"] is False and timing["workers"] == 1
+
+
+def test_the_estimate_deals_the_runs_to_the_workers_longest_first():
+    """Runs of 0.1, 0.06 and 0.05 simulated seconds and a static solution on two workers: the longest alone on one,
+    the next two on the other, the static solution onto the first to free (``R`` s of wall per simulated second,
+    ``S`` per static solution); on one worker their sum; no runs, no time."""
+    from scenarios.core.plausibility import STATIC_WALL_S as S, WALL_PER_SIMULATED_S as R, estimated_wall_s
+
+    runs = [("a", 0.06), ("s", None), ("b", 0.1), ("c", 0.05)]
+    assert S < 0.05 * R                     # the static solution is the shortest: it is dealt last
+    assert estimated_wall_s(runs, 2) == pytest.approx(max(0.1 * R + S, 0.11 * R), rel=1e-12)
+    assert estimated_wall_s(runs, 1) == pytest.approx(0.21 * R + S, rel=1e-12)
+    assert estimated_wall_s(runs, 8) == pytest.approx(0.1 * R, rel=1e-12)     # one run a worker
+    assert estimated_wall_s([], 2) == 0.0
