@@ -719,8 +719,9 @@ def _bearing_findings(bs, G, out) -> None:
         height = (G[n].addendum_coefficient + G[n].dedendum_coefficient) * G[n].module
         if rim <= 0:
             out.append(Finding("error", "bearing.pitch_diameter",
-                               f"the bore ({2 * bore * 1e3:.3f} mm) does not fit inside the {n.replace('_', ' ')}'s root "
-                               f"circle ({2 * G[n].root_radius * 1e3:.3f} mm)"))
+                               f"the bore ({2 * bore * 1e3:.3f} mm: pitch diameter {dm * 1e3:g} + roller diameter "
+                               f"{d * 1e3:g} + clearance {bs.clearance * 1e3:g} mm) does not fit inside the "
+                               f"{n.replace('_', ' ')}'s root circle ({2 * G[n].root_radius * 1e3:.3f} mm)"))
         elif rim < RIM_BACKUP_RATIO * height:
             out.append(Finding("warning", "bearing.pitch_diameter",
                                f"{n.replace('_', ' ')} rim under the teeth is {rim * 1e3:.2f} mm, less than "
@@ -779,6 +780,7 @@ def check_design(params, strict: bool = True) -> list[Finding]:
     if strict and errors:
         lines = "\n".join(f"  {f}" for f in errors)
         first = errors[0]
-        raise ParameterError(f"{first.parameter}: design check failed with {len(errors)} error(s):\n{lines}",
+        named = ", ".join(dict.fromkeys(f.parameter for f in errors))      # every parameter at fault, in order
+        raise ParameterError(f"{named}: design check failed with {len(errors)} error(s):\n{lines}",
                              parameter=first.parameter, problem=first.message)
     return found
