@@ -125,6 +125,10 @@ def check_runs(runs, out, force: bool = False, advice: list | None = None) -> li
             scene = build_dpgt(params, cfg.options)
         window = cfg.window if cfg.window is not None else statistics_window(scene)
         if advice is not None:
+            power = params.si().operating.output_power
+            if power < 0:       # meant, or a sign typed by mistake: said before it runs
+                advice.append((label, f"the output power is negative ({power / 1e3:g} kW): the machine brakes — the "
+                                      f"carrier drives the sun, the loaded flanks turn over (README: Operating points)"))
             advice += [(label, w) for w in run_advice(scene, cfg, window)]
             advice.append(("time", label, None if cfg.mode == "static" else cfg.settle + window))
         sizes[label] = output_bytes(scene, window, cfg.sample_rate)

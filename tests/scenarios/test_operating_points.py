@@ -131,14 +131,18 @@ def test_the_lubricant_study_takes_a_file_that_sets_an_oil_and_says_so(tmp_path,
     assert si.lubricant.viscosity_40 == pytest.approx(150e-6) and si.bearing.clearance == pytest.approx(30e-6)
 
 
-def test_braking_loads_the_flanks_reverse_driving_loads(tmp_path):
+def test_braking_loads_the_flanks_reverse_driving_loads(tmp_path, capsys):
     """Forward braking (the carrier drives the sun) loads the flanks that reverse driving loads, with the same
     torque-path force (the meshes carry |T|, the centrifugal load does not depend on the sign): a static solution of
-    each, drive-flank forces within 1 %."""
+    each, drive-flank forces within 1 %. The braking point is said to brake before it runs (a sign typed by mistake
+    shows), the driving one not."""
     out = tmp_path / "o"
     assert paper_study.main(["--mode", "static", "--snapshots", "2", "--operating", "brake: 2000 rpm, -150 kW, forward",
                              "--operating", "drive: 2000 rpm, 150 kW, reverse", "--out", str(out), "--workers", "1",
                              "--no-progress"]) == 0
+    said = [ln for ln in capsys.readouterr().out.splitlines() if "the machine brakes" in ln]
+    assert said == ["warning before the run (brake): the output power is negative (-150 kW): the machine brakes — "
+                    "the carrier drives the sun, the loaded flanks turn over (README: Operating points)"]
     import json
     b, d = (json.loads((out / n / "summary.json").read_text()) for n in ("brake", "drive"))
     assert b["power_W"] == -150e3 and b["direction"] == "forward" and d["direction"] == "reverse"
