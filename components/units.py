@@ -26,7 +26,8 @@ from typing import NamedTuple
 
 import pint
 
-__all__ = ["ureg", "Q_", "Quantity", "ParameterError", "KINDS", "Kind", "quantity", "to_si", "format_quantity"]
+__all__ = ["ureg", "Q_", "Quantity", "ParameterError", "KINDS", "Kind", "quantity", "to_si", "format_quantity",
+           "unit_text"]
 
 ureg = pint.UnitRegistry()
 ureg.define("rev = revolution")  # "rev/s", "rev/min" read naturally next to pint's built-in "rpm"
@@ -192,6 +193,21 @@ def _exponent(e: float) -> str:
     if f.denominator == 1:
         return str(f.numerator)
     return f"({f.numerator}/{f.denominator})"
+
+
+def unit_text(u) -> str:
+    """A unit as a reader writes it: pint's short pretty form ("kg·m²", "N/m"), with a fractional exponent as
+    ``^(p/q)`` ("N/m^(10/9)", where pint's form would print m¹⋅¹¹¹¹¹); "1" for no unit."""
+    items = (1 * u).unit_items() if not isinstance(u, Quantity) else u.unit_items()
+    if all(float(e).is_integer() for _, e in items):
+        return f"{u if not isinstance(u, Quantity) else u.units:~P}" or "1"
+
+    def part(name, e):
+        sym = ureg.get_symbol(name)
+        return sym if e == 1 else f"{sym}^{_exponent(e)}"
+    num = "·".join(part(n, e) for n, e in items if e > 0) or "1"
+    den = "·".join(part(n, -e) for n, e in items if e < 0)
+    return f"{num}/{den}" if den else num
 
 
 def format_quantity(q: Quantity) -> str:

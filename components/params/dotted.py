@@ -8,7 +8,7 @@ import tomllib
 from typing import Any, Mapping, TypeVar
 
 from ..names import did_you_mean
-from ..units import KINDS, ParameterError, Quantity, format_quantity
+from ..units import KINDS, ParameterError, Quantity, format_quantity, unit_text
 from ._machinery import Params, Span, convert, param_fields
 
 __all__ = ["with_overrides", "parameter_names", "flatten", "describe", "parameter_rows", "to_toml",
@@ -108,11 +108,6 @@ def _si_at(view, path: str):
     return view
 
 
-def _unit_text(u) -> str:
-    text = f"{u:~P}"
-    return text or "1"
-
-
 def parameter_rows(params: Params) -> list[dict[str, str]]:
     """Every leaf parameter as text: ``key`` (dotted), ``value`` and ``unit`` (a value left to its rule resolved, in
     SI), ``source`` (its tag, ``[paper]`` ...), ``note`` (the source's note) and ``meaning`` (the field's one-line
@@ -132,9 +127,9 @@ def parameter_rows(params: Params) -> list[dict[str, str]]:
             resolved = _si_at(si, path) if si is not None else None
             kind = KINDS.get(spec.kind)
             value = f"{resolved:.6g}" if isinstance(resolved, (int, float)) else "(rule)"
-            unit = _unit_text(Quantity(1.0, kind.si_unit).units) if kind is not None and resolved is not None else ""
+            unit = unit_text(Quantity(1.0, kind.si_unit).units) if kind is not None and resolved is not None else ""
         elif isinstance(v, Quantity):
-            value, unit = f"{v.magnitude:g}", _unit_text(v.units)
+            value, unit = f"{v.magnitude:g}", unit_text(v.units)
         else:
             value, unit = _describe_value(v), ""
         src = owner.source(name)

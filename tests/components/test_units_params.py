@@ -458,3 +458,13 @@ def test_bearing_rows_is_a_count_of_at_least_one():
     assert with_overrides(reference_dpgt(), {"bearing.rows": 2}).si().bearing.rows == 2
     with pytest.raises(ParameterError, match=r"^bearing\.rows"):
         with_overrides(reference_dpgt(), {"bearing.rows": 0})
+
+
+@pytest.mark.parametrize("unit, text", [("N/m**(10/9)", "N/m^(10/9)"), ("N*s/m**(10/9)", "N·s/m^(10/9)"),
+                                        ("kg*m**2", "kg·m²"), ("mm**2/s", "mm²/s"), ("dimensionless", "1")])
+def test_a_unit_reads_as_written_and_back_to_itself(unit, text):
+    """A fractional exponent as ^(p/q), not pint's decimal superscripts; the text parses back to the same unit."""
+    from components.units import unit_text, ureg
+    assert unit_text(ureg.Unit(unit)) == text
+    back = text.replace("^", "**").replace("·", "*").replace("²", "**2")
+    assert ureg.Quantity(1.0, back).to(unit).magnitude == pytest.approx(1.0, rel=1e-15)
