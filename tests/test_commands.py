@@ -512,6 +512,17 @@ def test_a_bad_time_is_refused_in_one_line(text, words, tmp_path, capsys):
     assert "--window" in err and words in err and err.count("\n") == 1
 
 
+@pytest.mark.parametrize("unit, words", [("r/min", "or an angular velocity with its unit"),
+                                         ("s", "or a time with its unit")])
+def test_a_quantity_of_the_wrong_kind_is_named_with_its_article(unit, words):
+    import argparse
+    import re
+
+    from scenarios.core.args import _float
+    with pytest.raises(argparse.ArgumentTypeError, match=re.escape(words)):
+        _float("3 kg", "a number", unit)
+
+
 @pytest.mark.parametrize("name,argv", [("bearing_rig", ["--radial-load", "{}"]), ("modal", ["--set", "planets={}"])])
 def test_bearing_rig_and_modal_take_overwrite_and_no_progress(name, argv, tmp_path, capsys):
     """A second run with other inputs into the same folder is refused naming what differs; --overwrite replaces it;

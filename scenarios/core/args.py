@@ -15,7 +15,7 @@ from pathlib import Path
 
 from components.names import argparse_hint, did_you_mean
 from components.scene import SceneOptions
-from components.units import ParameterError, quantity, to_si
+from components.units import KINDS, ParameterError, quantity, to_si
 
 from .points import parse_point
 
@@ -87,7 +87,7 @@ def _float(text: str, what: str, unit: str = "") -> float:
         try:
             x = float(quantity("value", text, dimension).to(name).magnitude)
         except ParameterError:
-            raise argparse.ArgumentTypeError(f"expected {what} or a {dimension.replace('_', ' ')} with its unit "
+            raise argparse.ArgumentTypeError(f"expected {what} or {KINDS[dimension].label} with its unit "
                                              f"(e.g. '{_EXAMPLE[unit]}'), got {text!r}") from None
     if not math.isfinite(x):
         raise argparse.ArgumentTypeError(f"expected a finite number ({what}), got {text!r}")
@@ -223,7 +223,8 @@ def quantity_of(dimension: str, positive_only: bool = False):
         try:
             x = to_si(quantity("value", text, dimension))
         except ParameterError as exc:
-            raise argparse.ArgumentTypeError(exc.problem or f"expected a {dimension} with its unit, got {text!r}") \
+            raise argparse.ArgumentTypeError(exc.problem or f"expected {KINDS[dimension].label} with its unit, got "
+                                             f"{text!r}") \
                 from None
         if positive_only and not x > 0:
             raise argparse.ArgumentTypeError(f"must be > 0, got {text!r}")
