@@ -315,7 +315,8 @@ def bin_series(t, speed, torque, oil=None, speed_bin: str | None = None, torque_
         f = {"name": name, "carrier_speed": f"{speed_b * rpm!r} rpm", "torque": f"{torque_b!r} N*m",
              "direction": "forward" if s == 0 else "reverse"}
         if oil_k is not None:
-            f["oil_temperature"] = f"{math.fsum(oil_k[sel] * dt[sel]) / time_b - 273.15!r} degC"
+            # the bin's time-mean oil temperature, to 6 digits (0.001 K: far below what a log measures)
+            f["oil_temperature"] = f"{math.fsum(oil_k[sel] * dt[sel]) / time_b - 273.15:.6g} degC"
         hours.append(time_b / 3600.0)
         rows.append((f, f"binned from {Path(source).name}: bin {name}"))
     if not rows:
@@ -718,11 +719,13 @@ def table_rows(rec: dict) -> list[dict]:
 
 
 def _csv(rows: list[dict]) -> str:
+    """The rows as CSV, numbers to 12 significant digits (1000 r/min reads 1000, not the 1000.0000000000001 its
+    round trip through rad/s gives)."""
     buf = io.StringIO()
     keys = list(dict.fromkeys(k for r in rows for k in r))
     w = csv.DictWriter(buf, fieldnames=keys)
     w.writeheader()
-    w.writerows(rows)
+    w.writerows({k: (f"{v:.12g}" if isinstance(v, float) else v) for k, v in r.items()} for r in rows)
     return buf.getvalue()
 
 

@@ -366,3 +366,12 @@ def test_a_one_bin_cycle_with_auto_has_the_single_dynamic_runs_life(auto):
                 got = rec["lives"][kind]["planets"][f"{letter}{j + 1}"][key]["life_h"]
                 assert got == pytest.approx(c3[kind][f"life_{key}_per_planet_h"][j], rel=1e-12, abs=0)
     assert rec["lives_ignore_dynamic_load"] == [] and rec["static_lives_note"] is None
+
+
+def test_the_table_reads_its_speeds_as_given(runs):
+    """1000 r/min round-trips through rad/s to 1000.0000000000001; the table writes 12 digits."""
+    import csv
+    with open(runs / "two" / "duty_cycle.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert {r["bin"]: r["carrier_rpm"] for r in rows} == {"fast": "4200", "back": "2000"}
+    assert all(len(r["hours"]) <= 14 for r in rows)
