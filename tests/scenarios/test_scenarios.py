@@ -55,7 +55,7 @@ def test_study_writes_documented_outputs(zero_power_study):
     rows = list(csv.DictReader((out / "comparison.csv").open()))
     assert {r["quantity"] for r in rows} >= {"bearing_load_mean_N", "roller_cage_rms_N", "life_L10_relative",
                                              "life_iso281_h", "life_iso16281_h"}
-    assert "| bearing | quantity | forward | reverse | reverse − forward | difference % |" in \
+    assert "| bearing | quantity | forward | reverse | reverse − forward | change |" in \
         (out / "comparison.md").read_text()
     for name in ("bars.png", "bearing_load_life.png", "c4_bearing_loads.png", "c4_roller_contacts.png", "c4_cage.png",
                  "c4_mesh.png", "c4_cage_orbit_inner.png", "c4_cage_orbit_outer.png"):
