@@ -6,7 +6,7 @@
 
 Writes DIR/c{condition}_{direction}/{results.nc, summary.json}, DIR/comparison.csv, DIR/comparison.md,
 DIR/bearing_load_life.png (the headline: mean load and L10 life per bearing type, forward vs reverse, the change
-in %), DIR/bars.png, per condition the time histories DIR/c{condition}_{bearing_loads,roller_contacts,cage,mesh}.png
+in % or, from ten times, as a ratio), DIR/bars.png, per condition the time histories DIR/c{condition}_{bearing_loads,roller_contacts,cage,mesh}.png
 and the cage orbits DIR/c{condition}_cage_orbit_{inner,outer}.png, and (with --animate) DIR/c{condition}_cage_orbits.gif.
 """
 from __future__ import annotations
@@ -55,7 +55,7 @@ EXAMPLES = ["{prog} --conditions 3 --out results/study",
             '{prog} --conditions 1,2,3,4 --directions forward,reverse --workers 2 --set bearing.clearance="30 um"',
             "{prog} --params my_machine.toml --animate --out results/mine"]
 WRITES = ("c{condition}_{direction}/{results.nc, summary.json} per run; comparison.csv and comparison.md (every "
-          "quantity forward vs reverse, the change in %); bearing_load_life.png (the headline: mean load and L10 "
+          "quantity forward vs reverse, the change in % or, from ten times, as a ratio); bearing_load_life.png (the headline: mean load and L10 "
           "life per bearing type), bars.png, per condition the time histories c{condition}_{bearing_loads, "
           "roller_contacts, cage, mesh}.png and the cage orbits c{condition}_cage_orbit_{inner,outer}.png; with "
           "--animate c{condition}_cage_orbits.gif")

@@ -21,7 +21,7 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
-from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator
+from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullLocator
 
 from components.results import format_change, percent_change
 
@@ -910,8 +910,9 @@ def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
                 if log:
                     ax.yaxis.set_major_locator(LogLocator(subs=(1.0,)))
                     ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: _value_text(v)))
-                    ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
-                    ax.grid(axis="y", which="minor", visible=False)
+                    # a tick per decade and no minor ones: the values are written on the bars, and each minor tick
+                    # is an artist the layout measures (a third of the figure's time)
+                    ax.yaxis.set_minor_locator(NullLocator())
                 ax.set_xticks(x, [f"{b} planet\nbearing" for b in bearings])
                 ax.set_xlim(-0.6, len(bearings) - 0.4)
                 ax.grid(axis="x", visible=False)
@@ -949,8 +950,10 @@ def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], t
     the panel cannot show sample by sample — fewer than :data:`ENVELOPE_MIN_SAMPLES` samples per period (they alias
     it) or more than :data:`ENVELOPE_MAX_PERIODS` periods in the window (solid ink at a panel's width): such a
     series is drawn over its whole periods from its first sample (:func:`period_envelope`) as the band of each
-    period's samples, minimum to maximum, and the line of each period's mean at its centre; the partial period at
-    the end is left out, and the legend and a note say so (``envelope_words`` names the period)."""
+    period's samples, minimum to maximum, and the line of the running mean over the m whole periods after which the
+    samples fall at the same phases again (:func:`sampling_repeat`; one point per period at the centre of its m, so
+    that the line spans only whole windows and carries no ripple of the sampling); the partial period at the end is
+    left out, and the legend and a note heading it say so (``envelope_words`` names the period)."""
     if not rows:
         raise ValueError("rows is empty")
     columns = list(columns)
@@ -1024,7 +1027,7 @@ def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], t
             ms = sorted({e[2] for e in enveloped})
             why = ([f"{few:.1f} samples per {envelope_words}: too few to draw its waveform (they alias it)"]
                    if few < ENVELOPE_MIN_SAMPLES else []) + \
-                  ([f"{many:.0f} {envelope_words}s in the window: too many to draw one by one"]
+                  ([f"{many:.0f} {envelope_words}s in the time shown: too many to draw one by one"]
                    if many > ENVELOPE_MAX_PERIODS else [])
             over = f"{ms[0]} {envelope_words}s" if ms[0] > 1 else f"one {envelope_words}"
             if len(ms) > 1:

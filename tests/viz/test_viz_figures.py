@@ -555,7 +555,7 @@ def test_a_history_of_many_periods_is_drawn_as_its_envelope_and_a_ramp_reads_as_
     np.testing.assert_allclose(xm, centres * 1e3, rtol=1e-12)       # one point per whole period, none past them
     np.testing.assert_allclose(ym * 1e3, 3000.0 + 4e4 * centres, rtol=1e-6)
     note = fig.legends[0].get_title().get_text()
-    assert "120 mesh cycles in the window: too many to draw one by one" in note and "samples per" not in note
+    assert "120 mesh cycles in the time shown: too many to draw one by one" in note and "samples per" not in note
     assert "line: mean over one mesh cycle" in _legend_labels(fig)
 
 
