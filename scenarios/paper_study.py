@@ -375,8 +375,8 @@ def point_figures(results: dict, out: Path, c, figures=None) -> list[Path]:
         if figures is not None and g not in figures:
             continue
         titles = {"inner": "inner planet bearing", "outer": "outer planet bearing", **MESH_COLUMNS}
-        # forward and reverse in rows of their own; the mesh histories, sampled a few times per mesh cycle, as
-        # their envelope over a mesh period
+        # forward and reverse in rows of their own; the mesh histories, too coarsely sampled or too long to draw
+        # cycle by cycle, per whole mesh cycle (viz.plots.time_history_group's envelope)
         paths.append(vp.time_history_group(rows, out / f"{point_tag(c)}_{g}.png", columns=cols,
                                            column_titles=titles, title=f"{_title(c)}: {HISTORY_GROUPS[g]}",
                                            separate_runs=True, envelope=mesh_period if g == "mesh" else None,
