@@ -6,7 +6,7 @@
 
 Writes DIR/c{condition}_{direction}/{results.nc, summary.json}, DIR/comparison.csv, DIR/comparison.md,
 DIR/bearing_load_life.png (the headline: mean load and L10 life per bearing type, forward vs reverse, the change
-in %), DIR/bars.png, per condition the time histories DIR/c{condition}_{bearing_loads,roller_contacts,cage,mesh}.png
+in % or, from ten times, as a ratio), DIR/bars.png, per condition the time histories DIR/c{condition}_{bearing_loads,roller_contacts,cage,mesh}.png
 and the cage orbits DIR/c{condition}_cage_orbit_{inner,outer}.png, and (with --animate) DIR/c{condition}_cage_orbits.gif.
 """
 from __future__ import annotations
@@ -26,7 +26,7 @@ from components.families import MESH_FAMILY
 from components.static import DEFAULT_SNAPSHOTS, STATIC_LIVES_NOTE
 from components.outputs import FAMILY, radial_tangential
 from components.outputs import relative_life as iso_relative_life
-from components.results import SUMMARY_WORDS, Summary, open_run, percent_change
+from components.results import SUMMARY_WORDS, Summary, format_change, open_run, percent_change
 from components.results.io import atomic_write_text, write_summary
 
 from .core.integrity import read_summary
@@ -55,7 +55,7 @@ EXAMPLES = ["{prog} --conditions 3 --out results/study",
             '{prog} --conditions 1,2,3,4 --directions forward,reverse --workers 2 --set bearing.clearance="30 um"',
             "{prog} --params my_machine.toml --animate --out results/mine"]
 WRITES = ("c{condition}_{direction}/{results.nc, summary.json} per run; comparison.csv and comparison.md (every "
-          "quantity forward vs reverse, the change in %); bearing_load_life.png (the headline: mean load and L10 "
+          "quantity forward vs reverse, the change in % or, from ten times, as a ratio); bearing_load_life.png (the headline: mean load and L10 "
           "life per bearing type), bars.png, per condition the time histories c{condition}_{bearing_loads, "
           "roller_contacts, cage, mesh}.png and the cage orbits c{condition}_cage_orbit_{inner,outer}.png; with "
           "--animate c{condition}_cage_orbits.gif")
@@ -181,6 +181,9 @@ def _fmt(x, nd=4):
 
 
 def write_tables(rows: list[dict], out: Path, machine: dict | None = None) -> tuple[Path, Path, str]:
+    """comparison.csv (every row, the change as a number: ``difference_pct``) and comparison.md (per point, the change
+    written as the headline writes it, :func:`components.results.format_change`); returns their paths and the
+    markdown."""
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=list(rows[0]) if rows else ["condition"])
     w.writeheader()
@@ -188,11 +191,12 @@ def write_tables(rows: list[dict], out: Path, machine: dict | None = None) -> tu
     atomic_write_text(out / "comparison.csv", buf.getvalue())
     md = []
     for c in sorted({r["condition"] for r in rows}, key=point_order):
-        md.append(f"\n### {_title(c)}\n\n| bearing | quantity | forward | reverse | reverse − forward | difference % "
+        md.append(f"\n### {_title(c)}\n\n| bearing | quantity | forward | reverse | reverse − forward | change "
                   f"|\n|---|---|---|---|---|---|")
         for r in rows:
             if r["condition"] == c:
-                pct = _fmt(r["difference_pct"], 3) if r["difference_pct"] is not None or r["difference"] is None \
+                pct = format_change(r["difference_pct"]) if r["difference_pct"] is not None \
+                    else "–" if r["difference"] is None \
                     else "– (sign changes)" if (r["forward"] or 0) * (r["reverse"] or 0) < 0 else "–"
                 md.append(f"| {r['bearing']} | {r['description']} [{r['unit']}] | {_fmt(r['forward'])} | "
                           f"{_fmt(r['reverse'])} | {_fmt(r['difference'])} | {pct} |")
@@ -226,7 +230,8 @@ def meaningless(results: dict) -> str:
 
 def headline_table(rows: list[dict]) -> str:
     """The study's answer in a few lines (what the headline figure shows): per condition and bearing type the mean
-    bearing load and both L10 lives, forward / reverse and the change, from the comparison's rows."""
+    bearing load and both L10 lives, forward / reverse and the change as the figure writes it
+    (:func:`components.results.format_change`: '−99.6 %', '×665'), from the comparison's rows."""
     at = {(r["condition"], r["bearing"], r["quantity"]): r for r in rows}
     num = lambda x, k: "–" if x is None else f"{x * k:.3g}"
     head = "".join(f" | {w} fwd / rev [{u}] (change)" for _, w, _, u in HEADLINE)
@@ -240,7 +245,7 @@ def headline_table(rows: list[dict]) -> str:
                 cells.append("–")
                 continue
             d = r["difference_pct"]
-            cells.append(f"{num(r['forward'], k)} / {num(r['reverse'], k)}" + ("" if d is None else f" ({d:+.1f} %)"))
+            cells.append(f"{num(r['forward'], k)} / {num(r['reverse'], k)}" + ("" if d is None else f" ({format_change(d)})"))
         lines.append(f"| {c} | {b} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
@@ -370,8 +375,8 @@ def point_figures(results: dict, out: Path, c, figures=None) -> list[Path]:
         if figures is not None and g not in figures:
             continue
         titles = {"inner": "inner planet bearing", "outer": "outer planet bearing", **MESH_COLUMNS}
-        # forward and reverse in rows of their own; the mesh histories, sampled a few times per mesh cycle, as
-        # their envelope over a mesh period
+        # forward and reverse in rows of their own; the mesh histories, too coarsely sampled or too long to draw
+        # cycle by cycle, per whole mesh cycle (viz.plots.time_history_group's envelope)
         paths.append(vp.time_history_group(rows, out / f"{point_tag(c)}_{g}.png", columns=cols,
                                            column_titles=titles, title=f"{_title(c)}: {HISTORY_GROUPS[g]}",
                                            separate_runs=True, envelope=mesh_period if g == "mesh" else None,

@@ -316,7 +316,9 @@ def _plot(f, spectra, f_m, f_c, s, sensor, out, place="housing_top"):
     where = "carrier acceleration (fixed frame)" if sensor == "axis" else (
         "accelerometer on the carrier bearing's boss" if place == "carrier_bearing" else "housing accelerometer")
     zero = [k for k in shown if not np.any(spectra[k][1])]      # a log axis cannot draw them: said in the title
-    title = f"{where.capitalize()}, carrier {s['carrier_rpm']:.0f} r/min, sun {abs(s['sun_rpm']):.1f} r/min" + (
+    # the speeds with their signs (the sun turns against the carrier, ω_s/ω_c = 1 − z_r/z_s < 0), a true minus
+    speed = lambda rpm, nd: f"{rpm:.{nd}f}".replace("-", "\u2212") + " r/min"
+    title = f"{where.capitalize()}, carrier {speed(s['carrier_rpm'], 0)}, sun {speed(s['sun_rpm'], 1)}" + (
         f"\n({', '.join(names[k] for k in zero)} zero for this sensor, not drawn)" if zero else "")
     return vp.spectrum(f, {names[k]: spectra[k][1] for k in shown if k not in zero}, marks, out / "spectrum.png",
                        fmax=min(f[-1], 2.5 * f_m), quantity=where, unit="m/s²", logy=True, title=title,

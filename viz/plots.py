@@ -21,16 +21,17 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
-from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator
+from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullLocator
 
-from components.results import percent_change
+from components.results import format_change, percent_change
 
 __all__ = ["time_histories", "bar_chart", "spectrum", "work_precision", "load_distribution", "against_viscosity",
            "mode_shapes", "fault_spectra", "fault_loads", "FAULT_QUANTITIES", "gear_quality", "forward_reverse_headline",
            "time_history_group", "cage_orbit_picture", "display_unit", "format_pct", "HEADLINE_QUANTITIES", "FWD", "REV",
            "STYLE", "tolerance_distributions", "tolerance_against_torque", "tolerance_life_cdf", "damage_shares",
            "binned_series", "morris_heatmap", "sobol_heatmap", "life_against_misalignment",
-           "slice_pressure_profiles", "slip_transients"]
+           "slice_pressure_profiles", "slip_transients", "period_envelope", "sampling_repeat", "ENVELOPE_MIN_SAMPLES",
+           "ENVELOPE_MAX_PERIODS"]
 
 # One style for every figure, applied with rc_context so the caller's rcParams stay untouched.
 STYLE = {
@@ -823,9 +824,9 @@ def _pct(fwd, rev) -> float | None:
 
 
 def format_pct(p: float) -> str:
-    """'+40 %', '−24 %', '+3.2 %' (one decimal below 10 %; a true minus sign)."""
-    s = f"{p:+.1f}" if abs(p) < 9.95 else f"{p:+.0f}"
-    return s.replace("-", "\u2212") + " %"
+    """The change ``p`` [%] as every figure and table writes it: '+40 %', '−24 %', '+3.2 %', '−99.6 %', '×665'
+    (the rule: :func:`components.results.format_change`)."""
+    return format_change(p)
 
 
 def _direction_legend(fig: Figure, present: Sequence[str], *, hatch: bool = False) -> None:
@@ -845,14 +846,23 @@ HEADLINE_QUANTITIES = (("bearing_load_mean_N", "mean bearing load", "N"),
                        ("life_iso16281_h", "L10 life, from the roller loads", "h"))
 
 
+LOG_UNITS = ("h",)       # quantities on a log axis in the headline: lives, which span decades between bearings
+_FILL = 0.72             # the tallest bar's top, as a share of its panel's height: room for its label and the change
+
+
 def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
                              quantities: Sequence[tuple] = HEADLINE_QUANTITIES, bearings: Sequence[str] = ("inner", "outer"),
                              title: str | None = None) -> Path:
     """The study's headline: per condition (a row) and quantity (a column), each bearing type's forward and
-    reverse bar with the change of reverse against forward written above the pair.
+    reverse bar with its value, and the change of reverse against forward written at the top of the panel above the
+    pair (:func:`format_pct`: '−99.6 %', '×665').
 
     values: (quantity key, condition, bearing, direction) -> value in SI units (None or absent: no such run).
-    quantities: (key, words, SI unit). Bars start at zero; forces are shown in kN from 1 kN on."""
+    quantities: (key, words, SI unit). Lives (a unit of :data:`LOG_UNITS`) are drawn on a log axis, as bearing
+    engineers read them: 35 h beside 60 000 h stays a bar, the axis holding the shortest and the longest life with
+    at least 0.3 decades below the shortest; other quantities on a linear axis from zero, forces in kN from 1 kN on.
+    Each value is written over its bar with three significant digits (no powers of ten), the forward value ending
+    and the reverse value starting at the pair's centre, so that the two never overlap whatever their heights."""
     conds = sorted({k[1] for k in values}, key=lambda c: (isinstance(c, str), c))   # conditions 1-4, then points
     if not conds:
         raise ValueError("values is empty")
@@ -867,23 +877,42 @@ def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
             for q_i, (key, words, unit) in enumerate(quantities):
                 ax = axes[c_i, q_i]
                 scale, shown = display_unit(unit, [v for k, v in values.items() if k[0] == key and v is not None])
-                top = 0.0
+                ys = {d: np.array([np.nan if values.get((key, c, b, d)) is None else float(values[(key, c, b, d)])
+                                   for b in bearings]) * scale for d in ("forward", "reverse")}
+                drawn = np.concatenate(list(ys.values()))
+                drawn = drawn[np.isfinite(drawn)]
+                log = unit in LOG_UNITS and drawn.size > 0 and bool(np.all(drawn > 0))
+                top = float(drawn.max()) if drawn.size else 0.0
+                if log:
+                    ax.set_yscale("log")
+                    base = 10.0 ** np.floor(np.log10(float(drawn.min())) - 0.3)
+                    ax.set_ylim(base, base * (top / base) ** (1.0 / _FILL))
+                else:
+                    base = 0.0
+                    ax.set_ylim(min(0.0, float(drawn.min()) / _FILL) if drawn.size else 0.0,
+                                top / _FILL if top > 0 else 1.0)
                 for k, (d, st) in enumerate((("forward", FWD), ("reverse", REV))):
-                    y = np.array([np.nan if values.get((key, c, b, d)) is None else float(values[(key, c, b, d)])
-                                  for b in bearings]) * scale
+                    y = ys[d]
                     if np.all(np.isnan(y)):
                         continue
-                    bars = ax.bar(x + (k - 0.5) * w, y, w, color=st["color"], label=d,
-                                  hatch="//" if d == "reverse" else None, edgecolor="white", linewidth=0)
-                    ax.bar_label(bars, labels=["" if np.isnan(v) else f"{v:.3g}" for v in y], fontsize=7,
-                                 padding=1.5)
-                    top = max(top, float(np.nanmax(y)))
+                    ax.bar(x + (k - 0.5) * w, y - base, w, bottom=base, color=st["color"], label=d,
+                           hatch="//" if d == "reverse" else None, edgecolor="white", linewidth=0)
+                    for i, v in enumerate(y):
+                        if np.isfinite(v):
+                            ax.annotate(_value_text(v), (x[i], v), xytext=(-1.5 if k == 0 else 1.5, 1.5),
+                                        textcoords="offset points", ha="right" if k == 0 else "left", va="bottom",
+                                        fontsize=7, gid="value_label")
                 for i, b in enumerate(bearings):
                     p = _pct(values.get((key, c, b, "forward")), values.get((key, c, b, "reverse")))
                     if p is not None:
-                        ax.text(x[i], 1.16 * top, format_pct(p), ha="center", va="bottom", fontsize=8.5,
-                                fontweight="bold", color="#333333", gid="pct_change")
-                ax.set_ylim(0.0, 1.38 * top if top > 0 else 1.0)
+                        ax.text(x[i], 0.97, format_pct(p), transform=ax.get_xaxis_transform(), ha="center",
+                                va="top", fontsize=8.5, fontweight="bold", color="#333333", gid="pct_change")
+                if log:
+                    ax.yaxis.set_major_locator(LogLocator(subs=(1.0,)))
+                    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: _value_text(v)))
+                    # a tick per decade and no minor ones: the values are written on the bars, and each minor tick
+                    # is an artist the layout measures (a third of the figure's time)
+                    ax.yaxis.set_minor_locator(NullLocator())
                 ax.set_xticks(x, [f"{b} planet\nbearing" for b in bearings])
                 ax.set_xlim(-0.6, len(bearings) - 0.4)
                 ax.grid(axis="x", visible=False)
@@ -896,6 +925,18 @@ def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
         return _save(fig, path)
 
 
+def _value_text(v: float) -> str:
+    """A value as a bar's label or a log axis' tick: three significant digits without a power of ten, thousands
+    grouped by a narrow space ('35.3', '1 860', '50 700', '0.978')."""
+    v = float(v)
+    if v == 0.0 or not np.isfinite(v):
+        return f"{v:g}"
+    mag = int(np.floor(np.log10(abs(v))))
+    if mag < 3:
+        return f"{v:.3g}"
+    return f"{round(v, 2 - mag):,.0f}".replace(",", "\u202f")
+
+
 def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], title: str | None = None,
                        column_titles: Mapping[str, str] | None = None, separate_runs: bool = False,
                        envelope: float | None = None, envelope_words: str = "period") -> Path:
@@ -905,10 +946,14 @@ def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], t
     rows: (words, SI unit, {column: {run: (t [s], y [SI])}}); a run named "forward"/"reverse" gets the
     study's styles, any other name the next colour. Forces are shown in kN from 1 kN on.
     ``separate_runs``: each quantity gets a row per run (forward above reverse), the rows of a quantity on one y
-    scale, so that two runs never lie over each other. ``envelope``: a period [s] (the mesh period) that the
-    samples resolve poorly: a series with fewer than :data:`ENVELOPE_MIN_SAMPLES` samples per period is drawn as the
-    band between the running minimum and maximum of its samples over one period with their running mean over it
-    (scipy.ndimage's filters), and the figure says so (``envelope_words`` names the period)."""
+    scale, so that two runs never lie over each other. ``envelope``: a period [s] (the mesh period) whose waveform
+    the panel cannot show sample by sample — fewer than :data:`ENVELOPE_MIN_SAMPLES` samples per period (they alias
+    it) or more than :data:`ENVELOPE_MAX_PERIODS` periods in the window (solid ink at a panel's width): such a
+    series is drawn over its whole periods from its first sample (:func:`period_envelope`) as the band of each
+    period's samples, minimum to maximum, and the line of the running mean over the m whole periods after which the
+    samples fall at the same phases again (:func:`sampling_repeat`; one point per period at the centre of its m, so
+    that the line spans only whole windows and carries no ripple of the sampling); the partial period at the end is
+    left out, and the legend and a note heading it say so (``envelope_words`` names the period)."""
     if not rows:
         raise ValueError("rows is empty")
     columns = list(columns)
@@ -944,13 +989,18 @@ def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], t
                     t = np.asarray(t, float)
                     y = np.asarray(y, float) * scale
                     per = envelope / float(np.median(np.diff(t))) if envelope and t.size > 2 else None
-                    if per is not None and per < ENVELOPE_MIN_SAMPLES:
-                        from scipy.ndimage import maximum_filter1d, minimum_filter1d, uniform_filter1d  # deferred: scipy only for an envelope
-                        k = max(2, int(round(per)))
-                        ax.fill_between(t * tscale, minimum_filter1d(y, k), maximum_filter1d(y, k),
-                                        color=st["color"], alpha=0.25, lw=0)
-                        (ln,) = ax.plot(t * tscale, uniform_filter1d(y, k), lw=1.0, **st)
-                        enveloped.append(per)
+                    many = (t[-1] - t[0]) / envelope if per is not None else 0.0
+                    edges = None
+                    if per is not None and (per < ENVELOPE_MIN_SAMPLES or many > ENVELOPE_MAX_PERIODS):
+                        edges, lo, hi, mean = period_envelope(t, y, envelope)
+                    m = sampling_repeat(per) if per is not None else 1
+                    if edges is not None and edges.size > m:
+                        ax.fill_between(edges * tscale, np.append(lo, lo[-1]), np.append(hi, hi[-1]), step="post",
+                                        color=st["color"], alpha=0.25, lw=0, gid="period_range")
+                        # the mean over m whole periods, one point per period, only where all m are in the window
+                        (ln,) = ax.plot(0.5 * (edges[:-m] + edges[m:]) * tscale, np.convolve(mean, np.ones(m) / m, "valid"),
+                                        lw=1.0, gid="period_mean", **st)
+                        enveloped.append((per, many, m))
                     else:
                         # many samples: thinner lines, so that two overlaid runs stay apart
                         lw = 1.2 if t.size < 200 else 0.9 if t.size < 1000 else 0.6
@@ -971,36 +1021,117 @@ def time_history_group(rows: Sequence[tuple], path, *, columns: Sequence[str], t
                 hi = max(ax.get_ylim()[1] for ax in group)
                 for ax in group:
                     ax.set_ylim(lo, hi)
+        note = None
+        if enveloped:
+            few, many = min(e[0] for e in enveloped), max(e[1] for e in enveloped)
+            ms = sorted({e[2] for e in enveloped})
+            why = ([f"{few:.1f} samples per {envelope_words}: too few to draw its waveform (they alias it)"]
+                   if few < ENVELOPE_MIN_SAMPLES else []) + \
+                  ([f"{many:.0f} {envelope_words}s in the time shown: too many to draw one by one"]
+                   if many > ENVELOPE_MAX_PERIODS else [])
+            over = f"{ms[0]} {envelope_words}s" if ms[0] > 1 else f"one {envelope_words}"
+            if len(ms) > 1:
+                over = f"{'–'.join(map(str, (ms[0], ms[-1])))} {envelope_words}s"
+            note = _wrap("; ".join(why) + f". Shown per whole {envelope_words} from the first sample, the partial last "
+                         f"one left out; the mean over {over}, after which the samples fall at the same points of the "
+                         f"{envelope_words} again (fewer would leave a ripple of the sampling in it); peaks of every "
+                         f"step: summary.json", int(15 * fig.get_figwidth()))
+            mean_words = f"line: mean over {over}"
         if handles:
             order = sorted(handles, key=lambda k: {"forward": 0, "reverse": 1}.get(k, 2))
-            fig.legend([handles[k] for k in order], order, loc="outside lower center", ncols=len(order),
-                       frameon=False)
-        if enveloped:
-            fig.text(0.5, 0.0, f"{min(enveloped):.1f} samples per {envelope_words}: too few to draw its waveform "
-                               f"(they alias it); the bands are the range of the samples over each {envelope_words}, "
-                               f"the lines their mean over it (peaks from every step: summary.json)",
-                     ha="center", va="bottom", fontsize=7, gid="envelope_note", wrap=True)
+            shown_handles, labels = [handles[k] for k in order], list(order)
+            if enveloped:
+                shown_handles += [Patch(color="0.55", alpha=0.4, lw=0), Line2D([], [], color="0.3", lw=1.0)]
+                labels += [f"band: range of the samples in each {envelope_words}", mean_words]
+            legend = fig.legend(shown_handles, labels, loc="outside lower center", ncols=len(labels), frameon=False,
+                                title=note, title_fontsize=7)
+            if note:            # the note heads the legend, where the layout keeps room for it
+                legend.get_title().set_gid("envelope_note")
         if title:
             _suptitle(fig, title)
         return _save(fig, path)
 
 
 ENVELOPE_MIN_SAMPLES = 8     # samples per period below which a history is drawn as its envelope (time_history_group)
+ENVELOPE_MAX_PERIODS = 50    # periods in a window above which a history is drawn as its envelope: at a panel's
+                             # width (~450 px at 150 dpi) a period then gets under 9 px, too few to show its shape
 
 
-def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = None) -> Path:
+def sampling_repeat(samples_per_period: float, most: int = 10, tol: float = 0.01) -> int:
+    """The fewest whole periods m (1 to ``most``) after which a uniform sampling falls at the same points of a
+    period again: m·s within ``tol`` of a whole number of samples, relative to m·s (s = ``samples_per_period``; the
+    m with the smallest such misfit if none is within it). Over m periods the samples' phases fill the period on a
+    grid of m·s points, so a mean over them holds no ripple of the sampling — over one period it does: at 4.36
+    samples per period the phases drift 0.36 of a sample per period and the one-period mean beats with that drift
+    (m = 3: 13.07 samples)."""
+    s = float(samples_per_period)
+    if not s > 0.0:
+        raise ValueError(f"samples_per_period: expected > 0, got {s}")
+    m = np.arange(1, int(most) + 1)
+    misfit = np.abs(m * s - np.round(m * s)) / (m * s)
+    ok = np.flatnonzero(misfit <= tol)
+    return int(m[ok[0]] if ok.size else m[np.argmin(misfit)])
+
+
+def period_envelope(t, y, period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A sampled history over its whole periods: (edges (n+1,), minimum (n,), maximum (n,), mean (n,)).
+
+    The periods run from the first sample, ``t[0] + k·period``; only the n whole ones that end by the last sample
+    count (the partial one at the end is left out, so no statistic mixes a fraction of a period in). Minimum and
+    maximum are those of the samples in [edge_k, edge_k+1) (NaN where a period holds no sample); the mean is the
+    time average over the period of the straight lines between the samples — the exact integral of the piecewise
+    linear interpolant, so that a ramp's mean is its value at the period's centre whatever the sampling, and a
+    period need not hold a whole number of samples."""
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    period = float(period)
+    if t.size < 2 or not period > 0.0:
+        raise ValueError(f"period_envelope: expected two samples or more and a period > 0 s, got {t.size} and {period}")
+    n = int(np.floor((t[-1] - t[0]) / period * (1.0 + 1e-12)))
+    edges = t[0] + period * np.arange(n + 1)
+    if n == 0:
+        return edges, *(np.empty(0),) * 3
+    edges[-1] = min(edges[-1], t[-1])                       # round-off: the last edge is at most the last sample
+    cum = np.concatenate([[0.0], np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(t))])     # ∫ y dt up to each sample
+    k = np.clip(np.searchsorted(t, edges, side="right") - 1, 0, t.size - 2)
+    dt = edges - t[k]
+    slope = (y[k + 1] - y[k]) / (t[k + 1] - t[k])
+    integral = cum[k] + y[k] * dt + 0.5 * slope * dt ** 2  # ∫ y dt up to each edge
+    mean = np.diff(integral) / np.diff(edges)
+    start = np.searchsorted(t, edges, side="left")
+    start[-1] = np.searchsorted(t, edges[-1], side="right")     # the last period holds a sample on its end
+    empty = start[1:] == start[:-1]
+    first = np.minimum(start[:-1], start[-1] - 1)
+    lo = np.minimum.reduceat(y[:start[-1]], first)
+    hi = np.maximum.reduceat(y[:start[-1]], first)
+    lo[empty], hi[empty] = np.nan, np.nan
+    return edges, lo, hi, mean
+
+
+# the axes of a cage orbit (viz.results.view_angle's frames): (the axis labels' words, the title's words)
+ORBIT_FRAMES = {"carrier": ("carrier axes", "axes turning with the carrier, not the planet"),
+                "fixed": ("housing axes", "the housing's fixed axes")}
+
+
+def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = None, frame: str = "carrier") -> Path:
     """Static cage orbits, one column per run side by side: the guide clearance circle, the cage centre's trail
     coloured by time (one colour bar, in ms), its start and end, the bore centre; the top row shows the whole
     clearance on one scale in µm for all runs, the bottom row zooms onto each trail (one span for all, so the
     orbits' sizes compare).
 
     panels: (label, t [s] (n,), offset of the cage centre from the bore centre [m] (n, 2), guide clearance
-    C_g [m]) — the offset as :func:`viz.results.cage_orbits` gives it (carrier axes). A cage pressed into its
+    C_g [m]) — the offset as :func:`viz.results.cage_orbits` gives it. ``frame``: the axes the offsets are in, a key
+    of :data:`ORBIT_FRAMES` ("carrier", :func:`viz.results.cage_orbits`' default, or "fixed"), named in the axis
+    labels and in a line of the title: the picture is of the cage centre relative to the planet's (the bore's)
+    centre, and the axes do not turn with the planet. A cage pressed into its
     land sits beyond the circle by the land contact's deflection: that band, from the circle to the farthest the
     trail reaches, is shaded and named in the legend with its depth."""
 
     if not panels:
         raise ValueError("panels is empty")
+    if frame not in ORBIT_FRAMES:
+        raise ValueError(f"frame: expected one of {list(ORBIT_FRAMES)}, got {frame!r}")
+    axes_words, frame_words = ORBIT_FRAMES[frame]
     t_all = np.concatenate([np.asarray(p[1], float) for p in panels])
     tscale, tunit = display_unit("s", t_all)
     norm = Normalize(float(np.min(t_all)) * tscale, float(np.max(t_all)) * tscale)
@@ -1049,23 +1180,23 @@ def cage_orbit_picture(panels: Sequence[tuple], path, *, title: str | None = Non
                     ax.set_ylim(mid[1] - half, mid[1] + half)
                     ax.set_title(f"{label}: zoom on the trail", fontsize=8.5)
                 ax.set_aspect("equal")
-                ax.set_xlabel(_axis_label("cage centre offset x", "µm"))
+                ax.set_xlabel(_axis_label(f"cage centre offset x, {axes_words}", "µm"))
                 if k == 0:
-                    ax.set_ylabel(_axis_label("cage centre offset y", "µm"))
+                    ax.set_ylabel(_axis_label(f"cage centre offset y, {axes_words}", "µm"))
         cb = fig.colorbar(lc, ax=axes.ravel().tolist(), shrink=0.6, pad=0.02)
         cb.set_label(_axis_label("time", tunit))
         handles = [Line2D([], [], color="0.45", lw=1.4, ls="--", label="guide clearance circle"),
                    Line2D([], [], color=cmap(0.6), lw=1.3, label="cage centre (colour: time)"),
                    Line2D([], [], marker="o", mfc="white", mec="k", ls="none", label="start"),
                    Line2D([], [], marker="s", color="#d50000", ls="none", label="end"),
-                   Line2D([], [], marker="+", color="0.35", mew=1.2, ls="none", label="bore centre"),
+                   Line2D([], [], marker="+", color="0.35", mew=1.2, ls="none", label="planet (bore) centre"),
                    Line2D([], [], color="k", lw=0.7, label="zoomed area")]
         if beyond > 0:
             handles.append(Patch(color="#f2c14e", alpha=0.35, label=f"beyond the circle: the land contact's "
                                                                    f"deflection (up to {beyond:.3g} µm)"))
         fig.legend(handles=handles, loc="outside lower center", ncols=3, frameon=False, fontsize=7.5)
-        if title:
-            _suptitle(fig, title)
+        where = f"cage centre relative to the planet centre; {frame_words}"
+        _suptitle(fig, f"{title}\n{where}" if title else where)
         return _save(fig, path)
 
 

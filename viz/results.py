@@ -565,18 +565,19 @@ def study_cage_animation(run_fwd_path, run_rev_path, out_path, *, pair: int = 0,
 
 
 def study_cage_pictures(runs: Mapping[str, object], out_dir, *, pair: int = 0, prefix: str = "",
-                        title: str | None = None) -> list[Path]:
+                        title: str | None = None, frame: str = "carrier") -> list[Path]:
     """Static cage-orbit pictures of a study, one PNG per bearing type (``{prefix}cage_orbit_{inner,outer}.png``
     in ``out_dir``): a panel per run (label -> results file, run directory or :class:`Run`, e.g. forward and
     reverse) with the guide clearance circle and the cage centre's trail coloured by time
-    (:func:`viz.plots.cage_orbit_picture`). Runs without a cage are left out; no runs with one: no picture."""
+    (:func:`viz.plots.cage_orbit_picture`), the offsets in ``frame``'s axes (:func:`cage_orbits`), which the picture
+    names. Runs without a cage are left out; no runs with one: no picture."""
     loaded = {label: _as_run(r) for label, r in runs.items()}
     paths = []
     for kind in ("inner", "outer"):
         panels = []
         for label, run in loaded.items():
             try:
-                e = cage_orbits(run, pair)[kind]
+                e = cage_orbits(run, pair, frame)[kind]
             except ResultsError:              # bearings without a cage: nothing to draw
                 continue
             panels.append((label, run.t, e, float(run.geometry["bearing"]["guide_clearance"])))
@@ -584,5 +585,6 @@ def study_cage_pictures(runs: Mapping[str, object], out_dir, *, pair: int = 0, p
             continue
         rpm = _rpm(next(iter(loaded.values())))
         head = (title + "\n" if title else "") + f"{kind} planet bearing, planet pair {pair + 1}" + (f", carrier {rpm}" if rpm else "")
-        paths.append(cage_orbit_picture(panels, Path(out_dir) / f"{prefix}cage_orbit_{kind}.png", title=head))
+        paths.append(cage_orbit_picture(panels, Path(out_dir) / f"{prefix}cage_orbit_{kind}.png", title=head,
+                                        frame=frame))
     return paths

@@ -15,9 +15,9 @@ engine, enters here.
 from .reader import (RESULTS_NAME, SUMMARY_NAME, DamagedResults, Results, ResultsError, RunFiles, count_samples,
                      json_attr, load_summary, open_dataset, open_run, read_results, results_path)
 from .summary import (BEARING_KINDS, DIMENSIONLESS_KEYS, SUMMARY_WORDS, UNIT_SUFFIXES, Quantity, Section, Summary,
-                      describe_key, percent_change, unit_of_key)
+                      describe_key, format_change, percent_change, unit_of_key)
 
 __all__ = ["RESULTS_NAME", "SUMMARY_NAME", "DamagedResults", "Results", "ResultsError", "RunFiles", "count_samples",
            "json_attr", "load_summary", "open_dataset", "open_run", "read_results", "results_path", "BEARING_KINDS", "DIMENSIONLESS_KEYS",
-           "SUMMARY_WORDS", "UNIT_SUFFIXES", "Quantity", "Section", "Summary", "describe_key", "percent_change",
-           "unit_of_key"]
+           "SUMMARY_WORDS", "UNIT_SUFFIXES", "Quantity", "Section", "Summary", "describe_key", "format_change",
+           "percent_change", "unit_of_key"]

@@ -285,3 +285,29 @@ def percent_change(before, after) -> float | None:
     if not (np.isfinite(before) and np.isfinite(after)) or before == 0.0 or before * after < 0.0:
         return None
     return (after - before) / before * 100.0
+
+
+RATIO_FROM = 10.0       # a change to ten times the value or more is written as the ratio (format_change)
+
+
+def format_change(pct: float) -> str:
+    """A change in % (:func:`percent_change`) as a reader reads it, the one rule of every table and figure:
+
+    * up to ten times the value: in %, one decimal below 10 %, whole percents above ('+3.2 %', '−24 %', '+598 %'),
+      a true minus sign;
+    * ten times the value or more (+900 % and beyond, :data:`RATIO_FROM`): the ratio after/before with three
+      significant digits ('×665', '×12.3'; whole numbers from ×1000) — '+66434 %' reads as nothing in particular;
+    * a fall to a tenth or less (−90 % and beyond): in % with the decimals that keep one significant digit of what
+      is left, 100 % + pct ('−99.6 %' where 0.4 % is left, '−99.96 %' where 0.04 % is); only a fall to zero reads
+      '−100 %'."""
+    pct = float(pct)
+    if not np.isfinite(pct):
+        raise ValueError(f"pct: expected a finite change in %, got {pct}")
+    ratio = 1.0 + pct / 100.0
+    if ratio >= RATIO_FROM:
+        return "\u00d7" + (f"{ratio:.3g}" if ratio < 1000.0 else f"{ratio:.0f}")
+    decimals = 1 if abs(pct) < 9.95 else 0
+    left = 100.0 + pct                       # what a fall leaves, in % of the value before
+    if 0.0 < left < 10.0:
+        decimals = max(decimals, -int(np.floor(np.log10(left))))
+    return f"{pct:+.{decimals}f}".replace("-", "\u2212") + " %"

@@ -81,3 +81,25 @@ def test_the_reader_opens_a_results_file_lazily(tmp_path):
         assert np.array_equal(ds["a.load"].values[:, 1], 2 * t)
         from components.results import json_attr
         assert json_attr(ds.attrs, "meta") == {"direction": "forward"}
+
+
+@pytest.mark.parametrize("before, after, text", [
+    (100.0, 140.0, "+40 %"), (100.0, 75.6, "−24 %"), (100.0, 103.21, "+3.2 %"), (100.0, 698.0, "+598 %"),
+    (120000.0, 447.0, "−99.6 %"),         # 0.37 % left: one decimal keeps its one digit
+    (487000.0, 1420.0, "−99.7 %"),
+    (10000.0, 4.0, "−99.96 %"),           # 0.04 % left
+    (100.0, 2.4, "−98 %"),                # 2.4 % left: whole percents keep its digit
+    (100.0, 0.0, "−100 %"),               # nothing left
+    (461.0, 306600.0, "\u00d7665"),       # +66 408 %: the ratio
+    (100.0, 999.0, "+899 %"), (100.0, 1000.0, "\u00d710"), (100.0, 1234.0, "\u00d712.3"),
+    (1.0, 12345.0, "\u00d712345")])
+def test_a_change_is_written_with_the_digits_it_needs_and_as_a_ratio_from_ten_times(before, after, text):
+    """The one rule of every table and figure (format_change): the truths from the pairs of values by hand."""
+    from components.results import format_change, percent_change
+    assert format_change(percent_change(before, after)) == text
+
+
+def test_a_change_that_is_not_a_number_is_refused():
+    from components.results import format_change
+    with pytest.raises(ValueError, match="pct: expected a finite change"):
+        format_change(float("nan"))

@@ -55,7 +55,7 @@ def test_study_writes_documented_outputs(zero_power_study):
     rows = list(csv.DictReader((out / "comparison.csv").open()))
     assert {r["quantity"] for r in rows} >= {"bearing_load_mean_N", "roller_cage_rms_N", "life_L10_relative",
                                              "life_iso281_h", "life_iso16281_h"}
-    assert "| bearing | quantity | forward | reverse | reverse − forward | difference % |" in \
+    assert "| bearing | quantity | forward | reverse | reverse − forward | change |" in \
         (out / "comparison.md").read_text()
     for name in ("bars.png", "bearing_load_life.png", "c4_bearing_loads.png", "c4_roller_contacts.png", "c4_cage.png",
                  "c4_mesh.png", "c4_cage_orbit_inner.png", "c4_cage_orbit_outer.png"):
@@ -473,3 +473,34 @@ def test_spectrum_params_file_is_a_users_machine_and_its_conflicts_are_refused(t
         with pytest.raises(SystemExit) as exc:
             spectrum.machine(spectrum.parse_args([*argv, "--out", str(tmp_path / "o")]))
         assert words in str(exc.value) and "\n" not in str(exc.value), str(exc.value)
+
+
+def test_headline_table_writes_each_change_as_the_figure_does():
+    """The headline table's change is the figure's (components.results.format_change): a deep fall with the digits
+    it needs (120 000 → 447 h: −99.6 %, not −100 %), a tenfold rise as the ratio (461 → 306 600 h: ×665, not
+    +66 408 %), a change of sign none; from rows built by hand."""
+    from components.results import percent_change
+    pairs = {("inner", "bearing_load_mean_N"): (6851.0, 973.9), ("inner", "life_iso281_h"): (461.0, 306600.0),
+             ("inner", "life_iso16281_h"): (1459.0, -1.0),
+             ("outer", "bearing_load_mean_N"): (5290.0, 6350.0), ("outer", "life_iso281_h"): (120000.0, 447.0),
+             ("outer", "life_iso16281_h"): (3530.0, 1860.0)}
+    rows = [{"condition": "cruise", "bearing": b, "quantity": q, "forward": f, "reverse": r,
+             "difference_pct": percent_change(f, r)} for (b, q), (f, r) in pairs.items()]
+    lines = paper_study.headline_table(rows).splitlines()
+    inner = next(x for x in lines if x.startswith("| cruise | inner |"))
+    outer = next(x for x in lines if x.startswith("| cruise | outer |"))
+    assert inner == "| cruise | inner | 6.85 / 0.974 (\u221286 %) | 461 / 3.07e+05 (\u00d7665) | 1.46e+03 / -1 |"
+    assert outer == "| cruise | outer | 5.29 / 6.35 (+20 %) | 1.2e+05 / 447 (\u221299.6 %) | 3.53e+03 / 1.86e+03 (\u221247 %) |"
+
+
+def test_the_spectrum_title_gives_the_speeds_with_their_signs(tmp_path, monkeypatch):
+    """Ring fixed, the sun turns against the carrier: at 2000 r/min, −3290.3 r/min (ω_s/ω_c = 1 − z_r/z_s =
+    1 − 82/31); the title keeps the sign (a true minus)."""
+    from viz import plots as vp
+    seen = {}
+    monkeypatch.setattr(vp, "spectrum", lambda *a, **k: seen.update(k))
+    f = np.linspace(0.0, 7000.0, 701)
+    spectra = {k: (f, 1.0 + 0 * f, 10.0) for k in ("housing", *spectrum.SENSOR_PATHS)}
+    sun = 2000.0 * (1 - 82 / 31)
+    spectrum._plot(f, spectra, 2733.3, 33.33, {"carrier_rpm": 2000.0, "sun_rpm": sun}, "housing", tmp_path)
+    assert seen["title"].startswith("Housing accelerometer, carrier 2000 r/min, sun \u22123290.3 r/min")

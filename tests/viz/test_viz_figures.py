@@ -87,10 +87,18 @@ def test_headline_writes_the_change_of_every_pair(tmp_path, captured):
     fig = captured[-1]
     axes = fig.axes
     assert len(axes) == 2 * 2                            # conditions 1 and 3 × two quantities
-    for ax in axes:
-        assert UNIT.search(ax.get_ylabel()), ax.get_ylabel()
-        lo, hi = ax.get_ylim()
-        assert lo <= 0.0 < hi                            # bars start at zero
+    for row, c in enumerate((1, 3)):
+        for col, (key, _, _) in enumerate(QUANT):
+            ax = axes[row * 2 + col]
+            assert UNIT.search(ax.get_ylabel()), ax.get_ylabel()
+            lo, hi = ax.get_ylim()
+            if key == "bearing_load_mean_N":
+                assert ax.get_yscale() == "linear" and lo <= 0.0 < hi        # loads: bars from zero
+            else:                                        # lives: a log axis holding the shortest and the longest
+                lives = [v for k, v in values.items() if k[:2] == (key, c) and v is not None]
+                assert ax.get_yscale() == "log" and 0 < lo < min(lives) and max(lives) < hi
+                assert all(p.get_y() == lo for p in ax.patches)             # each bar rises from the axis' foot
+                np.testing.assert_allclose(sorted(p.get_y() + p.get_height() for p in ax.patches), sorted(lives))
     # loads over 1 kN are shown in kN: the tallest bar of condition 3's load panel is 13.1
     load3 = axes[1 * 2 + 0]
     assert "[kN]" in load3.get_ylabel()
@@ -121,6 +129,45 @@ def test_headline_legend_names_only_runs_that_exist(tmp_path, captured):
     # forward bars only: two per panel (inner, outer), none for the missing reverse runs
     for ax in fig.axes:
         assert len([p for p in ax.patches if np.isfinite(p.get_height())]) == 2
+
+
+def _overlaps(boxes) -> list:
+    return [(i, j) for i in range(len(boxes)) for j in range(i + 1, len(boxes))
+            if boxes[i].x0 < boxes[j].x1 and boxes[j].x0 < boxes[i].x1 and boxes[i].y0 < boxes[j].y1
+            and boxes[j].y0 < boxes[i].y1]
+
+
+@pytest.mark.parametrize("lives", [
+    {"inner": (1860.0, 35.0), "outer": (35.0, 1860.0)},                 # the shortest beside a life 53 times longer
+    {"inner": (120000.0, 447.0), "outer": (1020.0, 556.0)},             # the cruise point: wide labels, close lives
+    {"inner": (487000.0, 486000.0), "outer": (1860000.0, 1790000.0)}])  # widest labels at one height
+def test_headline_value_labels_never_overlap_and_read_the_values(tmp_path, captured, lives):
+    """Two bearings' forward and reverse lives: every value written over its bar with three significant digits
+    (no power of ten), and no two of the panel's texts — values and changes — overlapping once drawn."""
+    values = {}
+    for b, (f, r) in lives.items():
+        values[("life_iso281_h", 2, b, "forward")], values[("life_iso281_h", 2, b, "reverse")] = f, r
+    plots.forward_reverse_headline(values, tmp_path / "h.png", quantities=QUANT[1:])
+    fig = captured[-1]
+    (ax,) = fig.axes
+    renderer = fig.canvas.get_renderer()
+    labels = [t for t in ax.texts if t.get_gid() == "value_label"]
+    shown = sorted(float(t.get_text().replace("\u202f", "")) for t in labels)
+    truth = sorted(float(f"{v:.3g}") for v in values.values())
+    assert shown == truth and not any("e" in t.get_text() for t in labels)
+    boxes = [t.get_window_extent(renderer) for t in labels + _pct_texts(ax)]
+    assert len(boxes) == 6 and _overlaps(boxes) == []
+    assert all(ax.bbox.x0 <= b.x0 and b.x1 <= ax.bbox.x1 and b.y1 <= ax.bbox.y1 for b in boxes)   # inside the panel
+
+
+def test_headline_writes_a_tenfold_change_as_a_ratio_and_a_deep_fall_with_its_digits(tmp_path, captured):
+    """461 h → 306 600 h is ×665 (a percentage, +66 408 %, means nothing in particular); 120 000 h → 447 h is
+    −99.6 % (not −100 %)."""
+    values = {("life_iso281_h", 1, "inner", "forward"): 461.0, ("life_iso281_h", 1, "inner", "reverse"): 306600.0,
+              ("life_iso281_h", 1, "outer", "forward"): 120000.0, ("life_iso281_h", 1, "outer", "reverse"): 447.0}
+    plots.forward_reverse_headline(values, tmp_path / "h.png", quantities=QUANT[1:])
+    texts = sorted(_pct_texts(captured[-1].axes[0]), key=lambda t: t.get_position()[0])
+    assert [t.get_text() for t in texts] == ["\u00d7665", "\u221299.6 %"]
 
 
 # ------------------------------------------------------------------------------ bar chart
@@ -223,7 +270,11 @@ def test_cage_orbit_picture(tmp_path, captured):
         assert ax.get_xlim()[1] > C * 1e6 and ax.get_ylim()[0] < -C * 1e6
     assert lc.norm.vmin == pytest.approx(t[0] * 1e3) and lc.norm.vmax == pytest.approx(t[-1] * 1e3)
     labels = _legend_labels(fig)
-    assert {"guide clearance circle", "start", "end", "bore centre"} <= set(labels)
+    assert {"guide clearance circle", "start", "end", "planet (bore) centre"} <= set(labels)
+    # the frame is named: the cage centre relative to the planet centre, in axes turning with the carrier
+    assert all("carrier axes" in ax.get_xlabel() for ax in axes) and "carrier axes" in axes[0].get_ylabel()
+    assert "relative to the planet centre; axes turning with the carrier, not the planet" in \
+        " ".join(fig._suptitle.get_text().split())
     # the zoom row shows the trails: each trail lies inside its zoom panel
     for ax, e in zip(axes[2:], (fwd, rev)):
         (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
@@ -285,7 +336,7 @@ def test_display_unit(unit, values, factor, shown):
 
 
 @pytest.mark.parametrize("p, text", [(40.0, "+40 %"), (-24.4, "−24 %"), (3.21, "+3.2 %"), (-0.04, "−0.0 %"),
-                                     (159.4, "+159 %")])
+                                     (159.4, "+159 %"), (-99.63, "−99.6 %"), (66408.0, "×665")])
 def test_format_pct(p, text):
     assert plots.format_pct(p) == text
 
@@ -439,30 +490,93 @@ def test_separate_runs_put_forward_and_reverse_in_rows_of_their_own_on_one_scale
     np.testing.assert_allclose(axes[1, 0].get_lines()[0].get_ydata(), 13.0)      # kN
 
 
+def _band_and_mean(ax):
+    band = next(c for c in ax.collections if c.get_gid() == "period_range")
+    mean = next(ln for ln in ax.get_lines() if ln.get_gid() == "period_mean")
+    return band.get_paths()[0].vertices, mean.get_xdata(), mean.get_ydata()
+
+
 def test_a_history_sampled_a_few_times_per_period_is_drawn_as_its_envelope(tmp_path, captured):
-    """4.4 samples per period (the mesh at 25 kHz): a band from the running minimum to the running maximum of the
-    samples over one period (by hand here with a plain loop), their running mean as the line, and a note; 20
-    samples per period: the samples themselves."""
+    """4.36 samples per period (the mesh at 5740 Hz recorded at 25 kHz) of a periodic waveform of mean A with three
+    harmonics: the band of each whole period's samples (by hand here with a plain loop), from the first sample to
+    the last whole period; the mean line only where its periods are whole, and on the waveform's mean A (closed
+    form) — over the 3 periods after which the samples fall at the same phases again (13.07 samples), where a
+    one-period mean beats with the sampling; the legend and the note say so."""
     T = 1 / 5740.0
-    t = np.arange(0.03, 0.032, 1 / 25000.0)
-    y = 2000.0 + 500.0 * np.sin(2 * np.pi * t / T)
+    t = np.arange(0.03, 0.052, 1 / 25000.0)
+    A, B = 2000.0, 500.0
+    ph = 2 * np.pi * t / T
+    y = A + B * np.sin(ph) + 0.5 * B * np.sin(2 * ph + 1.0) + 0.3 * B * np.sin(3 * ph + 2.0)
     rows = [("mesh force", "N", {"m": {"forward": (t, y)}})]
     plots.time_history_group(rows, tmp_path / "e.png", columns=["m"], envelope=T, envelope_words="mesh cycle")
     fig = captured[-1]
-    ax = fig.axes[0]
-    (band,) = ax.collections
-    verts = band.get_paths()[0].vertices
-    k = 4                                                   # round(4.36)
-    hand_max = [max(y[max(0, i - k // 2):i - k // 2 + k]) for i in range(y.size)]
-    assert verts[:, 1].max() == pytest.approx(max(hand_max) / 1e3)
-    assert verts[:, 1].min() == pytest.approx(y.min() / 1e3, rel=1e-9)
-    line = ax.get_lines()[0].get_ydata()
-    assert np.all(line <= y.max() / 1e3 + 1e-12) and np.all(line >= y.min() / 1e3 - 1e-12)
-    assert any(tx.get_gid() == "envelope_note" and "4.4 samples per mesh cycle" in tx.get_text() for tx in fig.texts)
-    t2 = np.arange(0.03, 0.032, T / 20)
+    verts, xm, ym = _band_and_mean(fig.axes[0])
+    n = int((t[-1] - t[0]) / T)                                     # whole periods in the record
+    hand_lo, hand_hi = [], []
+    for i in range(n):
+        inside = [v for tk, v in zip(t, y) if t[0] + i * T - 1e-12 <= tk < t[0] + (i + 1) * T - 1e-12]
+        hand_lo.append(min(inside))
+        hand_hi.append(max(inside))
+    x_ms = verts[:, 0]
+    assert x_ms.min() == pytest.approx(t[0] * 1e3) and x_ms.max() == pytest.approx((t[0] + n * T) * 1e3)
+    assert x_ms.max() < t[-1] * 1e3                                  # the partial last period is left out
+    assert verts[:, 1].max() == pytest.approx(max(hand_hi) / 1e3) and verts[:, 1].min() == pytest.approx(min(hand_lo) / 1e3)
+    for lo, hi in zip(hand_lo, hand_hi):                            # each period's range is a step of the band
+        assert np.any(np.isclose(verts[:, 1], lo / 1e3, rtol=1e-12)) and np.any(np.isclose(verts[:, 1], hi / 1e3, rtol=1e-12))
+    m = 3                                                           # 3 × 4.355 = 13.07 samples
+    assert plots.sampling_repeat(25000.0 * T) == m
+    assert xm.min() == pytest.approx((t[0] + m * T / 2) * 1e3) and xm.max() == pytest.approx((t[0] + (n - m / 2) * T) * 1e3)
+    assert np.abs(ym * 1e3 - A).max() < 0.005 * B                   # on the mean, no edge jump, no sampling ripple
+    one = plots.period_envelope(t, y, T)[3]                         # what one period's mean would show: a ripple
+    assert np.abs(one - A).max() > 0.02 * B
+    labels = _legend_labels(fig)
+    assert "band: range of the samples in each mesh cycle" in labels and "line: mean over 3 mesh cycles" in labels
+    note = next(tx for lg in fig.legends for tx in [lg.get_title()] if tx.get_gid() == "envelope_note")
+    assert "4.4 samples per mesh cycle" in note.get_text() and "partial last one left out" in note.get_text()
+    t2 = np.arange(0.03, 0.032, T / 20)                             # 20 samples per period, 11 periods: drawn
     plots.time_history_group([("mesh force", "N", {"m": {"forward": (t2, 0 * t2 + 1.0)}})], tmp_path / "f.png",
                              columns=["m"], envelope=T)
-    assert not captured[-1].axes[0].collections and not captured[-1].texts
+    assert not captured[-1].axes[0].collections and not any(lg.get_title().get_text() for lg in captured[-1].legends)
+
+
+def test_a_history_of_many_periods_is_drawn_as_its_envelope_and_a_ramp_reads_as_its_mean(tmp_path, captured):
+    """40 samples per period but 120 periods (condition 1's record: solid ink sample by sample): drawn as the band
+    and the mean of each whole period; the mean of a ramp under a sine over a period is the ramp at the period's
+    centre (closed form), and its line starts half a period after the first sample."""
+    T = 1 / 1366.0
+    t = np.arange(0.0, 120.5 * T, T / 40)
+    ramp = 3000.0 + 4e4 * t
+    y = ramp + 800.0 * np.sin(2 * np.pi * t / T + 0.7)
+    plots.time_history_group([("mesh force", "N", {"m": {"forward": (t, y)}})], tmp_path / "g.png", columns=["m"],
+                             envelope=T, envelope_words="mesh cycle")
+    fig = captured[-1]
+    verts, xm, ym = _band_and_mean(fig.axes[0])
+    centres = t[0] + (np.arange(120) + 0.5) * T
+    np.testing.assert_allclose(xm, centres * 1e3, rtol=1e-12)       # one point per whole period, none past them
+    np.testing.assert_allclose(ym * 1e3, 3000.0 + 4e4 * centres, rtol=1e-6)
+    note = fig.legends[0].get_title().get_text()
+    assert "120 mesh cycles in the time shown: too many to draw one by one" in note and "samples per" not in note
+    assert "line: mean over one mesh cycle" in _legend_labels(fig)
+
+
+@pytest.mark.parametrize("per, m", [(25000 / 5740, 3), (40.0, 1), (8.0, 1), (25000 / 2733.333, 5), (2.5, 2)])
+def test_the_sampling_repeats_after_the_fewest_whole_periods_that_hold_a_whole_number_of_samples(per, m):
+    """4.355 samples per period: 13.07 in 3 periods; 9.146: 45.73 in 5 (within 1 %); 2.5: 5 in 2."""
+    assert plots.sampling_repeat(per) == m
+    assert abs(m * per - round(m * per)) <= 0.01 * m * per
+
+
+def test_the_cage_orbit_picture_names_the_housing_frame_and_refuses_an_unknown_one(tmp_path, captured):
+    t = np.linspace(0, 0.02, 200)
+    e = 100e-6 * np.column_stack([np.cos(t * 300), np.sin(t * 300)])
+    plots.cage_orbit_picture([("forward", t, e, 150e-6)], tmp_path / "o.png", frame="fixed", title="orbits")
+    fig = captured[-1]
+    assert all("housing axes" in ax.get_xlabel() for ax in _visible_axes(fig))
+    title = fig._suptitle.get_text()
+    assert title.startswith("orbits\n")            # the caller's title, then the frame (wrapped to the figure's width)
+    assert " ".join(title.split()[1:]) == "cage centre relative to the planet centre; the housing's fixed axes"
+    with pytest.raises(ValueError, match="frame: expected one of"):
+        plots.cage_orbit_picture([("forward", t, e, 150e-6)], tmp_path / "p.png", frame="planet")
 
 
 def test_a_cage_beyond_its_clearance_circle_is_drawn_in_the_land_deflection_band(tmp_path, captured):
