@@ -4,9 +4,14 @@ The sensor sits on the housing at angle ψ_s of the fixed frame, at distance r_s
 reads along its axis e (radial at ψ_s, or tangential 90° ahead). What it reads is the sum of three paths,
 each with physical parameters (:class:`components.params.SensorParams`, ``rig.sensor.*``):
 
-* **mesh** — the local ring-mesh path: a = Σ_n w(ψ_n − ψ_s)·(F_n·e)/m_eq, each outer planet's ring-mesh
+* **mesh** — the local ring-mesh path: a = Σ_n w(ψ_n − ψ_s)·(F̃_n·e)/m_eq, each outer planet's ring-mesh
   force on the ring weighted by a Hann window of its angular distance from the sensor (McFadden & Smith
-  1985; Inalpolat & Kahraman 2009): the ring's local vibration under a passing planet.
+  1985; Inalpolat & Kahraman 2009): the ring's local vibration under a passing planet. F̃_n is the force's
+  vibration: the force less its mean over the run, the mean taken in the planet's own radial and tangential
+  directions (it turns with the planet). a = F/m_eq is the ring's response above its local modes; the steady
+  load deflects the ring where the planet is, and that deflection passing the sensor reads ω²·F/k_local —
+  (N f_c / f_local)² of F/m_eq, 4·10⁻⁴ for planets passing at 100 Hz and a local mode at 5 kHz —, so it is
+  left out rather than read as F/m_eq (which put a 200 m/s² line at 3 f_c into the rig machine's spectrum).
 * **torque** — the housing's rocking: the ring's torsional support puts the reaction torque M = −T_r on
   the housing (T_r: the support's torque on the ring). The sun's and carrier's supports are centred,
   isotropic translational springs (no torsional part): their forces pass through the axis (to within
@@ -48,7 +53,7 @@ from mbd.ad import wrap_angle
 from .families import FAMILY
 from .params import HousingSI, SensorSI
 
-__all__ = ["PATHS", "hann_window", "sensor_axis", "rocking_lever", "mesh_path", "mode_acceleration",
+__all__ = ["PATHS", "hann_window", "sensor_axis", "rocking_lever", "mesh_path", "vibration", "mode_acceleration",
            "housing_paths", "paths", "HousingLoads", "sensor_from_dict"]
 
 PATHS = ("mesh", "torque", "bearing")   # their sum is the housing sensor
@@ -90,6 +95,18 @@ def mesh_path(psi_planets, ring_force, sensor) -> np.ndarray:
     return (w * along).sum(axis=-1) / sensor.equivalent_mass
 
 
+def vibration(psi_planets, ring_force) -> np.ndarray:
+    """Each planet's ring-mesh force less its mean over the samples (axis 0), the mean taken in the planet's own
+    radial and tangential directions at ψ_n (module docstring: the mesh path reads the vibration).
+
+    ``psi_planets`` (n, N) [rad], ``ring_force`` (n, N, 2) [N], both in the fixed frame; returns (n, N, 2)."""
+    psi, F = np.asarray(psi_planets, float), np.asarray(ring_force, float)
+    c, s = np.cos(psi), np.sin(psi)
+    radial, tangential = F[..., 0] * c + F[..., 1] * s, -F[..., 0] * s + F[..., 1] * c
+    radial, tangential = radial - radial.mean(axis=0), tangential - tangential.mean(axis=0)
+    return np.stack([radial * c - tangential * s, radial * s + tangential * c], axis=-1)
+
+
 def mode_acceleration(t, load, inertia: float, frequency: float, damping_ratio: float) -> np.ndarray:
     """ẍ of m ẍ + c ẋ + k x = load(t), m = ``inertia`` (a mass or a moment of inertia), k = m ω_n²,
     c = 2ζ m ω_n (ω_n = 2π ``frequency``), the load sampled at the equally spaced times ``t``: exact for a
@@ -121,8 +138,10 @@ def housing_paths(t, force, torque, sensor) -> dict[str, np.ndarray]:
 
 def paths(t, psi_planets, ring_force, force, torque, sensor) -> dict[str, np.ndarray]:
     """Every path of the housing sensor and their sum ("mesh", "torque", "bearing", "housing") [m/s²] from
-    a run's samples (arguments as :func:`mesh_path` and :func:`housing_paths`)."""
-    out = {"mesh": mesh_path(psi_planets, ring_force, sensor), **housing_paths(t, force, torque, sensor)}
+    a run's samples (arguments as :func:`mesh_path` and :func:`housing_paths`); the mesh path of the ring-mesh
+    forces' vibration (:func:`vibration`)."""
+    out = {"mesh": mesh_path(psi_planets, vibration(psi_planets, ring_force), sensor),
+           **housing_paths(t, force, torque, sensor)}
     out["housing"] = out["mesh"] + out["torque"] + out["bearing"]
     return out
 

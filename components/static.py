@@ -32,8 +32,10 @@ __all__ = ["STATIC_LIVES_NOTE", "steady_motion", "held_dofs", "snapshot_times", 
 # summary keys a static solution cannot give (they need the motion's transients)
 # what a static solution's lives are: every output that shows them says it (summary.json, the studies' tables)
 STATIC_LIVES_NOTE = ("lives from the quasi-static solution's mean loads: they leave out the dynamic load (the meshes' "
-                     "dynamic factor, impacts, cage motion), so they are longer than a dynamic run's of the same mean "
-                     "load where the load fluctuates")
+                     "dynamic factor, impacts, cage motion), which shortens a life for the same mean load (a life goes "
+                     "with the mean of a power of the load); where the load hardly fluctuates a static and a dynamic "
+                     "life differ by what their mean loads differ, either way, and a forward/reverse change can differ "
+                     "from the dynamic one where the two directions' loads fluctuate unequally")
 # The rollers' slip and what follows from it (their share of time in the load zone, the entry, the smearing indicator)
 # are a dynamic run's: out of the load zone a roller's spin keeps the memory of its inertia and slows by 1.4–28 % under
 # EHL traction, where a static roller spins at the balance of its place (within 0.3 %), and in the load zone, where the

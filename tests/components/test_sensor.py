@@ -79,6 +79,27 @@ def test_mesh_path_by_hand():
     assert two == pytest.approx([750.0 / 6.07, 1500.0 / 6.07])
 
 
+def test_the_mesh_path_reads_the_forces_vibration_not_their_steady_load():
+    """Three planets orbiting at f_c = 1 Hz, each pressing on the ring with a steady 5 kN radial and 1.8 kN
+    tangential load (steady in its own directions: it turns with the planet) plus a 300 N radial vibration at
+    f_m = 20 f_c, over one whole revolution: the vibration is the 300 N part alone, and the mesh path reads it
+    alone — the steady load, which would read 5 kN / m_eq at every planet pass, reads nothing."""
+    from components.sensor import paths, vibration
+    s = _sensor()
+    t = np.arange(4000) / 4000.0
+    psi = 2 * np.pi * t[:, None] + 2 * np.pi * np.arange(3) / 3
+    c, sn = np.cos(psi), np.sin(psi)
+    radial_vib = 300.0 * np.sin(2 * np.pi * 20.0 * t)[:, None] * np.ones(3)
+    on_ring = lambda r, q: np.stack([r * c - q * sn, r * sn + q * c], axis=-1)     # noqa: E731
+    steady, vib = on_ring(5000.0 + 0 * psi, 1800.0 + 0 * psi), on_ring(radial_vib, 0 * psi)
+    assert np.abs(vibration(psi, steady + vib) - vib).max() < 1e-9
+    zero = np.zeros((t.size, 2))
+    read = lambda F: paths(t, psi, F, zero, np.zeros(t.size), s)["mesh"]           # noqa: E731
+    assert np.abs(read(steady)).max() < 1e-9
+    assert read(steady + vib) == pytest.approx(mesh_path(psi, vib, s), abs=1e-9)
+    assert np.abs(mesh_path(psi, steady, s)).max() > 0.5 * 5000.0 / 6.07          # what the law alone reads
+
+
 # ---------------------------------------------------------------------------------------------------------
 # one mode: closed forms
 # ---------------------------------------------------------------------------------------------------------
