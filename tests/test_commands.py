@@ -512,6 +512,23 @@ def test_a_bad_time_is_refused_in_one_line(text, words, tmp_path, capsys):
     assert "--window" in err and words in err and err.count("\n") == 1
 
 
+def test_an_out_folder_that_cannot_be_made_is_refused_naming_out(tmp_path, capsys):
+    """A file, a folder under a file, a place where nothing can be made (the kernel's /proc, whatever its
+    permissions say): one line naming --out, exit 2; a folder that can be made leaves no trace of the check."""
+    import os
+    from pathlib import Path
+    (tmp_path / "a_file").write_text("x")
+    cases = [(tmp_path / "a_file", "exists and is not a folder"), (tmp_path / "a_file" / "sub", "is a file")]
+    if os.path.isdir("/proc/self"):
+        cases.append((Path("/proc/dpgt_out"), "cannot make a folder in '/proc'"))
+    for out, words in cases:
+        assert paper_study.main(["--mode", "static", "--out", str(out)]) == USAGE
+        err = capsys.readouterr().err
+        assert err.startswith("error: argument --out: ") and words in err and err.count("\n") == 1, err
+    assert paper_study.parse_args(["--out", str(tmp_path / "new" / "deep")]).out == str(tmp_path / "new" / "deep")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]
+
+
 @pytest.mark.parametrize("unit, words", [("r/min", "or an angular velocity with its unit"),
                                          ("s", "or a time with its unit")])
 def test_a_quantity_of_the_wrong_kind_is_named_with_its_article(unit, words):

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import tempfile
 import re
 import textwrap
 from pathlib import Path
@@ -261,8 +262,10 @@ def out_folder(text):
         parent = parent.parent
     if not parent.is_dir():
         raise argparse.ArgumentTypeError(f"cannot make the folder {text!r}: {str(parent)!r} is a file")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise argparse.ArgumentTypeError(f"cannot write into {str(parent)!r} (permission denied)")
+    try:        # made and removed: what the folder's permissions do not tell (/proc, a read-only mount, quotas)
+        os.rmdir(tempfile.mkdtemp(prefix=".dpgt-probe-", dir=parent))
+    except OSError as exc:
+        raise argparse.ArgumentTypeError(f"cannot make a folder in {str(parent)!r} ({exc.strerror or exc})") from None
     return str(p)
 
 
