@@ -299,7 +299,8 @@ def history_groups(runs: dict) -> dict[str, tuple[list, list[str]]]:
             if "bearing.load_radial" in out:
                 put("bearing_loads", "bearing load, radial (+ outward)", "N", col, d, t,
                     out["bearing.load_radial"][:, i])
-                put("bearing_loads", "bearing load, tangential", "N", col, d, t, out["bearing.load_tangential"][:, i])
+                put("bearing_loads", "bearing load, tangential (+ counter-clockwise)", "N", col, d, t,
+                    out["bearing.load_tangential"][:, i])
             if b["type"] != "rollers":
                 continue
             put("roller_contacts", "roller–inner race load", "N", col, d, t,
