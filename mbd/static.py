@@ -23,7 +23,9 @@ element families' own J_q, J_v.
 The solver (:func:`solve_static`): the orbiting bodies' unknowns are *local* — no element joins two of them —
 so they are solved body by body inside every step (:func:`_local_solve`: small Newton systems with
 brackets, all bodies at once), and the rest by pseudo-transient continuation on the Schur complement
-(:func:`_ptc`), which walks bodies across their clearances and ends in Newton's quadratic convergence.
+(:func:`_ptc`), which walks bodies across their clearances and ends in Newton's quadratic convergence. Where
+that stalls on a direction without stiffness — gears floating in their backlash under the drag torques at idle — a
+last pass walks those free modes to their contacts (:func:`_walk_free_modes`).
 
 It solves the same model as :func:`mbd.simulate`, not another one: where the dynamics do not rectify, its
 solution is the dynamic run's mean (the tests compare both on the same scenes).
