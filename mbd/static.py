@@ -707,7 +707,8 @@ def _walk(prob: _Problem, x: np.ndarray, g: np.ndarray, K: np.ndarray, outer: np
     free modes: the mass-scaled singular directions of the Schur complement (the locals following) whose singular
     values are below μ_min (stiffness the regularization would hide); the walk: along the force projected on them,
     w, marched in steps of one cap until the force along w, wᵀg, changes sign (a contact closed), its root then
-    bracketed (:func:`scipy.optimize.brentq`) to within the unknowns' tolerances."""
+    bracketed (:func:`scipy.optimize.brentq`) to within the unknowns' tolerances. A root where the modes already are
+    (within those tolerances) is no walk: None, and the continuation's μ grows as it would without."""
     from scipy.optimize import brentq     # deferred: only the last pass walks
     M = prob.M
     Kll = K[np.ix_(loc, loc)] + np.diag(prob.mu_min * M[loc])
@@ -743,4 +744,6 @@ def _walk(prob: _Problem, x: np.ndarray, g: np.ndarray, K: np.ndarray, outer: np
     a = brentq(phi, lo, hi, xtol=xtol, maxiter=200)
     if _TRACE:
         print(f"walk: bracket [{lo:.3g}, {hi:.3g}] at {a:.6g}")
+    if np.all(np.abs(a * w) <= prob.tol):       # the force along the modes vanishes where they are: nothing to walk
+        return None
     return x + a * w
