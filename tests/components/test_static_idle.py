@@ -35,24 +35,25 @@ def _centrifugal(si):
     return np.array(out)
 
 
-@pytest.mark.parametrize("direction", ["forward", "reverse"])
-def test_at_idle_the_pins_carry_the_planets_centrifugal_force(direction):
-    """The static state exists at 1500 r/min and 0 kW, and every pin's mean reaction is m Ω² r radially (planet 0.557
-    kg, its rollers and cage 0.077 kg, at 82.5 and 87 mm: 1291.5 and 1361.9 N) within 1 % and tangentially below 1 %
-    of it. What else pushes a planet is the mesh forces of the loss torque path — the coast flanks of the inner–outer
-    and outer–ring meshes carry 3.6 and 7.5 N (measured), under 0.6 % of the pin load — and gravity, whose mean over
-    the carrier revolution the snapshots span is nil (measured: radial within 0.37 %, tangential ≤ 9.8 N). The roller
-    and cage mass left out would miss by 12 %, Ω in r/s or 2Ω by far more. The planets' flanks are closed where the
-    loss torque passes (inner–outer and outer–ring coast flanks > 1 N), the drive flanks open (the sun transmits
-    nothing)."""
-    p = _idle(direction)
+@pytest.mark.parametrize("rpm, direction", [(1500, "forward"), (1500, "reverse"), (1000, "forward"), (500, "reverse")])
+def test_at_idle_the_pins_carry_the_planets_centrifugal_force(rpm, direction):
+    """The static state exists at no power and every pin's mean reaction is m Ω² r radially (planet 0.557 kg, its
+    rollers and cage 0.077 kg, at 82.5 and 87 mm: 1291.5 and 1361.9 N at 1500 r/min, 574.0 and 605.3 N at 1000,
+    143.5 and 151.3 N at 500) within 1 % and tangentially below 1 % of it. What else pushes a planet is the mesh
+    forces of the loss torque path — the coast flanks of the inner–outer and outer–ring meshes carry 3.6 and 7.5 N
+    at 1500 r/min, 0.4 and 0.8 N at 500 (measured), under 0.6 % of the pin load — and gravity, whose mean over the
+    carrier revolution the snapshots span is nil (measured: radial within 0.37 %, tangential ≤ 9.8 N). The roller and
+    cage mass left out would miss by 12 %, Ω in r/s or 2Ω by far more. The planets' flanks are closed where the loss
+    torque passes (inner–outer and outer–ring coast flanks carry a force; at the start, in the middle of their
+    backlash, they carried none, and the solver stalled there), the drive flanks open (the sun transmits nothing)."""
+    p = with_overrides(reference_dpgt(4, direction), {**IDLE, "operating.carrier_speed": f"{rpm} rpm"})
     st, sols = static_statistics(build(p), 16)
     F = _centrifugal(p.si())
     radial, tangential = st.stats("load_radial")["mean"], st.stats("load_tangential")["mean"]
     np.testing.assert_allclose(radial, F, rtol=0.01)
     np.testing.assert_array_less(np.abs(tangential), 0.01 * F)
     for key in ("inner_outer", "outer_ring"):
-        assert st.stats(f"{key}_coast_force")["mean"].min() > 1.0, key
+        assert st.stats(f"{key}_coast_force")["mean"].min() > 1e-3 * F.max(), key
     for key in MESH_FAMILY:
         assert st.stats(f"{key}_drive_force")["mean"].max() < 1e-3, key
 
