@@ -137,7 +137,8 @@ def solve_snapshots(scene, times, engine: str = "auto", system: mbd.System | Non
     its closing gap's rate (docs/model.md §7.1), so the force has no root there. Such a snapshot is moved on by a
     small fraction of a mesh period (:data:`MOVES`; a snapshot sits at the middle of its mesh-phase stratum, 1/n of
     a mesh period wide, so a 2 % move stays inside it for n < 25 snapshots, a 5 % move for n < 10);
-    the solutions' ``t`` say where each was taken, and a snapshot that no move solves raises the first error."""
+    the solutions' ``t`` say where each was taken, and a snapshot that no move solves raises the first error, the
+    operating point named."""
     m = scene.model
     system = system if system is not None else mbd.System(m)
     motion, hold, rates = steady_motion(scene), held_dofs(scene), rate_groups(scene)
@@ -165,8 +166,17 @@ def solve_snapshots(scene, times, engine: str = "auto", system: mbd.System | Non
                 continue
             break
         else:
-            raise first
+            raise mbd.ModelError(f"{_point(scene)}: {first} (a dynamic run, --mode dynamic, needs none)") \
+                from None
     return out
+
+
+def _point(scene) -> str:
+    """The operating point a failure names: the carrier's speed and the sun torque."""
+    sp, T = getattr(scene, "speeds", None), getattr(scene, "sun_torque", None)
+    if sp is None or T is None:
+        return "the static solution"
+    return f"the operating point at carrier speed {sp.carrier * 30.0 / math.pi:.6g} r/min, sun torque {T:.4g} N m"
 
 
 def static_statistics(scene, n_snapshots: int = DEFAULT_SNAPSHOTS, engine: str = "auto"):

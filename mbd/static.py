@@ -23,7 +23,9 @@ element families' own J_q, J_v.
 The solver (:func:`solve_static`): the orbiting bodies' unknowns are *local* — no element joins two of them —
 so they are solved body by body inside every step (:func:`_local_solve`: small Newton systems with
 brackets, all bodies at once), and the rest by pseudo-transient continuation on the Schur complement
-(:func:`_ptc`), which walks bodies across their clearances and ends in Newton's quadratic convergence.
+(:func:`_ptc`), which walks bodies across their clearances and ends in Newton's quadratic convergence. Where
+that stalls on a direction without stiffness — gears floating in their backlash under the drag torques at idle — a
+last pass walks those free modes to their contacts (:func:`_walk_free_modes`).
 
 It solves the same model as :func:`mbd.simulate`, not another one: where the dynamics do not rectify, its
 solution is the dynamic run's mean (the tests compare both on the same scenes).
@@ -454,6 +456,9 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
     if not ok:      # again without the rates' bisection: a machine without load (rates flip as the loads come in)
         x, more, ok = _ptc(prob, x_start, local, tol, cap, max_steps, regularization, bisect=False)
         steps += more
+    if not ok:      # again walking the free modes: a gear train floating in its backlash under the drag torques
+        x, more, ok = _ptc(prob, x_start, local, tol, cap, max_steps, regularization, bisect=True, walk=True)
+        steps += more
     if not ok:
         worst = int(np.argmax(np.abs(prob.residual(x)[0]) / np.maximum(prob.floor, 1e-300)))
         raise ModelError(f"solve_static: no static state at t = {t:.6g} s after {steps} steps (worst unknown: "
@@ -572,7 +577,7 @@ def _local_solve(prob: _Problem, x: np.ndarray, local: np.ndarray, cap: np.ndarr
 
 
 def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap: np.ndarray, max_steps: int,
-         regularization: float, bisect: bool = True):
+         regularization: float, bisect: bool = True, walk: bool = False):
     """Pseudo-transient continuation on the outer unknowns, the local ones solved after every step
     (:func:`_local_solve`): implicit Euler steps of the overdamped flow M x' = g, (K_c + μM) Δ = g_c with K_c the
     Schur complement of the local blocks and μ = 1/Δτ. μ starts where no unknown moves more than its ``cap``
@@ -585,7 +590,9 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
     traction makes the cage's moment a step of ≈ ±20 N·m within ≈ 1 rad/s with flat shoulders, where the stiffness
     is nil and Newton's steps from one shoulder land on the other; the shrinking bound brings the rate into the
     step, where Newton converges (:func:`_solve` runs the continuation again without it where it fails: at no load the
-    rates' residuals flip as the loads come in, not by jumping). Converged
+    rates' residuals flip as the loads come in, not by jumping). With ``walk``, a refused step first walks the
+    free modes, if any, to their contacts (:func:`_walk_free_modes`: gears floating in their backlash under the
+    drag torques at idle and light load) and goes on from there. Converged
     when every unknown's residual would move it less than its tolerance under its own stiffness,
     |g_i| ≤ (|K_ii| + μ_min M_i)·tol_i. Stops, unconverged, when μ has grown 10⁴-fold over its start (no step
     lowers |g|). Returns (x, steps, converged)."""
@@ -613,22 +620,10 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
             return x, k, True
         if k == max_steps or mu > 1e4 * mu_start:   # no step, however short, lowers |g|: resting on a force's jump
             break
-        Koo, Kol = K[np.ix_(outer, outer)], K[np.ix_(outer, loc)]
-        Klo, Kll = K[np.ix_(loc, outer)], K[np.ix_(loc, loc)]
         try:
-            # the local residuals are settled (solved, or resting at a force's jump): the outer step does not chase them
-            X = np.linalg.solve(Kll + np.diag(mu_min * M[loc]), Klo)
-            d = np.linalg.solve(Koo - Kol @ X + np.diag(mu * Mo), g[outer])
+            x_new, g_new, ok_new, clipped = _ptc_step(prob, x, g, K, outer, loc, mu, mu_min, local, cap, reach)
         except np.linalg.LinAlgError:
             return x, k, False
-        if not np.all(np.isfinite(d)):
-            return x, k, False
-        clipped = np.abs(d) >= reach[outer]
-        d = np.clip(d, -reach[outer], reach[outer])
-        x_new = x.copy()
-        x_new[outer] += d
-        x_new[loc] += np.clip(-X @ d, -cap[loc], cap[loc])        # the locals' linear prediction
-        x_new, g_new, ok_new = _local_solve(prob, x_new, local, cap)
         ratio = norm(g_new) / max(norm(g), 1e-300) if np.all(np.isfinite(g_new)) else np.inf
         if _TRACE:
             top = outer[np.argsort(-np.abs(g[outer]) / np.sqrt(Mo))[:3]]
@@ -638,8 +633,12 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
         # are in: what remains is Newton's end game) or μ at its floor — near a kink of the forces (a tooth pair's
         # stiffness edge, a contact closing) Newton's steps can cycle between two states on either side of it
         if ratio > 2.0 or (ratio > 1.0 and (mu <= mu_min or norm(g) < 1e-2 * g_start)):
-            mu = max(10.0 * mu, 10.0 * mu_min)
-            continue
+            walked = _walk_free_modes(prob, x, g, K, outer, loc, local, cap, norm) if walk else None
+            if walked is None:
+                mu = max(10.0 * mu, 10.0 * mu_min)
+                continue
+            x_new, g_new, ok_new = walked
+            ratio, clipped = norm(g_new) / max(norm(g), 1e-300), np.zeros(outer.size, bool)
         x, local_ok = x_new, ok_new
         g, K = prob.residual(x, jac=True)
         jumped = np.zeros(M.size, bool)
@@ -649,3 +648,102 @@ def _ptc(prob: _Problem, x: np.ndarray, local: np.ndarray, tol: np.ndarray, cap:
         sign = np.sign(g)
         mu = max(mu * (0.5 * ratio if ratio <= 1.0 else ratio), mu_min)
     return x, k, False              # the steps taken (fewer than max_steps where μ ran away)
+
+
+def _ptc_step(prob: _Problem, x: np.ndarray, g: np.ndarray, K: np.ndarray, outer: np.ndarray, loc: np.ndarray,
+              mu: float, mu_min: float, local: np.ndarray, cap: np.ndarray, reach: np.ndarray):
+    """One step of :func:`_ptc` from x (its residual g, K): the outer unknowns' implicit Euler step on the Schur
+    complement of the local blocks, clipped to ``reach``, the locals' linear prediction, then their own solve.
+    Returns (x_new, g_new, converged locals, clipped outer steps); raises LinAlgError where the step has none."""
+    M = prob.M
+    Koo, Kol = K[np.ix_(outer, outer)], K[np.ix_(outer, loc)]
+    Klo, Kll = K[np.ix_(loc, outer)], K[np.ix_(loc, loc)]
+    # the local residuals are settled (solved, or resting at a force's jump): the outer step does not chase them
+    X = np.linalg.solve(Kll + np.diag(mu_min * M[loc]), Klo)
+    d = np.linalg.solve(Koo - Kol @ X + np.diag(mu * M[outer]), g[outer])
+    if not np.all(np.isfinite(d)):
+        raise np.linalg.LinAlgError("a step without a finite value")
+    clipped = np.abs(d) >= reach[outer]
+    d = np.clip(d, -reach[outer], reach[outer])
+    x_new = x.copy()
+    x_new[outer] += d
+    x_new[loc] += np.clip(-X @ d, -cap[loc], cap[loc])        # the locals' linear prediction
+    x_new, g_new, ok_new = _local_solve(prob, x_new, local, cap)
+    return x_new, g_new, ok_new, clipped
+
+
+def _walk_free_modes(prob: _Problem, x: np.ndarray, g: np.ndarray, K: np.ndarray, outer: np.ndarray,
+                     loc: np.ndarray, local: np.ndarray, cap: np.ndarray, norm, max_walks: int = 8):
+    """The free modes walked along their forces until their contacts close, or None. A body or a train of bodies
+    inside a clearance — gears rolling together in their backlash, their flanks open — has a direction of no
+    stiffness along which a constant force pushes it (the drag torques at idle): the continuation's steps see no
+    stiffness there, every step short enough not to overshoot the contact leaves |g| where it was, and a longer one
+    closes the contact too far and is refused. Each walk (:func:`_walk`) closes one contact at least and may leave
+    another free mode (the sun rolling on the two inner planets whose flanks closed first, towards the third):
+    walked in turn, up to ``max_walks``, then the locals solved. The state is kept even where |g| grew (the mode
+    balances as a whole, its bodies not yet one by one: the first flanks to close carry the others' drag); the
+    continuation goes on from it with the closed contacts' stiffness. Returns (x, g, locals converged)."""
+    n0 = norm(g)
+    walked = False
+    for _ in range(max_walks):
+        x_new = _walk(prob, x, g, K, outer, loc, cap)
+        if x_new is None:
+            break
+        x, walked = x_new, True
+        g, K = prob.residual(x, jac=True)
+    if not walked:
+        return None
+    x, g, ok = _local_solve(prob, x, local, cap)
+    if _TRACE:
+        print(f"walk: |g| {n0:.4g} -> {norm(g):.4g}")
+    if not np.all(np.isfinite(g)):
+        return None
+    return x, g, ok
+
+
+def _walk(prob: _Problem, x: np.ndarray, g: np.ndarray, K: np.ndarray, outer: np.ndarray, loc: np.ndarray,
+          cap: np.ndarray):
+    """One walk of the free modes (:func:`_walk_free_modes`): x where the force along them vanishes, or None. The
+    free modes: the mass-scaled singular directions of the Schur complement (the locals following) whose singular
+    values are below μ_min (stiffness the regularization would hide); the walk: along the force projected on them,
+    w, marched in steps of one cap until the force along w, wᵀg, changes sign (a contact closed), its root then
+    bracketed (:func:`scipy.optimize.brentq`) to within the unknowns' tolerances. A root where the modes already are
+    (within those tolerances) is no walk: None, and the continuation's μ grows as it would without."""
+    from scipy.optimize import brentq     # deferred: only the last pass walks
+    M = prob.M
+    Kll = K[np.ix_(loc, loc)] + np.diag(prob.mu_min * M[loc])
+    X = np.linalg.solve(Kll, K[np.ix_(loc, outer)])
+    Kc = K[np.ix_(outer, outer)] - K[np.ix_(outer, loc)] @ X
+    s = 1.0 / np.sqrt(M[outer])
+    _, S, Vt = np.linalg.svd(s[:, None] * Kc * s[None, :])
+    N = Vt[S < prob.mu_min]
+    if _TRACE:
+        print(f"walk: {len(N)} free modes, singular values {S[-len(N) - 1:]}, mu_min {prob.mu_min:.3g}")
+    if not len(N):
+        return None
+    w = np.zeros(M.size)
+    w[outer] = s * (N.T @ (N @ (s * g[outer])))
+    w[loc] = -X @ w[outer]
+    moved = np.abs(w) > 1e-12 * np.abs(w).max()
+    if not moved.any() or np.all(np.abs(g[moved]) <= prob.floor[moved]):
+        return None
+    h = float(np.min(cap[moved] / np.abs(w[moved])))
+    phi = lambda a: float(w[outer] @ prob.residual(x + a * w)[0][outer])
+    lo, hi = 0.0, None
+    for k in range(1, 65):           # a clearance of up to 64 caps
+        f = phi(k * h)
+        if not np.isfinite(f):
+            return None
+        if f <= 0.0:
+            hi = k * h
+            break
+        lo = k * h
+    if hi is None:
+        return None
+    xtol = float(np.min(prob.tol[moved] / np.abs(w[moved])))
+    a = brentq(phi, lo, hi, xtol=xtol, maxiter=200)
+    if _TRACE:
+        print(f"walk: bracket [{lo:.3g}, {hi:.3g}] at {a:.6g}")
+    if np.all(np.abs(a * w) <= prob.tol):       # the force along the modes vanishes where they are: nothing to walk
+        return None
+    return x + a * w

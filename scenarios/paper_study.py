@@ -23,7 +23,7 @@ import numpy as np
 
 import mbd
 from components.families import MESH_FAMILY
-from components.static import DEFAULT_SNAPSHOTS, STATIC_LIVES_NOTE
+from components.static import DEFAULT_SNAPSHOTS, DYNAMIC_ONLY, STATIC_LIVES_NOTE
 from components.outputs import FAMILY, radial_tangential
 from components.outputs import relative_life as iso_relative_life
 from components.results import SUMMARY_WORDS, Summary, format_change, open_run, percent_change
@@ -570,7 +570,8 @@ class PaperStudy(Study):
         print(("\nnot a finding: " + doubts + "\n" if doubts else "\n") + headline_table(rows))   # the headline first
         print("\n" + text)
         if static:
-            left = sorted({q for q, _ in QUANTITIES} - {r["quantity"] for r in rows})
+            # what a static solution cannot give (components.static.DYNAMIC_ONLY), not what a failed run left empty
+            left = sorted(q for q, _ in QUANTITIES if q.startswith(DYNAMIC_ONLY))
             print(f"static mode ({self.a.snapshots} snapshots): left out, as only a dynamic run gives them: "
                   f"{', '.join(left)}; no time histories, cage orbits, bars of RMS values or animation")
             print(f"note: {STATIC_LIVES_NOTE}")

@@ -375,3 +375,41 @@ def test_the_table_reads_its_speeds_as_given(runs):
         rows = list(csv.DictReader(fh))
     assert {r["bin"]: r["carrier_rpm"] for r in rows} == {"fast": "4200", "back": "2000"}
     assert all(len(r["hours"]) <= 14 for r in rows)
+
+
+IDLE_BIN = '''
+[[bin]]
+name = "idle"
+carrier_speed = "1500 rpm"
+power = "0 kW"
+hours = 100
+
+[[bin]]
+name = "rated"
+carrier_speed = "4200 rpm"
+power = "200 kW"
+hours = 10
+'''
+
+
+def test_a_cycle_with_an_idle_bin_has_lives(tmp_path):
+    """An idle bin (1500 r/min, no power: the gears float in their backlash at the start, the drag torques close the
+    planets' flanks, docs/model.md §16) is solved quasi-statically like any other: the cycle's life is the hand
+    Miner sum of both bins' own lives (time shares 100/110 and 10/110), the idle bin's life far longer than the rated
+    one's (its pins carry the centrifugal force alone, ≈ 1.3 kN against ≈ 9 kN) and its damage share the smaller."""
+    p = _cycle(tmp_path, "idle.toml", IDLE_BIN)
+    assert duty_cycle.main(["--cycle", str(p), "--out", str(tmp_path / "out"), "--snapshots", SNAPSHOTS,
+                            "--workers", "1", "--no-progress"]) == 0
+    rec = _json(tmp_path / "out" / "duty_cycle.json")
+    s = {n: _json(tmp_path / "out" / n / "summary.json") for n in ("idle", "rated")}
+    tau = {"idle": 100 / 110, "rated": 10 / 110}
+    for kind, letter in (("inner", "a"), ("outer", "b")):
+        assert 1e3 < s["idle"][kind]["bearing_load_mean_N"] < 0.2 * s["rated"][kind]["bearing_load_mean_N"]
+        for key in ("iso281", "iso16281"):
+            for j in range(3):
+                lh = {n: s[n][kind][f"life_{key}_per_planet_h"][j] for n in s}
+                assert np.isfinite(lh["idle"]) and lh["idle"] > 10 * lh["rated"], (kind, key, lh)
+                hand = 1.0 / math.fsum(tau[n] / lh[n] for n in s)
+                got = rec["lives"][kind]["planets"][f"{letter}{j + 1}"][key]
+                assert got["life_h"] == pytest.approx(hand, rel=1e-12, abs=0)
+                assert got["damage_shares"][0] < got["damage_shares"][1]

@@ -192,3 +192,26 @@ def test_the_static_solution_takes_the_ehl_traction_law(study, argv, tmp_path):
     assert solved, sorted(str(f.relative_to(out)) for f in out.rglob("*.json"))
     for steps, snapshots in solved:
         assert steps < 40 * snapshots, (steps, snapshots)
+
+
+def test_a_point_without_a_static_state_fails_in_one_line_naming_it(tmp_path, capsys, monkeypatch):
+    """Where a point has no static state (planted: every instant refused), its run fails in one line naming the
+    operating point and what the solver found, and the study's note lists only what a static solution cannot give
+    (cage slip, pocket impacts, ...), not the loads and lives that the failed run left empty."""
+    import mbd
+    from components import static
+
+    def refuse(*args, **kwargs):
+        raise mbd.ModelError("solve_static: no static state at t = 0.01 s (planted)")
+    monkeypatch.setattr(static, "solve_static", refuse)
+    assert paper_study.main(["--mode", "static", "--snapshots", "2", "--operating", "idle: 1500 rpm, 0 kW",
+                             "--directions", "forward", "--workers", "1", "--out", str(tmp_path),
+                             "--no-progress"]) == 1
+    out = capsys.readouterr().out
+    failed = [line for line in out.splitlines() if line.startswith("FAILED idle_forward")]
+    assert len(failed) == 1, out
+    assert "carrier speed 1500 r/min, sun torque 0 N m" in failed[0] and "(planted)" in failed[0], failed[0]
+    left = next(line for line in out.splitlines() if "left out, as only a dynamic run gives them" in line)
+    assert "cage_slip_pct" in left and "pocket_impacts_per_rev" in left
+    for given in ("bearing_load_mean_N", "life_iso281_h", "life_iso16281_h", "roller_inner_race_max_N"):
+        assert given not in left, left
