@@ -23,12 +23,25 @@ class FolderLocked(RuntimeError):
 
 
 def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists and has not ended: a zombie (ended, not yet reaped by its parent) has."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:       # exists, another user's
         return True
+    try:
+        # /proc/PID/stat: "pid (name) state ...", the name may hold spaces and parentheses
+        return Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[0] != "Z"
+    except (OSError, IndexError):  # no /proc (not Linux), or it ended meanwhile
+        return _exists(pid)
+
+
+def _exists(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
     return True
 
 
@@ -43,11 +56,15 @@ def _dead(held: dict) -> bool:
     return held.get("host") == socket.gethostname() and isinstance(held.get("pid"), int) and not _alive(held["pid"])
 
 
-def release_dead(folder) -> bool:
+def release_dead(folder, wait: float = 0.0) -> bool:
     """Remove ``folder``'s lock if its holder was a process of this host that no longer exists (a worker stopped in
-    the middle of a run), and the temporary files that process left below the folder; whether there was one."""
+    the middle of a run), and the temporary files that process left below the folder; whether there was one.
+    ``wait`` [s]: how long a holder of this host that still runs is given to end (a worker being stopped)."""
     lock = Path(folder) / LOCK_NAME
     held = _holder(lock)
+    deadline = time.monotonic() + wait
+    while not _dead(held) and held.get("host") == socket.gethostname() and time.monotonic() < deadline:
+        time.sleep(0.05)
     if not _dead(held):
         return False
     for tmp in temporaries(folder, held["pid"]):

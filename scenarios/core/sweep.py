@@ -575,8 +575,8 @@ def _dead_runs_released(cases: list[Case], local: bool):
         yield
     except BaseException:
         if local:
-            for c in cases:
-                release_dead(c.out_dir)
+            for c in cases:     # a worker stopped by the close may take a moment to end
+                release_dead(c.out_dir, wait=5.0)
         raise
 
 

@@ -73,3 +73,19 @@ def test_a_live_or_foreign_holder_is_not_released(tmp_path):
     assert not release_dead(tmp_path) and (tmp_path / LOCK_NAME).exists()
     (tmp_path / LOCK_NAME).write_text(json.dumps({"pid": 2 ** 22 + 7, "host": "another-host", "started": "earlier"}))
     assert not release_dead(tmp_path) and (tmp_path / LOCK_NAME).exists()
+
+
+def test_an_ended_holder_not_yet_reaped_is_dead_and_one_ending_is_waited_for(tmp_path):
+    """A worker that ended but whose parent has not reaped it yet (a zombie) holds nothing; a holder still ending is
+    given ``wait`` seconds."""
+    import time
+    ended = subprocess.Popen([sys.executable, "-c", "pass"])
+    time.sleep(1.0)                                     # ended; its parent (this process) has not waited for it
+    _hold(tmp_path, ended.pid)
+    assert release_dead(tmp_path) and not (tmp_path / LOCK_NAME).exists()
+    ended.wait()
+    ending = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(0.5)"])
+    _hold(tmp_path, ending.pid)
+    assert not release_dead(tmp_path)                   # still running, not waited for
+    assert release_dead(tmp_path, wait=20.0) and not (tmp_path / LOCK_NAME).exists()
+    ending.wait()
