@@ -285,6 +285,7 @@ def _execute(case: Case, cfg, overwrite: bool) -> Outcome:
 
 
 SETTLED_ESTIMATE = 0.1      # share of a run's simulated time after which its time left is shown
+PLAIN_EVERY_S = 30.0        # a log or a pipe gets a line on the running runs this often (a terminal: their bars)
 
 
 @dataclass
@@ -399,22 +400,35 @@ def timed_call(fn: Callable, *args) -> tuple:
 
 
 class _RunBars:
-    """One bar per running case, fed from the progress.json each worker writes (simulated time)."""
+    """One bar per running case, fed from the progress.json each worker writes (simulated time); with ``plain`` (a
+    log or a pipe), a line on standard error every :data:`PLAIN_EVERY_S` with each running case's simulated time."""
 
-    def __init__(self, cases, show):
-        self.show = show
+    def __init__(self, cases, show, plain: bool = False):
+        self.show, self.plain = show, plain
+        self.cases, self.done, self.said = list(cases), set(), time.monotonic()
         self.bars = {}
         if show:
             for i, c in enumerate(cases):
                 self.bars[c.label] = (c, tqdm(total=1.0, desc=c.label, position=i + 1, leave=False, unit="",
                                               bar_format="{desc}: {percentage:3.0f}%|{bar}| {postfix}"))
 
+    @staticmethod
+    def _read(c) -> dict | None:
+        try:
+            return json.loads((Path(c.out_dir) / "progress.json").read_text())
+        except (OSError, ValueError):
+            return None
+
     def poll(self):
+        if self.plain and time.monotonic() - self.said >= PLAIN_EVERY_S:
+            self.said = time.monotonic()
+            running = [(c.label, d) for c in self.cases if c.label not in self.done and (d := self._read(c))]
+            if running:
+                print("runs: running " + ", ".join(f"{k} at t = {d['t']:.4g} of {d['t_end']:.4g} s"
+                                                   for k, d in running), file=sys.stderr, flush=True)
         for label, (c, b) in self.bars.items():
-            p = Path(c.out_dir) / "progress.json"
-            try:
-                d = json.loads(p.read_text())
-            except (OSError, ValueError):
+            d = self._read(c)
+            if d is None:
                 continue
             b.n = min(1.0, d["t"] / d["t_end"]) if d["t_end"] else 0.0
             rate = d["steps"] / max(d["wall_s"], 1e-9)
@@ -426,6 +440,7 @@ class _RunBars:
                               + (f"~{left:.0f} s left" if settled else "estimating the time left"))
 
     def finish(self, c):
+        self.done.add(c.label)
         if c.label in self.bars:
             b = self.bars[c.label][1]
             b.n = 1.0
@@ -510,7 +525,7 @@ def sweep(cases: list[Case], cfg, workers: int | None = None, scheduler: str | N
                 futs = {client.submit(execute_on_worker, c, wcfg, overwrite, code, texts, pure=False,
                                       retries=RETRIES, key=f"run-{c.label}-{time.time_ns()}"): c for c in todo}
             bar = tqdm(total=len(futs), desc="runs", disable=not bars, position=0)
-            runs = _RunBars(todo, bars)
+            runs = _RunBars(todo, bars, plain)
             while True:
                 done = [f for f in futs if f.done() and futs[f].label not in results]
                 if not done:
