@@ -605,7 +605,7 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
                 moving, ideal, ring_pts = _roller_ring(p, view, rol[lab].shape[1], ring_r[lab], r_roll[lab], col)
                 roller_meshes.append((moving, ideal, ring_pts, lab))
                 if note:  # one factor for all panels: say it once
-                    view.text(f"roller offsets ×{mag:.3g}", (0.5, 0.98 - view.line_height(fs)),
+                    view.text(f"rollers' offsets in their pockets at ×{mag:.3g} the orbits' scale", (0.5, 0.98 - view.line_height(fs)),
                               fs_small, justify="center", color="#666666", valign="top")
             view.text(lab, (0.5, 0.98), fs, justify="center", bold=True, valign="top")
             view.scale_bar(frac=0.25, size=fs_small)
@@ -618,7 +618,7 @@ def cage_orbit_animation(path, t, orbits: Mapping[str, np.ndarray], clearance_m,
                        ("dot", "#d50000", centre), ("line", _PANEL_COLORS[0], "its trail (panel colour)")]
             if rol:
                 entries += [("ring", "#bbbbbb", "roller, centred in its pocket"),
-                            ("ring", _PANEL_COLORS[0], f"roller, offset ×{mag:.3g}")]
+                            ("ring", _PANEL_COLORS[0], f"roller, its offset in the pocket at ×{mag:.3g} the orbits' scale")]
             _legend_strip(p, leg_row, (W, int(round(H * leg))), entries, fs_small)
 
         def render(i):
