@@ -268,7 +268,8 @@ def test_the_housing_loads_and_the_sensor_are_recorded_only_when_asked(tmp_path)
     """RunConfig(sensor=True) records housing.force_x/force_y/torque with units and long names, per supported
     body, equal to minus the supports' forces turned into the fixed frame (from the recorded body motion); it
     stores the sensor's parameters, and sensor_paths turns the file into the paths: the mesh path equals the
-    window formula applied to the recorded planet angles and ring-mesh forces, the sum is the housing sensor.
+    window formula applied to the recorded planet angles and the ring-mesh forces' vibration (less their mean in
+    each planet's radial and tangential directions), the sum is the housing sensor.
     Without it nothing is added."""
     import xarray as xr
 
@@ -302,8 +303,13 @@ def test_the_housing_loads_and_the_sensor_are_recorded_only_when_asked(tmp_path)
         P = ds["motion.position"].values[:, outer]
         psi = np.arctan2(P[..., 1], P[..., 0]) + phi[:, None]
         e = sensor_axis(s)
-        F = (ds["mesh_br.fx"].values * np.cos(phi)[:, None] - ds["mesh_br.fy"].values * np.sin(phi)[:, None]) * e[0] \
-            + (ds["mesh_br.fx"].values * np.sin(phi)[:, None] + ds["mesh_br.fy"].values * np.cos(phi)[:, None]) * e[1]
+        fx, fy = ds["mesh_br.fx"].values, ds["mesh_br.fy"].values            # on the ring, in R
+        Fx = fx * np.cos(phi)[:, None] - fy * np.sin(phi)[:, None]           # in I
+        Fy = fx * np.sin(phi)[:, None] + fy * np.cos(phi)[:, None]
+        # the vibration: less the mean in each planet's own radial and tangential directions
+        rad, tan = Fx * np.cos(psi) + Fy * np.sin(psi), -Fx * np.sin(psi) + Fy * np.cos(psi)
+        rad, tan = rad - rad.mean(axis=0), tan - tan.mean(axis=0)
+        F = (rad * np.cos(psi) - tan * np.sin(psi)) * e[0] + (rad * np.sin(psi) + tan * np.cos(psi)) * e[1]
         w = np.cos(np.pi * ((psi - s.angle + np.pi) % (2 * np.pi) - np.pi) / s.window_width) ** 2
         w[np.abs((psi - s.angle + np.pi) % (2 * np.pi) - np.pi) >= 0.5 * s.window_width] = 0.0
         expected = (w * F).sum(axis=1) / s.equivalent_mass
