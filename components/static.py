@@ -145,26 +145,27 @@ def solve_snapshots(scene, times, engine: str = "auto", system: mbd.System | Non
     ev = _evaluator(system, engine)
     period = 1.0 / scene.f_m if scene.f_m > 0 else 0.0
 
-    def solve(t, start):
-        return solve_static(m, motion, t, hold=hold, rates=rates, q_start=start[0], rates_start=start[1],
-                            system=system, evaluator=ev, max_rate_step=RATE_STEP)
+    def attempts(t):
+        """(time, start, walk) in the order tried: each instant and its moves, from the previous instant carried
+        over, failing that from the kinematic pose (the previous instant's contacts can be a worse start than
+        none); walking free modes (gears floating in their backlash) only where none of these solves."""
+        for walk in (False, True):
+            for move in (0.0, *(MOVES if period > 0 else ())):
+                tm = t + move * period
+                for start in ([carry(m, motion, out[-1], tm, rates)] if out else []) + [(None, None)]:
+                    yield tm, start, walk
 
     out = []
     for t in (float(x) for x in times):
         first = None
-        for move in (0.0, *(MOVES if period > 0 else ())):
-            tm = t + move * period
-            # from the previous instant carried over; failing that from the kinematic pose (the previous instant's
-            # contacts can be a worse start than none)
-            for start in ([carry(m, motion, out[-1], tm, rates)] if out else []) + [(None, None)]:
-                try:
-                    out.append(solve(tm, start))
-                    break
-                except mbd.ModelError as exc:
-                    first = first or exc
-            else:
-                continue
-            break
+        for tm, start, walk in attempts(t):
+            try:
+                out.append(solve_static(m, motion, tm, hold=hold, rates=rates, q_start=start[0],
+                                        rates_start=start[1], system=system, evaluator=ev, max_rate_step=RATE_STEP,
+                                        walk=walk))
+                break
+            except mbd.ModelError as exc:
+                first = first or exc
         else:
             raise mbd.ModelError(f"{_point(scene)}: {first} (a dynamic run, --mode dynamic, needs none)") \
                 from None

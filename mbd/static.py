@@ -388,7 +388,7 @@ def solve_static(model: Model, motion: SteadyMotion, t: float, *, hold=(), rates
                  system: System | None = None, engine: str = "auto", evaluator=None, length_tol: float = 1e-11,
                  rate_tol: float = 1e-6,
                  max_steps: int = 200, max_step: float = 2e-5, max_rate_step: float = 1e3,
-                 regularization: float = 1e-12, force_rtol: float = 1e-8) -> StaticSolution:
+                 regularization: float = 1e-12, force_rtol: float = 1e-8, walk: bool = True) -> StaticSolution:
     """The static state at time ``t`` (module docstring).
 
     ``hold``: free-DOF indices kept at their steady values (equations dropped). ``rates``: rate groups, each
@@ -402,14 +402,16 @@ def solve_static(model: Model, motion: SteadyMotion, t: float, *, hold=(), rates
     its own stiffness — ``length_tol`` [m] (angles at their body's radius of gyration), ``rate_tol`` [rad/s] — or
     is below ``force_rtol`` of the largest force balanced at the start (at its length scale: a body floating in
     a clearance keeps a round-off force and no stiffness); ``max_step`` [m] and ``max_rate_step`` [rad/s] bound
-    one step. One-line ModelError, naming the worst unknown, when it fails."""
+    one step; ``walk``: a last pass walks free modes to their contacts where the others fail (a caller with other
+    starts to try first turns it off and tries it last). One-line ModelError, naming the worst unknown, when it
+    fails."""
     with threadpool_limits(limits=1, user_api="blas"):     # dense systems of a few hundred: threads only contend
         return _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, system, engine, evaluator,
-                      length_tol, rate_tol, max_steps, max_step, max_rate_step, regularization, force_rtol)
+                      length_tol, rate_tol, max_steps, max_step, max_rate_step, regularization, force_rtol, walk)
 
 
 def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, system, engine, evaluator, length_tol,
-           rate_tol, max_steps, max_step, max_rate_step, regularization, force_rtol) -> StaticSolution:
+           rate_tol, max_steps, max_step, max_rate_step, regularization, force_rtol, walk) -> StaticSolution:
     t_wall = time.perf_counter()
     system = system if system is not None else System(model)
     evaluate = evaluator if evaluator is not None else _evaluator(system, engine)
@@ -456,7 +458,7 @@ def _solve(model, motion, t, hold, rates, tangential, q_start, rates_start, z, s
     if not ok:      # again without the rates' bisection: a machine without load (rates flip as the loads come in)
         x, more, ok = _ptc(prob, x_start, local, tol, cap, max_steps, regularization, bisect=False)
         steps += more
-    if not ok:      # again walking the free modes: a gear train floating in its backlash under the drag torques
+    if not ok and walk:     # again walking the free modes: a gear train floating in its backlash under drag torques
         x, more, ok = _ptc(prob, x_start, local, tol, cap, max_steps, regularization, bisect=True, walk=True)
         steps += more
     if not ok:
@@ -729,6 +731,8 @@ def _walk(prob: _Problem, x: np.ndarray, g: np.ndarray, K: np.ndarray, outer: np
         return None
     h = float(np.min(cap[moved] / np.abs(w[moved])))
     phi = lambda a: float(w[outer] @ prob.residual(x + a * w)[0][outer])
+    if not phi(0.0) > 0.0:           # |N s g|² in exact arithmetic: a force along the modes that rounds away
+        return None
     lo, hi = 0.0, None
     for k in range(1, 65):           # a clearance of up to 64 caps
         f = phi(k * h)

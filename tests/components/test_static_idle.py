@@ -83,3 +83,19 @@ def test_at_idle_the_static_state_is_the_dynamic_runs_mean(direction):
     for key in ("inner_outer", "outer_ring"):
         d, s = dyn.stats(f"{key}_coast_force")["mean"], st.stats(f"{key}_coast_force")["mean"]
         assert np.all(s > 0.5 * d) and np.all(s < d), (key, d, s)
+
+
+def test_the_walk_is_tried_only_where_nothing_else_solves(monkeypatch):
+    """Condition 4 forward has an instant that only a move of a few percent of a mesh period solves without the walk,
+    and the walk would solve unmoved: tried last, it leaves that instant, and every state of the instants before it,
+    as the solver without a walk finds them (bit for bit)."""
+    import components.static as cs
+    from components.dpgt import build_dpgt
+
+    scene = build_dpgt(reference_dpgt(4, "forward"))
+    _, sols = static_statistics(scene, 16)
+    real = cs.solve_static
+    monkeypatch.setattr(cs, "solve_static", lambda *a, **k: real(*a, **{**k, "walk": False}))
+    _, without = static_statistics(scene, 16)
+    assert [s.t for s in sols] == [s.t for s in without]
+    assert all(np.array_equal(s.q, w.q) for s, w in zip(sols, without))
