@@ -931,9 +931,12 @@ def _value_text(v: float) -> str:
     v = float(v)
     if v == 0.0 or not np.isfinite(v):
         return f"{v:g}"
+    v = float(f"{v:.3g}")                    # rounded first: 999.6 is 1 000, not 1e+03
     mag = int(np.floor(np.log10(abs(v))))
     if mag < 3:
         return f"{v:.3g}"
+    if mag >= 6:                             # millions: '12.3 M' stays as wide as '12 300'
+        return f"{v / 1e6:.3g}\u202fM"
     return f"{round(v, 2 - mag):,.0f}".replace(",", "\u202f")
 
 

@@ -294,20 +294,26 @@ def format_change(pct: float) -> str:
     """A change in % (:func:`percent_change`) as a reader reads it, the one rule of every table and figure:
 
     * up to ten times the value: in %, one decimal below 10 %, whole percents above ('+3.2 %', '−24 %', '+598 %'),
-      a true minus sign;
-    * ten times the value or more (+900 % and beyond, :data:`RATIO_FROM`): the ratio after/before with three
-      significant digits ('×665', '×12.3'; whole numbers from ×1000) — '+66434 %' reads as nothing in particular;
+      a true minus sign, no sign on a change that rounds to nothing ('0.0 %');
+    * ten times the value or more (+900 % and beyond as shown, :data:`RATIO_FROM`): the ratio after/before with
+      three significant digits ('×665', '×12.3'; whole numbers from ×1000) — '+66434 %' reads as nothing in
+      particular;
     * a fall to a tenth or less (−90 % and beyond): in % with the decimals that keep one significant digit of what
-      is left, 100 % + pct ('−99.6 %' where 0.4 % is left, '−99.96 %' where 0.04 % is); only a fall to zero reads
-      '−100 %'."""
-    pct = float(pct)
-    if not np.isfinite(pct):
+      is left, 100 % + pct, four at most ('−99.6 %' where 0.4 % is left, '−99.96 %' where 0.04 % is); a fall that
+      leaves less than 0.00005 % reads '−100 %'."""
+    if pct is None or not np.isfinite(float(pct)):
         raise ValueError(f"pct: expected a finite change in %, got {pct}")
-    ratio = 1.0 + pct / 100.0
-    if ratio >= RATIO_FROM:
-        return "\u00d7" + (f"{ratio:.3g}" if ratio < 1000.0 else f"{ratio:.0f}")
+    pct = float(pct)
     decimals = 1 if abs(pct) < 9.95 else 0
     left = 100.0 + pct                       # what a fall leaves, in % of the value before
-    if 0.0 < left < 10.0:
-        decimals = max(decimals, -int(np.floor(np.log10(left))))
-    return f"{pct:+.{decimals}f}".replace("-", "\u2212") + " %"
+    if 0.0 < left < 10.0:                    # one significant digit of it, four decimals at most
+        decimals = min(max(decimals, -int(np.floor(np.log10(left)))), 4)
+    text = f"{pct:+.{decimals}f}"
+    if 1.0 + float(text) / 100.0 >= RATIO_FROM:      # the digits shown decide the form: +899.5 % shows as ×10
+        ratio = max(float(f"{1.0 + pct / 100.0:.3g}"), RATIO_FROM)
+        return "\u00d7" + (f"{ratio:.3g}" if ratio < 1000.0 else f"{1.0 + pct / 100.0:.0f}")
+    if float(text) == 0.0:                   # a change that rounds to nothing has no sign
+        text = f"{0.0:.{decimals}f}"
+    elif float(text) == -100.0:              # what is left rounds away: the fall reads whole
+        text = "-100"
+    return text.replace("-", "\u2212") + " %"

@@ -406,16 +406,19 @@ class _RunBars:
     def __init__(self, cases, show, plain: bool = False):
         self.show, self.plain = show, plain
         self.cases, self.done, self.said = list(cases), set(), time.monotonic()
+        # a progress.json from before the sweep (an interrupted run's, queued again) is old news; a second's margin
+        # for a file system's coarse clock
+        self.since = time.time() - 1.0
         self.bars = {}
         if show:
             for i, c in enumerate(cases):
                 self.bars[c.label] = (c, tqdm(total=1.0, desc=c.label, position=i + 1, leave=False, unit="",
                                               bar_format="{desc}: {percentage:3.0f}%|{bar}| {postfix}"))
 
-    @staticmethod
-    def _read(c) -> dict | None:
+    def _read(self, c) -> dict | None:
+        p = Path(c.out_dir) / "progress.json"
         try:
-            return json.loads((Path(c.out_dir) / "progress.json").read_text())
+            return json.loads(p.read_text()) if p.stat().st_mtime >= self.since else None
         except (OSError, ValueError):
             return None
 
@@ -589,9 +592,10 @@ def _dead_runs_released(cases: list[Case], local: bool):
     try:
         yield
     except BaseException:
-        if local:
-            for c in cases:     # a worker stopped by the close may take a moment to end
-                release_dead(c.out_dir, wait=5.0)
+        if local:               # a worker stopped by the close may take a moment to end: 5 s for them all
+            deadline = time.monotonic() + 5.0
+            for c in cases:
+                release_dead(c.out_dir, wait=max(0.0, deadline - time.monotonic()))
         raise
 
 

@@ -92,7 +92,12 @@ def test_the_reader_opens_a_results_file_lazily(tmp_path):
     (100.0, 0.0, "−100 %"),               # nothing left
     (461.0, 306600.0, "\u00d7665"),       # +66 408 %: the ratio
     (100.0, 999.0, "+899 %"), (100.0, 1000.0, "\u00d710"), (100.0, 1234.0, "\u00d712.3"),
-    (1.0, 12345.0, "\u00d712345")])
+    (1.0, 12345.0, "\u00d712345"),
+    (100.0, 999.6, "\u00d710"),           # +899.6 % shows as +900: the digits shown decide the form
+    (100.0, 99950.0, "\u00d71000"),        # ×999.5: no power of ten
+    (10000.0, 9999.6, "0.0 %"),            # −0.004 %: no sign on nothing
+    (1.0, 1e-9, "\u2212100 %"),            # 1e-7 % left: below four decimals, the fall reads whole
+    (100.0, 99.96, "0.0 %")])
 def test_a_change_is_written_with_the_digits_it_needs_and_as_a_ratio_from_ten_times(before, after, text):
     """The one rule of every table and figure (format_change): the truths from the pairs of values by hand."""
     from components.results import format_change, percent_change
@@ -101,5 +106,6 @@ def test_a_change_is_written_with_the_digits_it_needs_and_as_a_ratio_from_ten_ti
 
 def test_a_change_that_is_not_a_number_is_refused():
     from components.results import format_change
-    with pytest.raises(ValueError, match="pct: expected a finite change"):
-        format_change(float("nan"))
+    for bad in (float("nan"), None):
+        with pytest.raises(ValueError, match="pct: expected a finite change"):
+            format_change(bad)

@@ -380,14 +380,22 @@ def test_the_estimate_deals_the_runs_to_the_workers_longest_first():
 
 def test_a_log_hears_of_the_running_runs_between_their_ends(tmp_path, monkeypatch, capsys):
     """Without a terminal (a log, a pipe) the runs' bars are off; every PLAIN_EVERY_S a line names each running run
-    and its simulated time (from the progress.json its worker writes), a finished one no more."""
+    and its simulated time (from the progress.json its worker writes since the sweep began), a finished one no
+    more."""
     from scenarios.core import sweep as sw
     cases = [_case(tmp_path / "a"), Case(4, "reverse", str(tmp_path / "b"), {"bearing.rollers": 8})]
+    import os
+    import time
     for c, t in zip(cases, (0.0125, 0.05)):
         Path(c.out_dir).mkdir(parents=True)
         (Path(c.out_dir) / "progress.json").write_text(json.dumps({"t": t, "t_end": 0.1, "wall_s": 1.0, "steps": 9}))
+        os.utime(Path(c.out_dir) / "progress.json", (time.time() - 3600, time.time() - 3600))   # an hour ago
     monkeypatch.setattr(sw, "PLAIN_EVERY_S", 0.0)
     bars = sw._RunBars(cases, show=False, plain=True)
+    bars.poll()
+    assert capsys.readouterr().err == ""                 # written before the sweep: an interrupted run's, old news
+    for c in cases:
+        (Path(c.out_dir) / "progress.json").touch()      # written since: the workers' own
     bars.poll()
     assert capsys.readouterr().err == "runs: running c4_forward at t = 0.0125 of 0.1 s, c4_reverse at t = 0.05 of 0.1 s\n"
     bars.finish(cases[0])

@@ -140,7 +140,10 @@ def _overlaps(boxes) -> list:
 @pytest.mark.parametrize("lives", [
     {"inner": (1860.0, 35.0), "outer": (35.0, 1860.0)},                 # the shortest beside a life 53 times longer
     {"inner": (120000.0, 447.0), "outer": (1020.0, 556.0)},             # the cruise point: wide labels, close lives
-    {"inner": (487000.0, 486000.0), "outer": (1860000.0, 1790000.0)}])  # widest labels at one height
+    {"inner": (487000.0, 486000.0), "outer": (1860000.0, 1790000.0)},  # widest labels at one height
+    {"inner": (12300000.0, 18600000.0), "outer": (12300000.0, 18600000.0)},   # millions: '12.3 M'
+    {"inner": (999.6, 35.0), "outer": (35.0, 999.6)}])                  # rounds up into the next decade: '1 000'
+
 def test_headline_value_labels_never_overlap_and_read_the_values(tmp_path, captured, lives):
     """Two bearings' forward and reverse lives: every value written over its bar with three significant digits
     (no power of ten), and no two of the panel's texts — values and changes — overlapping once drawn."""
@@ -152,7 +155,8 @@ def test_headline_value_labels_never_overlap_and_read_the_values(tmp_path, captu
     (ax,) = fig.axes
     renderer = fig.canvas.get_renderer()
     labels = [t for t in ax.texts if t.get_gid() == "value_label"]
-    shown = sorted(float(t.get_text().replace("\u202f", "")) for t in labels)
+    read = lambda s: float(s[:-1]) * 1e6 if s.endswith("M") else float(s)        # noqa: E731
+    shown = sorted(read(t.get_text().replace("\u202f", "")) for t in labels)
     truth = sorted(float(f"{v:.3g}") for v in values.values())
     assert shown == truth and not any("e" in t.get_text() for t in labels)
     boxes = [t.get_window_extent(renderer) for t in labels + _pct_texts(ax)]
@@ -335,7 +339,7 @@ def test_display_unit(unit, values, factor, shown):
     assert plots.display_unit(unit, values) == (factor, shown)
 
 
-@pytest.mark.parametrize("p, text", [(40.0, "+40 %"), (-24.4, "−24 %"), (3.21, "+3.2 %"), (-0.04, "−0.0 %"),
+@pytest.mark.parametrize("p, text", [(40.0, "+40 %"), (-24.4, "−24 %"), (3.21, "+3.2 %"), (-0.04, "0.0 %"),
                                      (159.4, "+159 %"), (-99.63, "−99.6 %"), (66408.0, "×665")])
 def test_format_pct(p, text):
     assert plots.format_pct(p) == text
