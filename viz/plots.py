@@ -908,10 +908,12 @@ def forward_reverse_headline(values: Mapping[tuple, float | None], path, *,
                         ax.text(x[i], 0.97, format_pct(p), transform=ax.get_xaxis_transform(), ha="center",
                                 va="top", fontsize=8.5, fontweight="bold", color="#333333", gid="pct_change")
                 if log:
-                    ax.yaxis.set_major_locator(LogLocator(subs=(1.0,)))
+                    # a tick per decade (1-2-5 where the axis spans less than two: one decade would leave it one
+                    # tick) and no minor ones: the values are written on the bars, and each minor tick is an artist
+                    # the layout measures (a third of the figure's time)
+                    lo, hi = ax.get_ylim()
+                    ax.yaxis.set_major_locator(LogLocator(subs=(1.0,) if hi / lo > 100.0 else (1.0, 2.0, 5.0)))
                     ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: _value_text(v)))
-                    # a tick per decade and no minor ones: the values are written on the bars, and each minor tick
-                    # is an artist the layout measures (a third of the figure's time)
                     ax.yaxis.set_minor_locator(NullLocator())
                 ax.set_xticks(x, [f"{b} planet\nbearing" for b in bearings])
                 ax.set_xlim(-0.6, len(bearings) - 0.4)

@@ -648,3 +648,16 @@ def test_a_small_difference_is_drawn_against_zero_in_the_oil_figure(tmp_path, ca
     assert heat.get_ylim()[0] == 0.0 and heat.get_ylim()[1] >= 100.1
     lo, hi = slip.get_ylim()
     assert lo <= -0.2 and hi >= 0.3 and lo < 0.0 < hi
+
+
+def test_a_narrow_life_axis_still_reads_at_two_ticks_at_least(tmp_path, captured):
+    """Lives within a decade (an idle point's 421 000 and 516 000 h) on the log axis: 1-2-5 ticks, not the one
+    decade tick a wider axis gets, every label plain."""
+    values = {("life_iso281_h", 2, b, d): v for b, pair in (("inner", (509000.0, 516000.0)),
+                                                           ("outer", (421000.0, 421000.0)))
+              for d, v in zip(("forward", "reverse"), pair)}
+    plots.forward_reverse_headline(values, tmp_path / "h.png", quantities=QUANT[1:])
+    (ax,) = captured[-1].axes
+    lo, hi = ax.get_ylim()
+    ticks = [t for t in ax.get_yticks() if lo <= t <= hi]
+    assert len(ticks) >= 2 and all("e" not in ax.yaxis.get_major_formatter()(t, 0) for t in ticks)
