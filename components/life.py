@@ -243,12 +243,11 @@ def miner_life(lives, shares) -> float | None:
     speed, gives the life in hours (N_i/L_i = t_i/L_h,i). A bin with no life (None: no load) does no damage;
     None when no bin does."""
     u = np.asarray(shares, float)
-    d = [ui / float(L) for ui, L in zip(u, lives) if L is not None and ui > 0]
     if len(u) != len(lives):
         raise ValueError(f"{len(lives)} lives for {len(u)} shares")
     if any(L is not None and not float(L) > 0 for L in lives):
         raise ValueError(f"lives must be > 0, got {list(lives)!r}")
-    total = math.fsum(d)
+    total = math.fsum(ui / float(L) for ui, L in zip(u, lives) if L is not None and ui > 0)
     return 1.0 / total if total > 0 else None
 
 
