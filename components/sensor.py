@@ -11,7 +11,7 @@ each with physical parameters (:class:`components.params.SensorParams`, ``rig.se
   directions (it turns with the planet). a = F/m_eq is the ring's response above its local modes; the steady
   load deflects the ring where the planet is, and that deflection passing the sensor reads ω²·F/k_local —
   (N f_c / f_local)² of F/m_eq, 4·10⁻⁴ for planets passing at 100 Hz and a local mode at 5 kHz —, so it is
-  left out rather than read as F/m_eq (which put a 200 m/s² line at 3 f_c into the rig machine's spectrum). Only
+  left out rather than read as F/m_eq (which would put a 200 m/s² line at 3 f_c into the rig machine's spectrum). Only
   the steady part is: the force's slow fluctuations at carrier orders still read as F/m_eq, overstated below the
   ring's local modes — the path is for the lines near f_m.
 * **torque** — the housing's rocking: the ring's torsional support puts the reaction torque M = −T_r on
