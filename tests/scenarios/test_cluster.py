@@ -177,11 +177,17 @@ def test_a_worker_killed_during_a_run_loses_no_finished_run_and_the_run_complete
     """One short run lands; the worker of the long one is killed mid-run: the scheduler gives the run to the other
     worker (or, if it gives up, the run is named failed and the same sweep again completes it)."""
     short = Case(4, "forward", str(tmp_path / "out" / "short"), window=0.002)
-    long = Case(4, "reverse", str(tmp_path / "out" / "long"), window=0.03)
+    # long enough that the short run lands while it runs, on a loaded machine too
+    long = Case(4, "reverse", str(tmp_path / "out" / "long"), window=0.06)
     cfg = RunConfig(settle=0.002, progress=False)
-    got = {}
-    t = threading.Thread(target=lambda: got.update(sweep([short, long], cfg, scheduler=cluster.address,
-                                                         progress=False)))
+    got, raised = {}, []
+
+    def study():
+        try:
+            got.update(sweep([short, long], cfg, scheduler=cluster.address, progress=False))
+        except BaseException as exc:        # said by the assertion below, not lost in the thread
+            raised.append(exc)
+    t = threading.Thread(target=study)
     t.start()
     landed = Path(short.out_dir) / "summary.json"
     deadline = time.monotonic() + STUDY_S
@@ -200,7 +206,7 @@ def test_a_worker_killed_during_a_run_loses_no_finished_run_and_the_run_complete
             else:
                 time.sleep(0.2)
     t.join(STUDY_S)
-    assert victim is not None and not t.is_alive()
+    assert not raised and victim is not None and not t.is_alive(), (raised, landed.exists())
     assert landed.read_bytes() == before                      # the finished run is kept as it landed
     if got["c4_reverse"].status is Status.FAILED:             # Dask gave up on it: named, and a re-run completes it
         assert "worker failure" in got["c4_reverse"].error
