@@ -198,9 +198,9 @@ def _exponent(e: float) -> str:
 def unit_text(u) -> str:
     """A unit as a reader writes it: pint's short pretty form ("kg·m²", "N/m"), with a fractional exponent as
     ``^(p/q)`` ("N/m^(10/9)", where pint's form would print m¹⋅¹¹¹¹¹); "1" for no unit."""
-    items = (1 * u).unit_items() if not isinstance(u, Quantity) else u.unit_items()
+    items = (1 * u).unit_items()
     if all(float(e).is_integer() for _, e in items):
-        return f"{u if not isinstance(u, Quantity) else u.units:~P}" or "1"
+        return f"{u:~P}" or "1"
 
     def part(name, e):
         sym = ureg.get_symbol(name)

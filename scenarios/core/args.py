@@ -9,8 +9,8 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import tempfile
 import re
+import tempfile
 import textwrap
 from pathlib import Path
 

@@ -256,9 +256,9 @@ class Study(abc.ABC):
             who = ", ".join(labels[:3]) + (f" and {len(labels) - 3} more" if len(labels) > 3 else "")
             print(f"warning before the run ({who}): {msg}", flush=True)
         todo = [c for c in cases if not _is_finished(c, cfg)]
-        done = resume_times(todo, cfg)          # a resumed run has only the rest of its simulated time to go
+        done, labels = resume_times(todo, cfg), {c.label for c in todo}    # a resumed run: only the rest of its time
         runs = [(label, t if t is None else max(t - done.get(label, 0.0), 0.0))
-                for kind, label, t in (x for x in advice if x[0] == "time") if label in {c.label for c in todo}]
+                for kind, label, t in (x for x in advice if x[0] == "time") if label in labels]
         if not runs:
             return
         workers = getattr(self.a, "workers", None) or min(len(runs), os.cpu_count() or 1)

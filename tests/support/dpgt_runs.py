@@ -100,3 +100,18 @@ def ramp_state(t: float = 0.003, engine: str = "compiled"):
     res = mbd.simulate(sc.model, sc.q0, sc.v0, t, stepper=mbd.PRODUCTION.stepper(),
                        controller=mbd.PRODUCTION.controller(), progress=False, engine=engine)
     return sc, res.state
+
+
+def assert_static_is_dynamic_mean(st, dyn, roller_rtol: float) -> None:
+    """A static solution's statistics ``st`` against a dynamic run's ``dyn`` (tests/components/test_load_path.py):
+    every pin's mean reaction as a vector within 1 % of its magnitude, the bearings' mean roller loads on pin and bore
+    within ``roller_rtol``, the planets' speeds relative to the carrier within 3e-4 and the cages' within 1.2 %."""
+    vec = lambda s: np.stack([s.stats("load_radial")["mean"], s.stats("load_tangential")["mean"]], axis=1)  # noqa: E731
+    Fd, Fs = vec(dyn), vec(st)
+    np.testing.assert_array_less(np.hypot(*(Fs - Fd).T), 0.01 * np.hypot(*Fd.T))
+    rb = st.plan.roller_bearing
+    for key in ("roller_inner_load", "roller_outer_load"):
+        md, ms = (np.bincount(rb, s.stats(key)["mean"]) / np.bincount(rb) for s in (dyn, st))
+        np.testing.assert_allclose(ms, md, rtol=roller_rtol, err_msg=key)
+    for key, rtol in (("planet_speed_rel", 3e-4), ("cage_speed_rel", 0.012)):
+        np.testing.assert_allclose(st.stats(key)["mean"], dyn.stats(key)["mean"], rtol=rtol, err_msg=key)
